@@ -1,0 +1,27 @@
+// Shared pieces of the subcommands: loading a scenario with its errors
+// printed, citing a scenario field for a world error, the world setup.
+#ifndef ADSE_HARNESS_CLI_CLI_SUPPORT_H_
+#define ADSE_HARNESS_CLI_CLI_SUPPORT_H_
+
+#include <optional>
+#include <string>
+
+#include "harness/spec/spec.h"
+#include "stack/base/status.h"
+#include "stack/world/world.h"
+
+namespace adse::cli {
+
+// Loads and validates `path`; on failure prints the errors to stderr.
+std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path);
+
+// Prints `status` as "file:line:col: error: message", locating the field
+// path that starts the message ("task.goal: ...") in the scenario.
+void ReportError(const spec::Spec& spec, const Status& status);
+
+// The world and task of a scenario, ready for World::Open.
+world::WorldSetup WorldSetupFromSpec(const spec::Spec& spec);
+
+}  // namespace adse::cli
+
+#endif  // ADSE_HARNESS_CLI_CLI_SUPPORT_H_

@@ -1,0 +1,58 @@
+// adse: design-space exploration of autonomous-driving systems.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+
+#include "harness/cli/commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "adse: find the cheapest computer on which a self-driving stack still "
+      "drives well.\nA scenario YAML file describes the study; see "
+      "scenarios/README.md."};
+  app.set_version_flag("--version", std::string("adse ") + ADSE_VERSION);
+  app.require_subcommand(1);
+
+  adse::cli::ValidateArgs validate;
+  CLI::App* validate_cmd = app.add_subcommand(
+      "validate", "Check a scenario file; print it normalised and the size of "
+                  "its design space");
+  validate_cmd->add_option("scenario", validate.scenario, "Scenario YAML file")
+      ->required();
+  validate_cmd->add_flag("!--no-world", validate.check_world,
+                         "Skip loading the map in SUMO (start/goal checks)");
+  validate_cmd->add_flag("-q,--quiet", validate.quiet,
+                         "Print only the summary, not the normalised spec");
+
+  adse::cli::WorldArgs world;
+  uint64_t seed = 0;
+  CLI::App* world_cmd = app.add_subcommand(
+      "world", "Check the simulated world alone: load the map, plan the ideal "
+               "path and, with --follow-ideal, drive it with a perfect "
+               "controller while the LiDAR scans");
+  world_cmd->add_option("scenario", world.scenario, "Scenario YAML file")
+      ->required();
+  world_cmd->add_flag("--follow-ideal", world.follow_ideal,
+                      "Drive the ideal path with a ground-truth controller");
+  world_cmd->add_option("-o,--out", world.out,
+                        "Output folder (default: <output>/world-check)");
+  CLI::Option* seed_opt = world_cmd->add_option(
+      "--seed", seed, "Traffic seed (overrides world.traffic.seed)");
+  world_cmd->add_flag("!--no-scan", world.scan, "Do not simulate the LiDAR");
+  world_cmd->add_option("--save-scans", world.save_every_nth_scan,
+                        "Keep every Nth scan as a PCD file (0: none)")
+      ->check(CLI::NonNegativeNumber);
+  world_cmd->add_flag("--json", world.json, "Print the summary as JSON");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    // CLI11 uses its own codes; usage errors are bad input (2).
+    return code == 0 ? 0 : 2;
+  }
+  if (seed_opt->count() > 0) world.seed = seed;
+  if (*validate_cmd) return adse::cli::RunValidate(validate);
+  if (*world_cmd) return adse::cli::RunWorld(world);
+  return 2;
+}

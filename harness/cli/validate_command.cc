@@ -1,0 +1,43 @@
+#include <fmt/core.h>
+
+#include <cstdio>
+
+#include "harness/cli/cli_support.h"
+#include "harness/cli/commands.h"
+#include "harness/spec/spec_parser.h"
+
+namespace adse::cli {
+
+int RunValidate(const ValidateArgs& args) {
+  std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
+  if (!spec) return 2;
+  if (args.check_world) {
+    Result<std::unique_ptr<world::World>> world =
+        world::World::Open(WorldSetupFromSpec(*spec));
+    if (!world.ok()) {
+      ReportError(*spec, world.status());
+      return ExitCodeFor(world.status()) == 1 ? 1 : 2;
+    }
+    const world::World& w = **world;
+    std::fprintf(stderr,
+                 "world: map %s, route of %zu edges, ideal path %.1f m, "
+                 "%zu obstacles, %zu parking slots\n",
+                 w.map().net_path.c_str(), w.route_edges().size(),
+                 w.ideal_path().length_m(), w.scene().obstacles().size(),
+                 w.scene().parking_slots().size());
+  }
+  if (!args.quiet) std::fputs(spec::NormalizedYaml(*spec).c_str(), stdout);
+  std::string factors;
+  for (const spec::DesignParameter& p : spec->design_space.parameters) {
+    if (!factors.empty()) factors += " x ";
+    factors += fmt::format("{} {}", p.name, p.values.size());
+  }
+  // A YAML comment, so stdout stays a loadable scenario.
+  std::fprintf(stdout, "# %s: valid; design space: %llu points (%s)\n",
+               args.scenario.c_str(),
+               static_cast<unsigned long long>(spec->design_space.Size()),
+               factors.c_str());
+  return 0;
+}
+
+}  // namespace adse::cli

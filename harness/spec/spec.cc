@@ -1,0 +1,151 @@
+#include "harness/spec/spec.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "harness/spec/text_util.h"
+
+namespace adse::spec {
+namespace fs = std::filesystem;
+
+int DesignParameter::IndexOf(double value) const {
+  if (!std::isfinite(value)) return -1;
+  // Values are sorted: find the nearest by binary search.
+  auto it = std::lower_bound(values.begin(), values.end(), value);
+  const double tolerance = 1e-9 * std::max(1.0, std::fabs(value));
+  if (it != values.end() && std::fabs(*it - value) <= tolerance) {
+    return static_cast<int>(it - values.begin());
+  }
+  if (it != values.begin() && std::fabs(*(it - 1) - value) <= tolerance) {
+    return static_cast<int>(it - values.begin() - 1);
+  }
+  return -1;
+}
+
+std::string DesignParameter::DescribeValues() const {
+  constexpr size_t kListAll = 12;
+  std::vector<std::string> parts;
+  if (values.size() <= kListAll) {
+    for (double v : values) parts.push_back(FormatNumber(v));
+    return JoinList(parts);
+  }
+  // Long lists: first values, an ellipsis, the last; the count says the
+  // rest.
+  for (size_t i = 0; i < 3; ++i) parts.push_back(FormatNumber(values[i]));
+  parts.push_back("...");
+  parts.push_back(FormatNumber(values.back()));
+  return JoinList(parts) + " (" + std::to_string(values.size()) + " values)";
+}
+
+uint64_t DesignSpace::Size() const {
+  if (parameters.empty()) return 0;
+  uint64_t size = 1;
+  for (const DesignParameter& p : parameters) {
+    const uint64_t n = p.values.size();
+    if (n == 0) return 0;
+    if (size > std::numeric_limits<uint64_t>::max() / n) {
+      return std::numeric_limits<uint64_t>::max();
+    }
+    size *= n;
+  }
+  return size;
+}
+
+const DesignParameter* DesignSpace::Find(const std::string& name) const {
+  for (const DesignParameter& p : parameters) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
+}
+
+const DesignParameter* DesignSpace::FindByBind(const std::string& target) const {
+  for (const DesignParameter& p : parameters) {
+    if (p.bind == target) return &p;
+  }
+  return nullptr;
+}
+
+std::vector<std::string> DesignSpace::Names() const {
+  std::vector<std::string> names;
+  for (const DesignParameter& p : parameters) names.push_back(p.name);
+  return names;
+}
+
+Status DesignSpace::Check(const DesignPoint& point) const {
+  std::vector<std::string> errors;
+  const std::vector<std::string> names = Names();
+  for (const auto& [name, value] : point) {
+    const DesignParameter* p = Find(name);
+    if (p == nullptr) {
+      errors.push_back("unknown parameter '" + name + "'" +
+                       DidYouMean(name, names) +
+                       "; parameters: " + JoinList(names));
+    } else if (p->IndexOf(value) < 0) {
+      errors.push_back(name + ": expected one of " + p->DescribeValues() +
+                       ", found " + FormatNumber(value));
+    }
+  }
+  std::vector<std::string> missing;
+  for (const DesignParameter& p : parameters) {
+    if (point.count(p.name) == 0) missing.push_back(p.name);
+  }
+  if (!missing.empty()) {
+    errors.push_back("missing parameter" +
+                     std::string(missing.size() > 1 ? "s " : " ") +
+                     JoinList(missing));
+  }
+  if (errors.empty()) return Status::Ok();
+  std::string message;
+  for (const std::string& e : errors) {
+    if (!message.empty()) message += "\n";
+    message += e;
+  }
+  return Status::InvalidArgument(message);
+}
+
+const std::vector<MetricInfo>& KnownMetrics() {
+  static const std::vector<MetricInfo> kMetrics = {
+      {"completed", "the ego reached the goal before the timeout (0 or 1)",
+       true},
+      {"nav_time_s", "time from the start event to reaching the goal, s"},
+      {"deviation_score",
+       "normalised distance between actual and ideal trajectory, in [0, 1]"},
+      {"max_deviation_m", "largest lateral error from the ideal path, m"},
+      {"zigzag_index", "jitter of the lateral error around its smooth fit"},
+      {"ctrl_rate_hz", "control-command rate over the navigation, Hz"},
+      {"hardware_cost", "value of the scenario's cost expression"},
+      {"e2e_latency_p50_s", "median LiDAR-to-control latency, s"},
+      {"e2e_latency_p99_s", "99th percentile LiDAR-to-control latency, s"},
+      {"dropped_messages", "messages dropped by keep-last queues, count"},
+      {"collisions", "collisions of the ego with vehicles or obstacles, count"},
+  };
+  return kMetrics;
+}
+
+std::string Spec::Where(const std::string& field_path) const {
+  std::string path = field_path;
+  while (!path.empty()) {
+    if (auto it = marks.find(path); it != marks.end() && it->second.line > 0) {
+      return source_path + ":" + std::to_string(it->second.line) + ":" +
+             std::to_string(it->second.column) + ": ";
+    }
+    // Climb to the parent: "a.b[2]" -> "a.b", "a.b" -> "a".
+    const size_t cut = path.find_last_of(".[");
+    if (cut == std::string::npos) break;
+    path.resize(cut);
+  }
+  return source_path + ": ";
+}
+
+std::string Spec::ResolvedOutput() const {
+  fs::path path(output);
+  if (path.is_relative()) {
+    std::error_code ec;
+    path = fs::current_path(ec) / path;
+  }
+  return path.lexically_normal().string();
+}
+
+}  // namespace adse::spec

@@ -1,0 +1,167 @@
+// Scenario spec v1: one YAML file describes a whole study. These are the
+// typed options every part of adse reads. Field documentation for users is
+// in scenarios/README.md; parsing and validation in spec_parser.h.
+#ifndef ADSE_HARNESS_SPEC_SPEC_H_
+#define ADSE_HARNESS_SPEC_SPEC_H_
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "stack/config/stack_config.h"
+#include "stack/world/world_options.h"
+
+namespace adse::spec {
+
+// A design point: parameter name -> value, ordered by name.
+using DesignPoint = std::map<std::string, double>;
+
+struct DesignParameter {
+  std::string name;   // key under design_space:
+  std::string bind;   // "platform.cores", "stack.lidar.rate_hz", ...
+  // The allowed values, ascending and distinct. A `range: [lo, hi]` with an
+  // optional `step` (default 1) is expanded here.
+  std::vector<double> values;
+  bool integer = false;  // all values are whole numbers
+
+  // Index of the allowed value equal to `value` (within a relative 1e-9, so
+  // "1.2" typed on a command line matches), or -1.
+  int IndexOf(double value) const;
+  // "7, 14" or, for long regular lists, "1, 2, ..., 28 (28 values)".
+  std::string DescribeValues() const;
+};
+
+struct DesignSpace {
+  std::vector<DesignParameter> parameters;  // in file order
+
+  // Number of points (product of value counts); saturates at UINT64_MAX.
+  uint64_t Size() const;
+  const DesignParameter* Find(const std::string& name) const;
+  // The parameter bound to `target` ("platform.cores"), or nullptr.
+  const DesignParameter* FindByBind(const std::string& target) const;
+  std::vector<std::string> Names() const;
+  // Ok when `point` names exactly the space's parameters with allowed values;
+  // otherwise InvalidArgument naming the parameter and the allowed values.
+  Status Check(const DesignPoint& point) const;
+};
+
+enum class PlatformKind { kVirtual, kCgroup };
+enum class CostModel { kMeasured, kCounted };
+
+struct PlatformOptions {
+  PlatformKind kind = PlatformKind::kVirtual;
+  // Frequency at which measured callback costs are taken as-is.
+  double reference_ghz = 2.1;
+  CostModel cost_model = CostModel::kMeasured;
+  // Calibration file for cost_model: counted (absolute path; may be empty).
+  std::string calibration;
+  // Defaults when the design space does not bind them.
+  int cores = 4;
+  double freq_ghz = 2.1;
+};
+
+struct Objective {
+  std::string metric;  // a metric name, e.g. "nav_time_s"
+  bool minimize = true;
+};
+
+// A metric named in objectives and constraint/cost expressions.
+struct MetricInfo {
+  std::string name;
+  std::string doc;
+  bool boolean = false;
+};
+// Metrics a run reports (documented in scenarios/README.md).
+const std::vector<MetricInfo>& KnownMetrics();
+
+struct ExplorationOptions {
+  std::string strategy = "agent";  // exhaustive|random|ga|nsga2|agent|llm
+  int budget = 15;                 // evaluations, replicas not counted
+  int batch = 1;                   // points proposed per round
+  uint64_t seed = 1;
+  DesignPoint start_from;          // empty: the strategy chooses
+  // GA / NSGA-II settings.
+  int population = 8;
+  double crossover_rate = 0.9;
+  double mutation_rate = 0.2;
+};
+
+struct LlmOptions {
+  std::string backend = "ollama";  // ollama|openai|replay
+  std::string endpoint = "http://127.0.0.1:11434";
+  // Model per role: dse, vision, text, command, interpretation.
+  std::map<std::string, std::string> models;
+  std::string prompts;      // folder of prompt templates; empty: built-in
+  std::string replay_from;  // campaign folder, for backend: replay
+  double timeout_s = 120.0;
+  int retries = 2;
+  std::string api_key_env = "OPENAI_API_KEY";
+};
+
+struct SlurmOptions {
+  std::string partition;
+  std::string account;
+  int nodes = 1;
+  int cpus = 0;            // 0: workers * cores_per_worker
+  std::string time_limit = "02:00:00";
+  int max_parallel = 0;    // array throttle; 0: no limit
+  int shard_size = 0;      // points per array task; 0: automatic
+  std::vector<std::string> extra_args;
+};
+
+struct HarnessOptions {
+  int workers = 0;          // 0 means auto: host cores / cores_per_worker
+  int cores_per_worker = 1;
+  int memory_mb = 4096;
+  double run_timeout_s = 900.0;
+  int retries = 1;
+  int replicas = 1;
+  std::string isolation = "auto";  // auto|cgroup|affinity
+  std::string executor = "local";  // local|slurm
+  std::string cache_dir;           // empty: the user's cache dir
+  SlurmOptions slurm;
+};
+
+// Where in the file a field was written, for messages after parsing.
+struct SourceMark {
+  int line = 0;    // 1-based; 0 when the field took its default
+  int column = 0;  // 1-based
+};
+
+struct Spec {
+  int version = 1;
+  std::string name;
+  std::string source_path;  // the file as given
+  std::string source_text;  // its exact text
+  std::string base_dir;     // folder relative paths in the file resolve from
+
+  world::WorldOptions world;
+  world::TaskOptions task;
+  StackConfig stack;
+  PlatformOptions platform;
+  DesignSpace design_space;
+  std::string cost = "cores * freq_ghz";
+  std::vector<Objective> objectives;
+  std::vector<std::string> constraints;  // expressions, as written
+  ExplorationOptions exploration;
+  LlmOptions llm;
+  HarnessOptions harness;
+  std::string output;  // as written; see ResolvedOutput()
+
+  // Field path ("task.goal.x") -> where it was written.
+  std::map<std::string, SourceMark> marks;
+
+  // "file:line:col: " for a field path, or "file: " when not written.
+  // A field that took its default cites its closest written parent
+  // ("task.goal.tolerance_m" -> where `goal:` was written).
+  std::string Where(const std::string& field_path) const;
+
+  // `output` made absolute: relative paths resolve from the current
+  // working directory (the parser refused any that escape it).
+  std::string ResolvedOutput() const;
+};
+
+}  // namespace adse::spec
+
+#endif  // ADSE_HARNESS_SPEC_SPEC_H_

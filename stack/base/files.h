@@ -1,0 +1,29 @@
+// Filesystem helpers: atomic writes, cache folders, bounded reads.
+#ifndef ADSE_STACK_BASE_FILES_H_
+#define ADSE_STACK_BASE_FILES_H_
+
+#include <cstddef>
+#include <string>
+
+#include "stack/base/status.h"
+
+namespace adse {
+
+// Reads a whole file; refuses files larger than `max_bytes`.
+Result<std::string> ReadFile(const std::string& path,
+                             size_t max_bytes = 64u << 20);
+
+// Writes `data` to a temporary name in the target's folder, flushes it and
+// renames it over `path`, so readers see the old file or the whole new one.
+Status WriteFileAtomic(const std::string& path, const std::string& data);
+
+// adse's cache root: $ADSE_CACHE_DIR, else $XDG_CACHE_HOME/adse, else
+// ~/.cache/adse, else <tmp>/adse-cache.
+std::string DefaultCacheDir();
+
+// Creates `path` and its parents. Ok when it exists already.
+Status MakeDirs(const std::string& path);
+
+}  // namespace adse
+
+#endif  // ADSE_STACK_BASE_FILES_H_

@@ -1,0 +1,103 @@
+#include "stack/world/geometry.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace adse::world {
+namespace {
+
+// Index i of the segment [points[i], points[i+1]] holding arc length s, with
+// s already clamped to [0, length]. Callers ensure points.size() >= 2.
+size_t SegmentAt(const std::vector<double>& s_m, double s) {
+  // First vertex strictly beyond s; the segment starts one before it.
+  const auto it = std::upper_bound(s_m.begin(), s_m.end(), s);
+  size_t i = static_cast<size_t>(it - s_m.begin());
+  i = i == 0 ? 0 : i - 1;
+  return std::min(i, s_m.size() - 2);
+}
+
+}  // namespace
+
+void Path2::UpdateArcLength() {
+  s_m.assign(points.size(), 0.0);
+  for (size_t i = 1; i < points.size(); ++i) {
+    s_m[i] = s_m[i - 1] + (points[i] - points[i - 1]).norm();
+  }
+}
+
+Eigen::Vector2d Path2::PointAt(double s) const {
+  if (points.empty()) return Eigen::Vector2d::Zero();
+  if (points.size() == 1 || s_m.size() != points.size()) return points.front();
+  s = std::clamp(s, 0.0, length_m());
+  const size_t i = SegmentAt(s_m, s);
+  const double ds = s_m[i + 1] - s_m[i];
+  if (ds <= 0.0) return points[i];
+  const double t = std::clamp((s - s_m[i]) / ds, 0.0, 1.0);
+  return points[i] + t * (points[i + 1] - points[i]);
+}
+
+double Path2::HeadingAt(double s) const {
+  if (points.size() < 2 || s_m.size() != points.size()) return 0.0;
+  s = std::clamp(s, 0.0, length_m());
+  const size_t seg = SegmentAt(s_m, s);
+  // Repeated points give zero-length segments with no direction: use the
+  // nearest real segment ahead, else behind.
+  for (size_t i = seg; i + 1 < points.size(); ++i) {
+    const Eigen::Vector2d d = points[i + 1] - points[i];
+    if (d.squaredNorm() > 0.0) return std::atan2(d.y(), d.x());
+  }
+  for (size_t i = seg; i-- > 0;) {
+    const Eigen::Vector2d d = points[i + 1] - points[i];
+    if (d.squaredNorm() > 0.0) return std::atan2(d.y(), d.x());
+  }
+  return 0.0;
+}
+
+double Path2::MaxGap() const {
+  double gap = 0.0;
+  for (size_t i = 1; i < points.size(); ++i) {
+    gap = std::max(gap, (points[i] - points[i - 1]).norm());
+  }
+  return gap;
+}
+
+std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box) {
+  const Eigen::Vector2d ax(std::cos(box.yaw_rad), std::sin(box.yaw_rad));
+  const Eigen::Vector2d ay(-ax.y(), ax.x());
+  const Eigen::Vector2d hx = 0.5 * box.length_m * ax;
+  const Eigen::Vector2d hy = 0.5 * box.width_m * ay;
+  // Front-right, front-left, rear-left, rear-right: counter-clockwise.
+  return {box.center + hx - hy, box.center + hx + hy, box.center - hx + hy,
+          box.center - hx - hy};
+}
+
+bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b) {
+  // Two convex shapes are disjoint iff some edge normal separates them; a
+  // box has two distinct normals. Boxes are closed sets, so touching boxes
+  // overlap (a collision check should err towards "hit").
+  const Eigen::Vector2d a_axes[2] = {
+      {std::cos(a.yaw_rad), std::sin(a.yaw_rad)},
+      {-std::sin(a.yaw_rad), std::cos(a.yaw_rad)}};
+  const Eigen::Vector2d b_axes[2] = {
+      {std::cos(b.yaw_rad), std::sin(b.yaw_rad)},
+      {-std::sin(b.yaw_rad), std::cos(b.yaw_rad)}};
+  const double a_half[2] = {0.5 * a.length_m, 0.5 * a.width_m};
+  const double b_half[2] = {0.5 * b.length_m, 0.5 * b.width_m};
+  const Eigen::Vector2d d = b.center - a.center;
+  auto separated_along = [&](const Eigen::Vector2d& axis) {
+    const double ra = a_half[0] * std::abs(a_axes[0].dot(axis)) +
+                      a_half[1] * std::abs(a_axes[1].dot(axis));
+    const double rb = b_half[0] * std::abs(b_axes[0].dot(axis)) +
+                      b_half[1] * std::abs(b_axes[1].dot(axis));
+    return std::abs(d.dot(axis)) > ra + rb;
+  };
+  for (const auto& axis : a_axes) {
+    if (separated_along(axis)) return false;
+  }
+  for (const auto& axis : b_axes) {
+    if (separated_along(axis)) return false;
+  }
+  return true;
+}
+
+}  // namespace adse::world

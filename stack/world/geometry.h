@@ -1,0 +1,50 @@
+// Plain geometric types shared by the world and the stack (Eigen only).
+#ifndef ADSE_STACK_WORLD_GEOMETRY_H_
+#define ADSE_STACK_WORLD_GEOMETRY_H_
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace adse::world {
+
+// Planar pose; yaw counter-clockwise from +x, radians.
+struct Pose2 {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double yaw_rad = 0.0;
+};
+
+// An oriented box standing on the ground (vehicles, parked cars).
+struct OrientedBox {
+  Eigen::Vector2d center = Eigen::Vector2d::Zero();
+  double yaw_rad = 0.0;
+  double length_m = 4.5;
+  double width_m = 1.8;
+  double height_m = 1.5;
+};
+
+// A polyline with cumulative arc length, e.g. the ideal path.
+struct Path2 {
+  std::vector<Eigen::Vector2d> points;
+  std::vector<double> s_m;  // s_m[i] = arc length at points[i]; s_m[0] = 0
+
+  double length_m() const { return s_m.empty() ? 0.0 : s_m.back(); }
+  // Recomputes s_m from points.
+  void UpdateArcLength();
+  // Point at arc length s (clamped to the ends).
+  Eigen::Vector2d PointAt(double s) const;
+  // Tangent heading at arc length s.
+  double HeadingAt(double s) const;
+  // Largest distance between consecutive points.
+  double MaxGap() const;
+};
+
+// The four corners of a box, counter-clockwise.
+std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box);
+
+// True when two oriented boxes overlap (separating axis test).
+bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b);
+
+}  // namespace adse::world
+
+#endif  // ADSE_STACK_WORLD_GEOMETRY_H_

@@ -1,0 +1,130 @@
+#include "stack/world/ideal_driver.h"
+
+#include <algorithm>
+#include <chrono>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
+
+namespace adse::world {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+// Curvature of the path around arc length s, from the heading change over
+// a window (robust to the 0.5 m sampling).
+double CurvatureAt(const Path2& path, double s) {
+  const double ds = 2.0;
+  double dh = path.HeadingAt(std::min(s + ds, path.length_m())) -
+              path.HeadingAt(std::max(s - ds, 0.0));
+  dh = std::atan2(std::sin(dh), std::cos(dh));
+  return std::abs(dh) / (2 * ds);
+}
+
+}  // namespace
+
+double DistanceToPath(const Path2& path, const Eigen::Vector2d& p, double* s_out) {
+  double best = std::numeric_limits<double>::infinity();
+  double best_s = 0.0;
+  for (size_t i = 0; i + 1 < path.points.size(); ++i) {
+    const Eigen::Vector2d a = path.points[i];
+    const Eigen::Vector2d ab = path.points[i + 1] - a;
+    const double len2 = ab.squaredNorm();
+    const double u = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    const double d = (a + u * ab - p).norm();
+    if (d < best) {
+      best = d;
+      best_s = path.s_m[i] + u * std::sqrt(len2);
+    }
+  }
+  if (path.points.size() == 1) best = (path.points[0] - p).norm();
+  if (s_out) *s_out = best_s;
+  return best;
+}
+
+Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
+                                        const IdealDriverOptions& options,
+                                        const ScanCallback& on_scan) {
+  IdealDriveReport report;
+  const Path2& path = world.ideal_path();
+  const double dt = world.step_s();
+  const VehicleLimits& limits = world.ego_limits();
+  const double scan_period = lidar ? 1.0 / lidar->params().rate_hz : 0.0;
+  double next_scan_t = 0.0;
+  double point_sum = 0.0;
+  double s_progress = 0.0;
+  while (world.time_s() < options.timeout_s) {
+    const VehicleState& ego = world.ego();
+    const Eigen::Vector2d pos(ego.x_m, ego.y_m);
+    report.trajectory.push_back({world.time_s(), ego.x_m, ego.y_m, ego.yaw_rad,
+                                 ego.v_mps, ego.steer_rad, ego.accel_mps2});
+    double s_here = 0.0;
+    const double lateral = DistanceToPath(path, pos, &s_here);
+    s_progress = std::max(s_progress, s_here);
+    report.max_lateral_error_m = std::max(report.max_lateral_error_m, lateral);
+    if (world.goal_reached() && ego.v_mps < 0.5) {
+      report.reached_goal = true;
+      break;
+    }
+    if (lidar && options.scan && world.time_s() + 1e-9 >= next_scan_t) {
+      const auto t0 = Clock::now();
+      std::vector<OrientedBox> boxes;
+      for (const OtherVehicle& v : world.others()) boxes.push_back(v.box);
+      const Pose2 pose{ego.x_m, ego.y_m, ego.yaw_rad};
+      PointCloud cloud = lidar->Scan(pose, world.time_s(), boxes);
+      report.lidar_wall_s += Seconds(Clock::now() - t0);
+      point_sum += static_cast<double>(cloud.points.size());
+      ++report.scans;
+      if (on_scan) on_scan(cloud, pose);
+      next_scan_t += scan_period;
+    }
+    // Pure pursuit on the true pose.
+    // Shorter lookahead when slow (in curves) keeps corners from being cut.
+    const double lookahead = std::clamp(options.lookahead_time_s * ego.v_mps,
+                                        options.min_lookahead_m, options.lookahead_m);
+    const Eigen::Vector2d target = path.PointAt(s_progress + lookahead);
+    const Eigen::Vector2d local =
+        Eigen::Rotation2Dd(-ego.yaw_rad) * (target - pos);
+    const double ld2 = std::max(local.squaredNorm(), 1e-6);
+    const double curvature = 2.0 * local.y() / ld2;
+    ControlCommand command;
+    command.steer_rad = std::atan(curvature * limits.wheelbase_m);
+    // Speed: limit, curves ahead, and a stop at the goal.
+    double v_target = options.speed_limit_mps;
+    for (double ahead = 0.0; ahead <= 20.0; ahead += 2.0) {
+      const double k = CurvatureAt(path, s_progress + ahead);
+      if (k > 1e-4) {
+        const double v_curve = std::sqrt(options.max_lateral_accel_mps2 / k);
+        const double v_allowed = std::sqrt(v_curve * v_curve +
+                                           2 * options.comfort_decel_mps2 * ahead);
+        v_target = std::min(v_target, v_allowed);
+      }
+    }
+    const double remaining = std::max(0.0, path.length_m() - s_progress);
+    v_target = std::min(v_target, std::sqrt(2 * options.comfort_decel_mps2 * remaining));
+    command.accel_mps2 = 1.5 * (v_target - ego.v_mps);
+    // Near the goal, brake exactly as much as stopping on it needs; a
+    // proportional controller alone lags and overshoots.
+    if (remaining > 0.05) {
+      const double stop_decel = ego.v_mps * ego.v_mps / (2 * remaining);
+      if (stop_decel > 0.8 * options.comfort_decel_mps2) {
+        command.accel_mps2 = std::min(command.accel_mps2, -stop_decel);
+      }
+    } else {
+      command.accel_mps2 = -limits.max_decel_mps2;
+    }
+    command.accel_mps2 = std::clamp(command.accel_mps2, -limits.max_decel_mps2,
+                                    limits.max_accel_mps2);
+    const auto t0 = Clock::now();
+    ADSE_RETURN_IF_ERROR(world.Step(command));
+    report.world_wall_s += Seconds(Clock::now() - t0);
+    (void)dt;
+  }
+  report.time_s = world.time_s();
+  report.collisions = world.collisions();
+  report.mean_points_per_scan = report.scans ? point_sum / report.scans : 0.0;
+  return report;
+}
+
+}  // namespace adse::world

@@ -1,0 +1,68 @@
+#include "stack/world/vehicle_model.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace adse::world {
+
+void BicycleModel::Step(const ControlCommand& command, double dt_s) {
+  if (!(dt_s > 0.0)) return;
+  const VehicleLimits& lim = limits_;
+  const VehicleState s0 = state_;
+
+  // Steering actuator: rate-limited towards the clamped target.
+  const double target =
+      std::clamp(command.steer_rad, -lim.max_steer_rad, lim.max_steer_rad);
+  const double max_delta = lim.max_steer_rate_rad_per_s * dt_s;
+  double steer1 =
+      s0.steer_rad + std::clamp(target - s0.steer_rad, -max_delta, max_delta);
+  steer1 = std::clamp(steer1, -lim.max_steer_rad, lim.max_steer_rad);
+
+  // Longitudinal: braking stops the car, it never reverses.
+  const double accel =
+      std::clamp(command.accel_mps2, -lim.max_decel_mps2, lim.max_accel_mps2);
+  const double v0 = std::clamp(s0.v_mps, 0.0, lim.max_speed_mps);
+  const double v1 = std::clamp(v0 + accel * dt_s, 0.0, lim.max_speed_mps);
+
+  // Midpoint (RK2) step with inputs taken as linear over the step:
+  // heading at mid-step from the start yaw rate, then the whole step with
+  // mid-step speed, steer and heading. Rear-axle reference, so the velocity
+  // is along the heading (no side slip).
+  const double L = lim.wheelbase_m;
+  const double yaw_rate0 = v0 * std::tan(s0.steer_rad) / L;
+  const double yaw_mid = s0.yaw_rad + 0.5 * dt_s * yaw_rate0;
+  // Mean speed over the step, exact when the speed reaches 0 or the cap
+  // mid-step (then it stays there for the rest of the step).
+  double v_mid = 0.5 * (v0 + v1);
+  if (accel != 0.0 && std::abs(v1 - v0) < std::abs(accel) * dt_s) {
+    const double t_reach = (v1 - v0) / accel;
+    v_mid = (0.5 * (v0 + v1) * t_reach + v1 * (dt_s - t_reach)) / dt_s;
+  }
+  const double steer_mid = 0.5 * (s0.steer_rad + steer1);
+  const double yaw_rate_mid = v_mid * std::tan(steer_mid) / L;
+
+  state_.x_m = s0.x_m + dt_s * v_mid * std::cos(yaw_mid);
+  state_.y_m = s0.y_m + dt_s * v_mid * std::sin(yaw_mid);
+  state_.yaw_rad = std::remainder(s0.yaw_rad + dt_s * yaw_rate_mid, 2.0 * M_PI);
+  state_.v_mps = v1;
+  state_.steer_rad = steer1;
+  // The acceleration actually achieved (zero when held at rest or at the
+  // speed cap), as an IMU would report it.
+  state_.accel_mps2 = (v1 - v0) / dt_s;
+}
+
+OrientedBox BicycleModel::Body() const {
+  // The state is the rear axle centre; the body centre is taken half a
+  // wheelbase ahead of it, i.e. equal front and rear overhangs.
+  OrientedBox box;
+  const double half_wb = 0.5 * limits_.wheelbase_m;
+  box.center = Eigen::Vector2d(state_.x_m + half_wb * std::cos(state_.yaw_rad),
+                               state_.y_m + half_wb * std::sin(state_.yaw_rad));
+  box.yaw_rad = state_.yaw_rad;
+  box.length_m = limits_.length_m;
+  box.width_m = limits_.width_m;
+  box.height_m = limits_.height_m;
+  return box;
+}
+
+}  // namespace adse::world

@@ -1,0 +1,94 @@
+// The simulated world of one run: SUMO (via libsumo, hidden in world.cc)
+// with its traffic, the ego vehicle on a kinematic bicycle model, the static
+// scene and the ideal path. libsumo allows one simulation per process, so a
+// process holds at most one open World.
+#ifndef ADSE_STACK_WORLD_WORLD_H_
+#define ADSE_STACK_WORLD_WORLD_H_
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "stack/base/status.h"
+#include "stack/world/geometry.h"
+#include "stack/world/map_builder.h"
+#include "stack/world/scene.h"
+#include "stack/world/vehicle_model.h"
+#include "stack/world/world_options.h"
+
+namespace adse::world {
+
+struct WorldSetup {
+  WorldOptions world;
+  TaskOptions task;
+  VehicleLimits ego;
+  // Root of the cache of generated maps and map clouds.
+  std::string cache_dir;
+};
+
+// A location snapped to the road network.
+struct RoadLocation {
+  std::string edge;
+  int lane = 0;
+  double pos_m = 0.0;
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // on the lane centre
+};
+
+struct OtherVehicle {
+  std::string id;
+  OrientedBox box;
+  double speed_mps = 0.0;
+};
+
+// Errors from Open() start with the scenario field they concern
+// ("task.goal: ...", "world.map.net: ...") so callers can cite its line.
+class World {
+ public:
+  static Result<std::unique_ptr<World>> Open(const WorldSetup& setup);
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  // Advances SUMO and the ego by one step under `command`.
+  Status Step(const ControlCommand& command);
+
+  double time_s() const;
+  double step_s() const;
+  const VehicleState& ego() const;
+  const VehicleLimits& ego_limits() const;
+  OrientedBox ego_body() const;
+  // Other vehicles as of the last step.
+  const std::vector<OtherVehicle>& others() const;
+  // Collision events so far (ego overlapping another vehicle, counted once
+  // per contact).
+  int collisions() const;
+  bool goal_reached() const;
+  double distance_to_goal_m() const;
+
+  const Path2& ideal_path() const;
+  const std::vector<std::string>& route_edges() const;
+  // Largest gap between consecutive lane pieces (lanes and junction lanes)
+  // joined into the ideal path, before resampling: a continuity check.
+  double ideal_path_max_join_gap_m() const;
+  // Mean lane width along the ideal path.
+  double lane_width_m() const;
+  const RoadLocation& start() const;
+  const RoadLocation& goal() const;
+  const Scene& scene() const;
+  const MapArtifacts& map() const;
+  // Lane centrelines of the whole network (for pictures).
+  std::vector<std::vector<Eigen::Vector2d>> LaneShapes() const;
+
+  // Path of the localization map cloud (PCD), built once per map, occupancy
+  // and seed and cached next to the map.
+  Result<std::string> MapCloudPath() const;
+
+ private:
+  struct Impl;
+  explicit World(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace adse::world
+
+#endif  // ADSE_STACK_WORLD_WORLD_H_

@@ -1,0 +1,77 @@
+// Options of the simulated world and the driving task, as the scenario's
+// `world:` and `task:` sections give them. Filled by harness/spec; read by
+// stack/world. Units are in the names.
+#ifndef ADSE_STACK_WORLD_WORLD_OPTIONS_H_
+#define ADSE_STACK_WORLD_WORLD_OPTIONS_H_
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace adse::world {
+
+enum class Weather { kClear, kRain, kFog };
+
+struct MapOptions {
+  // Absolute path of a SUMO .net.xml. Empty when `generator` is set.
+  std::string net_path;
+  // Optional SUMO polygon file (.poly.xml) with walls, poles, buildings.
+  std::string polygons_path;
+  // "parking_lot" or "grid"; empty when `net_path` is set.
+  std::string generator;
+  // Generator parameters by name (see scenarios/README.md).
+  std::map<std::string, double> generator_params;
+};
+
+struct Flow {
+  std::string from_edge;
+  std::string to_edge;
+  double vehicles_per_hour = 60.0;
+};
+
+struct TrafficOptions {
+  // Seeds SUMO's randomness and the parked-car layout.
+  uint64_t seed = 1;
+  std::vector<Flow> flows;
+  // Fraction of parking slots holding a parked car, in [0, 1].
+  double parked_occupancy = 0.0;
+};
+
+struct WorldOptions {
+  MapOptions map;
+  TrafficOptions traffic;
+  Weather weather = Weather::kClear;
+  // World (SUMO and ego dynamics) step.
+  double step_s = 0.05;
+};
+
+// A place on the map: either a world coordinate or an edge position.
+struct Location {
+  bool by_edge = false;
+  double x_m = 0.0;
+  double y_m = 0.0;
+  std::string edge;
+  double pos_m = 0.0;
+  int lane = 0;
+};
+
+enum class TaskKind { kLaneDriving, kValetParking };
+
+struct TaskOptions {
+  TaskKind kind = TaskKind::kLaneDriving;
+  Location start;
+  Location goal;
+  // The goal counts as reached within this distance.
+  double goal_tolerance_m = 2.0;
+  double speed_limit_kmh = 30.0;
+  // Simulated time after the start event at which a run is abandoned.
+  double timeout_s = 1500.0;
+};
+
+const char* WeatherName(Weather weather);
+const char* TaskKindName(TaskKind kind);
+
+}  // namespace adse::world
+
+#endif  // ADSE_STACK_WORLD_WORLD_OPTIONS_H_

@@ -1,0 +1,196 @@
+// Design points: ParsePoint, DesignSpace::Check, costs, constraints and
+// applying a point to the platform and stack.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "harness/spec/spec_parser.h"
+
+namespace adse::spec {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr double kTol = 1e-9;
+
+Spec Reference() {
+  Result<Spec> spec = ParseSpec(R"(adse: 1
+world: {map: {generate: parking_lot}}
+task: {start: {x: 0, y: 0}, goal: {x: 80, y: 40}}
+platform: {cores: 6, freq_ghz: 1.8}
+design_space:
+  cores:    {bind: platform.cores,      range: [1, 28]}
+  freq_ghz: {bind: platform.freq_ghz,   values: [1.0, 1.2, 1.5, 1.8, 2.1]}
+  lidar_hz: {bind: stack.lidar.rate_hz, values: [7, 14]}
+constraints: [nav_time_s <= 400, ctrl_rate_hz >= 1, completed]
+)",
+                                "ref.yaml", "");
+  EXPECT_TRUE(spec.ok()) << spec.status().message();
+  return spec.ok() ? *spec : Spec();
+}
+
+TEST(DesignPointTest, ParsesAGoodPoint) {
+  const Spec spec = Reference();
+  Result<DesignPoint> point =
+      ParsePoint(spec.design_space, "cores=4, freq_ghz=1.2,lidar_hz=14");
+  ASSERT_TRUE(point.ok()) << point.status().message();
+  EXPECT_NEAR(point->at("cores"), 4, kTol);
+  EXPECT_NEAR(point->at("freq_ghz"), 1.2, kTol);
+  EXPECT_NEAR(point->at("lidar_hz"), 14, kTol);
+  EXPECT_TRUE(spec.design_space.Check(*point).ok());
+}
+
+TEST(DesignPointTest, SnapsToTheExactAllowedValue) {
+  const Spec spec = Reference();
+  Result<DesignPoint> point =
+      ParsePoint(spec.design_space, "cores=4,freq_ghz=1.2000000000001,"
+                                    "lidar_hz=14");
+  ASSERT_TRUE(point.ok()) << point.status().message();
+  EXPECT_EQ(point->at("freq_ghz"), spec.design_space.Find("freq_ghz")->values[1]);
+}
+
+TEST(DesignPointTest, UnknownParameterGetsASuggestion) {
+  const Spec spec = Reference();
+  Result<DesignPoint> point =
+      ParsePoint(spec.design_space, "cores=4,freq_ghz=1.2,lidar=14");
+  ASSERT_FALSE(point.ok());
+  EXPECT_THAT(point.status().message(),
+              HasSubstr("unknown parameter 'lidar'"));
+  EXPECT_THAT(point.status().message(),
+              HasSubstr("(did you mean 'lidar_hz'?)"));
+  EXPECT_THAT(point.status().message(), HasSubstr("missing parameter: lidar_hz"));
+}
+
+TEST(DesignPointTest, DisallowedValueListsTheAllowedOnes) {
+  const Spec spec = Reference();
+  Result<DesignPoint> point =
+      ParsePoint(spec.design_space, "cores=4,freq_ghz=1.3,lidar_hz=10");
+  ASSERT_FALSE(point.ok());
+  EXPECT_THAT(point.status().message(),
+              HasSubstr("freq_ghz: expected one of 1, 1.2, 1.5, 1.8, 2.1, "
+                        "found 1.3"));
+  EXPECT_THAT(point.status().message(),
+              HasSubstr("lidar_hz: expected one of 7, 14, found 10"));
+  point = ParsePoint(spec.design_space, "cores=40,freq_ghz=1.2,lidar_hz=7");
+  ASSERT_FALSE(point.ok());
+  EXPECT_THAT(point.status().message(),
+              HasSubstr("cores: expected one of 1, 2, 3, ..., 28 (28 values), "
+                        "found 40"));
+}
+
+TEST(DesignPointTest, MissingParametersAreListed) {
+  const Spec spec = Reference();
+  Result<DesignPoint> point = ParsePoint(spec.design_space, "cores=4");
+  ASSERT_FALSE(point.ok());
+  EXPECT_THAT(point.status().message(),
+              HasSubstr("missing parameters: freq_ghz, lidar_hz"));
+}
+
+TEST(DesignPointTest, MalformedText) {
+  const Spec spec = Reference();
+  EXPECT_THAT(ParsePoint(spec.design_space, "").status().message(),
+              HasSubstr("expected name=value pairs"));
+  EXPECT_THAT(
+      ParsePoint(spec.design_space, "cores:4,freq_ghz=1,lidar_hz=7")
+          .status()
+          .message(),
+      HasSubstr("expected name=value, found 'cores:4'"));
+  EXPECT_THAT(
+      ParsePoint(spec.design_space, "cores=four,freq_ghz=1,lidar_hz=7")
+          .status()
+          .message(),
+      HasSubstr("cores: expected a number, found 'four'"));
+  EXPECT_THAT(ParsePoint(spec.design_space,
+                         "cores=4,cores=5,freq_ghz=1,lidar_hz=7")
+                  .status()
+                  .message(),
+              HasSubstr("cores: expected one value, found it twice"));
+}
+
+TEST(DesignPointTest, CheckNamesParameterAndAllowedValues) {
+  const Spec spec = Reference();
+  EXPECT_TRUE(spec.design_space
+                  .Check({{"cores", 23}, {"freq_ghz", 1.5}, {"lidar_hz", 7}})
+                  .ok());
+  Status s = spec.design_space.Check(
+      {{"cores", 23}, {"freq_ghz", 1.6}, {"lidar_hz", 7}});
+  EXPECT_THAT(s.message(), HasSubstr("freq_ghz: expected one of"));
+  s = spec.design_space.Check({{"cores", 23}, {"freq_ghz", 1.5}});
+  EXPECT_THAT(s.message(), HasSubstr("missing parameter lidar_hz"));
+  s = spec.design_space.Check(
+      {{"cores", 23}, {"freq", 1.5}, {"freq_ghz", 1.5}, {"lidar_hz", 7}});
+  EXPECT_THAT(s.message(), HasSubstr("unknown parameter 'freq'"));
+}
+
+TEST(DesignPointTest, SizeSaturates) {
+  DesignSpace space;
+  for (int i = 0; i < 10; ++i) {
+    DesignParameter p;
+    p.name = "p" + std::to_string(i);
+    p.values.assign(100000, 0.0);
+    space.parameters.push_back(p);
+  }
+  EXPECT_EQ(space.Size(), UINT64_MAX);
+  EXPECT_EQ(DesignSpace().Size(), 0u);
+}
+
+TEST(DesignPointTest, CostUsesThePointAndPlatformDefaults) {
+  const Spec spec = Reference();
+  Result<double> cost = EvaluateCost(
+      spec, {{"cores", 18}, {"freq_ghz", 1.8}, {"lidar_hz", 7}});
+  ASSERT_TRUE(cost.ok()) << cost.status().message();
+  EXPECT_NEAR(*cost, 32.4, 1e-9);
+
+  // freq_ghz not bound: the platform's default frequency counts.
+  Result<Spec> only_hz = ParseSpec(R"(adse: 1
+world: {map: {generate: grid}}
+task: {start: {x: 0, y: 0}, goal: {x: 1, y: 1}}
+platform: {cores: 6, freq_ghz: 1.5}
+design_space: {hz: {bind: stack.lidar.rate_hz, values: [7, 14]}}
+cost: cores * freq_ghz + hz / 7
+)",
+                                   "c.yaml", "");
+  ASSERT_TRUE(only_hz.ok()) << only_hz.status().message();
+  cost = EvaluateCost(*only_hz, {{"hz", 14}});
+  ASSERT_TRUE(cost.ok()) << cost.status().message();
+  EXPECT_NEAR(*cost, 6 * 1.5 + 2, 1e-9);
+  EXPECT_FALSE(EvaluateCost(*only_hz, {{"hz", 10}}).ok());
+}
+
+TEST(DesignPointTest, ConstraintsOverMetrics) {
+  const Spec spec = Reference();
+  const DesignPoint point = {{"cores", 18}, {"freq_ghz", 1.8}, {"lidar_hz", 7}};
+  std::map<std::string, double> metrics = {
+      {"nav_time_s", 165}, {"ctrl_rate_hz", 7.8}, {"completed", 1}};
+  for (const std::string& c : spec.constraints) {
+    Result<bool> ok = EvaluateConstraint(spec, c, metrics, point);
+    ASSERT_TRUE(ok.ok()) << ok.status().message();
+    EXPECT_TRUE(*ok) << c;
+  }
+  metrics = {{"nav_time_s", 1248}, {"ctrl_rate_hz", 0.91}, {"completed", 0}};
+  for (const std::string& c : spec.constraints) {
+    Result<bool> ok = EvaluateConstraint(spec, c, metrics, point);
+    ASSERT_TRUE(ok.ok()) << ok.status().message();
+    EXPECT_FALSE(*ok) << c;
+  }
+  metrics["nav_time_s"] = std::nan("");
+  EXPECT_FALSE(*EvaluateConstraint(spec, "nav_time_s", metrics, point));
+  EXPECT_FALSE(EvaluateConstraint(spec, "collisions == 0", {}, point).ok());
+}
+
+TEST(DesignPointTest, ApplyPointSetsPlatformAndStack) {
+  const Spec spec = Reference();
+  Result<PointConfig> config = ApplyPoint(
+      spec, {{"cores", 23}, {"freq_ghz", 1.5}, {"lidar_hz", 14}});
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_EQ(config->platform.cores, 23);
+  EXPECT_NEAR(config->platform.freq_ghz, 1.5, kTol);
+  EXPECT_NEAR(config->stack.Get("lidar.rate_hz"), 14, kTol);
+  EXPECT_NEAR(config->stack.Lidar().rate_hz, 14, kTol);
+  EXPECT_FALSE(ApplyPoint(spec, {{"cores", 23}}).ok());
+}
+
+}  // namespace
+}  // namespace adse::spec

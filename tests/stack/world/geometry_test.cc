@@ -1,0 +1,119 @@
+#include "stack/world/geometry.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace adse::world {
+namespace {
+
+OrientedBox Box(double x, double y, double yaw, double length, double width) {
+  OrientedBox b;
+  b.center = Eigen::Vector2d(x, y);
+  b.yaw_rad = yaw;
+  b.length_m = length;
+  b.width_m = width;
+  return b;
+}
+
+TEST(BoxCornersTest, CounterClockwiseAroundCentre) {
+  const auto c = BoxCorners(Box(1.0, 2.0, M_PI / 2, 4.0, 2.0));
+  ASSERT_EQ(c.size(), 4u);
+  // Rotated 90 degrees: length along +y.
+  EXPECT_NEAR(c[0].x(), 2.0, 1e-12);
+  EXPECT_NEAR(c[0].y(), 4.0, 1e-12);
+  EXPECT_NEAR(c[2].x(), 0.0, 1e-12);
+  EXPECT_NEAR(c[2].y(), 0.0, 1e-12);
+  double area2 = 0.0;  // shoelace: positive when counter-clockwise
+  for (int i = 0; i < 4; ++i) {
+    const auto& a = c[i];
+    const auto& b = c[(i + 1) % 4];
+    area2 += a.x() * b.y() - b.x() * a.y();
+  }
+  EXPECT_NEAR(area2 / 2, 8.0, 1e-12);
+}
+
+TEST(BoxesOverlapTest, SeparatedOverlappingAndTouching) {
+  const OrientedBox a = Box(0, 0, 0, 4, 2);
+  EXPECT_TRUE(BoxesOverlap(a, Box(3.0, 0.5, 0, 4, 2)));
+  EXPECT_FALSE(BoxesOverlap(a, Box(4.01, 0, 0, 4, 2)));
+  EXPECT_FALSE(BoxesOverlap(a, Box(0, 2.01, 0, 4, 2)));
+  // Touching edges count as overlap (closed boxes).
+  EXPECT_TRUE(BoxesOverlap(a, Box(4.0, 0, 0, 4, 2)));
+  EXPECT_TRUE(BoxesOverlap(a, Box(0, 2.0, 0, 4, 2)));
+  // Containment.
+  EXPECT_TRUE(BoxesOverlap(a, Box(0.1, 0, 0.3, 1, 0.5)));
+  // Symmetric.
+  EXPECT_TRUE(BoxesOverlap(Box(3.0, 0.5, 0, 4, 2), a));
+}
+
+TEST(BoxesOverlapTest, RotatedCasesNeedAllAxes) {
+  const OrientedBox a = Box(0, 0, 0, 2, 2);
+  // A diamond (square rotated 45 deg, half-diagonal sqrt 2) whose corner
+  // points at a's corner (1, 1): the gap along the diagonal is what
+  // separates them, which only the diamond's own axes detect.
+  const double s = std::sqrt(2.0);
+  EXPECT_FALSE(BoxesOverlap(a, Box(2.0 + 0.02, 2.0 + 0.02, M_PI / 4, 2, 2)));
+  EXPECT_FALSE(BoxesOverlap(Box(2.02, 2.02, M_PI / 4, 2, 2), a));
+  EXPECT_TRUE(BoxesOverlap(a, Box(1.0 + s / 2 - 0.01, 1.0 + s / 2 - 0.01,
+                                  M_PI / 4, 2, 2)));
+  // Diamond's corner poking into a's side.
+  EXPECT_TRUE(BoxesOverlap(a, Box(1.0 + s - 0.05, 0, M_PI / 4, 2, 2)));
+  EXPECT_FALSE(BoxesOverlap(a, Box(1.0 + s + 0.05, 0, M_PI / 4, 2, 2)));
+  // Long thin boxes crossing in an X: the centres are far from each
+  // other's extents along their own short axes.
+  EXPECT_TRUE(BoxesOverlap(Box(0, 0, 0.5, 10, 0.2), Box(0, 0, -0.5, 10, 0.2)));
+}
+
+Path2 LShape() {
+  Path2 p;
+  p.points = {{0, 0}, {10, 0}, {10, 5}};
+  p.UpdateArcLength();
+  return p;
+}
+
+TEST(Path2Test, ArcLengthAndPointAtOnLShape) {
+  const Path2 p = LShape();
+  ASSERT_EQ(p.s_m.size(), 3u);
+  EXPECT_DOUBLE_EQ(p.s_m[1], 10.0);
+  EXPECT_DOUBLE_EQ(p.length_m(), 15.0);
+  EXPECT_TRUE(p.PointAt(4.0).isApprox(Eigen::Vector2d(4, 0)));
+  EXPECT_TRUE(p.PointAt(10.0).isApprox(Eigen::Vector2d(10, 0)));
+  EXPECT_TRUE(p.PointAt(12.5).isApprox(Eigen::Vector2d(10, 2.5)));
+  // Clamped beyond the ends.
+  EXPECT_TRUE(p.PointAt(-3.0).isApprox(Eigen::Vector2d(0, 0)));
+  EXPECT_TRUE(p.PointAt(99.0).isApprox(Eigen::Vector2d(10, 5)));
+  EXPECT_DOUBLE_EQ(p.MaxGap(), 10.0);
+}
+
+TEST(Path2Test, HeadingAtOnLShape) {
+  const Path2 p = LShape();
+  EXPECT_NEAR(p.HeadingAt(0.0), 0.0, 1e-12);
+  EXPECT_NEAR(p.HeadingAt(9.9), 0.0, 1e-12);
+  EXPECT_NEAR(p.HeadingAt(10.1), M_PI / 2, 1e-12);
+  EXPECT_NEAR(p.HeadingAt(15.0), M_PI / 2, 1e-12);
+  EXPECT_NEAR(p.HeadingAt(100.0), M_PI / 2, 1e-12);
+  EXPECT_NEAR(p.HeadingAt(-1.0), 0.0, 1e-12);
+}
+
+TEST(Path2Test, RepeatedPointsAndDegenerateInputs) {
+  Path2 p;
+  p.points = {{0, 0}, {0, 0}, {0, 3}, {0, 3}};
+  p.UpdateArcLength();
+  EXPECT_NEAR(p.HeadingAt(0.0), M_PI / 2, 1e-12);
+  EXPECT_NEAR(p.HeadingAt(3.0), M_PI / 2, 1e-12);
+  EXPECT_TRUE(p.PointAt(1.5).isApprox(Eigen::Vector2d(0, 1.5)));
+
+  Path2 empty;
+  empty.UpdateArcLength();
+  EXPECT_EQ(empty.length_m(), 0.0);
+  EXPECT_TRUE(empty.PointAt(1.0).isZero());
+  Path2 one;
+  one.points = {{2, 3}};
+  one.UpdateArcLength();
+  EXPECT_TRUE(one.PointAt(5.0).isApprox(Eigen::Vector2d(2, 3)));
+  EXPECT_EQ(one.MaxGap(), 0.0);
+}
+
+}  // namespace
+}  // namespace adse::world

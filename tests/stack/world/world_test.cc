@@ -1,0 +1,293 @@
+// The SUMO world end to end: generated and real maps, routing, the ideal
+// path, traffic determinism, the ego, LiDAR seeing SUMO vehicles, and the
+// errors for bad maps and bad start/goal. Each TEST runs in its own process
+// (gtest_discover_tests), which libsumo needs.
+#include "stack/world/world.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "stack/base/hash.h"
+#include "stack/world/ideal_driver.h"
+#include "stack/world/lidar.h"
+#include "stack/world/map_cloud.h"
+
+namespace adse::world {
+namespace {
+
+std::string CacheDir() {
+  const char* dir = std::getenv("ADSE_CACHE_DIR");
+  return dir ? dir : (std::filesystem::temp_directory_path() / "adse-test-cache").string();
+}
+
+// A small parking lot: one aisle between two rows, ring road around it.
+// Ring south lane (eastbound) at y = -1.75; north lane (westbound) at
+// y = 28 + 1.75.
+WorldSetup SmallLot() {
+  WorldSetup setup;
+  setup.world.map.generator = "parking_lot";
+  setup.world.map.generator_params = {{"rows", 2}, {"slots_per_row", 8}};
+  setup.world.traffic.seed = 3;
+  setup.world.traffic.parked_occupancy = 0.5;
+  setup.task.start = {.x_m = 8.0, .y_m = -1.75};
+  setup.task.goal = {.x_m = 10.0, .y_m = 29.75};
+  setup.cache_dir = CacheDir();
+  return setup;
+}
+
+TEST(WorldTest, GeneratedParkingLotLoadsAndIdealPathIsContinuous) {
+  Result<std::unique_ptr<World>> world = World::Open(SmallLot());
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  const World& w = **world;
+  const Path2& path = w.ideal_path();
+  // East along the south ring, north on the east side, west on the north ring.
+  EXPECT_GE(w.route_edges().size(), 3u);
+  EXPECT_GT(path.length_m(), 60.0);
+  EXPECT_LT(path.MaxGap(), 0.51);
+  EXPECT_LT(w.ideal_path_max_join_gap_m(), 0.5);
+  EXPECT_NEAR(path.points.front().x(), 8.0, 0.3);
+  EXPECT_NEAR(path.points.front().y(), -1.75, 0.3);
+  EXPECT_NEAR(path.points.back().x(), 10.0, 0.3);
+  EXPECT_NEAR(path.points.back().y(), 29.75, 0.3);
+  // Heading changes smoothly: no kinks from missing junction lanes.
+  for (double s = 1.0; s < path.length_m() - 1.0; s += 0.5) {
+    double dh = path.HeadingAt(s + 0.5) - path.HeadingAt(s);
+    dh = std::atan2(std::sin(dh), std::cos(dh));
+    EXPECT_LT(std::abs(dh), 0.5) << "kink at s=" << s;
+  }
+  EXPECT_EQ(w.scene().parking_slots().size(), 16u);
+  int parked = 0;
+  for (const auto& slot : w.scene().parking_slots()) parked += slot.occupied;
+  EXPECT_GT(parked, 0);
+  EXPECT_LT(parked, 16);
+  EXPECT_NEAR(w.lane_width_m(), 3.5, 0.01);
+}
+
+TEST(WorldTest, GridMapLoadsAndRoutes) {
+  WorldSetup setup;
+  setup.world.map.generator = "grid";
+  setup.world.map.generator_params = {{"number", 3}, {"length_m", 100}, {"lanes", 1}};
+  setup.task.start = {.by_edge = true, .edge = "A0B0", .pos_m = 10.0};
+  setup.task.goal = {.by_edge = true, .edge = "C1C2", .pos_m = 50.0};
+  setup.cache_dir = CacheDir();
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  EXPECT_LT((*world)->ideal_path().MaxGap(), 0.51);
+  EXPECT_LT((*world)->ideal_path_max_join_gap_m(), 0.5);
+  // 90 + 100 + 100 + 50 m along lanes, plus junction arcs.
+  EXPECT_NEAR((*world)->ideal_path().length_m(), 340.0, 15.0);
+  EXPECT_EQ((*world)->scene().obstacles().size(), 4u);  // city blocks
+}
+
+TEST(WorldTest, RealOsmNetworkFromSumoToolsLoadsAndRoutes) {
+  const std::string net = "/usr/share/sumo/tools/game/DRT/osm.net.xml";
+  ASSERT_TRUE(std::filesystem::exists(net)) << "sumo-tools is not installed";
+  WorldSetup setup;
+  setup.world.map.net_path = net;
+  setup.task.start = {.x_m = 899.9, .y_m = 400.8};
+  setup.task.goal = {.x_m = 1093.9, .y_m = 253.8};
+  setup.cache_dir = CacheDir();
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  EXPECT_GE((*world)->route_edges().size(), 5u);
+  // At least the straight-line distance, at most SUMO's route length.
+  EXPECT_GT((*world)->ideal_path().length_m(), 240.0);
+  EXPECT_LT((*world)->ideal_path().length_m(), 640.0);
+  EXPECT_LT((*world)->ideal_path_max_join_gap_m(), 0.5);
+  EXPECT_LT((*world)->ideal_path().MaxGap(), 0.51);
+  // A bare net gets roadside poles for the LiDAR.
+  EXPECT_GT((*world)->scene().obstacles().size(), 100u);
+}
+
+std::string TrafficFingerprint(uint64_t seed) {
+  WorldSetup setup = SmallLot();
+  setup.world.traffic.seed = seed;
+  setup.world.traffic.flows = {{"E2_W2", "W0_E0", 1800.0}};
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  EXPECT_TRUE(world.ok()) << world.status().ToString();
+  if (!world.ok()) return "";
+  std::string text;
+  for (int i = 0; i < 400; ++i) {
+    EXPECT_TRUE((*world)->Step(ControlCommand{}).ok());
+    if (i % 20 == 0) {
+      for (const OtherVehicle& v : (*world)->others()) {
+        text += v.id + ":" + std::to_string(std::lround(v.box.center.x() * 1000)) + "," +
+                std::to_string(std::lround(v.box.center.y() * 1000)) + ";";
+      }
+    }
+  }
+  EXPECT_FALSE(text.empty()) << "no traffic appeared";
+  return Sha256Hex(text);
+}
+
+TEST(WorldTest, TrafficIsIdenticalForTheSameSeedAndDiffersForAnother) {
+  // Worlds opened one after another in one process: libsumo restarts cleanly.
+  const std::string a = TrafficFingerprint(11);
+  const std::string b = TrafficFingerprint(11);
+  const std::string c = TrafficFingerprint(12);
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+}
+
+TEST(WorldTest, PerfectControllerReachesTheGoalWithoutCollisions) {
+  Result<std::unique_ptr<World>> world = World::Open(SmallLot());
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  LidarParams params;
+  LidarSimulator lidar(&(*world)->scene(), params, Weather::kClear, 1);
+  IdealDriverOptions options;
+  options.timeout_s = 120.0;
+  Result<IdealDriveReport> report = DriveIdealPath(**world, &lidar, options);
+  ASSERT_TRUE(report.ok()) << report.status().ToString();
+  EXPECT_TRUE(report->reached_goal);
+  EXPECT_EQ(report->collisions, 0);
+  EXPECT_LT(report->max_lateral_error_m, 0.35);
+  // About 80 m at up to 8.3 m/s with slow corners.
+  EXPECT_GT(report->time_s, 10.0);
+  EXPECT_LT(report->time_s, 40.0);
+  EXPECT_GT(report->scans, 50);
+  EXPECT_GT(report->mean_points_per_scan, 1000.0);
+}
+
+TEST(WorldTest, LidarSeesSumoVehicles) {
+  WorldSetup setup = SmallLot();
+  setup.world.traffic.parked_occupancy = 0.0;
+  // Westbound on the south ring: passes the ego on the opposite lane.
+  setup.world.traffic.flows = {{"E0_W0", "W2_E2", 1800.0}};
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  World& w = **world;
+  // Let traffic in; the ego stands still at the start.
+  const OtherVehicle* seen = nullptr;
+  for (int i = 0; i < 400 && seen == nullptr; ++i) {
+    ASSERT_TRUE(w.Step(ControlCommand{}).ok());
+    for (const OtherVehicle& v : w.others()) {
+      const double d = (v.box.center - Eigen::Vector2d(w.ego().x_m, w.ego().y_m)).norm();
+      if (d > 8.0 && d < 25.0) seen = &v;
+    }
+  }
+  ASSERT_NE(seen, nullptr) << "no vehicle came within LiDAR view";
+  LidarParams params;
+  params.range_noise_stddev_m = 0.0;
+  LidarSimulator lidar(&w.scene(), params, Weather::kClear, 1);
+  const Pose2 pose{w.ego().x_m, w.ego().y_m, w.ego().yaw_rad};
+  std::vector<OrientedBox> boxes;
+  for (const OtherVehicle& v : w.others()) boxes.push_back(v.box);
+  const PointCloud with = lidar.Scan(pose, w.time_s(), boxes);
+  int on_vehicle = 0;
+  const OrientedBox box = seen->box;
+  for (const Eigen::Vector3f& p : with.points) {
+    // Sensor frame -> world frame.
+    const double c = std::cos(pose.yaw_rad), s = std::sin(pose.yaw_rad);
+    const Eigen::Vector2d world_xy(pose.x_m + c * p.x() - s * p.y(), pose.y_m + s * p.x() + c * p.y());
+    const Eigen::Vector2d local = Eigen::Rotation2Dd(-box.yaw_rad) * (world_xy - box.center);
+    if (std::abs(local.x()) <= box.length_m / 2 + 0.05 && std::abs(local.y()) <= box.width_m / 2 + 0.05 &&
+        p.z() > -params.mount_height_m + 0.1) {
+      ++on_vehicle;
+    }
+  }
+  EXPECT_GT(on_vehicle, 10);
+}
+
+TEST(WorldTest, MapCloudIsBuiltOnceAndCached) {
+  Result<std::unique_ptr<World>> world = World::Open(SmallLot());
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  Result<std::string> path = (*world)->MapCloudPath();
+  ASSERT_TRUE(path.ok()) << path.status().ToString();
+  const auto first_write = std::filesystem::last_write_time(*path);
+  Result<std::vector<Eigen::Vector3f>> cloud = ReadPcd(*path);
+  ASSERT_TRUE(cloud.ok());
+  EXPECT_GT(cloud->size(), 10000u);
+  Result<std::string> again = (*world)->MapCloudPath();
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(*again, *path);
+  EXPECT_EQ(std::filesystem::last_write_time(*again), first_write);
+}
+
+TEST(WorldTest, CorruptNetIsReportedWithSumosCause) {
+  const std::string net = (std::filesystem::temp_directory_path() / "adse_corrupt.net.xml").string();
+  std::ofstream(net) << "<net version=\"1.9\">\n  <edge id=\"a\"\n";
+  WorldSetup setup;
+  setup.world.map.net_path = net;
+  setup.task.start = {.x_m = 0, .y_m = 0};
+  setup.task.goal = {.x_m = 10, .y_m = 0};
+  setup.cache_dir = CacheDir();
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_FALSE(world.ok());
+  EXPECT_EQ(world.status().code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(world.status().message().find("world.map.net"), std::string::npos);
+  EXPECT_NE(world.status().message().find("adse_corrupt.net.xml"), std::string::npos);
+  // SUMO's own reason, not a bare "Process Error".
+  EXPECT_EQ(world.status().message().find("Process Error"), std::string::npos)
+      << world.status().message();
+}
+
+TEST(WorldTest, StartOffTheRoadIsRejected) {
+  WorldSetup setup = SmallLot();
+  setup.task.start = {.x_m = 15.0, .y_m = 8.0};  // in the parking rows
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_FALSE(world.ok());
+  EXPECT_NE(world.status().message().find("task.start"), std::string::npos);
+  EXPECT_NE(world.status().message().find("off the road"), std::string::npos)
+      << world.status().message();
+}
+
+TEST(WorldTest, UnreachableGoalIsRejected) {
+  // Two separate road pieces: no route joins them.
+  const auto dir = std::filesystem::temp_directory_path() / "adse_islands";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "n.nod.xml") << R"(<nodes>
+  <node id="a" x="0" y="0"/><node id="b" x="100" y="0"/>
+  <node id="c" x="0" y="50"/><node id="d" x="100" y="50"/></nodes>)";
+  std::ofstream(dir / "e.edg.xml") << R"(<edges>
+  <edge id="ab" from="a" to="b" numLanes="1"/><edge id="cd" from="c" to="d" numLanes="1"/></edges>)";
+  const std::string net = (dir / "islands.net.xml").string();
+  ASSERT_EQ(std::system(("netconvert -n " + (dir / "n.nod.xml").string() + " -e " +
+                         (dir / "e.edg.xml").string() + " -o " + net +
+                         " --offset.disable-normalization true >/dev/null 2>&1")
+                            .c_str()),
+            0);
+  WorldSetup setup;
+  setup.world.map.net_path = net;
+  setup.task.start = {.x_m = 10, .y_m = -1.6};
+  setup.task.goal = {.x_m = 90, .y_m = 48.4};
+  setup.cache_dir = CacheDir();
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_FALSE(world.ok());
+  EXPECT_NE(world.status().message().find("task.goal"), std::string::npos);
+  EXPECT_NE(world.status().message().find("unreachable"), std::string::npos)
+      << world.status().message();
+}
+
+TEST(WorldTest, SecondOpenWorldInOneProcessIsRefused) {
+  Result<std::unique_ptr<World>> first = World::Open(SmallLot());
+  ASSERT_TRUE(first.ok()) << first.status().ToString();
+  Result<std::unique_ptr<World>> second = World::Open(SmallLot());
+  ASSERT_FALSE(second.ok());
+  EXPECT_EQ(second.status().code(), Status::Code::kUnavailable);
+}
+
+TEST(WorldTest, ValetParkingPathEndsInsideTheGoalSlot) {
+  WorldSetup setup = SmallLot();
+  setup.task.kind = TaskKind::kValetParking;
+  // Slot 3 of row 0 (below the aisle): x in [17, 19.5], y in [5.5, 10.5].
+  setup.task.goal = {.x_m = 18.25, .y_m = 8.0};
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  const Path2& path = (*world)->ideal_path();
+  EXPECT_NEAR(path.points.back().x(), 18.25, 0.1);
+  EXPECT_NEAR(path.points.back().y(), 8.0, 0.1);
+  EXPECT_LT(path.MaxGap(), 0.51);
+  for (const auto& slot : (*world)->scene().parking_slots()) {
+    if ((slot.box.center - Eigen::Vector2d(18.25, 8.0)).norm() < 0.5) {
+      EXPECT_FALSE(slot.occupied) << "the goal slot must stay free";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace adse::world
