@@ -90,7 +90,7 @@ TEST(WorldTest, RealOsmNetworkFromSumoToolsLoadsAndRoutes) {
   WorldSetup setup;
   setup.world.map.net_path = net;
   setup.task.start = {.x_m = 899.9, .y_m = 400.8};
-  setup.task.goal = {.x_m = 1093.9, .y_m = 253.8};
+  setup.task.goal = {.x_m = 1100.0, .y_m = 232.0};
   setup.cache_dir = CacheDir();
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_TRUE(world.ok()) << world.status().ToString();

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Builds every benchmark (target adse_benchmarks) in build/ and runs each
+# build/bin/*_bench, after printing what machine the figures come from.
+#   scripts/bench.sh [extra google-benchmark flags, e.g. --benchmark_filter=Lidar]
+set -euo pipefail
+
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${root}/build"
+jobs="${BENCH_BUILD_JOBS:-$(nproc)}"
+
+if [[ ! -f "${build}/CMakeCache.txt" ]]; then
+  cmake -S "${root}" -B "${build}" -DCMAKE_BUILD_TYPE=RelWithDebInfo
+fi
+cmake --build "${build}" --target adse_benchmarks -j "${jobs}"
+
+echo "== machine"
+echo "nproc: $(nproc)"
+lscpu | grep 'Model name' || true
+echo "build type: $(grep -E '^CMAKE_BUILD_TYPE:' "${build}/CMakeCache.txt" | cut -d= -f2)"
+echo "load average: $(cut -d' ' -f1-3 /proc/loadavg)"
+
+shopt -s nullglob
+benches=("${build}"/bin/*_bench)
+if [[ ${#benches[@]} -eq 0 ]]; then
+  echo "no benchmarks found in ${build}/bin" >&2
+  exit 1
+fi
+status=0
+for bench in "${benches[@]}"; do
+  echo
+  echo "== $(basename "${bench}")"
+  "${bench}" --benchmark_format=console "$@" || status=1
+done
+exit "${status}"

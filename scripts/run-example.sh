@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds adse and runs the most complete job that
+# exists on the bundled robotaxi scenario: validate it (280-point space),
+# then drive its world with a perfect controller while the LiDAR scans.
+# No network and no LLM needed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+scripts/build.sh --target adse
+scenario=scenarios/robotaxi_parking_lot.yaml
+echo "== adse validate $scenario"
+build/bin/adse validate --quiet "$scenario"
+echo "== adse world $scenario --follow-ideal"
+build/bin/adse world "$scenario" --follow-ideal
