@@ -2,14 +2,17 @@
 # Builds every benchmark (target adse_benchmarks) in build/ and runs each
 # build/bin/*_bench, after printing what machine the figures come from.
 #   scripts/bench.sh [extra google-benchmark flags, e.g. --benchmark_filter=Lidar]
+# ADSE_BUILD_DIR overrides the build folder, ADSE_JOBS the build jobs (2) and
+# ADSE_BUILD_TYPE the build type of a fresh configure (RelWithDebInfo).
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${root}/build"
-jobs="${BENCH_BUILD_JOBS:-$(nproc)}"
+build="${ADSE_BUILD_DIR:-${root}/build}"
+jobs="${ADSE_JOBS:-2}"
 
 if [[ ! -f "${build}/CMakeCache.txt" ]]; then
-  cmake -S "${root}" -B "${build}" -DCMAKE_BUILD_TYPE=RelWithDebInfo
+  cmake -S "${root}" -B "${build}" \
+    -DCMAKE_BUILD_TYPE="${ADSE_BUILD_TYPE:-RelWithDebInfo}"
 fi
 cmake --build "${build}" --target adse_benchmarks -j "${jobs}"
 

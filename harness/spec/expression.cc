@@ -79,9 +79,9 @@ Result<Expression> Expression::Parse(
     return Status::InvalidArgument("empty expression");
   }
   if (size_t position = 0; HasAssignment(text, &position)) {
-    return Status::InvalidArgument(
-        "assignment '=' at position " + std::to_string(position + 1) +
-        " (use '==' to compare)");
+    return Status::InvalidArgument("assignment '=' at position " +
+                                   std::to_string(position + 1) +
+                                   " (use '==' to compare)");
   }
   try {
     impl->parser.SetExpr(text);

@@ -21,8 +21,8 @@ class Expression {
   // Parses `text`, which may use only `allowed_names` as variables. Errors
   // (InvalidArgument) are one line: a syntax error with its position, an
   // unknown name with a suggestion, an assignment, or several results.
-  static Result<Expression> Parse(const std::string& text,
-                                  const std::vector<std::string>& allowed_names);
+  static Result<Expression> Parse(
+      const std::string& text, const std::vector<std::string>& allowed_names);
 
   Expression(const Expression& other);
   Expression& operator=(const Expression& other);

@@ -60,7 +60,8 @@ const DesignParameter* DesignSpace::Find(const std::string& name) const {
   return nullptr;
 }
 
-const DesignParameter* DesignSpace::FindByBind(const std::string& target) const {
+const DesignParameter* DesignSpace::FindByBind(
+    const std::string& target) const {
   for (const DesignParameter& p : parameters) {
     if (p.bind == target) return &p;
   }

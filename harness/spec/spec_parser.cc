@@ -31,9 +31,9 @@ namespace fs = std::filesystem;
 // Vocabulary of the format.
 
 const std::vector<std::string> kTopKeys = {
-    "adse",        "name",        "world",       "task",        "stack",
-    "platform",    "design_space", "cost",       "objectives",  "constraints",
-    "exploration", "llm",         "harness",     "output"};
+    "adse",        "name",         "world",   "task",       "stack",
+    "platform",    "design_space", "cost",    "objectives", "constraints",
+    "exploration", "llm",          "harness", "output"};
 const std::vector<std::string> kWorldKeys = {"map", "traffic", "weather",
                                              "step_s"};
 const std::vector<std::string> kMapKeys = {"generate", "params", "net",
@@ -43,8 +43,7 @@ const std::vector<std::string> kTrafficKeys = {"seed", "flows",
 const std::vector<std::string> kFlowKeys = {"from", "to", "vehicles_per_hour"};
 const std::vector<std::string> kTaskKeys = {"kind", "start", "goal",
                                             "speed_limit_kmh", "timeout_s"};
-const std::vector<std::string> kStartKeys = {"x", "y", "edge", "pos_m",
-                                             "lane"};
+const std::vector<std::string> kStartKeys = {"x", "y", "edge", "pos_m", "lane"};
 const std::vector<std::string> kGoalKeys = {"x",     "y",    "edge",
                                             "pos_m", "lane", "tolerance_m"};
 const std::vector<std::string> kPlatformKeys = {
@@ -53,8 +52,8 @@ const std::vector<std::string> kParameterKeys = {"bind", "range", "values",
                                                  "step"};
 const std::vector<std::string> kObjectiveKeys = {"minimize", "maximize"};
 const std::vector<std::string> kExplorationKeys = {
-    "strategy",   "budget",         "batch",        "seed",
-    "start_from", "population",     "crossover_rate", "mutation_rate"};
+    "strategy",   "budget",     "batch",          "seed",
+    "start_from", "population", "crossover_rate", "mutation_rate"};
 const std::vector<std::string> kLlmKeys = {
     "backend",     "endpoint",  "models",  "prompts",
     "replay_from", "timeout_s", "retries", "api_key_env"};
@@ -62,8 +61,8 @@ const std::vector<std::string> kHarnessKeys = {
     "workers",  "cores_per_worker", "memory_mb", "run_timeout_s", "retries",
     "replicas", "isolation",        "executor",  "cache_dir",     "slurm"};
 const std::vector<std::string> kSlurmKeys = {
-    "partition",    "account",    "nodes",      "cpus",
-    "time_limit",   "max_parallel", "shard_size", "extra_args"};
+    "partition",  "account",      "nodes",      "cpus",
+    "time_limit", "max_parallel", "shard_size", "extra_args"};
 
 const std::vector<std::string> kWeathers = {"clear", "rain", "fog"};
 const std::vector<std::string> kTaskKinds = {"lane_driving", "valet_parking"};
@@ -135,16 +134,18 @@ std::vector<std::string> MetricNames() {
 
 const char* WeatherText(world::Weather w) {
   switch (w) {
-    case world::Weather::kClear: return "clear";
-    case world::Weather::kRain: return "rain";
-    case world::Weather::kFog: return "fog";
+    case world::Weather::kClear:
+      return "clear";
+    case world::Weather::kRain:
+      return "rain";
+    case world::Weather::kFog:
+      return "fog";
   }
   return "clear";
 }
 
 const char* TaskKindText(world::TaskKind k) {
-  return k == world::TaskKind::kValetParking ? "valet_parking"
-                                             : "lane_driving";
+  return k == world::TaskKind::kValetParking ? "valet_parking" : "lane_driving";
 }
 
 bool IsIdentifier(std::string_view s) {
@@ -188,8 +189,8 @@ bool IsSlurmTime(const std::string& s) {
   std::string rest = s;
   if (const size_t dash = s.find('-'); dash != std::string::npos) {
     const std::string days = s.substr(0, dash);
-    if (days.empty() || days.find_first_not_of("0123456789") !=
-                            std::string::npos) {
+    if (days.empty() ||
+        days.find_first_not_of("0123456789") != std::string::npos) {
       return false;
     }
     rest = s.substr(dash + 1);
@@ -324,12 +325,12 @@ struct Bounds {
                          hi_open ? ")" : "]");
     }
     if (has_lo) {
-      return fmt::format("{} {} {}", noun, lo_open ? ">" : ">=",
-                         FormatNumber(lo));
+      return fmt::format("{} {} {}", noun,
+                         lo_open ? ">" : ">=", FormatNumber(lo));
     }
     if (has_hi) {
-      return fmt::format("{} {} {}", noun, hi_open ? "<" : "<=",
-                         FormatNumber(hi));
+      return fmt::format("{} {} {}", noun,
+                         hi_open ? "<" : "<=", FormatNumber(hi));
     }
     return noun;
   }
@@ -448,17 +449,14 @@ class SpecReader {
       const std::string path = Join(v.path, name);
       if (auto seen = first_line.find(name); seen != first_line.end()) {
         Error(key.Mark(), path, "each key once",
-              fmt::format("'{}' again (first at line {})", name,
-                          seen->second));
+              fmt::format("'{}' again (first at line {})", name, seen->second));
         continue;
       }
       first_line[name] = key.Mark().line + 1;
       if (allowed != nullptr &&
-          std::find(allowed->begin(), allowed->end(), name) ==
-              allowed->end()) {
-        Error(key.Mark(), path,
-              "a key among {" + JoinList(*allowed) + "}", Quote(name),
-              DidYouMean(name, *allowed));
+          std::find(allowed->begin(), allowed->end(), name) == allowed->end()) {
+        Error(key.Mark(), path, "a key among {" + JoinList(*allowed) + "}",
+              Quote(name), DidYouMean(name, *allowed));
         continue;
       }
       Val entry;
@@ -522,8 +520,7 @@ class SpecReader {
     uint64_t value = 0;
     const auto [end, ec] =
         std::from_chars(text.data(), text.data() + text.size(), value);
-    if (text.empty() || ec != std::errc() ||
-        end != text.data() + text.size()) {
+    if (text.empty() || ec != std::errc() || end != text.data() + text.size()) {
       Error(v, "an integer in [0, 18446744073709551615]");
       return false;
     }
@@ -600,8 +597,10 @@ void SpecReader::Read(const YAML::Node& root) {
   top.mark = root.Mark();
   top.key_mark = top.mark;
   if (!root.IsDefined() || root.IsNull()) {
-    Error(YAML::Mark(), "", "a scenario map with adse, world, task and "
-                            "design_space", "an empty document");
+    Error(YAML::Mark(), "",
+          "a scenario map with adse, world, task and "
+          "design_space",
+          "an empty document");
     return;
   }
   Fields f;
@@ -687,8 +686,9 @@ void SpecReader::ReadWorld(const Val& v) {
   if (const Val* e = f.Get("map")) {
     ReadMapSource(*e);
   } else {
-    Missing(v, "map", "{generate: parking_lot|grid, params: {...}} or "
-                      "{net: <file.net.xml>}");
+    Missing(v, "map",
+            "{generate: parking_lot|grid, params: {...}} or "
+            "{net: <file.net.xml>}");
   }
   if (const Val* e = f.Get("traffic")) ReadTraffic(*e);
   if (const Val* e = f.Get("weather")) {
@@ -783,8 +783,8 @@ void SpecReader::ReadMapSource(const Val& v) {
       std::error_code ec;
       if (!fs::is_regular_file(map.polygons_path, ec)) {
         Error(e->mark, e->path, "an existing SUMO polygon file (.poly.xml)",
-              Quote(e->node.Scalar()) + " (no such file: " +
-                  map.polygons_path + ")");
+              Quote(e->node.Scalar()) + " (no such file: " + map.polygons_path +
+                  ")");
       }
     }
   }
@@ -956,8 +956,8 @@ void SpecReader::ReadPlatform(const Val& v) {
   if (const Val* e = f.Get("kind")) {
     std::string kind;
     if (ReadEnum(*e, &kind, kPlatformKinds)) {
-      p.kind = kind == "cgroup" ? PlatformKind::kCgroup
-                                : PlatformKind::kVirtual;
+      p.kind =
+          kind == "cgroup" ? PlatformKind::kCgroup : PlatformKind::kVirtual;
     }
   }
   if (const Val* e = f.Get("reference_ghz")) {
@@ -974,9 +974,9 @@ void SpecReader::ReadPlatform(const Val& v) {
     if (ReadPath(*e, &p.calibration, "a path to a calibration file")) {
       std::error_code ec;
       if (!fs::is_regular_file(p.calibration, ec)) {
-        Error(e->mark, e->path, "an existing calibration file",
-              Quote(e->node.Scalar()) + " (no such file: " + p.calibration +
-                  ")");
+        Error(
+            e->mark, e->path, "an existing calibration file",
+            Quote(e->node.Scalar()) + " (no such file: " + p.calibration + ")");
       }
     }
   }
@@ -1016,8 +1016,7 @@ void SpecReader::ReadParameter(const std::string& name, const Val& v,
           Quote(name));
     ok = false;
   } else if (const std::vector<std::string> metrics = MetricNames();
-             std::find(metrics.begin(), metrics.end(), name) !=
-             metrics.end()) {
+             std::find(metrics.begin(), metrics.end(), name) != metrics.end()) {
     Error(v.key_mark, v.path, "a parameter name that is not a metric name",
           Quote(name));
     ok = false;
@@ -1039,8 +1038,9 @@ void SpecReader::ReadParameter(const std::string& name, const Val& v,
   p.name = name;
   const std::vector<std::string> targets = BindTargets();
   if (const Val* e = f.Get("bind")) {
-    if (ReadString(*e, &p.bind, "a target: platform.cores, platform.freq_ghz "
-                                "or stack.<knob>")) {
+    if (ReadString(*e, &p.bind,
+                   "a target: platform.cores, platform.freq_ghz "
+                   "or stack.<knob>")) {
       if (std::find(targets.begin(), targets.end(), p.bind) == targets.end()) {
         Error(*e,
               "a target: platform.cores, platform.freq_ghz or stack.<knob> "
@@ -1055,8 +1055,8 @@ void SpecReader::ReadParameter(const std::string& name, const Val& v,
         (*bound)[p.bind] = name;
       }
       // `cores` and `freq_ghz` always mean the platform's in expressions.
-      if ((name == "cores" && p.bind != kPlatformCores) ||
-          (name == "freq_ghz" && p.bind != kPlatformFreq)) {
+      if (ok && ((name == "cores" && p.bind != kPlatformCores) ||
+                 (name == "freq_ghz" && p.bind != kPlatformFreq))) {
         Error(v.key_mark, v.path,
               std::string("the name '") + name + "' to bind platform." + name +
                   " (it means the platform's value in expressions)",
@@ -1067,8 +1067,9 @@ void SpecReader::ReadParameter(const std::string& name, const Val& v,
       ok = false;
     }
   } else {
-    Missing(v, "bind", "a target: platform.cores, platform.freq_ghz or "
-                       "stack.<knob>");
+    Missing(v, "bind",
+            "a target: platform.cores, platform.freq_ghz or "
+            "stack.<knob>");
     ok = false;
   }
 
@@ -1080,8 +1081,7 @@ void SpecReader::ReadParameter(const std::string& name, const Val& v,
     return;
   }
   if (!range && !values) {
-    Error(v.key_mark, v.path, "exactly one of 'range' or 'values'",
-          "neither");
+    Error(v.key_mark, v.path, "exactly one of 'range' or 'values'", "neither");
     return;
   }
   if (step && !range) {
@@ -1178,9 +1178,9 @@ bool SpecReader::CheckBinding(const DesignParameter& p, const Val& at,
     integer = knob->integer;
     what = knob->doc;
   }
-  const std::string expected = fmt::format(
-      "values allowed for {}: {} ({})", p.bind,
-      bounds.Describe(integer ? "integers" : "numbers"), what);
+  const std::string expected =
+      fmt::format("values allowed for {}: {} ({})", p.bind,
+                  bounds.Describe(integer ? "integers" : "numbers"), what);
   for (double value : p.values) {
     if (bounds.Contains(value) && (!integer || value == std::floor(value))) {
       continue;
@@ -1249,10 +1249,11 @@ void SpecReader::ReadObjectives(const Val& v) {
                     "a map {minimize: <metric>} or {maximize: <metric>}")) {
       continue;
     }
-    if (f.order.size() != 1) {
+    if (item.node.size() != 1) {
       Error(item, "exactly one of minimize or maximize");
       continue;
     }
+    if (f.order.empty()) continue;  // its key was reported
     const Val& e = *f.Get(f.order[0]);
     Objective objective;
     objective.minimize = f.order[0] == "minimize";
@@ -1323,9 +1324,8 @@ void SpecReader::ReadStartFrom(const Val& v) {
     const Val& e = *f.Get(name);
     const DesignParameter* p = space.Find(name);
     if (p == nullptr) {
-      Error(e.key_mark, e.path,
-            "a design parameter (" + JoinList(names) + ")", Quote(name),
-            DidYouMean(name, names));
+      Error(e.key_mark, e.path, "a design parameter (" + JoinList(names) + ")",
+            Quote(name), DidYouMean(name, names));
       continue;
     }
     double value = 0;
@@ -1379,9 +1379,9 @@ void SpecReader::ReadLlm(const Val& v) {
     if (ReadPath(*e, &llm.prompts, "a folder of prompt templates")) {
       std::error_code ec;
       if (!fs::is_directory(llm.prompts, ec)) {
-        Error(e->mark, e->path, "an existing folder of prompt templates",
-              Quote(e->node.Scalar()) + " (no such folder: " + llm.prompts +
-                  ")");
+        Error(
+            e->mark, e->path, "an existing folder of prompt templates",
+            Quote(e->node.Scalar()) + " (no such folder: " + llm.prompts + ")");
       }
     }
   }
@@ -1390,8 +1390,8 @@ void SpecReader::ReadLlm(const Val& v) {
       std::error_code ec;
       if (!fs::exists(llm.replay_from, ec)) {
         Error(e->mark, e->path, "an existing recorded campaign folder",
-              Quote(e->node.Scalar()) + " (no such folder: " +
-                  llm.replay_from + ")");
+              Quote(e->node.Scalar()) + " (no such folder: " + llm.replay_from +
+                  ")");
       }
     }
   }
@@ -1471,7 +1471,8 @@ void SpecReader::ReadSlurm(const Val& v) {
   if (const Val* e = f.Get("nodes")) {
     ReadInt(*e, &s.nodes, Bounds::Closed(1, 1e6));
   }
-  if (const Val* e = f.Get("cpus")) ReadInt(*e, &s.cpus, Bounds::Closed(0, 1e7));
+  if (const Val* e = f.Get("cpus"))
+    ReadInt(*e, &s.cpus, Bounds::Closed(0, 1e7));
   if (const Val* e = f.Get("time_limit")) {
     const std::string expected =
         "a Slurm time limit (M, M:S, H:M:S, D-H, D-H:M or D-H:M:S)";
@@ -1517,7 +1518,7 @@ void SpecReader::ReadOutput(const Val* v) {
     const fs::path normal = path.lexically_normal();
     const std::string first =
         normal.empty() ? std::string() : normal.begin()->string();
-    if (first == ".." ) {
+    if (first == "..") {
       Error(*v, expected, " (the path escapes the working directory)");
       return;
     }
@@ -1623,11 +1624,10 @@ Result<Spec> ParseSpec(std::string_view text, const std::string& file_name,
   Spec spec;
   spec.source_path = file_name;
   std::error_code ec;
-  spec.base_dir = fs::absolute(base_dir.empty() ? fs::path(".")
-                                                : fs::path(base_dir),
-                               ec)
-                      .lexically_normal()
-                      .string();
+  spec.base_dir =
+      fs::absolute(base_dir.empty() ? fs::path(".") : fs::path(base_dir), ec)
+          .lexically_normal()
+          .string();
   if (spec.base_dir.size() > 1 && spec.base_dir.back() == '/') {
     spec.base_dir.pop_back();
   }
@@ -1677,8 +1677,7 @@ Result<Spec> ParseSpec(std::string_view text, const std::string& file_name,
       reader.FileError(mark, "(file)", "valid YAML",
                        std::string("a syntax error: ") + e.msg);
     } catch (const std::exception& e) {
-      reader.FileError(YAML::Mark(), "(file)", "a readable scenario",
-                       e.what());
+      reader.FileError(YAML::Mark(), "(file)", "a readable scenario", e.what());
     }
   }
 
@@ -1725,13 +1724,12 @@ std::string NormalizedYaml(const Spec& spec) {
   out << YAML::Key << "map" << YAML::Value << YAML::Flow << YAML::BeginMap;
   if (!w.map.generator.empty()) {
     out << YAML::Key << "generate" << YAML::Value << w.map.generator;
-    out << YAML::Key << "params" << YAML::Value << YAML::Flow
-        << YAML::BeginMap;
+    out << YAML::Key << "params" << YAML::Value << YAML::Flow << YAML::BeginMap;
     for (const GeneratorParam& p : GeneratorParams(w.map.generator)) {
       auto it = w.map.generator_params.find(p.name);
       out << YAML::Key << p.name << YAML::Value;
       EmitNumber(out, it != w.map.generator_params.end() ? it->second
-                                                          : p.default_value);
+                                                         : p.default_value);
     }
     out << YAML::EndMap;
   } else {
@@ -1804,8 +1802,7 @@ std::string NormalizedYaml(const Spec& spec) {
   for (const DesignParameter& d : spec.design_space.parameters) {
     out << YAML::Key << d.name << YAML::Value << YAML::Flow << YAML::BeginMap;
     out << YAML::Key << "bind" << YAML::Value << d.bind;
-    out << YAML::Key << "values" << YAML::Value << YAML::Flow
-        << YAML::BeginSeq;
+    out << YAML::Key << "values" << YAML::Value << YAML::Flow << YAML::BeginSeq;
     for (double value : d.values) EmitNumber(out, value);
     out << YAML::EndSeq << YAML::EndMap;
   }
@@ -2037,8 +2034,8 @@ Result<double> EvaluateCost(const Spec& spec, const DesignPoint& point) {
 Result<bool> EvaluateConstraint(const Spec& spec, const std::string& constraint,
                                 const std::map<std::string, double>& metrics,
                                 const DesignPoint& point) {
-  Result<Expression> e = Expression::Parse(
-      constraint, ConstraintVariableNames(spec.design_space));
+  Result<Expression> e =
+      Expression::Parse(constraint, ConstraintVariableNames(spec.design_space));
   if (!e.ok()) {
     return Status::InvalidArgument("constraint '" + constraint +
                                    "': " + e.status().message());

@@ -23,8 +23,8 @@ int EditDistance(std::string_view a, std::string_view b) {
   for (size_t i = 1; i <= n; ++i) {
     for (size_t j = 1; j <= m; ++j) {
       const int cost = lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1;
-      at(i, j) = std::min({at(i - 1, j) + 1, at(i, j - 1) + 1,
-                           at(i - 1, j - 1) + cost});
+      at(i, j) = std::min(
+          {at(i - 1, j) + 1, at(i, j - 1) + 1, at(i - 1, j - 1) + cost});
       if (i > 1 && j > 1 && lower(a[i - 1]) == lower(b[j - 2]) &&
           lower(a[i - 2]) == lower(b[j - 1])) {
         at(i, j) = std::min(at(i, j), at(i - 2, j - 2) + 1);
@@ -45,14 +45,15 @@ std::string DidYouMean(std::string_view word,
     int score = EditDistance(word, candidate);
     // Short words tolerate one edit, longer ones two, so that unrelated
     // short words are not suggested.
-    const int limit =
-        std::min<int>(2, std::max<int>(1, static_cast<int>(candidate.size()) / 3));
+    const int limit = std::min<int>(
+        2, std::max<int>(1, static_cast<int>(candidate.size()) / 3));
     // A truncated name ("lidar" for "lidar_hz") is a likely slip too.
     const std::string_view shorter =
         word.size() < candidate.size() ? word : std::string_view(candidate);
     const std::string_view longer =
         word.size() < candidate.size() ? std::string_view(candidate) : word;
-    const bool prefix = shorter.size() >= 3 && longer.substr(0, shorter.size()) == shorter;
+    const bool prefix =
+        shorter.size() >= 3 && longer.substr(0, shorter.size()) == shorter;
     if (prefix) score = std::min(score, limit);
     if (score > limit) continue;
     if (best == nullptr || score < best_score) {

@@ -8,6 +8,8 @@ namespace adse::world {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
+// Beams steeper than this (within ~1e-12 rad of vertical) cross no face.
+constexpr double kMinCos = 1e-12;
 
 double WrapPi(double a) {
   a = std::remainder(a, 2.0 * M_PI);
@@ -70,15 +72,15 @@ LidarSimulator::LidarSimulator(const Scene* scene, const LidarParams& params,
   const int beams = std::max(1, params_.beams);
   elevations_rad_.resize(beams);
   for (int i = 0; i < beams; ++i) {
-    const double deg =
-        beams == 1 ? 0.0
-                   : params_.vertical_fov_down_deg +
-                         (params_.vertical_fov_up_deg -
-                          params_.vertical_fov_down_deg) *
-                             i / (beams - 1);
+    const double deg = beams == 1 ? 0.0
+                                  : params_.vertical_fov_down_deg +
+                                        (params_.vertical_fov_up_deg -
+                                         params_.vertical_fov_down_deg) *
+                                            i / (beams - 1);
     elevations_rad_[i] = deg * kDegToRad;
     elevation_cos_.push_back(std::cos(elevations_rad_[i]));
     elevation_sin_.push_back(std::sin(elevations_rad_[i]));
+    elevation_tan_.push_back(std::tan(elevations_rad_[i]));
   }
   const double res_deg = params_.horizontal_resolution_deg > 0.0
                              ? params_.horizontal_resolution_deg
@@ -114,7 +116,9 @@ PointCloud LidarSimulator::Scan(const Pose2& sensor_pose, double stamp_s,
   const double sy = std::sin(sensor_pose.yaw_rad);
   const int columns = azimuths();
   const int beams = static_cast<int>(elevations_rad_.size());
-  const Eigen::Vector3d origin(sensor_pose.x_m, sensor_pose.y_m, h);
+  const Eigen::Vector2d origin(sensor_pose.x_m, sensor_pose.y_m);
+  beam_best_m_.resize(beams);
+  beam_hit_.resize(beams);
 
   // Vehicles that can be reached, with the azimuth columns they can cover,
   // so each ray tests only the one or two boxes in its direction.
@@ -122,6 +126,8 @@ PointCloud LidarSimulator::Scan(const Pose2& sensor_pose, double stamp_s,
   for (const OrientedBox& box : vehicles) {
     const Eigen::Vector2d rel =
         box.center - Eigen::Vector2d(sensor_pose.x_m, sensor_pose.y_m);
+    // Every point of the footprint is within half a diagonal of its centre,
+    // so a farther centre means the whole box is out of range.
     const double half_diag = 0.5 * std::hypot(box.length_m, box.width_m);
     if (rel.norm() > limit + half_diag) continue;
     VehicleInView v;
@@ -159,7 +165,8 @@ PointCloud LidarSimulator::Scan(const Pose2& sensor_pose, double stamp_s,
           1;
       v.azimuth_count =
           static_cast<int>(std::min<long>(columns, j_hi - j_lo + 1));
-      v.first_azimuth = static_cast<int>(((j_lo % columns) + columns) % columns);
+      v.first_azimuth =
+          static_cast<int>(((j_lo % columns) + columns) % columns);
     }
     in_view_.push_back(v);
   }
@@ -173,8 +180,13 @@ PointCloud LidarSimulator::Scan(const Pose2& sensor_pose, double stamp_s,
     for (size_t k = 0; k < in_view_.size(); ++k) {
       const VehicleInView& v = in_view_[k];
       const int offset = ((j - v.first_azimuth) % columns + columns) % columns;
-      if (offset < v.azimuth_count) column_vehicles_.push_back(static_cast<int>(k));
+      if (offset < v.azimuth_count) {
+        column_vehicles_.push_back(static_cast<int>(k));
+      }
     }
+    // Nearest return per beam from the ground and the vehicles first; the
+    // scene is then searched only up to it.
+    double s_reach = 0.0;  // farthest horizontal distance any beam needs
     for (int i = 0; i < beams; ++i) {
       const double ce = elevation_cos_[i], se = elevation_sin_[i];
       double best = limit;
@@ -198,20 +210,41 @@ PointCloud LidarSimulator::Scan(const Pose2& sensor_pose, double stamp_s,
           hit = true;
         }
       }
-      if (scene_ != nullptr) {
-        // Searching only up to the nearest hit so far keeps the walk short.
-        const double t = scene_->CastRay(
-            origin, Eigen::Vector3d(ce * wx, ce * wy, se), best);
-        if (t >= 0.0 && t <= best) {
-          best = t;
-          hit = true;
+      beam_best_m_[i] = best;
+      beam_hit_[i] = hit;
+      if (ce > kMinCos) s_reach = std::max(s_reach, best * ce);
+    }
+    if (scene_ != nullptr) {
+      // All beams of a column share one vertical plane: the faces crossing
+      // it are found with one grid walk, then each beam takes the first
+      // face its height at that distance falls within.
+      scene_->CrossingsAlong(origin, Eigen::Vector2d(wx, wy), s_reach,
+                             &crossings_);
+      for (int i = 0; i < beams && !crossings_.empty(); ++i) {
+        const double ce = elevation_cos_[i];
+        if (ce <= kMinCos) continue;  // vertical: runs along no face
+        const double s_max = beam_best_m_[i] * ce;
+        for (const FaceCrossing& c : crossings_) {
+          if (c.s_m > s_max) break;
+          const double z = h + c.s_m * elevation_tan_[i];
+          if (z < c.z_min_m || z > c.z_max_m) continue;
+          const double t = c.s_m / ce;
+          if (t <= beam_best_m_[i]) {
+            beam_best_m_[i] = t;
+            beam_hit_[i] = true;
+          }
+          break;
         }
       }
-      if (!hit) continue;
+    }
+    for (int i = 0; i < beams; ++i) {
+      if (!beam_hit_[i]) continue;
       if (dropout > 0.0 && random_.Bernoulli(dropout)) continue;
+      const double best = beam_best_m_[i];
       const double r = sigma > 0.0 ? best + random_.Normal(0.0, sigma) : best;
       // A real sensor reports nothing beyond its range (or behind itself).
       if (r <= 0.0 || r > limit) continue;
+      const double ce = elevation_cos_[i], se = elevation_sin_[i];
       cloud.points.emplace_back(static_cast<float>(r * ce * ca),
                                 static_cast<float>(r * ce * sa),
                                 static_cast<float>(r * se));

@@ -44,11 +44,14 @@ struct PointCloud {
 
 class LidarSimulator {
  public:
+  // `scene` may be null (ground and vehicles only); it must outlive this.
   LidarSimulator(const Scene* scene, const LidarParams& params,
                  Weather weather, uint64_t seed);
 
   // One full revolution from `sensor_pose` (at mount height) at time
   // `stamp_s`, seeing the static scene, the ground and `vehicles`.
+  // `vehicles` should not hold the ego: a box containing the sensor is
+  // ignored, but one below it would show its roof.
   PointCloud Scan(const Pose2& sensor_pose, double stamp_s,
                   const std::vector<OrientedBox>& vehicles);
 
@@ -77,12 +80,15 @@ class LidarSimulator {
   Random random_;
   std::vector<double> elevations_rad_;
   // Per-beam and per-azimuth trigonometry, computed once.
-  std::vector<double> elevation_cos_, elevation_sin_;
+  std::vector<double> elevation_cos_, elevation_sin_, elevation_tan_;
   std::vector<double> azimuth_cos_, azimuth_sin_;
   double azimuth_step_rad_ = 0.0;
   // Scratch reused across scans (no allocation per scan after the first).
   std::vector<VehicleInView> in_view_;
   std::vector<int> column_vehicles_;
+  std::vector<FaceCrossing> crossings_;
+  std::vector<double> beam_best_m_;  // nearest return so far, per beam
+  std::vector<char> beam_hit_;
 };
 
 }  // namespace adse::world

@@ -74,10 +74,14 @@ void SampleGround(const Scene& scene, const MapCloudOptions& options,
       pmin = pmin.cwiseMin(p);
       pmax = pmax.cwiseMax(p);
     }
-    const int x0 = std::clamp(static_cast<int>((pmin.x() - lo.x()) / kBucketM), 0, bx - 1);
-    const int x1 = std::clamp(static_cast<int>((pmax.x() - lo.x()) / kBucketM), 0, bx - 1);
-    const int y0 = std::clamp(static_cast<int>((pmin.y() - lo.y()) / kBucketM), 0, by - 1);
-    const int y1 = std::clamp(static_cast<int>((pmax.y() - lo.y()) / kBucketM), 0, by - 1);
+    const int x0 =
+        std::clamp(static_cast<int>((pmin.x() - lo.x()) / kBucketM), 0, bx - 1);
+    const int x1 =
+        std::clamp(static_cast<int>((pmax.x() - lo.x()) / kBucketM), 0, bx - 1);
+    const int y0 =
+        std::clamp(static_cast<int>((pmin.y() - lo.y()) / kBucketM), 0, by - 1);
+    const int y1 =
+        std::clamp(static_cast<int>((pmax.y() - lo.y()) / kBucketM), 0, by - 1);
     for (int y = y0; y <= y1; ++y) {
       for (int x = x0; x <= x1; ++x) {
         buckets[static_cast<size_t>(y) * bx + x].push_back(static_cast<int>(i));
@@ -88,8 +92,10 @@ void SampleGround(const Scene& scene, const MapCloudOptions& options,
     for (int ix = 0; ix < nx; ++ix) {
       const double x = lo.x() + ix * step;
       const double y = lo.y() + iy * step;
-      const int cx = std::clamp(static_cast<int>((x - lo.x()) / kBucketM), 0, bx - 1);
-      const int cy = std::clamp(static_cast<int>((y - lo.y()) / kBucketM), 0, by - 1);
+      const int cx =
+          std::clamp(static_cast<int>((x - lo.x()) / kBucketM), 0, bx - 1);
+      const int cy =
+          std::clamp(static_cast<int>((y - lo.y()) / kBucketM), 0, by - 1);
       bool hidden = false;
       for (const int i : buckets[static_cast<size_t>(cy) * bx + cx]) {
         if (InsidePolygon(obstacles[i].footprint, x, y)) {
@@ -166,8 +172,8 @@ Result<PcdHeader> ParseHeader(const std::string& path,
     const auto tok = Tokens(line);
     if (tok.empty() || tok[0][0] == '#') continue;
     const std::string key(tok[0]);
-    const std::string where = "header line " + std::to_string(line_no) + " (" +
-                              key + "): ";
+    const std::string where =
+        "header line " + std::to_string(line_no) + " (" + key + "): ";
     auto list_size_ok = [&](size_t n) {
       return !h.fields.empty() && n == h.fields.size();
     };
@@ -185,7 +191,8 @@ Result<PcdHeader> ParseHeader(const std::string& path,
       for (size_t i = 1; i < tok.size(); ++i) {
         uint64_t v = 0;
         if (!ParseU64(tok[i], &v) || (v != 1 && v != 2 && v != 4 && v != 8)) {
-          return Corrupt(path, where + "bad size '" + std::string(tok[i]) + "'");
+          return Corrupt(path,
+                         where + "bad size '" + std::string(tok[i]) + "'");
         }
         h.fields[i - 1].size = v;
       }
@@ -195,9 +202,10 @@ Result<PcdHeader> ParseHeader(const std::string& path,
         return Corrupt(path, where + "needs one entry per field, after FIELDS");
       }
       for (size_t i = 1; i < tok.size(); ++i) {
-        if (tok[i].size() != 1 || std::string_view("FIU").find(tok[i][0]) ==
-                                      std::string_view::npos) {
-          return Corrupt(path, where + "bad type '" + std::string(tok[i]) + "'");
+        if (tok[i].size() != 1 ||
+            std::string_view("FIU").find(tok[i][0]) == std::string_view::npos) {
+          return Corrupt(path,
+                         where + "bad type '" + std::string(tok[i]) + "'");
         }
         h.fields[i - 1].type = tok[i][0];
       }
@@ -240,7 +248,8 @@ Result<PcdHeader> ParseHeader(const std::string& path,
   if (!have_width || !have_height) {
     return Corrupt(path, "header lacks WIDTH or HEIGHT");
   }
-  if (h.height != 0 && h.width > std::numeric_limits<uint64_t>::max() / h.height) {
+  if (h.height != 0 &&
+      h.width > std::numeric_limits<uint64_t>::max() / h.height) {
     return Corrupt(path, "WIDTH x HEIGHT overflows");
   }
   if (!have_points) h.points = h.width * h.height;
@@ -259,8 +268,8 @@ Result<PcdHeader> ParseHeader(const std::string& path,
     for (int k = 0; k < 3; ++k) {
       if (f.name == std::string(1, "xyz"[k])) {
         if (f.type != 'F' || f.count != 1 || (f.size != 4 && f.size != 8)) {
-          return Corrupt(path, "field " + f.name +
-                                   " must be one float32 or float64");
+          return Corrupt(path,
+                         "field " + f.name + " must be one float32 or float64");
         }
         h.xyz[k] = static_cast<int>(i);
       }
@@ -349,8 +358,8 @@ Result<std::vector<Eigen::Vector3f>> ReadAscii(const std::string& path,
     if (tok.empty()) continue;
     const std::string where = "data line " + std::to_string(line_no) + ": ";
     if (read == h.points) {
-      return Corrupt(path, where + "more points than POINTS " +
-                               std::to_string(h.points));
+      return Corrupt(
+          path, where + "more points than POINTS " + std::to_string(h.points));
     }
     if (tok.size() != h.point_tokens) {
       return Corrupt(path, where + std::to_string(tok.size()) +
@@ -361,7 +370,8 @@ Result<std::vector<Eigen::Vector3f>> ReadAscii(const std::string& path,
     for (size_t t = 0; t < tok.size(); ++t) {
       double d;
       if (!ParseDouble(tok[t], &d)) {
-        return Corrupt(path, where + "bad number '" + std::string(tok[t]) + "'");
+        return Corrupt(path,
+                       where + "bad number '" + std::string(tok[t]) + "'");
       }
       for (int k = 0; k < 3; ++k) {
         if (h.fields[h.xyz[k]].column == t) v[k] = d;
@@ -403,8 +413,7 @@ std::vector<Eigen::Vector3f> SampleSceneSurface(
               nz == 0 ? obstacle.z_min_m
                       : obstacle.z_min_m + dz * (static_cast<double>(k) / nz);
           points.emplace_back(static_cast<float>(p.x()),
-                              static_cast<float>(p.y()),
-                              static_cast<float>(z));
+                              static_cast<float>(p.y()), static_cast<float>(z));
         }
       }
     }
@@ -425,10 +434,14 @@ Status WritePcd(const std::string& path,
       "SIZE 4 4 4\n"
       "TYPE F F F\n"
       "COUNT 1 1 1\n"
-      "WIDTH " + n + "\n"
+      "WIDTH " +
+      n +
+      "\n"
       "HEIGHT 1\n"
       "VIEWPOINT 0 0 0 1 0 0 0\n"
-      "POINTS " + n + "\n"
+      "POINTS " +
+      n +
+      "\n"
       "DATA binary\n";
   const size_t header = out.size();
   out.resize(header + points.size() * 3 * sizeof(float));

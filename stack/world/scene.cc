@@ -39,6 +39,38 @@ bool SegmentTouchesBox(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
   return true;
 }
 
+// Nearest hit of the ray with the face over segment a-b at a distance in
+// [0, *t_best); updates *t_best when found. Rejects with multiplications
+// first and divides only for a hit: most faces tested are missed.
+inline void IntersectFace(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                          double z_min, double z_max,
+                          const Eigen::Vector3d& origin,
+                          const Eigen::Vector3d& dir, double* t_best) {
+  // Solve origin.xy + t*dir.xy = a + u*(b - a); t is the 3D distance since
+  // dir is a unit vector.
+  const double ex = b.x() - a.x();
+  const double ey = b.y() - a.y();
+  double denom = Cross(dir.x(), dir.y(), ex, ey);
+  const double wx = a.x() - origin.x();
+  const double wy = a.y() - origin.y();
+  double t_num = Cross(wx, wy, ex, ey);
+  double u_num = Cross(wx, wy, dir.x(), dir.y());
+  // Parallel (incl. along the face): grazing, not a return.
+  if (denom == 0.0) return;
+  if (denom < 0.0) {
+    denom = -denom;
+    t_num = -t_num;
+    u_num = -u_num;
+  }
+  // Now t = t_num / denom and u = u_num / denom with denom > 0.
+  if (t_num < 0.0 || u_num < 0.0 || u_num > denom) return;
+  const double t = t_num / denom;
+  if (!(t < *t_best)) return;
+  const double z = origin.z() + t * dir.z();
+  if (z < z_min || z > z_max) return;
+  *t_best = t;
+}
+
 }  // namespace
 
 std::vector<std::array<Eigen::Vector2d, 2>> ObstacleEdges(
@@ -58,6 +90,11 @@ std::vector<std::array<Eigen::Vector2d, 2>> ObstacleEdges(
 }
 
 void Scene::AddObstacle(Obstacle obstacle) {
+  // NaN or infinite coordinates would poison the bounds and the grid.
+  bool finite =
+      std::isfinite(obstacle.z_min_m) && std::isfinite(obstacle.z_max_m);
+  for (const auto& p : obstacle.footprint) finite = finite && p.allFinite();
+  if (!finite) return;
   if (obstacle.z_min_m > obstacle.z_max_m) {
     std::swap(obstacle.z_min_m, obstacle.z_max_m);
   }
@@ -82,8 +119,8 @@ void Scene::Finalize(double cell_size_m) {
   cell_ = cell_size_m > 0.0 ? cell_size_m : 4.0;
   grid_origin_ = min_;
   const Eigen::Vector2d extent = max_ - min_;
-  if (extent.x() / cell_ * (extent.y() / cell_) > kMaxCells) {
-    cell_ = std::sqrt(extent.x() * extent.y() / kMaxCells) * 1.01;
+  while ((extent.x() / cell_ + 1.0) * (extent.y() / cell_ + 1.0) > kMaxCells) {
+    cell_ *= 2.0;
   }
   // floor()+1 keeps points on the max edge inside the last cell.
   nx_ = static_cast<int>(std::floor(extent.x() / cell_)) + 1;
@@ -97,10 +134,14 @@ void Scene::Finalize(double cell_size_m) {
     const Segment& s = segments_[i];
     const Eigen::Vector2d lo = s.a.cwiseMin(s.b) - grid_origin_;
     const Eigen::Vector2d hi = s.a.cwiseMax(s.b) - grid_origin_;
-    const int ix0 = std::clamp(static_cast<int>(std::floor((lo.x() - eps) / cell_)), 0, nx_ - 1);
-    const int ix1 = std::clamp(static_cast<int>(std::floor((hi.x() + eps) / cell_)), 0, nx_ - 1);
-    const int iy0 = std::clamp(static_cast<int>(std::floor((lo.y() - eps) / cell_)), 0, ny_ - 1);
-    const int iy1 = std::clamp(static_cast<int>(std::floor((hi.y() + eps) / cell_)), 0, ny_ - 1);
+    const int ix0 = std::clamp(
+        static_cast<int>(std::floor((lo.x() - eps) / cell_)), 0, nx_ - 1);
+    const int ix1 = std::clamp(
+        static_cast<int>(std::floor((hi.x() + eps) / cell_)), 0, nx_ - 1);
+    const int iy0 = std::clamp(
+        static_cast<int>(std::floor((lo.y() - eps) / cell_)), 0, ny_ - 1);
+    const int iy1 = std::clamp(
+        static_cast<int>(std::floor((hi.y() + eps) / cell_)), 0, ny_ - 1);
     for (int iy = iy0; iy <= iy1; ++iy) {
       for (int ix = ix0; ix <= ix1; ++ix) {
         const Eigen::Vector2d c_lo =
@@ -113,6 +154,22 @@ void Scene::Finalize(double cell_size_m) {
         }
       }
     }
+  }
+  // Per-cell height spans, widened a little so a float bound never cuts off
+  // a face that the double-precision test would hit.
+  cell_z_lo_m_.assign(cells_.size(), std::numeric_limits<float>::infinity());
+  cell_z_hi_m_.assign(cells_.size(), -std::numeric_limits<float>::infinity());
+  for (size_t c = 0; c < cells_.size(); ++c) {
+    double lo = kInf, hi = -kInf;
+    for (const int i : cells_[c]) {
+      lo = std::min(lo, segments_[i].z_min_m);
+      hi = std::max(hi, segments_[i].z_max_m);
+    }
+    if (cells_[c].empty()) continue;
+    const double pad = 1e-6 * (1.0 + std::max(std::abs(lo), std::abs(hi)));
+    constexpr float kInfF = std::numeric_limits<float>::infinity();
+    cell_z_lo_m_[c] = std::nextafter(static_cast<float>(lo - pad), -kInfF);
+    cell_z_hi_m_[c] = std::nextafter(static_cast<float>(hi + pad), kInfF);
   }
   cell_begin_.assign(cells_.size() + 1, 0);
   size_t total = 0;
@@ -131,38 +188,19 @@ void Scene::Finalize(double cell_size_m) {
   indexed_segments_ = segments_.size();
 }
 
-void Scene::Intersect(const Segment& s, const Eigen::Vector3d& origin,
-                      const Eigen::Vector3d& dir, double t_lo,
-                      double* t_best) {
-  // Solve origin.xy + t*dir.xy = a + u*(b - a); t is the 3D distance since
-  // dir is a unit vector.
-  const double ex = s.b.x() - s.a.x();
-  const double ey = s.b.y() - s.a.y();
-  const double denom = Cross(dir.x(), dir.y(), ex, ey);
-  // Parallel (incl. along the face): grazing, not a return.
-  if (denom == 0.0) return;
-  const double wx = s.a.x() - origin.x();
-  const double wy = s.a.y() - origin.y();
-  const double t = Cross(wx, wy, ex, ey) / denom;
-  if (!(t >= t_lo && t < *t_best)) return;
-  const double u = Cross(wx, wy, dir.x(), dir.y()) / denom;
-  if (u < 0.0 || u > 1.0) return;
-  const double z = origin.z() + t * dir.z();
-  if (z < s.z_min_m || z > s.z_max_m) return;
-  *t_best = t;
-}
-
 double Scene::CastRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                       double max_range_m) const {
   if (segments_.empty() || !(max_range_m > 0.0)) return -1.0;
   const double dx = dir.x(), dy = dir.y(), dz = dir.z();
-  if (std::hypot(dx, dy) < kMinHorizontal) return -1.0;
+  if (dx * dx + dy * dy < kMinHorizontal * kMinHorizontal) return -1.0;
 
   // Hits are accepted up to max_range_m inclusive.
   double best = std::nextafter(max_range_m, kInf);
   if (indexed_segments_ != segments_.size() || nx_ <= 0 || ny_ <= 0) {
     // Not (re)finalized: still right, just slow.
-    for (const Segment& s : segments_) Intersect(s, origin, dir, 0.0, &best);
+    for (const Segment& s : segments_) {
+      IntersectFace(s.a, s.b, s.z_min_m, s.z_max_m, origin, dir, &best);
+    }
     return best <= max_range_m ? best : -1.0;
   }
 
@@ -181,19 +219,98 @@ double Scene::CastRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
   }
   if (t0 > t1) return -1.0;
 
+  const Segment* segs = segments_.data();
+  const uint32_t* items = cell_items_.data();
+  const uint32_t* begin = cell_begin_.data();
+  const float* cell_lo = cell_z_lo_m_.data();
+  const float* cell_hi = cell_z_hi_m_.data();
+  WalkGrid(
+      origin.x(), origin.y(), dx, dy, t0, t1,
+      [&](size_t c, double t_enter, double t_exit) {
+        // Ray height span while in this cell (the float bounds are
+        // rounded outwards when built).
+        const double za = origin.z() + dz * t_enter;
+        const double zb = origin.z() + dz * std::min(t_exit, t1);
+        if (std::max(za, zb) >= cell_lo[c] && std::min(za, zb) <= cell_hi[c]) {
+          for (uint32_t k = begin[c], end = begin[c + 1]; k < end; ++k) {
+            const Segment& s = segs[items[k]];
+            IntersectFace(s.a, s.b, s.z_min_m, s.z_max_m, origin, dir, &best);
+          }
+        }
+        // A hit inside this cell beats anything in later cells.
+        return best <= t_exit;
+      });
+  return best <= max_range_m ? best : -1.0;
+}
+
+void Scene::CrossingsAlong(const Eigen::Vector2d& origin,
+                           const Eigen::Vector2d& dir, double max_s_m,
+                           std::vector<FaceCrossing>* crossings) const {
+  crossings->clear();
+  if (segments_.empty() || !(max_s_m >= 0.0)) return;
+  auto add = [&](const Segment& s) {
+    const double ex = s.b.x() - s.a.x();
+    const double ey = s.b.y() - s.a.y();
+    double denom = Cross(dir.x(), dir.y(), ex, ey);
+    if (denom == 0.0) return;  // parallel: grazing, not a return
+    const double wx = s.a.x() - origin.x();
+    const double wy = s.a.y() - origin.y();
+    double s_num = Cross(wx, wy, ex, ey);
+    double u_num = Cross(wx, wy, dir.x(), dir.y());
+    if (denom < 0.0) {
+      denom = -denom;
+      s_num = -s_num;
+      u_num = -u_num;
+    }
+    if (s_num < 0.0 || u_num < 0.0 || u_num > denom) return;
+    const double dist = s_num / denom;
+    if (dist > max_s_m) return;
+    crossings->push_back({dist, s.z_min_m, s.z_max_m});
+  };
+  if (indexed_segments_ != segments_.size() || nx_ <= 0 || ny_ <= 0) {
+    for (const Segment& s : segments_) add(s);
+  } else {
+    const Segment* segs = segments_.data();
+    const uint32_t* items = cell_items_.data();
+    const uint32_t* begin = cell_begin_.data();
+    WalkGrid(origin.x(), origin.y(), dir.x(), dir.y(), 0.0, max_s_m,
+             [&](size_t c, double, double) {
+               for (uint32_t k = begin[c], end = begin[c + 1]; k < end; ++k) {
+                 add(segs[items[k]]);
+               }
+               return false;
+             });
+  }
+  // A face spanning several cells is found in each: identical inputs give
+  // bitwise identical crossings, which sorting brings together.
+  std::sort(crossings->begin(), crossings->end(),
+            [](const FaceCrossing& a, const FaceCrossing& b) {
+              if (a.s_m != b.s_m) return a.s_m < b.s_m;
+              if (a.z_min_m != b.z_min_m) return a.z_min_m < b.z_min_m;
+              return a.z_max_m < b.z_max_m;
+            });
+  crossings->erase(
+      std::unique(crossings->begin(), crossings->end(),
+                  [](const FaceCrossing& a, const FaceCrossing& b) {
+                    return a.s_m == b.s_m && a.z_min_m == b.z_min_m &&
+                           a.z_max_m == b.z_max_m;
+                  }),
+      crossings->end());
+}
+
+template <typename Visit>
+void Scene::WalkGrid(double ox, double oy, double dx, double dy, double t0,
+                     double t1, Visit&& visit) const {
   // Clip to the grid rectangle (slightly enlarged: faces on its border).
   const double margin = 1e-7 * cell_;
-  const double gx0 = grid_origin_.x() - margin;
-  const double gy0 = grid_origin_.y() - margin;
-  const double gx1 = grid_origin_.x() + nx_ * cell_ + margin;
-  const double gy1 = grid_origin_.y() + ny_ * cell_ + margin;
   const double d[2] = {dx, dy};
-  const double o[2] = {origin.x(), origin.y()};
-  const double lo[2] = {gx0, gy0};
-  const double hi[2] = {gx1, gy1};
+  const double o[2] = {ox, oy};
+  const double lo[2] = {grid_origin_.x() - margin, grid_origin_.y() - margin};
+  const double hi[2] = {grid_origin_.x() + nx_ * cell_ + margin,
+                        grid_origin_.y() + ny_ * cell_ + margin};
   for (int k = 0; k < 2; ++k) {
     if (d[k] == 0.0) {
-      if (o[k] < lo[k] || o[k] > hi[k]) return -1.0;
+      if (o[k] < lo[k] || o[k] > hi[k]) return;
       continue;
     }
     double ta = (lo[k] - o[k]) / d[k];
@@ -202,12 +319,12 @@ double Scene::CastRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
     t0 = std::max(t0, ta);
     t1 = std::min(t1, tb);
   }
-  if (t0 > t1) return -1.0;
+  if (t0 > t1) return;
 
   // Amanatides-Woo walk over the cells the ray's 2D shadow crosses, from
-  // the entry point at t0. Boundaries are kept as ray distances.
-  const double px = o[0] + t0 * dx - grid_origin_.x();
-  const double py = o[1] + t0 * dy - grid_origin_.y();
+  // the entry point at t0. Boundaries are kept as ray parameters.
+  const double px = ox + t0 * dx - grid_origin_.x();
+  const double py = oy + t0 * dy - grid_origin_.y();
   int ix = std::clamp(static_cast<int>(std::floor(px / cell_)), 0, nx_ - 1);
   int iy = std::clamp(static_cast<int>(std::floor(py / cell_)), 0, ny_ - 1);
   const int step_x = dx > 0.0 ? 1 : -1;
@@ -217,35 +334,28 @@ double Scene::CastRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
   double t_max_x = kInf, t_max_y = kInf;
   if (dx != 0.0) {
     const double bx = grid_origin_.x() + (ix + (dx > 0.0 ? 1 : 0)) * cell_;
-    t_max_x = (bx - o[0]) / dx;
+    t_max_x = (bx - ox) / dx;
   }
   if (dy != 0.0) {
     const double by = grid_origin_.y() + (iy + (dy > 0.0 ? 1 : 0)) * cell_;
-    t_max_y = (by - o[1]) / dy;
+    t_max_y = (by - oy) / dy;
   }
-
-  const Segment* segs = segments_.data();
-  const uint32_t* items = cell_items_.data();
-  const uint32_t* begin = cell_begin_.data();
+  double t_enter = t0;
   while (true) {
     const size_t c = static_cast<size_t>(iy) * nx_ + ix;
-    for (uint32_t k = begin[c], end = begin[c + 1]; k < end; ++k) {
-      Intersect(segs[items[k]], origin, dir, 0.0, &best);
-    }
     const double t_exit = std::min(t_max_x, t_max_y);
-    // A hit inside this cell beats anything in later cells.
-    if (best <= t_exit || t_exit > t1) break;
+    if (visit(c, t_enter, t_exit) || t_exit > t1) return;
+    t_enter = t_exit;
     if (t_max_x < t_max_y) {
       ix += step_x;
-      if (ix < 0 || ix >= nx_) break;
+      if (ix < 0 || ix >= nx_) return;
       t_max_x += t_delta_x;
     } else {
       iy += step_y;
-      if (iy < 0 || iy >= ny_) break;
+      if (iy < 0 || iy >= ny_) return;
       t_max_y += t_delta_y;
     }
   }
-  return best <= max_range_m ? best : -1.0;
 }
 
 }  // namespace adse::world

@@ -30,6 +30,14 @@ struct Obstacle {
 std::vector<std::array<Eigen::Vector2d, 2>> ObstacleEdges(
     const Obstacle& obstacle);
 
+// Where a horizontal 2D ray crosses an obstacle face: at horizontal
+// distance s_m, a face spanning z_min_m..z_max_m.
+struct FaceCrossing {
+  double s_m;
+  double z_min_m;
+  double z_max_m;
+};
+
 // A parking slot (for parked cars and valet goals).
 struct ParkingSlot {
   OrientedBox box;  // slot rectangle; length along the slot's depth
@@ -42,6 +50,8 @@ class Scene {
  public:
   Scene() = default;
 
+  // Obstacles with a non-finite coordinate are ignored; z_min > z_max are
+  // swapped.
   void AddObstacle(Obstacle obstacle);
   void AddParkingSlot(ParkingSlot slot);
   // Builds the acceleration grid; call after the last Add*(). Until then
@@ -56,6 +66,14 @@ class Scene {
   double CastRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                  double max_range_m) const;
 
+  // Every face crossed by the 2D ray (origin, unit dir) within max_s_m,
+  // nearest first. All rays of a spinning LiDAR's azimuth column share
+  // these: a ray at elevation e from height h hits the first crossing with
+  // h + s tan(e) within the face's z span, at distance s / cos(e) (the
+  // same answer CastRay gives), so the grid is walked once per column.
+  void CrossingsAlong(const Eigen::Vector2d& origin, const Eigen::Vector2d& dir,
+                      double max_s_m, std::vector<FaceCrossing>* crossings) const;
+
   // Axis-aligned bounds of all obstacles: min and max corners.
   Eigen::Vector2d min_corner() const { return min_; }
   Eigen::Vector2d max_corner() const { return max_; }
@@ -67,11 +85,12 @@ class Scene {
     Eigen::Vector2d a, b;
     double z_min_m, z_max_m;
   };
-  // Nearest hit of the ray with segment `s` at distance in [t_lo, *t_best];
-  // updates *t_best when found.
-  static void Intersect(const Segment& s, const Eigen::Vector3d& origin,
-                        const Eigen::Vector3d& dir, double t_lo,
-                        double* t_best);
+  // Calls visit(cell, t_enter, t_exit) for each grid cell the 2D ray
+  // origin + t * (dx, dy), t in [t0, t1], passes through, in order, until
+  // visit returns true. Defined (and only used) in scene.cc.
+  template <typename Visit>
+  void WalkGrid(double ox, double oy, double dx, double dy, double t0,
+                double t1, Visit&& visit) const;
   std::vector<Obstacle> obstacles_;
   std::vector<ParkingSlot> slots_;
   std::vector<Segment> segments_;
@@ -87,6 +106,9 @@ class Scene {
   // Segments of cell c are cell_items_[cell_begin_[c] .. cell_begin_[c+1]).
   std::vector<uint32_t> cell_begin_;
   std::vector<uint32_t> cell_items_;
+  // Height span of each cell's faces: a ray passing over (or under) every
+  // face of a cell skips it, e.g. above a row of parked cars.
+  std::vector<float> cell_z_lo_m_, cell_z_hi_m_;
   Eigen::Vector2d grid_origin_ = Eigen::Vector2d::Zero();
   // Number of segments the grid indexes; fewer than segments_ = stale grid.
   size_t indexed_segments_ = 0;

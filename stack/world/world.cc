@@ -847,7 +847,7 @@ Result<std::string> World::MapCloudPath() const {
   hasher.Add("adse-cloud-v1").Add(w.map.key)
       .Add(static_cast<long long>(w.setup.world.traffic.seed))
       .Add(w.setup.world.traffic.parked_occupancy)
-      .Add(options.spacing_m).Add(options.ground_spacing_m);
+      .Add(options.spacing_m).Add(options.ground_spacing_m).Add(options.ground_margin_m);
   const std::string path = w.map.cache_folder + "/cloud-" + hasher.Hex().substr(0, 16) + ".pcd";
   std::error_code ec;
   if (fs::exists(path, ec)) return path;

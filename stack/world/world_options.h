@@ -48,6 +48,21 @@ struct WorldOptions {
 
 // A place on the map: either a world coordinate or an edge position.
 struct Location {
+  static Location Xy(double x_m, double y_m) {
+    Location l;
+    l.x_m = x_m;
+    l.y_m = y_m;
+    return l;
+  }
+  static Location OnEdge(std::string edge, double pos_m, int lane = 0) {
+    Location l;
+    l.by_edge = true;
+    l.edge = std::move(edge);
+    l.pos_m = pos_m;
+    l.lane = lane;
+    return l;
+  }
+
   bool by_edge = false;
   double x_m = 0.0;
   double y_m = 0.0;

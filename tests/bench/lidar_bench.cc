@@ -39,8 +39,8 @@ Scene ParkingLot() {
       OrientedBox car;
       car.center = {10 + slot * 4.0, y};
       car.yaw_rad = M_PI / 2 + rng.Uniform(-0.05, 0.05);
-      scene.AddObstacle(
-          Prism(BoxCorners(car), rng.Uniform(1.4, 1.9), ObstacleKind::kParkedCar));
+      scene.AddObstacle(Prism(BoxCorners(car), rng.Uniform(1.4, 1.9),
+                              ObstacleKind::kParkedCar));
     }
     for (int k = 0; k < 7; ++k) {  // lamp posts: octagons, 6 m
       std::vector<Eigen::Vector2d> fp;
@@ -59,9 +59,9 @@ Scene ParkingLot() {
   }
   for (int k = 0; k < 6; ++k) {  // buildings around the lot
     const double x = -30 + k * 35.0;
-    scene.AddObstacle(Prism({{x, h + 10}, {x + 25, h + 10}, {x + 25, h + 30},
-                             {x, h + 30}},
-                            12.0, ObstacleKind::kBuilding));
+    scene.AddObstacle(
+        Prism({{x, h + 10}, {x + 25, h + 10}, {x + 25, h + 30}, {x, h + 30}},
+              12.0, ObstacleKind::kBuilding));
   }
   scene.Finalize();
   return scene;
@@ -94,9 +94,9 @@ void BM_LidarScan(benchmark::State& state) {
     const auto start = std::chrono::steady_clock::now();
     const PointCloud cloud =
         lidar.Scan(poses[scans % poses.size()], 0.0, vehicles);
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                             start)
-                   .count();
+    seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+            .count();
     points += cloud.points.size();
     ++scans;
     benchmark::DoNotOptimize(cloud.points.data());

@@ -44,11 +44,12 @@ TEST(DesignPointTest, ParsesAGoodPoint) {
 
 TEST(DesignPointTest, SnapsToTheExactAllowedValue) {
   const Spec spec = Reference();
-  Result<DesignPoint> point =
-      ParsePoint(spec.design_space, "cores=4,freq_ghz=1.2000000000001,"
-                                    "lidar_hz=14");
+  Result<DesignPoint> point = ParsePoint(spec.design_space,
+                                         "cores=4,freq_ghz=1.2000000000001,"
+                                         "lidar_hz=14");
   ASSERT_TRUE(point.ok()) << point.status().message();
-  EXPECT_EQ(point->at("freq_ghz"), spec.design_space.Find("freq_ghz")->values[1]);
+  EXPECT_EQ(point->at("freq_ghz"),
+            spec.design_space.Find("freq_ghz")->values[1]);
 }
 
 TEST(DesignPointTest, UnknownParameterGetsASuggestion) {
@@ -56,11 +57,11 @@ TEST(DesignPointTest, UnknownParameterGetsASuggestion) {
   Result<DesignPoint> point =
       ParsePoint(spec.design_space, "cores=4,freq_ghz=1.2,lidar=14");
   ASSERT_FALSE(point.ok());
-  EXPECT_THAT(point.status().message(),
-              HasSubstr("unknown parameter 'lidar'"));
+  EXPECT_THAT(point.status().message(), HasSubstr("unknown parameter 'lidar'"));
   EXPECT_THAT(point.status().message(),
               HasSubstr("(did you mean 'lidar_hz'?)"));
-  EXPECT_THAT(point.status().message(), HasSubstr("missing parameter: lidar_hz"));
+  EXPECT_THAT(point.status().message(),
+              HasSubstr("missing parameter: lidar_hz"));
 }
 
 TEST(DesignPointTest, DisallowedValueListsTheAllowedOnes) {
@@ -92,21 +93,19 @@ TEST(DesignPointTest, MalformedText) {
   const Spec spec = Reference();
   EXPECT_THAT(ParsePoint(spec.design_space, "").status().message(),
               HasSubstr("expected name=value pairs"));
-  EXPECT_THAT(
-      ParsePoint(spec.design_space, "cores:4,freq_ghz=1,lidar_hz=7")
-          .status()
-          .message(),
-      HasSubstr("expected name=value, found 'cores:4'"));
-  EXPECT_THAT(
-      ParsePoint(spec.design_space, "cores=four,freq_ghz=1,lidar_hz=7")
-          .status()
-          .message(),
-      HasSubstr("cores: expected a number, found 'four'"));
-  EXPECT_THAT(ParsePoint(spec.design_space,
-                         "cores=4,cores=5,freq_ghz=1,lidar_hz=7")
+  EXPECT_THAT(ParsePoint(spec.design_space, "cores:4,freq_ghz=1,lidar_hz=7")
                   .status()
                   .message(),
-              HasSubstr("cores: expected one value, found it twice"));
+              HasSubstr("expected name=value, found 'cores:4'"));
+  EXPECT_THAT(ParsePoint(spec.design_space, "cores=four,freq_ghz=1,lidar_hz=7")
+                  .status()
+                  .message(),
+              HasSubstr("cores: expected a number, found 'four'"));
+  EXPECT_THAT(
+      ParsePoint(spec.design_space, "cores=4,cores=5,freq_ghz=1,lidar_hz=7")
+          .status()
+          .message(),
+      HasSubstr("cores: expected one value, found it twice"));
 }
 
 TEST(DesignPointTest, CheckNamesParameterAndAllowedValues) {
@@ -138,8 +137,8 @@ TEST(DesignPointTest, SizeSaturates) {
 
 TEST(DesignPointTest, CostUsesThePointAndPlatformDefaults) {
   const Spec spec = Reference();
-  Result<double> cost = EvaluateCost(
-      spec, {{"cores", 18}, {"freq_ghz", 1.8}, {"lidar_hz", 7}});
+  Result<double> cost =
+      EvaluateCost(spec, {{"cores", 18}, {"freq_ghz", 1.8}, {"lidar_hz", 7}});
   ASSERT_TRUE(cost.ok()) << cost.status().message();
   EXPECT_NEAR(*cost, 32.4, 1e-9);
 
@@ -182,8 +181,8 @@ TEST(DesignPointTest, ConstraintsOverMetrics) {
 
 TEST(DesignPointTest, ApplyPointSetsPlatformAndStack) {
   const Spec spec = Reference();
-  Result<PointConfig> config = ApplyPoint(
-      spec, {{"cores", 23}, {"freq_ghz", 1.5}, {"lidar_hz", 14}});
+  Result<PointConfig> config =
+      ApplyPoint(spec, {{"cores", 23}, {"freq_ghz", 1.5}, {"lidar_hz", 14}});
   ASSERT_TRUE(config.ok()) << config.status().message();
   EXPECT_EQ(config->platform.cores, 23);
   EXPECT_NEAR(config->platform.freq_ghz, 1.5, kTol);

@@ -22,8 +22,8 @@ TEST(ExpressionTest, EvaluatesWithVariables) {
 }
 
 TEST(ExpressionTest, ComparisonsAndBareBooleans) {
-  Result<Expression> e = Expression::Parse(
-      "nav_time_s <= 400 && completed", {"nav_time_s", "completed"});
+  Result<Expression> e = Expression::Parse("nav_time_s <= 400 && completed",
+                                           {"nav_time_s", "completed"});
   ASSERT_TRUE(e.ok()) << e.status().message();
   EXPECT_EQ(e->Evaluate({{"nav_time_s", 165}, {"completed", 1}}), 1.0);
   EXPECT_EQ(e->Evaluate({{"nav_time_s", 505}, {"completed", 1}}), 0.0);

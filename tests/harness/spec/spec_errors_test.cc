@@ -28,8 +28,7 @@ design_space:
   cores: {bind: platform.cores, range: [1, 4]}
 )";
 
-std::string ErrorOf(const std::string& text,
-                    const std::string& base_dir = "") {
+std::string ErrorOf(const std::string& text, const std::string& base_dir = "") {
   Result<Spec> spec = ParseSpec(text, "bad.yaml", base_dir);
   EXPECT_FALSE(spec.ok()) << "parsed although it should not:\n" << text;
   if (spec.ok()) return "";
@@ -38,8 +37,8 @@ std::string ErrorOf(const std::string& text,
 }
 
 // The message names the field and its place "bad.yaml:<line>:<col>".
-void ExpectError(const std::string& text, const std::string& field,
-                 int line, const std::string& detail = "") {
+void ExpectError(const std::string& text, const std::string& field, int line,
+                 const std::string& detail = "") {
   const std::string message = ErrorOf(text);
   const std::string location = "bad.yaml:" + std::to_string(line) + ":";
   bool found = false;
@@ -62,8 +61,7 @@ TEST(SpecErrorsTest, HeadIsValid) {
 }
 
 TEST(SpecErrorsTest, MessageFormatIsFileLineColumnFieldExpectedFound) {
-  const std::string message =
-      ErrorOf(std::string(kHead) + "world2: 1\n");
+  const std::string message = ErrorOf(std::string(kHead) + "world2: 1\n");
   EXPECT_EQ(message,
             "bad.yaml:9:1: error: world2: expected a key among {adse, name, "
             "world, task, stack, platform, design_space, cost, objectives, "
@@ -82,8 +80,8 @@ TEST(SpecErrorsTest, StringWhereANumberIsExpected) {
 TEST(SpecErrorsTest, MapWhereAListIsExpected) {
   ExpectError(std::string(kHead) + "constraints: {completed: 1}\n",
               "constraints", 9, "found a map");
-  ExpectError(std::string(kHead) + "objectives: nav_time_s\n", "objectives",
-              9, "expected a list");
+  ExpectError(std::string(kHead) + "objectives: nav_time_s\n", "objectives", 9,
+              "expected a list");
 }
 
 TEST(SpecErrorsTest, UnknownKeyWithSuggestion) {
@@ -107,8 +105,8 @@ TEST(SpecErrorsTest, MisspelledEnumValueWithSuggestion) {
 }
 
 TEST(SpecErrorsTest, DuplicateKey) {
-  ExpectError(std::string(kHead) + "task:\n  kind: valet_parking\n", "task",
-              9, "found 'task' again (first at line 4)");
+  ExpectError(std::string(kHead) + "task:\n  kind: valet_parking\n", "task", 9,
+              "found 'task' again (first at line 4)");
   ExpectError(
       std::string(kHead) + "platform: {cores: 2, freq_ghz: 1, cores: 3}\n",
       "platform.cores", 9, "again");
@@ -158,17 +156,16 @@ TEST(SpecErrorsTest, ValuesOutsideTheTargetRange) {
 }
 
 TEST(SpecErrorsTest, BindToANonExistentTarget) {
-  ExpectError(std::string(kHead) +
-                  "  hz: {bind: stack.lidar.rate_hzz, values: [7]}\n",
-              "design_space.hz.bind", 9,
-              "(did you mean 'stack.lidar.rate_hz'?)");
-  ExpectError(std::string(kHead) + "  m: {bind: platform.memory, values: [1]}\n",
-              "design_space.m.bind", 9, "found 'platform.memory'");
+  ExpectError(
+      std::string(kHead) + "  hz: {bind: stack.lidar.rate_hzz, values: [7]}\n",
+      "design_space.hz.bind", 9, "(did you mean 'stack.lidar.rate_hz'?)");
+  ExpectError(
+      std::string(kHead) + "  m: {bind: platform.memory, values: [1]}\n",
+      "design_space.m.bind", 9, "found 'platform.memory'");
 }
 
 TEST(SpecErrorsTest, TwoParametersBindTheSameTarget) {
-  ExpectError(std::string(kHead) +
-                  "  n: {bind: platform.cores, values: [2]}\n",
+  ExpectError(std::string(kHead) + "  n: {bind: platform.cores, values: [2]}\n",
               "design_space.n.bind", 9, "already bound by 'cores'");
 }
 
@@ -184,9 +181,9 @@ TEST(SpecErrorsTest, ParameterNameMustBeAnIdentifier) {
 TEST(SpecErrorsTest, StartPointOutsideTheSpace) {
   ExpectError(std::string(kHead) + "exploration:\n  start_from: {cores: 6}\n",
               "exploration.start_from.cores", 10, "found 6");
-  ExpectError(std::string(kHead) +
-                  "exploration:\n  start_from: {cores: 2, corez: 1}\n",
-              "exploration.start_from.corez", 10, "(did you mean 'cores'?)");
+  ExpectError(
+      std::string(kHead) + "exploration:\n  start_from: {cores: 2, corez: 1}\n",
+      "exploration.start_from.corez", 10, "(did you mean 'cores'?)");
   ExpectError(std::string(kHead) +
                   "  hz: {bind: stack.lidar.rate_hz, values: [7]}\n"
                   "exploration:\n  start_from: {cores: 2}\n",
@@ -235,10 +232,11 @@ TEST(SpecErrorsTest, NonPositiveRatesAndTimeouts) {
               "stack.lidar.rate_hz", 9, "in [0.5, 100]");
   ExpectError(std::string(kHead) + "harness: {run_timeout_s: 0}\n",
               "harness.run_timeout_s", 9, "a number > 0");
-  ExpectError(std::string(kHead) + "llm: {timeout_s: -5}\n", "llm.timeout_s",
-              9, "a number > 0");
+  ExpectError(std::string(kHead) + "llm: {timeout_s: -5}\n", "llm.timeout_s", 9,
+              "a number > 0");
   std::string text = kHead;
-  text.replace(text.find("  goal:"), 0, "  timeout_s: 0\n  speed_limit_kmh: -1\n");
+  text.replace(text.find("  goal:"), 0,
+               "  timeout_s: 0\n  speed_limit_kmh: -1\n");
   ExpectError(text, "task.timeout_s", 6, "a number > 0");
   ExpectError(text, "task.speed_limit_kmh", 7, "a number in (0, 300]");
   text = kHead;
@@ -275,11 +273,10 @@ TEST(SpecErrorsTest, OutputEscapingTheWorkingDirectory) {
   ExpectError(std::string(kHead) + "output: a/../../x\n", "output", 9,
               "escapes");
   // Staying inside after normalisation, or absolute, is fine.
-  Result<Spec> ok = ParseSpec(std::string(kHead) + "output: a/../b\n",
-                              "bad.yaml", "");
+  Result<Spec> ok =
+      ParseSpec(std::string(kHead) + "output: a/../b\n", "bad.yaml", "");
   EXPECT_TRUE(ok.ok()) << ok.status().message();
-  ok = ParseSpec(std::string(kHead) + "output: /tmp/results\n", "bad.yaml",
-                 "");
+  ok = ParseSpec(std::string(kHead) + "output: /tmp/results\n", "bad.yaml", "");
   EXPECT_TRUE(ok.ok()) << ok.status().message();
 }
 
@@ -297,10 +294,10 @@ TEST(SpecErrorsTest, ExpressionErrors) {
               "unknown name 'corez' (did you mean 'cores'?)");
   ExpectError(std::string(kHead) + "cost: cores *\n", "cost", 9,
               "syntax error");
-  ExpectError(std::string(kHead) +
-                  "constraints: [completed, nav_time <= 400]\n",
-              "constraints[1]", 9,
-              "unknown name 'nav_time' (did you mean 'nav_time_s'?)");
+  ExpectError(
+      std::string(kHead) + "constraints: [completed, nav_time <= 400]\n",
+      "constraints[1]", 9,
+      "unknown name 'nav_time' (did you mean 'nav_time_s'?)");
   ExpectError(std::string(kHead) + "constraints: [nav_time_s = 400]\n",
               "constraints[0]", 9, "use '==' to compare");
 }

@@ -21,9 +21,9 @@ task: {start: {x: 0, y: 0}, goal: {x: 100, y: 0}}
 std::string FailsFast(const std::string& text, double seconds = 2.0) {
   const auto start = std::chrono::steady_clock::now();
   Result<Spec> spec = ParseSpec(text, "evil.yaml", "");
-  const double elapsed = std::chrono::duration<double>(
-                             std::chrono::steady_clock::now() - start)
-                             .count();
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
   EXPECT_LT(elapsed, seconds);
   EXPECT_FALSE(spec.ok());
   return spec.ok() ? "" : spec.status().message();
@@ -71,8 +71,10 @@ TEST(SpecHostileTest, AliasBombUnderTheLimitIsNotExpanded) {
   // into. Each must fail fast without expanding.
   const std::string bomb = NestedLaughs(10, 10);
   const std::string head = kHead;
-  EXPECT_THAT(FailsFast(head + "design_space: {n: {bind: platform.cores, "
-                               "values: " + bomb + "}}\n"),
+  EXPECT_THAT(FailsFast(head +
+                        "design_space: {n: {bind: platform.cores, "
+                        "values: " +
+                        bomb + "}}\n"),
               HasSubstr("evil.yaml:4:55: error: design_space.n.values[0]: "
                         "expected a number, found a list of 10 items"));
   EXPECT_THAT(FailsFast(head + "constraints: " + bomb + "\n"),
@@ -97,9 +99,9 @@ TEST(SpecHostileTest, SelfReferencingAliasDoesNotLoop) {
 }
 
 TEST(SpecHostileTest, DeepFlowSequenceNesting) {
-  const std::string text = std::string(kHead) + "design_space: " +
-                           std::string(10000, '[') + std::string(10000, ']') +
-                           "\n";
+  const std::string text = std::string(kHead) +
+                           "design_space: " + std::string(10000, '[') +
+                           std::string(10000, ']') + "\n";
   const std::string message = FailsFast(text);
   EXPECT_THAT(message, HasSubstr("evil.yaml:4:"));
   EXPECT_THAT(message, HasSubstr("expected nesting at most 64 levels deep"));
@@ -124,8 +126,8 @@ TEST(SpecHostileTest, DeepBlockNesting) {
 }
 
 TEST(SpecHostileTest, TooManyNodes) {
-  std::string text = std::string(kHead) +
-                     "design_space: {n: {bind: platform.cores, values: [";
+  std::string text =
+      std::string(kHead) + "design_space: {n: {bind: platform.cores, values: [";
   for (int i = 0; i < 150000; ++i) text += i ? ",1" : "1";
   text += "]}}\n";
   EXPECT_THAT(FailsFast(text), HasSubstr("expected at most 100000 nodes"));

@@ -158,8 +158,7 @@ TEST(SpecParserTest, MarksPointAtWhereFieldsWereWritten) {
   EXPECT_EQ(spec.Where("design_space.lidar_hz"), "test.yaml:20:3: ");
   EXPECT_EQ(spec.Where("constraints[1]").rfind("test.yaml:23:", 0), 0u);
   // A defaulted field cites its closest written parent.
-  EXPECT_EQ(spec.Where("exploration.population").rfind("test.yaml:24:", 0),
-            0u);
+  EXPECT_EQ(spec.Where("exploration.population").rfind("test.yaml:24:", 0), 0u);
   EXPECT_EQ(spec.Where("no_such_field"), "test.yaml: ");
 }
 
@@ -342,11 +341,37 @@ TEST(SpecParserTest, EveryExampleScenarioInTheRepositoryParses) {
     EXPECT_GT(spec->design_space.Size(), 0u) << entry.path();
     // What the tools print must read back.
     Result<Spec> again = ParseSpec(NormalizedYaml(*spec), "n.yaml", "");
-    EXPECT_TRUE(again.ok()) << entry.path() << ": "
-                            << again.status().message();
+    EXPECT_TRUE(again.ok()) << entry.path() << ": " << again.status().message();
   }
   // Guard against passing vacuously when the examples go missing.
   EXPECT_GE(found, 1) << "no scenarios/*.yaml in " << folder;
+}
+
+TEST(SpecParserTest, FullExamplesInTheFormatReferenceParse) {
+  // Every ```yaml block of scenarios/README.md that is a whole spec.
+  std::ifstream in(fs::path(ADSE_SOURCE_DIR) / "scenarios/README.md");
+  ASSERT_TRUE(in) << "scenarios/README.md is missing";
+  std::string line, block;
+  bool inside = false;
+  int checked = 0;
+  while (std::getline(in, line)) {
+    if (!inside && line == "```yaml") {
+      inside = true;
+      block.clear();
+    } else if (inside && line == "```") {
+      inside = false;
+      if (block.rfind("adse:", 0) != 0) continue;
+      ++checked;
+      Result<Spec> spec = ParseSpec(block, "README.md", "");
+      EXPECT_TRUE(spec.ok()) << spec.status().message() << "\n" << block;
+      if (spec.ok()) {
+        EXPECT_EQ(spec->design_space.Size(), 280u);
+      }
+    } else if (inside) {
+      block += line + "\n";
+    }
+  }
+  EXPECT_GE(checked, 1);
 }
 
 TEST(SpecParserTest, ResolvedOutputIsAbsolute) {

@@ -55,8 +55,8 @@ TEST(BoxesOverlapTest, RotatedCasesNeedAllAxes) {
   const double s = std::sqrt(2.0);
   EXPECT_FALSE(BoxesOverlap(a, Box(2.0 + 0.02, 2.0 + 0.02, M_PI / 4, 2, 2)));
   EXPECT_FALSE(BoxesOverlap(Box(2.02, 2.02, M_PI / 4, 2, 2), a));
-  EXPECT_TRUE(BoxesOverlap(a, Box(1.0 + s / 2 - 0.01, 1.0 + s / 2 - 0.01,
-                                  M_PI / 4, 2, 2)));
+  EXPECT_TRUE(BoxesOverlap(
+      a, Box(1.0 + s / 2 - 0.01, 1.0 + s / 2 - 0.01, M_PI / 4, 2, 2)));
   // Diamond's corner poking into a's side.
   EXPECT_TRUE(BoxesOverlap(a, Box(1.0 + s - 0.05, 0, M_PI / 4, 2, 2)));
   EXPECT_FALSE(BoxesOverlap(a, Box(1.0 + s + 0.05, 0, M_PI / 4, 2, 2)));

@@ -122,8 +122,7 @@ TEST(LidarTest, VehicleBoxShadowsTheWallBehindIt) {
   int shadow = 0, beside = 0;
   for (const auto& p : cloud.points) {
     const double slope = (p.z() + h - 1.5) / p.x();  // rises over the roof?
-    if (p.x() > 10.0 && std::abs(p.y()) < 0.5 * p.x() / 10.0 &&
-        slope < 0.0) {
+    if (p.x() > 10.0 && std::abs(p.y()) < 0.5 * p.x() / 10.0 && slope < 0.0) {
       ++shadow;
     }
     if (std::abs(p.x() - 20.0) < 1e-3 && std::abs(p.y()) > 3.0) ++beside;
@@ -160,11 +159,12 @@ TEST(LidarTest, RotatedVehicleAndTheSensorsOwnBody) {
   EXPECT_EQ(cloud.points.size(), 47u);
 }
 
-// Independent reference: every ray against the ground and every box, no
-// culling, box entry found by clipping the ray against the box's 6 planes.
-std::vector<Eigen::Vector3f> ReferenceScan(const LidarSimulator& lidar,
-                                           const Pose2& pose,
-                                           const std::vector<OrientedBox>& boxes) {
+// Independent reference: every ray on its own against the ground, every
+// box (no culling; entry found by clipping against the box's 6 planes) and
+// the scene through Scene::CastRay.
+std::vector<Eigen::Vector3f> ReferenceScan(
+    const LidarSimulator& lidar, const Pose2& pose,
+    const std::vector<OrientedBox>& boxes, const Scene* scene = nullptr) {
   const double h = lidar.params().mount_height_m;
   const double limit = lidar.max_range_m();
   std::vector<Eigen::Vector3f> out;
@@ -186,8 +186,8 @@ std::vector<Eigen::Vector3f> ReferenceScan(const LidarSimulator& lidar,
         const Eigen::Vector3d lo(-b.length_m / 2, -b.width_m / 2, 0);
         const Eigen::Vector3d hi(b.length_m / 2, b.width_m / 2, b.height_m);
         double enter = 0, leave = std::numeric_limits<double>::infinity();
-        bool inside_start = (o.array() >= lo.array()).all() &&
-                            (o.array() <= hi.array()).all();
+        bool inside_start =
+            (o.array() >= lo.array()).all() && (o.array() <= hi.array()).all();
         for (int k = 0; k < 3; ++k) {
           if (std::abs(d[k]) < 1e-15) {
             if (o[k] < lo[k] || o[k] > hi[k]) leave = -1;
@@ -198,6 +198,11 @@ std::vector<Eigen::Vector3f> ReferenceScan(const LidarSimulator& lidar,
           leave = std::min(leave, std::max(t1, t2));
         }
         if (!inside_start && enter <= leave) best = std::min(best, enter);
+      }
+      if (scene != nullptr) {
+        const double t = scene->CastRay(Eigen::Vector3d(pose.x_m, pose.y_m, h),
+                                        d_world, std::min(best, limit));
+        if (t >= 0) best = std::min(best, t);
       }
       if (best <= limit) out.push_back((best * d_sensor).cast<float>());
     }
@@ -220,9 +225,9 @@ TEST(LidarTest, VehiclesMatchAnUnculledReference) {
   // One straddling the sensor's azimuth 0 / 360 seam, one very close, one
   // whose centre is out of range but near face (58 m) is not, one far away.
   boxes.push_back({Eigen::Vector2d(6.5, 3.5), 0.4, 4.5, 1.8, 1.5});
-  boxes.push_back({Eigen::Vector2d(1.0 + 61 * std::cos(0.5),
-                                   2.0 + 61 * std::sin(0.5)),
-                   0.5, 6.0, 2.0, 4.5});
+  boxes.push_back(
+      {Eigen::Vector2d(1.0 + 61 * std::cos(0.5), 2.0 + 61 * std::sin(0.5)), 0.5,
+       6.0, 2.0, 4.5});
   boxes.push_back({Eigen::Vector2d(0.5, 2.0), 0.0, 4.5, 1.8, 1.5});
   boxes.push_back({Eigen::Vector2d(500, 0), 0.0, 4.5, 1.8, 1.5});
   LidarParams p = NoiselessParams();
@@ -238,6 +243,56 @@ TEST(LidarTest, VehiclesMatchAnUnculledReference) {
   }
 }
 
+TEST(LidarTest, SceneReturnsMatchPerRayCastRay) {
+  // Clutter with raised bases (overhangs a beam can pass under), thin
+  // walls and tall buildings, plus vehicles, seen from several poses.
+  Scene scene;
+  Random rng(21);
+  for (int i = 0; i < 200; ++i) {
+    Obstacle o;
+    const Eigen::Vector2d c(rng.Uniform(-60, 60), rng.Uniform(-60, 60));
+    if (i % 3 == 0) {
+      o.footprint = {
+          c, c + Eigen::Vector2d(rng.Uniform(-10, 10), rng.Uniform(-10, 10))};
+    } else {
+      OrientedBox b;
+      b.center = c;
+      b.yaw_rad = rng.Uniform(-M_PI, M_PI);
+      b.length_m = rng.Uniform(0.3, 12);
+      b.width_m = rng.Uniform(0.3, 6);
+      o.footprint = BoxCorners(b);
+    }
+    o.z_min_m = rng.Uniform() < 0.3 ? rng.Uniform(0.5, 3.0) : 0.0;
+    o.z_max_m = o.z_min_m + rng.Uniform(0.3, 10.0);
+    scene.AddObstacle(o);
+  }
+  scene.Finalize();
+  std::vector<OrientedBox> boxes;
+  for (int i = 0; i < 8; ++i) {
+    boxes.push_back(
+        {Eigen::Vector2d(rng.Uniform(-20, 20), rng.Uniform(-20, 20)),
+         rng.Uniform(-M_PI, M_PI), 4.5, 1.8, 1.5});
+  }
+  LidarParams p = NoiselessParams();
+  p.beams = 24;
+  p.vertical_fov_down_deg = -25.0;
+  p.vertical_fov_up_deg = 20.0;
+  p.horizontal_resolution_deg = 0.5;
+  LidarSimulator lidar(&scene, p, Weather::kClear, 1);
+  size_t compared = 0;
+  for (const Pose2 pose : {Pose2{0, 0, 0}, Pose2{13.7, -8.2, 2.1},
+                           Pose2{-75, 10, 0.3}, Pose2{30, 45, -1.2}}) {
+    const auto got = lidar.Scan(pose, 0.0, boxes).points;
+    const auto want = ReferenceScan(lidar, pose, boxes, &scene);
+    ASSERT_EQ(got.size(), want.size());
+    for (size_t i = 0; i < got.size(); ++i) {
+      ASSERT_LT((got[i] - want[i]).norm(), 1e-4) << i;
+    }
+    compared += got.size();
+  }
+  EXPECT_GT(compared, 20000u);
+}
+
 TEST(LidarTest, DownwardBeamsHitGroundAtHeightOverTan) {
   const double h = 1.9;
   LidarSimulator lidar(nullptr, NoiselessParams(), Weather::kClear, 1);
@@ -246,7 +301,8 @@ TEST(LidarTest, DownwardBeamsHitGroundAtHeightOverTan) {
   for (const auto& p : cloud.points) {
     EXPECT_NEAR(p.z(), -h, 1e-4);
     const double horizontal = std::hypot(p.x(), p.y());
-    const int e = static_cast<int>(std::lround(std::atan2(p.z(), horizontal) / kDeg));
+    const int e =
+        static_cast<int>(std::lround(std::atan2(p.z(), horizontal) / kDeg));
     EXPECT_NEAR(horizontal, h / std::tan(-e * kDeg), 1e-3) << e;
     ++per_beam[e];
   }
@@ -286,7 +342,8 @@ TEST(LidarTest, ReturnsNeverExceedRangeInAnyWeather) {
     const PointCloud cloud = lidar.Scan({0, 0, 0}, 0.0, {});
     ASSERT_GT(cloud.points.size(), 1000u);
     double farthest = 0.0;
-    for (const auto& pt : cloud.points) farthest = std::max<double>(farthest, pt.norm());
+    for (const auto& pt : cloud.points)
+      farthest = std::max<double>(farthest, pt.norm());
     EXPECT_LE(farthest, limit + 1e-4) << WeatherName(w);
     EXPECT_GT(farthest, 0.8 * limit) << WeatherName(w);
   }
@@ -395,10 +452,9 @@ TEST(LidarTest, PointsAreInTheSensorFrameOfARotatedPose) {
         Eigen::Rotation2Dd(-car.yaw_rad) * (w.head<2>() - car.center);
     const bool ground = std::abs(w.z()) < 1e-3;
     const bool wall = std::abs(w.y() - 13.0) < 1e-3;
-    const bool in_car =
-        std::abs(local.x()) <= 0.5 * car.length_m + 1e-3 &&
-        std::abs(local.y()) <= 0.5 * car.width_m + 1e-3 &&
-        w.z() <= car.height_m + 1e-3;
+    const bool in_car = std::abs(local.x()) <= 0.5 * car.length_m + 1e-3 &&
+                        std::abs(local.y()) <= 0.5 * car.width_m + 1e-3 &&
+                        w.z() <= car.height_m + 1e-3;
     const bool on_car_surface =
         in_car && (std::abs(std::abs(local.x()) - 0.5 * car.length_m) < 1e-3 ||
                    std::abs(std::abs(local.y()) - 0.5 * car.width_m) < 1e-3 ||

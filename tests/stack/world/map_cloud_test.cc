@@ -31,9 +31,9 @@ Scene TestScene() {
   Obstacle pole;
   pole.kind = ObstacleKind::kPole;
   for (int k = 0; k < 6; ++k) {
-    pole.footprint.push_back(Eigen::Vector2d(-6, -3) +
-                             0.15 * Eigen::Vector2d(std::cos(k * M_PI / 3),
-                                                    std::sin(k * M_PI / 3)));
+    pole.footprint.push_back(
+        Eigen::Vector2d(-6, -3) +
+        0.15 * Eigen::Vector2d(std::cos(k * M_PI / 3), std::sin(k * M_PI / 3)));
   }
   pole.z_max_m = 4.0;
   scene.AddObstacle(pole);
@@ -58,9 +58,11 @@ double DistanceToFaces(const Scene& scene, const Eigen::Vector3d& p) {
       const Eigen::Vector2d ab = b - a;
       const double len2 = ab.squaredNorm();
       const double u =
-          len2 > 0 ? std::clamp((p.head<2>() - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+          len2 > 0 ? std::clamp((p.head<2>() - a).dot(ab) / len2, 0.0, 1.0)
+                   : 0.0;
       const double horizontal = (p.head<2>() - (a + u * ab)).norm();
-      const double vertical = std::max({0.0, o.z_min_m - p.z(), p.z() - o.z_max_m});
+      const double vertical =
+          std::max({0.0, o.z_min_m - p.z(), p.z() - o.z_max_m});
       best = std::min(best, std::hypot(horizontal, vertical));
     }
   }
@@ -86,7 +88,8 @@ TEST(MapCloudTest, FacePointsLieOnFacesAndCoverThem) {
         const Eigen::Vector3f q(xy.x(), xy.y(),
                                 rng.Uniform(o.z_min_m, o.z_max_m));
         double nearest = std::numeric_limits<double>::infinity();
-        for (const auto& p : cloud) nearest = std::min<double>(nearest, (p - q).norm());
+        for (const auto& p : cloud)
+          nearest = std::min<double>(nearest, (p - q).norm());
         EXPECT_LE(nearest, opt.spacing_m * std::sqrt(0.5) + 1e-6);
       }
     }
@@ -121,7 +124,8 @@ TEST(MapCloudTest, GroundGridCoversBoundsButNotUnderFootprints) {
     // Not inside the parked car (centre (3, -2), 4.5 x 1.8).
     const Eigen::Vector2d rel = Eigen::Vector2d(p.x() - 3, p.y() + 2);
     const double along = rel.dot(Eigen::Vector2d(std::cos(0.4), std::sin(0.4)));
-    const double across = rel.dot(Eigen::Vector2d(-std::sin(0.4), std::cos(0.4)));
+    const double across =
+        rel.dot(Eigen::Vector2d(-std::sin(0.4), std::cos(0.4)));
     EXPECT_FALSE(std::abs(along) < 2.2 && std::abs(across) < 0.85)
         << p.transpose();
   }
@@ -177,8 +181,11 @@ TEST_F(PcdTest, WriteReadRoundTripIsExact) {
   const std::string raw = ReadRaw(path);
   const std::string n = std::to_string(points.size());
   EXPECT_NE(raw.find("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n"
-                     "COUNT 1 1 1\nWIDTH " + n + "\nHEIGHT 1\n"
-                     "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + n + "\nDATA binary\n"),
+                     "COUNT 1 1 1\nWIDTH " +
+                     n +
+                     "\nHEIGHT 1\n"
+                     "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS " +
+                     n + "\nDATA binary\n"),
             std::string::npos);
   EXPECT_EQ(raw.size() - raw.find("DATA binary\n") - 12, points.size() * 12);
 
@@ -224,12 +231,15 @@ TEST_F(PcdTest, MalformedHeadersAreCorruption) {
       {"points_mismatch", head + "WIDTH 2\nHEIGHT 1\nPOINTS 1\n" + tail},
       {"no_width", head + "HEIGHT 1\nPOINTS 1\n" + tail},
       {"bad_width", head + "WIDTH two\nHEIGHT 1\nPOINTS 1\n" + tail},
-      {"no_z", "FIELDS x y\nSIZE 4 4\nTYPE F F\nWIDTH 1\nHEIGHT 1\n"
-               "DATA ascii\n1 2\n"},
-      {"int_x", "FIELDS x y z\nSIZE 4 4 4\nTYPE I F F\nWIDTH 1\nHEIGHT 1\n"
-                "DATA ascii\n1 2 3\n"},
-      {"size_count", "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 1\n"
-                     "HEIGHT 1\nDATA ascii\n1 2 3\n"},
+      {"no_z",
+       "FIELDS x y\nSIZE 4 4\nTYPE F F\nWIDTH 1\nHEIGHT 1\n"
+       "DATA ascii\n1 2\n"},
+      {"int_x",
+       "FIELDS x y z\nSIZE 4 4 4\nTYPE I F F\nWIDTH 1\nHEIGHT 1\n"
+       "DATA ascii\n1 2 3\n"},
+      {"size_count",
+       "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 1\n"
+       "HEIGHT 1\nDATA ascii\n1 2 3\n"},
       {"unknown_key", head + "WIDTH 1\nHEIGHT 1\nCOLOUR red\n" + tail},
       {"data_kind", head + "WIDTH 1\nHEIGHT 1\nDATA zipped\n1 2 3\n"},
       {"bad_number", head + "WIDTH 1\nHEIGHT 1\nDATA ascii\n1 2 x3\n"},
@@ -251,8 +261,9 @@ TEST_F(PcdTest, MalformedHeadersAreCorruption) {
         << name << ": " << r.status().ToString();
     EXPECT_NE(r.status().message().find(path), std::string::npos) << name;
   }
-  WriteRaw(Path("compressed.pcd"), head + "WIDTH 1\nHEIGHT 1\n"
-                                          "DATA binary_compressed\n");
+  WriteRaw(Path("compressed.pcd"), head +
+                                       "WIDTH 1\nHEIGHT 1\n"
+                                       "DATA binary_compressed\n");
   EXPECT_EQ(ReadPcd(Path("compressed.pcd")).status().code(),
             Status::Code::kInvalidArgument);
 }

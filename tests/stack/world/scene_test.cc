@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -53,7 +54,8 @@ Scene RandomScene(uint64_t seed, double cell) {
     const Eigen::Vector2d c(rng.Uniform(-50, 50), rng.Uniform(-30, 30));
     const int kind = static_cast<int>(rng.Below(3));
     if (kind == 0) {  // thin wall
-      o = Wall(c, c + Eigen::Vector2d(rng.Uniform(-15, 15), rng.Uniform(-15, 15)));
+      o = Wall(c,
+               c + Eigen::Vector2d(rng.Uniform(-15, 15), rng.Uniform(-15, 15)));
     } else if (kind == 1) {  // parked car
       OrientedBox b;
       b.center = c;
@@ -107,6 +109,47 @@ TEST(SceneTest, CastRayMatchesBruteForceOnRandomRays) {
     }
     EXPECT_GT(hits, 1500);  // the comparison exercises real hits
   }
+}
+
+TEST(SceneTest, CrossingsAlongListsEveryFaceCrossedInOrder) {
+  const Scene scene = RandomScene(7, 4.0);
+  Random rng(5);
+  size_t total = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector2d o(rng.Uniform(-80, 80), rng.Uniform(-60, 60));
+    const double az = rng.Uniform(-M_PI, M_PI);
+    Eigen::Vector2d d(std::cos(az), std::sin(az));
+    if (i % 7 == 0) d = Eigen::Vector2d(i % 2 ? 1 : -1, 0);
+    const double max_s = rng.Uniform(0, 150);
+    std::vector<FaceCrossing> got;
+    scene.CrossingsAlong(o, d, max_s, &got);
+    // Brute force: each face crossed within reach, via a 2x2 solve.
+    std::vector<FaceCrossing> want;
+    for (const Obstacle& ob : scene.obstacles()) {
+      for (const auto& e : ObstacleEdges(ob)) {
+        Eigen::Matrix2d m;
+        m << d.x(), e[0].x() - e[1].x(), d.y(), e[0].y() - e[1].y();
+        if (m.determinant() == 0.0) continue;
+        const Eigen::Vector2d su = m.inverse() * (e[0] - o);
+        if (su[0] < 0 || su[0] > max_s || su[1] < 0 || su[1] > 1) continue;
+        want.push_back({su[0], ob.z_min_m, ob.z_max_m});
+      }
+    }
+    std::sort(want.begin(), want.end(),
+              [](const auto& a, const auto& b) { return a.s_m < b.s_m; });
+    ASSERT_EQ(got.size(), want.size()) << i;
+    for (size_t k = 0; k < got.size(); ++k) {
+      EXPECT_NEAR(got[k].s_m, want[k].s_m, 1e-9) << i;
+      EXPECT_EQ(got[k].z_max_m - got[k].z_min_m,
+                want[k].z_max_m - want[k].z_min_m)
+          << i;
+      if (k > 0) {
+        EXPECT_LE(got[k - 1].s_m, got[k].s_m);
+      }
+    }
+    total += got.size();
+  }
+  EXPECT_GT(total, 3000u);
 }
 
 TEST(SceneTest, ThinWallIsHitFromBothSidesAndPassedOver) {
@@ -173,8 +216,24 @@ TEST(SceneTest, EmptySceneAndDegenerateObstacles) {
   closed_ring.footprint = {{10, -1}, {12, -1}, {12, 1}, {10, 1}, {10, -1}};
   scene.AddObstacle(closed_ring);
   scene.Finalize();
+  Obstacle broken;  // a NaN from a bad map file must not poison the grid
+  broken.footprint = {{std::nan(""), 0}, {5, 5}};
+  scene.AddObstacle(broken);
+  scene.Finalize();
   EXPECT_EQ(ObstacleEdges(closed_ring).size(), 4u);
+  EXPECT_EQ(scene.obstacles().size(), 2u);
   EXPECT_NEAR(scene.CastRay({0, 0, 1}, {1, 0, 0}, 50), 10.0, 1e-12);
+}
+
+TEST(SceneTest, HugeSparseMapsGetCoarserCells) {
+  // Two walls 200 km apart: a 4 m grid would need 2.5e9 cells.
+  Scene scene;
+  scene.AddObstacle(Wall({0, 0}, {0, 10}));
+  scene.AddObstacle(Wall({200000, 0}, {200000, 200000}));
+  scene.Finalize(4.0);
+  EXPECT_GT(scene.cell_size_m(), 4.0);
+  EXPECT_NEAR(scene.CastRay({-5, 5, 1}, {1, 0, 0}, 100), 5.0, 1e-9);
+  EXPECT_NEAR(scene.CastRay({199990, 100000, 1}, {1, 0, 0}, 100), 10.0, 1e-9);
 }
 
 }  // namespace

@@ -34,8 +34,8 @@ WorldSetup SmallLot() {
   setup.world.map.generator_params = {{"rows", 2}, {"slots_per_row", 8}};
   setup.world.traffic.seed = 3;
   setup.world.traffic.parked_occupancy = 0.5;
-  setup.task.start = {.x_m = 8.0, .y_m = -1.75};
-  setup.task.goal = {.x_m = 10.0, .y_m = 29.75};
+  setup.task.start = Location::Xy(8.0, -1.75);
+  setup.task.goal = Location::Xy(10.0, 29.75);
   setup.cache_dir = CacheDir();
   return setup;
 }
@@ -72,8 +72,8 @@ TEST(WorldTest, GridMapLoadsAndRoutes) {
   WorldSetup setup;
   setup.world.map.generator = "grid";
   setup.world.map.generator_params = {{"number", 3}, {"length_m", 100}, {"lanes", 1}};
-  setup.task.start = {.by_edge = true, .edge = "A0B0", .pos_m = 10.0};
-  setup.task.goal = {.by_edge = true, .edge = "C1C2", .pos_m = 50.0};
+  setup.task.start = Location::OnEdge("A0B0", 10.0);
+  setup.task.goal = Location::OnEdge("C1C2", 50.0);
   setup.cache_dir = CacheDir();
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_TRUE(world.ok()) << world.status().ToString();
@@ -89,8 +89,8 @@ TEST(WorldTest, RealOsmNetworkFromSumoToolsLoadsAndRoutes) {
   ASSERT_TRUE(std::filesystem::exists(net)) << "sumo-tools is not installed";
   WorldSetup setup;
   setup.world.map.net_path = net;
-  setup.task.start = {.x_m = 899.9, .y_m = 400.8};
-  setup.task.goal = {.x_m = 1100.0, .y_m = 232.0};
+  setup.task.start = Location::Xy(899.9, 400.8);
+  setup.task.goal = Location::Xy(1100.0, 232.0);
   setup.cache_dir = CacheDir();
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_TRUE(world.ok()) << world.status().ToString();
@@ -213,8 +213,8 @@ TEST(WorldTest, CorruptNetIsReportedWithSumosCause) {
   std::ofstream(net) << "<net version=\"1.9\">\n  <edge id=\"a\"\n";
   WorldSetup setup;
   setup.world.map.net_path = net;
-  setup.task.start = {.x_m = 0, .y_m = 0};
-  setup.task.goal = {.x_m = 10, .y_m = 0};
+  setup.task.start = Location::Xy(0, 0);
+  setup.task.goal = Location::Xy(10, 0);
   setup.cache_dir = CacheDir();
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_FALSE(world.ok());
@@ -228,7 +228,7 @@ TEST(WorldTest, CorruptNetIsReportedWithSumosCause) {
 
 TEST(WorldTest, StartOffTheRoadIsRejected) {
   WorldSetup setup = SmallLot();
-  setup.task.start = {.x_m = 15.0, .y_m = 8.0};  // in the parking rows
+  setup.task.start = Location::Xy(15.0, 8.0);  // in the parking rows
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_FALSE(world.ok());
   EXPECT_NE(world.status().message().find("task.start"), std::string::npos);
@@ -253,8 +253,8 @@ TEST(WorldTest, UnreachableGoalIsRejected) {
             0);
   WorldSetup setup;
   setup.world.map.net_path = net;
-  setup.task.start = {.x_m = 10, .y_m = -1.6};
-  setup.task.goal = {.x_m = 90, .y_m = 48.4};
+  setup.task.start = Location::Xy(10, -1.6);
+  setup.task.goal = Location::Xy(90, 48.4);
   setup.cache_dir = CacheDir();
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_FALSE(world.ok());
@@ -275,7 +275,7 @@ TEST(WorldTest, ValetParkingPathEndsInsideTheGoalSlot) {
   WorldSetup setup = SmallLot();
   setup.task.kind = TaskKind::kValetParking;
   // Slot 3 of row 0 (below the aisle): x in [17, 19.5], y in [5.5, 10.5].
-  setup.task.goal = {.x_m = 18.25, .y_m = 8.0};
+  setup.task.goal = Location::Xy(18.25, 8.0);
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   const Path2& path = (*world)->ideal_path();
