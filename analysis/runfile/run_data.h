@@ -1,0 +1,85 @@
+// Everything one run stores: the in-memory form of a run file (HDF5, see
+// results-schema/). Plain data: no HDF5 types here.
+#ifndef ADSE_ANALYSIS_RUNFILE_RUN_DATA_H_
+#define ADSE_ANALYSIS_RUNFILE_RUN_DATA_H_
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "stack/runtime/trace.h"
+
+namespace adse::runfile {
+
+struct EgoSample {
+  double t_s, x_m, y_m, yaw_rad, v_mps, steer_rad, accel_mps2;
+};
+
+struct PathPoint {
+  double s_m, x_m, y_m;
+};
+
+// Other vehicles, decimated (e.g. every 0.5 s).
+struct VehicleSample {
+  double t_s;
+  std::string id;
+  double x_m, y_m, yaw_rad, speed_mps, length_m, width_m;
+};
+
+// A control command as the vehicle received it.
+struct ControlSample {
+  double t_s;        // publish time
+  double stamp_s;    // originating sensor time
+  double accel_mps2, steer_rad;
+};
+
+struct CollisionEvent {
+  double t_s;
+  std::string other_id;
+};
+
+struct NamedCallback {
+  std::string name;  // "<node>/<callback>"
+  int32_t node = -1;
+  std::string kind;  // "subscription" | "timer"
+  int32_t topic = -1;
+  double period_s = 0.0;
+};
+
+struct RunData {
+  // Identity and provenance (root attributes).
+  std::string status = "complete";       // complete | failed
+  std::string termination_reason;        // goal_reached | timeout | ... | error text
+  std::string scenario_name;
+  std::string scenario_text;             // the scenario file, verbatim
+  std::string scenario_hash;             // sha256 of scenario_text
+  std::string content_key;               // run key (empty until the harness sets it)
+  std::string adse_version;
+  std::string host;                      // hostname, CPU model, cores
+  std::string created_utc;               // ISO 8601
+  uint64_t seed = 0;
+  std::map<std::string, double> design_point;
+  std::map<std::string, std::string> platform;  // kind, cores, freq_ghz, cost_model, ...
+
+  // World.
+  std::vector<EgoSample> ego;
+  std::vector<PathPoint> ideal_path;
+  double lane_width_m = 3.5;
+  std::vector<VehicleSample> vehicles;
+  std::vector<CollisionEvent> collisions;
+
+  // Stack and trace.
+  std::vector<std::string> node_names;
+  std::vector<NamedCallback> callback_info;
+  std::vector<std::string> topic_names;
+  stack::Trace trace;
+  std::vector<ControlSample> controls;
+
+  // Metrics by name (see scenarios/README.md); booleans as 0/1.
+  std::map<std::string, double> metrics;
+};
+
+}  // namespace adse::runfile
+
+#endif  // ADSE_ANALYSIS_RUNFILE_RUN_DATA_H_

@@ -1,0 +1,63 @@
+// Executors decide when a graph's callbacks run and what they cost. The
+// `virtual` platform simulates N cores at f GHz as discrete events; the
+// real-time `cgroup` platform will implement the same interface.
+#ifndef ADSE_STACK_RUNTIME_EXECUTOR_H_
+#define ADSE_STACK_RUNTIME_EXECUTOR_H_
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "stack/base/status.h"
+#include "stack/runtime/graph.h"
+#include "stack/runtime/trace.h"
+
+namespace adse::stack {
+
+// Linear cost of one callback at the reference frequency: fixed + per unit.
+struct CountedCost {
+  double fixed_s = 0.0;
+  double per_unit_s = 0.0;
+};
+
+enum class CostModelKind { kMeasured, kCounted };
+
+struct VirtualPlatformOptions {
+  int cores = 4;                 // virtual cores
+  double freq_ghz = 2.1;         // their frequency
+  double reference_ghz = 2.1;    // frequency at which host costs count as-is
+  CostModelKind cost_model = CostModelKind::kMeasured;
+  // kCounted: cost per callback name ("<node>/<callback>"). A callback
+  // without an entry costs `default_counted`.
+  std::map<std::string, CountedCost> counted;
+  CountedCost default_counted{1e-4, 0.0};
+  // Scales every cost: how much heavier the modelled production stack is
+  // than adse's own (1 = as measured).
+  double cost_scale = 1.0;
+};
+
+class Executor {
+ public:
+  virtual ~Executor() = default;
+
+  // Publishes a message from outside the graph (a sensor) at time t_s >=
+  // now_s(). Subscribers see it at t_s.
+  virtual void PublishExternal(int topic, MessagePtr message, double stamp_s,
+                               double t_s) = 0;
+  // Processes every event before t_s (arrivals, timers, starts, ends) and
+  // leaves the clock at t_s.
+  virtual Status AdvanceTo(double t_s) = 0;
+  virtual double now_s() const = 0;
+  virtual const Trace& trace() const = 0;
+};
+
+// Validates `options` (cores >= 1, frequencies > 0, ...), naming the field.
+Status ValidateVirtualPlatformOptions(const VirtualPlatformOptions& options);
+
+// The virtual platform. `graph` must outlive the executor.
+Result<std::unique_ptr<Executor>> CreateVirtualExecutor(
+    const Graph* graph, const VirtualPlatformOptions& options);
+
+}  // namespace adse::stack
+
+#endif  // ADSE_STACK_RUNTIME_EXECUTOR_H_

@@ -1,0 +1,87 @@
+// Messages exchanged on the stack's topics. Plain data; Eigen only. A
+// message is published once and shared read-only by every subscriber.
+#ifndef ADSE_STACK_RUNTIME_MESSAGES_H_
+#define ADSE_STACK_RUNTIME_MESSAGES_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "stack/world/geometry.h"
+
+namespace adse::stack {
+
+// Publish times and sequence numbers are recorded by the runtime in the
+// trace, not in the message.
+struct Header {
+  // Time of the sensor sample this message derives from (for end-to-end
+  // latency); for timer-born messages, the stamp of the input they used.
+  double stamp_s = 0.0;
+};
+
+// A LiDAR scan or a filtered cloud, points in the vehicle frame (x forward,
+// y left, z up; origin on the ground under the rear axle).
+struct PointCloudMsg {
+  Header header;
+  std::vector<Eigen::Vector3f> points;
+};
+
+// Wheel odometry: what the vehicle reports about its own motion.
+struct OdometryMsg {
+  Header header;
+  double v_mps = 0.0;
+  double yaw_rate_rps = 0.0;
+};
+
+// A pose estimate in the map frame with its covariance (x, y, yaw).
+struct PoseMsg {
+  Header header;
+  world::Pose2 pose;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  double v_mps = 0.0;      // filtered speed (EKF output)
+  double fitness = 0.0;    // scan matcher fitness (NDT), lower is better
+  bool valid = true;       // false: localization lost
+};
+
+struct TrackedObject {
+  int id = 0;
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // map frame
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();
+  double length_m = 0.0;
+  double width_m = 0.0;
+  int age = 0;  // updates seen
+};
+
+struct ObjectsMsg {
+  Header header;
+  std::vector<TrackedObject> objects;
+};
+
+// The route as a reference path in the map frame.
+struct PathMsg {
+  Header header;
+  world::Path2 path;
+};
+
+struct TrajectoryPoint {
+  double x_m = 0.0, y_m = 0.0, yaw_rad = 0.0;
+  double s_m = 0.0;    // arc length along the reference path
+  double v_mps = 0.0;  // target speed at this point
+};
+
+struct TrajectoryMsg {
+  Header header;
+  std::vector<TrajectoryPoint> points;
+  bool stop_for_goal = false;
+  bool stop_for_obstacle = false;
+};
+
+struct ControlMsg {
+  Header header;
+  double accel_mps2 = 0.0;
+  double steer_rad = 0.0;
+};
+
+}  // namespace adse::stack
+
+#endif  // ADSE_STACK_RUNTIME_MESSAGES_H_
