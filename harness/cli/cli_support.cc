@@ -38,12 +38,5 @@ void ReportError(const spec::Spec& spec, const Status& status) {
   std::fprintf(stderr, "%serror: %s\n", where.c_str(), message.c_str());
 }
 
-world::WorldSetup WorldSetupFromSpec(const spec::Spec& spec) {
-  world::WorldSetup setup;
-  setup.world = spec.world;
-  setup.task = spec.task;
-  setup.cache_dir = spec.harness.cache_dir;
-  return setup;
-}
 
 }  // namespace adse::cli

@@ -19,9 +19,6 @@ std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path);
 // path that starts the message ("task.goal: ...") in the scenario.
 void ReportError(const spec::Spec& spec, const Status& status);
 
-// The world and task of a scenario, ready for World::Open.
-world::WorldSetup WorldSetupFromSpec(const spec::Spec& spec);
-
 }  // namespace adse::cli
 
 #endif  // ADSE_HARNESS_CLI_CLI_SUPPORT_H_

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace adse::cli {
 
@@ -26,6 +27,29 @@ struct WorldArgs {
   bool json = false;
 };
 int RunWorld(const WorldArgs& args);
+
+struct SimulateArgs {
+  std::string scenario;
+  std::string point;              // "cores=4,freq_ghz=1.2"; empty: start_from
+  std::optional<uint64_t> seed;   // overrides world.traffic.seed
+  std::string out;                // default: <output>/simulate/<point>.h5
+  bool json = false;
+  bool quiet = false;
+};
+int RunSimulate(const SimulateArgs& args);
+
+struct CalibrateArgs {
+  std::string scenario;
+  std::string point;     // empty: start_from
+  int runs = 2;          // measured runs fitted together (seeds seed, seed+1, ...)
+  std::string out = "calibration.json";
+};
+int RunCalibrate(const CalibrateArgs& args);
+
+struct SchemaCheckArgs {
+  std::vector<std::string> files;
+};
+int RunSchemaCheck(const SchemaCheckArgs& args);
 
 }  // namespace adse::cli
 

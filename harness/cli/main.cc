@@ -44,6 +44,40 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   world_cmd->add_flag("--json", world.json, "Print the summary as JSON");
 
+  adse::cli::SimulateArgs simulate;
+  uint64_t simulate_seed = 0;
+  CLI::App* simulate_cmd = app.add_subcommand(
+      "simulate", "Drive one design point in closed loop (world + stack on the "
+                  "virtual platform) and print its metrics");
+  simulate_cmd->add_option("scenario", simulate.scenario, "Scenario YAML file")->required();
+  simulate_cmd->add_option("-p,--point", simulate.point,
+                           "Design point, e.g. cores=4,freq_ghz=1.2,lidar_hz=14 "
+                           "(default: exploration.start_from)");
+  CLI::Option* simulate_seed_opt = simulate_cmd->add_option(
+      "--seed", simulate_seed, "Traffic and sensor seed (overrides world.traffic.seed)");
+  simulate_cmd->add_option("-o,--out", simulate.out,
+                           "Run file (default: <output>/simulate/<point>.h5)");
+  simulate_cmd->add_flag("--json", simulate.json, "Print metrics and timings as JSON");
+  simulate_cmd->add_flag("-q,--quiet", simulate.quiet, "No progress line");
+
+  adse::cli::CalibrateArgs calibrate;
+  CLI::App* calibrate_cmd = app.add_subcommand(
+      "calibrate", "Fit the `counted` cost model's per-callback costs on this host "
+                   "from measured runs");
+  calibrate_cmd->add_option("scenario", calibrate.scenario, "Scenario YAML file")->required();
+  calibrate_cmd->add_option("-p,--point", calibrate.point,
+                            "Design point to run (default: exploration.start_from)");
+  calibrate_cmd->add_option("--runs", calibrate.runs, "Measured runs to fit")
+      ->check(CLI::Range(1, 100));
+  calibrate_cmd->add_option("-o,--out", calibrate.out, "Calibration file to write");
+
+  adse::cli::SchemaCheckArgs schema_check;
+  CLI::App* schema_cmd = app.add_subcommand("schema", "Run-file schema tools");
+  schema_cmd->require_subcommand(1);
+  CLI::App* schema_check_cmd = schema_cmd->add_subcommand(
+      "check", "Check run files against results-schema/run.schema.json");
+  schema_check_cmd->add_option("files", schema_check.files, "Run files (.h5)")->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -52,6 +86,10 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   if (seed_opt->count() > 0) world.seed = seed;
+  if (simulate_seed_opt->count() > 0) simulate.seed = simulate_seed;
+  if (*simulate_cmd) return adse::cli::RunSimulate(simulate);
+  if (*calibrate_cmd) return adse::cli::RunCalibrate(calibrate);
+  if (*schema_check_cmd) return adse::cli::RunSchemaCheck(schema_check);
   if (*validate_cmd) return adse::cli::RunValidate(validate);
   if (*world_cmd) return adse::cli::RunWorld(world);
   return 2;

@@ -4,6 +4,7 @@
 
 #include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
+#include "harness/sim/simulator.h"
 #include "harness/spec/spec_parser.h"
 
 namespace adse::cli {
@@ -13,7 +14,7 @@ int RunValidate(const ValidateArgs& args) {
   if (!spec) return 2;
   if (args.check_world) {
     Result<std::unique_ptr<world::World>> world =
-        world::World::Open(WorldSetupFromSpec(*spec));
+        world::World::Open(sim::WorldSetupFromSpec(*spec));
     if (!world.ok()) {
       ReportError(*spec, world.status());
       return ExitCodeFor(world.status()) == 1 ? 1 : 2;

@@ -8,6 +8,7 @@
 
 #include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
+#include "harness/sim/simulator.h"
 #include "stack/base/files.h"
 #include "stack/world/ideal_driver.h"
 #include "stack/world/lidar.h"
@@ -40,7 +41,7 @@ std::string PathCsv(const world::Path2& path) {
 int RunWorld(const WorldArgs& args) {
   std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
   if (!spec) return 2;
-  world::WorldSetup setup = WorldSetupFromSpec(*spec);
+  world::WorldSetup setup = sim::WorldSetupFromSpec(*spec);
   if (args.seed) setup.world.traffic.seed = *args.seed;
   Result<std::unique_ptr<world::World>> opened = world::World::Open(setup);
   if (!opened.ok()) {

@@ -59,6 +59,9 @@ struct PlatformOptions {
   // Defaults when the design space does not bind them.
   int cores = 4;
   double freq_ghz = 2.1;
+  // Multiplies every callback cost: how much heavier the modelled
+  // production stack is than adse's own implementation (1 = as measured).
+  double cost_scale = 1.0;
 };
 
 struct Objective {

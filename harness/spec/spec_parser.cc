@@ -47,7 +47,8 @@ const std::vector<std::string> kStartKeys = {"x", "y", "edge", "pos_m", "lane"};
 const std::vector<std::string> kGoalKeys = {"x",     "y",    "edge",
                                             "pos_m", "lane", "tolerance_m"};
 const std::vector<std::string> kPlatformKeys = {
-    "kind", "reference_ghz", "cost_model", "calibration", "cores", "freq_ghz"};
+    "kind", "reference_ghz", "cost_model", "calibration", "cores", "freq_ghz",
+    "cost_scale"};
 const std::vector<std::string> kParameterKeys = {"bind", "range", "values",
                                                  "step"};
 const std::vector<std::string> kObjectiveKeys = {"minimize", "maximize"};
@@ -986,6 +987,9 @@ void SpecReader::ReadPlatform(const Val& v) {
   if (const Val* e = f.Get("freq_ghz")) {
     ReadNumber(*e, &p.freq_ghz, {0, kMaxFreqGhz, true, false});
   }
+  if (const Val* e = f.Get("cost_scale")) {
+    ReadNumber(*e, &p.cost_scale, {0, 1000, true, false});
+  }
 }
 
 void SpecReader::ReadDesignSpace(const Val& v) {
@@ -1796,6 +1800,8 @@ std::string NormalizedYaml(const Spec& spec) {
   out << YAML::Key << "cores" << YAML::Value << p.cores;
   out << YAML::Key << "freq_ghz" << YAML::Value;
   EmitNumber(out, p.freq_ghz);
+  out << YAML::Key << "cost_scale" << YAML::Value;
+  EmitNumber(out, p.cost_scale);
   out << YAML::EndMap;
 
   out << YAML::Key << "design_space" << YAML::Value << YAML::BeginMap;

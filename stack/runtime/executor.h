@@ -34,6 +34,10 @@ struct VirtualPlatformOptions {
   // Scales every cost: how much heavier the modelled production stack is
   // than adse's own (1 = as measured).
   double cost_scale = 1.0;
+  // kCounted runs leave CallbackRecord::host_cpu_s at 0 so that their traces
+  // are bit-identical; true measures it anyway (for calibration), at the
+  // price of that identity.
+  bool record_host_cpu_when_counted = false;
 };
 
 class Executor {
@@ -54,7 +58,11 @@ class Executor {
 // Validates `options` (cores >= 1, frequencies > 0, ...), naming the field.
 Status ValidateVirtualPlatformOptions(const VirtualPlatformOptions& options);
 
-// The virtual platform. `graph` must outlive the executor.
+// The virtual platform. `graph` must outlive the executor and not change
+// while it exists. Its exact semantics (event order, readiness, dispatch,
+// cost) are documented at the top of virtual_executor.cc. Rejects invalid
+// options and graphs (timer period <= 0, queue depth < 1, bad indices,
+// empty functions).
 Result<std::unique_ptr<Executor>> CreateVirtualExecutor(
     const Graph* graph, const VirtualPlatformOptions& options);
 

@@ -18,6 +18,7 @@ struct CallbackRecord {
   double end_s = 0.0;     // outputs published
   double cost_s = 0.0;    // simulated execution time (end - start)
   double host_cpu_s = 0.0;  // thread CPU time the real code took on the host
+                            // (0 in counted runs unless asked for)
   double work_units = 0.0;
   int32_t cores = 1;      // virtual cores held
   int32_t first_core = 0; // lowest index of the cores held

@@ -137,6 +137,7 @@ struct World::Impl {
   std::unique_ptr<BicycleModel> ego;
   std::vector<OtherVehicle> others;
   std::set<std::string> in_contact;
+  std::vector<std::string> new_contacts;
   int collisions = 0;
   double time_s = 0.0;
   bool sumo_running = false;
@@ -796,10 +797,14 @@ Status World::Step(const ControlCommand& command) {
     if (!read.ok()) throw std::runtime_error(read.message());
     const OrientedBox body = w.ego->Body();
     std::set<std::string> contact;
+    w.new_contacts.clear();
     for (const OtherVehicle& v : w.others) {
       if (BoxesOverlap(body, v.box)) {
         contact.insert(v.id);
-        if (!w.in_contact.count(v.id)) ++w.collisions;
+        if (!w.in_contact.count(v.id)) {
+          ++w.collisions;
+          w.new_contacts.push_back(v.id);
+        }
       }
     }
     w.in_contact = std::move(contact);
@@ -813,6 +818,7 @@ const VehicleLimits& World::ego_limits() const { return impl_->setup.ego; }
 OrientedBox World::ego_body() const { return impl_->ego->Body(); }
 const std::vector<OtherVehicle>& World::others() const { return impl_->others; }
 int World::collisions() const { return impl_->collisions; }
+const std::vector<std::string>& World::new_contacts() const { return impl_->new_contacts; }
 double World::distance_to_goal_m() const {
   const VehicleState& s = impl_->ego->state();
   return (Vec2(s.x_m, s.y_m) - impl_->goal_xy).norm();

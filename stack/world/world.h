@@ -62,6 +62,8 @@ class World {
   // Collision events so far (ego overlapping another vehicle, counted once
   // per contact).
   int collisions() const;
+  // Vehicles whose contact with the ego began in the last step.
+  const std::vector<std::string>& new_contacts() const;
   bool goal_reached() const;
   double distance_to_goal_m() const;
 

@@ -1,0 +1,602 @@
+#include <algorithm>
+#include <cstring>
+
+#include "analysis/runfile/hdf5_util_impl.h"
+
+namespace adse::runfile::internal {
+namespace {
+
+std::mutex& Hdf5Mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+// Chunks of at most this many rows (and bytes): small enough for HDF5's
+// default 1 MiB chunk cache, big enough that per-chunk overhead vanishes.
+constexpr size_t kMaxChunkRows = 4096;
+constexpr size_t kMaxChunkBytes = 512 * 1024;
+constexpr unsigned kDeflateLevel = 4;
+
+herr_t CollectErrors(unsigned /*n*/, const H5E_error2_t* err, void* data) {
+  auto* out = static_cast<std::vector<std::string>*>(data);
+  if (err != nullptr && err->desc != nullptr && err->desc[0] != '\0') {
+    out->push_back(err->desc);
+  }
+  return 0;
+}
+
+// Absolute HDF5 path of `name` below `loc`, for messages.
+std::string PathOf(hid_t loc, const std::string& name) {
+  char buffer[512];
+  const ssize_t n = H5Iget_name(loc, buffer, sizeof(buffer));
+  std::string parent = n > 0 ? std::string(buffer) : std::string("?");
+  if (name.empty() || name == ".") return parent;
+  if (parent.empty() || parent.back() != '/') parent += '/';
+  return parent + name;
+}
+
+Status ReadError(const std::string& what) { return Status::Corruption(what); }
+Status ReadHdf5Error(const std::string& object, const std::string& action) {
+  return Status::Corruption(object + ": " + action + ": " + TakeHdf5Error());
+}
+Status WriteHdf5Error(const std::string& object, const std::string& action) {
+  return Status::IoError(object + ": " + action + ": " + TakeHdf5Error());
+}
+
+// A fixed-length UTF-8 string type just long enough for `value` (at least
+// one byte: HDF5 has no empty strings). Fixed rather than variable length:
+// variable-length strings live in HDF5's global heap, which has no
+// checksums, and a damaged heap crashes libhdf5 on read.
+Handle MakeFixedStringType(const std::string& value) {
+  Handle type(H5Tcopy(H5T_C_S1));
+  if (!type.valid() ||
+      H5Tset_size(type.get(), std::max<size_t>(1, value.size())) < 0 ||
+      H5Tset_strpad(type.get(), H5T_STR_NULLPAD) < 0 ||
+      H5Tset_cset(type.get(), H5T_CSET_UTF8) < 0) {
+    return Handle();
+  }
+  return type;
+}
+
+// `value` padded to the type's size (the empty string becomes one NUL).
+std::vector<char> PaddedString(const std::string& value) {
+  std::vector<char> bytes(std::max<size_t>(1, value.size()), '\0');
+  std::copy(value.begin(), value.end(), bytes.begin());
+  return bytes;
+}
+
+// Builds the packed compound for `fields`; `file` picks little-endian
+// standard types (what goes to disk) over native ones (memory). On x86 the
+// two are equal, so writes and reads need no conversion.
+Handle MakeCompoundType(const std::vector<FieldDesc>& fields, bool file) {
+  Handle compound(H5Tcreate(H5T_COMPOUND, RowSize(fields)));
+  if (!compound.valid()) return Handle();
+  size_t offset = 0;
+  for (const FieldDesc& field : fields) {
+    Handle member;
+    switch (field.type) {
+      case FieldType::kFloat64:
+        member = Handle(H5Tcopy(file ? H5T_IEEE_F64LE : H5T_NATIVE_DOUBLE));
+        break;
+      case FieldType::kInt32:
+        member = Handle(H5Tcopy(file ? H5T_STD_I32LE : H5T_NATIVE_INT32));
+        break;
+      case FieldType::kInt64:
+        member = Handle(H5Tcopy(file ? H5T_STD_I64LE : H5T_NATIVE_INT64));
+        break;
+      case FieldType::kUInt64:
+        member = Handle(H5Tcopy(file ? H5T_STD_U64LE : H5T_NATIVE_UINT64));
+        break;
+      case FieldType::kEnum8: {
+        member = Handle(H5Tenum_create(file ? H5T_STD_I8LE : H5T_NATIVE_INT8));
+        if (!member.valid()) return Handle();
+        for (const auto& [value_name, value] : field.enum_values) {
+          int8_t v = value;
+          if (H5Tenum_insert(member.get(), value_name.c_str(), &v) < 0) {
+            return Handle();
+          }
+        }
+        break;
+      }
+      case FieldType::kString:
+        member = Handle(H5Tcopy(H5T_C_S1));
+        if (!member.valid() ||
+            H5Tset_size(member.get(), field.string_bytes) < 0 ||
+            H5Tset_strpad(member.get(), H5T_STR_NULLPAD) < 0 ||
+            H5Tset_cset(member.get(), H5T_CSET_UTF8) < 0) {
+          return Handle();
+        }
+        break;
+    }
+    if (!member.valid() || H5Tinsert(compound.get(), field.name.c_str(), offset,
+                                     member.get()) < 0) {
+      return Handle();
+    }
+    offset += FieldSize(field);
+  }
+  return compound;
+}
+
+// The attribute `name` of `loc`, or a Corruption naming it.
+Result<Handle> OpenAttr(hid_t loc, const std::string& name) {
+  const htri_t exists = H5Aexists(loc, name.c_str());
+  if (exists < 0) return ReadHdf5Error(PathOf(loc, ""), "attribute " + name);
+  if (exists == 0) {
+    return ReadError(PathOf(loc, "") + ": missing attribute '" + name + "'");
+  }
+  Handle attr(H5Aopen(loc, name.c_str(), H5P_DEFAULT));
+  if (!attr.valid()) {
+    return ReadHdf5Error(PathOf(loc, ""), "opening attribute '" + name + "'");
+  }
+  return attr;
+}
+
+// Reads a one-element numeric attribute converted to `mem_type`.
+template <typename T>
+Result<T> ReadNumericAttr(hid_t loc, const std::string& name, hid_t mem_type) {
+  Result<Handle> attr = OpenAttr(loc, name);
+  if (!attr.ok()) return attr.status();
+  const std::string what = PathOf(loc, "") + ": attribute '" + name + "'";
+  Handle type(H5Aget_type(attr->get()));
+  Handle space(H5Aget_space(attr->get()));
+  if (!type.valid() || !space.valid()) return ReadHdf5Error(what, "type");
+  const H5T_class_t type_class = H5Tget_class(type.get());
+  if (type_class != H5T_FLOAT && type_class != H5T_INTEGER) {
+    return ReadError(what + " is " + TypeClassName(type_class) +
+                     ", expected a number");
+  }
+  if (H5Sget_simple_extent_npoints(space.get()) != 1) {
+    return ReadError(what + " is not a single value");
+  }
+  T value{};
+  if (H5Aread(attr->get(), mem_type, &value) < 0) {
+    return ReadHdf5Error(what, "reading");
+  }
+  return value;
+}
+
+// Reads a one-element string (variable or fixed length) from an attribute
+// or dataset: `is_attr` picks H5Aread/H5Dread.
+Result<std::string> ReadScalarString(hid_t obj, bool is_attr,
+                                     const std::string& what) {
+  Handle type(is_attr ? H5Aget_type(obj) : H5Dget_type(obj));
+  Handle space(is_attr ? H5Aget_space(obj) : H5Dget_space(obj));
+  if (!type.valid() || !space.valid()) return ReadHdf5Error(what, "type");
+  const H5T_class_t type_class = H5Tget_class(type.get());
+  if (type_class != H5T_STRING) {
+    return ReadError(what + " is " + TypeClassName(type_class) +
+                     ", expected a string");
+  }
+  if (H5Sget_simple_extent_npoints(space.get()) != 1) {
+    return ReadError(what + " is not a single string");
+  }
+  const htri_t variable = H5Tis_variable_str(type.get());
+  if (variable < 0) return ReadHdf5Error(what, "type");
+  if (variable > 0) {
+    Handle mem_type(H5Tcopy(type.get()));  // keeps the file's charset
+    char* text = nullptr;
+    const herr_t rc = is_attr ? H5Aread(obj, mem_type.get(), &text)
+                              : H5Dread(obj, mem_type.get(), H5S_ALL, H5S_ALL,
+                                        H5P_DEFAULT, &text);
+    if (rc < 0) return ReadHdf5Error(what, "reading");
+    std::string value = text != nullptr ? std::string(text) : std::string();
+    if (text != nullptr) H5free_memory(text);
+    return value;
+  }
+  const size_t size = H5Tget_size(type.get());
+  if (size == 0) return ReadHdf5Error(what, "type size");
+  std::vector<char> buffer(size + 1, '\0');
+  const herr_t rc = is_attr ? H5Aread(obj, type.get(), buffer.data())
+                            : H5Dread(obj, type.get(), H5S_ALL, H5S_ALL,
+                                      H5P_DEFAULT, buffer.data());
+  if (rc < 0) return ReadHdf5Error(what, "reading");
+  return std::string(buffer.data(), ::strnlen(buffer.data(), size));
+}
+
+// Creates (replacing) a scalar attribute and writes one value.
+Status WriteAttr(hid_t loc, const std::string& name, hid_t file_type,
+                 hid_t mem_type, const void* value) {
+  const std::string what = PathOf(loc, "") + ": attribute '" + name + "'";
+  const htri_t exists = H5Aexists(loc, name.c_str());
+  if (exists < 0) return WriteHdf5Error(what, "checking");
+  if (exists > 0 && H5Adelete(loc, name.c_str()) < 0) {
+    return WriteHdf5Error(what, "replacing");
+  }
+  Handle space(H5Screate(H5S_SCALAR));
+  if (!space.valid()) return WriteHdf5Error(what, "dataspace");
+  Handle attr(H5Acreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT,
+                         H5P_DEFAULT));
+  if (!attr.valid()) return WriteHdf5Error(what, "creating");
+  if (H5Awrite(attr.get(), mem_type, value) < 0) {
+    return WriteHdf5Error(what, "writing");
+  }
+  if (!attr.Close()) return WriteHdf5Error(what, "closing");
+  return Status::Ok();
+}
+
+herr_t CollectAttrName(hid_t /*loc*/, const char* name,
+                       const H5A_info_t* /*info*/, void* data) {
+  static_cast<std::vector<std::string>*>(data)->push_back(name);
+  return 0;
+}
+
+}  // namespace
+
+Hdf5Session::Hdf5Session() : lock_(Hdf5Mutex()) {
+  if (H5Eget_auto2(H5E_DEFAULT, &saved_func_, &saved_data_) >= 0) {
+    restore_ = true;
+  }
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+}
+
+Hdf5Session::~Hdf5Session() {
+  H5Eclear2(H5E_DEFAULT);
+  if (restore_) H5Eset_auto2(H5E_DEFAULT, saved_func_, saved_data_);
+}
+
+bool Handle::Close() {
+  if (id_ < 0) return true;
+  const hid_t id = std::exchange(id_, -1);
+  herr_t rc = -1;
+  switch (H5Iget_type(id)) {
+    case H5I_FILE:
+      rc = H5Fclose(id);
+      break;
+    case H5I_GROUP:
+      rc = H5Gclose(id);
+      break;
+    case H5I_DATASET:
+      rc = H5Dclose(id);
+      break;
+    case H5I_DATASPACE:
+      rc = H5Sclose(id);
+      break;
+    case H5I_DATATYPE:
+      rc = H5Tclose(id);
+      break;
+    case H5I_ATTR:
+      rc = H5Aclose(id);
+      break;
+    case H5I_GENPROP_LST:
+      rc = H5Pclose(id);
+      break;
+    default:
+      rc = H5Idec_ref(id) < 0 ? -1 : 0;
+      break;
+  }
+  return rc >= 0;
+}
+
+std::string TakeHdf5Error() {
+  std::vector<std::string> descriptions;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_DOWNWARD, CollectErrors, &descriptions);
+  H5Eclear2(H5E_DEFAULT);
+  if (descriptions.empty()) return "unknown HDF5 error";
+  // Downward: from the API call to the deepest cause. Name both when they
+  // differ, e.g. "unable to open file (truncated file: eof = ...)".
+  if (descriptions.size() == 1) return descriptions.front();
+  return descriptions.front() + " (" + descriptions.back() + ")";
+}
+
+Handle MakeFileAccessProps() {
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS));
+  if (!fapl.valid()) return fapl;
+#if H5_VERSION_GE(1, 10, 7)
+  H5Pset_file_locking(fapl.get(), /*use_file_locking=*/false,
+                      /*ignore_when_disabled=*/true);
+#endif
+  // Closing the file id really closes the file, whatever ids leak.
+  H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_STRONG);
+  // The 1.10 file format checksums all metadata, so damage is reported
+  // instead of being read (or crashing libhdf5). Pinned, not "latest", so
+  // files stay readable by HDF5 1.10+ whatever library adse is built with.
+#if H5_VERSION_GE(1, 10, 2)
+  H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V110, H5F_LIBVER_V110);
+#endif
+  return fapl;
+}
+
+htri_t IsHdf5File(const std::string& path) {
+#if H5_VERSION_GE(1, 12, 0)
+  Handle fapl = MakeFileAccessProps();
+  return H5Fis_accessible(path.c_str(), fapl.get());
+#else
+  return H5Fis_hdf5(path.c_str());
+#endif
+}
+
+Handle MakeGroupCreateProps() {
+  Handle gcpl(H5Pcreate(H5P_GROUP_CREATE));
+  if (gcpl.valid()) H5Pset_obj_track_times(gcpl.get(), false);
+  return gcpl;
+}
+
+ObjectKind GetObjectKind(hid_t file, const std::string& path) {
+  // H5Lexists fails (rather than returning 0) on a missing parent, so walk
+  // the components.
+  size_t pos = 0;
+  while (pos != std::string::npos) {
+    pos = path.find('/', pos + 1);
+    const std::string prefix = path.substr(0, pos);
+    if (prefix.empty() || prefix == "/") continue;
+    if (H5Lexists(file, prefix.c_str(), H5P_DEFAULT) <= 0) {
+      H5Eclear2(H5E_DEFAULT);
+      return ObjectKind::kMissing;
+    }
+  }
+  Handle object(H5Oopen(file, path.c_str(), H5P_DEFAULT));
+  if (!object.valid()) {
+    H5Eclear2(H5E_DEFAULT);
+    return ObjectKind::kOther;  // e.g. a dangling soft link
+  }
+  switch (H5Iget_type(object.get())) {
+    case H5I_GROUP:
+      return ObjectKind::kGroup;
+    case H5I_DATASET:
+      return ObjectKind::kDataset;
+    default:
+      return ObjectKind::kOther;
+  }
+}
+
+const char* TypeClassName(H5T_class_t type_class) {
+  switch (type_class) {
+    case H5T_INTEGER:
+      return "int";
+    case H5T_FLOAT:
+      return "float";
+    case H5T_STRING:
+      return "string";
+    case H5T_ENUM:
+      return "enum";
+    case H5T_COMPOUND:
+      return "compound";
+    case H5T_TIME:
+      return "time";
+    case H5T_BITFIELD:
+      return "bitfield";
+    case H5T_OPAQUE:
+      return "opaque";
+    case H5T_REFERENCE:
+      return "reference";
+    case H5T_VLEN:
+      return "vlen";
+    case H5T_ARRAY:
+      return "array";
+    default:
+      return "unknown";
+  }
+}
+
+Status WriteStringAttr(hid_t loc, const std::string& name,
+                       const std::string& value) {
+  Handle type = MakeFixedStringType(value);
+  if (!type.valid()) return WriteHdf5Error(PathOf(loc, ""), "string type");
+  const std::vector<char> bytes = PaddedString(value);
+  return WriteAttr(loc, name, type.get(), type.get(), bytes.data());
+}
+
+Status WriteF64Attr(hid_t loc, const std::string& name, double value) {
+  return WriteAttr(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
+}
+
+Status WriteI32Attr(hid_t loc, const std::string& name, int32_t value) {
+  return WriteAttr(loc, name, H5T_STD_I32LE, H5T_NATIVE_INT32, &value);
+}
+
+Status WriteU64Attr(hid_t loc, const std::string& name, uint64_t value) {
+  return WriteAttr(loc, name, H5T_STD_U64LE, H5T_NATIVE_UINT64, &value);
+}
+
+Result<std::string> ReadStringAttr(hid_t loc, const std::string& name) {
+  Result<Handle> attr = OpenAttr(loc, name);
+  if (!attr.ok()) return attr.status();
+  return ReadScalarString(attr->get(), /*is_attr=*/true,
+                          PathOf(loc, "") + ": attribute '" + name + "'");
+}
+
+Result<double> ReadF64Attr(hid_t loc, const std::string& name) {
+  return ReadNumericAttr<double>(loc, name, H5T_NATIVE_DOUBLE);
+}
+
+Result<int64_t> ReadI64Attr(hid_t loc, const std::string& name) {
+  return ReadNumericAttr<int64_t>(loc, name, H5T_NATIVE_INT64);
+}
+
+Result<uint64_t> ReadU64Attr(hid_t loc, const std::string& name) {
+  return ReadNumericAttr<uint64_t>(loc, name, H5T_NATIVE_UINT64);
+}
+
+Result<std::vector<std::string>> ListAttributes(hid_t loc) {
+  std::vector<std::string> names;
+  hsize_t index = 0;
+  if (H5Aiterate2(loc, H5_INDEX_NAME, H5_ITER_INC, &index, CollectAttrName,
+                  &names) < 0) {
+    return ReadHdf5Error(PathOf(loc, ""), "listing attributes");
+  }
+  return names;
+}
+
+Status WriteStringDataset(hid_t parent, const std::string& name,
+                          const std::string& value) {
+  const std::string what = PathOf(parent, name);
+  Handle type = MakeFixedStringType(value);
+  Handle space(H5Screate(H5S_SCALAR));
+  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE));
+  if (!type.valid() || !space.valid() || !dcpl.valid() ||
+      H5Pset_obj_track_times(dcpl.get(), false) < 0) {
+    return WriteHdf5Error(what, "preparing");
+  }
+  Handle dataset(H5Dcreate2(parent, name.c_str(), type.get(), space.get(),
+                            H5P_DEFAULT, dcpl.get(), H5P_DEFAULT));
+  if (!dataset.valid()) return WriteHdf5Error(what, "creating");
+  const std::vector<char> bytes = PaddedString(value);
+  if (H5Dwrite(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT,
+               bytes.data()) < 0) {
+    return WriteHdf5Error(what, "writing");
+  }
+  if (!dataset.Close()) return WriteHdf5Error(what, "closing");
+  return Status::Ok();
+}
+
+Result<std::string> ReadStringDataset(hid_t parent, const std::string& name) {
+  const std::string what = PathOf(parent, name);
+  const ObjectKind kind = GetObjectKind(parent, what);
+  if (kind != ObjectKind::kDataset) {
+    return ReadError(what + ": missing dataset");
+  }
+  Handle dataset(H5Dopen2(parent, name.c_str(), H5P_DEFAULT));
+  if (!dataset.valid()) return ReadHdf5Error(what, "opening");
+  return ReadScalarString(dataset.get(), /*is_attr=*/false, what);
+}
+
+size_t FieldSize(const FieldDesc& field) {
+  switch (field.type) {
+    case FieldType::kFloat64:
+    case FieldType::kInt64:
+    case FieldType::kUInt64:
+      return 8;
+    case FieldType::kInt32:
+      return 4;
+    case FieldType::kEnum8:
+      return 1;
+    case FieldType::kString:
+      return field.string_bytes;
+  }
+  return 0;
+}
+
+size_t RowSize(const std::vector<FieldDesc>& fields) {
+  size_t size = 0;
+  for (const FieldDesc& field : fields) size += FieldSize(field);
+  return size;
+}
+
+H5T_class_t FieldClass(FieldType type) {
+  switch (type) {
+    case FieldType::kFloat64:
+      return H5T_FLOAT;
+    case FieldType::kInt32:
+    case FieldType::kInt64:
+    case FieldType::kUInt64:
+      return H5T_INTEGER;
+    case FieldType::kEnum8:
+      return H5T_ENUM;
+    case FieldType::kString:
+      return H5T_STRING;
+  }
+  return H5T_NO_CLASS;
+}
+
+Status WriteRows(hid_t parent, const std::string& name,
+                 const std::vector<FieldDesc>& fields, size_t rows,
+                 const char* data) {
+  const std::string what = PathOf(parent, name);
+  Handle file_type = MakeCompoundType(fields, /*file=*/true);
+  Handle mem_type = MakeCompoundType(fields, /*file=*/false);
+  if (!file_type.valid() || !mem_type.valid()) {
+    return WriteHdf5Error(what, "building the row type");
+  }
+  const hsize_t dims[1] = {static_cast<hsize_t>(rows)};
+  const hsize_t max_dims[1] = {H5S_UNLIMITED};
+  Handle space(H5Screate_simple(1, dims, max_dims));
+  const size_t row_size = std::max<size_t>(1, RowSize(fields));
+  size_t chunk_rows =
+      std::clamp<size_t>(kMaxChunkBytes / row_size, 1, kMaxChunkRows);
+  if (rows > 0) chunk_rows = std::min(chunk_rows, rows);
+  const hsize_t chunk[1] = {static_cast<hsize_t>(chunk_rows)};
+  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE));
+  if (!space.valid() || !dcpl.valid() ||
+      H5Pset_chunk(dcpl.get(), 1, chunk) < 0 ||
+      H5Pset_shuffle(dcpl.get()) < 0 ||
+      H5Pset_deflate(dcpl.get(), kDeflateLevel) < 0 ||
+      H5Pset_fletcher32(dcpl.get()) < 0 ||
+      H5Pset_obj_track_times(dcpl.get(), false) < 0) {
+    return WriteHdf5Error(what, "preparing");
+  }
+  Handle dataset(H5Dcreate2(parent, name.c_str(), file_type.get(), space.get(),
+                            H5P_DEFAULT, dcpl.get(), H5P_DEFAULT));
+  if (!dataset.valid()) return WriteHdf5Error(what, "creating");
+  if (rows > 0 && H5Dwrite(dataset.get(), mem_type.get(), H5S_ALL, H5S_ALL,
+                           H5P_DEFAULT, data) < 0) {
+    return WriteHdf5Error(what, "writing " + std::to_string(rows) + " rows");
+  }
+  if (!dataset.Close()) return WriteHdf5Error(what, "closing");
+  return Status::Ok();
+}
+
+Result<PackedRows> ReadRows(hid_t parent, const std::string& name,
+                            const std::vector<FieldDesc>& fields) {
+  const std::string what = PathOf(parent, name);
+  if (GetObjectKind(parent, what) != ObjectKind::kDataset) {
+    return ReadError(what + ": missing dataset");
+  }
+  Handle dataset(H5Dopen2(parent, name.c_str(), H5P_DEFAULT));
+  if (!dataset.valid()) return ReadHdf5Error(what, "opening");
+  Handle type(H5Dget_type(dataset.get()));
+  Handle space(H5Dget_space(dataset.get()));
+  if (!type.valid() || !space.valid()) return ReadHdf5Error(what, "type");
+  const H5T_class_t type_class = H5Tget_class(type.get());
+  if (type_class != H5T_COMPOUND) {
+    return ReadError(what + ": is " + TypeClassName(type_class) +
+                     ", expected a compound (table) dataset");
+  }
+  // A damaged type can place members outside the row; HDF5's conversion
+  // would then read out of bounds, so refuse such a type up front.
+  const size_t type_size = H5Tget_size(type.get());
+  const int members = H5Tget_nmembers(type.get());
+  if (type_size == 0 || members < 0) return ReadHdf5Error(what, "row type");
+  for (int i = 0; i < members; ++i) {
+    Handle member(H5Tget_member_type(type.get(), static_cast<unsigned>(i)));
+    const size_t offset =
+        H5Tget_member_offset(type.get(), static_cast<unsigned>(i));
+    const size_t size = member.valid() ? H5Tget_size(member.get()) : 0;
+    if (size == 0 || offset > type_size || size > type_size - offset) {
+      return ReadError(what + ": damaged row type (field " + std::to_string(i) +
+                       " lies outside the row)");
+    }
+  }
+  for (const FieldDesc& field : fields) {
+    const int index = H5Tget_member_index(type.get(), field.name.c_str());
+    if (index < 0) {
+      H5Eclear2(H5E_DEFAULT);
+      return ReadError(what + ": missing field '" + field.name + "'");
+    }
+    const H5T_class_t member_class =
+        H5Tget_member_class(type.get(), static_cast<unsigned>(index));
+    if (member_class != FieldClass(field.type)) {
+      return ReadError(what + ": field '" + field.name + "' is " +
+                       TypeClassName(member_class) + ", expected " +
+                       TypeClassName(FieldClass(field.type)));
+    }
+    if (field.type == FieldType::kString) {
+      Handle member(
+          H5Tget_member_type(type.get(), static_cast<unsigned>(index)));
+      if (!member.valid() || H5Tis_variable_str(member.get()) != 0) {
+        return ReadError(what + ": field '" + field.name +
+                         "' must be a fixed-length string");
+      }
+    }
+  }
+  if (H5Sget_simple_extent_ndims(space.get()) != 1) {
+    return ReadError(what + ": expected a 1-D dataset");
+  }
+  hsize_t dims[1] = {0};
+  if (H5Sget_simple_extent_dims(space.get(), dims, nullptr) < 0) {
+    return ReadHdf5Error(what, "shape");
+  }
+  Handle mem_type = MakeCompoundType(fields, /*file=*/false);
+  if (!mem_type.valid()) return ReadHdf5Error(what, "building the row type");
+  PackedRows packed;
+  packed.rows = static_cast<size_t>(dims[0]);
+  packed.bytes.assign(packed.rows * RowSize(fields), '\0');
+  if (packed.rows > 0 &&
+      H5Dread(dataset.get(), mem_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT,
+              packed.bytes.data()) < 0) {
+    return ReadHdf5Error(what,
+                         "reading " + std::to_string(packed.rows) + " rows");
+  }
+  return packed;
+}
+
+}  // namespace adse::runfile::internal

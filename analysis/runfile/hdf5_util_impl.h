@@ -1,0 +1,137 @@
+// Private to analysis/runfile: thin RAII and helpers over the HDF5 C API.
+// The only header of the module that includes hdf5.h.
+#ifndef ADSE_ANALYSIS_RUNFILE_HDF5_UTIL_IMPL_H_
+#define ADSE_ANALYSIS_RUNFILE_HDF5_UTIL_IMPL_H_
+
+#include <hdf5.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "stack/base/status.h"
+
+namespace adse::runfile::internal {
+
+// Held for the duration of every public call: serializes HDF5 use (the
+// library may be built without thread safety) and turns off HDF5's own
+// error printing, restoring the caller's setting afterwards.
+class Hdf5Session {
+ public:
+  Hdf5Session();
+  ~Hdf5Session();
+  Hdf5Session(const Hdf5Session&) = delete;
+  Hdf5Session& operator=(const Hdf5Session&) = delete;
+
+ private:
+  std::unique_lock<std::mutex> lock_;
+  H5E_auto2_t saved_func_ = nullptr;
+  void* saved_data_ = nullptr;
+  bool restore_ = false;
+};
+
+// Owns one HDF5 id of any kind and closes it on destruction.
+class Handle {
+ public:
+  Handle() = default;
+  explicit Handle(hid_t id) : id_(id) {}
+  ~Handle() { Reset(); }
+  Handle(Handle&& other) noexcept : id_(std::exchange(other.id_, -1)) {}
+  Handle& operator=(Handle&& other) noexcept {
+    if (this != &other) {
+      Reset();
+      id_ = std::exchange(other.id_, -1);
+    }
+    return *this;
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+
+  hid_t get() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+  // Closes now; false if HDF5 reported an error (e.g. a failed flush).
+  bool Close();
+  void Reset() { (void)Close(); }
+
+ private:
+  hid_t id_ = -1;
+};
+
+// The innermost description on HDF5's error stack of this thread (the most
+// specific one, e.g. "truncated file: eof = ..."), then clears the stack.
+std::string TakeHdf5Error();
+
+// File access properties: the HDF5 1.10 file format (checksummed metadata)
+// and no file locking (useless for write-once files and unsupported on some
+// NFS/Lustre mounts, where it makes opens fail).
+Handle MakeFileAccessProps();
+// H5Fis_hdf5 / H5Fis_accessible: >0 HDF5, 0 not HDF5, <0 unreadable.
+htri_t IsHdf5File(const std::string& path);
+// Creation properties that leave out object timestamps, so the same run
+// gives the same bytes.
+Handle MakeGroupCreateProps();
+
+enum class ObjectKind { kMissing, kGroup, kDataset, kOther };
+// What `path` (absolute, '/'-separated) names below `file`; checks each
+// component so that a missing parent is not an error.
+ObjectKind GetObjectKind(hid_t file, const std::string& path);
+
+// "float", "int", "string", "enum", "compound", ... for an HDF5 type class.
+const char* TypeClassName(H5T_class_t type_class);
+
+// Scalar attributes. Strings are written as fixed-length UTF-8 of their
+// own size (see MakeFixedStringType); reads also accept variable-length.
+// Numeric reads convert from any int/float.
+Status WriteStringAttr(hid_t loc, const std::string& name,
+                       const std::string& value);
+Status WriteF64Attr(hid_t loc, const std::string& name, double value);
+Status WriteI32Attr(hid_t loc, const std::string& name, int32_t value);
+Status WriteU64Attr(hid_t loc, const std::string& name, uint64_t value);
+Result<std::string> ReadStringAttr(hid_t loc, const std::string& name);
+Result<double> ReadF64Attr(hid_t loc, const std::string& name);
+Result<int64_t> ReadI64Attr(hid_t loc, const std::string& name);
+Result<uint64_t> ReadU64Attr(hid_t loc, const std::string& name);
+// Names of all attributes of `loc`, in name order.
+Result<std::vector<std::string>> ListAttributes(hid_t loc);
+
+// Scalar string dataset, written like string attributes.
+Status WriteStringDataset(hid_t parent, const std::string& name,
+                          const std::string& value);
+Result<std::string> ReadStringDataset(hid_t parent, const std::string& name);
+
+// One field of a compound row dataset. Rows are packed (no padding) in the
+// order of the fields, in the file and in memory alike.
+enum class FieldType { kFloat64, kInt32, kInt64, kUInt64, kEnum8, kString };
+struct FieldDesc {
+  std::string name;
+  FieldType type = FieldType::kFloat64;
+  size_t string_bytes = 0;                                  // kString only
+  std::vector<std::pair<std::string, int8_t>> enum_values;  // kEnum8 only
+};
+size_t FieldSize(const FieldDesc& field);
+size_t RowSize(const std::vector<FieldDesc>& fields);
+// The HDF5 type class a field must have in a file.
+H5T_class_t FieldClass(FieldType type);
+
+// Writes `rows` packed rows as a 1-D chunked, compressed compound dataset
+// in one H5Dwrite. `data` may be null when rows == 0.
+Status WriteRows(hid_t parent, const std::string& name,
+                 const std::vector<FieldDesc>& fields, size_t rows,
+                 const char* data);
+
+struct PackedRows {
+  size_t rows = 0;
+  std::vector<char> bytes;  // rows * RowSize(fields)
+};
+// Reads a compound row dataset into packed rows, converting by field name
+// (field order and extra fields in the file do not matter). Fails naming
+// the dataset if it is missing, not 1-D compound, or lacks a field.
+Result<PackedRows> ReadRows(hid_t parent, const std::string& name,
+                            const std::vector<FieldDesc>& fields);
+
+}  // namespace adse::runfile::internal
+
+#endif  // ADSE_ANALYSIS_RUNFILE_HDF5_UTIL_IMPL_H_

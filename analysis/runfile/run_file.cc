@@ -1,0 +1,720 @@
+#include "analysis/runfile/run_file.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <functional>
+#include <new>
+
+#include "analysis/runfile/hdf5_util_impl.h"
+#include "stack/base/files.h"
+#include "stack/base/hash.h"
+
+namespace adse::runfile {
+namespace {
+
+namespace fs = std::filesystem;
+using internal::FieldDesc;
+using internal::FieldType;
+using internal::Handle;
+
+// ---------------------------------------------------------------------------
+// Row layouts. Each table is a list of columns that know how to pack a field
+// of a C++ row into the packed HDF5 row and back; names, types and order are
+// those of results-schema/run.schema.json.
+
+template <typename Row>
+struct Column {
+  FieldDesc desc;
+  std::function<void(const Row&, char*)> pack;
+  std::function<void(const char*, Row*)> unpack;
+};
+
+template <typename Row, typename T>
+Column<Row> Scalar(const char* name, FieldType type, T Row::*member) {
+  return {FieldDesc{name, type, 0, {}},
+          [member](const Row& row, char* out) {
+            std::memcpy(out, &(row.*member), sizeof(T));
+          },
+          [member](const char* in, Row* row) {
+            std::memcpy(&(row->*member), in, sizeof(T));
+          }};
+}
+
+template <typename Row>
+Column<Row> F64(const char* name, double Row::*member) {
+  return Scalar(name, FieldType::kFloat64, member);
+}
+template <typename Row>
+Column<Row> I32(const char* name, int32_t Row::*member) {
+  return Scalar(name, FieldType::kInt32, member);
+}
+template <typename Row>
+Column<Row> I64(const char* name, int64_t Row::*member) {
+  return Scalar(name, FieldType::kInt64, member);
+}
+template <typename Row>
+Column<Row> U64(const char* name, uint64_t Row::*member) {
+  return Scalar(name, FieldType::kUInt64, member);
+}
+
+// Copies at most `width` bytes, backing off so a UTF-8 character is never
+// split; the rest of the field stays NUL (the buffer is zeroed).
+void PackString(const std::string& value, size_t width, char* out) {
+  size_t n = std::min(value.size(), width);
+  if (n < value.size()) {
+    while (n > 0 && (static_cast<unsigned char>(value[n]) & 0xC0) == 0x80) --n;
+  }
+  std::memcpy(out, value.data(), n);
+}
+
+template <typename Row>
+Column<Row> Str(const char* name, size_t width, std::string Row::*member) {
+  return {FieldDesc{name, FieldType::kString, width, {}},
+          [member, width](const Row& row, char* out) {
+            PackString(row.*member, width, out);
+          },
+          [member, width](const char* in, Row* row) {
+            (row->*member).assign(in, ::strnlen(in, width));
+          }};
+}
+
+Column<stack::TopicEvent> TopicKindColumn() {
+  using stack::TopicEvent;
+  return {FieldDesc{"kind",
+                    FieldType::kEnum8,
+                    0,
+                    {{"publish", TopicEvent::kPublish},
+                     {"take", TopicEvent::kTake},
+                     {"drop", TopicEvent::kDrop}}},
+          [](const TopicEvent& row, char* out) {
+            const int8_t kind = row.kind;
+            std::memcpy(out, &kind, 1);
+          },
+          [](const char* in, TopicEvent* row) {
+            int8_t kind = 0;
+            std::memcpy(&kind, in, 1);
+            row->kind = static_cast<TopicEvent::Kind>(kind);
+          }};
+}
+
+// Rows of the small index tables.
+struct IndexedName {
+  int32_t index = 0;
+  std::string name;
+};
+struct CallbackInfoRow {
+  int32_t index = 0;
+  std::string name;
+  int32_t node = -1;
+  std::string kind;
+  int32_t topic = -1;
+  double period_s = 0.0;
+};
+struct OverrunRow {
+  int32_t callback = 0;
+  int64_t count = 0;
+};
+
+const std::vector<Column<EgoSample>>& EgoColumns() {
+  static const auto* columns = new std::vector<Column<EgoSample>>{
+      F64("t_s", &EgoSample::t_s),
+      F64("x_m", &EgoSample::x_m),
+      F64("y_m", &EgoSample::y_m),
+      F64("yaw_rad", &EgoSample::yaw_rad),
+      F64("v_mps", &EgoSample::v_mps),
+      F64("steer_rad", &EgoSample::steer_rad),
+      F64("accel_mps2", &EgoSample::accel_mps2)};
+  return *columns;
+}
+
+const std::vector<Column<PathPoint>>& PathColumns() {
+  static const auto* columns = new std::vector<Column<PathPoint>>{
+      F64("s_m", &PathPoint::s_m), F64("x_m", &PathPoint::x_m),
+      F64("y_m", &PathPoint::y_m)};
+  return *columns;
+}
+
+const std::vector<Column<VehicleSample>>& VehicleColumns() {
+  static const auto* columns = new std::vector<Column<VehicleSample>>{
+      F64("t_s", &VehicleSample::t_s),
+      Str("id", kIdBytes, &VehicleSample::id),
+      F64("x_m", &VehicleSample::x_m),
+      F64("y_m", &VehicleSample::y_m),
+      F64("yaw_rad", &VehicleSample::yaw_rad),
+      F64("speed_mps", &VehicleSample::speed_mps),
+      F64("length_m", &VehicleSample::length_m),
+      F64("width_m", &VehicleSample::width_m)};
+  return *columns;
+}
+
+const std::vector<Column<CollisionEvent>>& CollisionColumns() {
+  static const auto* columns = new std::vector<Column<CollisionEvent>>{
+      F64("t_s", &CollisionEvent::t_s),
+      Str("other_id", kIdBytes, &CollisionEvent::other_id)};
+  return *columns;
+}
+
+const std::vector<Column<IndexedName>>& IndexedNameColumns() {
+  static const auto* columns = new std::vector<Column<IndexedName>>{
+      I32("index", &IndexedName::index),
+      Str("name", kNameBytes, &IndexedName::name)};
+  return *columns;
+}
+
+const std::vector<Column<CallbackInfoRow>>& CallbackInfoColumns() {
+  static const auto* columns = new std::vector<Column<CallbackInfoRow>>{
+      I32("index", &CallbackInfoRow::index),
+      Str("name", kNameBytes, &CallbackInfoRow::name),
+      I32("node", &CallbackInfoRow::node),
+      Str("kind", kKindBytes, &CallbackInfoRow::kind),
+      I32("topic", &CallbackInfoRow::topic),
+      F64("period_s", &CallbackInfoRow::period_s)};
+  return *columns;
+}
+
+const std::vector<Column<stack::CallbackRecord>>& CallbackColumns() {
+  using stack::CallbackRecord;
+  static const auto* columns = new std::vector<Column<CallbackRecord>>{
+      I32("callback", &CallbackRecord::callback),
+      I32("node", &CallbackRecord::node),
+      F64("ready_s", &CallbackRecord::ready_s),
+      F64("start_s", &CallbackRecord::start_s),
+      F64("end_s", &CallbackRecord::end_s),
+      F64("cost_s", &CallbackRecord::cost_s),
+      F64("host_cpu_s", &CallbackRecord::host_cpu_s),
+      F64("work_units", &CallbackRecord::work_units),
+      I32("cores", &CallbackRecord::cores),
+      I32("first_core", &CallbackRecord::first_core)};
+  return *columns;
+}
+
+const std::vector<Column<stack::TopicEvent>>& TopicEventColumns() {
+  using stack::TopicEvent;
+  static const auto* columns = new std::vector<Column<TopicEvent>>{
+      TopicKindColumn(),
+      I32("topic", &TopicEvent::topic),
+      I32("callback", &TopicEvent::callback),
+      F64("t_s", &TopicEvent::t_s),
+      U64("seq", &TopicEvent::seq),
+      F64("stamp_s", &TopicEvent::stamp_s)};
+  return *columns;
+}
+
+const std::vector<Column<OverrunRow>>& OverrunColumns() {
+  static const auto* columns = new std::vector<Column<OverrunRow>>{
+      I32("callback", &OverrunRow::callback), I64("count", &OverrunRow::count)};
+  return *columns;
+}
+
+const std::vector<Column<ControlSample>>& ControlColumns() {
+  static const auto* columns = new std::vector<Column<ControlSample>>{
+      F64("t_s", &ControlSample::t_s), F64("stamp_s", &ControlSample::stamp_s),
+      F64("accel_mps2", &ControlSample::accel_mps2),
+      F64("steer_rad", &ControlSample::steer_rad)};
+  return *columns;
+}
+
+template <typename Row>
+std::vector<FieldDesc> Descs(const std::vector<Column<Row>>& columns) {
+  std::vector<FieldDesc> descs;
+  descs.reserve(columns.size());
+  for (const auto& column : columns) descs.push_back(column.desc);
+  return descs;
+}
+
+// Packs all rows into one buffer and writes it with a single H5Dwrite.
+template <typename Row>
+Status WriteTable(hid_t parent, const std::string& name,
+                  const std::vector<Row>& rows,
+                  const std::vector<Column<Row>>& columns) {
+  const std::vector<FieldDesc> descs = Descs(columns);
+  const size_t row_size = internal::RowSize(descs);
+  std::vector<size_t> offsets;
+  size_t offset = 0;
+  for (const auto& desc : descs) {
+    offsets.push_back(offset);
+    offset += internal::FieldSize(desc);
+  }
+  std::vector<char> buffer(rows.size() * row_size, '\0');
+  for (size_t c = 0; c < columns.size(); ++c) {
+    const auto& pack = columns[c].pack;
+    char* out = buffer.data() + offsets[c];
+    for (const Row& row : rows) {
+      pack(row, out);
+      out += row_size;
+    }
+  }
+  return internal::WriteRows(parent, name, descs, rows.size(), buffer.data());
+}
+
+template <typename Row>
+Result<std::vector<Row>> ReadTable(hid_t parent, const std::string& name,
+                                   const std::vector<Column<Row>>& columns) {
+  const std::vector<FieldDesc> descs = Descs(columns);
+  Result<internal::PackedRows> packed = internal::ReadRows(parent, name, descs);
+  if (!packed.ok()) return packed.status();
+  const size_t row_size = internal::RowSize(descs);
+  std::vector<Row> rows(packed->rows);
+  size_t offset = 0;
+  for (const auto& column : columns) {
+    const char* in = packed->bytes.data() + offset;
+    for (Row& row : rows) {
+      column.unpack(in, &row);
+      in += row_size;
+    }
+    offset += internal::FieldSize(column.desc);
+  }
+  return rows;
+}
+
+// ---------------------------------------------------------------------------
+// Writing.
+
+Result<Handle> CreateGroup(hid_t parent, const char* name) {
+  Handle gcpl = internal::MakeGroupCreateProps();
+  Handle group(H5Gcreate2(parent, name, H5P_DEFAULT, gcpl.get(), H5P_DEFAULT));
+  if (!group.valid()) {
+    return Status::IoError(std::string("creating group /") + name + ": " +
+                           internal::TakeHdf5Error());
+  }
+  return group;
+}
+
+Status WriteContents(hid_t file, const RunData& run) {
+  using internal::WriteF64Attr;
+  using internal::WriteStringAttr;
+
+  // Root attributes; `status` comes last so a file cut short never has it.
+  ADSE_RETURN_IF_ERROR(
+      internal::WriteI32Attr(file, "schema_version", kSchemaVersion));
+  ADSE_RETURN_IF_ERROR(WriteStringAttr(file, "adse_version", run.adse_version));
+  ADSE_RETURN_IF_ERROR(
+      WriteStringAttr(file, "scenario_name", run.scenario_name));
+  ADSE_RETURN_IF_ERROR(
+      WriteStringAttr(file, "scenario_hash", run.scenario_hash));
+  ADSE_RETURN_IF_ERROR(WriteStringAttr(file, "content_key", run.content_key));
+  ADSE_RETURN_IF_ERROR(internal::WriteU64Attr(file, "seed", run.seed));
+  ADSE_RETURN_IF_ERROR(
+      WriteStringAttr(file, "termination_reason", run.termination_reason));
+  ADSE_RETURN_IF_ERROR(WriteStringAttr(file, "host", run.host));
+  ADSE_RETURN_IF_ERROR(WriteStringAttr(file, "created_utc", run.created_utc));
+  ADSE_RETURN_IF_ERROR(WriteF64Attr(file, "lane_width_m", run.lane_width_m));
+
+  {
+    Result<Handle> group = CreateGroup(file, "scenario");
+    if (!group.ok()) return group.status();
+    ADSE_RETURN_IF_ERROR(
+        internal::WriteStringDataset(group->get(), "yaml", run.scenario_text));
+  }
+  {
+    Result<Handle> group = CreateGroup(file, "design_point");
+    if (!group.ok()) return group.status();
+    for (const auto& [name, value] : run.design_point) {
+      ADSE_RETURN_IF_ERROR(WriteF64Attr(group->get(), name, value));
+    }
+  }
+  {
+    Result<Handle> group = CreateGroup(file, "platform");
+    if (!group.ok()) return group.status();
+    for (const auto& [name, value] : run.platform) {
+      ADSE_RETURN_IF_ERROR(WriteStringAttr(group->get(), name, value));
+    }
+  }
+  {
+    Result<Handle> group = CreateGroup(file, "ego");
+    if (!group.ok()) return group.status();
+    ADSE_RETURN_IF_ERROR(
+        WriteTable(group->get(), "trajectory", run.ego, EgoColumns()));
+  }
+  {
+    Result<Handle> group = CreateGroup(file, "world");
+    if (!group.ok()) return group.status();
+    ADSE_RETURN_IF_ERROR(
+        WriteTable(group->get(), "ideal_path", run.ideal_path, PathColumns()));
+    ADSE_RETURN_IF_ERROR(
+        WriteTable(group->get(), "vehicles", run.vehicles, VehicleColumns()));
+    ADSE_RETURN_IF_ERROR(WriteTable(group->get(), "collisions", run.collisions,
+                                    CollisionColumns()));
+  }
+  {
+    Result<Handle> group = CreateGroup(file, "trace");
+    if (!group.ok()) return group.status();
+    auto indexed = [](const std::vector<std::string>& names) {
+      std::vector<IndexedName> rows(names.size());
+      for (size_t i = 0; i < names.size(); ++i) {
+        rows[i] = {static_cast<int32_t>(i), names[i]};
+      }
+      return rows;
+    };
+    ADSE_RETURN_IF_ERROR(WriteTable(
+        group->get(), "nodes", indexed(run.node_names), IndexedNameColumns()));
+    std::vector<CallbackInfoRow> info(run.callback_info.size());
+    for (size_t i = 0; i < info.size(); ++i) {
+      const NamedCallback& cb = run.callback_info[i];
+      info[i] = {static_cast<int32_t>(i),
+                 cb.name,
+                 cb.node,
+                 cb.kind,
+                 cb.topic,
+                 cb.period_s};
+    }
+    ADSE_RETURN_IF_ERROR(
+        WriteTable(group->get(), "callback_info", info, CallbackInfoColumns()));
+    ADSE_RETURN_IF_ERROR(WriteTable(group->get(), "topics",
+                                    indexed(run.topic_names),
+                                    IndexedNameColumns()));
+    ADSE_RETURN_IF_ERROR(WriteTable(group->get(), "callbacks",
+                                    run.trace.callbacks, CallbackColumns()));
+    ADSE_RETURN_IF_ERROR(WriteTable(group->get(), "topic_events",
+                                    run.trace.topic_events,
+                                    TopicEventColumns()));
+    std::vector<OverrunRow> overruns(run.trace.timer_overruns.size());
+    for (size_t i = 0; i < overruns.size(); ++i) {
+      overruns[i] = {static_cast<int32_t>(i), run.trace.timer_overruns[i]};
+    }
+    ADSE_RETURN_IF_ERROR(
+        WriteTable(group->get(), "timer_overruns", overruns, OverrunColumns()));
+  }
+  {
+    Result<Handle> group = CreateGroup(file, "control");
+    if (!group.ok()) return group.status();
+    ADSE_RETURN_IF_ERROR(
+        WriteTable(group->get(), "commands", run.controls, ControlColumns()));
+  }
+  {
+    Result<Handle> group = CreateGroup(file, "metrics");
+    if (!group.ok()) return group.status();
+    for (const auto& [name, value] : run.metrics) {
+      ADSE_RETURN_IF_ERROR(WriteF64Attr(group->get(), name, value));
+    }
+  }
+  return WriteStringAttr(file, "status", run.status);
+}
+
+Status Validate(const RunData& run) {
+  if (run.status != "complete" && run.status != "failed") {
+    return Status::InvalidArgument(
+        "run status must be complete or failed, got '" + run.status + "'");
+  }
+  // The hash doubles as the checksum of /scenario/yaml (stored without one).
+  if (!run.scenario_hash.empty() &&
+      run.scenario_hash != Sha256Hex(run.scenario_text)) {
+    return Status::InvalidArgument(
+        "scenario_hash is not the sha256 of scenario_text");
+  }
+  const auto& events = run.trace.topic_events;
+  for (size_t i = 0; i < events.size(); ++i) {
+    const int kind = events[i].kind;
+    if (kind < stack::TopicEvent::kPublish || kind > stack::TopicEvent::kDrop) {
+      return Status::InvalidArgument("topic event " + std::to_string(i) +
+                                     " has unknown kind " +
+                                     std::to_string(kind));
+    }
+  }
+  return Status::Ok();
+}
+
+// Makes `path`'s bytes durable before it is renamed into place.
+Status SyncPath(const std::string& path, bool directory) {
+  const int fd = ::open(path.c_str(), O_RDONLY | (directory ? O_DIRECTORY : 0));
+  if (fd < 0) return Status::IoError(path + ": " + std::strerror(errno));
+  const int rc = ::fsync(fd);
+  const int err = errno;
+  ::close(fd);
+  // Some filesystems refuse fsync on a directory; the rename still holds.
+  if (rc != 0 && !(directory && (err == EINVAL || err == EBADF))) {
+    return Status::IoError(path + ": fsync: " + std::strerror(err));
+  }
+  return Status::Ok();
+}
+
+Status WriteRunFileImpl(const std::string& path, const RunData& run) {
+  ADSE_RETURN_IF_ERROR(Validate(run));
+  const fs::path target(path);
+  if (target.has_parent_path()) {
+    ADSE_RETURN_IF_ERROR(MakeDirs(target.parent_path().string()));
+  }
+  const std::string tmp =
+      path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
+  Status status;
+  {
+    internal::Hdf5Session session;
+    Handle fapl = internal::MakeFileAccessProps();
+    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()));
+    if (!file.valid()) {
+      status = Status::IoError(
+          tmp + ": cannot create HDF5 file: " + internal::TakeHdf5Error());
+    } else {
+      status = WriteContents(file.get(), run).WithContext(tmp);
+      // Closing flushes metadata; a failure here means the file is bad.
+      if (!file.Close() && status.ok()) {
+        status =
+            Status::IoError(tmp + ": closing: " + internal::TakeHdf5Error());
+      }
+    }
+  }
+  if (status.ok()) status = SyncPath(tmp, /*directory=*/false);
+  if (status.ok() && ::rename(tmp.c_str(), path.c_str()) != 0) {
+    status = Status::IoError(path + ": rename from " + tmp +
+                             " failed: " + std::strerror(errno));
+  }
+  if (!status.ok()) {
+    ::unlink(tmp.c_str());
+    return status;
+  }
+  const std::string folder =
+      target.has_parent_path() ? target.parent_path().string() : ".";
+  return SyncPath(folder, /*directory=*/true);
+}
+
+// ---------------------------------------------------------------------------
+// Reading. Every failure is a Corruption whose message names the HDF5 object;
+// the caller prefixes the file name.
+
+template <typename T>
+Status Assign(Result<T> result, T* out) {
+  if (!result.ok()) return result.status();
+  *out = std::move(result).value();
+  return Status::Ok();
+}
+
+Result<Handle> OpenGroup(hid_t file, const std::string& path) {
+  if (internal::GetObjectKind(file, path) != internal::ObjectKind::kGroup) {
+    return Status::Corruption(path + ": missing group");
+  }
+  Handle group(H5Gopen2(file, path.c_str(), H5P_DEFAULT));
+  if (!group.valid()) {
+    return Status::Corruption(path + ": opening: " + internal::TakeHdf5Error());
+  }
+  return group;
+}
+
+// Places index-table rows by their index, which must cover 0..n-1 once.
+Status ByIndex(const std::string& what, std::vector<IndexedName> rows,
+               std::vector<std::string>* out) {
+  out->assign(rows.size(), std::string());
+  std::vector<bool> seen(rows.size(), false);
+  for (IndexedName& row : rows) {
+    if (row.index < 0 || static_cast<size_t>(row.index) >= rows.size() ||
+        seen[row.index]) {
+      return Status::Corruption(what + ": bad or repeated index " +
+                                std::to_string(row.index));
+    }
+    seen[row.index] = true;
+    (*out)[row.index] = std::move(row.name);
+  }
+  return Status::Ok();
+}
+
+Status ReadContents(hid_t file, RunData* run) {
+  using internal::ReadStringAttr;
+  Result<int64_t> version = internal::ReadI64Attr(file, "schema_version");
+  if (!version.ok()) return version.status();
+  if (*version != kSchemaVersion) {
+    return Status::Corruption("/: schema_version " + std::to_string(*version) +
+                              " is not the supported " +
+                              std::to_string(kSchemaVersion));
+  }
+  ADSE_RETURN_IF_ERROR(Assign(ReadStringAttr(file, "status"), &run->status));
+  ADSE_RETURN_IF_ERROR(Assign(ReadStringAttr(file, "termination_reason"),
+                              &run->termination_reason));
+  ADSE_RETURN_IF_ERROR(
+      Assign(ReadStringAttr(file, "adse_version"), &run->adse_version));
+  ADSE_RETURN_IF_ERROR(
+      Assign(ReadStringAttr(file, "scenario_name"), &run->scenario_name));
+  ADSE_RETURN_IF_ERROR(
+      Assign(ReadStringAttr(file, "scenario_hash"), &run->scenario_hash));
+  ADSE_RETURN_IF_ERROR(
+      Assign(ReadStringAttr(file, "content_key"), &run->content_key));
+  ADSE_RETURN_IF_ERROR(Assign(ReadStringAttr(file, "host"), &run->host));
+  ADSE_RETURN_IF_ERROR(
+      Assign(ReadStringAttr(file, "created_utc"), &run->created_utc));
+  ADSE_RETURN_IF_ERROR(Assign(internal::ReadU64Attr(file, "seed"), &run->seed));
+  ADSE_RETURN_IF_ERROR(
+      Assign(internal::ReadF64Attr(file, "lane_width_m"), &run->lane_width_m));
+
+  {
+    Result<Handle> group = OpenGroup(file, "/scenario");
+    if (!group.ok()) return group.status();
+    ADSE_RETURN_IF_ERROR(
+        Assign(internal::ReadStringDataset(group->get(), "yaml"),
+               &run->scenario_text));
+  }
+  if (!run->scenario_hash.empty() &&
+      run->scenario_hash != Sha256Hex(run->scenario_text)) {
+    return Status::Corruption(
+        "/scenario/yaml: text does not match scenario_hash (damaged)");
+  }
+  // Groups holding one attribute per entry.
+  auto read_numbers = [file](const std::string& path,
+                             std::map<std::string, double>* out) -> Status {
+    Result<Handle> group = OpenGroup(file, path);
+    if (!group.ok()) return group.status();
+    Result<std::vector<std::string>> names =
+        internal::ListAttributes(group->get());
+    if (!names.ok()) return names.status();
+    out->clear();
+    for (const std::string& name : *names) {
+      Result<double> value = internal::ReadF64Attr(group->get(), name);
+      if (!value.ok()) return value.status();
+      (*out)[name] = *value;
+    }
+    return Status::Ok();
+  };
+  ADSE_RETURN_IF_ERROR(read_numbers("/design_point", &run->design_point));
+  ADSE_RETURN_IF_ERROR(read_numbers("/metrics", &run->metrics));
+  {
+    Result<Handle> group = OpenGroup(file, "/platform");
+    if (!group.ok()) return group.status();
+    Result<std::vector<std::string>> names =
+        internal::ListAttributes(group->get());
+    if (!names.ok()) return names.status();
+    run->platform.clear();
+    for (const std::string& name : *names) {
+      Result<std::string> value = ReadStringAttr(group->get(), name);
+      if (!value.ok()) return value.status();
+      run->platform[name] = *value;
+    }
+  }
+  {
+    Result<Handle> group = OpenGroup(file, "/ego");
+    if (!group.ok()) return group.status();
+    ADSE_RETURN_IF_ERROR(
+        Assign(ReadTable(group->get(), "trajectory", EgoColumns()), &run->ego));
+  }
+  {
+    Result<Handle> group = OpenGroup(file, "/world");
+    if (!group.ok()) return group.status();
+    ADSE_RETURN_IF_ERROR(
+        Assign(ReadTable(group->get(), "ideal_path", PathColumns()),
+               &run->ideal_path));
+    ADSE_RETURN_IF_ERROR(Assign(
+        ReadTable(group->get(), "vehicles", VehicleColumns()), &run->vehicles));
+    ADSE_RETURN_IF_ERROR(
+        Assign(ReadTable(group->get(), "collisions", CollisionColumns()),
+               &run->collisions));
+  }
+  {
+    Result<Handle> group = OpenGroup(file, "/trace");
+    if (!group.ok()) return group.status();
+    Result<std::vector<IndexedName>> nodes =
+        ReadTable(group->get(), "nodes", IndexedNameColumns());
+    if (!nodes.ok()) return nodes.status();
+    ADSE_RETURN_IF_ERROR(
+        ByIndex("/trace/nodes", std::move(nodes).value(), &run->node_names));
+    Result<std::vector<IndexedName>> topics =
+        ReadTable(group->get(), "topics", IndexedNameColumns());
+    if (!topics.ok()) return topics.status();
+    ADSE_RETURN_IF_ERROR(
+        ByIndex("/trace/topics", std::move(topics).value(), &run->topic_names));
+
+    Result<std::vector<CallbackInfoRow>> info =
+        ReadTable(group->get(), "callback_info", CallbackInfoColumns());
+    if (!info.ok()) return info.status();
+    run->callback_info.assign(info->size(), NamedCallback{});
+    std::vector<bool> seen(info->size(), false);
+    for (CallbackInfoRow& row : *info) {
+      if (row.index < 0 || static_cast<size_t>(row.index) >= info->size() ||
+          seen[row.index]) {
+        return Status::Corruption(
+            "/trace/callback_info: bad or repeated index " +
+            std::to_string(row.index));
+      }
+      seen[row.index] = true;
+      run->callback_info[row.index] = {std::move(row.name), row.node,
+                                       std::move(row.kind), row.topic,
+                                       row.period_s};
+    }
+
+    ADSE_RETURN_IF_ERROR(
+        Assign(ReadTable(group->get(), "callbacks", CallbackColumns()),
+               &run->trace.callbacks));
+    ADSE_RETURN_IF_ERROR(
+        Assign(ReadTable(group->get(), "topic_events", TopicEventColumns()),
+               &run->trace.topic_events));
+
+    Result<std::vector<OverrunRow>> overruns =
+        ReadTable(group->get(), "timer_overruns", OverrunColumns());
+    if (!overruns.ok()) return overruns.status();
+    run->trace.timer_overruns.assign(overruns->size(), 0);
+    for (const OverrunRow& row : *overruns) {
+      if (row.callback < 0 ||
+          static_cast<size_t>(row.callback) >= overruns->size()) {
+        return Status::Corruption("/trace/timer_overruns: bad callback " +
+                                  std::to_string(row.callback));
+      }
+      run->trace.timer_overruns[row.callback] = row.count;
+    }
+  }
+  {
+    Result<Handle> group = OpenGroup(file, "/control");
+    if (!group.ok()) return group.status();
+    ADSE_RETURN_IF_ERROR(Assign(
+        ReadTable(group->get(), "commands", ControlColumns()), &run->controls));
+  }
+  return Status::Ok();
+}
+
+Result<RunData> ReadRunFileImpl(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return Status::NotFound(path + ": no such file");
+  if (fs::is_directory(path, ec)) {
+    return Status::InvalidArgument(path +
+                                   ": is a directory, expected a run file");
+  }
+  internal::Hdf5Session session;
+  const htri_t is_hdf5 = internal::IsHdf5File(path);
+  if (is_hdf5 < 0) {
+    return Status::IoError(path +
+                           ": cannot read: " + internal::TakeHdf5Error());
+  }
+  if (is_hdf5 == 0) {
+    return Status::Corruption(path + ": not an HDF5 file (no HDF5 signature)");
+  }
+  Handle fapl = internal::MakeFileAccessProps();
+  Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get()));
+  if (!file.valid()) {
+    return Status::Corruption(path +
+                              ": cannot open as HDF5 (truncated or "
+                              "damaged?): " +
+                              internal::TakeHdf5Error());
+  }
+  RunData run;
+  Status status = ReadContents(file.get(), &run);
+  if (!status.ok()) {
+    return Status::Corruption(path + ": " + status.message());
+  }
+  return run;
+}
+
+}  // namespace
+
+Status WriteRunFile(const std::string& path, const RunData& run) {
+  try {
+    return WriteRunFileImpl(path, run);
+  } catch (const std::bad_alloc&) {
+    return Status::Internal(path + ": out of memory writing the run file");
+  } catch (const std::exception& e) {
+    return Status::Internal(path + ": writing the run file: " + e.what());
+  }
+}
+
+Result<RunData> ReadRunFile(const std::string& path) {
+  try {
+    return ReadRunFileImpl(path);
+  } catch (const std::bad_alloc&) {
+    // A damaged header can claim absurd sizes.
+    return Status::Corruption(path +
+                              ": out of memory reading (sizes in the "
+                              "file are implausible?)");
+  } catch (const std::exception& e) {
+    return Status::Corruption(path + ": reading the run file: " + e.what());
+  }
+}
+
+}  // namespace adse::runfile

@@ -1,0 +1,333 @@
+// CheckRunFile: validates a run file against results-schema/run.schema.json,
+// driven by the JSON alone so the schema stays the single contract.
+#include <algorithm>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "analysis/runfile/hdf5_util_impl.h"
+#include "analysis/runfile/run_file.h"
+#include "stack/base/files.h"
+#include "stack/base/hash.h"
+
+namespace adse::runfile {
+namespace {
+
+namespace fs = std::filesystem;
+using internal::Handle;
+using internal::ObjectKind;
+using nlohmann::json;
+
+// Schema class names mapped to HDF5 type classes.
+bool ClassMatches(const std::string& schema_class, H5T_class_t actual) {
+  if (schema_class == "float") return actual == H5T_FLOAT;
+  if (schema_class == "int") return actual == H5T_INTEGER;
+  if (schema_class == "string") return actual == H5T_STRING;
+  if (schema_class == "enum") return actual == H5T_ENUM;
+  if (schema_class == "compound") return actual == H5T_COMPOUND;
+  return false;
+}
+
+class Checker {
+ public:
+  Checker(hid_t file, const json& schema, std::vector<std::string>* problems)
+      : file_(file), schema_(schema), problems_(problems) {}
+
+  void Run() {
+    for (const json& attr : schema_.at("root_attributes")) CheckRootAttr(attr);
+    for (const json& group : schema_.at("groups")) CheckGroup(group);
+    for (const json& dataset : schema_.at("datasets")) CheckDataset(dataset);
+  }
+
+ private:
+  void Problem(const std::string& path, const std::string& what) {
+    problems_->push_back(path + ": " + what);
+  }
+
+  // Opens attribute `name` of `loc` and checks its class; invalid if absent
+  // or of the wrong class (a problem is recorded).
+  Handle OpenAttr(hid_t loc, const std::string& loc_path,
+                  const std::string& name, const std::string& schema_class) {
+    const htri_t exists = H5Aexists(loc, name.c_str());
+    if (exists <= 0) {
+      internal::TakeHdf5Error();
+      Problem(loc_path, "missing attribute '" + name + "'");
+      return Handle();
+    }
+    Handle attr(H5Aopen(loc, name.c_str(), H5P_DEFAULT));
+    Handle type(attr.valid() ? H5Aget_type(attr.get()) : -1);
+    if (!type.valid()) {
+      Problem(loc_path, "attribute '" + name +
+                            "' unreadable: " + internal::TakeHdf5Error());
+      return Handle();
+    }
+    const H5T_class_t actual = H5Tget_class(type.get());
+    if (!ClassMatches(schema_class, actual)) {
+      Problem(loc_path, "attribute '" + name + "' is " +
+                            internal::TypeClassName(actual) + ", expected " +
+                            schema_class);
+      return Handle();
+    }
+    return attr;
+  }
+
+  void CheckRootAttr(const json& spec) {
+    const std::string name = spec.at("name").get<std::string>();
+    const std::string schema_class = spec.at("class").get<std::string>();
+    Handle attr = OpenAttr(file_, "/", name, schema_class);
+    if (!attr.valid()) return;
+    attr.Reset();
+    if (name == "schema_version") {
+      const int64_t wanted = schema_.at("schema_version").get<int64_t>();
+      Result<int64_t> version = internal::ReadI64Attr(file_, name);
+      if (!version.ok()) {
+        Problem("/", version.status().message());
+      } else if (*version != wanted) {
+        Problem("/", "schema_version " + std::to_string(*version) +
+                         " is not compatible with schema version " +
+                         std::to_string(wanted));
+      }
+    }
+    if (spec.contains("values") && schema_class == "string") {
+      Result<std::string> value = internal::ReadStringAttr(file_, name);
+      if (!value.ok()) {
+        Problem("/", value.status().message());
+        return;
+      }
+      const auto& values = spec.at("values");
+      if (std::find(values.begin(), values.end(), *value) == values.end()) {
+        Problem("/", "attribute '" + name + "' is '" + *value +
+                         "', expected one of " + values.dump());
+      }
+    }
+  }
+
+  void CheckGroup(const json& spec) {
+    const std::string path = spec.at("path").get<std::string>();
+    const ObjectKind kind = internal::GetObjectKind(file_, path);
+    if (kind == ObjectKind::kMissing) {
+      Problem(path, "missing group");
+      return;
+    }
+    if (kind != ObjectKind::kGroup) {
+      Problem(path, "is not a group");
+      return;
+    }
+    if (!spec.contains("attribute_class")) return;
+    const std::string schema_class =
+        spec.at("attribute_class").get<std::string>();
+    Handle group(H5Gopen2(file_, path.c_str(), H5P_DEFAULT));
+    Result<std::vector<std::string>> names =
+        group.valid() ? internal::ListAttributes(group.get())
+                      : Result<std::vector<std::string>>(Status::Corruption(
+                            "opening: " + internal::TakeHdf5Error()));
+    if (!names.ok()) {
+      Problem(path, names.status().message());
+      return;
+    }
+    for (const std::string& name : *names) {
+      OpenAttr(group.get(), path, name, schema_class);
+    }
+  }
+
+  void CheckDataset(const json& spec) {
+    const std::string path = spec.at("path").get<std::string>();
+    const ObjectKind kind = internal::GetObjectKind(file_, path);
+    if (kind == ObjectKind::kMissing) {
+      Problem(path, "missing dataset");
+      return;
+    }
+    if (kind != ObjectKind::kDataset) {
+      Problem(path, "is not a dataset");
+      return;
+    }
+    Handle dataset(H5Dopen2(file_, path.c_str(), H5P_DEFAULT));
+    Handle type(dataset.valid() ? H5Dget_type(dataset.get()) : -1);
+    Handle space(dataset.valid() ? H5Dget_space(dataset.get()) : -1);
+    if (!type.valid() || !space.valid()) {
+      Problem(path, "unreadable: " + internal::TakeHdf5Error());
+      return;
+    }
+    const H5T_class_t actual = H5Tget_class(type.get());
+    const int rank = H5Sget_simple_extent_ndims(space.get());
+    if (spec.value("shape", std::string("rows")) == "scalar") {
+      if (rank != 0) Problem(path, "expected a scalar dataset");
+      const std::string schema_class = spec.at("class").get<std::string>();
+      if (!ClassMatches(schema_class, actual)) {
+        Problem(path, std::string("is ") + internal::TypeClassName(actual) +
+                          ", expected " + schema_class);
+        return;
+      }
+      if (spec.contains("sha256_attribute")) CheckSha256(path, spec);
+      return;
+    }
+    if (rank != 1) Problem(path, "expected a 1-D dataset (one row per entry)");
+    if (actual != H5T_COMPOUND) {
+      Problem(path, std::string("is ") + internal::TypeClassName(actual) +
+                        ", expected a compound (table) dataset");
+      return;
+    }
+    for (const json& field : spec.at("fields")) CheckField(path, type, field);
+  }
+
+  // A string dataset whose sha256 a root attribute records (when not
+  // empty): the text itself carries no HDF5 checksum.
+  void CheckSha256(const std::string& path, const json& spec) {
+    const std::string attr = spec.at("sha256_attribute").get<std::string>();
+    Result<std::string> hash = internal::ReadStringAttr(file_, attr);
+    if (!hash.ok() || hash->empty()) return;  // reported with the attributes
+    const auto slash = path.rfind('/');
+    Handle parent(H5Oopen(file_,
+                          path.substr(0, std::max<size_t>(slash, 1)).c_str(),
+                          H5P_DEFAULT));
+    Result<std::string> text =
+        parent.valid()
+            ? internal::ReadStringDataset(parent.get(), path.substr(slash + 1))
+            : Result<std::string>(
+                  Status::Corruption(internal::TakeHdf5Error()));
+    if (!text.ok()) {
+      Problem(path, text.status().message());
+    } else if (Sha256Hex(*text) != *hash) {
+      Problem(path, "text does not match attribute '" + attr + "' (damaged)");
+    }
+  }
+
+  void CheckField(const std::string& path, const Handle& type,
+                  const json& field) {
+    const std::string name = field.at("name").get<std::string>();
+    const std::string schema_class = field.at("class").get<std::string>();
+    const int index = H5Tget_member_index(type.get(), name.c_str());
+    if (index < 0) {
+      internal::TakeHdf5Error();
+      Problem(path, "missing field '" + name + "'");
+      return;
+    }
+    Handle member(H5Tget_member_type(type.get(), static_cast<unsigned>(index)));
+    if (!member.valid()) {
+      Problem(path,
+              "field '" + name + "' unreadable: " + internal::TakeHdf5Error());
+      return;
+    }
+    const H5T_class_t actual = H5Tget_class(member.get());
+    if (!ClassMatches(schema_class, actual)) {
+      Problem(path, "field '" + name + "' is " +
+                        internal::TypeClassName(actual) + ", expected " +
+                        schema_class);
+      return;
+    }
+    if (schema_class == "string" && field.contains("size") &&
+        H5Tis_variable_str(member.get()) != 0) {
+      Problem(path, "field '" + name + "' must be a fixed-length string");
+    }
+    if (schema_class == "enum" && field.contains("values")) {
+      CheckEnum(path, name, member, field.at("values"));
+    }
+  }
+
+  // Every documented code must exist in the file's enum with its value.
+  void CheckEnum(const std::string& path, const std::string& field,
+                 const Handle& member, const json& values) {
+    Handle base(H5Tget_super(member.get()));
+    const size_t size = H5Tget_size(member.get());
+    for (const auto& [code_name, code] : values.items()) {
+      unsigned char raw[16] = {};
+      if (!base.valid() || size > 8 ||
+          H5Tenum_valueof(member.get(), code_name.c_str(), raw) < 0 ||
+          H5Tconvert(base.get(), H5T_NATIVE_INT64, 1, raw, nullptr,
+                     H5P_DEFAULT) < 0) {
+        internal::TakeHdf5Error();
+        Problem(path,
+                "field '" + field + "' lacks enum code '" + code_name + "'");
+        continue;
+      }
+      int64_t value = 0;
+      std::memcpy(&value, raw, sizeof(value));
+      if (value != code.get<int64_t>()) {
+        Problem(path, "field '" + field + "' enum code '" + code_name +
+                          "' is " + std::to_string(value) + ", expected " +
+                          std::to_string(code.get<int64_t>()));
+      }
+    }
+  }
+
+  hid_t file_;
+  const json& schema_;
+  std::vector<std::string>* problems_;
+};
+
+Result<json> LoadSchema(const std::string& schema_path) {
+  Result<std::string> text = ReadFile(schema_path);
+  if (!text.ok()) return text.status().WithContext("loading the run schema");
+  json schema = json::parse(*text, nullptr, /*allow_exceptions=*/false);
+  if (schema.is_discarded() || !schema.is_object()) {
+    return Status::Corruption(schema_path + ": not valid JSON");
+  }
+  for (const char* key :
+       {"schema_version", "root_attributes", "groups", "datasets"}) {
+    if (!schema.contains(key)) {
+      return Status::Corruption(schema_path + ": lacks '" + key + "'");
+    }
+  }
+  return schema;
+}
+
+Status CheckImpl(const std::string& path, const std::string& schema_path,
+                 std::vector<std::string>* problems) {
+  Result<json> schema = LoadSchema(schema_path);
+  if (!schema.ok()) return schema.status();
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return Status::NotFound(path + ": no such file");
+
+  std::vector<std::string> found;
+  {
+    internal::Hdf5Session session;
+    const htri_t is_hdf5 = internal::IsHdf5File(path);
+    if (is_hdf5 <= 0) {
+      found.push_back("/: not an HDF5 file");
+    } else {
+      Handle fapl = internal::MakeFileAccessProps();
+      Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get()));
+      if (!file.valid()) {
+        found.push_back("/: cannot open (truncated or damaged?): " +
+                        internal::TakeHdf5Error());
+      } else {
+        try {
+          Checker(file.get(), *schema, &found).Run();
+        } catch (const json::exception& e) {
+          return Status::Corruption(schema_path +
+                                    ": malformed schema: " + e.what());
+        }
+      }
+    }
+  }
+  if (problems != nullptr) {
+    problems->insert(problems->end(), found.begin(), found.end());
+  }
+  if (found.empty()) return Status::Ok();
+  return Status::Corruption(path + ": " + std::to_string(found.size()) +
+                            " problem(s) against " + schema_path +
+                            "; first: " + found.front());
+}
+
+}  // namespace
+
+std::string SchemaPath() {
+  return std::string(ADSE_SCHEMA_DIR) + "/run.schema.json";
+}
+
+Status CheckRunFile(const std::string& path,
+                    std::vector<std::string>* problems) {
+  return CheckRunFile(path, SchemaPath(), problems);
+}
+
+Status CheckRunFile(const std::string& path, const std::string& schema_path,
+                    std::vector<std::string>* problems) {
+  try {
+    return CheckImpl(path, schema_path, problems);
+  } catch (const std::exception& e) {
+    return Status::Internal(path + ": checking the run file: " + e.what());
+  }
+}
+
+}  // namespace adse::runfile

@@ -1,0 +1,175 @@
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "analysis/runfile/run_file.h"
+#include "harness/cli/cli_support.h"
+#include "harness/cli/commands.h"
+#include "harness/sim/calibration.h"
+#include "harness/sim/simulator.h"
+#include "harness/spec/spec_parser.h"
+#include "stack/base/hash.h"
+
+namespace adse::cli {
+namespace {
+
+// The point from --point, or the scenario's exploration.start_from.
+std::optional<spec::DesignPoint> ResolvePoint(const spec::Spec& spec, const std::string& text) {
+  if (text.empty()) {
+    if (!spec.exploration.start_from.empty()) return spec.exploration.start_from;
+    std::string names;
+    for (const auto& p : spec.design_space.parameters) {
+      names += (names.empty() ? "" : ",") + p.name + "=<value>";
+    }
+    std::fprintf(stderr, "error: --point is required (the scenario has no exploration.start_from): --point %s\n",
+                 names.c_str());
+    return std::nullopt;
+  }
+  Result<spec::DesignPoint> point = spec::ParsePoint(spec.design_space, text);
+  if (!point.ok()) {
+    std::fprintf(stderr, "error: --point: %s\n", point.status().message().c_str());
+    return std::nullopt;
+  }
+  return std::move(point).value();
+}
+
+std::string PointSlug(const spec::DesignPoint& point) {
+  std::string slug;
+  for (const auto& [name, value] : point) {
+    slug += (slug.empty() ? "" : "_") + fmt::format("{}-{}", name, value);
+  }
+  return slug;
+}
+
+std::string FormatMetric(double value) {
+  if (std::isnan(value)) return "n/a";
+  return fmt::format("{:.4g}", value);
+}
+
+}  // namespace
+
+int RunSimulate(const SimulateArgs& args) {
+  std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
+  if (!spec) return 2;
+  std::optional<spec::DesignPoint> point = ResolvePoint(*spec, args.point);
+  if (!point) return 2;
+  sim::SimulateOptions options;
+  options.seed = args.seed;
+  const bool tty = ::isatty(STDERR_FILENO) && !args.quiet;
+  if (tty) {
+    options.progress = [](double t, double timeout) {
+      std::fprintf(stderr, "\rsimulating: t = %6.1f s of at most %.0f s", t, timeout);
+      std::fflush(stderr);
+    };
+  }
+  sim::SimulationStats stats;
+  Result<runfile::RunData> run = sim::SimulatePoint(*spec, *point, options, &stats);
+  if (tty) std::fprintf(stderr, "\r%60s\r", "");
+  if (!run.ok()) {
+    ReportError(*spec, run.status());
+    return ExitCodeFor(run.status()) == 1 ? 1 : 2;
+  }
+  const std::string out = args.out.empty()
+                              ? spec->output + "/simulate/" + PointSlug(*point) + ".h5"
+                              : args.out;
+  const auto t0 = std::chrono::steady_clock::now();
+  Status written = runfile::WriteRunFile(out, *run);
+  const double write_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!written.ok()) {
+    std::fprintf(stderr, "error: writing %s: %s\n", out.c_str(), written.message().c_str());
+    return 1;
+  }
+  const auto& m = run->metrics;
+  if (args.json) {
+    nlohmann::json doc;
+    doc["point"] = *point;
+    doc["seed"] = run->seed;
+    doc["termination_reason"] = run->termination_reason;
+    for (const auto& [name, value] : m) {
+      doc["metrics"][name] = std::isnan(value) ? nlohmann::json(nullptr) : nlohmann::json(value);
+    }
+    doc["run_file"] = out;
+    doc["timing_s"] = {{"wall", stats.wall_s + write_s}, {"setup", stats.setup_s},
+                       {"stack_cpu", stats.stack_cpu_s}, {"executor", stats.executor_s},
+                       {"world", stats.world_s}, {"lidar", stats.lidar_s},
+                       {"hdf5_write", write_s}, {"simulated", stats.simulated_s}};
+    std::printf("%s\n", doc.dump(2).c_str());
+    return 0;
+  }
+  std::printf("point       %s (seed %llu)\n", PointSlug(*point).c_str(),
+              static_cast<unsigned long long>(run->seed));
+  std::printf("ended       %s at t = %.1f s\n", run->termination_reason.c_str(),
+              run->ego.empty() ? 0.0 : run->ego.back().t_s);
+  for (const char* name : {"completed", "nav_time_s", "ctrl_rate_hz", "hardware_cost",
+                           "e2e_latency_p50_s", "e2e_latency_p99_s", "dropped_messages",
+                           "lidar_frames_dropped", "collisions", "cpu_utilization"}) {
+    auto it = m.find(name);
+    std::printf("%-20s %s\n", name, it == m.end() ? "n/a" : FormatMetric(it->second).c_str());
+  }
+  std::printf("run file    %s\n", out.c_str());
+  std::printf("wall time   %.2f s for %.1f s simulated (stack %.2f s, world %.2f s, LiDAR %.2f s, "
+              "executor %.2f s, HDF5 %.2f s)\n",
+              stats.wall_s + write_s, stats.simulated_s, stats.stack_cpu_s, stats.world_s,
+              stats.lidar_s, stats.executor_s, write_s);
+  return 0;
+}
+
+int RunCalibrate(const CalibrateArgs& args) {
+  std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
+  if (!spec) return 2;
+  std::optional<spec::DesignPoint> point = ResolvePoint(*spec, args.point);
+  if (!point) return 2;
+  // Calibration measures host CPU time, whatever the scenario asked for.
+  spec->platform.cost_model = spec::CostModel::kMeasured;
+  std::vector<runfile::RunData> runs;
+  for (int i = 0; i < args.runs; ++i) {
+    sim::SimulateOptions options;
+    options.seed = spec->world.traffic.seed + static_cast<uint64_t>(i);
+    std::fprintf(stderr, "calibration run %d/%d...\n", i + 1, args.runs);
+    Result<runfile::RunData> run = sim::SimulatePoint(*spec, *point, options);
+    if (!run.ok()) {
+      ReportError(*spec, run.status());
+      return ExitCodeFor(run.status()) == 1 ? 1 : 2;
+    }
+    runs.push_back(std::move(run).value());
+  }
+  std::vector<const runfile::RunData*> pointers;
+  for (const auto& r : runs) pointers.push_back(&r);
+  const sim::Calibration calibration = sim::FitCalibration(pointers);
+  Status written = sim::WriteCalibration(args.out, calibration, runs.front().host);
+  if (!written.ok()) {
+    std::fprintf(stderr, "error: %s\n", written.message().c_str());
+    return 1;
+  }
+  std::printf("%-45s %12s %14s\n", "callback", "fixed_ms", "per_unit_us");
+  for (const auto& [name, cost] : calibration) {
+    std::printf("%-45s %12.3f %14.4f\n", name.c_str(), cost.fixed_s * 1e3, cost.per_unit_s * 1e6);
+  }
+  std::printf("wrote %s (%d runs)\n", args.out.c_str(), args.runs);
+  return 0;
+}
+
+int RunSchemaCheck(const SchemaCheckArgs& args) {
+  int worst = 0;
+  for (const std::string& file : args.files) {
+    std::vector<std::string> problems;
+    Status status = runfile::CheckRunFile(file, &problems);
+    if (status.ok()) {
+      std::printf("%s: ok\n", file.c_str());
+      continue;
+    }
+    worst = std::max(worst, ExitCodeFor(status) == 1 ? 1 : 2);
+    if (problems.empty()) {
+      std::fprintf(stderr, "%s: %s\n", file.c_str(), status.message().c_str());
+    }
+    for (const std::string& p : problems) std::fprintf(stderr, "%s: %s\n", file.c_str(), p.c_str());
+  }
+  return worst;
+}
+
+}  // namespace adse::cli

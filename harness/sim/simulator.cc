@@ -1,0 +1,253 @@
+#include "harness/sim/simulator.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <fstream>
+#include <thread>
+
+#include "analysis/metrics/run_metrics.h"
+#include "harness/spec/spec_parser.h"
+#include "harness/sim/calibration.h"
+#include "stack/algorithms/command_gate.h"
+#include "stack/base/hash.h"
+#include "stack/base/random.h"
+#include "stack/nodes/ad_stack.h"
+#include "stack/runtime/executor.h"
+#include "stack/world/lidar.h"
+#include "stack/world/map_cloud.h"
+
+namespace adse::sim {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+std::string HostDescription() {
+  char name[256] = {0};
+  ::gethostname(name, sizeof(name) - 1);
+  std::string cpu;
+  std::ifstream info("/proc/cpuinfo");
+  for (std::string line; std::getline(info, line);) {
+    if (line.rfind("model name", 0) == 0) {
+      cpu = line.substr(line.find(':') + 2);
+      break;
+    }
+  }
+  return fmt::format("{}; {}; {} cores", name, cpu, std::thread::hardware_concurrency());
+}
+
+std::string UtcNow() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  ::gmtime_r(&now, &tm);
+  char text[32];
+  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return text;
+}
+
+}  // namespace
+
+world::WorldSetup WorldSetupFromSpec(const spec::Spec& spec) {
+  world::WorldSetup setup;
+  setup.world = spec.world;
+  setup.task = spec.task;
+  setup.cache_dir = spec.harness.cache_dir;
+  return setup;
+}
+
+Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::DesignPoint& point,
+                                       const SimulateOptions& options, SimulationStats* stats_out) {
+  const auto t_begin = Clock::now();
+  SimulationStats stats;
+  Result<spec::PointConfig> config = spec::ApplyPoint(spec, point);
+  if (!config.ok()) return config.status();
+  const spec::PlatformOptions& platform = config->platform;
+  const StackConfig& stack_config = config->stack;
+
+  world::WorldSetup setup = WorldSetupFromSpec(spec);
+  if (options.seed) setup.world.traffic.seed = *options.seed;
+  const uint64_t seed = setup.world.traffic.seed;
+  Result<std::unique_ptr<world::World>> opened = world::World::Open(setup);
+  if (!opened.ok()) return opened.status();
+  world::World& w = **opened;
+
+  Result<std::string> cloud_path = w.MapCloudPath();
+  if (!cloud_path.ok()) return cloud_path.status().WithContext("localization map");
+  Result<std::vector<Eigen::Vector3f>> map_cloud = world::ReadPcd(*cloud_path);
+  if (!map_cloud.ok()) return map_cloud.status().WithContext("localization map");
+
+  stack::StackInputs inputs;
+  inputs.route = w.ideal_path();
+  inputs.lane_width_m = w.lane_width_m();
+  inputs.map_cloud = std::move(map_cloud).value();
+  inputs.initial_pose = {w.ego().x_m, w.ego().y_m, w.ego().yaw_rad};
+  inputs.speed_limit_mps = spec.task.speed_limit_kmh / 3.6;
+  inputs.goal_tolerance_m = spec.task.goal_tolerance_m;
+  inputs.wheelbase_m = w.ego_limits().wheelbase_m;
+  inputs.vehicle_length_m = w.ego_limits().length_m;
+  inputs.vehicle_width_m = w.ego_limits().width_m;
+
+  stack::Graph graph;
+  Result<std::unique_ptr<stack::AdStack>> ad_stack =
+      stack::AdStack::Build(stack_config, inputs, &graph);
+  if (!ad_stack.ok()) return ad_stack.status().WithContext("building the stack");
+  const stack::StackTopics topics = (*ad_stack)->topics();
+
+  runfile::RunData run;
+  // The vehicle side: the safety gate between the computer and the actuators.
+  algorithms::CommandGateParams gate_params;
+  gate_params.stale_after_s = stack_config.Get("control.stale_after_s");
+  gate_params.emergency_decel_mps2 = stack_config.Get("control.emergency_decel_mps2");
+  algorithms::CommandGate gate(gate_params);
+  graph.AddSink<stack::ControlMsg>(topics.control, [&](const stack::ControlMsg& m, double t_s) {
+    gate.OnCommand(t_s, m.accel_mps2, m.steer_rad);
+    run.controls.push_back({t_s, m.header.stamp_s, m.accel_mps2, m.steer_rad});
+  });
+  graph.AddSink<stack::PoseMsg>(topics.pose, [&](const stack::PoseMsg& m, double t_s) {
+    gate.OnLocalization(t_s, m.valid);
+  });
+
+  // The executor takes the graph as it is now: sinks must be added first.
+  stack::VirtualPlatformOptions vp;
+  vp.cores = platform.cores;
+  vp.freq_ghz = platform.freq_ghz;
+  vp.reference_ghz = platform.reference_ghz;
+  vp.cost_scale = platform.cost_scale;
+  if (platform.cost_model == spec::CostModel::kCounted) {
+    vp.cost_model = stack::CostModelKind::kCounted;
+    Result<std::map<std::string, stack::CountedCost>> calibration =
+        LoadCalibration(platform.calibration);
+    if (!calibration.ok()) return calibration.status().WithContext("platform.calibration");
+    vp.counted = std::move(calibration).value();
+  }
+  Result<std::unique_ptr<stack::Executor>> made = stack::CreateVirtualExecutor(&graph, vp);
+  if (!made.ok()) return made.status().WithContext("platform");
+  stack::Executor& executor = **made;
+
+  const world::LidarParams lidar_params = stack_config.Lidar();
+  world::LidarSimulator lidar(&w.scene(), lidar_params, setup.world.weather,
+                              Random::DeriveSeed(seed, "lidar"));
+  Random odometry_noise(Random::DeriveSeed(seed, "odometry"));
+  const double lidar_period = 1.0 / lidar_params.rate_hz;
+  const double odometry_period = 1.0 / stack_config.Get("odometry.rate_hz");
+  double next_lidar = 0.0, next_odometry = 0.0, next_vehicles = 0.0, next_progress = 0.0;
+  stats.setup_s = Seconds(Clock::now() - t_begin);
+
+  const double dt = w.step_s();
+  const double timeout = spec.task.timeout_s;
+  std::string reason = "timeout";
+  auto record_ego = [&] {
+    const world::VehicleState& s = w.ego();
+    run.ego.push_back({w.time_s(), s.x_m, s.y_m, s.yaw_rad, s.v_mps, s.steer_rad, s.accel_mps2});
+  };
+  record_ego();
+  while (w.time_s() < timeout - 1e-9) {
+    const double t = w.time_s();
+    const world::VehicleState& ego = w.ego();
+    // Sensors sample the world as it is at this step.
+    while (next_lidar < t + dt - 1e-9) {
+      const auto t0 = Clock::now();
+      std::vector<world::OrientedBox> boxes;
+      boxes.reserve(w.others().size());
+      for (const world::OtherVehicle& v : w.others()) boxes.push_back(v.box);
+      world::PointCloud scan = lidar.Scan({ego.x_m, ego.y_m, ego.yaw_rad}, next_lidar, boxes);
+      stack::PointCloudMsg msg;
+      msg.header.stamp_s = next_lidar;
+      msg.points = std::move(scan.points);
+      // Sensor frame to vehicle frame: the sensor sits above the rear axle.
+      for (Eigen::Vector3f& p : msg.points) p.z() += static_cast<float>(lidar_params.mount_height_m);
+      stats.lidar_s += Seconds(Clock::now() - t0);
+      executor.PublishExternal(topics.lidar_raw,
+                               std::make_shared<const stack::PointCloudMsg>(std::move(msg)),
+                               next_lidar, std::max(next_lidar, t));
+      next_lidar += lidar_period;
+    }
+    while (next_odometry < t + dt - 1e-9) {
+      stack::OdometryMsg msg;
+      msg.header.stamp_s = next_odometry;
+      msg.v_mps = ego.v_mps * (1.0 + odometry_noise.Normal(0.0, 0.005));
+      msg.yaw_rate_rps = ego.v_mps * std::tan(ego.steer_rad) / w.ego_limits().wheelbase_m +
+                         odometry_noise.Normal(0.0, 0.002);
+      executor.PublishExternal(topics.odometry,
+                               std::make_shared<const stack::OdometryMsg>(msg), next_odometry,
+                               std::max(next_odometry, t));
+      next_odometry += odometry_period;
+    }
+    const auto t_exec = Clock::now();
+    const double cpu_before = stats.stack_cpu_s;
+    (void)cpu_before;
+    Status advanced = executor.AdvanceTo(t + dt);
+    stats.executor_s += Seconds(Clock::now() - t_exec);
+    if (!advanced.ok()) return advanced.WithContext(fmt::format("stack at t={:.2f} s", t));
+
+    const algorithms::GateOutput command = gate.Output(t + dt);
+    const auto t_world = Clock::now();
+    Status stepped = w.Step({command.accel_mps2, command.steer_rad});
+    stats.world_s += Seconds(Clock::now() - t_world);
+    if (!stepped.ok()) return stepped;
+    record_ego();
+    for (const std::string& id : w.new_contacts()) run.collisions.push_back({w.time_s(), id});
+    if (w.time_s() + 1e-9 >= next_vehicles) {
+      for (const world::OtherVehicle& v : w.others()) {
+        run.vehicles.push_back({w.time_s(), v.id, v.box.center.x(), v.box.center.y(), v.box.yaw_rad,
+                                v.speed_mps, v.box.length_m, v.box.width_m});
+      }
+      next_vehicles += options.vehicle_record_period_s;
+    }
+    if (options.progress && w.time_s() >= next_progress) {
+      options.progress(w.time_s(), timeout);
+      next_progress += 1.0;
+    }
+    if (w.goal_reached()) {
+      reason = "goal_reached";
+      break;
+    }
+  }
+
+  // Provenance and the stack's description.
+  run.status = "complete";
+  run.termination_reason = reason;
+  run.scenario_name = spec.name;
+  run.scenario_text = spec.source_text;
+  run.scenario_hash = Sha256Hex(spec.source_text);
+  run.adse_version = ADSE_VERSION;
+  run.host = HostDescription();
+  run.created_utc = UtcNow();
+  run.seed = seed;
+  run.design_point = point;
+  run.platform = {{"kind", platform.kind == spec::PlatformKind::kVirtual ? "virtual" : "cgroup"},
+                  {"cores", std::to_string(platform.cores)},
+                  {"freq_ghz", fmt::format("{}", platform.freq_ghz)},
+                  {"reference_ghz", fmt::format("{}", platform.reference_ghz)},
+                  {"cost_model", platform.cost_model == spec::CostModel::kCounted ? "counted"
+                                                                                  : "measured"},
+                  {"cost_scale", fmt::format("{}", platform.cost_scale)}};
+  for (size_t i = 0; i < w.ideal_path().points.size(); ++i) {
+    run.ideal_path.push_back({w.ideal_path().s_m[i], w.ideal_path().points[i].x(),
+                              w.ideal_path().points[i].y()});
+  }
+  run.lane_width_m = w.lane_width_m();
+  for (const stack::NodeSpec& n : graph.nodes()) run.node_names.push_back(n.name);
+  for (const stack::TopicSpec& t : graph.topics()) run.topic_names.push_back(t.name);
+  for (const stack::CallbackSpec& c : graph.callbacks()) {
+    run.callback_info.push_back(
+        {c.name, c.node, c.kind == stack::CallbackSpec::Kind::kTimer ? "timer" : "subscription",
+         c.topic, c.period_s});
+  }
+  run.trace = executor.trace();
+  for (const stack::CallbackRecord& r : run.trace.callbacks) stats.stack_cpu_s += r.host_cpu_s;
+  stats.executor_s = std::max(0.0, stats.executor_s - stats.stack_cpu_s);
+  run.metrics = analysis::ComputeRunMetrics(run);
+  Result<double> cost = spec::EvaluateCost(spec, point);
+  run.metrics["hardware_cost"] = cost.ok() ? *cost : std::nan("");
+  stats.simulated_s = w.time_s();
+  stats.wall_s = Seconds(Clock::now() - t_begin);
+  if (stats_out) *stats_out = stats;
+  return run;
+}
+
+}  // namespace adse::sim

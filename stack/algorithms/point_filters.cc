@@ -1,0 +1,128 @@
+#include "stack/algorithms/point_filters.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "stack/base/random.h"
+
+namespace adse::algorithms {
+
+Points CropPoints(const Points& points, const CropParams& params) {
+  Points out;
+  out.reserve(points.size());
+  const double min_r2 = params.min_range_m * params.min_range_m;
+  const double max_r2 = params.max_range_m * params.max_range_m;
+  for (const Eigen::Vector3f& p : points) {
+    if (!p.allFinite()) continue;
+    const double r2 = double(p.x()) * p.x() + double(p.y()) * p.y();
+    if (r2 < min_r2 || r2 > max_r2) continue;
+    if (p.z() < params.z_min_m || p.z() > params.z_max_m) continue;
+    if (params.remove_ego && p.x() >= params.ego_x_min_m &&
+        p.x() <= params.ego_x_max_m &&
+        std::abs(p.y()) <= params.ego_half_width_m) {
+      continue;
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+namespace {
+
+// RANSAC over the low points. Returns false when no plausible plane wins,
+// so the caller keeps z = 0 (flat ground is the safe default: a bad fit
+// would call a car's side "ground").
+bool FitGroundPlane(const Points& points, const GroundParams& params,
+                    Eigen::Vector4d* plane, int64_t* work) {
+  std::vector<Eigen::Vector3d> low;
+  low.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) {
+    if (p.allFinite() && std::abs(p.z()) < params.ransac_candidate_band_m) {
+      low.push_back(p.cast<double>());
+    }
+  }
+  if (low.size() < 3 || params.ransac_iterations <= 0) return false;
+  Random random(params.seed);
+  const double cos_max_tilt = std::cos(params.max_plane_tilt_rad);
+  size_t best_inliers = 0;
+  Eigen::Vector4d best(0, 0, 1, 0);
+  for (int it = 0; it < params.ransac_iterations; ++it) {
+    const Eigen::Vector3d& a = low[random.Below(low.size())];
+    const Eigen::Vector3d& b = low[random.Below(low.size())];
+    const Eigen::Vector3d& c = low[random.Below(low.size())];
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    const double norm = n.norm();
+    if (norm < 1e-6) continue;  // degenerate (collinear or repeated)
+    n /= norm;
+    if (n.z() < 0) n = -n;
+    if (n.z() < cos_max_tilt) continue;
+    const double d = -n.dot(a);
+    // Height of the plane under the origin: z = -d / nz.
+    if (std::abs(d / n.z()) > params.max_plane_offset_m) continue;
+    size_t inliers = 0;
+    for (const Eigen::Vector3d& p : low) {
+      if (std::abs(n.dot(p) + d) < params.ransac_inlier_distance_m) ++inliers;
+    }
+    *work += static_cast<int64_t>(low.size());
+    if (inliers > best_inliers) {
+      best_inliers = inliers;
+      best << n, d;
+    }
+  }
+  if (best_inliers < 3 ||
+      best_inliers < params.min_inlier_fraction * double(low.size())) {
+    return false;
+  }
+  // Refine by least squares on the inliers (z = a x + b y + c) so the
+  // plane does not hinge on three noisy samples.
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : low) {
+    if (std::abs(best.head<3>().dot(p) + best(3)) <
+        params.ransac_inlier_distance_m) {
+      const Eigen::Vector3d row(p.x(), p.y(), 1.0);
+      ata += row * row.transpose();
+      atb += row * p.z();
+    }
+  }
+  const Eigen::Vector3d abc = ata.ldlt().solve(atb);
+  if (abc.allFinite()) {
+    Eigen::Vector3d n(-abc(0), -abc(1), 1.0);
+    const double norm = n.norm();
+    n /= norm;
+    const double d = -abc(2) / norm;
+    if (n.z() >= cos_max_tilt &&
+        std::abs(d / n.z()) <= params.max_plane_offset_m) {
+      best << n, d;
+    }
+  }
+  *plane = best;
+  return true;
+}
+
+}  // namespace
+
+GroundResult RemoveGround(const Points& points, const GroundParams& params) {
+  GroundResult result;
+  result.work_units = static_cast<int64_t>(points.size());
+  if (params.fit_plane) {
+    result.plane_fitted =
+        FitGroundPlane(points, params, &result.plane, &result.work_units);
+  }
+  const Eigen::Vector3d n = result.plane.head<3>();
+  const double d = result.plane(3);
+  result.obstacles.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) {
+    if (!p.allFinite()) continue;
+    const double height = n.dot(p.cast<double>()) + d;
+    if (height > params.height_threshold_m) {
+      result.obstacles.push_back(p);
+    } else {
+      result.ground.push_back(p);
+    }
+  }
+  return result;
+}
+
+}  // namespace adse::algorithms

@@ -1,0 +1,128 @@
+#include "stack/algorithms/tracker.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <tuple>
+
+namespace adse::algorithms {
+
+void Tracker::Reset() {
+  tracks_.clear();
+  next_id_ = 1;
+  has_time_ = false;
+  last_t_s_ = 0.0;
+  last_work_units_ = 0;
+}
+
+void Tracker::Predict(Track* track, double dt_s) const {
+  if (dt_s <= 0.0) return;
+  Eigen::Matrix4d f = Eigen::Matrix4d::Identity();
+  f(0, 2) = f(1, 3) = dt_s;
+  // White acceleration noise integrated over dt (per axis).
+  const double q = params_.accel_noise_mps2 * params_.accel_noise_mps2;
+  const double dt2 = dt_s * dt_s, dt3 = dt2 * dt_s, dt4 = dt3 * dt_s;
+  Eigen::Matrix4d qm = Eigen::Matrix4d::Zero();
+  for (int a = 0; a < 2; ++a) {
+    qm(a, a) = q * dt4 / 4;
+    qm(a, a + 2) = qm(a + 2, a) = q * dt3 / 2;
+    qm(a + 2, a + 2) = q * dt2;
+  }
+  track->position += dt_s * track->velocity;
+  track->covariance = f * track->covariance * f.transpose() + qm;
+}
+
+void Tracker::Correct(Track* track, const Detection& detection) const {
+  Eigen::Matrix<double, 2, 4> h = Eigen::Matrix<double, 2, 4>::Zero();
+  h(0, 0) = h(1, 1) = 1.0;
+  const Eigen::Matrix2d r = Eigen::Matrix2d::Identity() *
+                            params_.position_noise_m * params_.position_noise_m;
+  const Eigen::Matrix4d& p = track->covariance;
+  const Eigen::Matrix2d s = h * p * h.transpose() + r;
+  const Eigen::Matrix<double, 4, 2> k = p * h.transpose() * s.inverse();
+  Eigen::Vector4d x;
+  x << track->position, track->velocity;
+  x += k * (detection.center - track->position);
+  track->position = x.head<2>();
+  track->velocity = x.tail<2>();
+  // Joseph form: stays symmetric positive definite under rounding.
+  const Eigen::Matrix4d i_kh = Eigen::Matrix4d::Identity() - k * h;
+  track->covariance = i_kh * p * i_kh.transpose() + k * r * k.transpose();
+  const double w = std::clamp(params_.size_smoothing, 0.0, 1.0);
+  track->length_m = (1 - w) * track->length_m + w * detection.length_m;
+  track->width_m = (1 - w) * track->width_m + w * detection.width_m;
+  track->yaw_rad = detection.yaw_rad;
+}
+
+void Tracker::Update(double t_s, const std::vector<Detection>& detections) {
+  double dt = has_time_ ? t_s - last_t_s_ : 0.0;
+  dt = std::min(dt, params_.max_dt_s);
+  if (!has_time_ || t_s > last_t_s_) {
+    last_t_s_ = t_s;
+    has_time_ = true;
+  }
+  for (Track& track : tracks_) Predict(&track, dt);
+
+  // Greedy global nearest neighbour: all gated pairs, closest first. Ties
+  // break by track then detection index, so results are deterministic.
+  std::vector<std::tuple<double, size_t, size_t>> pairs;
+  const double gate2 = params_.gate_m * params_.gate_m;
+  for (size_t t = 0; t < tracks_.size(); ++t) {
+    for (size_t d = 0; d < detections.size(); ++d) {
+      const double d2 =
+          (detections[d].center - tracks_[t].position).squaredNorm();
+      if (d2 <= gate2) pairs.emplace_back(d2, t, d);
+    }
+  }
+  last_work_units_ = static_cast<int64_t>(tracks_.size()) *
+                     static_cast<int64_t>(detections.size());
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<char> track_used(tracks_.size(), 0);
+  std::vector<char> det_used(detections.size(), 0);
+  for (const auto& [d2, t, d] : pairs) {
+    if (track_used[t] || det_used[d]) continue;
+    track_used[t] = det_used[d] = 1;
+    Track& track = tracks_[t];
+    Correct(&track, detections[d]);
+    ++track.hits;
+    track.misses = 0;
+    track.last_seen_s = t_s;
+    if (track.hits >= params_.confirm_hits) track.confirmed = true;
+  }
+  for (size_t t = 0; t < tracks_.size(); ++t) {
+    ++tracks_[t].age;
+    if (!track_used[t]) ++tracks_[t].misses;
+  }
+  std::erase_if(tracks_, [&](const Track& track) {
+    return track.misses >= (track.confirmed ? params_.max_misses
+                                            : params_.tentative_max_misses);
+  });
+  for (size_t d = 0; d < detections.size(); ++d) {
+    if (det_used[d]) continue;
+    Track track;
+    track.id = next_id_++;
+    track.position = detections[d].center;
+    track.covariance.setZero();
+    const double pn = params_.position_noise_m * params_.position_noise_m;
+    const double vn =
+        params_.initial_velocity_std_mps * params_.initial_velocity_std_mps;
+    track.covariance.diagonal() << pn, pn, vn, vn;
+    track.length_m = detections[d].length_m;
+    track.width_m = detections[d].width_m;
+    track.yaw_rad = detections[d].yaw_rad;
+    track.age = 1;
+    track.hits = 1;
+    track.last_seen_s = t_s;
+    track.confirmed = params_.confirm_hits <= 1;
+    tracks_.push_back(track);
+  }
+}
+
+std::vector<Track> Tracker::ConfirmedTracks() const {
+  std::vector<Track> out;
+  for (const Track& track : tracks_) {
+    if (track.confirmed) out.push_back(track);
+  }
+  return out;  // tracks_ is ordered by id: births are appended
+}
+
+}  // namespace adse::algorithms

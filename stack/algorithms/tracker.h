@@ -1,0 +1,75 @@
+// Multi-object tracker in the map frame: a constant-velocity Kalman filter
+// per track, greedy nearest-neighbour association inside a gate, birth
+// after N hits and deletion after M misses. Eigen and std types only.
+#ifndef ADSE_STACK_ALGORITHMS_TRACKER_H_
+#define ADSE_STACK_ALGORITHMS_TRACKER_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "stack/algorithms/clustering.h"
+
+namespace adse::algorithms {
+
+struct TrackerParams {
+  double gate_m = 2.0;   // a detection further from a prediction is not it
+  int confirm_hits = 3;  // hits before a track is reported (births)
+  int max_misses = 3;    // consecutive misses that delete a confirmed track
+  // Consecutive misses that delete a tentative track: clutter dies fast.
+  int tentative_max_misses = 1;
+  double accel_noise_mps2 = 2.0;  // process noise (white accel, 1 sigma)
+  double position_noise_m = 0.3;  // detection centre noise (1 sigma)
+  double initial_velocity_std_mps = 8.0;  // a new track's speed is unknown
+  double size_smoothing = 0.3;  // weight of a new box size (0..1, EMA)
+  double max_dt_s = 2.0;        // longer gaps predict at most this far
+};
+
+struct Track {
+  int id = 0;  // unique, increasing from 1, never reused
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();        // map frame
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();        // m/s
+  Eigen::Matrix4d covariance = Eigen::Matrix4d::Identity();  // px py vx vy
+  double length_m = 0.0;
+  double width_m = 0.0;
+  double yaw_rad = 0.0;  // of the last box (boxes have no front)
+  int age = 0;           // updates since birth
+  int hits = 0;          // updates with an associated detection
+  int misses = 0;        // consecutive updates without one
+  bool confirmed = false;
+  double last_seen_s = 0.0;  // time of the last associated detection
+};
+
+class Tracker {
+ public:
+  explicit Tracker(const TrackerParams& params = {}) : params_(params) {}
+
+  // One frame of detections (map frame) taken at time t_s. Out-of-order
+  // frames (t_s earlier than the last) are applied without prediction.
+  void Update(double t_s, const std::vector<Detection>& detections);
+
+  // Confirmed tracks, ordered by id.
+  std::vector<Track> ConfirmedTracks() const;
+  // All tracks including tentative ones, ordered by id.
+  const std::vector<Track>& tracks() const { return tracks_; }
+  void Reset();
+
+  // Association work of the last update: tracks x detections.
+  int64_t last_work_units() const { return last_work_units_; }
+  const TrackerParams& params() const { return params_; }
+
+ private:
+  void Predict(Track* track, double dt_s) const;
+  void Correct(Track* track, const Detection& detection) const;
+
+  TrackerParams params_;
+  std::vector<Track> tracks_;
+  int next_id_ = 1;
+  bool has_time_ = false;
+  double last_t_s_ = 0.0;
+  int64_t last_work_units_ = 0;
+};
+
+}  // namespace adse::algorithms
+
+#endif  // ADSE_STACK_ALGORITHMS_TRACKER_H_

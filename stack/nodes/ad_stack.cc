@@ -1,0 +1,450 @@
+#include "stack/nodes/ad_stack.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <optional>
+
+#include "stack/algorithms/clustering.h"
+#include "stack/algorithms/control.h"
+#include "stack/algorithms/ekf.h"
+#include "stack/algorithms/ndt_matcher.h"
+#include "stack/algorithms/planning.h"
+#include "stack/algorithms/point_filters.h"
+#include "stack/algorithms/tracker.h"
+
+namespace adse::stack {
+namespace {
+
+namespace algo = adse::algorithms;
+
+// Amdahl fractions of the data-parallel nodes: the share of their work that
+// more threads speed up (ndt_omp-style scan matching; per-cluster work).
+// PCL 1.13's NDT and clustering run serially on the host; their parallel
+// speed-up on the virtual platform is this model, not a measurement.
+constexpr double kNdtParallelFraction = 0.85;
+constexpr double kClusteringParallelFraction = 0.6;
+// Braking asked for while there is no valid pose to steer by.
+constexpr double kNoPoseDecelMps2 = 3.0;
+
+double WrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+
+class Stack final : public AdStack {
+ public:
+  Stack(const StackConfig& config, const StackInputs& inputs)
+      : config_(config), inputs_(inputs) {}
+  const StackTopics& topics() const override { return topics_; }
+  Status Build(Graph* graph);
+
+ private:
+  void BuildSensing(Graph* g);
+  Status BuildLocalization(Graph* g);
+  void BuildPerception(Graph* g);
+  void BuildPlanning(Graph* g);
+  void BuildControl(Graph* g);
+
+  StackConfig config_;
+  StackInputs inputs_;
+  StackTopics topics_;
+  int points_ = -1, downsampled_ = -1, ndt_pose_ = -1, obstacle_points_ = -1,
+      detections_ = -1, route_ = -1, trajectory_raw_ = -1;
+
+  // Node state. Callbacks of one node never overlap (the executor's
+  // mutual exclusion), so none of this needs locking.
+  algo::CropParams crop_;
+  std::unique_ptr<algo::NdtMatcher> ndt_;
+  std::optional<PoseMsg> ndt_latest_ekf_;
+  double ndt_latest_ekf_t_ = 0.0;  // when that EKF pose was received
+  algo::Ekf ekf_;
+  double ekf_last_t_ = 0.0;
+  double ekf_stamp_ = -1.0;  // stamp of the newest fused NDT pose
+  struct PoseAt {
+    double t_s;
+    world::Pose2 pose;
+  };
+  std::deque<PoseAt> ekf_history_;
+  std::optional<PoseMsg> cluster_pose_;
+  std::unique_ptr<algo::Tracker> tracker_;
+  std::unique_ptr<algo::BehaviorVelocityPlanner> planner_;
+  std::optional<PoseMsg> planner_pose_;
+  std::optional<ObjectsMsg> planner_objects_;
+  bool planner_has_route_ = false;
+  std::optional<PoseMsg> smoother_pose_;
+  std::unique_ptr<algo::TrajectoryFollower> follower_;
+  std::optional<PoseMsg> follower_pose_;
+  std::optional<TrajectoryMsg> follower_trajectory_;
+  double follower_last_t_ = -1.0;
+};
+
+Status Stack::Build(Graph* g) {
+  topics_.lidar_raw = g->AddTopic<PointCloudMsg>("/sensing/lidar/points_raw");
+  topics_.odometry = g->AddTopic<OdometryMsg>("/sensing/odometry");
+  points_ = g->AddTopic<PointCloudMsg>("/sensing/lidar/points");
+  downsampled_ = g->AddTopic<PointCloudMsg>("/localization/points_downsampled");
+  ndt_pose_ = g->AddTopic<PoseMsg>("/localization/ndt_pose");
+  topics_.pose = g->AddTopic<PoseMsg>("/localization/pose");
+  obstacle_points_ = g->AddTopic<PointCloudMsg>("/perception/obstacle_points");
+  detections_ = g->AddTopic<ObjectsMsg>("/perception/detections");
+  topics_.objects = g->AddTopic<ObjectsMsg>("/perception/objects");
+  route_ = g->AddTopic<PathMsg>("/planning/route");
+  trajectory_raw_ = g->AddTopic<TrajectoryMsg>("/planning/trajectory_raw");
+  topics_.trajectory = g->AddTopic<TrajectoryMsg>("/planning/trajectory");
+  topics_.control = g->AddTopic<ControlMsg>("/control/command");
+  BuildSensing(g);
+  ADSE_RETURN_IF_ERROR(BuildLocalization(g));
+  BuildPerception(g);
+  BuildPlanning(g);
+  BuildControl(g);
+  return Status::Ok();
+}
+
+void Stack::BuildSensing(Graph* g) {
+  // LiDAR driver: range and ego-body crop of the raw scan.
+  crop_.max_range_m = config_.Get("lidar.range_m");
+  crop_.ego_x_max_m = inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2 + 0.2;
+  crop_.ego_x_min_m = inputs_.wheelbase_m / 2 - inputs_.vehicle_length_m / 2 - 0.2;
+  crop_.ego_half_width_m = inputs_.vehicle_width_m / 2 + 0.2;
+  const int node = g->AddNode("lidar_driver");
+  g->Subscribe<PointCloudMsg>(node, topics_.lidar_raw, "points_raw", 1,
+                              [this](const PointCloudMsg& in, CallbackContext& ctx) {
+                                PointCloudMsg out;
+                                out.header = in.header;
+                                out.points = algo::CropPoints(in.points, crop_);
+                                ctx.ReportWork({static_cast<double>(in.points.size()), 0.0, 1});
+                                ctx.Publish(points_, std::move(out));
+                              });
+}
+
+Status Stack::BuildLocalization(Graph* g) {
+  // Voxel filter feeding the scan matcher.
+  const double leaf = config_.Get("localization.voxel_leaf_m");
+  const int voxel = g->AddNode("voxel_filter");
+  g->Subscribe<PointCloudMsg>(voxel, points_, "points", 1,
+                              [this, leaf](const PointCloudMsg& in, CallbackContext& ctx) {
+                                PointCloudMsg out;
+                                out.header = in.header;
+                                out.points = algo::VoxelDownsample(in.points, leaf);
+                                ctx.ReportWork({static_cast<double>(in.points.size()), 0.0, 1});
+                                ctx.Publish(downsampled_, std::move(out));
+                              });
+
+  // NDT scan matching against the map cloud, guessed from the EKF.
+  algo::NdtParams ndt_params;
+  ndt_params.resolution_m = config_.Get("localization.ndt_resolution_m");
+  ndt_params.max_iterations = static_cast<int>(config_.Get("localization.ndt_max_iterations"));
+  ndt_params.max_fitness_m2 = config_.Get("localization.ndt_max_fitness");
+  ndt_ = std::make_unique<algo::NdtMatcher>(ndt_params);
+  ADSE_RETURN_IF_ERROR(ndt_->SetMap(inputs_.map_cloud));
+  const int threads = static_cast<int>(config_.Get("localization.ndt_threads"));
+  const int ndt_node = g->AddNode("ndt_scan_matcher");
+  // The initial-pose buffer runs in its own callback group (a node of its
+  // own here), as in Autoware: a long alignment must not starve it, or the
+  // next alignment starts from a stale guess.
+  const int ndt_buffer = g->AddNode("ndt_scan_matcher_pose_buffer");
+  g->Subscribe<PoseMsg>(ndt_buffer, topics_.pose, "ekf_pose", 1,
+                        [this](const PoseMsg& in, CallbackContext& ctx) {
+                          ndt_latest_ekf_ = in;
+                          ndt_latest_ekf_t_ = ctx.now_s();
+                        });
+  g->Subscribe<PointCloudMsg>(
+      ndt_node, downsampled_, "points", 1,
+      [this, threads](const PointCloudMsg& in, CallbackContext& ctx) {
+        world::Pose2 guess = inputs_.initial_pose;
+        if (ndt_latest_ekf_) {
+          // Move the EKF pose back to the scan's time along its motion.
+          const PoseMsg& e = *ndt_latest_ekf_;
+          const double dt = in.header.stamp_s - ndt_latest_ekf_t_;
+          guess = e.pose;
+          guess.x_m += e.v_mps * dt * std::cos(e.pose.yaw_rad);
+          guess.y_m += e.v_mps * dt * std::sin(e.pose.yaw_rad);
+        }
+        Result<algo::NdtResult> r = ndt_->Align(in.points, guess);
+        PoseMsg out;
+        out.header = in.header;
+        out.valid = r.ok() && r->accepted;
+        if (r.ok()) {
+          out.pose = r->pose;
+          out.fitness = r->fitness_score_m2;
+          ctx.ReportWork({static_cast<double>(r->work_units), kNdtParallelFraction, threads});
+        }
+        out.covariance = Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.01 * 0.01).asDiagonal();
+        ctx.Publish(ndt_pose_, std::move(out));
+      });
+
+  // EKF: odometry prediction, NDT correction with delay compensation.
+  algo::EkfParams ekf_params;
+  ekf_params.lost_after_s = config_.Get("localization.lost_after_s");
+  ekf_ = algo::Ekf(ekf_params);
+  ekf_.Initialize(inputs_.initial_pose, 0.0, 0.0);
+  const int ekf_node = g->AddNode("ekf_localizer");
+  g->Subscribe<OdometryMsg>(ekf_node, topics_.odometry, "odometry", 10,
+                            [this](const OdometryMsg& in, CallbackContext& ctx) {
+                              ekf_.Predict(std::max(0.0, ctx.now_s() - ekf_last_t_));
+                              ekf_last_t_ = ctx.now_s();
+                              ekf_.UpdateOdometry(in.v_mps, in.yaw_rate_rps, 0.05, 0.01);
+                            });
+  g->Subscribe<PoseMsg>(
+      ekf_node, ndt_pose_, "ndt_pose", 1, [this](const PoseMsg& in, CallbackContext& ctx) {
+        if (!in.valid) return;
+        ekf_.Predict(std::max(0.0, ctx.now_s() - ekf_last_t_));
+        ekf_last_t_ = ctx.now_s();
+        // The match describes the scan's time: carry it forward by the motion
+        // the EKF saw since then.
+        world::Pose2 measured = in.pose;
+        const auto then = std::lower_bound(
+            ekf_history_.begin(), ekf_history_.end(), in.header.stamp_s,
+            [](const PoseAt& p, double t) { return p.t_s < t; });
+        if (then != ekf_history_.end()) {
+          const world::Pose2 now = ekf_.pose();
+          const double dyaw = WrapAngle(now.yaw_rad - then->pose.yaw_rad);
+          const Eigen::Vector2d moved_world(now.x_m - then->pose.x_m, now.y_m - then->pose.y_m);
+          const double c = std::cos(measured.yaw_rad - then->pose.yaw_rad);
+          const double s = std::sin(measured.yaw_rad - then->pose.yaw_rad);
+          measured.x_m += c * moved_world.x() - s * moved_world.y();
+          measured.y_m += s * moved_world.x() + c * moved_world.y();
+          measured.yaw_rad = WrapAngle(measured.yaw_rad + dyaw);
+        }
+        if (ekf_.UpdatePose(measured, in.covariance)) ekf_stamp_ = in.header.stamp_s;
+      });
+  g->AddTimer(ekf_node, "publish", 1.0 / config_.Get("localization.ekf_rate_hz"),
+              [this](CallbackContext& ctx) {
+                ekf_.Predict(std::max(0.0, ctx.now_s() - ekf_last_t_));
+                ekf_last_t_ = ctx.now_s();
+                ekf_history_.push_back({ctx.now_s(), ekf_.pose()});
+                while (ekf_history_.size() > 1 && ekf_history_.front().t_s < ctx.now_s() - 3.0) {
+                  ekf_history_.pop_front();
+                }
+                PoseMsg out;
+                out.header.stamp_s = ekf_stamp_;
+                out.pose = ekf_.pose();
+                out.v_mps = ekf_.v_mps();
+                out.covariance = ekf_.PoseCovariance();
+                out.valid = !ekf_.Lost();
+                ctx.Publish(topics_.pose, std::move(out));
+              });
+  return Status::Ok();
+}
+
+void Stack::BuildPerception(Graph* g) {
+  algo::GroundParams ground;
+  ground.height_threshold_m = config_.Get("perception.ground_height_m");
+  const double max_range = config_.Get("perception.max_range_m");
+  const int ground_node = g->AddNode("ground_filter");
+  g->Subscribe<PointCloudMsg>(
+      ground_node, points_, "points", 1,
+      [this, ground, max_range](const PointCloudMsg& in, CallbackContext& ctx) {
+        algo::GroundResult r = algo::RemoveGround(in.points, ground);
+        PointCloudMsg out;
+        out.header = in.header;
+        const double r2 = max_range * max_range;
+        for (const Eigen::Vector3f& p : r.obstacles) {
+          if (p.x() * p.x() + p.y() * p.y() <= r2) out.points.push_back(p);
+        }
+        ctx.ReportWork({static_cast<double>(r.work_units), 0.0, 1});
+        ctx.Publish(obstacle_points_, std::move(out));
+      });
+
+  algo::ClusteringParams clustering;
+  clustering.tolerance_m = config_.Get("perception.cluster_tolerance_m");
+  clustering.min_points = static_cast<int>(config_.Get("perception.min_cluster_points"));
+  const int threads = static_cast<int>(config_.Get("perception.threads"));
+  const double max_object_m = config_.Get("perception.max_object_size_m");
+  const int cluster_node = g->AddNode("euclidean_cluster");
+  g->Subscribe<PoseMsg>(cluster_node, topics_.pose, "pose", 1,
+                        [this](const PoseMsg& in, CallbackContext&) { cluster_pose_ = in; });
+  g->Subscribe<PointCloudMsg>(
+      cluster_node, obstacle_points_, "points", 1,
+      [this, clustering, threads, max_object_m](const PointCloudMsg& in, CallbackContext& ctx) {
+        // Downsample first, as production clustering pipelines do: object
+        // shapes survive a 0.2 m grid and the clustering cost drops.
+        const std::vector<Eigen::Vector3f> sparse = algo::VoxelDownsample(in.points, 0.2);
+        algo::DetectionResult r = algo::DetectObjects(sparse, clustering);
+        ObjectsMsg out;
+        out.header = in.header;
+        const world::Pose2 pose = cluster_pose_ ? cluster_pose_->pose : inputs_.initial_pose;
+        for (const algo::Detection& d : r.detections) {
+          // Clusters larger than any vehicle are static structure (a wall's
+          // corner fits a box spanning the road); the map, not the object
+          // list, describes them.
+          if (std::max(d.length_m, d.width_m) > max_object_m) continue;
+          const algo::Detection m = algo::ToMapFrame(d, pose);
+          TrackedObject o;
+          o.position = m.center;
+          o.length_m = m.length_m;
+          o.width_m = m.width_m;
+          out.objects.push_back(o);
+        }
+        ctx.ReportWork({static_cast<double>(r.work_units), kClusteringParallelFraction, threads});
+        ctx.Publish(detections_, std::move(out));
+      });
+
+  tracker_ = std::make_unique<algo::Tracker>();
+  const int tracker_node = g->AddNode("multi_object_tracker");
+  g->Subscribe<ObjectsMsg>(tracker_node, detections_, "detections", 1,
+                           [this](const ObjectsMsg& in, CallbackContext& ctx) {
+                             std::vector<algo::Detection> detections;
+                             for (const TrackedObject& o : in.objects) {
+                               algo::Detection d;
+                               d.center = o.position;
+                               d.length_m = o.length_m;
+                               d.width_m = o.width_m;
+                               detections.push_back(d);
+                             }
+                             tracker_->Update(in.header.stamp_s, detections);
+                             ObjectsMsg out;
+                             out.header = in.header;
+                             for (const algo::Track& t : tracker_->ConfirmedTracks()) {
+                               TrackedObject o;
+                               o.id = t.id;
+                               o.position = t.position;
+                               o.velocity = t.velocity;
+                               o.length_m = t.length_m;
+                               o.width_m = t.width_m;
+                               o.age = t.age;
+                               out.objects.push_back(o);
+                             }
+                             ctx.ReportWork({static_cast<double>(tracker_->last_work_units()), 0.0, 1});
+                             ctx.Publish(topics_.objects, std::move(out));
+                           });
+}
+
+void Stack::BuildPlanning(Graph* g) {
+  // Mission planner: the route from the map and the goal, published once.
+  const int mission = g->AddNode("mission_planner");
+  g->AddTimer(mission, "route", 1e6, [this](CallbackContext& ctx) {
+    PathMsg out;
+    out.header.stamp_s = -1.0;
+    out.path = inputs_.route;
+    ctx.ReportWork({static_cast<double>(inputs_.route.points.size()), 0.0, 1});
+    ctx.Publish(route_, std::move(out));
+  });
+
+  algo::PlannerParams params;
+  params.horizon_m = config_.Get("planning.horizon_m");
+  params.speed_limit_mps = inputs_.speed_limit_mps;
+  params.max_lateral_accel_mps2 = config_.Get("planning.max_lateral_accel_mps2");
+  params.corridor_half_width_m = config_.Get("planning.corridor_half_width_m");
+  params.stop_margin_m = config_.Get("planning.stop_margin_m");
+  params.ego_front_m = inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2;
+  planner_ = std::make_unique<algo::BehaviorVelocityPlanner>(params);
+  const int node = g->AddNode("behavior_velocity_planner");
+  g->Subscribe<PathMsg>(node, route_, "route", 1, [this](const PathMsg& in, CallbackContext&) {
+    planner_->SetPath(in.path, in.path.points.back());
+    planner_has_route_ = true;
+  });
+  g->Subscribe<PoseMsg>(node, topics_.pose, "pose", 1,
+                        [this](const PoseMsg& in, CallbackContext&) { planner_pose_ = in; });
+  g->Subscribe<ObjectsMsg>(node, topics_.objects, "objects", 1,
+                           [this](const ObjectsMsg& in, CallbackContext&) { planner_objects_ = in; });
+  g->AddTimer(node, "plan", 1.0 / config_.Get("planning.rate_hz"), [this](CallbackContext& ctx) {
+    if (!planner_has_route_ || !planner_pose_) return;
+    std::vector<algo::PlannerObstacle> obstacles;
+    if (planner_objects_) {
+      for (const TrackedObject& o : planner_objects_->objects) {
+        algo::PlannerObstacle ob;
+        ob.id = o.id;
+        ob.position = o.position;
+        ob.velocity = o.velocity;
+        ob.length_m = o.length_m;
+        ob.width_m = o.width_m;
+        obstacles.push_back(ob);
+      }
+    }
+    const algo::PlannedTrajectory plan = planner_->Plan(planner_pose_->pose, obstacles);
+    TrajectoryMsg out;
+    out.header.stamp_s = planner_pose_->header.stamp_s;
+    out.stop_for_goal = plan.stop_for_goal;
+    out.stop_for_obstacle = plan.stop_for_obstacle;
+    for (const algo::PlannedPoint& p : plan.points) {
+      out.points.push_back({p.x_m, p.y_m, p.yaw_rad, p.s_m, p.v_mps});
+    }
+    ctx.ReportWork({static_cast<double>(plan.work_units), 0.0, 1});
+    ctx.Publish(trajectory_raw_, std::move(out));
+  });
+
+  algo::SmootherParams smoother;
+  smoother.max_accel_mps2 = config_.Get("planning.max_accel_mps2");
+  smoother.max_decel_mps2 = config_.Get("planning.max_decel_mps2");
+  const int smoother_node = g->AddNode("velocity_smoother");
+  g->Subscribe<PoseMsg>(smoother_node, topics_.pose, "pose", 1,
+                        [this](const PoseMsg& in, CallbackContext&) { smoother_pose_ = in; });
+  g->Subscribe<TrajectoryMsg>(
+      smoother_node, trajectory_raw_, "trajectory", 1,
+      [this, smoother](const TrajectoryMsg& in, CallbackContext& ctx) {
+        std::vector<algo::PlannedPoint> points;
+        points.reserve(in.points.size());
+        for (const TrajectoryPoint& p : in.points) {
+          algo::PlannedPoint q;
+          q.x_m = p.x_m;
+          q.y_m = p.y_m;
+          q.yaw_rad = p.yaw_rad;
+          q.s_m = p.s_m;
+          q.v_mps = p.v_mps;
+          points.push_back(q);
+        }
+        algo::SmoothVelocity(&points, smoother_pose_ ? smoother_pose_->v_mps : 0.0, smoother);
+        TrajectoryMsg out = in;
+        for (size_t i = 0; i < points.size(); ++i) out.points[i].v_mps = points[i].v_mps;
+        ctx.ReportWork({static_cast<double>(points.size()), 0.0, 1});
+        ctx.Publish(topics_.trajectory, std::move(out));
+      });
+}
+
+void Stack::BuildControl(Graph* g) {
+  algo::FollowerParams params;
+  params.pure_pursuit.wheelbase_m = inputs_.wheelbase_m;
+  follower_ = std::make_unique<algo::TrajectoryFollower>(params);
+  const int node = g->AddNode("trajectory_follower");
+  g->Subscribe<PoseMsg>(node, topics_.pose, "pose", 1,
+                        [this](const PoseMsg& in, CallbackContext&) { follower_pose_ = in; });
+  g->Subscribe<TrajectoryMsg>(
+      node, topics_.trajectory, "trajectory", 1,
+      [this](const TrajectoryMsg& in, CallbackContext&) { follower_trajectory_ = in; });
+  g->AddTimer(node, "control", 1.0 / config_.Get("control.rate_hz"), [this](CallbackContext& ctx) {
+    ControlMsg out;
+    out.header.stamp_s = follower_pose_ ? follower_pose_->header.stamp_s : -1.0;
+    const double dt = follower_last_t_ < 0 ? 0.0 : ctx.now_s() - follower_last_t_;
+    follower_last_t_ = ctx.now_s();
+    if (!follower_pose_ || !follower_pose_->valid) {
+      // Nothing to steer by: ask for a stop.
+      out.accel_mps2 = -kNoPoseDecelMps2;
+    } else {
+      std::vector<algo::PlannedPoint> points;
+      if (follower_trajectory_) {
+        points.reserve(follower_trajectory_->points.size());
+        for (const TrajectoryPoint& p : follower_trajectory_->points) {
+          algo::PlannedPoint q;
+          q.x_m = p.x_m;
+          q.y_m = p.y_m;
+          q.yaw_rad = p.yaw_rad;
+          q.s_m = p.s_m;
+          q.v_mps = p.v_mps;
+          points.push_back(q);
+        }
+      }
+      const algo::FollowerCommand c =
+          follower_->Update(follower_pose_->pose, follower_pose_->v_mps, points, dt);
+      out.accel_mps2 = c.accel_mps2;
+      out.steer_rad = c.steer_rad;
+      ctx.ReportWork({static_cast<double>(points.size()), 0.0, 1});
+    }
+    ctx.Publish(topics_.control, std::move(out));
+  });
+}
+
+}  // namespace
+
+Result<std::unique_ptr<AdStack>> AdStack::Build(const StackConfig& config,
+                                                const StackInputs& inputs, Graph* graph) {
+  if (inputs.route.points.size() < 2) {
+    return Status::InvalidArgument("the stack needs a route of at least two points");
+  }
+  if (inputs.map_cloud.empty()) {
+    return Status::InvalidArgument("the stack needs a localization map cloud");
+  }
+  auto stack = std::make_unique<Stack>(config, inputs);
+  ADSE_RETURN_IF_ERROR(stack->Build(graph));
+  return std::unique_ptr<AdStack>(std::move(stack));
+}
+
+}  // namespace adse::stack

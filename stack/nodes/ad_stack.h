@@ -1,0 +1,57 @@
+// The autonomous-driving stack under test as a node graph: sensing,
+// localization (voxel filter + NDT + EKF), perception (ground removal,
+// clustering, tracking), planning (route, behaviour/velocity, smoother) and
+// control (pure pursuit + PID). Nodes are thin wrappers around
+// stack/algorithms. The vehicle-side command gate is not part of the graph:
+// it runs on the vehicle's safety controller, not the computer being sized.
+#ifndef ADSE_STACK_NODES_AD_STACK_H_
+#define ADSE_STACK_NODES_AD_STACK_H_
+
+#include <memory>
+#include <vector>
+
+#include "stack/base/status.h"
+#include "stack/config/stack_config.h"
+#include "stack/runtime/graph.h"
+#include "stack/world/geometry.h"
+
+namespace adse::stack {
+
+// What the car's computer knows before it drives: its map, its mission and
+// its own body. Never the ground truth of the run.
+struct StackInputs {
+  world::Path2 route;          // mission planner's route from map and goal
+  double lane_width_m = 3.5;
+  std::vector<Eigen::Vector3f> map_cloud;  // localization map (map frame)
+  world::Pose2 initial_pose;   // given at start, as an operator does
+  double speed_limit_mps = 30.0 / 3.6;
+  double goal_tolerance_m = 2.0;
+  double wheelbase_m = 2.7;
+  double vehicle_length_m = 4.6;
+  double vehicle_width_m = 1.9;
+};
+
+// Topic indices the harness talks to.
+struct StackTopics {
+  int lidar_raw = -1;   // in: PointCloudMsg, vehicle frame
+  int odometry = -1;    // in: OdometryMsg
+  int pose = -1;        // out: PoseMsg (EKF)
+  int control = -1;     // out: ControlMsg
+  int trajectory = -1;  // out: TrajectoryMsg
+  int objects = -1;     // out: ObjectsMsg
+};
+
+class AdStack {
+ public:
+  // Adds the stack's nodes and topics to `graph`. The returned object owns
+  // the nodes' state and must outlive the executor running the graph.
+  static Result<std::unique_ptr<AdStack>> Build(const StackConfig& config,
+                                                const StackInputs& inputs,
+                                                Graph* graph);
+  virtual ~AdStack() = default;
+  virtual const StackTopics& topics() const = 0;
+};
+
+}  // namespace adse::stack
+
+#endif  // ADSE_STACK_NODES_AD_STACK_H_

@@ -1,0 +1,659 @@
+// The `virtual` platform: a discrete-event simulation of N cores at f GHz
+// that runs a Graph's real callback code on the host thread and charges each
+// callback a simulated cost.
+//
+// Semantics (the contract the tests check):
+// - One simulated clock, starting at 0. Events: callback completion, external
+//   arrival (PublishExternal) and timer fire. Events at equal times are
+//   applied completions first, then arrivals, then timer fires, each kind in
+//   insertion order; after every event at a time is applied, dispatch runs.
+// - Each published message goes to every subscription of its topic. A
+//   subscription keeps the last `queue_depth` messages; a full queue drops its
+//   oldest (kDrop). Sinks are called synchronously at publish time, free.
+// - Readiness: a subscription is ready when its queue is non-empty and it is
+//   not running; its ready time is the arrival time of the oldest queued
+//   message (the one it will take). A timer is ready when it fired and that
+//   fire has not started; a fire arriving while an earlier fire still waits
+//   is skipped and counted in Trace::timer_overruns (ROS 2 timers do not
+//   queue missed periods). A running timer that fires waits for its end.
+// - Callbacks of one node exclude each other (ROS 2's default mutually
+//   exclusive callback group).
+// - Dispatch: while a core is free, start the ready callback (whose node is
+//   idle) with the earliest ready time, ties to the lower callback index.
+//   Non-preemptive. A subscription takes its OLDEST queued message (kTake).
+//   The real code runs at once; it sees now_s() = start; its publications are
+//   held until its end.
+// - Cost: base = host thread CPU time (kMeasured) or fixed + per_unit * units
+//   (kCounted; host_cpu_s is then recorded as 0 unless
+//   record_host_cpu_when_counted); k = min(max_threads, free cores at start)
+//   cores are held to the end; cost = base * (1 - p + p / k) * reference_ghz /
+//   freq_ghz * cost_scale, at least 1 us. At start + cost the cores are freed,
+//   held publications are released in order (kPublish, per-topic seq from 0)
+//   and the CallbackRecord is appended (records are in completion order).
+// - AdvanceTo(t) applies events strictly before t, then sets now = t.
+// - Errors (a callback or sink throws, a bad topic) are sticky: AdvanceTo
+//   returns the same Status from then on.
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "stack/runtime/executor.h"
+
+namespace adse::stack {
+namespace {
+
+// Nothing is instantaneous: keeps the clock moving and ends after starts.
+constexpr double kMinCostS = 1e-6;
+// Guards against absurd allocations from a typo; far above any real computer.
+constexpr int kMaxCores = 4096;
+// PublishExternal slightly in the past (rounding in the caller's time
+// arithmetic) is moved to now; further back is a caller bug.
+constexpr double kPastToleranceS = 1e-9;
+
+double ThreadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) +
+         static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+bool IsFinitePositive(double v) { return std::isfinite(v) && v > 0.0; }
+
+Status ValidateCountedCost(const CountedCost& cost, const std::string& field) {
+  if (!std::isfinite(cost.fixed_s) || cost.fixed_s < 0.0) {
+    return Status::InvalidArgument(fmt::format(
+        "{}.fixed_s must be finite and >= 0, got {}", field, cost.fixed_s));
+  }
+  if (!std::isfinite(cost.per_unit_s) || cost.per_unit_s < 0.0) {
+    return Status::InvalidArgument(
+        fmt::format("{}.per_unit_s must be finite and >= 0, got {}", field,
+                    cost.per_unit_s));
+  }
+  return Status::Ok();
+}
+
+// Event kinds double as the tie-break rank at equal times.
+enum EventKind : uint64_t { kCompletion = 0, kArrival = 1, kTimerFire = 2 };
+constexpr int kKindShift = 62;
+
+struct Event {
+  double t;
+  uint64_t key;   // kind << 62 | insertion sequence
+  int32_t index;  // completion, timer: callback; arrival: slot in arrivals_
+};
+
+// std::push_heap builds a max-heap; this order puts the earliest on top.
+struct EventLater {
+  bool operator()(const Event& a, const Event& b) const {
+    if (a.t != b.t) return a.t > b.t;
+    return a.key > b.key;
+  }
+};
+
+struct Arrival {
+  int32_t topic = -1;
+  MessagePtr message;
+  double stamp_s = 0.0;
+};
+
+struct QueuedMessage {
+  MessagePtr message;
+  uint64_t seq = 0;
+  double stamp_s = 0.0;
+  double arrival_s = 0.0;
+};
+
+struct HeldPublication {
+  int32_t topic;
+  MessagePtr message;
+  double stamp_s;
+};
+
+struct CallbackState {
+  const CallbackSpec* spec = nullptr;
+  bool is_timer = false;
+  bool running = false;
+  bool in_ready = false;
+  // Subscriptions: keep-last ring buffer of capacity queue_depth.
+  std::vector<QueuedMessage> ring;
+  int head = 0;
+  int size = 0;
+  // Timers.
+  bool fire_pending = false;
+  double fire_s = 0.0;
+  int64_t next_fire = 0;  // k of the fire at phase + k * period in the heap
+  CountedCost counted;
+  CallbackRecord record;              // the run in progress
+  std::vector<HeldPublication> held;  // its publications, until its end
+};
+
+// The context handed to callbacks; one instance, reused for every run since
+// callbacks execute one at a time on the host thread.
+class VirtualContext final : public CallbackContext {
+ public:
+  explicit VirtualContext(int num_topics) : num_topics_(num_topics) {}
+
+  void Begin(double now_s, std::vector<HeldPublication>* held) {
+    now_s_ = now_s;
+    held_ = held;
+    work_ = WorkReport{};
+    bad_topic_ = false;
+  }
+  double now_s() const override { return now_s_; }
+  void ReportWork(const WorkReport& work) override { work_ = work; }
+  const WorkReport& work() const { return work_; }
+  // The first publication to a topic index the graph does not have.
+  bool bad_topic() const { return bad_topic_; }
+  int bad_topic_index() const { return bad_topic_index_; }
+
+ protected:
+  void PublishErased(int topic, MessagePtr message, double stamp_s) override {
+    if (topic < 0 || topic >= num_topics_ || message == nullptr) {
+      if (!bad_topic_) bad_topic_index_ = topic;
+      bad_topic_ = true;
+      return;
+    }
+    held_->push_back({topic, std::move(message), stamp_s});
+  }
+
+ private:
+  int num_topics_;
+  double now_s_ = 0.0;
+  std::vector<HeldPublication>* held_ = nullptr;
+  WorkReport work_;
+  bool bad_topic_ = false;
+  int bad_topic_index_ = -1;
+};
+
+class VirtualExecutor final : public Executor {
+ public:
+  VirtualExecutor(const Graph* graph, const VirtualPlatformOptions& options);
+
+  void PublishExternal(int topic, MessagePtr message, double stamp_s,
+                       double t_s) override;
+  Status AdvanceTo(double t_s) override;
+  double now_s() const override { return now_; }
+  const Trace& trace() const override { return trace_; }
+
+ private:
+  void PushEvent(double t, EventKind kind, int32_t index) {
+    heap_.push_back(
+        {t, (static_cast<uint64_t>(kind) << kKindShift) | next_seq_++, index});
+    std::push_heap(heap_.begin(), heap_.end(), EventLater());
+  }
+  Event PopEvent() {
+    std::pop_heap(heap_.begin(), heap_.end(), EventLater());
+    Event e = heap_.back();
+    heap_.pop_back();
+    return e;
+  }
+  void PushTimerFire(int c) {
+    CallbackState& st = states_[c];
+    const double t = st.spec->phase_s +
+                     static_cast<double>(st.next_fire) * st.spec->period_s;
+    PushEvent(t, kTimerFire, c);
+  }
+
+  void ApplyEvent(const Event& e);
+  void OnArrival(int32_t slot);
+  void OnTimerFire(int c);
+  void OnCompletion(int c);
+  // Publishes `message` on `topic` now: traces it, queues it for every
+  // subscription and calls the sinks.
+  void Deliver(int topic, const MessagePtr& message, double stamp_s,
+               int publisher);
+  void Enqueue(int c, const MessagePtr& message, uint64_t seq, double stamp_s);
+  void MakeReady(int c) {
+    CallbackState& st = states_[c];
+    if (st.in_ready) return;
+    st.in_ready = true;
+    ready_.push_back(c);
+  }
+  double ReadyTime(const CallbackState& st) const {
+    return st.is_timer ? st.fire_s : st.ring[st.head].arrival_s;
+  }
+  void Dispatch();
+  void Start(int c);
+  void Fail(Status status) {
+    if (error_.ok()) error_ = std::move(status);
+  }
+
+  const Graph* graph_;
+  double freq_factor_;  // reference_ghz / freq_ghz * cost_scale
+  bool measured_;
+  bool read_clock_;  // host CPU time is measured around each callback
+
+  double now_ = 0.0;
+  uint64_t next_seq_ = 0;
+  std::vector<Event> heap_;
+  std::vector<Arrival> arrivals_;       // payloads of pending arrivals
+  std::vector<int32_t> free_arrivals_;  // reusable slots in arrivals_
+
+  std::vector<CallbackState> states_;
+  std::vector<int> ready_;                     // ready callbacks, unordered
+  std::vector<std::vector<int>> topic_subs_;   // per topic: subscriptions
+  std::vector<std::vector<int>> topic_sinks_;  // per topic: sink indices
+  std::vector<uint64_t> topic_seq_;            // per topic: next seq
+  std::vector<char> node_busy_;
+  std::vector<int32_t> core_owner_;  // callback holding each core, or -1
+  int free_cores_;
+
+  VirtualContext context_;
+  Trace trace_;
+  Status error_;
+  bool in_advance_ = false;
+};
+
+VirtualExecutor::VirtualExecutor(const Graph* graph,
+                                 const VirtualPlatformOptions& options)
+    : graph_(graph),
+      freq_factor_(options.reference_ghz / options.freq_ghz *
+                   options.cost_scale),
+      measured_(options.cost_model == CostModelKind::kMeasured),
+      read_clock_(measured_ || options.record_host_cpu_when_counted),
+      free_cores_(options.cores),
+      context_(static_cast<int>(graph->topics().size())) {
+  const auto& callbacks = graph->callbacks();
+  const size_t num_topics = graph->topics().size();
+  topic_subs_.resize(num_topics);
+  topic_sinks_.resize(num_topics);
+  topic_seq_.assign(num_topics, 0);
+  node_busy_.assign(graph->nodes().size(), 0);
+  core_owner_.assign(options.cores, -1);
+
+  states_.resize(callbacks.size());
+  for (size_t c = 0; c < callbacks.size(); ++c) {
+    const CallbackSpec& spec = callbacks[c];
+    CallbackState& st = states_[c];
+    st.spec = &spec;
+    st.is_timer = spec.kind == CallbackSpec::Kind::kTimer;
+    auto it = options.counted.find(spec.name);
+    st.counted =
+        it != options.counted.end() ? it->second : options.default_counted;
+    if (st.is_timer) {
+      PushTimerFire(static_cast<int>(c));
+    } else {
+      st.ring.resize(spec.queue_depth);
+      topic_subs_[spec.topic].push_back(static_cast<int>(c));
+    }
+    st.held.reserve(4);
+  }
+  for (size_t s = 0; s < graph->sinks().size(); ++s) {
+    topic_sinks_[graph->sinks()[s].topic].push_back(static_cast<int>(s));
+  }
+  ready_.reserve(callbacks.size());
+  heap_.reserve(callbacks.size() + 64);
+  trace_.timer_overruns.assign(callbacks.size(), 0);
+  // Amortised growth would do; reserving skips the first few copies.
+  trace_.callbacks.reserve(4096);
+  trace_.topic_events.reserve(16384);
+}
+
+void VirtualExecutor::PublishExternal(int topic, MessagePtr message,
+                                      double stamp_s, double t_s) {
+  if (topic < 0 || topic >= static_cast<int>(topic_subs_.size())) {
+    Fail(Status::InvalidArgument(
+        fmt::format("PublishExternal: no topic with index {}", topic)));
+    return;
+  }
+  if (message == nullptr) {
+    Fail(Status::InvalidArgument(
+        fmt::format("PublishExternal: null message on topic '{}'",
+                    graph_->topics()[topic].name)));
+    return;
+  }
+  if (!std::isfinite(t_s) || t_s < now_ - kPastToleranceS) {
+    Fail(Status::InvalidArgument(
+        fmt::format("PublishExternal on topic '{}' at t={} before now={}",
+                    graph_->topics()[topic].name, t_s, now_)));
+    return;
+  }
+  t_s = std::max(t_s, now_);
+  int32_t slot;
+  if (!free_arrivals_.empty()) {
+    slot = free_arrivals_.back();
+    free_arrivals_.pop_back();
+  } else {
+    slot = static_cast<int32_t>(arrivals_.size());
+    arrivals_.emplace_back();
+  }
+  Arrival& a = arrivals_[slot];
+  a.topic = topic;
+  a.message = std::move(message);
+  a.stamp_s = stamp_s;
+  PushEvent(t_s, kArrival, slot);
+}
+
+Status VirtualExecutor::AdvanceTo(double t_s) {
+  if (!error_.ok()) return error_;
+  if (in_advance_) {
+    return Status::Internal("AdvanceTo called from inside a callback or sink");
+  }
+  if (!std::isfinite(t_s) || t_s < now_) {
+    return Status::InvalidArgument(
+        fmt::format("AdvanceTo({}) must be finite and >= now ({})", t_s, now_));
+  }
+  in_advance_ = true;
+  while (error_.ok() && !heap_.empty() && heap_.front().t < t_s) {
+    const double batch_t = heap_.front().t;
+    now_ = batch_t;
+    // Every event at this time, in (kind, sequence) order, before dispatch.
+    while (error_.ok() && !heap_.empty() && heap_.front().t == batch_t) {
+      ApplyEvent(PopEvent());
+    }
+    if (error_.ok()) Dispatch();
+  }
+  in_advance_ = false;
+  if (!error_.ok()) return error_;
+  now_ = t_s;
+  return Status::Ok();
+}
+
+void VirtualExecutor::ApplyEvent(const Event& e) {
+  switch (static_cast<EventKind>(e.key >> kKindShift)) {
+    case kCompletion:
+      OnCompletion(e.index);
+      break;
+    case kArrival:
+      OnArrival(e.index);
+      break;
+    case kTimerFire:
+      OnTimerFire(e.index);
+      break;
+  }
+}
+
+void VirtualExecutor::OnArrival(int32_t slot) {
+  // Move out first: a sink may call PublishExternal and grow arrivals_.
+  Arrival& a = arrivals_[slot];
+  const int topic = a.topic;
+  const double stamp_s = a.stamp_s;
+  MessagePtr message = std::move(a.message);
+  free_arrivals_.push_back(slot);
+  Deliver(topic, message, stamp_s, -1);
+}
+
+void VirtualExecutor::OnTimerFire(int c) {
+  CallbackState& st = states_[c];
+  ++st.next_fire;
+  PushTimerFire(c);
+  if (st.fire_pending) {
+    ++trace_.timer_overruns[c];  // the earlier fire still waits: skip this
+    return;
+  }
+  st.fire_pending = true;
+  st.fire_s = now_;
+  if (!st.running) MakeReady(c);
+}
+
+void VirtualExecutor::OnCompletion(int c) {
+  CallbackState& st = states_[c];
+  const CallbackRecord& rec = st.record;
+  for (int i = rec.first_core, left = rec.cores; left > 0; ++i) {
+    if (core_owner_[i] == c) {
+      core_owner_[i] = -1;
+      --left;
+    }
+  }
+  free_cores_ += rec.cores;
+  node_busy_[st.spec->node] = 0;
+  st.running = false;
+  trace_.callbacks.push_back(rec);
+  // Index loop: a sink may publish externally, which does not touch `held`,
+  // but keep no iterator across user code anyway.
+  for (size_t i = 0; i < st.held.size() && error_.ok(); ++i) {
+    HeldPublication& p = st.held[i];
+    Deliver(p.topic, p.message, p.stamp_s, c);
+  }
+  st.held.clear();
+  if (st.is_timer ? st.fire_pending : st.size > 0) MakeReady(c);
+}
+
+void VirtualExecutor::Deliver(int topic, const MessagePtr& message,
+                              double stamp_s, int publisher) {
+  const uint64_t seq = topic_seq_[topic]++;
+  trace_.topic_events.push_back(
+      {TopicEvent::kPublish, topic, publisher, now_, seq, stamp_s});
+  for (int c : topic_subs_[topic]) Enqueue(c, message, seq, stamp_s);
+  for (int s : topic_sinks_[topic]) {
+    const SinkSpec& sink = graph_->sinks()[s];
+    try {
+      sink.fn(message, now_);
+    } catch (const std::exception& e) {
+      Fail(Status::Internal(fmt::format("sink #{} on topic '{}' threw: {}", s,
+                                        graph_->topics()[topic].name,
+                                        e.what())));
+      return;
+    } catch (...) {
+      Fail(Status::Internal(fmt::format("sink #{} on topic '{}' threw", s,
+                                        graph_->topics()[topic].name)));
+      return;
+    }
+  }
+}
+
+void VirtualExecutor::Enqueue(int c, const MessagePtr& message, uint64_t seq,
+                              double stamp_s) {
+  CallbackState& st = states_[c];
+  const int depth = static_cast<int>(st.ring.size());
+  if (st.size == depth) {
+    // Keep-last: the oldest message makes room.
+    QueuedMessage& old = st.ring[st.head];
+    trace_.topic_events.push_back(
+        {TopicEvent::kDrop, st.spec->topic, c, now_, old.seq, old.stamp_s});
+    old.message.reset();
+    st.head = st.head + 1 == depth ? 0 : st.head + 1;
+    --st.size;
+  }
+  int tail = st.head + st.size;
+  if (tail >= depth) tail -= depth;
+  st.ring[tail] = {message, seq, stamp_s, now_};
+  ++st.size;
+  if (!st.running) MakeReady(c);
+}
+
+void VirtualExecutor::Dispatch() {
+  // The ready set is small (at most one entry per callback), so a scan is
+  // cheaper than keeping it ordered as drops move ready times.
+  while (free_cores_ > 0 && error_.ok()) {
+    int best_pos = -1;
+    int best_c = 0;
+    double best_t = 0.0;
+    for (size_t i = 0; i < ready_.size(); ++i) {
+      const int c = ready_[i];
+      const CallbackState& st = states_[c];
+      if (node_busy_[st.spec->node]) continue;
+      const double t = ReadyTime(st);
+      if (best_pos < 0 || t < best_t || (t == best_t && c < best_c)) {
+        best_pos = static_cast<int>(i);
+        best_c = c;
+        best_t = t;
+      }
+    }
+    if (best_pos < 0) return;
+    ready_[best_pos] = ready_.back();
+    ready_.pop_back();
+    Start(best_c);
+  }
+}
+
+void VirtualExecutor::Start(int c) {
+  CallbackState& st = states_[c];
+  const CallbackSpec& spec = *st.spec;
+  st.in_ready = false;
+  st.running = true;
+  node_busy_[spec.node] = 1;
+
+  CallbackRecord& rec = st.record;
+  rec.callback = c;
+  rec.node = spec.node;
+  rec.start_s = now_;
+  MessagePtr message;
+  if (st.is_timer) {
+    rec.ready_s = st.fire_s;
+    st.fire_pending = false;
+  } else {
+    QueuedMessage& q = st.ring[st.head];
+    rec.ready_s = q.arrival_s;
+    message = std::move(q.message);
+    trace_.topic_events.push_back(
+        {TopicEvent::kTake, spec.topic, c, now_, q.seq, q.stamp_s});
+    st.head = st.head + 1 == static_cast<int>(st.ring.size()) ? 0 : st.head + 1;
+    --st.size;
+  }
+
+  context_.Begin(now_, &st.held);
+  // Counted runs skip the clock unless asked: host time differs run to run and
+  // would break bit-identical traces (and costs two syscalls).
+  const double cpu0 = read_clock_ ? ThreadCpuSeconds() : 0.0;
+  try {
+    if (st.is_timer) {
+      spec.on_timer(context_);
+    } else {
+      spec.on_message(message, context_);
+    }
+  } catch (const std::exception& e) {
+    Fail(Status::Internal(
+        fmt::format("callback '{}' threw: {}", spec.name, e.what())));
+  } catch (...) {
+    Fail(Status::Internal(fmt::format("callback '{}' threw", spec.name)));
+  }
+  const double host_cpu_s = read_clock_ ? ThreadCpuSeconds() - cpu0 : 0.0;
+  message.reset();
+  if (context_.bad_topic()) {
+    Fail(Status::Internal(fmt::format(
+        "callback '{}' published to topic index {}, which does not exist",
+        spec.name, context_.bad_topic_index())));
+  }
+
+  // Sanitise the report: a bad value must not yield a NaN clock.
+  const WorkReport& work = context_.work();
+  const double units = std::isfinite(work.units) ? work.units : 0.0;
+  double p =
+      std::isfinite(work.parallel_fraction) ? work.parallel_fraction : 0.0;
+  p = std::clamp(p, 0.0, 1.0);
+  const int k = std::max(1, std::min(work.max_threads, free_cores_));
+
+  const double base_s =
+      measured_ ? host_cpu_s
+                : st.counted.fixed_s + st.counted.per_unit_s * units;
+  double cost_s = base_s * (1.0 - p + p / k) * freq_factor_;
+  if (!(cost_s >= kMinCostS)) cost_s = kMinCostS;  // also catches NaN
+
+  int first_core = -1;
+  for (int i = 0, taken = 0; taken < k; ++i) {
+    if (core_owner_[i] >= 0) continue;
+    core_owner_[i] = c;
+    if (first_core < 0) first_core = i;
+    ++taken;
+  }
+  free_cores_ -= k;
+
+  rec.end_s = now_ + cost_s;
+  rec.cost_s = cost_s;
+  rec.host_cpu_s = host_cpu_s;
+  rec.work_units = units;
+  rec.cores = k;
+  rec.first_core = first_core;
+  PushEvent(rec.end_s, kCompletion, c);
+}
+
+Status ValidateGraph(const Graph& graph) {
+  const int num_topics = static_cast<int>(graph.topics().size());
+  const int num_nodes = static_cast<int>(graph.nodes().size());
+  for (const CallbackSpec& spec : graph.callbacks()) {
+    if (spec.node < 0 || spec.node >= num_nodes) {
+      return Status::InvalidArgument(fmt::format(
+          "callback '{}': node index {} out of range", spec.name, spec.node));
+    }
+    if (spec.kind == CallbackSpec::Kind::kSubscription) {
+      if (spec.topic < 0 || spec.topic >= num_topics) {
+        return Status::InvalidArgument(
+            fmt::format("callback '{}': topic index {} out of range", spec.name,
+                        spec.topic));
+      }
+      if (spec.queue_depth < 1) {
+        return Status::InvalidArgument(
+            fmt::format("callback '{}': queue_depth must be >= 1, got {}",
+                        spec.name, spec.queue_depth));
+      }
+      if (!spec.on_message) {
+        return Status::InvalidArgument(
+            fmt::format("callback '{}': no function", spec.name));
+      }
+    } else {
+      if (!IsFinitePositive(spec.period_s)) {
+        return Status::InvalidArgument(
+            fmt::format("timer '{}': period_s must be finite and > 0, got {}",
+                        spec.name, spec.period_s));
+      }
+      if (!std::isfinite(spec.phase_s) || spec.phase_s < 0.0) {
+        return Status::InvalidArgument(
+            fmt::format("timer '{}': phase_s must be finite and >= 0, got {}",
+                        spec.name, spec.phase_s));
+      }
+      if (!spec.on_timer) {
+        return Status::InvalidArgument(
+            fmt::format("timer '{}': no function", spec.name));
+      }
+    }
+  }
+  for (size_t s = 0; s < graph.sinks().size(); ++s) {
+    const SinkSpec& sink = graph.sinks()[s];
+    if (sink.topic < 0 || sink.topic >= num_topics) {
+      return Status::InvalidArgument(
+          fmt::format("sink #{}: topic index {} out of range", s, sink.topic));
+    }
+    if (!sink.fn) {
+      return Status::InvalidArgument(fmt::format("sink #{}: no function", s));
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ValidateVirtualPlatformOptions(const VirtualPlatformOptions& options) {
+  if (options.cores < 1 || options.cores > kMaxCores) {
+    return Status::InvalidArgument(fmt::format(
+        "cores must be in [1, {}], got {}", kMaxCores, options.cores));
+  }
+  if (!IsFinitePositive(options.freq_ghz)) {
+    return Status::InvalidArgument(fmt::format(
+        "freq_ghz must be finite and > 0, got {}", options.freq_ghz));
+  }
+  if (!IsFinitePositive(options.reference_ghz)) {
+    return Status::InvalidArgument(fmt::format(
+        "reference_ghz must be finite and > 0, got {}", options.reference_ghz));
+  }
+  if (!IsFinitePositive(options.cost_scale)) {
+    return Status::InvalidArgument(fmt::format(
+        "cost_scale must be finite and > 0, got {}", options.cost_scale));
+  }
+  if (options.cost_model != CostModelKind::kMeasured &&
+      options.cost_model != CostModelKind::kCounted) {
+    return Status::InvalidArgument("cost_model: unknown kind");
+  }
+  for (const auto& [name, cost] : options.counted) {
+    ADSE_RETURN_IF_ERROR(
+        ValidateCountedCost(cost, fmt::format("counted[{}]", name)));
+  }
+  return ValidateCountedCost(options.default_counted, "default_counted");
+}
+
+Result<std::unique_ptr<Executor>> CreateVirtualExecutor(
+    const Graph* graph, const VirtualPlatformOptions& options) {
+  if (graph == nullptr) return Status::InvalidArgument("graph is null");
+  ADSE_RETURN_IF_ERROR(ValidateVirtualPlatformOptions(options));
+  ADSE_RETURN_IF_ERROR(ValidateGraph(*graph));
+  return std::unique_ptr<Executor>(new VirtualExecutor(graph, options));
+}
+
+}  // namespace adse::stack

@@ -1,0 +1,69 @@
+#include "analysis/metrics/run_metrics.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace adse::analysis {
+namespace {
+
+runfile::RunData TenSecondRun() {
+  runfile::RunData run;
+  run.status = "complete";
+  run.termination_reason = "goal_reached";
+  run.platform["cores"] = "2";
+  for (int i = 0; i <= 100; ++i) run.ego.push_back({i * 0.1, 0, 0, 0, 0, 0, 0});
+  run.topic_names = {"/sensing/lidar/points_raw", "/control/command"};
+  // 20 Hz control for 10 s, and 5 commands after the end that must not count.
+  for (int i = 0; i < 205; ++i) {
+    stack::TopicEvent e;
+    e.kind = stack::TopicEvent::kPublish;
+    e.topic = 1;
+    e.t_s = i * 0.05;
+    run.trace.topic_events.push_back(e);
+    // Latencies 0.10 s .. 0.29 s repeating.
+    run.controls.push_back({e.t_s, e.t_s - 0.10 - 0.01 * (i % 20), 0.0, 0.0});
+  }
+  for (int i = 0; i < 7; ++i) {
+    stack::TopicEvent e;
+    e.kind = stack::TopicEvent::kDrop;
+    e.topic = 0;
+    e.t_s = i;
+    run.trace.topic_events.push_back(e);
+  }
+  stack::CallbackRecord r;
+  r.start_s = 1.0;
+  r.cost_s = 5.0;
+  r.cores = 2;
+  run.trace.callbacks.push_back(r);
+  run.collisions.push_back({3.0, "car"});
+  return run;
+}
+
+TEST(RunMetricsTest, KnownRunGivesKnownMetrics) {
+  const auto m = ComputeRunMetrics(TenSecondRun());
+  EXPECT_EQ(m.at("completed"), 1.0);
+  EXPECT_NEAR(m.at("nav_time_s"), 10.0, 1e-9);
+  EXPECT_NEAR(m.at("ctrl_rate_hz"), 20.1, 1e-9);  // 201 commands up to t = 10 s
+  EXPECT_EQ(m.at("dropped_messages"), 7.0);
+  EXPECT_EQ(m.at("lidar_frames_dropped"), 7.0);
+  EXPECT_EQ(m.at("collisions"), 1.0);
+  EXPECT_NEAR(m.at("e2e_latency_p50_s"), 0.195, 0.011);
+  EXPECT_NEAR(m.at("e2e_latency_p99_s"), 0.29, 0.002);
+  EXPECT_NEAR(m.at("cpu_utilization"), 10.0 / 20.0, 1e-9);
+}
+
+TEST(RunMetricsTest, TimeoutIsNotCompleted) {
+  runfile::RunData run = TenSecondRun();
+  run.termination_reason = "timeout";
+  EXPECT_EQ(ComputeRunMetrics(run).at("completed"), 0.0);
+}
+
+TEST(RunMetricsTest, PercentileInterpolates) {
+  EXPECT_NEAR(Percentile({4, 1, 3, 2}, 0.5), 2.5, 1e-12);
+  EXPECT_NEAR(Percentile({1, 2, 3, 4, 5}, 0.99), 4.96, 1e-12);
+  EXPECT_TRUE(std::isnan(Percentile({}, 0.5)));
+}
+
+}  // namespace
+}  // namespace adse::analysis

@@ -1,0 +1,113 @@
+// One design point end to end on the small robotaxi scenario: the stack on
+// the virtual platform drives to the goal when the computer is generous,
+// and shows starvation when it is not. Runs are real: SUMO, LiDAR, PCL NDT.
+#include "harness/sim/simulator.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "analysis/runfile/run_file.h"
+#include "harness/sim/calibration.h"
+#include "harness/spec/spec_parser.h"
+#include "stack/base/hash.h"
+
+namespace adse::sim {
+namespace {
+
+spec::Spec SmallScenario() {
+  Result<spec::Spec> spec =
+      spec::LoadSpec(std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml");
+  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
+  return std::move(spec).value();
+}
+
+spec::DesignPoint Point(double cores, double freq_ghz, double lidar_hz) {
+  return {{"cores", cores}, {"freq_ghz", freq_ghz}, {"lidar_hz", lidar_hz}};
+}
+
+TEST(SimulateTest, GenerousComputerDrivesToTheGoalAtTheNominalControlRate) {
+  Result<runfile::RunData> run = SimulatePoint(SmallScenario(), Point(16, 2.1, 14));
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  const auto& m = run->metrics;
+  EXPECT_EQ(run->termination_reason, "goal_reached");
+  EXPECT_EQ(m.at("completed"), 1.0);
+  EXPECT_EQ(m.at("collisions"), 0.0);
+  // 91 m of path at up to 30 km/h with slow corners.
+  EXPECT_GT(m.at("nav_time_s"), 12.0);
+  EXPECT_LT(m.at("nav_time_s"), 40.0);
+  // The follower runs at control.rate_hz = 30 Hz.
+  EXPECT_NEAR(m.at("ctrl_rate_hz"), 30.0, 3.0);
+  EXPECT_LT(m.at("e2e_latency_p99_s"), 0.6);
+  EXPECT_NEAR(m.at("hardware_cost"), 16 * 2.1, 1e-9);
+}
+
+TEST(SimulateTest, StarvedComputerControlsLessOftenAndDropsLidarFrames) {
+  const spec::Spec spec = SmallScenario();
+  Result<runfile::RunData> generous = SimulatePoint(spec, Point(16, 2.1, 14));
+  Result<runfile::RunData> starved = SimulatePoint(spec, Point(1, 1.0, 14));
+  ASSERT_TRUE(generous.ok()) << generous.status().ToString();
+  ASSERT_TRUE(starved.ok()) << starved.status().ToString();
+  const auto& g = generous->metrics;
+  const auto& s = starved->metrics;
+  EXPECT_LT(s.at("ctrl_rate_hz"), 0.7 * g.at("ctrl_rate_hz"));
+  EXPECT_GT(s.at("lidar_frames_dropped"), g.at("lidar_frames_dropped"));
+  EXPECT_GT(s.at("e2e_latency_p50_s"), g.at("e2e_latency_p50_s"));
+  // Slower or not there at all.
+  EXPECT_TRUE(s.at("completed") == 0.0 || s.at("nav_time_s") > g.at("nav_time_s"));
+}
+
+TEST(SimulateTest, CountedCostModelGivesIdenticalTraces) {
+  spec::Spec spec = SmallScenario();
+  // Calibrate from one measured run, then run the counted model twice.
+  Result<runfile::RunData> measured = SimulatePoint(spec, Point(16, 2.1, 7));
+  ASSERT_TRUE(measured.ok()) << measured.status().ToString();
+  const Calibration calibration = FitCalibration({&*measured});
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "adse_sim_test_calibration.json").string();
+  ASSERT_TRUE(WriteCalibration(path, calibration, "test").ok());
+  spec.platform.cost_model = spec::CostModel::kCounted;
+  spec.platform.calibration = path;
+  auto fingerprint = [&](const runfile::RunData& run) {
+    ContentHasher h;
+    for (const auto& r : run.trace.callbacks) {
+      h.Add(static_cast<long long>(r.callback)).Add(r.start_s).Add(r.end_s).Add(r.cost_s);
+    }
+    for (const auto& e : run.trace.topic_events) {
+      h.Add(static_cast<long long>(e.kind)).Add(static_cast<long long>(e.topic)).Add(e.t_s);
+    }
+    for (const auto& s : run.ego) h.Add(s.x_m).Add(s.y_m).Add(s.v_mps);
+    return h.Hex();
+  };
+  Result<runfile::RunData> a = SimulatePoint(spec, Point(4, 1.0, 7));
+  Result<runfile::RunData> b = SimulatePoint(spec, Point(4, 1.0, 7));
+  ASSERT_TRUE(a.ok()) << a.status().ToString();
+  ASSERT_TRUE(b.ok()) << b.status().ToString();
+  EXPECT_GT(a->trace.callbacks.size(), 100u);
+  EXPECT_EQ(fingerprint(*a), fingerprint(*b));
+}
+
+TEST(SimulateTest, RunFileIsWrittenAndPassesTheSchemaCheck) {
+  Result<runfile::RunData> run = SimulatePoint(SmallScenario(), Point(4, 2.1, 7));
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "adse_sim_test_run.h5").string();
+  ASSERT_TRUE(runfile::WriteRunFile(path, *run).ok());
+  std::vector<std::string> problems;
+  EXPECT_TRUE(runfile::CheckRunFile(path, &problems).ok());
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  Result<runfile::RunData> back = runfile::ReadRunFile(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->trace.callbacks.size(), run->trace.callbacks.size());
+  EXPECT_EQ(back->metrics.at("ctrl_rate_hz"), run->metrics.at("ctrl_rate_hz"));
+}
+
+TEST(SimulateTest, PointOutsideTheSpaceIsRejected) {
+  Result<runfile::RunData> run = SimulatePoint(SmallScenario(), Point(3, 2.1, 7));
+  ASSERT_FALSE(run.ok());
+  EXPECT_EQ(run.status().code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(run.status().message().find("cores"), std::string::npos) << run.status().message();
+}
+
+}  // namespace
+}  // namespace adse::sim

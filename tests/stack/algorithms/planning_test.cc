@@ -1,0 +1,212 @@
+#include "stack/algorithms/planning.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace adse::algorithms {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+world::Path2 Polyline(std::vector<Eigen::Vector2d> points) {
+  world::Path2 path;
+  path.points = std::move(points);
+  path.UpdateArcLength();
+  return path;
+}
+
+world::Path2 Straight(double length_m, double step_m) {
+  std::vector<Eigen::Vector2d> pts;
+  for (double x = 0.0; x <= length_m + 1e-9; x += step_m)
+    pts.emplace_back(x, 0);
+  return Polyline(pts);
+}
+
+PlannerObstacle Car(int id, double x, double y) {
+  PlannerObstacle ob;
+  ob.id = id;
+  ob.position = {x, y};
+  ob.length_m = 4.5;
+  ob.width_m = 1.8;
+  return ob;
+}
+
+TEST(BehaviorVelocityPlanner, FreeRoadAtSpeedLimit) {
+  BehaviorVelocityPlanner planner;
+  planner.SetPath(Straight(200, 5));
+  const PlannedTrajectory traj = planner.Plan(world::Pose2{10.2, 0.3, 0}, {});
+  ASSERT_EQ(traj.points.size(), 51u);
+  EXPECT_NEAR(traj.ego_s_m, 10.2, 1e-9);
+  EXPECT_NEAR(traj.lateral_offset_m, 0.3, 1e-9);
+  EXPECT_NEAR(traj.points.front().s_m, 10.2, 1e-9);
+  EXPECT_NEAR(traj.points.back().s_m, 60.2, 1e-9);
+  EXPECT_NEAR(traj.points[5].x_m, 15.2, 1e-9);
+  EXPECT_FALSE(traj.stop_for_goal);
+  EXPECT_FALSE(traj.stop_for_obstacle);
+  for (const PlannedPoint& p : traj.points) {
+    EXPECT_DOUBLE_EQ(p.v_mps, planner.params().speed_limit_mps);
+  }
+  EXPECT_GE(traj.work_units, 51);
+}
+
+TEST(BehaviorVelocityPlanner, StopsAtGoal) {
+  BehaviorVelocityPlanner planner;
+  planner.SetPath(Straight(100, 5));
+  const PlannedTrajectory traj = planner.Plan(world::Pose2{70, 0, 0}, {});
+  EXPECT_TRUE(traj.stop_for_goal);
+  ASSERT_FALSE(traj.points.empty());
+  EXPECT_NEAR(traj.points.back().s_m, 100.0, 1e-9);
+  EXPECT_EQ(traj.points.back().v_mps, 0.0);
+  EXPECT_GT(traj.points[traj.points.size() - 2].v_mps, 0.0);
+  EXPECT_NEAR(traj.stop_s_m, 100.0, 1e-9);
+  // Past the goal: one point, speed 0.
+  const PlannedTrajectory after = planner.Plan(world::Pose2{103, 0, 0}, {});
+  EXPECT_TRUE(after.stop_for_goal);
+  ASSERT_EQ(after.points.size(), 1u);
+  EXPECT_EQ(after.points[0].v_mps, 0.0);
+}
+
+TEST(BehaviorVelocityPlanner, GoalPointProjectedOnPath) {
+  BehaviorVelocityPlanner planner;
+  planner.SetPath(Straight(100, 5), Eigen::Vector2d(60.0, 0.4));
+  EXPECT_NEAR(planner.goal_s_m(), 60.0, 1e-9);
+  const PlannedTrajectory traj = planner.Plan(world::Pose2{30, 0, 0}, {});
+  EXPECT_TRUE(traj.stop_for_goal);
+  EXPECT_NEAR(traj.points.back().s_m, 60.0, 1e-9);
+  EXPECT_EQ(traj.points.back().v_mps, 0.0);
+}
+
+TEST(BehaviorVelocityPlanner, StopsBeforeObstacleInCorridor) {
+  BehaviorVelocityPlanner planner;
+  planner.SetPath(Straight(200, 5));
+  const PlannerParams& params = planner.params();
+  const PlannedTrajectory traj =
+      planner.Plan(world::Pose2{0, 0, 0}, {Car(7, 40.0, 0.5)});
+  EXPECT_TRUE(traj.stop_for_obstacle);
+  EXPECT_FALSE(traj.stop_for_goal);
+  EXPECT_EQ(traj.obstacle_id, 7);
+  // Rear-axle stop point: the car's rear (37.75) - margin - ego front.
+  const double expected_stop =
+      40.0 - 2.25 - params.stop_margin_m - params.ego_front_m;
+  EXPECT_NEAR(traj.stop_s_m, expected_stop, 1e-9);
+  bool saw_zero_at_stop = false;
+  for (const PlannedPoint& p : traj.points) {
+    // The ego front at this point is p.s + ego_front: standing still there
+    // leaves at least the margin to the obstacle's rear.
+    if (p.s_m + params.ego_front_m >=
+        40.0 - 2.25 - params.stop_margin_m - 1e-6) {
+      EXPECT_EQ(p.v_mps, 0.0) << "at s " << p.s_m;
+    } else {
+      EXPECT_GT(p.v_mps, 0.0) << "at s " << p.s_m;
+    }
+    if (std::abs(p.s_m - expected_stop) < 1e-9) saw_zero_at_stop = true;
+  }
+  EXPECT_TRUE(saw_zero_at_stop);  // an exact point at the stop line
+}
+
+TEST(BehaviorVelocityPlanner, IgnoresObstaclesOutsideCorridorOrBehind) {
+  BehaviorVelocityPlanner planner;
+  planner.SetPath(Straight(200, 5));
+  // Next lane (3.5 m over: 3.5 - 0.9 > 1.4) and behind the ego.
+  const PlannedTrajectory traj = planner.Plan(
+      world::Pose2{20, 0, 0}, {Car(1, 40.0, 3.5), Car(2, 5.0, 0.0)});
+  EXPECT_FALSE(traj.stop_for_obstacle);
+  EXPECT_EQ(traj.obstacle_id, -1);
+  for (const PlannedPoint& p : traj.points) EXPECT_GT(p.v_mps, 0.0);
+  // A crossing car (across the path) reaches further sideways.
+  PlannerObstacle crossing = Car(3, 40.0, 3.0);
+  crossing.yaw_rad = kPi / 2;  // 2.25 m half extent across the path
+  EXPECT_TRUE(
+      planner.Plan(world::Pose2{20, 0, 0}, {crossing}).stop_for_obstacle);
+}
+
+TEST(BehaviorVelocityPlanner, CurvatureLimitsSpeedInCurve) {
+  // 50 m straight, a quarter circle of radius 10 m (1 m chords), straight.
+  std::vector<Eigen::Vector2d> pts;
+  for (double x = 0; x <= 50; x += 5) pts.emplace_back(x, 0);
+  for (int i = 1; i <= 16; ++i) {
+    const double a = -kPi / 2 + i * (kPi / 2) / 16;
+    pts.emplace_back(50 + 10 * std::cos(a), 10 + 10 * std::sin(a));
+  }
+  for (double y = 15; y <= 60; y += 5) pts.emplace_back(60, y);
+  BehaviorVelocityPlanner planner;
+  planner.SetPath(Polyline(pts));
+  const PlannedTrajectory traj = planner.Plan(world::Pose2{30, 0, 0}, {});
+  const double v_curve =
+      std::sqrt(planner.params().max_lateral_accel_mps2 / 0.1);
+  bool checked_curve = false;
+  for (const PlannedPoint& p : traj.points) {
+    if (p.s_m < 45) {
+      EXPECT_DOUBLE_EQ(p.v_mps, planner.params().speed_limit_mps);
+    }
+    if (p.s_m > 54 && p.s_m < 62) {  // well inside the arc
+      EXPECT_NEAR(p.curvature_1pm, 0.1, 0.01);
+      EXPECT_NEAR(p.v_mps, v_curve, 0.2);
+      checked_curve = true;
+    }
+  }
+  EXPECT_TRUE(checked_curve);
+}
+
+TEST(BehaviorVelocityPlanner, ProjectionStaysOnItsLegOfAUTurn) {
+  // Out along y = 0 and back along y = 3: the return leg is closer to a
+  // pose at y = 1.6 but the ego is on the way out.
+  BehaviorVelocityPlanner planner;
+  planner.SetPath(Polyline({{0, 0}, {50, 0}, {50, 3}, {0, 3}}));
+  planner.Plan(world::Pose2{0, 0, 0}, {});
+  for (double x = 2; x <= 30; x += 2) {
+    const PlannedTrajectory traj = planner.Plan(world::Pose2{x, 1.6, 0}, {});
+    EXPECT_NEAR(traj.ego_s_m, x, 1e-9);
+  }
+  // Backward jitter does not move progress back.
+  EXPECT_NEAR(planner.Plan(world::Pose2{29.5, 0, 0}, {}).ego_s_m, 30.0, 1e-9);
+  // Far from the window (e.g. after a relocalization): global search.
+  EXPECT_NEAR(planner.Plan(world::Pose2{10, 3.2, kPi}, {}).ego_s_m, 93.0, 1e-9);
+}
+
+TEST(BehaviorVelocityPlanner, EmptyWithoutPath) {
+  BehaviorVelocityPlanner planner;
+  EXPECT_TRUE(planner.Plan(world::Pose2{}, {}).points.empty());
+}
+
+TEST(SmoothVelocity, RespectsAccelAndDecelLimits) {
+  BehaviorVelocityPlanner planner;
+  planner.SetPath(Straight(200, 5));
+  PlannedTrajectory traj =
+      planner.Plan(world::Pose2{0, 0, 0}, {Car(1, 45.0, 0.0)});
+  const std::vector<PlannedPoint> raw = traj.points;
+  SmootherParams params;
+  SmoothVelocity(&traj.points, 0.0, params);
+  ASSERT_EQ(traj.points.size(), raw.size());
+  EXPECT_DOUBLE_EQ(traj.points[0].v_mps, params.start_speed_mps);
+  double peak = 0.0;
+  for (size_t i = 0; i < raw.size(); ++i) {
+    const PlannedPoint& p = traj.points[i];
+    EXPECT_LE(p.v_mps, raw[i].v_mps + 1e-12);  // never raised
+    if (raw[i].v_mps == 0.0) {
+      EXPECT_EQ(p.v_mps, 0.0);
+    }
+    peak = std::max(peak, p.v_mps);
+    if (i == 0) continue;
+    const PlannedPoint& q = traj.points[i - 1];
+    const double ds = p.s_m - q.s_m;
+    const double dv2 = p.v_mps * p.v_mps - q.v_mps * q.v_mps;
+    EXPECT_LE(dv2, 2 * params.max_accel_mps2 * ds + 1e-9) << "at " << i;
+    EXPECT_GE(dv2, -2 * params.max_decel_mps2 * ds - 1e-9) << "at " << i;
+  }
+  EXPECT_GT(peak, 4.0);  // it does speed up in between
+  // Moving fast towards a near stop: the profile brakes from the start.
+  BehaviorVelocityPlanner near_planner;
+  near_planner.SetPath(Straight(200, 5));
+  PlannedTrajectory near =
+      near_planner.Plan(world::Pose2{0, 0, 0}, {Car(1, 20.0, 0.0)});
+  SmoothVelocity(&near.points, 10.0, params);
+  EXPECT_NEAR(near.points[0].v_mps,
+              std::sqrt(2 * params.max_decel_mps2 * near.stop_s_m), 1e-6);
+  EXPECT_LT(near.points[0].v_mps, 10.0);
+  SmoothVelocity(nullptr, 1.0, params);  // no crash
+}
+
+}  // namespace
+}  // namespace adse::algorithms

@@ -1,0 +1,116 @@
+#include "stack/algorithms/tracker.h"
+
+#include <gtest/gtest.h>
+
+#include "stack/base/random.h"
+
+namespace adse::algorithms {
+namespace {
+
+Detection At(double x, double y) {
+  Detection d;
+  d.center = {x, y};
+  d.length_m = 4.5;
+  d.width_m = 1.8;
+  return d;
+}
+
+TEST(Tracker, TwoObjectsKeepIdsAndVelocities) {
+  Tracker tracker;
+  Random random(11);
+  const Eigen::Vector2d v1(5.0, 0.0), v2(-2.0, 1.5);
+  const Eigen::Vector2d p1(0.0, 0.0), p2(30.0, -5.0);
+  const double dt = 0.1;
+  int id1 = -1, id2 = -1;
+  for (int k = 0; k < 60; ++k) {
+    const double t = k * dt;
+    std::vector<Detection> dets;
+    // Noisy centres (10 cm), listed in changing order.
+    const Eigen::Vector2d a = p1 + t * v1, b = p2 + t * v2;
+    dets.push_back(
+        At(a.x() + random.Normal(0, 0.1), a.y() + random.Normal(0, 0.1)));
+    dets.push_back(
+        At(b.x() + random.Normal(0, 0.1), b.y() + random.Normal(0, 0.1)));
+    if (k % 2) std::swap(dets[0], dets[1]);
+    tracker.Update(t, dets);
+    const auto tracks = tracker.ConfirmedTracks();
+    if (k < 2) {
+      EXPECT_TRUE(tracks.empty()) << "confirmed after " << k + 1 << " hits";
+      continue;
+    }
+    ASSERT_EQ(tracks.size(), 2u) << "at step " << k;
+    // Identify tracks by position; ids must never change.
+    const Track& t1 =
+        (tracks[0].position - a).norm() < (tracks[1].position - a).norm()
+            ? tracks[0]
+            : tracks[1];
+    const Track& t2 = &t1 == &tracks[0] ? tracks[1] : tracks[0];
+    if (id1 < 0) {
+      id1 = t1.id;
+      id2 = t2.id;
+      EXPECT_NE(id1, id2);
+    }
+    EXPECT_EQ(t1.id, id1);
+    EXPECT_EQ(t2.id, id2);
+    if (k >= 30) {
+      EXPECT_NEAR(t1.velocity.x(), v1.x(), 0.2);
+      EXPECT_NEAR(t1.velocity.y(), v1.y(), 0.2);
+      EXPECT_NEAR(t2.velocity.x(), v2.x(), 0.2);
+      EXPECT_NEAR(t2.velocity.y(), v2.y(), 0.2);
+      EXPECT_NEAR((t1.position - a).norm(), 0.0, 0.2);
+      EXPECT_NEAR(t1.length_m, 4.5, 1e-6);
+      EXPECT_EQ(t1.age, k + 1);
+    }
+  }
+}
+
+TEST(Tracker, FalsePositiveSeenOnceIsNeverConfirmed) {
+  Tracker tracker;
+  for (int k = 0; k < 10; ++k) {
+    std::vector<Detection> dets = {At(10.0, 0.0)};
+    if (k == 3) dets.push_back(At(-20.0, 7.0));  // clutter
+    tracker.Update(0.1 * k, dets);
+    const auto confirmed = tracker.ConfirmedTracks();
+    for (const Track& t : confirmed) EXPECT_NEAR(t.position.x(), 10.0, 0.5);
+  }
+  EXPECT_EQ(tracker.ConfirmedTracks().size(), 1u);
+  EXPECT_EQ(tracker.tracks().size(), 1u);  // the tentative one is gone
+}
+
+TEST(Tracker, ConfirmedTrackDeletedAfterMisses) {
+  TrackerParams params;
+  params.max_misses = 3;
+  Tracker tracker(params);
+  for (int k = 0; k < 5; ++k) tracker.Update(0.1 * k, {At(1.0, 1.0)});
+  ASSERT_EQ(tracker.ConfirmedTracks().size(), 1u);
+  const int id = tracker.ConfirmedTracks()[0].id;
+  tracker.Update(0.5, {});
+  tracker.Update(0.6, {});
+  ASSERT_EQ(tracker.ConfirmedTracks().size(), 1u);  // two misses: kept
+  EXPECT_EQ(tracker.ConfirmedTracks()[0].misses, 2);
+  tracker.Update(0.7, {At(1.0, 1.0)});  // seen again: same id
+  ASSERT_EQ(tracker.ConfirmedTracks().size(), 1u);
+  EXPECT_EQ(tracker.ConfirmedTracks()[0].id, id);
+  for (int k = 0; k < 3; ++k) tracker.Update(0.8 + 0.1 * k, {});
+  EXPECT_TRUE(tracker.ConfirmedTracks().empty());
+  // A new object gets a new id.
+  for (int k = 0; k < 3; ++k) tracker.Update(2.0 + 0.1 * k, {At(1.0, 1.0)});
+  ASSERT_EQ(tracker.ConfirmedTracks().size(), 1u);
+  EXPECT_GT(tracker.ConfirmedTracks()[0].id, id);
+}
+
+TEST(Tracker, GateSeparatesFarDetections) {
+  TrackerParams params;
+  params.gate_m = 1.0;
+  Tracker tracker(params);
+  for (int k = 0; k < 3; ++k) tracker.Update(0.1 * k, {At(0.0, 0.0)});
+  // A jump of 3 m is not the same object: the old track misses.
+  tracker.Update(0.3, {At(3.0, 0.0)});
+  ASSERT_EQ(tracker.tracks().size(), 2u);
+  EXPECT_EQ(tracker.tracks()[0].misses, 1);
+  EXPECT_FALSE(tracker.tracks()[1].confirmed);
+  EXPECT_EQ(tracker.last_work_units(), 1);
+}
+
+}  // namespace
+}  // namespace adse::algorithms
