@@ -7,6 +7,7 @@
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
+#include <pcl/console/print.h>
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_cloud.h>
@@ -57,6 +58,9 @@ struct NdtMatcher::Impl {
 
 NdtMatcher::NdtMatcher(const NdtParams& params)
     : params_(params), impl_(std::make_unique<Impl>()) {
+  // Planar map cells (walls) make PCL warn about degenerate covariances on
+  // every map build; they are handled, and the warnings drown real output.
+  pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
   impl_->ndt.setResolution(static_cast<float>(params_.resolution_m));
   impl_->ndt.setStepSize(params_.step_size_m);
   // PCL 1.13 compares the *squared* translation of the last step with its

@@ -62,6 +62,8 @@ const std::vector<KnobInfo>& StackKnobs() {
         // Control.
         {"control.rate_hz", false, 1.0, 500.0, 30.0,
          "trajectory follower rate (control-command topic), Hz"},
+        {"control.max_travel_per_fix_m", false, 0.1, 100.0, 2.0,
+         "speed cap: distance the car may cover per localization fix age, m"},
         {"control.stale_after_s", false, 0.05, 10.0, 0.5,
          "the command gate brakes when the newest command is older, s"},
         {"control.emergency_decel_mps2", false, 0.5, 10.0, 3.0,

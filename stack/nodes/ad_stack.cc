@@ -400,7 +400,9 @@ void Stack::BuildControl(Graph* g) {
   g->Subscribe<TrajectoryMsg>(
       node, topics_.trajectory, "trajectory", 1,
       [this](const TrajectoryMsg& in, CallbackContext&) { follower_trajectory_ = in; });
-  g->AddTimer(node, "control", 1.0 / config_.Get("control.rate_hz"), [this](CallbackContext& ctx) {
+  const double max_travel_per_fix_m = config_.Get("control.max_travel_per_fix_m");
+  g->AddTimer(node, "control", 1.0 / config_.Get("control.rate_hz"),
+              [this, max_travel_per_fix_m](CallbackContext& ctx) {
     ControlMsg out;
     out.header.stamp_s = follower_pose_ ? follower_pose_->header.stamp_s : -1.0;
     const double dt = follower_last_t_ < 0 ? 0.0 : ctx.now_s() - follower_last_t_;
@@ -409,6 +411,14 @@ void Stack::BuildControl(Graph* g) {
       // Nothing to steer by: ask for a stop.
       out.accel_mps2 = -kNoPoseDecelMps2;
     } else {
+      // Degraded mode: drive no faster than lets the car cover
+      // max_travel_per_fix_m between localization fixes, so a slow scan
+      // matcher still gets a close initial guess (the stack slows down
+      // rather than losing itself).
+      const double fix_age = ctx.now_s() - follower_pose_->header.stamp_s;
+      const double speed_cap = follower_pose_->header.stamp_s < 0
+                                   ? 0.0
+                                   : max_travel_per_fix_m / std::max(fix_age, 1e-3);
       std::vector<algo::PlannedPoint> points;
       if (follower_trajectory_) {
         points.reserve(follower_trajectory_->points.size());
@@ -418,7 +428,7 @@ void Stack::BuildControl(Graph* g) {
           q.y_m = p.y_m;
           q.yaw_rad = p.yaw_rad;
           q.s_m = p.s_m;
-          q.v_mps = p.v_mps;
+          q.v_mps = std::min(p.v_mps, speed_cap);
           points.push_back(q);
         }
       }
