@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds adse and runs the most complete job that
 # exists on the bundled robotaxi scenario: validate it (280-point space),
-# then drive its world with a perfect controller while the LiDAR scans.
-# No network and no LLM needed.
+# drive its world with a perfect controller while the LiDAR scans, then
+# evaluate its start point in closed loop with the AD stack on the virtual
+# platform. No network and no LLM needed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -12,3 +13,5 @@ echo "== adse validate $scenario"
 build/bin/adse validate --quiet "$scenario"
 echo "== adse world $scenario --follow-ideal"
 build/bin/adse world "$scenario" --follow-ideal
+echo "== adse simulate $scenario (exploration.start_from)"
+build/bin/adse simulate "$scenario"

@@ -178,8 +178,6 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
       next_odometry += odometry_period;
     }
     const auto t_exec = Clock::now();
-    const double cpu_before = stats.stack_cpu_s;
-    (void)cpu_before;
     Status advanced = executor.AdvanceTo(t + dt);
     stats.executor_s += Seconds(Clock::now() - t_exec);
     if (!advanced.ok()) return advanced.WithContext(fmt::format("stack at t={:.2f} s", t));
@@ -239,8 +237,17 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
          c.topic, c.period_s});
   }
   run.trace = executor.trace();
-  for (const stack::CallbackRecord& r : run.trace.callbacks) stats.stack_cpu_s += r.host_cpu_s;
-  stats.executor_s = std::max(0.0, stats.executor_s - stats.stack_cpu_s);
+  // executor_s so far is the wall time inside AdvanceTo: the callbacks plus
+  // the executor's own bookkeeping. Only the measured model records the
+  // callbacks' host CPU time, so only then can the two be told apart.
+  stats.stack_and_executor_s = stats.executor_s;
+  if (vp.cost_model == stack::CostModelKind::kMeasured) {
+    for (const stack::CallbackRecord& r : run.trace.callbacks) stats.stack_cpu_s += r.host_cpu_s;
+    stats.executor_s = std::max(0.0, stats.executor_s - stats.stack_cpu_s);
+  } else {
+    stats.stack_cpu_s = std::nan("");
+    stats.executor_s = std::nan("");
+  }
   run.metrics = analysis::ComputeRunMetrics(run);
   Result<double> cost = spec::EvaluateCost(spec, point);
   run.metrics["hardware_cost"] = cost.ok() ? *cost : std::nan("");

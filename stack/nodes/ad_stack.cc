@@ -8,6 +8,7 @@
 #include "stack/algorithms/clustering.h"
 #include "stack/algorithms/control.h"
 #include "stack/algorithms/ekf.h"
+#include "stack/algorithms/map_filter.h"
 #include "stack/algorithms/ndt_matcher.h"
 #include "stack/algorithms/planning.h"
 #include "stack/algorithms/point_filters.h"
@@ -28,6 +29,24 @@ constexpr double kClusteringParallelFraction = 0.6;
 constexpr double kNoPoseDecelMps2 = 3.0;
 
 double WrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+
+// Trajectory points as the planning and control algorithms take them; the
+// speed can be capped on the way.
+std::vector<algo::PlannedPoint> ToPlanned(const std::vector<TrajectoryPoint>& points,
+                                          double max_v_mps = INFINITY) {
+  std::vector<algo::PlannedPoint> out;
+  out.reserve(points.size());
+  for (const TrajectoryPoint& p : points) {
+    algo::PlannedPoint q;
+    q.x_m = p.x_m;
+    q.y_m = p.y_m;
+    q.yaw_rad = p.yaw_rad;
+    q.s_m = p.s_m;
+    q.v_mps = std::min(p.v_mps, max_v_mps);
+    out.push_back(q);
+  }
+  return out;
+}
 
 class Stack final : public AdStack {
  public:
@@ -63,6 +82,8 @@ class Stack final : public AdStack {
     world::Pose2 pose;
   };
   std::deque<PoseAt> ekf_history_;
+  algo::MapFilter map_filter_;
+  std::optional<PoseMsg> ground_pose_;
   std::optional<PoseMsg> cluster_pose_;
   std::unique_ptr<algo::Tracker> tracker_;
   std::unique_ptr<algo::BehaviorVelocityPlanner> planner_;
@@ -229,18 +250,26 @@ void Stack::BuildPerception(Graph* g) {
   algo::GroundParams ground;
   ground.height_threshold_m = config_.Get("perception.ground_height_m");
   const double max_range = config_.Get("perception.max_range_m");
+  map_filter_.SetMap(inputs_.map_cloud);
   const int ground_node = g->AddNode("ground_filter");
+  g->Subscribe<PoseMsg>(ground_node, topics_.pose, "pose", 1,
+                        [this](const PoseMsg& in, CallbackContext&) { ground_pose_ = in; });
   g->Subscribe<PointCloudMsg>(
       ground_node, points_, "points", 1,
       [this, ground, max_range](const PointCloudMsg& in, CallbackContext& ctx) {
         algo::GroundResult r = algo::RemoveGround(in.points, ground);
-        PointCloudMsg out;
-        out.header = in.header;
+        std::vector<Eigen::Vector3f> near;
         const double r2 = max_range * max_range;
         for (const Eigen::Vector3f& p : r.obstacles) {
-          if (p.x() * p.x() + p.y() * p.y() <= r2) out.points.push_back(p);
+          if (p.x() * p.x() + p.y() * p.y() <= r2) near.push_back(p);
         }
-        ctx.ReportWork({static_cast<double>(r.work_units), 0.0, 1});
+        // What the static map explains (walls, poles, parked cars) is not
+        // an object to stop for.
+        PointCloudMsg out;
+        out.header = in.header;
+        out.points = map_filter_.Filter(
+            near, ground_pose_ ? ground_pose_->pose : inputs_.initial_pose);
+        ctx.ReportWork({static_cast<double>(r.work_units + near.size()), 0.0, 1});
         ctx.Publish(obstacle_points_, std::move(out));
       });
 
@@ -371,17 +400,7 @@ void Stack::BuildPlanning(Graph* g) {
   g->Subscribe<TrajectoryMsg>(
       smoother_node, trajectory_raw_, "trajectory", 1,
       [this, smoother](const TrajectoryMsg& in, CallbackContext& ctx) {
-        std::vector<algo::PlannedPoint> points;
-        points.reserve(in.points.size());
-        for (const TrajectoryPoint& p : in.points) {
-          algo::PlannedPoint q;
-          q.x_m = p.x_m;
-          q.y_m = p.y_m;
-          q.yaw_rad = p.yaw_rad;
-          q.s_m = p.s_m;
-          q.v_mps = p.v_mps;
-          points.push_back(q);
-        }
+        std::vector<algo::PlannedPoint> points = ToPlanned(in.points);
         algo::SmoothVelocity(&points, smoother_pose_ ? smoother_pose_->v_mps : 0.0, smoother);
         TrajectoryMsg out = in;
         for (size_t i = 0; i < points.size(); ++i) out.points[i].v_mps = points[i].v_mps;
@@ -419,19 +438,9 @@ void Stack::BuildControl(Graph* g) {
       const double speed_cap = follower_pose_->header.stamp_s < 0
                                    ? 0.0
                                    : max_travel_per_fix_m / std::max(fix_age, 1e-3);
-      std::vector<algo::PlannedPoint> points;
-      if (follower_trajectory_) {
-        points.reserve(follower_trajectory_->points.size());
-        for (const TrajectoryPoint& p : follower_trajectory_->points) {
-          algo::PlannedPoint q;
-          q.x_m = p.x_m;
-          q.y_m = p.y_m;
-          q.yaw_rad = p.yaw_rad;
-          q.s_m = p.s_m;
-          q.v_mps = std::min(p.v_mps, speed_cap);
-          points.push_back(q);
-        }
-      }
+      const std::vector<algo::PlannedPoint> points =
+          follower_trajectory_ ? ToPlanned(follower_trajectory_->points, speed_cap)
+                               : std::vector<algo::PlannedPoint>{};
       const algo::FollowerCommand c =
           follower_->Update(follower_pose_->pose, follower_pose_->v_mps, points, dt);
       out.accel_mps2 = c.accel_mps2;

@@ -19,17 +19,18 @@ row() {
 import json, sys
 d = json.load(sys.stdin); m = d["metrics"]; t = d["timing_s"]
 p = ", ".join("%s=%g" % kv for kv in d["point"].items())
-print("| %s | %s | %.1f | %.2f | %.3f | %d | %.2f | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.1f |" % (
-    p, d["termination_reason"], m["nav_time_s"], m["ctrl_rate_hz"], m["e2e_latency_p50_s"] or float("nan"),
-    m["lidar_frames_dropped"], m["cpu_utilization"], t["wall"], t["stack_cpu"], t["world"], t["lidar"],
-    t["executor"], t["hdf5_write"], t["simulated"] / t["wall"]))'
+n = lambda v: float("nan") if v is None else v
+print("| %s | %s | %.1f | %.2f | %.3f | %d | %.2f | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.1f |" % (
+    p, d["termination_reason"], m["nav_time_s"], m["ctrl_rate_hz"], n(m["e2e_latency_p50_s"]),
+    m["lidar_frames_dropped"], m["cpu_utilization"], t["wall"], t["stack_and_executor"], n(t["stack_cpu"]),
+    n(t["executor"]), t["world"], t["lidar"], t["hdf5_write"], t["simulated"] / t["wall"]))'
 }
 
 echo "scenario: ${scenario}"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1 /proc/loadavg)"
 echo
-echo "| point | ended | nav_time_s | ctrl_rate_hz | e2e p50 s | LiDAR drops | CPU util | wall s | stack s | world s | LiDAR s | executor s | HDF5 s | sim s / wall s |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| point | ended | nav_time_s | ctrl_rate_hz | e2e p50 s | LiDAR drops | CPU util | wall s | stack+exec s | stack s | executor s | world s | LiDAR s | HDF5 s | sim s / wall s |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for point in ${SWEEP_POINTS:-cores=28,freq_ghz=2.1,lidar_hz=14 cores=1,freq_ghz=1.0,lidar_hz=14 \
     cores=4,freq_ghz=1.2,lidar_hz=14 cores=6,freq_ghz=1.5,lidar_hz=7 cores=18,freq_ghz=1.8,lidar_hz=7 \
     cores=23,freq_ghz=1.5,lidar_hz=7}; do
@@ -38,14 +39,14 @@ done
 echo
 echo "cores sweep at 1.5 GHz, 14 Hz:"
 echo
-echo "| point | ended | nav_time_s | ctrl_rate_hz | e2e p50 s | LiDAR drops | CPU util | wall s | stack s | world s | LiDAR s | executor s | HDF5 s | sim s / wall s |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| point | ended | nav_time_s | ctrl_rate_hz | e2e p50 s | LiDAR drops | CPU util | wall s | stack+exec s | stack s | executor s | world s | LiDAR s | HDF5 s | sim s / wall s |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for cores in ${SWEEP_CORES:-1 2 4 6 8 12 16 20 28}; do
   row "cores=${cores},freq_ghz=1.5,lidar_hz=14"
 done
 echo
 echo "measured-model spread, ${REPEATS:-5} runs of ${repeat_point}:"
 echo
-echo "| point | ended | nav_time_s | ctrl_rate_hz | e2e p50 s | LiDAR drops | CPU util | wall s | stack s | world s | LiDAR s | executor s | HDF5 s | sim s / wall s |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| point | ended | nav_time_s | ctrl_rate_hz | e2e p50 s | LiDAR drops | CPU util | wall s | stack+exec s | stack s | executor s | world s | LiDAR s | HDF5 s | sim s / wall s |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for _ in $(seq "${REPEATS:-5}"); do row "${repeat_point}"; done

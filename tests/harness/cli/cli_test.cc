@@ -67,18 +67,18 @@ TEST(CliTest, StartOffTheRoadIsReportedAtItsLineWithExitCode2) {
       Variant("offroad", "start: {x: 20.0, y: -1.75}", "start: {x: 20.0, y: 6.0}");
   const CommandRun run = Adse("validate -q " + file);
   EXPECT_EQ(run.exit_code, 2) << run.out;
-  // The start is on line 16 of the example.
-  EXPECT_TRUE(std::regex_search(run.out, std::regex("adse_cli_offroad\\.yaml:16:[0-9]+: error: task\\.start")))
+  // The start is on line 17 of the example.
+  EXPECT_TRUE(std::regex_search(run.out, std::regex("adse_cli_offroad\\.yaml:17:[0-9]+: error: task\\.start")))
       << run.out;
   EXPECT_NE(run.out.find("off the road network"), std::string::npos) << run.out;
 }
 
 TEST(CliTest, UnknownFlowEdgeIsReportedAtItsLine) {
-  const std::string file = Variant("flow", "from: E4_W4", "from: E9_W9");
+  const std::string file = Variant("flow", "from: W4_E4", "from: E9_W9");
   const CommandRun run = Adse("validate -q " + file);
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_NE(run.out.find("world.traffic.flows[0].from: no edge 'E9_W9'"), std::string::npos) << run.out;
-  EXPECT_TRUE(std::regex_search(run.out, std::regex("adse_cli_flow\\.yaml:10:[0-9]+:"))) << run.out;
+  EXPECT_TRUE(std::regex_search(run.out, std::regex("adse_cli_flow\\.yaml:11:[0-9]+:"))) << run.out;
 }
 
 TEST(CliTest, MisspelledKeyGetsADidYouMeanAndNothingIsWritten) {
@@ -121,6 +121,44 @@ TEST(CliTest, WorldFollowIdealReachesTheGoalAndWritesWhatItSaw) {
   EXPECT_TRUE(fs::exists(out / "scans" / "scan_00000.pcd"));
   EXPECT_TRUE(fs::exists(out / "scans" / "scan_00050.pcd"));
   EXPECT_FALSE(fs::exists(out / "scans" / "scan_00010.pcd"));
+}
+
+std::string Small() { return std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml"; }
+
+TEST(CliTest, SimulateWritesARunFileThatPassesTheSchemaCheck) {
+  const fs::path out = fs::temp_directory_path() / "adse_cli_simulate.h5";
+  fs::remove(out);
+  const CommandRun run =
+      Adse("simulate " + Small() + " --point cores=16,freq_ghz=2.1,lidar_hz=7 --json -q -o " + out.string() +
+           " 2>/dev/null");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const nlohmann::json doc = nlohmann::json::parse(run.out);
+  EXPECT_EQ(doc["termination_reason"], "goal_reached");
+  EXPECT_EQ(doc["metrics"]["completed"].get<double>(), 1.0);
+  EXPECT_NEAR(doc["metrics"]["hardware_cost"].get<double>(), 16 * 2.1, 1e-9);
+  EXPECT_GT(doc["timing_s"]["simulated"].get<double>(), 10.0);
+  ASSERT_TRUE(fs::exists(out));
+  const CommandRun check = Adse("schema check " + out.string());
+  EXPECT_EQ(check.exit_code, 0) << check.out;
+  EXPECT_NE(check.out.find(": ok"), std::string::npos) << check.out;
+}
+
+TEST(CliTest, SimulateRejectsAPointOutsideTheSpace) {
+  const CommandRun run = Adse("simulate " + Small() + " --point cores=3,freq_ghz=2.1,lidar_hz=7");
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("cores"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("1, 4, 16"), std::string::npos) << run.out;
+  const CommandRun unknown = Adse("simulate " + Small() + " --point cores=4,freq_ghz=2.1,lidar=7");
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
+  EXPECT_NE(unknown.out.find("lidar"), std::string::npos) << unknown.out;
+}
+
+TEST(CliTest, SchemaCheckRejectsAFileThatIsNotARunFile) {
+  const fs::path bogus = fs::temp_directory_path() / "adse_cli_bogus.h5";
+  std::ofstream(bogus) << "not hdf5\n";
+  const CommandRun run = Adse("schema check " + bogus.string());
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("adse_cli_bogus.h5"), std::string::npos) << run.out;
 }
 
 }  // namespace

@@ -1,0 +1,84 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "stack/base/files.h"
+#include "stack/base/hash.h"
+#include "stack/base/random.h"
+#include "stack/base/status.h"
+#include "stack/base/subprocess.h"
+
+namespace adse {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(StatusTest, ExitCodesSeparateBadInputFromFailures) {
+  EXPECT_EQ(ExitCodeFor(Status::Ok()), 0);
+  EXPECT_EQ(ExitCodeFor(Status::InvalidArgument("x")), 2);
+  EXPECT_EQ(ExitCodeFor(Status::Corruption("x")), 2);
+  EXPECT_EQ(ExitCodeFor(Status::IoError("x")), 1);
+  EXPECT_EQ(Status::NotFound("f").WithContext("map").message(), "map: f");
+}
+
+TEST(HashTest, Sha256MatchesAKnownVectorAndPartsAreDelimited) {
+  EXPECT_EQ(Sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_NE(ContentHasher().Add("ab").Add("c").Hex(), ContentHasher().Add("a").Add("bc").Hex());
+  EXPECT_EQ(ContentHasher().Add(0.1).Hex(), ContentHasher().Add(0.1).Hex());
+  EXPECT_NE(ContentHasher().Add(0.1).Hex(), ContentHasher().Add(0.1000000001).Hex());
+}
+
+TEST(RandomTest, SameSeedSameStreamAndDerivedSeedsDiffer) {
+  Random a(42), b(42), c(43);
+  for (int i = 0; i < 100; ++i) {
+    const double x = a.Uniform();
+    EXPECT_EQ(x, b.Uniform());
+    EXPECT_GE(x, 0.0);
+    EXPECT_LT(x, 1.0);
+  }
+  EXPECT_NE(Random(42).NextU64(), c.NextU64());
+  EXPECT_NE(Random::DeriveSeed(7, "lidar"), Random::DeriveSeed(7, "traffic"));
+  // Mean and spread of the normal draw.
+  Random n(1);
+  double sum = 0, sum2 = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double x = n.Normal(1.0, 2.0);
+    sum += x;
+    sum2 += x * x;
+  }
+  EXPECT_NEAR(sum / 20000, 1.0, 0.05);
+  EXPECT_NEAR(std::sqrt(sum2 / 20000 - (sum / 20000) * (sum / 20000)), 2.0, 0.05);
+}
+
+TEST(FilesTest, AtomicWriteReplacesWholeAndLeavesNoTemporary) {
+  const fs::path dir = fs::temp_directory_path() / "adse_files_test";
+  fs::remove_all(dir);
+  const std::string path = (dir / "sub" / "f.txt").string();
+  ASSERT_TRUE(WriteFileAtomic(path, "first").ok());
+  ASSERT_TRUE(WriteFileAtomic(path, "second").ok());
+  Result<std::string> text = ReadFile(path);
+  ASSERT_TRUE(text.ok());
+  EXPECT_EQ(*text, "second");
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(dir / "sub")) files += e.is_regular_file();
+  EXPECT_EQ(files, 1);
+  EXPECT_EQ(ReadFile((dir / "missing").string()).status().code(), Status::Code::kNotFound);
+  EXPECT_EQ(ReadFile(path, 3).status().code(), Status::Code::kInvalidArgument);
+}
+
+TEST(SubprocessTest, ExitStatusAndOutputTailAreReported) {
+  Result<ProcessResult> ok = RunProcess({"sh", "-c", "echo hello"});
+  ASSERT_TRUE(ok.ok());
+  EXPECT_EQ(ok->exit_code, 0);
+  EXPECT_EQ(ok->output, "hello\n");
+  const Status failed = RunChecked({"sh", "-c", "echo broken map >&2; exit 3"});
+  EXPECT_FALSE(failed.ok());
+  EXPECT_NE(failed.message().find("exited with status 3"), std::string::npos);
+  EXPECT_NE(failed.message().find("broken map"), std::string::npos);
+  EXPECT_FALSE(RunProcess({"/nonexistent/program"}).ok());
+}
+
+}  // namespace
+}  // namespace adse
