@@ -34,4 +34,12 @@ for bench in "${benches[@]}"; do
   echo "== $(basename "${bench}")"
   "${bench}" --benchmark_format=console "$@" || status=1
 done
+# Closed-loop runs of the robotaxi example: outcome and wall-time split per
+# design point (a few minutes; ADSE_BENCH_SWEEP=0 skips it).
+if [[ "${ADSE_BENCH_SWEEP:-1}" != 0 ]]; then
+  cmake --build "${build}" --target adse -j "${jobs}"
+  echo
+  echo "== simulate_sweep"
+  ADSE_BIN="${build}/bin/adse" "${root}/tests/bench/simulate_sweep.sh" || status=1
+fi
 exit "${status}"

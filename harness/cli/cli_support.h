@@ -8,7 +8,6 @@
 
 #include "harness/spec/spec.h"
 #include "stack/base/status.h"
-#include "stack/world/world.h"
 
 namespace adse::cli {
 
