@@ -8,7 +8,7 @@ PACKAGES=(
   libyaml-cpp-dev libeigen3-dev libmuparser-dev libcli11-dev libfmt-dev
   libspdlog-dev nlohmann-json3-dev libssl-dev
   sumo sumo-tools
-  libpcl-dev libopencv-dev libceres-dev libhdf5-dev
+  libpcl-dev libopencv-dev libceres-dev libhdf5-dev libpagmo-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-h5py python3-pandas
 )

@@ -20,6 +20,13 @@ struct PathPoint {
   double s_m, x_m, y_m;
 };
 
+// One vertex of a lane centreline (for pictures); the vertices of one lane
+// are consecutive rows, in driving order.
+struct LanePoint {
+  int32_t lane;  // 0-based lane number within the run file
+  double x_m, y_m;
+};
+
 // Other vehicles, decimated (e.g. every 0.5 s).
 struct VehicleSample {
   double t_s;
@@ -66,6 +73,7 @@ struct RunData {
   std::vector<EgoSample> ego;
   std::vector<PathPoint> ideal_path;
   double lane_width_m = 3.5;
+  std::vector<LanePoint> lanes;          // may be empty (not recorded)
   std::vector<VehicleSample> vehicles;
   std::vector<CollisionEvent> collisions;
 

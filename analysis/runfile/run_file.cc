@@ -139,6 +139,13 @@ const std::vector<Column<PathPoint>>& PathColumns() {
   return *columns;
 }
 
+const std::vector<Column<LanePoint>>& LaneColumns() {
+  static const auto* columns = new std::vector<Column<LanePoint>>{
+      I32("lane", &LanePoint::lane), F64("x_m", &LanePoint::x_m),
+      F64("y_m", &LanePoint::y_m)};
+  return *columns;
+}
+
 const std::vector<Column<VehicleSample>>& VehicleColumns() {
   static const auto* columns = new std::vector<Column<VehicleSample>>{
       F64("t_s", &VehicleSample::t_s),
@@ -336,6 +343,8 @@ Status WriteContents(hid_t file, const RunData& run) {
     if (!group.ok()) return group.status();
     ADSE_RETURN_IF_ERROR(
         WriteTable(group->get(), "ideal_path", run.ideal_path, PathColumns()));
+    ADSE_RETURN_IF_ERROR(
+        WriteTable(group->get(), "lanes", run.lanes, LaneColumns()));
     ADSE_RETURN_IF_ERROR(
         WriteTable(group->get(), "vehicles", run.vehicles, VehicleColumns()));
     ADSE_RETURN_IF_ERROR(WriteTable(group->get(), "collisions", run.collisions,
@@ -593,6 +602,13 @@ Status ReadContents(hid_t file, RunData* run) {
     ADSE_RETURN_IF_ERROR(
         Assign(ReadTable(group->get(), "ideal_path", PathColumns()),
                &run->ideal_path));
+    // Files written before /world/lanes existed (same schema version, see
+    // results-schema/README.md "Versioning") simply have no lanes.
+    if (internal::GetObjectKind(file, "/world/lanes") !=
+        internal::ObjectKind::kMissing) {
+      ADSE_RETURN_IF_ERROR(
+          Assign(ReadTable(group->get(), "lanes", LaneColumns()), &run->lanes));
+    }
     ADSE_RETURN_IF_ERROR(Assign(
         ReadTable(group->get(), "vehicles", VehicleColumns()), &run->vehicles));
     ADSE_RETURN_IF_ERROR(

@@ -51,6 +51,14 @@ struct SchemaCheckArgs {
 };
 int RunSchemaCheck(const SchemaCheckArgs& args);
 
+struct AnalyzeArgs {
+  std::vector<std::string> targets;     // run files or folders of them
+  std::vector<std::string> thresholds;  // NAME=VALUE (diagnosis options)
+  std::vector<std::string> diff;        // two analysis version folders
+  bool json = false;
+};
+int RunAnalyze(const AnalyzeArgs& args);
+
 }  // namespace adse::cli
 
 #endif  // ADSE_HARNESS_CLI_COMMANDS_H_

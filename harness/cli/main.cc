@@ -78,6 +78,19 @@ int main(int argc, char** argv) {
       "check", "Check run files against results-schema/run.schema.json");
   schema_check_cmd->add_option("files", schema_check.files, "Run files (.h5)")->required();
 
+  adse::cli::AnalyzeArgs analyze;
+  CLI::App* analyze_cmd = app.add_subcommand(
+      "analyze", "Recompute metrics, deviation, diagnosis, pictures and the Pareto front from "
+                 "run files, into a new analysis version next to them (raw data is never "
+                 "rewritten); exit 2 if any file could not be read");
+  analyze_cmd->add_option("targets", analyze.targets, "Run files (.h5) or folders of them");
+  analyze_cmd->add_option("--threshold", analyze.thresholds,
+                          "Diagnosis option NAME=VALUE (repeatable), e.g. "
+                          "frequency_bound_fraction=0.2");
+  analyze_cmd->add_option("--diff", analyze.diff, "Compare two analysis version folders: --diff A B")
+      ->expected(2);
+  analyze_cmd->add_flag("--json", analyze.json, "Print the report(s) as JSON");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -90,6 +103,13 @@ int main(int argc, char** argv) {
   if (*simulate_cmd) return adse::cli::RunSimulate(simulate);
   if (*calibrate_cmd) return adse::cli::RunCalibrate(calibrate);
   if (*schema_check_cmd) return adse::cli::RunSchemaCheck(schema_check);
+  if (*analyze_cmd) {
+    if (analyze.targets.empty() && analyze.diff.empty()) {
+      std::fprintf(stderr, "error: analyze needs run files or folders, or --diff A B\n");
+      return 2;
+    }
+    return adse::cli::RunAnalyze(analyze);
+  }
   if (*validate_cmd) return adse::cli::RunValidate(validate);
   if (*world_cmd) return adse::cli::RunWorld(world);
   return 2;

@@ -9,6 +9,7 @@
 #include "analysis/runfile/run_file.h"
 #include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
+#include "harness/report/run_report.h"
 #include "harness/sim/calibration.h"
 #include "harness/sim/simulator.h"
 #include "harness/spec/spec_parser.h"
@@ -76,6 +77,14 @@ int RunSimulate(const SimulateArgs& args) {
   const std::string out = args.out.empty()
                               ? spec->output + "/simulate/" + PointSlug(*point) + ".h5"
                               : args.out;
+  // The analysis (deviation fit, diagnosis) of the fresh run; its metrics
+  // are stored with the run's own.
+  Result<report::RunReport> analysed = report::AnalyzeRun(*run, out, report::AnalyzeOptions{});
+  if (!analysed.ok()) {
+    std::fprintf(stderr, "error: analysing the run: %s\n", analysed.status().message().c_str());
+    return 1;
+  }
+  for (const auto& [name, value] : analysed->metrics) run->metrics.emplace(name, value);
   const auto t0 = std::chrono::steady_clock::now();
   Status written = runfile::WriteRunFile(out, *run);
   const double write_s =
@@ -84,16 +93,8 @@ int RunSimulate(const SimulateArgs& args) {
     std::fprintf(stderr, "error: writing %s: %s\n", out.c_str(), written.message().c_str());
     return 1;
   }
-  const auto& m = run->metrics;
   if (args.json) {
-    nlohmann::json doc;
-    doc["point"] = *point;
-    doc["seed"] = run->seed;
-    doc["termination_reason"] = run->termination_reason;
-    for (const auto& [name, value] : m) {
-      doc["metrics"][name] = std::isnan(value) ? nlohmann::json(nullptr) : nlohmann::json(value);
-    }
-    doc["run_file"] = out;
+    nlohmann::json doc = report::ToJson(*analysed);
     auto number = [](double v) { return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v); };
     doc["timing_s"] = {{"wall", stats.wall_s + write_s}, {"setup", stats.setup_s},
                        {"stack_and_executor", stats.stack_and_executor_s},
@@ -105,14 +106,7 @@ int RunSimulate(const SimulateArgs& args) {
   }
   std::printf("point       %s (seed %llu)\n", PointSlug(*point).c_str(),
               static_cast<unsigned long long>(run->seed));
-  std::printf("ended       %s at t = %.1f s\n", run->termination_reason.c_str(),
-              run->ego.empty() ? 0.0 : run->ego.back().t_s);
-  for (const char* name : {"completed", "nav_time_s", "ctrl_rate_hz", "hardware_cost",
-                           "e2e_latency_p50_s", "e2e_latency_p99_s", "dropped_messages",
-                           "lidar_frames_dropped", "collisions", "cpu_utilization"}) {
-    auto it = m.find(name);
-    std::printf("%-20s %s\n", name, it == m.end() ? "n/a" : FormatMetric(it->second).c_str());
-  }
+  std::fputs(report::FormatSummary(*analysed).c_str(), stdout);
   std::printf("run file    %s\n", out.c_str());
   std::printf("wall time   %.2f s for %.1f s simulated: stack+executor %.2f s (stack %s, executor %s), "
               "world %.2f s, LiDAR %.2f s, HDF5 %.2f s\n",

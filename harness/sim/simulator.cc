@@ -229,6 +229,12 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
                               w.ideal_path().points[i].y()});
   }
   run.lane_width_m = w.lane_width_m();
+  const std::vector<std::vector<Eigen::Vector2d>> lanes = w.LaneShapes();
+  for (size_t i = 0; i < lanes.size(); ++i) {
+    for (const Eigen::Vector2d& p : lanes[i]) {
+      run.lanes.push_back({static_cast<int32_t>(i), p.x(), p.y()});
+    }
+  }
   for (const stack::NodeSpec& n : graph.nodes()) run.node_names.push_back(n.name);
   for (const stack::TopicSpec& t : graph.topics()) run.topic_names.push_back(t.name);
   for (const stack::CallbackSpec& c : graph.callbacks()) {

@@ -37,6 +37,7 @@ RunData MakeRun() {
   run.metrics = {{"collision", 0.0}};
   run.ego = {{0, 0, 0, 0, 10, 0, 0}, {0.1, 1, 0, 0, 10, 0, 0}};
   run.vehicles = {{0, "v1", 20, 0, 0, 9, 4.5, 1.8}};
+  run.lanes = {{0, 0, 0}, {0, 50, 0}, {1, 50, 3.5}, {1, 0, 3.5}};
   run.node_names = {"planner"};
   run.topic_names = {"/pose"};
   run.callback_info = {{"planner/on_pose", 0, "subscription", 0, 0.0}};
@@ -144,6 +145,20 @@ TEST_F(RunFileCheckTest, ReportsADeletedDataset) {
   EXPECT_NE(status.message().find(path), std::string::npos);
   EXPECT_EQ(problems,
             std::vector<std::string>{"/world/vehicles: missing dataset"});
+}
+
+TEST_F(RunFileCheckTest, ReportsMissingLanes) {
+  // Readers accept older files without /world/lanes, but the schema says a
+  // file written now always has it.
+  const std::string path = Copy("no_lanes.h5");
+  {
+    Editable file(path);
+    ASSERT_GE(H5Ldelete(file.get(), "/world/lanes", H5P_DEFAULT), 0);
+  }
+  std::vector<std::string> problems;
+  EXPECT_EQ(CheckRunFile(path, &problems).code(), Status::Code::kCorruption);
+  EXPECT_EQ(problems,
+            std::vector<std::string>{"/world/lanes: missing dataset"});
 }
 
 TEST_F(RunFileCheckTest, ReportsADeletedGroupAndEverythingBelowIt) {

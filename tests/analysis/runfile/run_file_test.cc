@@ -103,6 +103,14 @@ std::string Diff(const RunData& a, const RunData& b) {
       num(at + "y_m", a.ideal_path[i].y_m, b.ideal_path[i].y_m);
     }
   }
+  if (size("lanes", a.lanes.size(), b.lanes.size())) {
+    for (size_t i = 0; i < a.lanes.size(); ++i) {
+      const std::string at = "lanes[" + std::to_string(i) + "].";
+      integer(at + "lane", a.lanes[i].lane, b.lanes[i].lane);
+      num(at + "x_m", a.lanes[i].x_m, b.lanes[i].x_m);
+      num(at + "y_m", a.lanes[i].y_m, b.lanes[i].y_m);
+    }
+  }
   if (size("vehicles", a.vehicles.size(), b.vehicles.size())) {
     for (size_t i = 0; i < a.vehicles.size(); ++i) {
       const VehicleSample &x = a.vehicles[i], &y = b.vehicles[i];
@@ -218,6 +226,12 @@ RunData MakeFullRun(size_t events = 5000) {
   run.ego[4].v_mps = std::numeric_limits<double>::infinity();
   for (int i = 0; i < 50; ++i) {
     run.ideal_path.push_back({1.0 * i, 1.0 * i, 0.02 * i * i});
+  }
+  // Three lanes of different lengths, rows of a lane consecutive.
+  for (int lane = 0; lane < 3; ++lane) {
+    for (int i = 0; i < 4 + lane; ++i) {
+      run.lanes.push_back({lane, -5.0 + 2.5 * i, 3.5 * lane - 0.125});
+    }
   }
   for (int i = 0; i < 40; ++i) {
     run.vehicles.push_back({0.5 * (i / 2), "veh" + std::to_string(i % 2),
@@ -626,6 +640,44 @@ TEST_F(RunFileTest, MissingDatasetIsCorruptionNamingIt) {
       << back.status().message();
 }
 
+TEST_F(RunFileTest, LanesAreStoredAsOneRowPerVertex) {
+  const std::string path = Path("run.h5");
+  const RunData run = MakeFullRun(10);
+  ASSERT_TRUE(WriteRunFile(path, run).ok());
+  RawHdf5 raw(path);
+  ASSERT_GE(raw.file(), 0);
+  const std::vector<Member> members =
+      CompoundMembers(raw.file(), "/world/lanes");
+  EXPECT_EQ(Names(members), (std::vector<std::string>{"lane", "x_m", "y_m"}));
+  ASSERT_EQ(members.size(), 3u);
+  EXPECT_EQ(members[0].type_class, H5T_INTEGER);
+  EXPECT_EQ(members[0].size, 4u);
+  EXPECT_EQ(members[1].type_class, H5T_FLOAT);
+  const hid_t dataset = H5Dopen2(raw.file(), "/world/lanes", H5P_DEFAULT);
+  ASSERT_GE(dataset, 0);
+  const hid_t space = H5Dget_space(dataset);
+  hsize_t dims[1] = {0};
+  H5Sget_simple_extent_dims(space, dims, nullptr);
+  EXPECT_EQ(dims[0], run.lanes.size());
+  H5Sclose(space);
+  H5Dclose(dataset);
+}
+
+TEST_F(RunFileTest, FileWithoutLanesReadsAsNoLanes) {
+  // Files written before /world/lanes existed have the same schema version.
+  const std::string path = Path("run.h5");
+  RunData run = MakeFullRun(10);
+  ASSERT_TRUE(WriteRunFile(path, run).ok());
+  {
+    RawHdf5 raw(path, H5F_ACC_RDWR);
+    ASSERT_GE(H5Ldelete(raw.file(), "/world/lanes", H5P_DEFAULT), 0);
+  }
+  Result<RunData> back = ReadRunFile(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  run.lanes.clear();
+  EXPECT_EQ(Diff(run, *back), "");
+}
+
 TEST_F(RunFileTest, FileWithoutStatusNeverLooksComplete) {
   // What a writer that died before its last step would leave (under its
   // temporary name): everything but the final `status` attribute.
@@ -697,6 +749,9 @@ assert len(ev) == 1000 and set(ev["kind"].tolist()) == {0, 1, 2}
 assert h5py.check_enum_dtype(f["trace/topic_events"].dtype["kind"]) == \
     {"publish": 0, "take": 1, "drop": 2}
 assert f["world/vehicles"][:]["id"][0] == b"veh0"
+lanes = f["world/lanes"][:]
+assert lanes.dtype.names == ("lane", "x_m", "y_m"), lanes.dtype.names
+assert lanes["lane"].tolist() == [0] * 4 + [1] * 5 + [2] * 6
 assert f["scenario/yaml"].asstr()[()].startswith("name: cut_in")
 assert f["metrics"].attrs["min_ttc_s"] == 0.75
 try:

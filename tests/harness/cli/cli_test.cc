@@ -161,4 +161,47 @@ TEST(CliTest, SchemaCheckRejectsAFileThatIsNotARunFile) {
   EXPECT_NE(run.out.find("adse_cli_bogus.h5"), std::string::npos) << run.out;
 }
 
+TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
+  const fs::path dir = fs::temp_directory_path() / "adse_cli_analyze";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "runs");
+  const CommandRun sim = Adse("simulate " + Small() + " --point cores=16,freq_ghz=2.1,lidar_hz=7 -q -o " +
+                              (dir / "runs" / "a.h5").string());
+  ASSERT_EQ(sim.exit_code, 0) << sim.out;
+  std::ofstream(dir / "runs" / "broken.h5") << "truncated";
+  const CommandRun first = Adse("analyze " + dir.string());
+  EXPECT_EQ(first.exit_code, 2) << first.out;  // one file could not be read
+  EXPECT_NE(first.out.find("skipped " + (dir / "runs" / "broken.h5").string()), std::string::npos)
+      << first.out;
+  EXPECT_NE(first.out.find("1 runs analysed"), std::string::npos) << first.out;
+  ASSERT_TRUE(fs::exists(dir / "analysis" / "v1" / "summary.json"));
+  EXPECT_TRUE(fs::exists(dir / "analysis" / "v1" / "pareto.png"));
+  EXPECT_TRUE(fs::exists(dir / "runs" / "a.analysis" / "v1" / "report.json"));
+  EXPECT_TRUE(fs::exists(dir / "runs" / "a.analysis" / "v1" / "trajectory.png"));
+  // Raw data is never rewritten; a second analysis is a new version.
+  const auto raw_time = fs::last_write_time(dir / "runs" / "a.h5");
+  Adse("analyze " + dir.string() + " --threshold frequency_bound_fraction=0.5");
+  EXPECT_EQ(fs::last_write_time(dir / "runs" / "a.h5"), raw_time);
+  ASSERT_TRUE(fs::exists(dir / "analysis" / "v2" / "summary.json"));
+  const CommandRun diff = Adse("analyze --diff " + (dir / "analysis" / "v1").string() + " " +
+                               (dir / "analysis" / "v2").string());
+  EXPECT_EQ(diff.exit_code, 0) << diff.out;
+  EXPECT_NE(diff.out.find("0 of 1 points changed"), std::string::npos) << diff.out;
+  const CommandRun bad = Adse("analyze " + dir.string() + " --threshold nonsense=1");
+  EXPECT_EQ(bad.exit_code, 2) << bad.out;
+  EXPECT_NE(bad.out.find("nonsense"), std::string::npos) << bad.out;
+}
+
+TEST(CliTest, AnalyzeOneRunPrintsDeviationAndDiagnosis) {
+  const fs::path run = fs::temp_directory_path() / "adse_cli_analyze_one.h5";
+  fs::remove_all(fs::temp_directory_path() / "adse_cli_analyze_one.analysis");
+  ASSERT_EQ(Adse("simulate " + Small() + " --point cores=1,freq_ghz=1.0,lidar_hz=14 -q -o " + run.string())
+                .exit_code,
+            0);
+  const CommandRun r = Adse("analyze " + run.string());
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("deviation_score"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("diagnosis   cpu_bound"), std::string::npos) << r.out;
+}
+
 }  // namespace

@@ -1,0 +1,643 @@
+#include "analysis/diagnosis/diagnosis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <set>
+#include <tuple>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "analysis/metrics/run_metrics.h"
+
+namespace adse::analysis {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr char kExternal[] = "external";
+constexpr char kCpuBound[] = "cpu_bound";
+constexpr char kFrequencyBound[] = "frequency_bound";
+constexpr char kMoreCores[] = "more cores";
+constexpr char kHigherFrequency[] = "higher frequency";
+constexpr char kLowerSensorRate[] = "lower sensor rate";
+
+// ---- Options ---------------------------------------------------------------
+
+enum class Range { kAny, kNonNegative, kPositive, kFraction, kFlag };
+
+struct OptionSpec {
+  const char* name;
+  double DiagnosisOptions::*field;
+  Range range;
+};
+
+constexpr OptionSpec kOptionSpecs[] = {
+    {"cpu_bound_base_fraction", &DiagnosisOptions::cpu_bound_base_fraction,
+     Range::kNonNegative},
+    {"cpu_bound_tighten_hz", &DiagnosisOptions::cpu_bound_tighten_hz,
+     Range::kPositive},
+    {"cpu_bound_floor_fraction", &DiagnosisOptions::cpu_bound_floor_fraction,
+     Range::kNonNegative},
+    {"frequency_bound_fraction", &DiagnosisOptions::frequency_bound_fraction,
+     Range::kFraction},
+    {"frequency_bound_driving_inputs_only",
+     &DiagnosisOptions::frequency_bound_driving_inputs_only, Range::kFlag},
+    {"min_messages", &DiagnosisOptions::min_messages, Range::kNonNegative},
+    {"start_s", &DiagnosisOptions::start_s, Range::kNonNegative},
+    {"end_s", &DiagnosisOptions::end_s, Range::kAny},
+    {"remedy_exec_load", &DiagnosisOptions::remedy_exec_load, Range::kPositive},
+    {"remedy_wait_ratio", &DiagnosisOptions::remedy_wait_ratio,
+     Range::kPositive},
+};
+
+bool InRange(Range range, double v) {
+  switch (range) {
+    case Range::kAny:
+      return true;
+    case Range::kNonNegative:
+      return v >= 0.0;
+    case Range::kPositive:
+      return v > 0.0;
+    case Range::kFraction:
+      return v >= 0.0 && v < 1.0;
+    case Range::kFlag:
+      return v == 0.0 || v == 1.0;
+  }
+  return false;
+}
+
+const char* RangeText(Range range) {
+  switch (range) {
+    case Range::kAny:
+      return "finite";
+    case Range::kNonNegative:
+      return ">= 0";
+    case Range::kPositive:
+      return "> 0";
+    case Range::kFraction:
+      return "in [0, 1)";
+    case Range::kFlag:
+      return "0 or 1";
+  }
+  return "";
+}
+
+// ---- Helpers ---------------------------------------------------------------
+
+// Length of [a0, a1] ∩ [b0, b1] (0 when disjoint or degenerate).
+double Overlap(double a0, double a1, double b0, double b1) {
+  return std::max(0.0, std::min(a1, b1) - std::max(a0, b0));
+}
+
+std::string Join(const std::vector<std::string>& parts, const char* sep) {
+  std::string out;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    if (i > 0) out += sep;
+    out += parts[i];
+  }
+  return out;
+}
+
+double RunEnd(const runfile::RunData& run) {
+  if (!run.ego.empty()) return run.ego.back().t_s;
+  // No trajectory (a failed run): the last thing the trace saw.
+  double end = 0.0;
+  for (const auto& r : run.trace.callbacks) end = std::max(end, r.end_s);
+  for (const auto& e : run.trace.topic_events) end = std::max(end, e.t_s);
+  for (const auto& c : run.controls) end = std::max(end, c.t_s);
+  return end;
+}
+
+int ParseCores(const runfile::RunData& run) {
+  auto it = run.platform.find("cores");
+  if (it == run.platform.end()) return 0;
+  char* end = nullptr;
+  const long v = std::strtol(it->second.c_str(), &end, 10);
+  if (end == it->second.c_str() || v < 0 || v > 1 << 20) return 0;
+  return static_cast<int>(v);
+}
+
+// Everything Diagnose needs indexed once, defensively against bad indices.
+class TraceView {
+ public:
+  TraceView(const runfile::RunData& run, const DiagnosisOptions& options)
+      : run_(run) {
+    const double run_end = RunEnd(run);
+    start_s_ =
+        std::isfinite(options.start_s) ? std::max(0.0, options.start_s) : 0.0;
+    end_s_ = (options.end_s < 0.0 || !std::isfinite(options.end_s))
+                 ? run_end
+                 : std::min(options.end_s, run_end);
+    window_s_ = std::max(0.0, end_s_ - start_s_);
+    for (const runfile::NamedCallback& info : run.callback_info) {
+      if (info.node >= 0 &&
+          info.node < static_cast<int>(run.node_names.size())) {
+        node_of_.push_back(run.node_names[info.node]);
+      } else {
+        const size_t slash = info.name.rfind('/');
+        node_of_.push_back(slash == std::string::npos
+                               ? info.name
+                               : info.name.substr(0, slash));
+      }
+    }
+  }
+
+  double start_s() const { return start_s_; }
+  double end_s() const { return end_s_; }
+  double window_s() const { return window_s_; }
+  bool InWindow(double t) const { return t >= start_s_ && t < end_s_; }
+  double Clip(double a, double b) const {
+    return Overlap(a, b, start_s_, end_s_);
+  }
+  double Rate(int64_t count) const {
+    return window_s_ > 0.0 ? static_cast<double>(count) / window_s_ : 0.0;
+  }
+
+  int num_callbacks() const {
+    return static_cast<int>(run_.callback_info.size());
+  }
+  int num_topics() const { return static_cast<int>(run_.topic_names.size()); }
+  bool ValidCallback(int c) const { return c >= 0 && c < num_callbacks(); }
+  bool ValidTopic(int t) const { return t >= 0 && t < num_topics(); }
+
+  std::string CallbackName(int c) const {
+    return ValidCallback(c) ? run_.callback_info[c].name
+                            : fmt::format("callback#{}", c);
+  }
+  // The node's name from callback_info, else the "<node>/" prefix of the
+  // callback's name; "" for an unknown callback.
+  const std::string& NodeOfCallback(int c) const {
+    static const std::string kNone;
+    return ValidCallback(c) ? node_of_[c] : kNone;
+  }
+
+ private:
+  const runfile::RunData& run_;
+  double start_s_ = 0.0, end_s_ = 0.0, window_s_ = 0.0;
+  std::vector<std::string> node_of_;  // by callback index
+};
+
+// ---- Per-core utilisation --------------------------------------------------
+
+// The trace keeps only each execution's lowest core and core count. The
+// virtual executor gives a starting callback the lowest-numbered free cores,
+// so replaying starts in time order recovers the exact cores held; where the
+// replay disagrees with the recorded first_core (another platform), the
+// contiguous range first_core..first_core+cores-1 is assumed.
+std::vector<double> CoreUtilization(const runfile::RunData& run,
+                                    const TraceView& view) {
+  const auto& records = run.trace.callbacks;
+  int num_cores = ParseCores(run);
+  for (const auto& r : records) {
+    if (r.first_core >= 0 && r.cores > 0) {
+      num_cores = std::max(num_cores, r.first_core + r.cores);
+    }
+  }
+  std::vector<double> busy_s(num_cores, 0.0);
+  std::vector<size_t> order(records.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return std::tie(records[a].start_s, records[a].first_core, a) <
+           std::tie(records[b].start_s, records[b].first_core, b);
+  });
+  // End of the execution holding each core (-inf: free).
+  std::vector<double> held_until(num_cores,
+                                 -std::numeric_limits<double>::infinity());
+  std::vector<int> cores;
+  for (size_t i : order) {
+    const stack::CallbackRecord& r = records[i];
+    if (r.first_core < 0 || r.cores <= 0) continue;
+    cores.clear();
+    for (int c = 0; c < num_cores && static_cast<int>(cores.size()) < r.cores;
+         ++c) {
+      if (held_until[c] <= r.start_s) cores.push_back(c);
+    }
+    if (static_cast<int>(cores.size()) != r.cores ||
+        cores.front() != r.first_core) {
+      cores.clear();
+      for (int c = r.first_core; c < r.first_core + r.cores; ++c) {
+        cores.push_back(c);
+      }
+    }
+    const double busy = view.Clip(r.start_s, r.end_s);
+    for (int c : cores) {
+      held_until[c] = std::max(held_until[c], r.end_s);
+      busy_s[c] += busy;
+    }
+  }
+  std::vector<double> utilization(num_cores, 0.0);
+  if (view.window_s() > 0.0) {
+    for (int c = 0; c < num_cores; ++c) {
+      utilization[c] = busy_s[c] / view.window_s();
+    }
+  }
+  return utilization;
+}
+
+// ---- Remedy evidence for a cpu_bound subscription --------------------------
+
+struct RemedyEvidence {
+  double exec_load = 0.0;
+  bool has_wait_ratio = false;
+  double core_wait_ratio = 0.0;
+};
+
+// exec_load = p50(cost of the subscription's runs) x publish_hz
+//           + sum over the node's other callbacks of their busy time / window.
+// Callbacks of one node exclude each other, so this is the share of time the
+// node alone would need to take every message: >= 1 means no number of
+// cores helps, only faster ones.
+// core_wait_ratio = sum over the subscription's runs of the part of
+// [ready, start] during which no callback of its node was running (so it
+// waited for a core, not for its own node) / sum of their costs.
+RemedyEvidence ComputeRemedyEvidence(const runfile::RunData& run,
+                                     const TraceView& view, int callback,
+                                     double publish_hz) {
+  RemedyEvidence ev;
+  const std::string node = view.NodeOfCallback(callback);
+  std::vector<std::pair<double, double>> node_busy;  // [start, end]
+  std::vector<double> costs;
+  double other_busy_s = 0.0;
+  for (const auto& r : run.trace.callbacks) {
+    if (!view.ValidCallback(r.callback) ||
+        view.NodeOfCallback(r.callback) != node) {
+      continue;
+    }
+    node_busy.emplace_back(r.start_s, r.end_s);
+    if (r.callback == callback) {
+      if (view.InWindow(r.ready_s)) costs.push_back(r.cost_s);
+    } else {
+      other_busy_s += view.Clip(r.start_s, r.end_s);
+    }
+  }
+  const double other_load =
+      view.window_s() > 0.0 ? other_busy_s / view.window_s() : 0.0;
+  const double exec_p50 = costs.empty() ? 0.0 : Percentile(costs, 0.5);
+  ev.exec_load = exec_p50 * publish_hz + other_load;
+
+  std::sort(node_busy.begin(), node_busy.end());
+  double wait_s = 0.0, cost_s = 0.0;
+  for (const auto& r : run.trace.callbacks) {
+    if (r.callback != callback || !view.InWindow(r.ready_s)) continue;
+    double node_busy_s = 0.0;
+    // Intervals of one node are disjoint; only those before r.start_s can
+    // overlap its wait.
+    auto it = std::lower_bound(node_busy.begin(), node_busy.end(), r.ready_s,
+                               [](const std::pair<double, double>& iv,
+                                  double t) { return iv.second <= t; });
+    for (; it != node_busy.end() && it->first < r.start_s; ++it) {
+      node_busy_s += Overlap(it->first, it->second, r.ready_s, r.start_s);
+    }
+    wait_s += std::max(0.0, (r.start_s - r.ready_s) - node_busy_s);
+    cost_s += r.cost_s;
+  }
+  if (cost_s > 0.0) {
+    ev.has_wait_ratio = true;
+    ev.core_wait_ratio = wait_s / cost_s;
+  }
+  return ev;
+}
+
+bool FindingLess(const Finding& a, const Finding& b) {
+  if (a.severity != b.severity) return a.severity > b.severity;
+  const std::string& ta = a.topics.empty() ? std::string() : a.topics[0];
+  const std::string& tb = b.topics.empty() ? std::string() : b.topics[0];
+  return std::tie(a.kind, a.node, ta, a.message) <
+         std::tie(b.kind, b.node, tb, b.message);
+}
+
+}  // namespace
+
+Status SetOption(DiagnosisOptions* options, const std::string& name,
+                 double value) {
+  if (options == nullptr) return Status::Internal("SetOption: null options");
+  for (const OptionSpec& spec : kOptionSpecs) {
+    if (name != spec.name) continue;
+    if (!std::isfinite(value) || !InRange(spec.range, value)) {
+      return Status::InvalidArgument(
+          fmt::format("diagnosis threshold {}={} out of range (must be {})",
+                      name, value, RangeText(spec.range)));
+    }
+    options->*spec.field = value;
+    return Status::Ok();
+  }
+  return Status::InvalidArgument(
+      fmt::format("unknown diagnosis threshold '{}'; valid names: {}", name,
+                  Join(DiagnosisOptionNames(), ", ")));
+}
+
+std::vector<std::string> DiagnosisOptionNames() {
+  std::vector<std::string> names;
+  for (const OptionSpec& spec : kOptionSpecs) names.emplace_back(spec.name);
+  return names;
+}
+
+double AllowedDeficit(const DiagnosisOptions& options, double rate_hz) {
+  return options.cpu_bound_base_fraction /
+             (1.0 + std::max(0.0, rate_hz) / options.cpu_bound_tighten_hz) +
+         options.cpu_bound_floor_fraction;
+}
+
+Diagnosis Diagnose(const runfile::RunData& run,
+                   const DiagnosisOptions& options) {
+  const TraceView view(run, options);
+  Diagnosis d;
+  d.window_start_s = view.start_s();
+  d.window_s = view.window_s();
+  const int num_topics = view.num_topics();
+  const int num_callbacks = view.num_callbacks();
+
+  // ---- Topic statistics ----
+  std::vector<std::set<std::string>> publishers(num_topics);
+  std::vector<int64_t> publishes(num_topics, 0);
+  // Publishes per publisher callback (-1: external): in the window, and over
+  // the whole run (for topics silent in the window).
+  std::vector<std::map<int, int64_t>> window_pubs(num_topics);
+  std::vector<std::map<int, int64_t>> run_pubs(num_topics);
+  std::vector<bool> published_in_window(num_callbacks, false);
+  // Per (topic, subscriber callback): takes and drops in the window.
+  std::map<std::pair<int, int>, std::pair<int64_t, int64_t>> subs;
+  for (int c = 0; c < num_callbacks; ++c) {
+    const runfile::NamedCallback& info = run.callback_info[c];
+    if (info.kind == "subscription" && view.ValidTopic(info.topic)) {
+      subs[{info.topic, c}];
+    }
+  }
+  for (const stack::TopicEvent& e : run.trace.topic_events) {
+    if (!view.ValidTopic(e.topic)) continue;
+    if (e.kind == stack::TopicEvent::kPublish) {
+      const std::string& node = view.NodeOfCallback(e.callback);
+      if (e.callback < 0) {
+        publishers[e.topic].insert(kExternal);
+      } else if (!node.empty()) {
+        publishers[e.topic].insert(node);
+      }
+      const int publisher = e.callback < 0 ? -1 : e.callback;
+      ++run_pubs[e.topic][publisher];
+      if (view.InWindow(e.t_s)) {
+        ++publishes[e.topic];
+        ++window_pubs[e.topic][publisher];
+        if (view.ValidCallback(publisher)) {
+          published_in_window[publisher] = true;
+        }
+      }
+      continue;
+    }
+    if (!view.InWindow(e.t_s) || !view.ValidCallback(e.callback)) continue;
+    auto& counts = subs[{e.topic, e.callback}];
+    if (e.kind == stack::TopicEvent::kTake) ++counts.first;
+    if (e.kind == stack::TopicEvent::kDrop) ++counts.second;
+  }
+  d.topics.resize(num_topics);
+  for (int t = 0; t < num_topics; ++t) {
+    TopicStats& ts = d.topics[t];
+    ts.name = run.topic_names[t];
+    ts.publisher = Join({publishers[t].begin(), publishers[t].end()}, ", ");
+    ts.publishes = publishes[t];
+    ts.publish_rate_hz = view.Rate(publishes[t]);
+  }
+  for (const auto& [key, counts] : subs) {  // ordered by (topic, callback)
+    SubscriberStats s;
+    s.callback = view.CallbackName(key.second);
+    s.takes = counts.first;
+    s.drops = counts.second;
+    s.take_rate_hz = view.Rate(counts.first);
+    d.topics[key.first].subscribers.push_back(std::move(s));
+  }
+
+  // ---- Callback statistics ----
+  std::vector<std::vector<double>> latencies(num_callbacks),
+      costs(num_callbacks);
+  std::vector<double> busy_core_s(num_callbacks, 0.0);
+  for (const stack::CallbackRecord& r : run.trace.callbacks) {
+    if (!view.ValidCallback(r.callback)) continue;
+    busy_core_s[r.callback] +=
+        view.Clip(r.start_s, r.end_s) * std::max(1, r.cores);
+    if (!view.InWindow(r.ready_s)) continue;
+    latencies[r.callback].push_back(r.end_s - r.ready_s);
+    costs[r.callback].push_back(r.cost_s);
+  }
+  d.callbacks.resize(num_callbacks);
+  for (int c = 0; c < num_callbacks; ++c) {
+    CallbackStats& cs = d.callbacks[c];
+    cs.name = run.callback_info[c].name;
+    cs.node = view.NodeOfCallback(c);
+    cs.runs = static_cast<int64_t>(latencies[c].size());
+    cs.latency_p50_s = Percentile(latencies[c], 0.5);
+    cs.latency_p99_s = Percentile(latencies[c], 0.99);
+    cs.latency_max_s = Percentile(latencies[c], 1.0);
+    cs.exec_p50_s = Percentile(costs[c], 0.5);
+    cs.utilization =
+        view.window_s() > 0.0 ? busy_core_s[c] / view.window_s() : 0.0;
+    if (c < static_cast<int>(run.trace.timer_overruns.size())) {
+      cs.timer_overruns = run.trace.timer_overruns[c];
+    }
+  }
+
+  d.core_utilization = CoreUtilization(run, view);
+
+  std::vector<double> e2e;
+  for (const runfile::ControlSample& c : run.controls) {
+    if (view.InWindow(c.t_s) && c.stamp_s >= 0.0) {
+      e2e.push_back(c.t_s - c.stamp_s);
+    }
+  }
+  d.e2e_latency_p50_s = Percentile(e2e, 0.5);
+  d.e2e_latency_p99_s = Percentile(e2e, 0.99);
+
+  if (view.window_s() <= 0.0) return d;  // no rates, nothing to diagnose
+  auto enough = [&](int t) {
+    return static_cast<double>(publishes[t]) >= options.min_messages &&
+           publishes[t] > 0;
+  };
+
+  // ---- CPU-bound: a subscription taking fewer messages than published ----
+  std::set<std::string> cpu_bound_nodes;
+  for (const auto& [key, counts] : subs) {
+    const auto [topic, callback] = key;
+    if (run.callback_info[callback].kind != "subscription" ||
+        run.callback_info[callback].topic != topic || !enough(topic)) {
+      continue;
+    }
+    const double publish_hz = view.Rate(publishes[topic]);
+    const double take_hz = view.Rate(counts.first);
+    const double deficit = 1.0 - take_hz / publish_hz;
+    const double allowed = AllowedDeficit(options, publish_hz);
+    if (!(deficit > allowed)) continue;
+
+    Finding f;
+    f.kind = kCpuBound;
+    f.node = view.NodeOfCallback(callback);
+    f.topics = {run.topic_names[topic]};
+    f.upstream = d.topics[topic].publisher;
+    f.severity = deficit;
+    const RemedyEvidence ev =
+        ComputeRemedyEvidence(run, view, callback, publish_hz);
+    f.rates_hz = {{"publish_hz", publish_hz},
+                  {"take_hz", take_hz},
+                  {"deficit", deficit},
+                  {"allowed_deficit", allowed},
+                  {"exec_load", ev.exec_load}};
+    if (ev.has_wait_ratio) f.rates_hz["core_wait_ratio"] = ev.core_wait_ratio;
+
+    const bool exec_limited = ev.exec_load >= options.remedy_exec_load;
+    const bool core_limited =
+        !ev.has_wait_ratio || ev.core_wait_ratio >= options.remedy_wait_ratio;
+    std::vector<std::string> remedies;
+    if (exec_limited) remedies.push_back(kHigherFrequency);
+    if (core_limited) remedies.push_back(kMoreCores);
+    if (remedies.empty()) {  // neither alone: the one nearer its threshold
+      remedies.push_back(ev.exec_load / options.remedy_exec_load >=
+                                 ev.core_wait_ratio / options.remedy_wait_ratio
+                             ? kHigherFrequency
+                             : kMoreCores);
+    }
+    const bool from_sensor = publishers[topic].size() == 1 &&
+                             *publishers[topic].begin() == kExternal;
+    if (from_sensor) remedies.push_back(kLowerSensorRate);
+    f.remedy = Join(remedies, "; ");
+
+    const std::string wait_text =
+        ev.has_wait_ratio
+            ? fmt::format("waits for a core {:.2f}x its execution time",
+                          ev.core_wait_ratio)
+            : std::string("never ran in the window");
+    f.message = fmt::format(
+        "{} cannot keep up with {}: takes {:.2f} Hz of {:.2f} Hz published "
+        "(deficit {:.1f}% > allowed {:.1f}% = {:g}/(1+{:.2f}/{:g})+{:g}); "
+        "execution load {:.2f} (>= {:g} needs faster cores), {} "
+        "(>= {:g} needs more cores) -> {}",
+        f.node, f.topics[0], take_hz, publish_hz, 100.0 * deficit,
+        100.0 * allowed, options.cpu_bound_base_fraction, publish_hz,
+        options.cpu_bound_tighten_hz, options.cpu_bound_floor_fraction,
+        ev.exec_load, options.remedy_exec_load, wait_text,
+        options.remedy_wait_ratio, f.remedy);
+    cpu_bound_nodes.insert(f.node);
+    d.findings.push_back(std::move(f));
+  }
+
+  // ---- Frequency-bound: one input much slower than the node's others ----
+  // Where a topic's rate comes from: follow its main publisher upstream
+  // (subscription -> its input topic) to a sensor, a timer or a cpu_bound
+  // node, whichever comes first.
+  auto main_publisher = [&](int topic) {
+    const auto& counts =
+        window_pubs[topic].empty() ? run_pubs[topic] : window_pubs[topic];
+    int best = -2;  // none
+    int64_t best_count = 0;
+    for (const auto& [callback, count] : counts) {  // ascending: ties low
+      if (count > best_count) {
+        best = callback;
+        best_count = count;
+      }
+    }
+    return best;
+  };
+  struct Origin {
+    std::string kind;      // "sensor" | "timer" | "cpu_bound" | "unknown"
+    std::string where;     // sensor topic, timer callback or node
+    double rate_hz = 0.0;  // sensor publish rate or timer rate; 0 unknown
+  };
+  auto trace_origin = [&](int topic) {
+    std::set<int> seen;
+    while (view.ValidTopic(topic) && seen.insert(topic).second) {
+      const int p = main_publisher(topic);
+      if (p == -1) {
+        return Origin{"sensor", run.topic_names[topic],
+                      view.Rate(publishes[topic])};
+      }
+      if (!view.ValidCallback(p)) break;
+      const runfile::NamedCallback& info = run.callback_info[p];
+      if (cpu_bound_nodes.count(view.NodeOfCallback(p)) > 0) {
+        return Origin{"cpu_bound", view.NodeOfCallback(p), 0.0};
+      }
+      if (info.kind == "timer") {
+        return Origin{"timer", info.name,
+                      info.period_s > 0.0 ? 1.0 / info.period_s : 0.0};
+      }
+      topic = info.topic;
+    }
+    return Origin{"unknown", "", 0.0};
+  };
+
+  // Inputs per node: distinct subscribed topics with enough publishes (and,
+  // if asked, only those whose callback publishes: the node's outputs follow
+  // them, unlike state kept for later).
+  const bool driving_only = options.frequency_bound_driving_inputs_only != 0;
+  std::map<std::string, std::set<int>> inputs;
+  for (int c = 0; c < num_callbacks; ++c) {
+    const runfile::NamedCallback& info = run.callback_info[c];
+    if (info.kind == "subscription" && view.ValidTopic(info.topic) &&
+        enough(info.topic) && (!driving_only || published_in_window[c])) {
+      inputs[view.NodeOfCallback(c)].insert(info.topic);
+    }
+  }
+  for (const auto& [node, topics] : inputs) {
+    if (topics.size() < 2) continue;
+    int slowest = -1;
+    for (int t : topics) {  // ascending index: ties go to the lower index
+      if (slowest < 0 || publishes[t] < publishes[slowest]) slowest = t;
+    }
+    std::vector<double> others;
+    for (int t : topics) {
+      if (t != slowest) others.push_back(view.Rate(publishes[t]));
+    }
+    const double slow_hz = view.Rate(publishes[slowest]);
+    const double median_hz = Percentile(others, 0.5);
+    if (!(median_hz > 0.0)) continue;
+    const double deficit = 1.0 - slow_hz / median_hz;
+    if (!(deficit > options.frequency_bound_fraction)) continue;
+
+    Finding f;
+    f.kind = kFrequencyBound;
+    f.node = node;
+    f.topics = {run.topic_names[slowest]};
+    f.upstream = d.topics[slowest].publisher;
+    f.severity = deficit;
+    f.rates_hz = {{"slowest_hz", slow_hz},
+                  {"others_median_hz", median_hz},
+                  {"deficit", deficit},
+                  {"allowed_fraction", options.frequency_bound_fraction}};
+    for (int t : topics) {
+      f.rates_hz["input_hz:" + run.topic_names[t]] = view.Rate(publishes[t]);
+    }
+    const Origin origin = trace_origin(slowest);
+    f.origin = origin.kind == "unknown" ? origin.kind
+                                        : origin.kind + ":" + origin.where;
+    if (origin.rate_hz > 0.0) f.rates_hz["origin_hz"] = origin.rate_hz;
+    const std::string upstream =
+        f.upstream.empty() ? std::string("unknown") : f.upstream;
+    f.remedy = fmt::format("raise the rate of {}'s publisher ({})", f.topics[0],
+                           upstream);
+    std::string cause;
+    if (origin.kind == "cpu_bound") {
+      cause = fmt::format("upstream limit: {} is cpu_bound", origin.where);
+      f.remedy += fmt::format("; relieve {} (cpu_bound)", origin.where);
+    } else if (origin.kind == "sensor") {
+      cause = fmt::format("its rate is set by the sensor topic {} ({:.2f} Hz)",
+                          origin.where, origin.rate_hz);
+      f.remedy += fmt::format("; raise the rate of sensor {}", origin.where);
+    } else if (origin.kind == "timer") {
+      cause = fmt::format(
+          "its rate is set by the timer {} ({:.2f} Hz): a configuration "
+          "choice",
+          origin.where, origin.rate_hz);
+      f.remedy += fmt::format("; shorten the period of {}", origin.where);
+    } else {
+      cause = "its origin is unknown";
+    }
+    f.message = fmt::format(
+        "{} is limited by its input {} at {:.2f} Hz, {:.1f}% below the "
+        "{:.2f} Hz median of its other inputs (> {:.1f}%); {} -> {}",
+        node, f.topics[0], slow_hz, 100.0 * deficit, median_hz,
+        100.0 * options.frequency_bound_fraction, cause, f.remedy);
+    d.findings.push_back(std::move(f));
+  }
+
+  std::sort(d.findings.begin(), d.findings.end(), FindingLess);
+  return d;
+}
+
+}  // namespace adse::analysis

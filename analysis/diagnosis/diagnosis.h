@@ -1,0 +1,148 @@
+// Trace statistics (topic rates, callback latencies, core utilisation,
+// end-to-end latency) and deterministic bottleneck diagnosis of one run,
+// computed from its stored RunData alone (never from the simulator).
+//
+// Everything is measured over a window [start_s, end_s) of simulated time;
+// rates are counts in the window divided by its length. Nothing here knows
+// the stack's node names: the graph is read from the run's callback_info.
+#ifndef ADSE_ANALYSIS_DIAGNOSIS_DIAGNOSIS_H_
+#define ADSE_ANALYSIS_DIAGNOSIS_DIAGNOSIS_H_
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "analysis/runfile/run_data.h"
+#include "stack/base/status.h"
+
+namespace adse::analysis {
+
+struct DiagnosisOptions {
+  // CPU-bound: a subscription falls behind its topic when its relative
+  // deficit 1 - take_hz / publish_hz exceeds
+  //   allowed(r) = base_fraction / (1 + r / tighten_hz) + floor_fraction
+  // with r = publish_hz. With the defaults: 1 Hz -> 32.3 %, 7 Hz -> 22.6 %,
+  // 10 Hz -> 20 %, 14 Hz -> 17.5 %, 100 Hz -> 7.7 %, never below 5 %:
+  // strict at high rates, lenient where a few late messages are a big share.
+  double cpu_bound_base_fraction = 0.3;    // extra allowance at low rates
+  double cpu_bound_tighten_hz = 10.0;      // rate at which it has halved
+  double cpu_bound_floor_fraction = 0.05;  // allowance at any rate (edges)
+  // Frequency-bound: a node's slowest input is more than this fraction below
+  // the median rate of its other inputs.
+  double frequency_bound_fraction = 0.10;
+  // 1: compare only inputs whose callback published in the window (they
+  // trigger the node's outputs); 0: every subscribed input, as the rule is
+  // stated. State inputs such as a 50 Hz pose cached by a 14 Hz LiDAR node
+  // make the latter flag most pipeline nodes of a healthy stack.
+  double frequency_bound_driving_inputs_only = 0;
+  // Topics with fewer publishes in the window are ignored (latched/one-shot).
+  double min_messages = 5;
+  // Window in simulated seconds; end_s < 0 means the run's end. Clamped to
+  // [0, run end].
+  double start_s = 0.0;
+  double end_s = -1.0;
+  // Remedy of a cpu_bound finding ("higher frequency" vs "more cores"), see
+  // Finding::remedy: the node's execution load at which faster cores are
+  // needed, and the core-wait / execution ratio at which more cores are.
+  double remedy_exec_load = 1.0;
+  double remedy_wait_ratio = 1.0;
+};
+
+// Sets one option by its field name (for `--threshold NAME=VALUE`).
+// Unknown names and out-of-range values -> InvalidArgument (the message of
+// an unknown name lists the valid ones).
+Status SetOption(DiagnosisOptions* options, const std::string& name,
+                 double value);
+// The names SetOption accepts, in declaration order.
+std::vector<std::string> DiagnosisOptionNames();
+// allowed(r) above: the largest relative deficit tolerated at `rate_hz`.
+double AllowedDeficit(const DiagnosisOptions& options, double rate_hz);
+
+struct SubscriberStats {
+  std::string callback;  // "<node>/<callback>"
+  double take_rate_hz = 0.0;
+  int64_t takes = 0;
+  int64_t drops = 0;
+};
+
+struct TopicStats {
+  std::string name;
+  // Node(s) publishing it over the whole run, sorted and ", "-joined;
+  // "external" for messages from outside the graph (sensors); "" if none.
+  std::string publisher;
+  double publish_rate_hz = 0.0;
+  int64_t publishes = 0;
+  std::vector<SubscriberStats> subscribers;  // by callback index
+};
+
+// Per callback, over runs whose ready_s lies in the window. Statistics of
+// a callback without runs are NaN.
+struct CallbackStats {
+  std::string name;  // "<node>/<callback>"
+  std::string node;
+  int64_t runs = 0;
+  double latency_p50_s = 0.0;  // end - ready
+  double latency_p99_s = 0.0;
+  double latency_max_s = 0.0;
+  double exec_p50_s = 0.0;  // cost
+  // Busy core-seconds (cost x cores, clipped to the window) / window; above
+  // 1 for callbacks holding several cores.
+  double utilization = 0.0;
+  int64_t timer_overruns = 0;  // whole run (the trace keeps only totals)
+};
+
+struct Finding {
+  std::string kind;  // "cpu_bound" | "frequency_bound"
+  // The node that cannot keep up (cpu_bound) / that is input-limited
+  // (frequency_bound).
+  std::string node;
+  std::vector<std::string> topics;  // the topic fallen behind / slow input
+  // Node(s) publishing topics[0] ("external" for a sensor).
+  std::string upstream;
+  // frequency_bound: where the slow input's rate comes from, following its
+  // main publisher upstream to the first of "sensor:<topic>",
+  // "timer:<callback>", "cpu_bound:<node>"; or "unknown". Empty otherwise.
+  std::string origin;
+  // Evidence by name. cpu_bound: publish_hz, take_hz, deficit,
+  // allowed_deficit, exec_load, core_wait_ratio. frequency_bound:
+  // slowest_hz, others_median_hz, deficit, allowed_fraction,
+  // "input_hz:<topic>" for every input considered, and origin_hz (the
+  // sensor's or timer's rate) when the origin has one.
+  std::map<std::string, double> rates_hz;
+  // "; "-joined, most important first. cpu_bound: "higher frequency" when
+  // exec_load >= remedy_exec_load, "more cores" when core_wait_ratio >=
+  // remedy_wait_ratio (if neither, the one nearer its threshold), plus
+  // "lower sensor rate" when the topic comes from outside the graph.
+  // frequency_bound: "raise the rate of <topic>'s publisher (<node>)", then
+  // by origin "; raise the rate of sensor <topic>" | "; shorten the period
+  // of <timer>" | "; relieve <node> (cpu_bound)".
+  std::string remedy;
+  std::string message;    // one readable sentence with the numbers
+  double severity = 0.0;  // the relative deficit; findings sort by it
+};
+
+struct Diagnosis {
+  double window_start_s = 0.0;
+  double window_s = 0.0;
+  std::vector<TopicStats> topics;        // by topic index
+  std::vector<CallbackStats> callbacks;  // by callback index
+  // Busy fraction of each virtual core over the window.
+  std::vector<double> core_utilization;
+  // LiDAR -> control: control publish time minus the stamp of the sensor
+  // message it derives from, over controls published in the window; NaN
+  // when there are none.
+  double e2e_latency_p50_s = 0.0;
+  double e2e_latency_p99_s = 0.0;
+  // Severity descending; ties by kind, node, topic (deterministic).
+  std::vector<Finding> findings;
+};
+
+// Never throws; a malformed run (indices out of range) is read defensively
+// and its bad entries ignored.
+Diagnosis Diagnose(const runfile::RunData& run,
+                   const DiagnosisOptions& options = {});
+
+}  // namespace adse::analysis
+
+#endif  // ADSE_ANALYSIS_DIAGNOSIS_DIAGNOSIS_H_

@@ -1,0 +1,131 @@
+// Pictures of runs and campaigns (OpenCV inside, PNG out): the top-down
+// trajectory image a vision model or a person looks at to judge a drive,
+// and the cost/time Pareto plot of a campaign. No OpenCV types here; every
+// function returns a Status and never throws.
+#ifndef ADSE_ANALYSIS_PICTURES_PICTURES_H_
+#define ADSE_ANALYSIS_PICTURES_PICTURES_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "analysis/runfile/run_data.h"
+#include "stack/base/status.h"
+
+namespace adse::analysis {
+
+// Colours of the pictures, so tests and documents can refer to them.
+struct Rgb {
+  uint8_t r, g, b;
+  bool operator==(const Rgb&) const = default;
+};
+inline constexpr Rgb kBackgroundRgb{255, 255, 255};
+inline constexpr Rgb kLaneRgb{215, 215, 215};         // lane surface
+inline constexpr Rgb kLaneCentreRgb{160, 160, 160};   // lane centreline
+inline constexpr Rgb kIdealPathRgb{0, 110, 40};       // dark green
+inline constexpr Rgb kTrajectoryRgb{80, 170, 255};    // light blue
+inline constexpr Rgb kVehiclePathRgb{245, 195, 160};  // faint orange
+inline constexpr Rgb kStartRgb{0, 170, 0};
+inline constexpr Rgb kGoalRgb{220, 0, 0};
+inline constexpr Rgb kFeasibleRgb{40, 90, 200};
+inline constexpr Rgb kInfeasibleRgb{150, 150, 150};
+inline constexpr Rgb kFrontRgb{230, 90, 0};  // front points + line
+inline constexpr Rgb kConstraintRgb{190, 30, 60};
+
+struct TrajectoryImageOptions {
+  int width_px = 1200;     // 200..4000
+  double margin_m = 10.0;  // world margin around the route and trajectory
+  bool draw_vehicles = true;
+};
+
+// Where the world lands in a trajectory image: a header band of
+// `map_top_px` rows (title, legend) above the map, whose pixel rows and
+// columns map linearly to world metres with y up.
+struct WorldToImage {
+  double min_x_m = 0.0;  // world x at the map's left edge
+  double max_y_m = 0.0;  // world y at the map's top edge
+  double px_per_m = 1.0;
+  int map_top_px = 0;
+  int width_px = 0;
+  int height_px = 0;  // whole image, header included
+
+  // Pixel coordinates (column, row; fractional) of a world point.
+  double Column(double x_m) const { return (x_m - min_x_m) * px_per_m; }
+  double Row(double y_m) const {
+    return map_top_px + (max_y_m - y_m) * px_per_m;
+  }
+  double MaxXM() const { return min_x_m + width_px / px_per_m; }
+  double MinYM() const { return max_y_m - (height_px - map_top_px) / px_per_m; }
+};
+
+// The mapping RenderTrajectoryImage uses for `run`. The map covers the
+// ideal path and the ego trajectory (or, when both are empty, the lanes)
+// plus margin_m, so the drive fills the picture even on a large network;
+// lanes and other vehicles outside are clipped. The map's aspect ratio is
+// kept between 1:4 and 2:1 (height:width) by widening the shorter side.
+// InvalidArgument for bad options or nothing finite to draw.
+Result<WorldToImage> TrajectoryImageMapping(
+    const runfile::RunData& run, const TrajectoryImageOptions& o = {});
+
+// Top-down render of a run: lanes (light grey bands lane_width_m wide with
+// a grey centreline, from run.lanes), the ideal path (dark green), the ego
+// trajectory (light blue, thicker), other vehicles' paths (faint), a start
+// marker (green circle at the first ego sample, else the path start) and a
+// goal marker (red cross at the path end) with labels, a scale bar with its
+// length, the world coordinates of the map corners written in the corners,
+// a title line (scenario, design point, outcome) and a legend. White
+// background, y up. Encoded as PNG in memory, then written atomically
+// (adse::WriteFileAtomic): no partial file on any error.
+Status RenderTrajectoryImage(const runfile::RunData& run,
+                             const std::string& png_path,
+                             const TrajectoryImageOptions& o = {});
+// The same picture as PNG bytes (e.g. for a vision model).
+Result<std::string> TrajectoryImagePng(const runfile::RunData& run,
+                                       const TrajectoryImageOptions& o = {});
+
+struct ParetoPlotPoint {
+  double cost = 0.0;
+  double nav_time_s = 0.0;
+  bool feasible = true;
+  bool on_front = false;
+  std::string label;  // written next to front points, e.g. "6c 1.5GHz 7Hz"
+};
+
+struct ParetoPlotOptions {
+  int width_px = 1000, height_px = 700;  // 300..4000 each
+  std::string x_label = "hardware cost", y_label = "navigation time (s)";
+  // Constraint lines (e.g. nav_time_s <= 400 as a horizontal line at 400).
+  std::vector<double> vertical_lines, horizontal_lines;
+  std::string title;
+};
+
+// Scatter of all points (feasible: filled circles; infeasible: grey
+// crosses; front points: in the front colour, a cross if infeasible, labelled)
+// with the front joined by a line in x order, constraint lines dashed, linear
+// axes with ticks and labels, a legend, and the title. Points with a non-finite
+// coordinate cannot be placed: they are left out and counted in a note.
+// InvalidArgument for bad options or no finite point; written like
+// RenderTrajectoryImage.
+Status RenderParetoPlot(const std::vector<ParetoPlotPoint>& points,
+                        const std::string& png_path,
+                        const ParetoPlotOptions& o = {});
+Result<std::string> ParetoPlotPng(const std::vector<ParetoPlotPoint>& points,
+                                  const ParetoPlotOptions& o = {});
+
+// A decoded picture, 8-bit RGB rows top to bottom (for checks and tests
+// that should not need OpenCV themselves).
+struct RgbImage {
+  int width_px = 0, height_px = 0;
+  std::vector<uint8_t> rgb;  // width_px * height_px * 3
+  Rgb At(int column, int row) const {
+    const size_t i = (static_cast<size_t>(row) * width_px + column) * 3;
+    return {rgb[i], rgb[i + 1], rgb[i + 2]};
+  }
+};
+// Reads an image file (PNG or anything cv::imread knows). NotFound if
+// missing, Corruption if it does not decode.
+Result<RgbImage> ReadImage(const std::string& path);
+
+}  // namespace adse::analysis
+
+#endif  // ADSE_ANALYSIS_PICTURES_PICTURES_H_

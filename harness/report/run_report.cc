@@ -1,0 +1,159 @@
+#include "harness/report/run_report.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "analysis/deviation/deviation.h"
+#include "analysis/diagnosis/diagnosis.h"
+#include "analysis/metrics/run_metrics.h"
+#include "analysis/pictures/pictures.h"
+#include "harness/spec/spec_parser.h"
+
+namespace adse::report {
+namespace {
+
+nlohmann::json Number(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
+Result<RunReport> AnalyzeRun(const runfile::RunData& run, const std::string& run_file,
+                             const AnalyzeOptions& options) {
+  RunReport r;
+  r.run_file = run_file;
+  r.scenario_name = run.scenario_name;
+  r.point = run.design_point;
+  r.seed = run.seed;
+  r.status = run.status;
+  r.termination_reason = run.termination_reason;
+  r.content_key = run.content_key;
+  // Metrics are recomputed from the trace, never copied, so a changed
+  // metric definition reaches old runs too; hardware_cost comes from the
+  // scenario's cost expression as stored.
+  r.metrics = analysis::ComputeRunMetrics(run);
+  if (auto it = run.metrics.find("hardware_cost"); it != run.metrics.end()) {
+    r.metrics["hardware_cost"] = it->second;
+  }
+
+  // Deviation from the ideal path.
+  std::vector<Eigen::Vector2d> ideal;
+  ideal.reserve(run.ideal_path.size());
+  for (const runfile::PathPoint& p : run.ideal_path) ideal.emplace_back(p.x_m, p.y_m);
+  std::vector<analysis::TimedXy> actual;
+  actual.reserve(run.ego.size());
+  for (const runfile::EgoSample& s : run.ego) actual.push_back({s.t_s, s.x_m, s.y_m});
+  analysis::DeviationOptions deviation_options;
+  deviation_options.normalize_by_m = options.deviation_normalize_by_m;
+  Result<analysis::DeviationResult> deviation =
+      analysis::FitDeviation(ideal, actual, run.lane_width_m, deviation_options);
+  if (deviation.ok()) {
+    r.metrics["deviation_score"] = deviation->deviation_score;
+    r.metrics["max_deviation_m"] = deviation->max_deviation_m;
+    r.metrics["offset_m"] = deviation->offset_m;
+    r.metrics["zigzag_index"] = deviation->zigzag_index;
+    r.deviation_complete = deviation->complete;
+    r.driven_fraction = deviation->driven_fraction;
+  } else {
+    r.deviation_error = deviation.status().message();
+    r.metrics["deviation_score"] = std::nan("");
+  }
+
+  // Bottlenecks.
+  analysis::DiagnosisOptions diagnosis_options;
+  // The stack's nodes cache a 50 Hz pose next to their 7-14 Hz data: as
+  // inputs those would make every healthy node look frequency-bound.
+  diagnosis_options.frequency_bound_driving_inputs_only = 1;
+  for (const auto& [name, value] : options.thresholds) {
+    ADSE_RETURN_IF_ERROR(analysis::SetOption(&diagnosis_options, name, value));
+  }
+  const analysis::Diagnosis diagnosis = analysis::Diagnose(run, diagnosis_options);
+  for (const analysis::Finding& f : diagnosis.findings) {
+    r.findings.push_back({f.kind, f.node, f.remedy, f.message, f.topics, f.rates_hz});
+  }
+
+  // Constraints, from the scenario stored in the run.
+  Result<spec::Spec> spec =
+      spec::ParseSpec(run.scenario_text, run.scenario_name + ".yaml (stored in the run)", ".");
+  if (spec.ok()) {
+    r.feasible = run.status == "complete";
+    for (const std::string& c : spec->constraints) {
+      Result<bool> ok = spec::EvaluateConstraint(*spec, c, r.metrics, run.design_point);
+      const bool satisfied = ok.ok() && *ok;
+      r.constraints.push_back({c, satisfied});
+      r.feasible = r.feasible && satisfied;
+    }
+  } else {
+    r.constraints_error = spec.status().message();
+  }
+
+  if (!options.image_dir.empty()) {
+    const std::string png = options.image_dir + "/trajectory.png";
+    Status drawn = analysis::RenderTrajectoryImage(run, png);
+    if (drawn.ok()) r.images["trajectory"] = png;
+  }
+  return r;
+}
+
+nlohmann::json ToJson(const RunReport& r) {
+  nlohmann::json j;
+  j["report_version"] = r.report_version;
+  j["run_file"] = r.run_file;
+  j["scenario"] = r.scenario_name;
+  j["point"] = r.point;
+  j["seed"] = r.seed;
+  j["status"] = r.status;
+  j["termination_reason"] = r.termination_reason;
+  j["content_key"] = r.content_key;
+  for (const auto& [name, value] : r.metrics) j["metrics"][name] = Number(value);
+  j["constraints"] = nlohmann::json::array();
+  for (const ConstraintStatus& c : r.constraints) {
+    j["constraints"].push_back({{"expression", c.expression}, {"satisfied", c.satisfied}});
+  }
+  if (!r.constraints_error.empty()) j["constraints_error"] = r.constraints_error;
+  j["feasible"] = r.feasible;
+  j["deviation"] = {{"complete", r.deviation_complete}, {"driven_fraction", r.driven_fraction}};
+  if (!r.deviation_error.empty()) j["deviation"]["error"] = r.deviation_error;
+  j["findings"] = nlohmann::json::array();
+  for (const FindingSummary& f : r.findings) {
+    j["findings"].push_back({{"kind", f.kind}, {"node", f.node}, {"topics", f.topics},
+                             {"rates_hz", f.rates_hz}, {"remedy", f.remedy},
+                             {"message", f.message}});
+  }
+  j["images"] = r.images;
+  return j;
+}
+
+std::string FormatSummary(const RunReport& r) {
+  std::string out;
+  auto metric = [&](const char* name) {
+    auto it = r.metrics.find(name);
+    return it == r.metrics.end() || !std::isfinite(it->second) ? std::string("n/a")
+                                                                : fmt::format("{:.4g}", it->second);
+  };
+  out += fmt::format("ended       {} ({})\n", r.termination_reason, r.status);
+  for (const char* name : {"completed", "nav_time_s", "ctrl_rate_hz", "hardware_cost",
+                           "deviation_score", "max_deviation_m", "offset_m", "zigzag_index",
+                           "e2e_latency_p50_s", "e2e_latency_p99_s", "dropped_messages",
+                           "lidar_frames_dropped", "collisions", "cpu_utilization"}) {
+    out += fmt::format("{:<20} {}\n", name, metric(name));
+  }
+  if (!r.deviation_complete && r.deviation_error.empty()) {
+    out += fmt::format("deviation   scored on the driven part ({:.0f} % of the path)\n",
+                       100 * r.driven_fraction);
+  }
+  for (const ConstraintStatus& c : r.constraints) {
+    out += fmt::format("constraint  {:<24} {}\n", c.expression, c.satisfied ? "ok" : "VIOLATED");
+  }
+  if (!r.constraints_error.empty()) out += "constraints n/a: " + r.constraints_error + "\n";
+  out += fmt::format("feasible    {}\n", r.feasible ? "yes" : "no");
+  if (r.findings.empty()) out += "diagnosis   no bottleneck found\n";
+  for (const FindingSummary& f : r.findings) {
+    out += fmt::format("diagnosis   {}: {} (remedy: {})\n", f.kind, f.message, f.remedy);
+  }
+  return out;
+}
+
+}  // namespace adse::report

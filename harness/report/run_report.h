@@ -1,0 +1,75 @@
+// RunReport: the one structured record per run that strategies, agents and
+// reports read — design point, constraint status, metrics, the deviation
+// fit, the diagnosis and image paths — built from a run file alone, so that
+// analysing during a campaign and re-analysing later are the same code.
+#ifndef ADSE_HARNESS_REPORT_RUN_REPORT_H_
+#define ADSE_HARNESS_REPORT_RUN_REPORT_H_
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "analysis/runfile/run_data.h"
+#include "stack/base/status.h"
+
+namespace adse::report {
+
+struct AnalyzeOptions {
+  // Diagnosis thresholds by name (see analysis/diagnosis), e.g.
+  // {"frequency_bound_fraction", 0.2}.
+  std::map<std::string, double> thresholds;
+  // Normaliser of the deviation score; 0: half the lane width.
+  double deviation_normalize_by_m = 0.0;
+  // Folder for pictures; empty: no pictures.
+  std::string image_dir;
+};
+
+struct ConstraintStatus {
+  std::string expression;
+  bool satisfied = false;
+};
+
+struct FindingSummary {
+  std::string kind, node, remedy, message;
+  std::vector<std::string> topics;
+  std::map<std::string, double> rates_hz;
+};
+
+struct RunReport {
+  int report_version = 1;
+  std::string run_file;
+  std::string scenario_name;
+  std::map<std::string, double> point;
+  uint64_t seed = 0;
+  std::string status;              // complete | failed
+  std::string termination_reason;
+  std::string content_key;
+  std::map<std::string, double> metrics;  // run metrics + deviation metrics
+  // Constraints as written in the scenario; `constraints_error` says why
+  // they could not be evaluated (e.g. the stored scenario no longer parses).
+  std::vector<ConstraintStatus> constraints;
+  std::string constraints_error;
+  bool feasible = false;
+  // Deviation fit (also in metrics as deviation_score, max_deviation_m,
+  // offset_m, zigzag_index).
+  bool deviation_complete = false;
+  double driven_fraction = 0.0;
+  std::string deviation_error;
+  std::vector<FindingSummary> findings;
+  std::map<std::string, std::string> images;  // "trajectory" -> png path
+};
+
+// Analyses one run. Fails only on inputs that cannot be analysed at all.
+Result<RunReport> AnalyzeRun(const runfile::RunData& run, const std::string& run_file,
+                             const AnalyzeOptions& options);
+
+nlohmann::json ToJson(const RunReport& report);
+
+// A short human summary: outcome, key metrics, constraints, findings.
+std::string FormatSummary(const RunReport& report);
+
+}  // namespace adse::report
+
+#endif  // ADSE_HARNESS_REPORT_RUN_REPORT_H_

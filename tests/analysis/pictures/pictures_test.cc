@@ -1,0 +1,351 @@
+// Trajectory image and Pareto plot: rendered from synthetic data, decoded
+// back, and probed at pixels whose colour is known from the mapping.
+#include "analysis/pictures/pictures.h"
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace adse::analysis {
+namespace {
+
+namespace fs = std::filesystem;
+using runfile::RunData;
+
+std::string Name(Rgb c) {
+  return "rgb(" + std::to_string(c.r) + "," + std::to_string(c.g) + "," +
+         std::to_string(c.b) + ")";
+}
+
+// True if some pixel within `radius` of (column, row) has exactly `colour`.
+bool ColourNear(const RgbImage& img, double column, double row, Rgb colour,
+                int radius = 1) {
+  const int c0 = static_cast<int>(std::lround(column));
+  const int r0 = static_cast<int>(std::lround(row));
+  for (int r = r0 - radius; r <= r0 + radius; ++r) {
+    for (int c = c0 - radius; c <= c0 + radius; ++c) {
+      if (r >= 0 && c >= 0 && r < img.height_px && c < img.width_px &&
+          img.At(c, r) == colour) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+int CountColour(const RgbImage& img, Rgb colour) {
+  int n = 0;
+  for (int r = 0; r < img.height_px; ++r) {
+    for (int c = 0; c < img.width_px; ++c) n += img.At(c, r) == colour;
+  }
+  return n;
+}
+
+// A square lane loop of 100 m, an ideal path along its bottom and right
+// sides, and a trajectory 1 m to the left of the path; one other vehicle
+// crossing the middle.
+RunData SquareRun() {
+  RunData run;
+  run.scenario_name = "square_loop";
+  run.termination_reason = "goal_reached";
+  run.design_point = {{"cores", 6}, {"freq_ghz", 1.5}, {"lidar_hz", 7}};
+  run.metrics = {{"nav_time_s", 42.5}};
+  run.lane_width_m = 3.5;
+  const double corners[5][2] = {{0, 0}, {100, 0}, {100, 100}, {0, 100}, {0, 0}};
+  for (const auto& c : corners) run.lanes.push_back({0, c[0], c[1]});
+  double s = 0;
+  for (int i = 0; i <= 100; ++i) run.ideal_path.push_back({s++, 1.0 * i, 0});
+  for (int i = 1; i <= 100; ++i) run.ideal_path.push_back({s++, 100, 1.0 * i});
+  double t = 0;
+  for (int i = 0; i <= 99; ++i) {
+    run.ego.push_back({t += 0.1, 1.0 * i, 1.0, 0, 5, 0, 0});
+  }
+  for (int i = 1; i <= 100; ++i) {
+    run.ego.push_back({t += 0.1, 99.0, 1.0 * i, M_PI / 2, 5, 0, 0});
+  }
+  for (int i = 0; i <= 6; ++i) {
+    run.vehicles.push_back(
+        {0.5 * i, "veh0", 20.0 + 10 * i, 50, 0, 5, 4.5, 1.8});
+  }
+  return run;
+}
+
+class PictureTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = ::testing::TempDir() + "pictures_test_XXXXXX";
+    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  std::string Path(const std::string& name) const {
+    return (fs::path(dir_) / name).string();
+  }
+  std::vector<std::string> Listing() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::recursive_directory_iterator(dir_)) {
+      names.push_back(fs::relative(e.path(), dir_).string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+  std::string dir_;
+};
+
+TEST_F(PictureTest, TrajectoryImageHasTheDrawingWhereTheMappingSays) {
+  const RunData run = SquareRun();
+  const std::string path = Path("trajectory.png");
+  const TrajectoryImageOptions options;  // 1200 px, 10 m margin
+  ASSERT_TRUE(RenderTrajectoryImage(run, path, options).ok());
+  Result<RgbImage> img = ReadImage(path);
+  ASSERT_TRUE(img.ok()) << img.status().ToString();
+  EXPECT_EQ(img->width_px, 1200);
+  Result<WorldToImage> map = TrajectoryImageMapping(run, options);
+  ASSERT_TRUE(map.ok());
+  EXPECT_EQ(map->height_px, img->height_px);
+  EXPECT_NEAR(map->px_per_m, 10.0, 1e-9);  // 120 m across 1200 px
+  EXPECT_NEAR(map->min_x_m, -10.0, 1e-9);
+  EXPECT_NEAR(map->MaxXM(), 110.0, 1e-9);
+  EXPECT_NEAR(map->MinYM(), -10.0, 1e-9);
+
+  auto at = [&](double x, double y, Rgb colour, int radius = 0) {
+    return ColourNear(*img, map->Column(x), map->Row(y), colour, radius);
+  };
+  // The trajectory along both sides, 1 m off the path; the path itself.
+  for (double x : {30.0, 50.0, 80.0}) {
+    EXPECT_TRUE(at(x, 1.0, kTrajectoryRgb)) << "x=" << x;
+    EXPECT_TRUE(at(x, 0.0, kIdealPathRgb, 1)) << "x=" << x;
+  }
+  for (double y : {30.0, 60.0}) {
+    EXPECT_TRUE(at(99.0, y, kTrajectoryRgb)) << "y=" << y;
+    EXPECT_TRUE(at(100.0, y, kIdealPathRgb, 1)) << "y=" << y;
+  }
+  // Lanes: the surface band on the far sides, the centreline there too.
+  EXPECT_TRUE(at(50.0, 101.0, kLaneRgb));
+  EXPECT_TRUE(at(1.0, 50.0, kLaneRgb));
+  EXPECT_TRUE(at(50.0, 100.0, kLaneCentreRgb, 1));
+  // Markers: start at the first ego sample, goal at the path's end.
+  EXPECT_TRUE(at(0.0, 1.0, kStartRgb));
+  EXPECT_TRUE(at(100.0, 100.0, kGoalRgb));
+  // The other vehicle, faintly.
+  EXPECT_TRUE(at(50.0, 50.0, kVehiclePathRgb, 1));
+  // White away from content: inside the loop, in the margin, the corners.
+  EXPECT_EQ(img->At(map->Column(40), map->Row(70)), kBackgroundRgb);
+  EXPECT_EQ(img->At(map->Column(-6), map->Row(40)), kBackgroundRgb);
+  EXPECT_EQ(img->At(map->Column(106), map->Row(40)), kBackgroundRgb);
+  for (const auto& [c, r] : std::vector<std::pair<int, int>>{
+           {1, 1},
+           {img->width_px - 2, 1},
+           {1, map->map_top_px + 1},
+           {img->width_px - 2, map->map_top_px + 1},
+           {1, img->height_px - 2},
+           {img->width_px - 2, img->height_px - 2}}) {
+    EXPECT_EQ(img->At(c, r), kBackgroundRgb)
+        << c << "," << r << " is " << Name(img->At(c, r));
+  }
+  // Corner coordinates, scale bar and header put dark pixels in those
+  // places.
+  auto dark_in = [&](int c0, int r0, int c1, int r1) {
+    for (int r = r0; r < r1; ++r) {
+      for (int c = c0; c < c1; ++c) {
+        const Rgb p = img->At(c, r);
+        if (p.r < 128 && p.g < 128 && p.b < 128) return true;
+      }
+    }
+    return false;
+  };
+  const int w = img->width_px, h = img->height_px, top = map->map_top_px;
+  EXPECT_TRUE(dark_in(0, 0, w / 2, top / 2));                 // title
+  EXPECT_TRUE(dark_in(0, top, 150, top + 30));                // top left
+  EXPECT_TRUE(dark_in(w - 150, top, w, top + 30));            // top right
+  EXPECT_TRUE(dark_in(0, h - 30, 150, h));                    // bottom left
+  EXPECT_TRUE(dark_in(w - 150, h - 30, w, h));                // bottom right
+  EXPECT_TRUE(dark_in(w / 2 - 100, h - 40, w / 2 + 100, h));  // scale bar
+}
+
+TEST_F(PictureTest, VehiclesCanBeLeftOut) {
+  TrajectoryImageOptions options;
+  options.width_px = 600;
+  options.draw_vehicles = false;
+  const RunData run = SquareRun();
+  ASSERT_TRUE(RenderTrajectoryImage(run, Path("t.png"), options).ok());
+  Result<RgbImage> img = ReadImage(Path("t.png"));
+  ASSERT_TRUE(img.ok());
+  EXPECT_EQ(img->width_px, 600);
+  EXPECT_EQ(CountColour(*img, kVehiclePathRgb), 0);
+  EXPECT_GT(CountColour(*img, kTrajectoryRgb), 100);
+}
+
+TEST_F(PictureTest, PngBytesAreAPng) {
+  Result<std::string> png = TrajectoryImagePng(SquareRun());
+  ASSERT_TRUE(png.ok()) << png.status().ToString();
+  ASSERT_GT(png->size(), 8u);
+  EXPECT_EQ(png->substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+}
+
+TEST_F(PictureTest, LongThinRoutesKeepAReadableAspect) {
+  RunData run;
+  for (int i = 0; i <= 1000; ++i)
+    run.ideal_path.push_back({1.0 * i, 1.0 * i, 0});
+  Result<WorldToImage> map = TrajectoryImageMapping(run, {});
+  ASSERT_TRUE(map.ok());
+  const int map_height = map->height_px - map->map_top_px;
+  EXPECT_GE(map_height, 1200 / 4 - 1);
+  run.ideal_path.clear();
+  for (int i = 0; i <= 1000; ++i)
+    run.ideal_path.push_back({1.0 * i, 0, 1.0 * i});
+  map = TrajectoryImageMapping(run, {});
+  ASSERT_TRUE(map.ok());
+  EXPECT_LE(map->height_px - map->map_top_px, 2 * 1200 + 1);
+}
+
+TEST_F(PictureTest, OddDataStillRenders) {
+  RunData run = SquareRun();
+  run.scenario_name = "Kreuzung Süd — ünïcödé";
+  run.termination_reason = "stack crashed\n  #0 somewhere\n";
+  run.status = "failed";
+  run.ego[10].x_m = std::numeric_limits<double>::quiet_NaN();
+  run.ego.front().y_m = std::numeric_limits<double>::infinity();
+  run.lanes.push_back({1, 1e9, 1e9});  // far off: clipped, not in bounds
+  run.lanes.push_back({1, -1e9, 5});
+  run.lanes.push_back({2, 1e300, 1e300});
+  run.design_point.clear();
+  ASSERT_TRUE(RenderTrajectoryImage(run, Path("odd.png")).ok());
+  Result<WorldToImage> map = TrajectoryImageMapping(run);
+  ASSERT_TRUE(map.ok());
+  EXPECT_NEAR(map->px_per_m, 10.0, 1e-9);
+  // Lanes alone still make a picture.
+  RunData lanes_only;
+  lanes_only.lanes = SquareRun().lanes;
+  EXPECT_TRUE(RenderTrajectoryImage(lanes_only, Path("lanes.png")).ok());
+}
+
+TEST_F(PictureTest, TrajectoryErrorsLeaveNoFile) {
+  const RunData empty;
+  Status status = RenderTrajectoryImage(empty, Path("empty.png"));
+  EXPECT_EQ(status.code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(status.message().find("nothing to draw"), std::string::npos);
+
+  TrajectoryImageOptions narrow;
+  narrow.width_px = 10;
+  EXPECT_EQ(
+      RenderTrajectoryImage(SquareRun(), Path("narrow.png"), narrow).code(),
+      Status::Code::kInvalidArgument);
+  TrajectoryImageOptions bad_margin;
+  bad_margin.margin_m = -1;
+  EXPECT_EQ(
+      RenderTrajectoryImage(SquareRun(), Path("m.png"), bad_margin).code(),
+      Status::Code::kInvalidArgument);
+  EXPECT_EQ(RenderTrajectoryImage(SquareRun(), "").code(),
+            Status::Code::kInvalidArgument);
+  EXPECT_TRUE(Listing().empty());
+
+  // The target is a folder: the rename fails, no temporary is left.
+  fs::create_directories(Path("taken.png"));
+  status = RenderTrajectoryImage(SquareRun(), Path("taken.png"));
+  EXPECT_FALSE(status.ok());
+  EXPECT_EQ(Listing(), std::vector<std::string>{"taken.png"});
+  // A parent that is a file.
+  std::ofstream(Path("file")) << "x";
+  EXPECT_FALSE(RenderTrajectoryImage(SquareRun(), Path("file/t.png")).ok());
+  EXPECT_EQ(Listing(), (std::vector<std::string>{"file", "taken.png"}));
+}
+
+TEST_F(PictureTest, ReadImageErrors) {
+  EXPECT_EQ(ReadImage(Path("missing.png")).status().code(),
+            Status::Code::kNotFound);
+  std::ofstream(Path("junk.png")) << "not a png";
+  EXPECT_EQ(ReadImage(Path("junk.png")).status().code(),
+            Status::Code::kCorruption);
+}
+
+// The reference study's shape: cost = cores x GHz, time falling with it.
+std::vector<ParetoPlotPoint> StudyPoints() {
+  return {
+      {4.8, 1248, false, false, "4c 1.2GHz 14Hz"},
+      {9.0, 505, false, true, "6c 1.5GHz 7Hz"},
+      {12.0, 380, true, true, "8c 1.5GHz"},
+      {16.0, 300, true, false, ""},
+      {20.0, 240, true, true, "10c 2.0GHz"},
+      {32.4, 165, true, true, "18c 1.8GHz 7Hz"},
+      {34.5, 171, true, false, "23c 1.5GHz 7Hz"},
+      {40.0, 200, true, false, ""},
+  };
+}
+
+TEST_F(PictureTest, ParetoPlotRendersPointsFrontAndConstraints) {
+  ParetoPlotOptions options;
+  options.horizontal_lines = {400};
+  options.title = "robotaxi: cost vs time";
+  const std::string path = Path("pareto.png");
+  ASSERT_TRUE(RenderParetoPlot(StudyPoints(), path, options).ok());
+  Result<RgbImage> img = ReadImage(path);
+  ASSERT_TRUE(img.ok()) << img.status().ToString();
+  EXPECT_EQ(img->width_px, 1000);
+  EXPECT_EQ(img->height_px, 700);
+  // The front's points and joining line: far more than the dots alone.
+  EXPECT_GT(CountColour(*img, kFrontRgb), 4 * 80 + 300);
+  EXPECT_GT(CountColour(*img, kFeasibleRgb), 3 * 20);
+  EXPECT_GT(CountColour(*img, kInfeasibleRgb), 5);
+  EXPECT_GT(CountColour(*img, kConstraintRgb), 200);  // dashed line
+  EXPECT_EQ(img->At(2, 2), kBackgroundRgb);
+  EXPECT_EQ(img->At(img->width_px - 3, img->height_px - 3), kBackgroundRgb);
+
+  // Without constraint lines there is no constraint colour at all.
+  ASSERT_TRUE(RenderParetoPlot(StudyPoints(), Path("plain.png")).ok());
+  Result<RgbImage> plain = ReadImage(Path("plain.png"));
+  ASSERT_TRUE(plain.ok());
+  EXPECT_EQ(CountColour(*plain, kConstraintRgb), 0);
+}
+
+TEST_F(PictureTest, ParetoPlotEdgeCases) {
+  // One point; equal values; non-finite points left out with a note.
+  EXPECT_TRUE(
+      RenderParetoPlot({{5, 100, true, true, "only"}}, Path("one.png")).ok());
+  std::vector<ParetoPlotPoint> points = {{5, 100, true, true, ""},
+                                         {5, 100, true, true, ""},
+                                         {6, INFINITY, false, false, ""},
+                                         {NAN, 3, false, false, ""}};
+  ParetoPlotOptions options;
+  options.width_px = 300;
+  options.height_px = 300;
+  options.y_label = std::string(500, 'y');  // longer than the plot
+  options.vertical_lines = {NAN, 4};
+  EXPECT_TRUE(RenderParetoPlot(points, Path("same.png"), options).ok());
+  Result<RgbImage> img = ReadImage(Path("same.png"));
+  ASSERT_TRUE(img.ok());
+  EXPECT_EQ(img->width_px, 300);
+  ParetoPlotOptions big_options;
+  big_options.width_px = big_options.height_px = 4000;
+  Result<std::string> big = ParetoPlotPng(StudyPoints(), big_options);
+  EXPECT_TRUE(big.ok()) << big.status().ToString();
+}
+
+TEST_F(PictureTest, ParetoPlotErrorsLeaveNoFile) {
+  EXPECT_EQ(RenderParetoPlot({}, Path("empty.png")).code(),
+            Status::Code::kInvalidArgument);
+  EXPECT_EQ(
+      RenderParetoPlot({{NAN, 1, true, true, ""}}, Path("nan.png")).code(),
+      Status::Code::kInvalidArgument);
+  ParetoPlotOptions tiny;
+  tiny.width_px = 100;
+  EXPECT_EQ(RenderParetoPlot(StudyPoints(), Path("tiny.png"), tiny).code(),
+            Status::Code::kInvalidArgument);
+  EXPECT_TRUE(Listing().empty());
+  fs::create_directories(Path("taken.png"));
+  EXPECT_FALSE(RenderParetoPlot(StudyPoints(), Path("taken.png")).ok());
+  EXPECT_EQ(Listing(), std::vector<std::string>{"taken.png"});
+}
+
+}  // namespace
+}  // namespace adse::analysis

@@ -1,0 +1,83 @@
+// The analysis of real runs of the small robotaxi scenario: the starved
+// computer is diagnosed CPU-bound at its localization/perception nodes, the
+// generous one is not, and both get a deviation score.
+#include "harness/report/run_report.h"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "harness/sim/simulator.h"
+#include "harness/spec/spec_parser.h"
+
+namespace adse::report {
+namespace {
+
+spec::Spec SmallScenario() {
+  Result<spec::Spec> spec =
+      spec::LoadSpec(std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml");
+  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
+  return std::move(spec).value();
+}
+
+RunReport Analyse(double cores, double ghz, double hz) {
+  Result<runfile::RunData> run =
+      sim::SimulatePoint(SmallScenario(), {{"cores", cores}, {"freq_ghz", ghz}, {"lidar_hz", hz}});
+  EXPECT_TRUE(run.ok()) << run.status().ToString();
+  Result<RunReport> report = AnalyzeRun(*run, "memory", AnalyzeOptions{});
+  EXPECT_TRUE(report.ok()) << report.status().ToString();
+  return std::move(report).value();
+}
+
+bool HasCpuBoundAt(const RunReport& r, const std::vector<std::string>& nodes) {
+  for (const FindingSummary& f : r.findings) {
+    if (f.kind != "cpu_bound") continue;
+    for (const std::string& n : nodes) {
+      if (f.node == n) return true;
+    }
+  }
+  return false;
+}
+
+const std::vector<std::string> kLocalizationAndPerception = {
+    "lidar_driver", "voxel_filter", "ndt_scan_matcher", "ground_filter", "euclidean_cluster",
+    "multi_object_tracker", "ekf_localizer"};
+
+TEST(RunReportTest, StarvedComputerIsDiagnosedCpuBoundAtLocalizationOrPerception) {
+  const RunReport r = Analyse(1, 1.0, 14);
+  EXPECT_TRUE(HasCpuBoundAt(r, kLocalizationAndPerception)) << ToJson(r).dump(2);
+  for (const FindingSummary& f : r.findings) {
+    EXPECT_FALSE(f.message.empty());
+    EXPECT_FALSE(f.remedy.empty());
+    EXPECT_FALSE(f.rates_hz.empty()) << "a finding carries its evidence";
+  }
+  EXPECT_FALSE(r.feasible);
+}
+
+TEST(RunReportTest, GenerousComputerIsNotCpuBoundAndDrivesCloseToThePath) {
+  const RunReport r = Analyse(16, 2.1, 14);
+  EXPECT_FALSE(HasCpuBoundAt(r, kLocalizationAndPerception)) << ToJson(r).dump(2);
+  EXPECT_TRUE(r.feasible) << ToJson(r).dump(2);
+  EXPECT_TRUE(r.deviation_complete);
+  // A tracking controller on a good pose stays well within half a lane.
+  EXPECT_LT(r.metrics.at("deviation_score"), 0.3);
+  EXPECT_GE(r.metrics.at("deviation_score"), 0.0);
+  EXPECT_LT(r.metrics.at("max_deviation_m"), 1.5);
+  ASSERT_EQ(r.constraints.size(), 3u);
+  for (const ConstraintStatus& c : r.constraints) EXPECT_TRUE(c.satisfied) << c.expression;
+  const nlohmann::json j = ToJson(r);
+  EXPECT_TRUE(j["metrics"].contains("zigzag_index"));
+  EXPECT_EQ(j["point"]["cores"], 16.0);
+}
+
+TEST(RunReportTest, UnknownThresholdIsAnError) {
+  runfile::RunData empty;
+  AnalyzeOptions options;
+  options.thresholds["no_such_threshold"] = 1.0;
+  Result<RunReport> r = AnalyzeRun(empty, "memory", options);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("no_such_threshold"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace adse::report
