@@ -15,3 +15,5 @@ echo "== adse world $scenario --follow-ideal"
 build/bin/adse world "$scenario" --follow-ideal
 echo "== adse simulate $scenario (exploration.start_from)"
 build/bin/adse simulate "$scenario"
+echo "== adse analyze results/robotaxi-parking-lot/simulate (offline re-analysis)"
+build/bin/adse analyze results/robotaxi-parking-lot/simulate
