@@ -12,6 +12,7 @@
 #include "analysis/metrics/run_metrics.h"
 #include "harness/spec/spec_parser.h"
 #include "harness/sim/calibration.h"
+#include "harness/sim/run_key.h"
 #include "stack/algorithms/command_gate.h"
 #include "stack/base/hash.h"
 #include "stack/base/random.h"
@@ -217,6 +218,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
   run.created_utc = UtcNow();
   run.seed = seed;
   run.design_point = point;
+  if (Result<std::string> key = RunKey(spec, point, seed); key.ok()) run.content_key = *key;
   run.platform = {{"kind", platform.kind == spec::PlatformKind::kVirtual ? "virtual" : "cgroup"},
                   {"cores", std::to_string(platform.cores)},
                   {"freq_ghz", fmt::format("{}", platform.freq_ghz)},

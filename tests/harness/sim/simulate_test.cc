@@ -45,6 +45,7 @@ TEST(SimulateTest, GenerousComputerDrivesToTheGoalAtTheNominalControlRate) {
   EXPECT_NEAR(m.at("ctrl_rate_hz"), 30.0, 3.0);
   EXPECT_LT(m.at("e2e_latency_p99_s"), 0.6);
   EXPECT_NEAR(m.at("hardware_cost"), 16 * 2.1, 1e-9);
+  EXPECT_EQ(run->content_key.size(), 64u);
 }
 
 TEST(SimulateTest, StarvedComputerControlsLessOftenAndDropsLidarFrames) {

@@ -1,0 +1,75 @@
+#include "harness/sim/run_key.h"
+
+#include "stack/base/files.h"
+#include "stack/base/hash.h"
+
+namespace adse::sim {
+namespace {
+
+// Bump when the meaning of a run changes without any input changing.
+constexpr char kKeyVersion[] = "adse-run-key-v1";
+
+Status AddFile(ContentHasher* h, const std::string& label, const std::string& path) {
+  h->Add(label);
+  if (path.empty()) return Status::Ok();
+  Result<std::string> bytes = ReadFile(path, 1u << 30);
+  if (!bytes.ok()) return bytes.status().WithContext(label);
+  h->Add(Sha256Hex(*bytes));
+  return Status::Ok();
+}
+
+void AddLocation(ContentHasher* h, const world::Location& l) {
+  h->Add(static_cast<long long>(l.by_edge));
+  if (l.by_edge) {
+    h->Add(l.edge).Add(l.pos_m).Add(static_cast<long long>(l.lane));
+  } else {
+    h->Add(l.x_m).Add(l.y_m);
+  }
+}
+
+}  // namespace
+
+Result<std::string> RunKey(const spec::Spec& spec, const spec::DesignPoint& point,
+                           uint64_t seed) {
+  ContentHasher h;
+  h.Add(kKeyVersion).Add(ADSE_VERSION);
+  // World.
+  const world::WorldOptions& w = spec.world;
+  h.Add("map").Add(w.map.generator);
+  for (const auto& [name, value] : w.map.generator_params) h.Add(name).Add(value);
+  ADSE_RETURN_IF_ERROR(AddFile(&h, "world.map.net", w.map.net_path));
+  ADSE_RETURN_IF_ERROR(AddFile(&h, "world.map.polygons", w.map.polygons_path));
+  h.Add("traffic").Add(w.traffic.parked_occupancy);
+  for (const world::Flow& f : w.traffic.flows) {
+    h.Add(f.from_edge).Add(f.to_edge).Add(f.vehicles_per_hour);
+  }
+  h.Add(static_cast<long long>(w.weather)).Add(w.step_s);
+  // Task.
+  const world::TaskOptions& t = spec.task;
+  h.Add("task").Add(static_cast<long long>(t.kind));
+  AddLocation(&h, t.start);
+  AddLocation(&h, t.goal);
+  h.Add(t.goal_tolerance_m).Add(t.speed_limit_kmh).Add(t.timeout_s);
+  // Stack: every knob's effective value, so a changed default changes keys.
+  h.Add("stack");
+  for (const KnobInfo& knob : StackKnobs()) h.Add(knob.path).Add(spec.stack.Get(knob.path));
+  // Platform.
+  const spec::PlatformOptions& p = spec.platform;
+  h.Add("platform").Add(static_cast<long long>(p.kind)).Add(p.reference_ghz);
+  h.Add(static_cast<long long>(p.cost_model)).Add(p.cost_scale);
+  h.Add(static_cast<long long>(p.cores)).Add(p.freq_ghz);
+  if (p.cost_model == spec::CostModel::kCounted) {
+    ADSE_RETURN_IF_ERROR(AddFile(&h, "platform.calibration", p.calibration));
+  }
+  // The point (with its bindings: the same name may bind another knob) and
+  // the seed.
+  h.Add("point");
+  for (const auto& [name, value] : point) {
+    const spec::DesignParameter* param = spec.design_space.Find(name);
+    h.Add(name).Add(param ? param->bind : std::string()).Add(value);
+  }
+  h.Add("seed").Add(static_cast<long long>(seed));
+  return h.Hex();
+}
+
+}  // namespace adse::sim

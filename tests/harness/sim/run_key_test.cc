@@ -1,0 +1,66 @@
+#include "harness/sim/run_key.h"
+
+#include <gtest/gtest.h>
+
+#include "harness/spec/spec_parser.h"
+
+namespace adse::sim {
+namespace {
+
+spec::Spec Small() {
+  Result<spec::Spec> spec =
+      spec::LoadSpec(std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml");
+  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
+  return std::move(spec).value();
+}
+
+const spec::DesignPoint kPoint = {{"cores", 4}, {"freq_ghz", 2.1}, {"lidar_hz", 7}};
+
+std::string Key(const spec::Spec& s, const spec::DesignPoint& p = kPoint, uint64_t seed = 3) {
+  Result<std::string> key = RunKey(s, p, seed);
+  EXPECT_TRUE(key.ok()) << key.status().ToString();
+  return key.ok() ? *key : "";
+}
+
+TEST(RunKeyTest, IgnoresExplorationHarnessAndOutput) {
+  const spec::Spec base = Small();
+  spec::Spec other = base;
+  other.exploration.strategy = "ga";
+  other.exploration.budget = 99;
+  other.harness.workers = 7;
+  other.output = "elsewhere";
+  other.name = "renamed";
+  EXPECT_EQ(Key(base), Key(other));
+  EXPECT_EQ(Key(base).size(), 64u);
+}
+
+TEST(RunKeyTest, ChangesWithWhatChangesARun) {
+  const spec::Spec base = Small();
+  const std::string key = Key(base);
+  EXPECT_NE(key, Key(base, {{"cores", 16}, {"freq_ghz", 2.1}, {"lidar_hz", 7}}));
+  EXPECT_NE(key, Key(base, kPoint, 4));
+  spec::Spec knob = base;
+  ASSERT_TRUE(knob.stack.Set("control.rate_hz", 20).ok());
+  EXPECT_NE(key, Key(knob));
+  spec::Spec traffic = base;
+  traffic.world.traffic.flows.at(0).vehicles_per_hour = 61;
+  EXPECT_NE(key, Key(traffic));
+  spec::Spec goal = base;
+  goal.task.goal.x_m += 0.5;
+  EXPECT_NE(key, Key(goal));
+  spec::Spec platform = base;
+  platform.platform.cost_scale = 20;
+  EXPECT_NE(key, Key(platform));
+}
+
+TEST(RunKeyTest, MissingCalibrationFileIsAnError) {
+  spec::Spec s = Small();
+  s.platform.cost_model = spec::CostModel::kCounted;
+  s.platform.calibration = "/nonexistent/calibration.json";
+  Result<std::string> key = RunKey(s, kPoint, 3);
+  ASSERT_FALSE(key.ok());
+  EXPECT_NE(key.status().message().find("platform.calibration"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace adse::sim
