@@ -1,0 +1,183 @@
+#include "harness/explore/strategy.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "harness/spec/spec_parser.h"
+
+namespace adse::explore {
+namespace {
+
+// Random draws tried before a saturated (astronomically large) space is
+// declared exhausted; a hit on a seen point there is already unlikely.
+constexpr int kSaturatedDrawAttempts = 1000;
+
+}  // namespace
+
+SpaceGrid::SpaceGrid(const spec::DesignSpace& space) : space_(&space) {
+  counts_.reserve(space.parameters.size());
+  for (const spec::DesignParameter& parameter : space.parameters) {
+    const int n = static_cast<int>(parameter.values.size());
+    counts_.push_back(n);
+    if (n <= 0) continue;
+    const uint64_t un = static_cast<uint64_t>(n);
+    // UINT64_MAX itself is reserved: "saturated" like DesignSpace::Size.
+    if (saturated_ || size_ > (std::numeric_limits<uint64_t>::max() - 1) / un) {
+      saturated_ = true;
+    } else {
+      size_ *= un;
+    }
+  }
+}
+
+spec::DesignPoint SpaceGrid::ToPoint(const Genes& genes) const {
+  spec::DesignPoint point;
+  for (size_t d = 0; d < counts_.size() && d < genes.size(); ++d) {
+    const spec::DesignParameter& parameter = space_->parameters[d];
+    point[parameter.name] = parameter.values[genes[d]];
+  }
+  return point;
+}
+
+std::optional<Genes> SpaceGrid::FromPoint(
+    const spec::DesignPoint& point) const {
+  Genes genes(counts_.size(), 0);
+  for (size_t d = 0; d < counts_.size(); ++d) {
+    const spec::DesignParameter& parameter = space_->parameters[d];
+    auto it = point.find(parameter.name);
+    if (it == point.end()) return std::nullopt;
+    const int index = parameter.IndexOf(it->second);
+    if (index < 0) return std::nullopt;
+    genes[d] = index;
+  }
+  return genes;
+}
+
+Genes SpaceGrid::Decode(uint64_t index) const {
+  Genes genes(counts_.size(), 0);
+  for (size_t d = counts_.size(); d-- > 0;) {
+    const uint64_t n = static_cast<uint64_t>(counts_[d]);
+    genes[d] = static_cast<int>(index % n);
+    index /= n;
+  }
+  return genes;
+}
+
+uint64_t SpaceGrid::Encode(const Genes& genes) const {
+  uint64_t index = 0;
+  for (size_t d = 0; d < counts_.size(); ++d) {
+    index = index * static_cast<uint64_t>(counts_[d]) +
+            static_cast<uint64_t>(genes[d]);
+  }
+  return index;
+}
+
+Genes SpaceGrid::RandomGenes(Random& random) const {
+  Genes genes(counts_.size(), 0);
+  for (size_t d = 0; d < counts_.size(); ++d) {
+    genes[d] =
+        static_cast<int>(random.Below(static_cast<uint64_t>(counts_[d])));
+  }
+  return genes;
+}
+
+UnseenSampler::UnseenSampler(const SpaceGrid* grid, uint64_t seed)
+    : grid_(grid), random_(seed), remaining_(grid->size()) {}
+
+std::optional<Genes> UnseenSampler::Next(const std::set<Genes>& seen) {
+  if (grid_->saturated()) {
+    for (int attempt = 0; attempt < kSaturatedDrawAttempts; ++attempt) {
+      Genes genes = grid_->RandomGenes(random_);
+      if (!seen.count(genes)) return genes;
+    }
+    return std::nullopt;
+  }
+  // Each draw retires one index, so skipping seen points terminates.
+  while (remaining_ > 0) {
+    const uint64_t j = random_.Below(remaining_);
+    const uint64_t last = remaining_ - 1;
+    auto at = [this](uint64_t i) {
+      auto it = swapped_.find(i);
+      return it == swapped_.end() ? i : it->second;
+    };
+    const uint64_t drawn = at(j);
+    swapped_[j] = at(last);
+    swapped_.erase(last);
+    --remaining_;
+    Genes genes = grid_->Decode(drawn);
+    if (!seen.count(genes)) return genes;
+  }
+  return std::nullopt;
+}
+
+std::vector<double> MinimizationObjectives(const spec::Spec& spec,
+                                           const Observation& observation) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> values;
+  values.reserve(spec.objectives.size());
+  for (const spec::Objective& objective : spec.objectives) {
+    auto it = observation.metrics.find(objective.metric);
+    if (observation.failed || it == observation.metrics.end()) {
+      values.push_back(kNaN);
+    } else {
+      values.push_back(objective.minimize ? it->second : -it->second);
+    }
+  }
+  return values;
+}
+
+double ConstraintViolation(const spec::Spec& spec,
+                           const Observation& observation) {
+  if (observation.failed) return std::numeric_limits<double>::infinity();
+  if (observation.feasible) return 0.0;
+  int violated = 0;
+  for (const std::string& constraint : spec.constraints) {
+    Result<bool> holds = spec::EvaluateConstraint(
+        spec, constraint, observation.metrics, observation.point);
+    // A constraint that cannot be evaluated (missing metric) counts as
+    // violated: nothing shows it holds.
+    if (!holds.ok() || !*holds) ++violated;
+  }
+  return std::max(violated, 1);
+}
+
+const std::vector<std::string>& StrategyNames() {
+  static const std::vector<std::string> kNames = {"exhaustive", "random", "ga",
+                                                  "nsga2"};
+  return kNames;
+}
+
+Result<std::unique_ptr<Strategy>> CreateStrategy(
+    const std::string& name, const StrategyContext& context) {
+  const std::vector<std::string>& names = StrategyNames();
+  bool known = false;
+  for (const std::string& n : names) known = known || n == name;
+  if (!known) {
+    return Status::InvalidArgument(
+        fmt::format("unknown exploration strategy '{}'; valid: {}", name,
+                    fmt::join(names, ", ")));
+  }
+  if (context.spec == nullptr) {
+    return Status::InvalidArgument("exploration strategy needs a spec");
+  }
+  const spec::Spec& spec = *context.spec;
+  if (spec.design_space.parameters.empty()) {
+    return Status::InvalidArgument(
+        "exploration needs a design space with at least one parameter");
+  }
+  for (const spec::DesignParameter& parameter : spec.design_space.parameters) {
+    if (parameter.values.empty()) {
+      return Status::InvalidArgument(fmt::format(
+          "design parameter '{}' has no allowed values", parameter.name));
+    }
+  }
+  if (name == "exhaustive") return NewExhaustiveStrategy(spec);
+  if (name == "random") return NewRandomStrategy(spec);
+  if (name == "ga") return NewGeneticStrategy(spec);
+  return NewNsga2Strategy(spec);
+}
+
+}  // namespace adse::explore
