@@ -204,7 +204,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
       if (!report.ok()) {
         std::fprintf(stderr, "error: %s: %s\n", file.c_str(), report.status().message().c_str());
         fs::remove_all(version, ec);
-        return ExitCodeFor(report.status()) == 1 ? 1 : 2;
+        return ExitCodeFor(report.status());
       }
       const nlohmann::json doc = report::ToJson(*report);
       if (Status s = WriteJson(version + "/report.json", doc); !s.ok()) {

@@ -72,7 +72,7 @@ int RunSimulate(const SimulateArgs& args) {
   if (tty) std::fprintf(stderr, "\r%60s\r", "");
   if (!run.ok()) {
     ReportError(*spec, run.status());
-    return ExitCodeFor(run.status()) == 1 ? 1 : 2;
+    return ExitCodeFor(run.status());
   }
   const std::string out = args.out.empty()
                               ? spec->output + "/simulate/" + PointSlug(*point) + ".h5"
@@ -131,7 +131,7 @@ int RunCalibrate(const CalibrateArgs& args) {
     Result<runfile::RunData> run = sim::SimulatePoint(*spec, *point, options);
     if (!run.ok()) {
       ReportError(*spec, run.status());
-      return ExitCodeFor(run.status()) == 1 ? 1 : 2;
+      return ExitCodeFor(run.status());
     }
     runs.push_back(std::move(run).value());
   }
@@ -160,7 +160,7 @@ int RunSchemaCheck(const SchemaCheckArgs& args) {
       std::printf("%s: ok\n", file.c_str());
       continue;
     }
-    worst = std::max(worst, ExitCodeFor(status) == 1 ? 1 : 2);
+    worst = std::max(worst, ExitCodeFor(status));
     if (problems.empty()) {
       std::fprintf(stderr, "%s: %s\n", file.c_str(), status.message().c_str());
     }

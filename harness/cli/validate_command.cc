@@ -17,7 +17,7 @@ int RunValidate(const ValidateArgs& args) {
         world::World::Open(sim::WorldSetupFromSpec(*spec));
     if (!world.ok()) {
       ReportError(*spec, world.status());
-      return ExitCodeFor(world.status()) == 1 ? 1 : 2;
+      return ExitCodeFor(world.status());
     }
     const world::World& w = **world;
     std::fprintf(stderr,

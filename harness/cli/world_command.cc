@@ -46,7 +46,7 @@ int RunWorld(const WorldArgs& args) {
   Result<std::unique_ptr<world::World>> opened = world::World::Open(setup);
   if (!opened.ok()) {
     ReportError(*spec, opened.status());
-    return ExitCodeFor(opened.status()) == 1 ? 1 : 2;
+    return ExitCodeFor(opened.status());
   }
   world::World& w = **opened;
 

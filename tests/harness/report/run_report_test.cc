@@ -9,25 +9,16 @@
 
 #include "harness/sim/simulator.h"
 #include "harness/spec/spec_parser.h"
+#include "tests/harness/testing/small_scenario.h"
 
 namespace adse::report {
 namespace {
 
-spec::Spec SmallScenario() {
-  Result<spec::Spec> spec =
-      spec::LoadSpec(std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml");
-  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
-  // The counted cost model with the bundled calibration: the same answers
-  // on any machine and under any load, so thresholds cannot flake.
-  spec->platform.cost_model = spec::CostModel::kCounted;
-  spec->platform.calibration =
-      std::string(ADSE_SOURCE_DIR) + "/scenarios/calibration/reference.json";
-  return std::move(spec).value();
-}
+using adse::testing::SmallScenario;
 
 RunReport Analyse(double cores, double ghz, double hz) {
   Result<runfile::RunData> run =
-      sim::SimulatePoint(SmallScenario(), {{"cores", cores}, {"freq_ghz", ghz}, {"lidar_hz", hz}});
+      sim::SimulatePoint(SmallScenario(), adse::testing::SmallPoint(cores, ghz, hz));
   EXPECT_TRUE(run.ok()) << run.status().ToString();
   Result<RunReport> report = AnalyzeRun(*run, "memory", AnalyzeOptions{});
   EXPECT_TRUE(report.ok()) << report.status().ToString();

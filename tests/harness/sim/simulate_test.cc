@@ -10,29 +10,18 @@
 #include "analysis/runfile/run_file.h"
 #include "harness/sim/calibration.h"
 #include "harness/spec/spec_parser.h"
+#include "tests/harness/testing/small_scenario.h"
 #include "stack/base/hash.h"
 
 namespace adse::sim {
 namespace {
 
-spec::Spec SmallScenario() {
-  Result<spec::Spec> spec =
-      spec::LoadSpec(std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml");
-  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
-  // The counted cost model with the bundled calibration: the same answers
-  // on any machine and under any load, so thresholds cannot flake.
-  spec->platform.cost_model = spec::CostModel::kCounted;
-  spec->platform.calibration =
-      std::string(ADSE_SOURCE_DIR) + "/scenarios/calibration/reference.json";
-  return std::move(spec).value();
-}
+using adse::testing::SmallPoint;
+using adse::testing::SmallScenario;
 
-spec::DesignPoint Point(double cores, double freq_ghz, double lidar_hz) {
-  return {{"cores", cores}, {"freq_ghz", freq_ghz}, {"lidar_hz", lidar_hz}};
-}
 
 TEST(SimulateTest, GenerousComputerDrivesToTheGoalAtTheNominalControlRate) {
-  Result<runfile::RunData> run = SimulatePoint(SmallScenario(), Point(16, 2.1, 14));
+  Result<runfile::RunData> run = SimulatePoint(SmallScenario(), SmallPoint(16, 2.1, 14));
   ASSERT_TRUE(run.ok()) << run.status().ToString();
   const auto& m = run->metrics;
   EXPECT_EQ(run->termination_reason, "goal_reached");
@@ -50,8 +39,8 @@ TEST(SimulateTest, GenerousComputerDrivesToTheGoalAtTheNominalControlRate) {
 
 TEST(SimulateTest, StarvedComputerControlsLessOftenAndDropsLidarFrames) {
   const spec::Spec spec = SmallScenario();
-  Result<runfile::RunData> generous = SimulatePoint(spec, Point(16, 2.1, 14));
-  Result<runfile::RunData> starved = SimulatePoint(spec, Point(1, 1.0, 14));
+  Result<runfile::RunData> generous = SimulatePoint(spec, SmallPoint(16, 2.1, 14));
+  Result<runfile::RunData> starved = SimulatePoint(spec, SmallPoint(1, 1.0, 14));
   ASSERT_TRUE(generous.ok()) << generous.status().ToString();
   ASSERT_TRUE(starved.ok()) << starved.status().ToString();
   const auto& g = generous->metrics;
@@ -67,7 +56,7 @@ TEST(SimulateTest, CountedCostModelGivesIdenticalTraces) {
   spec::Spec spec = SmallScenario();
   // Calibrate from one measured run, then run the counted model twice.
   spec.platform.cost_model = spec::CostModel::kMeasured;
-  Result<runfile::RunData> measured = SimulatePoint(spec, Point(16, 2.1, 7));
+  Result<runfile::RunData> measured = SimulatePoint(spec, SmallPoint(16, 2.1, 7));
   ASSERT_TRUE(measured.ok()) << measured.status().ToString();
   const Calibration calibration = FitCalibration({&*measured});
   const std::string path =
@@ -86,8 +75,8 @@ TEST(SimulateTest, CountedCostModelGivesIdenticalTraces) {
     for (const auto& s : run.ego) h.Add(s.x_m).Add(s.y_m).Add(s.v_mps);
     return h.Hex();
   };
-  Result<runfile::RunData> a = SimulatePoint(spec, Point(4, 1.0, 7));
-  Result<runfile::RunData> b = SimulatePoint(spec, Point(4, 1.0, 7));
+  Result<runfile::RunData> a = SimulatePoint(spec, SmallPoint(4, 1.0, 7));
+  Result<runfile::RunData> b = SimulatePoint(spec, SmallPoint(4, 1.0, 7));
   ASSERT_TRUE(a.ok()) << a.status().ToString();
   ASSERT_TRUE(b.ok()) << b.status().ToString();
   EXPECT_GT(a->trace.callbacks.size(), 100u);
@@ -95,7 +84,7 @@ TEST(SimulateTest, CountedCostModelGivesIdenticalTraces) {
 }
 
 TEST(SimulateTest, RunFileIsWrittenAndPassesTheSchemaCheck) {
-  Result<runfile::RunData> run = SimulatePoint(SmallScenario(), Point(4, 2.1, 7));
+  Result<runfile::RunData> run = SimulatePoint(SmallScenario(), SmallPoint(4, 2.1, 7));
   ASSERT_TRUE(run.ok()) << run.status().ToString();
   const std::string path =
       (std::filesystem::temp_directory_path() / "adse_sim_test_run.h5").string();
@@ -110,7 +99,7 @@ TEST(SimulateTest, RunFileIsWrittenAndPassesTheSchemaCheck) {
 }
 
 TEST(SimulateTest, PointOutsideTheSpaceIsRejected) {
-  Result<runfile::RunData> run = SimulatePoint(SmallScenario(), Point(3, 2.1, 7));
+  Result<runfile::RunData> run = SimulatePoint(SmallScenario(), SmallPoint(3, 2.1, 7));
   ASSERT_FALSE(run.ok());
   EXPECT_EQ(run.status().code(), Status::Code::kInvalidArgument);
   EXPECT_NE(run.status().message().find("cores"), std::string::npos) << run.status().message();

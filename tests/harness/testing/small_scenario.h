@@ -1,0 +1,32 @@
+// The small robotaxi scenario as closed-loop tests use it.
+#ifndef ADSE_TESTS_HARNESS_TESTING_SMALL_SCENARIO_H_
+#define ADSE_TESTS_HARNESS_TESTING_SMALL_SCENARIO_H_
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "harness/spec/spec_parser.h"
+
+namespace adse::testing {
+
+// scenarios/robotaxi_small.yaml with the counted cost model and the bundled
+// calibration: the same answers on any machine and under any load, so
+// thresholds cannot flake.
+inline spec::Spec SmallScenario() {
+  Result<spec::Spec> spec =
+      spec::LoadSpec(std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml");
+  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
+  spec->platform.cost_model = spec::CostModel::kCounted;
+  spec->platform.calibration =
+      std::string(ADSE_SOURCE_DIR) + "/scenarios/calibration/reference.json";
+  return std::move(spec).value();
+}
+
+inline spec::DesignPoint SmallPoint(double cores, double freq_ghz, double lidar_hz) {
+  return {{"cores", cores}, {"freq_ghz", freq_ghz}, {"lidar_hz", lidar_hz}};
+}
+
+}  // namespace adse::testing
+
+#endif  // ADSE_TESTS_HARNESS_TESTING_SMALL_SCENARIO_H_
