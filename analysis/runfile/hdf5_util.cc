@@ -1,7 +1,14 @@
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
+#include <filesystem>
+#include <limits>
 
 #include "analysis/runfile/hdf5_util_impl.h"
+#include "stack/base/files.h"
 
 namespace adse::runfile::internal {
 namespace {
@@ -43,19 +50,203 @@ Status WriteHdf5Error(const std::string& object, const std::string& action) {
   return Status::IoError(object + ": " + action + ": " + TakeHdf5Error());
 }
 
-// A fixed-length UTF-8 string type just long enough for `value` (at least
-// one byte: HDF5 has no empty strings). Fixed rather than variable length:
+// A fixed-length, NUL-padded UTF-8 string type of `bytes` (at least one
+// byte: HDF5 has no empty strings). Fixed rather than variable length:
 // variable-length strings live in HDF5's global heap, which has no
 // checksums, and a damaged heap crashes libhdf5 on read.
-Handle MakeFixedStringType(const std::string& value) {
+Handle MakeFixedStringTypeOfSize(size_t bytes) {
   Handle type(H5Tcopy(H5T_C_S1));
   if (!type.valid() ||
-      H5Tset_size(type.get(), std::max<size_t>(1, value.size())) < 0 ||
+      H5Tset_size(type.get(), std::max<size_t>(1, bytes)) < 0 ||
       H5Tset_strpad(type.get(), H5T_STR_NULLPAD) < 0 ||
       H5Tset_cset(type.get(), H5T_CSET_UTF8) < 0) {
     return Handle();
   }
   return type;
+}
+
+// A fixed-length string type just long enough for `value`.
+Handle MakeFixedStringType(const std::string& value) {
+  return MakeFixedStringTypeOfSize(value.size());
+}
+
+// Strings packed into one buffer of fixed-width, NUL-padded cells as wide as
+// the longest value (at least 1 byte). A NUL inside a value would end it
+// early on reading, so it is refused.
+struct PackedStrings {
+  size_t width = 1;
+  std::vector<char> bytes;  // values.size() * width
+};
+Result<PackedStrings> PackStrings(const std::vector<std::string>& values,
+                                  const std::string& what) {
+  PackedStrings packed;
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (values[i].find('\0') != std::string::npos) {
+      return Status::InvalidArgument(what + ": value " + std::to_string(i) +
+                                     " contains a NUL byte");
+    }
+    packed.width = std::max(packed.width, values[i].size());
+  }
+  packed.bytes.assign(values.size() * packed.width, '\0');
+  for (size_t i = 0; i < values.size(); ++i) {
+    std::copy(
+        values[i].begin(), values[i].end(),
+        packed.bytes.begin() + static_cast<std::ptrdiff_t>(i * packed.width));
+  }
+  return packed;
+}
+
+// Creation properties of a 1-D row or column dataset of `rows` elements of
+// `row_size` bytes: chunked, shuffled, deflated, Fletcher-32, no timestamps.
+Handle MakeRowsCreateProps(size_t rows, size_t row_size) {
+  row_size = std::max<size_t>(1, row_size);
+  size_t chunk_rows =
+      std::clamp<size_t>(kMaxChunkBytes / row_size, 1, kMaxChunkRows);
+  if (rows > 0) chunk_rows = std::min(chunk_rows, rows);
+  const hsize_t chunk[1] = {static_cast<hsize_t>(chunk_rows)};
+  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE));
+  if (!dcpl.valid() || H5Pset_chunk(dcpl.get(), 1, chunk) < 0 ||
+      H5Pset_shuffle(dcpl.get()) < 0 ||
+      H5Pset_deflate(dcpl.get(), kDeflateLevel) < 0 ||
+      H5Pset_fletcher32(dcpl.get()) < 0 ||
+      H5Pset_obj_track_times(dcpl.get(), false) < 0) {
+    return Handle();
+  }
+  return dcpl;
+}
+
+// Creates the 1-D dataset `name` of `rows` elements (unlimited maximum) and
+// writes `data` (which may be null when rows == 0) in one H5Dwrite.
+Status WriteOneDimensional(hid_t parent, const std::string& name,
+                           hid_t file_type, hid_t mem_type, size_t rows,
+                           const void* data) {
+  const std::string what = PathOf(parent, name);
+  const hsize_t dims[1] = {static_cast<hsize_t>(rows)};
+  const hsize_t max_dims[1] = {H5S_UNLIMITED};
+  Handle space(H5Screate_simple(1, dims, max_dims));
+  Handle dcpl = MakeRowsCreateProps(rows, H5Tget_size(file_type));
+  if (!space.valid() || !dcpl.valid()) {
+    return WriteHdf5Error(what, "preparing");
+  }
+  Handle dataset(H5Dcreate2(parent, name.c_str(), file_type, space.get(),
+                            H5P_DEFAULT, dcpl.get(), H5P_DEFAULT));
+  if (!dataset.valid()) return WriteHdf5Error(what, "creating");
+  if (rows > 0 && H5Dwrite(dataset.get(), mem_type, H5S_ALL, H5S_ALL,
+                           H5P_DEFAULT, data) < 0) {
+    return WriteHdf5Error(what, "writing " + std::to_string(rows) + " rows");
+  }
+  if (!dataset.Close()) return WriteHdf5Error(what, "closing");
+  return Status::Ok();
+}
+
+// A 1-D dataset opened for reading, its class checked.
+struct OpenColumn {
+  std::string what;
+  Handle dataset;
+  Handle type;
+  Handle space;
+  size_t rows = 0;
+};
+Result<OpenColumn> OpenColumnDataset(hid_t parent, const std::string& name,
+                                     H5T_class_t wanted) {
+  OpenColumn column;
+  column.what = PathOf(parent, name);
+  const std::string& what = column.what;
+  if (GetObjectKind(parent, what) != ObjectKind::kDataset) {
+    return ReadError(what + ": missing dataset");
+  }
+  column.dataset = Handle(H5Dopen2(parent, name.c_str(), H5P_DEFAULT));
+  if (!column.dataset.valid()) return ReadHdf5Error(what, "opening");
+  column.type = Handle(H5Dget_type(column.dataset.get()));
+  column.space = Handle(H5Dget_space(column.dataset.get()));
+  if (!column.type.valid() || !column.space.valid()) {
+    return ReadHdf5Error(what, "type");
+  }
+  const H5T_class_t type_class = H5Tget_class(column.type.get());
+  if (type_class != wanted) {
+    return ReadError(what + ": is " + TypeClassName(type_class) +
+                     ", expected " + TypeClassName(wanted));
+  }
+  if (H5Sget_simple_extent_ndims(column.space.get()) != 1) {
+    return ReadError(what + ": expected a 1-D dataset (one value per row)");
+  }
+  hsize_t dims[1] = {0};
+  if (H5Sget_simple_extent_dims(column.space.get(), dims, nullptr) < 0) {
+    return ReadHdf5Error(what, "shape");
+  }
+  column.rows = static_cast<size_t>(dims[0]);
+  return column;
+}
+
+template <typename T>
+Status ReadNumericColumn(hid_t parent, const std::string& name,
+                         H5T_class_t wanted, hid_t mem_type,
+                         std::vector<T>* out) {
+  Result<OpenColumn> column = OpenColumnDataset(parent, name, wanted);
+  if (!column.ok()) return column.status();
+  out->assign(column->rows, T{});
+  if (column->rows > 0 && H5Dread(column->dataset.get(), mem_type, H5S_ALL,
+                                  H5S_ALL, H5P_DEFAULT, out->data()) < 0) {
+    return ReadHdf5Error(column->what,
+                         "reading " + std::to_string(column->rows) + " rows");
+  }
+  return Status::Ok();
+}
+
+// Reads a 1-D array of strings (variable or fixed length) from an attribute
+// or dataset: `is_attr` picks H5Aread/H5Dread.
+Result<std::vector<std::string>> ReadStringArray(hid_t obj, bool is_attr,
+                                                 const std::string& what) {
+  Handle type(is_attr ? H5Aget_type(obj) : H5Dget_type(obj));
+  Handle space(is_attr ? H5Aget_space(obj) : H5Dget_space(obj));
+  if (!type.valid() || !space.valid()) return ReadHdf5Error(what, "type");
+  const H5T_class_t type_class = H5Tget_class(type.get());
+  if (type_class != H5T_STRING) {
+    return ReadError(what + " is " + TypeClassName(type_class) +
+                     ", expected strings");
+  }
+  if (H5Sget_simple_extent_ndims(space.get()) != 1) {
+    return ReadError(what + ": expected a 1-D array of strings");
+  }
+  const hssize_t points = H5Sget_simple_extent_npoints(space.get());
+  if (points < 0) return ReadHdf5Error(what, "shape");
+  const size_t n = static_cast<size_t>(points);
+  std::vector<std::string> values(n);
+  if (n == 0) return values;
+  const htri_t variable = H5Tis_variable_str(type.get());
+  if (variable < 0) return ReadHdf5Error(what, "type");
+  if (variable > 0) {
+    Handle mem_type(H5Tcopy(type.get()));  // keeps the file's charset
+    std::vector<char*> texts(n, nullptr);
+    const herr_t rc = is_attr ? H5Aread(obj, mem_type.get(), texts.data())
+                              : H5Dread(obj, mem_type.get(), H5S_ALL, H5S_ALL,
+                                        H5P_DEFAULT, texts.data());
+    if (rc < 0) return ReadHdf5Error(what, "reading");
+    for (size_t i = 0; i < n; ++i) {
+      if (texts[i] != nullptr) values[i] = texts[i];
+    }
+#if H5_VERSION_GE(1, 12, 0)
+    H5Treclaim(mem_type.get(), space.get(), H5P_DEFAULT, texts.data());
+#else
+    H5Dvlen_reclaim(mem_type.get(), space.get(), H5P_DEFAULT, texts.data());
+#endif
+    return values;
+  }
+  const size_t width = H5Tget_size(type.get());
+  if (width == 0) return ReadHdf5Error(what, "type size");
+  if (n > std::numeric_limits<size_t>::max() / width) {
+    return ReadError(what + ": implausible size");
+  }
+  std::vector<char> buffer(n * width, '\0');
+  const herr_t rc = is_attr ? H5Aread(obj, type.get(), buffer.data())
+                            : H5Dread(obj, type.get(), H5S_ALL, H5S_ALL,
+                                      H5P_DEFAULT, buffer.data());
+  if (rc < 0) return ReadHdf5Error(what, "reading");
+  for (size_t i = 0; i < n; ++i) {
+    const char* cell = buffer.data() + i * width;
+    values[i].assign(cell, ::strnlen(cell, width));
+  }
+  return values;
 }
 
 // `value` padded to the type's size (the empty string becomes one NUL).
@@ -193,21 +384,26 @@ Result<std::string> ReadScalarString(hid_t obj, bool is_attr,
   return std::string(buffer.data(), ::strnlen(buffer.data(), size));
 }
 
-// Creates (replacing) a scalar attribute and writes one value.
+// Creates (replacing) an attribute and writes its value(s): a scalar when
+// `count` is null, else a 1-D array of *count elements.
 Status WriteAttr(hid_t loc, const std::string& name, hid_t file_type,
-                 hid_t mem_type, const void* value) {
+                 hid_t mem_type, const void* value,
+                 const size_t* count = nullptr) {
   const std::string what = PathOf(loc, "") + ": attribute '" + name + "'";
   const htri_t exists = H5Aexists(loc, name.c_str());
   if (exists < 0) return WriteHdf5Error(what, "checking");
   if (exists > 0 && H5Adelete(loc, name.c_str()) < 0) {
     return WriteHdf5Error(what, "replacing");
   }
-  Handle space(H5Screate(H5S_SCALAR));
+  const hsize_t dims[1] = {count != nullptr ? static_cast<hsize_t>(*count) : 0};
+  Handle space(count != nullptr ? H5Screate_simple(1, dims, nullptr)
+                                : H5Screate(H5S_SCALAR));
   if (!space.valid()) return WriteHdf5Error(what, "dataspace");
   Handle attr(H5Acreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT,
                          H5P_DEFAULT));
   if (!attr.valid()) return WriteHdf5Error(what, "creating");
-  if (H5Awrite(attr.get(), mem_type, value) < 0) {
+  if ((count == nullptr || *count > 0) &&
+      H5Awrite(attr.get(), mem_type, value) < 0) {
     return WriteHdf5Error(what, "writing");
   }
   if (!attr.Close()) return WriteHdf5Error(what, "closing");
@@ -278,6 +474,90 @@ std::string TakeHdf5Error() {
   return descriptions.front() + " (" + descriptions.back() + ")";
 }
 
+Status SyncPath(const std::string& path, bool directory) {
+  const int fd = ::open(path.c_str(), O_RDONLY | (directory ? O_DIRECTORY : 0));
+  if (fd < 0) return Status::IoError(path + ": " + std::strerror(errno));
+  const int rc = ::fsync(fd);
+  const int err = errno;
+  ::close(fd);
+  // Some filesystems refuse fsync on a directory; the rename still holds.
+  if (rc != 0 && !(directory && (err == EINVAL || err == EBADF))) {
+    return Status::IoError(path + ": fsync: " + std::strerror(err));
+  }
+  return Status::Ok();
+}
+
+Status WriteFileAtomically(
+    const std::string& path,
+    const std::function<Status(hid_t file)>& write_contents) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  if (target.has_parent_path()) {
+    ADSE_RETURN_IF_ERROR(MakeDirs(target.parent_path().string()));
+  }
+  const std::string tmp =
+      path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
+  Status status;
+  {
+    Hdf5Session session;
+    Handle fapl = MakeFileAccessProps();
+    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()));
+    if (!file.valid()) {
+      status = Status::IoError(tmp +
+                               ": cannot create HDF5 file: " + TakeHdf5Error());
+    } else {
+      status = write_contents(file.get()).WithContext(tmp);
+      // Closing flushes metadata; a failure here means the file is bad.
+      if (!file.Close() && status.ok()) {
+        status = Status::IoError(tmp + ": closing: " + TakeHdf5Error());
+      }
+    }
+  }
+  if (status.ok()) status = SyncPath(tmp, /*directory=*/false);
+  if (status.ok() && ::rename(tmp.c_str(), path.c_str()) != 0) {
+    status = Status::IoError(path + ": rename from " + tmp +
+                             " failed: " + std::strerror(errno));
+  }
+  if (!status.ok()) {
+    ::unlink(tmp.c_str());
+    return status;
+  }
+  const std::string folder =
+      target.has_parent_path() ? target.parent_path().string() : ".";
+  return SyncPath(folder, /*directory=*/true);
+}
+
+Status ReadFileContents(
+    const std::string& path, const std::string& expected,
+    const std::function<Status(hid_t file)>& read_contents) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return Status::NotFound(path + ": no such file");
+  if (fs::is_directory(path, ec)) {
+    return Status::InvalidArgument(path + ": is a directory, expected " +
+                                   expected);
+  }
+  Hdf5Session session;
+  const htri_t is_hdf5 = IsHdf5File(path);
+  if (is_hdf5 < 0) {
+    return Status::IoError(path + ": cannot read: " + TakeHdf5Error());
+  }
+  if (is_hdf5 == 0) {
+    return Status::Corruption(path + ": not an HDF5 file (no HDF5 signature)");
+  }
+  Handle fapl = MakeFileAccessProps();
+  Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get()));
+  if (!file.valid()) {
+    return Status::Corruption(path +
+                              ": cannot open as HDF5 (truncated or "
+                              "damaged?): " +
+                              TakeHdf5Error());
+  }
+  Status status = read_contents(file.get());
+  if (!status.ok()) return Status::Corruption(path + ": " + status.message());
+  return Status::Ok();
+}
+
 Handle MakeFileAccessProps() {
   Handle fapl(H5Pcreate(H5P_FILE_ACCESS));
   if (!fapl.valid()) return fapl;
@@ -309,6 +589,28 @@ Handle MakeGroupCreateProps() {
   Handle gcpl(H5Pcreate(H5P_GROUP_CREATE));
   if (gcpl.valid()) H5Pset_obj_track_times(gcpl.get(), false);
   return gcpl;
+}
+
+Result<Handle> CreateGroup(hid_t parent, const std::string& name) {
+  Handle gcpl = MakeGroupCreateProps();
+  Handle group(
+      H5Gcreate2(parent, name.c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT));
+  if (!group.valid()) {
+    return Status::IoError("creating group " + PathOf(parent, name) + ": " +
+                           TakeHdf5Error());
+  }
+  return group;
+}
+
+Result<Handle> OpenGroup(hid_t file, const std::string& path) {
+  if (GetObjectKind(file, path) != ObjectKind::kGroup) {
+    return Status::Corruption(path + ": missing group");
+  }
+  Handle group(H5Gopen2(file, path.c_str(), H5P_DEFAULT));
+  if (!group.valid()) {
+    return Status::Corruption(path + ": opening: " + TakeHdf5Error());
+  }
+  return group;
 }
 
 ObjectKind GetObjectKind(hid_t file, const std::string& path) {
@@ -384,8 +686,32 @@ Status WriteI32Attr(hid_t loc, const std::string& name, int32_t value) {
   return WriteAttr(loc, name, H5T_STD_I32LE, H5T_NATIVE_INT32, &value);
 }
 
+Status WriteI64Attr(hid_t loc, const std::string& name, int64_t value) {
+  return WriteAttr(loc, name, H5T_STD_I64LE, H5T_NATIVE_INT64, &value);
+}
+
 Status WriteU64Attr(hid_t loc, const std::string& name, uint64_t value) {
   return WriteAttr(loc, name, H5T_STD_U64LE, H5T_NATIVE_UINT64, &value);
+}
+
+Status WriteStringListAttr(hid_t loc, const std::string& name,
+                           const std::vector<std::string>& values) {
+  const std::string what = PathOf(loc, "") + ": attribute '" + name + "'";
+  Result<PackedStrings> packed = PackStrings(values, what);
+  if (!packed.ok()) return packed.status();
+  Handle type = MakeFixedStringTypeOfSize(packed->width);
+  if (!type.valid()) return WriteHdf5Error(what, "string type");
+  const size_t count = values.size();
+  return WriteAttr(loc, name, type.get(), type.get(), packed->bytes.data(),
+                   &count);
+}
+
+Result<std::vector<std::string>> ReadStringListAttr(hid_t loc,
+                                                    const std::string& name) {
+  Result<Handle> attr = OpenAttr(loc, name);
+  if (!attr.ok()) return attr.status();
+  return ReadStringArray(attr->get(), /*is_attr=*/true,
+                         PathOf(loc, "") + ": attribute '" + name + "'");
 }
 
 Result<std::string> ReadStringAttr(hid_t loc, const std::string& name) {
@@ -450,6 +776,70 @@ Result<std::string> ReadStringDataset(hid_t parent, const std::string& name) {
   return ReadScalarString(dataset.get(), /*is_attr=*/false, what);
 }
 
+Status WriteColumn(hid_t parent, const std::string& name,
+                   const std::vector<double>& values) {
+  return WriteOneDimensional(parent, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                             values.size(), values.data());
+}
+
+Status WriteColumn(hid_t parent, const std::string& name,
+                   const std::vector<int64_t>& values) {
+  return WriteOneDimensional(parent, name, H5T_STD_I64LE, H5T_NATIVE_INT64,
+                             values.size(), values.data());
+}
+
+Status WriteColumn(hid_t parent, const std::string& name,
+                   const std::vector<uint64_t>& values) {
+  return WriteOneDimensional(parent, name, H5T_STD_U64LE, H5T_NATIVE_UINT64,
+                             values.size(), values.data());
+}
+
+Status WriteColumn(hid_t parent, const std::string& name,
+                   const std::vector<uint8_t>& values) {
+  return WriteOneDimensional(parent, name, H5T_STD_U8LE, H5T_NATIVE_UINT8,
+                             values.size(), values.data());
+}
+
+Status WriteColumn(hid_t parent, const std::string& name,
+                   const std::vector<std::string>& values) {
+  const std::string what = PathOf(parent, name);
+  Result<PackedStrings> packed = PackStrings(values, what);
+  if (!packed.ok()) return packed.status();
+  Handle type = MakeFixedStringTypeOfSize(packed->width);
+  if (!type.valid()) return WriteHdf5Error(what, "string type");
+  return WriteOneDimensional(parent, name, type.get(), type.get(),
+                             values.size(), packed->bytes.data());
+}
+
+Status ReadColumn(hid_t parent, const std::string& name,
+                  std::vector<double>* out) {
+  return ReadNumericColumn(parent, name, H5T_FLOAT, H5T_NATIVE_DOUBLE, out);
+}
+
+Status ReadColumn(hid_t parent, const std::string& name,
+                  std::vector<int64_t>* out) {
+  return ReadNumericColumn(parent, name, H5T_INTEGER, H5T_NATIVE_INT64, out);
+}
+
+Status ReadColumn(hid_t parent, const std::string& name,
+                  std::vector<uint64_t>* out) {
+  return ReadNumericColumn(parent, name, H5T_INTEGER, H5T_NATIVE_UINT64, out);
+}
+
+Status ReadColumn(hid_t parent, const std::string& name,
+                  std::vector<uint8_t>* out) {
+  return ReadNumericColumn(parent, name, H5T_INTEGER, H5T_NATIVE_UINT8, out);
+}
+
+Status ReadColumn(hid_t parent, const std::string& name,
+                  std::vector<std::string>* out) {
+  Result<OpenColumn> column = OpenColumnDataset(parent, name, H5T_STRING);
+  if (!column.ok()) return column.status();
+  return Assign(
+      ReadStringArray(column->dataset.get(), /*is_attr=*/false, column->what),
+      out);
+}
+
 size_t FieldSize(const FieldDesc& field) {
   switch (field.type) {
     case FieldType::kFloat64:
@@ -497,32 +887,8 @@ Status WriteRows(hid_t parent, const std::string& name,
   if (!file_type.valid() || !mem_type.valid()) {
     return WriteHdf5Error(what, "building the row type");
   }
-  const hsize_t dims[1] = {static_cast<hsize_t>(rows)};
-  const hsize_t max_dims[1] = {H5S_UNLIMITED};
-  Handle space(H5Screate_simple(1, dims, max_dims));
-  const size_t row_size = std::max<size_t>(1, RowSize(fields));
-  size_t chunk_rows =
-      std::clamp<size_t>(kMaxChunkBytes / row_size, 1, kMaxChunkRows);
-  if (rows > 0) chunk_rows = std::min(chunk_rows, rows);
-  const hsize_t chunk[1] = {static_cast<hsize_t>(chunk_rows)};
-  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE));
-  if (!space.valid() || !dcpl.valid() ||
-      H5Pset_chunk(dcpl.get(), 1, chunk) < 0 ||
-      H5Pset_shuffle(dcpl.get()) < 0 ||
-      H5Pset_deflate(dcpl.get(), kDeflateLevel) < 0 ||
-      H5Pset_fletcher32(dcpl.get()) < 0 ||
-      H5Pset_obj_track_times(dcpl.get(), false) < 0) {
-    return WriteHdf5Error(what, "preparing");
-  }
-  Handle dataset(H5Dcreate2(parent, name.c_str(), file_type.get(), space.get(),
-                            H5P_DEFAULT, dcpl.get(), H5P_DEFAULT));
-  if (!dataset.valid()) return WriteHdf5Error(what, "creating");
-  if (rows > 0 && H5Dwrite(dataset.get(), mem_type.get(), H5S_ALL, H5S_ALL,
-                           H5P_DEFAULT, data) < 0) {
-    return WriteHdf5Error(what, "writing " + std::to_string(rows) + " rows");
-  }
-  if (!dataset.Close()) return WriteHdf5Error(what, "closing");
-  return Status::Ok();
+  return WriteOneDimensional(parent, name, file_type.get(), mem_type.get(),
+                             rows, data);
 }
 
 Result<PackedRows> ReadRows(hid_t parent, const std::string& name,

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <utility>
@@ -64,6 +65,33 @@ class Handle {
 // specific one, e.g. "truncated file: eof = ..."), then clears the stack.
 std::string TakeHdf5Error();
 
+// ---------------------------------------------------------------------------
+// Whole files (used by run files and the campaign index alike).
+
+// Makes `path`'s bytes durable (fsync). For a folder, filesystems that refuse
+// fsync on directories are tolerated.
+Status SyncPath(const std::string& path, bool directory);
+
+// Writes a new HDF5 file at `path` atomically: creates the parent folders,
+// creates `<path>.tmp.<pid>` (MakeFileAccessProps), calls `write_contents`
+// on it inside an Hdf5Session, closes (flushes) and fsyncs it, renames it
+// over `path` and fsyncs the folder. So readers see the old file or the
+// whole new one. Errors of `write_contents` get the temporary's name as
+// context; file system failures are IoError. No temporary is left behind on
+// failure.
+Status WriteFileAtomically(
+    const std::string& path,
+    const std::function<Status(hid_t file)>& write_contents);
+
+// Opens the HDF5 file `path` read-only and calls `read_contents` inside an
+// Hdf5Session. NotFound if `path` does not exist; InvalidArgument if it is a
+// folder (`expected` names what should be there, e.g. "a run file"); IoError
+// if it cannot be read at all; Corruption "<path>: ..." if it is not HDF5,
+// cannot be opened (truncated, damaged) or `read_contents` fails (whose
+// message, naming the HDF5 object, then follows the path).
+Status ReadFileContents(const std::string& path, const std::string& expected,
+                        const std::function<Status(hid_t file)>& read_contents);
+
 // File access properties: the HDF5 1.10 file format (checksummed metadata)
 // and no file locking (useless for write-once files and unsupported on some
 // NFS/Lustre mounts, where it makes opens fail).
@@ -73,6 +101,20 @@ htri_t IsHdf5File(const std::string& path);
 // Creation properties that leave out object timestamps, so the same run
 // gives the same bytes.
 Handle MakeGroupCreateProps();
+
+// Creates group `name` below `parent` (no timestamps); IoError naming it.
+Result<Handle> CreateGroup(hid_t parent, const std::string& name);
+// Opens the group at absolute `path`; Corruption "<path>: missing group" if
+// there is none.
+Result<Handle> OpenGroup(hid_t file, const std::string& path);
+
+// Moves a result's value into `*out`, or returns its error.
+template <typename T>
+Status Assign(Result<T> result, T* out) {
+  if (!result.ok()) return result.status();
+  *out = std::move(result).value();
+  return Status::Ok();
+}
 
 enum class ObjectKind { kMissing, kGroup, kDataset, kOther };
 // What `path` (absolute, '/'-separated) names below `file`; checks each
@@ -89,11 +131,19 @@ Status WriteStringAttr(hid_t loc, const std::string& name,
                        const std::string& value);
 Status WriteF64Attr(hid_t loc, const std::string& name, double value);
 Status WriteI32Attr(hid_t loc, const std::string& name, int32_t value);
+Status WriteI64Attr(hid_t loc, const std::string& name, int64_t value);
 Status WriteU64Attr(hid_t loc, const std::string& name, uint64_t value);
 Result<std::string> ReadStringAttr(hid_t loc, const std::string& name);
 Result<double> ReadF64Attr(hid_t loc, const std::string& name);
 Result<int64_t> ReadI64Attr(hid_t loc, const std::string& name);
 Result<uint64_t> ReadU64Attr(hid_t loc, const std::string& name);
+// 1-D string array attribute, fixed-length UTF-8 as wide as the longest
+// value (at least 1 byte); may have no elements. InvalidArgument if a value
+// holds a NUL byte. Reads also accept variable-length strings.
+Status WriteStringListAttr(hid_t loc, const std::string& name,
+                           const std::vector<std::string>& values);
+Result<std::vector<std::string>> ReadStringListAttr(hid_t loc,
+                                                    const std::string& name);
 // Names of all attributes of `loc`, in name order.
 Result<std::vector<std::string>> ListAttributes(hid_t loc);
 
@@ -101,6 +151,37 @@ Result<std::vector<std::string>> ListAttributes(hid_t loc);
 Status WriteStringDataset(hid_t parent, const std::string& name,
                           const std::string& value);
 Result<std::string> ReadStringDataset(hid_t parent, const std::string& name);
+
+// Columns: 1-D datasets of one plain type, one element per row, stored like
+// row datasets (chunked, shuffled, deflated, Fletcher-32 checksummed; 0 rows
+// allowed), so h5py gives each as a numpy array and pandas as a Series.
+// Numbers are little-endian float64/int64/uint64/uint8. Strings are
+// fixed-length, NUL-padded UTF-8 as wide as the longest value (at least 1
+// byte); InvalidArgument if a value holds a NUL byte.
+Status WriteColumn(hid_t parent, const std::string& name,
+                   const std::vector<double>& values);
+Status WriteColumn(hid_t parent, const std::string& name,
+                   const std::vector<int64_t>& values);
+Status WriteColumn(hid_t parent, const std::string& name,
+                   const std::vector<uint64_t>& values);
+Status WriteColumn(hid_t parent, const std::string& name,
+                   const std::vector<uint8_t>& values);
+Status WriteColumn(hid_t parent, const std::string& name,
+                   const std::vector<std::string>& values);
+// Reads a column, converting to the C++ type. The file's type class must be
+// float (double) or int (integer types); strings may be fixed or variable
+// length. Corruption naming the dataset if it is missing, not 1-D, of
+// another class or unreadable.
+Status ReadColumn(hid_t parent, const std::string& name,
+                  std::vector<double>* out);
+Status ReadColumn(hid_t parent, const std::string& name,
+                  std::vector<int64_t>* out);
+Status ReadColumn(hid_t parent, const std::string& name,
+                  std::vector<uint64_t>* out);
+Status ReadColumn(hid_t parent, const std::string& name,
+                  std::vector<uint8_t>* out);
+Status ReadColumn(hid_t parent, const std::string& name,
+                  std::vector<std::string>* out);
 
 // One field of a compound row dataset. Rows are packed (no padding) in the
 // order of the fields, in the file and in memory alike.

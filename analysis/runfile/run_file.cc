@@ -1,26 +1,22 @@
 #include "analysis/runfile/run_file.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cstring>
 #include <exception>
-#include <filesystem>
 #include <functional>
 #include <new>
 
 #include "analysis/runfile/hdf5_util_impl.h"
-#include "stack/base/files.h"
 #include "stack/base/hash.h"
 
 namespace adse::runfile {
 namespace {
 
-namespace fs = std::filesystem;
+using internal::Assign;
+using internal::CreateGroup;
 using internal::FieldDesc;
 using internal::FieldType;
 using internal::Handle;
+using internal::OpenGroup;
 
 // ---------------------------------------------------------------------------
 // Row layouts. Each table is a list of columns that know how to pack a field
@@ -282,16 +278,6 @@ Result<std::vector<Row>> ReadTable(hid_t parent, const std::string& name,
 // ---------------------------------------------------------------------------
 // Writing.
 
-Result<Handle> CreateGroup(hid_t parent, const char* name) {
-  Handle gcpl = internal::MakeGroupCreateProps();
-  Handle group(H5Gcreate2(parent, name, H5P_DEFAULT, gcpl.get(), H5P_DEFAULT));
-  if (!group.valid()) {
-    return Status::IoError(std::string("creating group /") + name + ": " +
-                           internal::TakeHdf5Error());
-  }
-  return group;
-}
-
 Status WriteContents(hid_t file, const RunData& run) {
   using internal::WriteF64Attr;
   using internal::WriteStringAttr;
@@ -428,80 +414,15 @@ Status Validate(const RunData& run) {
   return Status::Ok();
 }
 
-// Makes `path`'s bytes durable before it is renamed into place.
-Status SyncPath(const std::string& path, bool directory) {
-  const int fd = ::open(path.c_str(), O_RDONLY | (directory ? O_DIRECTORY : 0));
-  if (fd < 0) return Status::IoError(path + ": " + std::strerror(errno));
-  const int rc = ::fsync(fd);
-  const int err = errno;
-  ::close(fd);
-  // Some filesystems refuse fsync on a directory; the rename still holds.
-  if (rc != 0 && !(directory && (err == EINVAL || err == EBADF))) {
-    return Status::IoError(path + ": fsync: " + std::strerror(err));
-  }
-  return Status::Ok();
-}
-
 Status WriteRunFileImpl(const std::string& path, const RunData& run) {
   ADSE_RETURN_IF_ERROR(Validate(run));
-  const fs::path target(path);
-  if (target.has_parent_path()) {
-    ADSE_RETURN_IF_ERROR(MakeDirs(target.parent_path().string()));
-  }
-  const std::string tmp =
-      path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
-  Status status;
-  {
-    internal::Hdf5Session session;
-    Handle fapl = internal::MakeFileAccessProps();
-    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()));
-    if (!file.valid()) {
-      status = Status::IoError(
-          tmp + ": cannot create HDF5 file: " + internal::TakeHdf5Error());
-    } else {
-      status = WriteContents(file.get(), run).WithContext(tmp);
-      // Closing flushes metadata; a failure here means the file is bad.
-      if (!file.Close() && status.ok()) {
-        status =
-            Status::IoError(tmp + ": closing: " + internal::TakeHdf5Error());
-      }
-    }
-  }
-  if (status.ok()) status = SyncPath(tmp, /*directory=*/false);
-  if (status.ok() && ::rename(tmp.c_str(), path.c_str()) != 0) {
-    status = Status::IoError(path + ": rename from " + tmp +
-                             " failed: " + std::strerror(errno));
-  }
-  if (!status.ok()) {
-    ::unlink(tmp.c_str());
-    return status;
-  }
-  const std::string folder =
-      target.has_parent_path() ? target.parent_path().string() : ".";
-  return SyncPath(folder, /*directory=*/true);
+  return internal::WriteFileAtomically(
+      path, [&run](hid_t file) { return WriteContents(file, run); });
 }
 
 // ---------------------------------------------------------------------------
 // Reading. Every failure is a Corruption whose message names the HDF5 object;
 // the caller prefixes the file name.
-
-template <typename T>
-Status Assign(Result<T> result, T* out) {
-  if (!result.ok()) return result.status();
-  *out = std::move(result).value();
-  return Status::Ok();
-}
-
-Result<Handle> OpenGroup(hid_t file, const std::string& path) {
-  if (internal::GetObjectKind(file, path) != internal::ObjectKind::kGroup) {
-    return Status::Corruption(path + ": missing group");
-  }
-  Handle group(H5Gopen2(file, path.c_str(), H5P_DEFAULT));
-  if (!group.valid()) {
-    return Status::Corruption(path + ": opening: " + internal::TakeHdf5Error());
-  }
-  return group;
-}
 
 // Places index-table rows by their index, which must cover 0..n-1 once.
 Status ByIndex(const std::string& what, std::vector<IndexedName> rows,
@@ -677,34 +598,10 @@ Status ReadContents(hid_t file, RunData* run) {
 }
 
 Result<RunData> ReadRunFileImpl(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return Status::NotFound(path + ": no such file");
-  if (fs::is_directory(path, ec)) {
-    return Status::InvalidArgument(path +
-                                   ": is a directory, expected a run file");
-  }
-  internal::Hdf5Session session;
-  const htri_t is_hdf5 = internal::IsHdf5File(path);
-  if (is_hdf5 < 0) {
-    return Status::IoError(path +
-                           ": cannot read: " + internal::TakeHdf5Error());
-  }
-  if (is_hdf5 == 0) {
-    return Status::Corruption(path + ": not an HDF5 file (no HDF5 signature)");
-  }
-  Handle fapl = internal::MakeFileAccessProps();
-  Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get()));
-  if (!file.valid()) {
-    return Status::Corruption(path +
-                              ": cannot open as HDF5 (truncated or "
-                              "damaged?): " +
-                              internal::TakeHdf5Error());
-  }
   RunData run;
-  Status status = ReadContents(file.get(), &run);
-  if (!status.ok()) {
-    return Status::Corruption(path + ": " + status.message());
-  }
+  ADSE_RETURN_IF_ERROR(internal::ReadFileContents(
+      path, "a run file",
+      [&run](hid_t file) { return ReadContents(file, &run); }));
   return run;
 }
 

@@ -114,20 +114,81 @@ class Checker {
       Problem(path, "is not a group");
       return;
     }
+    if (!spec.contains("attribute_class") && !spec.contains("attributes") &&
+        !spec.contains("column_class")) {
+      return;
+    }
+    Handle group(H5Gopen2(file_, path.c_str(), H5P_DEFAULT));
+    if (!group.valid()) {
+      Problem(path, "opening: " + internal::TakeHdf5Error());
+      return;
+    }
+    // Named attributes of the group, each of its class.
+    for (const json& attr : spec.value("attributes", json::array())) {
+      OpenAttr(group.get(), path, attr.at("name").get<std::string>(),
+               attr.at("class").get<std::string>());
+    }
+    if (spec.contains("column_class")) {
+      CheckColumns(group, path, spec.at("column_class").get<std::string>());
+    }
     if (!spec.contains("attribute_class")) return;
     const std::string schema_class =
         spec.at("attribute_class").get<std::string>();
-    Handle group(H5Gopen2(file_, path.c_str(), H5P_DEFAULT));
     Result<std::vector<std::string>> names =
-        group.valid() ? internal::ListAttributes(group.get())
-                      : Result<std::vector<std::string>>(Status::Corruption(
-                            "opening: " + internal::TakeHdf5Error()));
+        internal::ListAttributes(group.get());
     if (!names.ok()) {
       Problem(path, names.status().message());
       return;
     }
     for (const std::string& name : *names) {
       OpenAttr(group.get(), path, name, schema_class);
+    }
+  }
+
+  // Every member of the group must be a column (1-D dataset) of the class.
+  void CheckColumns(const Handle& group, const std::string& path,
+                    const std::string& schema_class) {
+    H5G_info_t info;
+    if (H5Gget_info(group.get(), &info) < 0) {
+      Problem(path, "listing members: " + internal::TakeHdf5Error());
+      return;
+    }
+    for (hsize_t i = 0; i < info.nlinks; ++i) {
+      const ssize_t size =
+          H5Lget_name_by_idx(group.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i,
+                             nullptr, 0, H5P_DEFAULT);
+      if (size < 0) {
+        Problem(path, "listing members: " + internal::TakeHdf5Error());
+        return;
+      }
+      std::string name(static_cast<size_t>(size) + 1, '\0');
+      H5Lget_name_by_idx(group.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i,
+                         name.data(), name.size(), H5P_DEFAULT);
+      name.resize(static_cast<size_t>(size));
+      const std::string member = path + "/" + name;
+      if (internal::GetObjectKind(file_, member) != ObjectKind::kDataset) {
+        Problem(member, "is not a dataset");
+        continue;
+      }
+      Handle dataset(H5Dopen2(file_, member.c_str(), H5P_DEFAULT));
+      Handle type(dataset.valid() ? H5Dget_type(dataset.get()) : -1);
+      Handle space(dataset.valid() ? H5Dget_space(dataset.get()) : -1);
+      if (!type.valid() || !space.valid()) {
+        Problem(member, "unreadable: " + internal::TakeHdf5Error());
+        continue;
+      }
+      CheckColumn(member, H5Tget_class(type.get()),
+                  H5Sget_simple_extent_ndims(space.get()), schema_class);
+    }
+  }
+
+  // A column: 1-D, one value of `schema_class` per row.
+  void CheckColumn(const std::string& path, H5T_class_t actual, int rank,
+                   const std::string& schema_class) {
+    if (rank != 1) Problem(path, "expected a 1-D dataset (one value per row)");
+    if (!ClassMatches(schema_class, actual)) {
+      Problem(path, std::string("is ") + internal::TypeClassName(actual) +
+                        ", expected " + schema_class);
     }
   }
 
@@ -151,7 +212,12 @@ class Checker {
     }
     const H5T_class_t actual = H5Tget_class(type.get());
     const int rank = H5Sget_simple_extent_ndims(space.get());
-    if (spec.value("shape", std::string("rows")) == "scalar") {
+    const std::string shape = spec.value("shape", std::string("rows"));
+    if (shape == "column") {
+      CheckColumn(path, actual, rank, spec.at("class").get<std::string>());
+      return;
+    }
+    if (shape == "scalar") {
       if (rank != 0) Problem(path, "expected a scalar dataset");
       const std::string schema_class = spec.at("class").get<std::string>();
       if (!ClassMatches(schema_class, actual)) {

@@ -59,6 +59,40 @@ struct AnalyzeArgs {
 };
 int RunAnalyze(const AnalyzeArgs& args);
 
+struct WorkerArgs {
+  std::string scenario;
+  std::string point;             // required
+  std::optional<uint64_t> seed;  // overrides world.traffic.seed
+  std::string out;               // run file to write (atomically)
+  std::string expect_key;        // refuse to run when the key differs
+};
+int RunWorker(const WorkerArgs& args);
+
+struct RunArgs {
+  std::string scenario;
+  std::string out;         // campaign folder; default: the scenario's output
+  std::string strategy;    // overrides exploration.strategy
+  int budget = -1;         // overrides exploration.budget
+  int workers = -1;        // overrides harness.workers (0: auto)
+  std::string isolation;   // overrides harness.isolation
+  bool no_cache = false;
+  std::string cache_dir;   // overrides harness.cache_dir
+  bool retry_failed = false;
+  bool quiet = false;
+  bool json = false;
+};
+int RunRun(const RunArgs& args);
+
+struct ExploreArgs {
+  std::string replay;                   // recorded campaign folder
+  std::vector<std::string> strategies;  // default: the recorded strategy set
+  int budget = 0;                       // 0: the recording's scenario budget
+  int seeds = 20;
+  uint64_t first_seed = 1;
+  bool json = false;
+};
+int RunExplore(const ExploreArgs& args);
+
 }  // namespace adse::cli
 
 #endif  // ADSE_HARNESS_CLI_COMMANDS_H_

@@ -91,6 +91,58 @@ int main(int argc, char** argv) {
       ->expected(2);
   analyze_cmd->add_flag("--json", analyze.json, "Print the report(s) as JSON");
 
+  adse::cli::RunArgs run;
+  CLI::App* run_cmd = app.add_subcommand(
+      "run", "Explore the scenario's design space within its budget: runs go to a pool of "
+             "worker processes (cgroup-limited), results to the campaign folder (runs/, "
+             "campaign.h5, report.md, pareto.png, summary.json). Run it again to resume.");
+  run_cmd->add_option("scenario", run.scenario, "Scenario YAML file")->required();
+  run_cmd->add_option("-o,--out", run.out, "Campaign folder (default: the scenario's output)");
+  run_cmd->add_option("--strategy", run.strategy,
+                      "Override exploration.strategy: exhaustive, random, ga, nsga2, agent");
+  run_cmd->add_option("--budget", run.budget, "Override exploration.budget (evaluations)")
+      ->check(CLI::NonNegativeNumber);
+  run_cmd->add_option("--workers", run.workers, "Override harness.workers (0: auto)")
+      ->check(CLI::NonNegativeNumber);
+  run_cmd->add_option("--isolation", run.isolation, "Override harness.isolation")
+      ->check(CLI::IsMember({"auto", "cgroup", "affinity"}));
+  run_cmd->add_flag("--no-cache", run.no_cache,
+                    "Neither read nor fill the shared evaluation cache");
+  run_cmd->add_option("--cache-dir", run.cache_dir, "Override harness.cache_dir");
+  run_cmd->add_flag("--retry-failed", run.retry_failed,
+                    "Run again points whose runs failed for good in an earlier session");
+  run_cmd->add_flag("-q,--quiet", run.quiet, "Only failures and errors on stderr");
+  run_cmd->add_flag("--json", run.json, "Print summary.json on stdout at the end");
+
+  adse::cli::WorkerArgs worker;
+  uint64_t worker_seed = 0;
+  CLI::App* worker_cmd = app.add_subcommand(
+      "worker", "Run one design point in this process and write its run file (what the "
+                "campaign's pool starts; rarely used by hand)");
+  worker_cmd->add_option("scenario", worker.scenario, "Scenario YAML file")->required();
+  worker_cmd->add_option("-p,--point", worker.point, "Design point")->required();
+  CLI::Option* worker_seed_opt = worker_cmd->add_option("--seed", worker_seed, "Traffic seed");
+  worker_cmd->add_option("-o,--out", worker.out, "Run file to write")->required();
+  worker_cmd->add_option("--expect-key", worker.expect_key,
+                         "Refuse to run unless the run's content key is this");
+
+  adse::cli::ExploreArgs explore;
+  CLI::App* explore_cmd = app.add_subcommand(
+      "explore", "Compare strategies without simulating: replay them against a recorded "
+                 "campaign over many seeds");
+  explore_cmd->add_option("--replay", explore.replay, "Recorded campaign folder (campaign.h5)")
+      ->required();
+  explore_cmd->add_option("--strategy", explore.strategies,
+                          "Strategies, comma-separated (default: all)")
+      ->delimiter(',');
+  explore_cmd->add_option("--budget", explore.budget, "Evaluations per replay (default: the "
+                                                      "recorded scenario's budget)")
+      ->check(CLI::PositiveNumber);
+  explore_cmd->add_option("--seeds", explore.seeds, "Seeds per strategy")
+      ->check(CLI::Range(1, 100000));
+  explore_cmd->add_option("--first-seed", explore.first_seed, "First exploration seed");
+  explore_cmd->add_flag("--json", explore.json, "Print the results as JSON");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -100,6 +152,10 @@ int main(int argc, char** argv) {
   }
   if (seed_opt->count() > 0) world.seed = seed;
   if (simulate_seed_opt->count() > 0) simulate.seed = simulate_seed;
+  if (worker_seed_opt->count() > 0) worker.seed = worker_seed;
+  if (*run_cmd) return adse::cli::RunRun(run);
+  if (*worker_cmd) return adse::cli::RunWorker(worker);
+  if (*explore_cmd) return adse::cli::RunExplore(explore);
   if (*simulate_cmd) return adse::cli::RunSimulate(simulate);
   if (*calibrate_cmd) return adse::cli::RunCalibrate(calibrate);
   if (*schema_check_cmd) return adse::cli::RunSchemaCheck(schema_check);

@@ -99,6 +99,8 @@ class EvolutionaryStrategy : public Strategy {
   }
 
   std::string name() const override { return name_; }
+  // A generation is evaluated as one round.
+  int RoundSize(int /*batch*/) const override { return population_size_; }
   std::string rationale() const override { return rationale_; }
 
  protected:

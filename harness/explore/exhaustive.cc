@@ -56,6 +56,7 @@ class ExhaustiveStrategy : public Strategy {
   }
 
   std::string name() const override { return "exhaustive"; }
+  bool adaptive() const override { return false; }
   std::string rationale() const override { return rationale_; }
 
  private:

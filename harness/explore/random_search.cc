@@ -55,6 +55,7 @@ class RandomStrategy : public Strategy {
   }
 
   std::string name() const override { return "random"; }
+  bool adaptive() const override { return false; }
   std::string rationale() const override { return rationale_; }
 
  private:

@@ -146,7 +146,7 @@ double ConstraintViolation(const spec::Spec& spec,
 
 const std::vector<std::string>& StrategyNames() {
   static const std::vector<std::string> kNames = {"exhaustive", "random", "ga",
-                                                  "nsga2"};
+                                                  "nsga2", "agent"};
   return kNames;
 }
 
@@ -177,6 +177,7 @@ Result<std::unique_ptr<Strategy>> CreateStrategy(
   if (name == "exhaustive") return NewExhaustiveStrategy(spec);
   if (name == "random") return NewRandomStrategy(spec);
   if (name == "ga") return NewGeneticStrategy(spec);
+  if (name == "agent") return NewAgentStrategy(spec);
   return NewNsga2Strategy(spec);
 }
 

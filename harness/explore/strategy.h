@@ -31,6 +31,14 @@
 
 namespace adse::explore {
 
+// A bottleneck found in a run (a summary of analysis/diagnosis's Finding).
+struct BottleneckHint {
+  std::string kind;    // "cpu_bound" | "frequency_bound"
+  std::string node;    // the node that cannot keep up / is input-limited
+  std::string remedy;  // e.g. "higher frequency; more cores"
+  double severity = 0.0;  // relative deficit
+};
+
 // What a strategy is told about an evaluated point.
 struct Observation {
   spec::DesignPoint point;
@@ -38,6 +46,8 @@ struct Observation {
   std::map<std::string, double> metrics;
   bool feasible = false;  // all constraints hold
   bool failed = false;    // the run failed (no metrics)
+  // The run's diagnosis, most severe first (empty when healthy or failed).
+  std::vector<BottleneckHint> bottlenecks;
 };
 
 class Strategy {
@@ -50,6 +60,15 @@ class Strategy {
   virtual std::string name() const = 0;
   // A short written reason for the last Ask (for the report), may be empty.
   virtual std::string rationale() const { return {}; }
+  // Whether proposals depend on what Tell reported. A non-adaptive
+  // strategy (exhaustive, random) may be asked whenever a worker is free;
+  // an adaptive one is asked in rounds of RoundSize points whose Tells all
+  // arrive, in proposal order, before the next Ask, so that a campaign
+  // proposes the same points however fast its runs finish.
+  virtual bool adaptive() const { return true; }
+  // Points per round for an adaptive strategy, given exploration.batch
+  // (GA / NSGA-II: a generation).
+  virtual int RoundSize(int batch) const { return batch < 1 ? 1 : batch; }
 };
 
 struct StrategyContext {
@@ -61,9 +80,9 @@ struct StrategyContext {
 // The names CreateStrategy accepts, in the order they are documented.
 const std::vector<std::string>& StrategyNames();
 
-// Factory keyed by name: "exhaustive", "random", "ga", "nsga2". An unknown
-// name, a missing spec or an empty design space gives InvalidArgument (the
-// first listing the valid names).
+// Factory keyed by name: "exhaustive", "random", "ga", "nsga2", "agent". An
+// unknown name, a missing spec or an empty design space gives
+// InvalidArgument (the first listing the valid names).
 Result<std::unique_ptr<Strategy>> CreateStrategy(
     const std::string& name, const StrategyContext& context);
 
@@ -138,6 +157,9 @@ std::unique_ptr<Strategy> NewExhaustiveStrategy(const spec::Spec& spec);
 std::unique_ptr<Strategy> NewRandomStrategy(const spec::Spec& spec);
 std::unique_ptr<Strategy> NewGeneticStrategy(const spec::Spec& spec);
 std::unique_ptr<Strategy> NewNsga2Strategy(const spec::Spec& spec);
+// The built-in reasoning strategy (agent.cc): a Ceres-fitted surrogate of
+// the metrics, constraint- and bottleneck-guided proposals with a rationale.
+std::unique_ptr<Strategy> NewAgentStrategy(const spec::Spec& spec);
 
 }  // namespace adse::explore
 

@@ -74,9 +74,13 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run, const std::string& run
     r.findings.push_back({f.kind, f.node, f.remedy, f.message, f.topics, f.rates_hz});
   }
 
-  // Constraints, from the scenario stored in the run.
+  // Constraints, from the scenario stored in the run. The files it names
+  // (a calibration, a net) need not exist where the run is re-analysed.
+  spec::ParseOptions parse_options;
+  parse_options.check_files = false;
   Result<spec::Spec> spec =
-      spec::ParseSpec(run.scenario_text, run.scenario_name + ".yaml (stored in the run)", ".");
+      spec::ParseSpec(run.scenario_text, run.scenario_name + ".yaml (stored in the run)", ".",
+                      parse_options);
   if (spec.ok()) {
     r.feasible = run.status == "complete";
     for (const std::string& c : spec->constraints) {

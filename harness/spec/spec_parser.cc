@@ -377,7 +377,8 @@ std::string Join(const std::string& path, const std::string& key) {
 
 class SpecReader {
  public:
-  SpecReader(Spec* spec) : spec_(*spec) {}
+  SpecReader(Spec* spec, bool check_files)
+      : spec_(*spec), check_files_(check_files) {}
 
   void Read(const YAML::Node& root);
 
@@ -588,6 +589,7 @@ class SpecReader {
                       const std::string& expected);
 
   Spec& spec_;
+  bool check_files_ = true;
   std::vector<Diagnostic> errors_;
   bool space_ok_ = false;
 };
@@ -758,7 +760,9 @@ void SpecReader::ReadMapSource(const Val& v) {
     if (ReadPath(*net, &map.net_path, "a path to a SUMO network (.net.xml)")) {
       written = net->node.Scalar();
       std::error_code ec;
-      if (!fs::is_regular_file(map.net_path, ec)) {
+      if (!check_files_) {
+        // Re-reading a stored scenario: the file need not exist here.
+      } else if (!fs::is_regular_file(map.net_path, ec)) {
         Error(net->mark, net->path, "an existing SUMO network file (.net.xml)",
               Quote(written) + " (no such file: " + map.net_path + ")");
       } else {
@@ -782,7 +786,7 @@ void SpecReader::ReadMapSource(const Val& v) {
     if (ReadPath(*e, &map.polygons_path,
                  "a path to a SUMO polygon file (.poly.xml)")) {
       std::error_code ec;
-      if (!fs::is_regular_file(map.polygons_path, ec)) {
+      if (check_files_ && !fs::is_regular_file(map.polygons_path, ec)) {
         Error(e->mark, e->path, "an existing SUMO polygon file (.poly.xml)",
               Quote(e->node.Scalar()) + " (no such file: " + map.polygons_path +
                   ")");
@@ -974,7 +978,7 @@ void SpecReader::ReadPlatform(const Val& v) {
   if (const Val* e = f.Get("calibration")) {
     if (ReadPath(*e, &p.calibration, "a path to a calibration file")) {
       std::error_code ec;
-      if (!fs::is_regular_file(p.calibration, ec)) {
+      if (check_files_ && !fs::is_regular_file(p.calibration, ec)) {
         Error(
             e->mark, e->path, "an existing calibration file",
             Quote(e->node.Scalar()) + " (no such file: " + p.calibration + ")");
@@ -1382,7 +1386,7 @@ void SpecReader::ReadLlm(const Val& v) {
   if (const Val* e = f.Get("prompts")) {
     if (ReadPath(*e, &llm.prompts, "a folder of prompt templates")) {
       std::error_code ec;
-      if (!fs::is_directory(llm.prompts, ec)) {
+      if (check_files_ && !fs::is_directory(llm.prompts, ec)) {
         Error(
             e->mark, e->path, "an existing folder of prompt templates",
             Quote(e->node.Scalar()) + " (no such folder: " + llm.prompts + ")");
@@ -1392,7 +1396,7 @@ void SpecReader::ReadLlm(const Val& v) {
   if (const Val* e = f.Get("replay_from")) {
     if (ReadPath(*e, &llm.replay_from, "a recorded campaign folder")) {
       std::error_code ec;
-      if (!fs::exists(llm.replay_from, ec)) {
+      if (check_files_ && !fs::exists(llm.replay_from, ec)) {
         Error(e->mark, e->path, "an existing recorded campaign folder",
               Quote(e->node.Scalar()) + " (no such folder: " + llm.replay_from +
                   ")");
@@ -1624,7 +1628,8 @@ std::vector<std::string> ConstraintVariableNames(const DesignSpace& space) {
 }
 
 Result<Spec> ParseSpec(std::string_view text, const std::string& file_name,
-                       const std::string& base_dir) {
+                       const std::string& base_dir,
+                       const ParseOptions& options) {
   Spec spec;
   spec.source_path = file_name;
   std::error_code ec;
@@ -1643,7 +1648,7 @@ Result<Spec> ParseSpec(std::string_view text, const std::string& file_name,
   }
   spec.source_text = std::string(text);
   spec.name = NameFromFile(file_name);
-  SpecReader reader(&spec);
+  SpecReader reader(&spec, options.check_files);
 
   // Scan events first: limits are enforced before any node exists.
   try {
@@ -1924,6 +1929,21 @@ std::string NormalizedYaml(const Spec& spec) {
       << spec.output;
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
+}
+
+std::string FormatPoint(const DesignSpace& space, const DesignPoint& point) {
+  std::string text;
+  auto add = [&text](const std::string& name, double value) {
+    text += fmt::format("{}{}={}", text.empty() ? "" : ",", name, value);
+  };
+  for (const DesignParameter& p : space.parameters) {
+    auto it = point.find(p.name);
+    if (it != point.end()) add(p.name, it->second);
+  }
+  for (const auto& [name, value] : point) {
+    if (space.Find(name) == nullptr) add(name, value);
+  }
+  return text;
 }
 
 Result<DesignPoint> ParsePoint(const DesignSpace& space,

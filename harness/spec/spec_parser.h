@@ -34,11 +34,19 @@ inline constexpr size_t kMaxParameterValues = 100000;
 // file resolve from the file's folder.
 Result<Spec> LoadSpec(const std::string& path);
 
+struct ParseOptions {
+  // Require the files the scenario names (net, polygons, calibration,
+  // prompts, replay_from) to exist. Off when re-reading the scenario
+  // stored in a run file, which is only read for its expressions.
+  bool check_files = true;
+};
+
 // Parses spec text. `file_name` is used in messages and for the default
 // name (its stem); `base_dir` is where relative paths resolve from (empty:
 // the current directory).
 Result<Spec> ParseSpec(std::string_view text, const std::string& file_name,
-                       const std::string& base_dir);
+                       const std::string& base_dir,
+                       const ParseOptions& options = {});
 
 // The whole spec, defaults filled in and paths absolute, in the v1 format.
 // ParseSpec reads it back to an equal spec.
@@ -49,6 +57,11 @@ std::string NormalizedYaml(const Spec& spec);
 // unknown parameters (with a suggestion), values not allowed (with the
 // allowed ones) and missing parameters.
 Result<DesignPoint> ParsePoint(const DesignSpace& space, std::string_view text);
+
+// The inverse of ParsePoint: "cores=4,freq_ghz=1.2,lidar_hz=14", parameters
+// in space order (names the space lacks follow in name order), values in
+// their shortest exact form.
+std::string FormatPoint(const DesignSpace& space, const DesignPoint& point);
 
 // Names the `cost` expression may use: design parameters, `cores`,
 // `freq_ghz`.

@@ -41,6 +41,11 @@ std::string Variant(const std::string& name, const std::string& from, const std:
   if (at != std::string::npos) text.replace(at, from.size(), to);
   const fs::path path = fs::temp_directory_path() / ("adse_cli_" + name + ".yaml");
   std::ofstream(path) << text;
+  // The example names its calibration relative to itself.
+  fs::create_directories(fs::temp_directory_path() / "calibration");
+  fs::copy_file(std::string(ADSE_SOURCE_DIR) + "/scenarios/calibration/reference.json",
+                fs::temp_directory_path() / "calibration/reference.json",
+                fs::copy_options::overwrite_existing);
   return path.string();
 }
 

@@ -42,6 +42,16 @@ TEST(DesignPointTest, ParsesAGoodPoint) {
   EXPECT_TRUE(spec.design_space.Check(*point).ok());
 }
 
+TEST(DesignPointTest, FormatPointIsTheInverseOfParsePoint) {
+  const Spec spec = Reference();
+  const DesignPoint point = {{"lidar_hz", 14}, {"cores", 4}, {"freq_ghz", 1.2}};
+  const std::string text = FormatPoint(spec.design_space, point);
+  EXPECT_EQ(text, "cores=4,freq_ghz=1.2,lidar_hz=14");  // space order
+  Result<DesignPoint> back = ParsePoint(spec.design_space, text);
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(*back, point);
+}
+
 TEST(DesignPointTest, SnapsToTheExactAllowedValue) {
   const Spec spec = Reference();
   Result<DesignPoint> point = ParsePoint(spec.design_space,

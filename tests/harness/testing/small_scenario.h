@@ -10,16 +10,17 @@
 
 namespace adse::testing {
 
-// scenarios/robotaxi_small.yaml with the counted cost model and the bundled
-// calibration: the same answers on any machine and under any load, so
-// thresholds cannot flake.
+inline std::string SmallScenarioPath() {
+  return std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml";
+}
+
+// scenarios/robotaxi_small.yaml, which uses the counted cost model and the
+// bundled calibration: the same answers on any machine and under any load,
+// so thresholds cannot flake.
 inline spec::Spec SmallScenario() {
-  Result<spec::Spec> spec =
-      spec::LoadSpec(std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml");
+  Result<spec::Spec> spec = spec::LoadSpec(SmallScenarioPath());
   EXPECT_TRUE(spec.ok()) << spec.status().ToString();
-  spec->platform.cost_model = spec::CostModel::kCounted;
-  spec->platform.calibration =
-      std::string(ADSE_SOURCE_DIR) + "/scenarios/calibration/reference.json";
+  EXPECT_EQ(spec->platform.cost_model, spec::CostModel::kCounted);
   return std::move(spec).value();
 }
 

@@ -1,0 +1,430 @@
+// The campaign index (campaign.h5): one column dataset per field, so h5py
+// gives numpy arrays and pandas a DataFrame with no adse code. Layout:
+// results-schema/campaign.schema.json (human guide: results-schema/README.md).
+#include "analysis/runfile/campaign_file.h"
+
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <new>
+#include <set>
+#include <utility>
+
+#include "analysis/runfile/hdf5_util_impl.h"
+
+namespace adse::runfile {
+namespace {
+
+using internal::Assign;
+using internal::Handle;
+using internal::ReadColumn;
+using internal::WriteColumn;
+
+constexpr char kKind[] = "adse-campaign";
+// Attribute of /evaluations/point and /evaluations/metrics: the column
+// names in CampaignIndex order (h5py lists datasets by name instead).
+constexpr char kNamesAttr[] = "names";
+// Separator of /iterations/content_keys.
+constexpr char kKeySeparator = ',';
+
+// ---------------------------------------------------------------------------
+// Validation before anything touches the disk.
+
+bool HasNul(const std::string& text) {
+  return text.find('\0') != std::string::npos;
+}
+
+// Column names become HDF5 link names: no '/', not "." and not empty.
+Status CheckNames(const char* what, const std::vector<std::string>& names) {
+  std::set<std::string> seen;
+  for (const std::string& name : names) {
+    if (name.empty() || name == "." || name.find('/') != std::string::npos ||
+        HasNul(name)) {
+      return Status::InvalidArgument(std::string(what) + " name '" + name +
+                                     "' cannot be an HDF5 dataset name "
+                                     "(empty, '.', or holds '/' or NUL)");
+    }
+    if (!seen.insert(name).second) {
+      return Status::InvalidArgument(std::string(what) + " name '" + name +
+                                     "' is listed twice");
+    }
+  }
+  return Status::Ok();
+}
+
+// Every entry of a row's map must have a column, or it would be lost.
+Status CheckKeys(const char* what, size_t row,
+                 const std::map<std::string, double>& values,
+                 const std::set<std::string>& columns) {
+  for (const auto& entry : values) {
+    if (columns.count(entry.first) == 0) {
+      return Status::InvalidArgument(
+          "evaluation " + std::to_string(row) + ": " + what + " '" +
+          entry.first + "' is not in CampaignIndex::" + what + "s");
+    }
+  }
+  return Status::Ok();
+}
+
+Status Validate(const CampaignIndex& index) {
+  ADSE_RETURN_IF_ERROR(CheckNames("parameter", index.parameters));
+  ADSE_RETURN_IF_ERROR(CheckNames("metric", index.metrics));
+  for (const std::string* text :
+       {&index.scenario_name, &index.scenario_text, &index.strategy,
+        &index.isolation, &index.adse_version}) {
+    if (HasNul(*text)) {
+      return Status::InvalidArgument("campaign attribute holds a NUL byte");
+    }
+  }
+  const std::set<std::string> parameters(index.parameters.begin(),
+                                         index.parameters.end());
+  const std::set<std::string> metrics(index.metrics.begin(),
+                                      index.metrics.end());
+  for (size_t i = 0; i < index.evaluations.size(); ++i) {
+    const EvaluationRow& row = index.evaluations[i];
+    ADSE_RETURN_IF_ERROR(CheckKeys("parameter", i, row.point, parameters));
+    ADSE_RETURN_IF_ERROR(CheckKeys("metric", i, row.metrics, metrics));
+  }
+  for (size_t i = 0; i < index.iterations.size(); ++i) {
+    for (const std::string& key : index.iterations[i].content_keys) {
+      if (key.empty() || key.find(kKeySeparator) != std::string::npos) {
+        return Status::InvalidArgument("iteration " + std::to_string(i) +
+                                       ": content key '" + key +
+                                       "' is empty or holds a ','");
+      }
+    }
+  }
+  // Strings with NUL inside are refused by WriteColumn, naming the dataset.
+  return Status::Ok();
+}
+
+// ---------------------------------------------------------------------------
+// Writing.
+
+template <typename T, typename Row, typename Get>
+std::vector<T> Gather(const std::vector<Row>& rows, Get get) {
+  std::vector<T> out;
+  out.reserve(rows.size());
+  for (const Row& row : rows) out.push_back(static_cast<T>(get(row)));
+  return out;
+}
+
+// One float64 column per name, NaN where a row's map lacks it, plus the
+// names in order as an attribute.
+Status WriteNumberGroup(hid_t parent, const char* group_name,
+                        const std::vector<std::string>& names,
+                        const std::vector<EvaluationRow>& rows,
+                        std::map<std::string, double> EvaluationRow::*member) {
+  Result<Handle> group = internal::CreateGroup(parent, group_name);
+  if (!group.ok()) return group.status();
+  ADSE_RETURN_IF_ERROR(
+      internal::WriteStringListAttr(group->get(), kNamesAttr, names));
+  std::vector<double> column(rows.size());
+  for (const std::string& name : names) {
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const auto& values = rows[i].*member;
+      const auto found = values.find(name);
+      column[i] = found != values.end()
+                      ? found->second
+                      : std::numeric_limits<double>::quiet_NaN();
+    }
+    ADSE_RETURN_IF_ERROR(WriteColumn(group->get(), name, column));
+  }
+  return Status::Ok();
+}
+
+std::string JoinKeys(const std::vector<std::string>& keys) {
+  std::string out;
+  for (size_t i = 0; i < keys.size(); ++i) {
+    if (i > 0) out += kKeySeparator;
+    out += keys[i];
+  }
+  return out;
+}
+
+Status WriteContents(hid_t file, const CampaignIndex& index) {
+  using internal::WriteStringAttr;
+  ADSE_RETURN_IF_ERROR(
+      internal::WriteI32Attr(file, "schema_version", kCampaignSchemaVersion));
+  ADSE_RETURN_IF_ERROR(WriteStringAttr(file, "kind", kKind));
+  ADSE_RETURN_IF_ERROR(
+      WriteStringAttr(file, "scenario_name", index.scenario_name));
+  ADSE_RETURN_IF_ERROR(
+      WriteStringAttr(file, "scenario_text", index.scenario_text));
+  ADSE_RETURN_IF_ERROR(WriteStringAttr(file, "strategy", index.strategy));
+  ADSE_RETURN_IF_ERROR(
+      internal::WriteU64Attr(file, "exploration_seed", index.exploration_seed));
+  ADSE_RETURN_IF_ERROR(internal::WriteI64Attr(file, "budget", index.budget));
+  ADSE_RETURN_IF_ERROR(WriteStringAttr(file, "isolation", index.isolation));
+  ADSE_RETURN_IF_ERROR(
+      WriteStringAttr(file, "adse_version", index.adse_version));
+
+  {
+    const auto& rows = index.evaluations;
+    Result<Handle> group = internal::CreateGroup(file, "evaluations");
+    if (!group.ok()) return group.status();
+    const hid_t g = group->get();
+    using Row = EvaluationRow;
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "index",
+        Gather<int64_t>(rows, [](const Row& r) { return r.index; })));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "iteration",
+        Gather<int64_t>(rows, [](const Row& r) { return r.iteration; })));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "content_key",
+        Gather<std::string>(rows, [](const Row& r) { return r.content_key; })));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "status",
+        Gather<std::string>(rows, [](const Row& r) { return r.status; })));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "reason",
+        Gather<std::string>(rows, [](const Row& r) { return r.reason; })));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "source",
+        Gather<std::string>(rows, [](const Row& r) { return r.source; })));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "attempts",
+        Gather<int64_t>(rows, [](const Row& r) { return r.attempts; })));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "wall_s",
+        Gather<double>(rows, [](const Row& r) { return r.wall_s; })));
+    ADSE_RETURN_IF_ERROR(
+        WriteColumn(g, "feasible", Gather<uint8_t>(rows, [](const Row& r) {
+                      return r.feasible ? 1 : 0;
+                    })));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "seed",
+        Gather<uint64_t>(rows, [](const Row& r) { return r.seed; })));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "bottlenecks_json", Gather<std::string>(rows, [](const Row& r) {
+          return r.bottlenecks_json;
+        })));
+    ADSE_RETURN_IF_ERROR(
+        WriteNumberGroup(g, "point", index.parameters, rows, &Row::point));
+    ADSE_RETURN_IF_ERROR(
+        WriteNumberGroup(g, "metrics", index.metrics, rows, &Row::metrics));
+  }
+  {
+    const auto& rows = index.iterations;
+    Result<Handle> group = internal::CreateGroup(file, "iterations");
+    if (!group.ok()) return group.status();
+    const hid_t g = group->get();
+    using Row = IterationRow;
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "iteration",
+        Gather<int64_t>(rows, [](const Row& r) { return r.iteration; })));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "strategy",
+        Gather<std::string>(rows, [](const Row& r) { return r.strategy; })));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "rationale",
+        Gather<std::string>(rows, [](const Row& r) { return r.rationale; })));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "content_keys", Gather<std::string>(rows, [](const Row& r) {
+          return JoinKeys(r.content_keys);
+        })));
+  }
+  return Status::Ok();
+}
+
+// ---------------------------------------------------------------------------
+// Reading. Failures name the HDF5 object; ReadFileContents prefixes the file
+// and makes them Corruption.
+
+// Reads column `name` of the group at `group_path` and checks it has `rows`
+// rows (the length of the group's first column).
+template <typename T>
+Status ReadSized(hid_t group, const std::string& group_path,
+                 const std::string& name, size_t rows, std::vector<T>* out) {
+  ADSE_RETURN_IF_ERROR(ReadColumn(group, name, out));
+  if (out->size() != rows) {
+    return Status::Corruption(group_path + "/" + name + ": " +
+                              std::to_string(out->size()) + " rows, expected " +
+                              std::to_string(rows) +
+                              " like the other columns of " + group_path);
+  }
+  return Status::Ok();
+}
+
+// The float64 columns of /evaluations/point or /evaluations/metrics into the
+// rows' maps (NaN left out), their order from the `names` attribute.
+Status ReadNumberGroup(hid_t file, const std::string& path,
+                       std::vector<std::string>* names,
+                       std::vector<EvaluationRow>* rows,
+                       std::map<std::string, double> EvaluationRow::*member) {
+  Result<Handle> group = internal::OpenGroup(file, path);
+  if (!group.ok()) return group.status();
+  ADSE_RETURN_IF_ERROR(
+      Assign(internal::ReadStringListAttr(group->get(), kNamesAttr), names));
+  std::set<std::string> seen;
+  for (const std::string& name : *names) {
+    if (name.empty() || !seen.insert(name).second) {
+      return Status::Corruption(path + ": attribute '" + kNamesAttr +
+                                "' has an empty or repeated name '" + name +
+                                "'");
+    }
+  }
+  std::vector<double> column;
+  for (const std::string& name : *names) {
+    ADSE_RETURN_IF_ERROR(
+        ReadSized(group->get(), path, name, rows->size(), &column));
+    for (size_t i = 0; i < rows->size(); ++i) {
+      if (!std::isnan(column[i])) ((*rows)[i].*member)[name] = column[i];
+    }
+  }
+  return Status::Ok();
+}
+
+std::vector<std::string> SplitKeys(const std::string& joined) {
+  std::vector<std::string> keys;
+  if (joined.empty()) return keys;
+  size_t start = 0;
+  while (true) {
+    const size_t end = joined.find(kKeySeparator, start);
+    keys.push_back(joined.substr(start, end - start));
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  return keys;
+}
+
+Status ReadContents(hid_t file, CampaignIndex* index) {
+  using internal::ReadStringAttr;
+  // `kind` first: a run file (same schema_version) is told apart clearly.
+  Result<std::string> kind = ReadStringAttr(file, "kind");
+  if (!kind.ok()) {
+    return Status::Corruption(kind.status().message() +
+                              " (not an adse campaign index)");
+  }
+  if (*kind != kKind) {
+    return Status::Corruption("/: attribute 'kind' is '" + *kind +
+                              "', expected '" + kKind + "'");
+  }
+  Result<int64_t> version = internal::ReadI64Attr(file, "schema_version");
+  if (!version.ok()) return version.status();
+  if (*version != kCampaignSchemaVersion) {
+    return Status::Corruption("/: schema_version " + std::to_string(*version) +
+                              " is not the supported " +
+                              std::to_string(kCampaignSchemaVersion));
+  }
+  ADSE_RETURN_IF_ERROR(
+      Assign(ReadStringAttr(file, "scenario_name"), &index->scenario_name));
+  ADSE_RETURN_IF_ERROR(
+      Assign(ReadStringAttr(file, "scenario_text"), &index->scenario_text));
+  ADSE_RETURN_IF_ERROR(
+      Assign(ReadStringAttr(file, "strategy"), &index->strategy));
+  ADSE_RETURN_IF_ERROR(Assign(internal::ReadU64Attr(file, "exploration_seed"),
+                              &index->exploration_seed));
+  ADSE_RETURN_IF_ERROR(
+      Assign(internal::ReadI64Attr(file, "budget"), &index->budget));
+  ADSE_RETURN_IF_ERROR(
+      Assign(ReadStringAttr(file, "isolation"), &index->isolation));
+  ADSE_RETURN_IF_ERROR(
+      Assign(ReadStringAttr(file, "adse_version"), &index->adse_version));
+
+  {
+    const std::string path = "/evaluations";
+    Result<Handle> group = internal::OpenGroup(file, path);
+    if (!group.ok()) return group.status();
+    const hid_t g = group->get();
+    std::vector<int64_t> numbers;
+    ADSE_RETURN_IF_ERROR(ReadColumn(g, "index", &numbers));
+    const size_t n = numbers.size();
+    auto& rows = index->evaluations;
+    rows.assign(n, EvaluationRow{});
+    for (size_t i = 0; i < n; ++i) rows[i].index = numbers[i];
+
+    auto ints = [&](const char* name, int64_t EvaluationRow::*member) {
+      ADSE_RETURN_IF_ERROR(ReadSized(g, path, name, n, &numbers));
+      for (size_t i = 0; i < n; ++i) rows[i].*member = numbers[i];
+      return Status::Ok();
+    };
+    auto strings = [&](const char* name, std::string EvaluationRow::*member) {
+      std::vector<std::string> column;
+      ADSE_RETURN_IF_ERROR(ReadSized(g, path, name, n, &column));
+      for (size_t i = 0; i < n; ++i) rows[i].*member = std::move(column[i]);
+      return Status::Ok();
+    };
+    ADSE_RETURN_IF_ERROR(ints("iteration", &EvaluationRow::iteration));
+    ADSE_RETURN_IF_ERROR(strings("content_key", &EvaluationRow::content_key));
+    ADSE_RETURN_IF_ERROR(strings("status", &EvaluationRow::status));
+    ADSE_RETURN_IF_ERROR(strings("reason", &EvaluationRow::reason));
+    ADSE_RETURN_IF_ERROR(strings("source", &EvaluationRow::source));
+    ADSE_RETURN_IF_ERROR(ints("attempts", &EvaluationRow::attempts));
+    ADSE_RETURN_IF_ERROR(
+        strings("bottlenecks_json", &EvaluationRow::bottlenecks_json));
+    {
+      std::vector<double> wall;
+      ADSE_RETURN_IF_ERROR(ReadSized(g, path, "wall_s", n, &wall));
+      for (size_t i = 0; i < n; ++i) rows[i].wall_s = wall[i];
+      std::vector<uint8_t> feasible;
+      ADSE_RETURN_IF_ERROR(ReadSized(g, path, "feasible", n, &feasible));
+      for (size_t i = 0; i < n; ++i) rows[i].feasible = feasible[i] != 0;
+      std::vector<uint64_t> seeds;
+      ADSE_RETURN_IF_ERROR(ReadSized(g, path, "seed", n, &seeds));
+      for (size_t i = 0; i < n; ++i) rows[i].seed = seeds[i];
+    }
+    ADSE_RETURN_IF_ERROR(ReadNumberGroup(file, path + "/point",
+                                         &index->parameters, &rows,
+                                         &EvaluationRow::point));
+    ADSE_RETURN_IF_ERROR(ReadNumberGroup(file, path + "/metrics",
+                                         &index->metrics, &rows,
+                                         &EvaluationRow::metrics));
+  }
+  {
+    const std::string path = "/iterations";
+    Result<Handle> group = internal::OpenGroup(file, path);
+    if (!group.ok()) return group.status();
+    const hid_t g = group->get();
+    std::vector<int64_t> numbers;
+    ADSE_RETURN_IF_ERROR(ReadColumn(g, "iteration", &numbers));
+    const size_t n = numbers.size();
+    auto& rows = index->iterations;
+    rows.assign(n, IterationRow{});
+    for (size_t i = 0; i < n; ++i) rows[i].iteration = numbers[i];
+    std::vector<std::string> column;
+    ADSE_RETURN_IF_ERROR(ReadSized(g, path, "strategy", n, &column));
+    for (size_t i = 0; i < n; ++i) rows[i].strategy = std::move(column[i]);
+    ADSE_RETURN_IF_ERROR(ReadSized(g, path, "rationale", n, &column));
+    for (size_t i = 0; i < n; ++i) rows[i].rationale = std::move(column[i]);
+    ADSE_RETURN_IF_ERROR(ReadSized(g, path, "content_keys", n, &column));
+    for (size_t i = 0; i < n; ++i) rows[i].content_keys = SplitKeys(column[i]);
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status WriteCampaignIndex(const std::string& path, const CampaignIndex& index) {
+  try {
+    ADSE_RETURN_IF_ERROR(Validate(index));
+    return internal::WriteFileAtomically(
+        path, [&index](hid_t file) { return WriteContents(file, index); });
+  } catch (const std::bad_alloc&) {
+    return Status::Internal(path +
+                            ": out of memory writing the campaign index");
+  } catch (const std::exception& e) {
+    return Status::Internal(path + ": writing the campaign index: " + e.what());
+  }
+}
+
+Result<CampaignIndex> ReadCampaignIndex(const std::string& path) {
+  try {
+    CampaignIndex index;
+    ADSE_RETURN_IF_ERROR(internal::ReadFileContents(
+        path, "a campaign index",
+        [&index](hid_t file) { return ReadContents(file, &index); }));
+    return index;
+  } catch (const std::bad_alloc&) {
+    // A damaged header can claim absurd sizes.
+    return Status::Corruption(path +
+                              ": out of memory reading (sizes in the "
+                              "file are implausible?)");
+  } catch (const std::exception& e) {
+    return Status::Corruption(path +
+                              ": reading the campaign index: " + e.what());
+  }
+}
+
+}  // namespace adse::runfile

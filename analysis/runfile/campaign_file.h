@@ -1,0 +1,85 @@
+// The campaign index (`campaign.h5`): one row per evaluation of a campaign
+// — design point, status, metrics, feasibility, content key — plus each
+// round's proposal and rationale. It is rebuilt from the run files at any
+// time, so it is a convenience for h5py/pandas users and for replay, never
+// the only copy of a result. Layout: results-schema/campaign.schema.json.
+#ifndef ADSE_ANALYSIS_RUNFILE_CAMPAIGN_FILE_H_
+#define ADSE_ANALYSIS_RUNFILE_CAMPAIGN_FILE_H_
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "stack/base/status.h"
+
+namespace adse::runfile {
+
+inline constexpr int kCampaignSchemaVersion = 1;
+
+struct EvaluationRow {
+  int64_t index = 0;      // evaluation number, 0-based, in proposal order
+  int64_t iteration = 0;  // the round that proposed it
+  std::string content_key;  // 64 hex; the run file is runs/<key>.h5
+  // "complete" (a run file exists) | "failed" (no run after retries)
+  std::string status;
+  // complete: the run's termination_reason (goal_reached, timeout, ...);
+  // failed: the last attempt's outcome (timeout, out_of_memory, crashed,
+  // exit_error) and its detail.
+  std::string reason;
+  // "simulated" | "campaign" (already in runs/) | "cache" (shared cache)
+  std::string source;
+  int64_t attempts = 0;
+  double wall_s = 0.0;     // worker wall time of the last attempt
+  bool feasible = false;
+  uint64_t seed = 0;
+  std::map<std::string, double> point;    // design parameter -> value
+  std::map<std::string, double> metrics;  // NaN where a run lacks one
+  // The diagnosis as JSON text ([{kind,node,remedy,severity}, ...]).
+  std::string bottlenecks_json;
+};
+
+struct IterationRow {
+  int64_t iteration = 0;
+  std::string strategy;
+  std::string rationale;
+  std::vector<std::string> content_keys;  // the points proposed
+};
+
+struct CampaignIndex {
+  std::string scenario_name;
+  std::string scenario_text;  // the exact YAML the campaign ran
+  std::string strategy;
+  uint64_t exploration_seed = 0;
+  int64_t budget = 0;
+  std::string isolation;  // how workers were confined, in words
+  std::string adse_version;
+  // Parameter and metric names (columns), in a stable order.
+  std::vector<std::string> parameters;
+  std::vector<std::string> metrics;
+  std::vector<EvaluationRow> evaluations;
+  std::vector<IterationRow> iterations;
+};
+
+// Writes the index atomically (temporary name, fsync, rename), so a reader
+// sees the old or the new file. Columns: /evaluations/<field> and
+// /evaluations/point/<parameter>, /evaluations/metrics/<metric> as
+// equal-length 1-D datasets (pandas: one Series per dataset).
+// A row's point/metrics entry missing from its map is stored as NaN.
+// InvalidArgument (nothing written) if a parameter or metric name is empty,
+// ".", holds '/' or is listed twice; if a row's point or metrics has a name
+// not in `parameters`/`metrics` (it would be lost); if an iteration's
+// content key is empty or holds ','; or if a string holds a NUL byte.
+// IoError if the file cannot be written (no temporary is left).
+Status WriteCampaignIndex(const std::string& path, const CampaignIndex& index);
+
+// NotFound / Corruption (naming the file and object) like ReadRunFile:
+// Corruption also for a file whose `kind` is not "adse-campaign" (e.g. a run
+// file), another schema_version, a missing dataset or columns of unequal
+// length. NaN point/metric values are left out of the rows' maps, so a
+// write/read round trip is exact except for explicit NaN entries.
+Result<CampaignIndex> ReadCampaignIndex(const std::string& path);
+
+}  // namespace adse::runfile
+
+#endif  // ADSE_ANALYSIS_RUNFILE_CAMPAIGN_FILE_H_

@@ -1,0 +1,82 @@
+// `adse run`: a whole campaign. Explores the scenario's design space with
+// its strategy within the budget, runs each point in a worker process of
+// the pool, and keeps the campaign folder's views (campaign.h5, report.md,
+// summary.json, pareto.png) rebuilt from the run files. Killed at any
+// moment and started again, it loses nothing and repeats nothing.
+#ifndef ADSE_HARNESS_CAMPAIGN_CAMPAIGN_H_
+#define ADSE_HARNESS_CAMPAIGN_CAMPAIGN_H_
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "harness/campaign/evaluation.h"
+#include "harness/campaign/explorer.h"
+#include "harness/pool/worker_pool.h"
+#include "harness/spec/spec.h"
+#include "stack/base/status.h"
+
+namespace adse::campaign {
+
+struct CampaignOptions {
+  // Campaign folder; empty: the scenario's output.
+  std::string output_dir;
+  // Overrides of the scenario's exploration settings (empty / < 0: keep).
+  std::string strategy;
+  int budget = -1;
+  // Overrides of the scenario's harness settings (empty / < 0: keep).
+  std::string isolation;
+  int workers = -1;
+  // Read and fill the shared evaluation cache.
+  bool use_cache = true;
+  // Cache folder; empty: harness.cache_dir, else <user cache>/runs.
+  std::string cache_dir;
+  // Run again points whose runs failed for good in an earlier session.
+  bool retry_failed = false;
+  // The worker command line before its arguments; empty: this executable
+  // with "worker". Tests substitute wrappers that misbehave on purpose.
+  std::vector<std::string> worker_command;
+  // Pool settings not in the scenario (tests point cgroup_root elsewhere).
+  pool::PoolOptions pool;
+  // Progress events (may be null).
+  ExplorerListener* listener = nullptr;
+  // Told each failed attempt as it happens: (row so far, attempt, detail).
+  std::function<void(const EvalRequest&, int attempt, const std::string&)>
+      on_attempt_failed;
+  // Told once the pool is up: its slots, how workers are confined, and why
+  // auto fell back to affinity (empty when it did not).
+  std::function<void(int workers, const std::string& isolation,
+                     const std::string& fallback)>
+      on_pool_ready;
+};
+
+struct CampaignSummary {
+  std::string output_dir;
+  std::string strategy;
+  std::string isolation;       // how workers were confined
+  std::string isolation_note;  // why auto fell back, if it did
+  int workers = 0;
+  ExplorationResult exploration;
+  std::vector<int> pareto_front;  // indices into exploration.evaluations
+  int simulated = 0, reused = 0, failed = 0;
+  double wall_s = 0.0;
+  // The signal that stopped the campaign early, or 0.
+  int interrupted_by = 0;
+};
+
+// Runs (or resumes) the campaign of `spec`. Errors: InvalidArgument for
+// bad options, Unavailable when the folder is locked by another run or
+// `isolation: cgroup` cannot be had, IoError when the folder cannot be
+// written. Failed runs do not make it fail: they are in the summary.
+Result<CampaignSummary> RunCampaign(const spec::Spec& spec,
+                                    const CampaignOptions& options);
+
+// Rebuilds campaign.h5, report.md, summary.json and pareto.png from an
+// exploration's rows (also done by RunCampaign as it goes).
+Status WriteCampaignViews(const spec::Spec& spec,
+                          const CampaignSummary& summary);
+
+}  // namespace adse::campaign
+
+#endif  // ADSE_HARNESS_CAMPAIGN_CAMPAIGN_H_

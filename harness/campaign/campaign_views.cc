@@ -1,0 +1,267 @@
+// The campaign folder's views, all rebuilt from the evaluation rows:
+// campaign.h5 (index), summary.json, report.md and pareto.png.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "analysis/pictures/pictures.h"
+#include "analysis/runfile/campaign_file.h"
+#include "harness/campaign/campaign.h"
+#include "harness/campaign/run_store.h"
+#include "harness/spec/spec_parser.h"
+#include "stack/base/files.h"
+
+namespace adse::campaign {
+namespace {
+
+std::string Number(double v) {
+  if (std::isnan(v)) return "—";
+  return fmt::format("{:.4g}", v);
+}
+
+double Metric(const EvaluationRow& row, const std::string& name) {
+  auto it = row.metrics.find(name);
+  return it == row.metrics.end() ? NAN : it->second;
+}
+
+nlohmann::json RowJson(const spec::Spec& spec, const EvaluationRow& row) {
+  nlohmann::json metrics = nlohmann::json::object();
+  for (const auto& [name, value] : row.metrics) {
+    metrics[name] =
+        std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
+  }
+  nlohmann::json j = {
+      {"index", row.index},
+      {"iteration", row.iteration},
+      {"point", row.point},
+      {"point_text", spec::FormatPoint(spec.design_space, row.point)},
+      {"content_key", row.content_key},
+      {"status", row.status},
+      {"reason", row.reason},
+      {"source", row.source},
+      {"attempts", row.attempts},
+      {"wall_s", row.wall_s},
+      {"feasible", row.feasible},
+      {"metrics", metrics}};
+  j["bottlenecks"] =
+      nlohmann::json::parse(row.bottlenecks_json, nullptr, false);
+  if (j["bottlenecks"].is_discarded())
+    j["bottlenecks"] = nlohmann::json::array();
+  return j;
+}
+
+std::string Duration(double s) {
+  if (s < 60) return fmt::format("{:.1f} s", s);
+  const int total = static_cast<int>(std::lround(s));
+  if (total < 3600) return fmt::format("{}m{:02d}s", total / 60, total % 60);
+  return fmt::format("{}h{:02d}m", total / 3600, (total / 60) % 60);
+}
+
+// One line per row: a markdown table cell must not hold a newline or |.
+std::string Cell(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  std::string out;
+  for (char c : text) {
+    if (c == '|') out += "\\";
+    out += c;
+  }
+  return out;
+}
+
+std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s) {
+  const auto& rows = s.exploration.evaluations;
+  std::ostringstream md;
+  md << "# Campaign: " << spec.name << "\n\n";
+  md << fmt::format("- scenario: `{}`\n", spec.source_path);
+  md << fmt::format(
+      "- strategy: `{}` (exploration.seed {}), budget {}: {} evaluations, {} "
+      "simulated, {} reused (this folder or the shared cache), {} failed\n",
+      spec.exploration.strategy, spec.exploration.seed, spec.exploration.budget,
+      rows.size(), s.simulated, s.reused, s.failed);
+  md << fmt::format("- workers: {}, {}\n", s.workers, s.isolation);
+  if (!s.isolation_note.empty()) md << "- note: " << s.isolation_note << "\n";
+  md << fmt::format("- wall time: {}\n", Duration(s.wall_s));
+  if (s.interrupted_by != 0) {
+    md << fmt::format(
+        "- **stopped early by signal {}**: run the same command again to "
+        "resume; finished runs are kept and not repeated\n",
+        s.interrupted_by);
+  }
+  std::vector<std::string> objectives;
+  for (const spec::Objective& o : spec.objectives) {
+    objectives.push_back((o.minimize ? "minimize " : "maximize ") + o.metric);
+  }
+  md << fmt::format("- objectives: {}\n", fmt::join(objectives, ", "));
+  md << fmt::format(
+      "- constraints: {}\n\n",
+      spec.constraints.empty()
+          ? std::string("none")
+          : fmt::format("`{}`", fmt::join(spec.constraints, "`, `")));
+
+  std::vector<std::string> columns;
+  for (const spec::Objective& o : spec.objectives) columns.push_back(o.metric);
+  for (const char* extra : {"hardware_cost", "nav_time_s", "ctrl_rate_hz"}) {
+    if (std::find(columns.begin(), columns.end(), extra) == columns.end()) {
+      columns.push_back(extra);
+    }
+  }
+  const std::set<int> front(s.pareto_front.begin(), s.pareto_front.end());
+  md << "## Pareto front (" << front.size() << " points)\n\n";
+  md << "Constraint-aware and non-dominated over the objectives; infeasible "
+        "points appear only when nothing is feasible.\n\n";
+  md << "| # | point | " << fmt::format("{}", fmt::join(columns, " | "))
+     << " | feasible | picture |\n|---|---|";
+  for (size_t i = 0; i < columns.size(); ++i) md << "---|";
+  md << "---|---|\n";
+  for (int i : s.pareto_front) {
+    const EvaluationRow& row = rows[static_cast<size_t>(i)];
+    md << "| " << row.index << " | "
+       << spec::FormatPoint(spec.design_space, row.point) << " | ";
+    for (const std::string& c : columns) md << Number(Metric(row, c)) << " | ";
+    md << (row.feasible ? "yes" : "no") << " | [png](images/" << row.content_key
+       << "/trajectory.png) |\n";
+  }
+
+  md << "\n## Iterations\n\nEach round's proposal and the strategy's "
+        "reasoning.\n\n| iteration | proposed | rationale |\n|---|---|---|\n";
+  std::map<int64_t, std::vector<std::string>> proposed;
+  for (const EvaluationRow& row : rows) {
+    proposed[row.iteration].push_back(
+        spec::FormatPoint(spec.design_space, row.point));
+  }
+  for (const runfile::IterationRow& it : s.exploration.iterations) {
+    md << "| " << it.iteration << " | "
+       << Cell(fmt::format("{}", fmt::join(proposed[it.iteration], "; ")))
+       << " | " << Cell(it.rationale.empty() ? "—" : it.rationale) << " |\n";
+  }
+
+  md << "\n## All evaluations\n\n| # | point | status | reason | source | "
+        "hardware_cost | nav_time_s | ctrl_rate_hz | deviation_score | "
+        "feasible |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const EvaluationRow& row : rows) {
+    md << fmt::format(
+        "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", row.index,
+        spec::FormatPoint(spec.design_space, row.point), row.status,
+        Cell(row.reason), row.source, Number(Metric(row, "hardware_cost")),
+        Number(Metric(row, "nav_time_s")), Number(Metric(row, "ctrl_rate_hz")),
+        Number(Metric(row, "deviation_score")), row.feasible ? "yes" : "no");
+  }
+
+  md << "\n## Failures\n\n";
+  bool any = false;
+  for (const EvaluationRow& row : rows) {
+    if (row.status == "complete") continue;
+    any = true;
+    md << fmt::format("- #{} {} (run `{}`, {} attempt(s)): {}\n", row.index,
+                      spec::FormatPoint(spec.design_space, row.point),
+                      row.content_key.substr(0, 12), row.attempts, row.reason);
+    md << fmt::format(
+        "  record: `runs/{}.failed.json`, logs: `logs/{}.*.log`\n",
+        row.content_key, row.content_key);
+  }
+  if (!any) md << "None.\n";
+  return md.str();
+}
+
+}  // namespace
+
+Status WriteCampaignViews(const spec::Spec& spec,
+                          const CampaignSummary& summary) {
+  const CampaignFolder folder(summary.output_dir);
+  const auto& rows = summary.exploration.evaluations;
+
+  runfile::CampaignIndex index;
+  index.scenario_name = spec.name;
+  index.scenario_text = spec.source_text;
+  index.strategy = spec.exploration.strategy;
+  index.exploration_seed = spec.exploration.seed;
+  index.budget = spec.exploration.budget;
+  index.isolation = summary.isolation;
+  index.adse_version = ADSE_VERSION;
+  index.parameters = spec.design_space.Names();
+  std::set<std::string> metric_names;
+  for (const EvaluationRow& row : rows) {
+    for (const auto& [name, value] : row.metrics) metric_names.insert(name);
+  }
+  index.metrics.assign(metric_names.begin(), metric_names.end());
+  index.evaluations = rows;
+  index.iterations = summary.exploration.iterations;
+  ADSE_RETURN_IF_ERROR(
+      runfile::WriteCampaignIndex(folder.Path("campaign.h5"), index));
+
+  // The front is recomputed so that views written mid-campaign are right.
+  const std::vector<int> front = ParetoFrontOf(spec, rows);
+  CampaignSummary current = summary;
+  current.pareto_front = front;
+
+  nlohmann::json j;
+  j["scenario"] = spec.name;
+  j["scenario_file"] = spec.source_path;
+  j["strategy"] = spec.exploration.strategy;
+  j["exploration_seed"] = spec.exploration.seed;
+  j["budget"] = spec.exploration.budget;
+  j["workers"] = summary.workers;
+  j["isolation"] = summary.isolation;
+  j["isolation_note"] = summary.isolation_note;
+  j["wall_s"] = summary.wall_s;
+  j["interrupted_by_signal"] = summary.interrupted_by;
+  j["complete"] = summary.interrupted_by == 0;
+  j["counts"] = {{"evaluations", rows.size()},
+                 {"simulated", summary.simulated},
+                 {"reused", summary.reused},
+                 {"failed", summary.failed}};
+  j["objectives"] = nlohmann::json::array();
+  for (const spec::Objective& o : spec.objectives) {
+    j["objectives"].push_back({{"metric", o.metric}, {"minimize", o.minimize}});
+  }
+  j["constraints"] = spec.constraints;
+  j["pareto_front"] = nlohmann::json::array();
+  for (int i : front) j["pareto_front"].push_back(RowJson(spec, rows[i]));
+  j["evaluations"] = nlohmann::json::array();
+  for (const EvaluationRow& row : rows)
+    j["evaluations"].push_back(RowJson(spec, row));
+  j["iterations"] = nlohmann::json::array();
+  for (const runfile::IterationRow& it : summary.exploration.iterations) {
+    j["iterations"].push_back({{"iteration", it.iteration},
+                               {"strategy", it.strategy},
+                               {"rationale", it.rationale},
+                               {"content_keys", it.content_keys}});
+  }
+  ADSE_RETURN_IF_ERROR(WriteFileAtomic(
+      folder.Path("summary.json"),
+      j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"));
+  ADSE_RETURN_IF_ERROR(
+      WriteFileAtomic(folder.Path("report.md"), ReportMarkdown(spec, current)));
+
+  std::vector<analysis::ParetoPlotPoint> plot;
+  const std::set<int> on_front(front.begin(), front.end());
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const double cost = Metric(rows[i], "hardware_cost");
+    const double nav = Metric(rows[i], "nav_time_s");
+    if (!std::isfinite(cost) || !std::isfinite(nav)) continue;
+    const bool front_point = on_front.count(static_cast<int>(i)) > 0;
+    plot.push_back({cost, nav, rows[i].feasible, front_point,
+                    front_point
+                        ? spec::FormatPoint(spec.design_space, rows[i].point)
+                        : std::string()});
+  }
+  if (!plot.empty()) {
+    analysis::ParetoPlotOptions options;
+    options.title =
+        fmt::format("{}: {} evaluations, {} on the front ({})", spec.name,
+                    rows.size(), front.size(), spec.exploration.strategy);
+    // The picture is a convenience: a plot that cannot be drawn (e.g. no
+    // finite point) leaves the other views intact.
+    (void)analysis::RenderParetoPlot(plot, folder.Path("pareto.png"), options);
+  }
+  return Status::Ok();
+}
+
+}  // namespace adse::campaign

@@ -1,0 +1,40 @@
+// One evaluation of a campaign as every part sees it: the row of the
+// campaign index. A live run's RunReport and a recorded index row become
+// the same row, and strategies are told the same Observation from it, so a
+// replay over recorded results behaves exactly like the live campaign.
+#ifndef ADSE_HARNESS_CAMPAIGN_EVALUATION_H_
+#define ADSE_HARNESS_CAMPAIGN_EVALUATION_H_
+
+#include <string>
+#include <vector>
+
+#include "analysis/pareto/pareto.h"
+#include "analysis/runfile/campaign_file.h"
+#include "harness/explore/strategy.h"
+#include "harness/report/run_report.h"
+#include "harness/spec/spec.h"
+
+namespace adse::campaign {
+
+using runfile::EvaluationRow;
+
+// The row for a complete run: metrics, feasibility, termination reason and
+// the diagnosis (bottlenecks_json) from its report. Index, iteration,
+// source, attempts and wall time are the caller's.
+EvaluationRow RowFromReport(const report::RunReport& report);
+
+// What a strategy is told about a row (failed rows: failed = true).
+explore::Observation ObservationFromRow(const EvaluationRow& row);
+
+// The row in the form analysis/pareto ranks: the spec's objectives in
+// minimisation form; a failed row or a missing objective is infeasible.
+analysis::Evaluation ParetoEvaluation(const spec::Spec& spec,
+                                      const EvaluationRow& row);
+
+// Indices (into `rows`) of the constraint-aware Pareto front.
+std::vector<int> ParetoFrontOf(const spec::Spec& spec,
+                               const std::vector<EvaluationRow>& rows);
+
+}  // namespace adse::campaign
+
+#endif  // ADSE_HARNESS_CAMPAIGN_EVALUATION_H_

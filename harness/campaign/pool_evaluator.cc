@@ -1,0 +1,265 @@
+#include "harness/campaign/pool_evaluator.h"
+
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "analysis/runfile/run_file.h"
+#include "harness/report/run_report.h"
+#include "harness/sim/run_key.h"
+#include "harness/spec/spec_parser.h"
+
+namespace adse::campaign {
+namespace fs = std::filesystem;
+
+namespace {
+
+// The last non-empty line of a worker's output, for one-line messages.
+std::string LastLine(const std::string& text) {
+  size_t end = text.find_last_not_of(" \n\r\t");
+  if (end == std::string::npos) return "";
+  const size_t begin = text.rfind('\n', end);
+  return text.substr(begin == std::string::npos ? 0 : begin + 1,
+                     end + 1 - (begin == std::string::npos ? 0 : begin + 1));
+}
+
+std::string Describe(const pool::JobResult& r, double timeout_s,
+                     int memory_mb) {
+  switch (r.outcome) {
+    case pool::Outcome::kOk:
+      return "ok";
+    case pool::Outcome::kTimeout:
+      return fmt::format("killed after run_timeout_s = {:g} s", timeout_s);
+    case pool::Outcome::kOutOfMemory:
+      return fmt::format("out of memory (limit memory_mb = {})", memory_mb);
+    case pool::Outcome::kCrashed:
+      return fmt::format("crashed: killed by signal {} ({})", r.signal,
+                         strsignal(r.signal));
+    case pool::Outcome::kExitError: {
+      const std::string line = LastLine(r.stderr_tail);
+      return fmt::format("worker exited with status {}{}{}", r.exit_code,
+                         line.empty() ? "" : ": ", line);
+    }
+    case pool::Outcome::kCancelled:
+      return "cancelled";
+  }
+  return "unknown";
+}
+
+}  // namespace
+
+PoolEvaluator::PoolEvaluator(const spec::Spec& spec,
+                             const CampaignFolder& folder,
+                             pool::WorkerPool* pool,
+                             PoolEvaluatorOptions options)
+    : spec_(spec), folder_(folder), pool_(pool), options_(std::move(options)) {}
+
+int PoolEvaluator::capacity() const { return pool_->slots(); }
+
+int PoolEvaluator::outstanding() const {
+  return static_cast<int>(queued_.size() + running_.size() + ready_.size());
+}
+
+bool PoolEvaluator::interrupted() const {
+  return pool::InterruptRequested() != 0;
+}
+
+std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
+                                                    const std::string& source) {
+  const std::string path = folder_.RunPath(p.key);
+  Result<runfile::RunData> run = runfile::ReadRunFile(path);
+  if (run.ok() && run->content_key != p.key) {
+    run = Status::Corruption(fmt::format("{}: holds run {} (renamed by hand?)",
+                                         path, run->content_key));
+  }
+  report::AnalyzeOptions analyze;
+  std::error_code ec;
+  const std::string image_dir = folder_.ImageDir(p.key);
+  // Pictures are drawn once; a resumed campaign reuses them.
+  if (!fs::exists(image_dir + "/trajectory.png", ec)) {
+    fs::create_directories(image_dir, ec);
+    analyze.image_dir = image_dir;
+  }
+  Result<report::RunReport> report =
+      run.ok() ? report::AnalyzeRun(*run, path, analyze)
+               : Result<report::RunReport>(run.status());
+  if (!report.ok()) {
+    // Keep the evidence, out of the way of the content-keyed name.
+    fs::rename(path, path + ".unreadable", ec);
+    std::fprintf(stderr, "warning: %s is unusable (%s); running it again\n",
+                 path.c_str(), report.status().message().c_str());
+    return std::nullopt;
+  }
+  EvaluationRow row = RowFromReport(*report);
+  row.index = p.request.index;
+  row.iteration = p.request.iteration;
+  row.content_key = p.key;
+  row.source = source;
+  row.attempts = p.attempt;
+  return row;
+}
+
+EvaluationRow PoolEvaluator::FailedRow(const Pending& p,
+                                       const FailureRecord& record,
+                                       const std::string& source) const {
+  EvaluationRow row;
+  row.index = p.request.index;
+  row.iteration = p.request.iteration;
+  row.content_key = p.key;
+  row.status = "failed";
+  row.reason = record.outcome + ": " + record.detail;
+  row.source = source;
+  row.attempts = record.attempts;
+  row.wall_s = record.wall_s;
+  row.seed = p.seed;
+  row.point = p.request.point;
+  row.bottlenecks_json = "[]";
+  return row;
+}
+
+void PoolEvaluator::Start(const EvalRequest& request) {
+  Pending p;
+  p.request = request;
+  p.seed = spec_.world.traffic.seed;
+  Result<std::string> key = sim::RunKey(spec_, request.point, p.seed);
+  if (!key.ok()) {
+    // Only an unreadable input file makes this fail; no run can help.
+    FailureRecord record;
+    record.outcome = "input_error";
+    record.detail = key.status().message();
+    ready_.push_back(FailedRow(p, record, "campaign"));
+    return;
+  }
+  p.key = *key;
+  std::error_code ec;
+  if (fs::exists(folder_.RunPath(p.key), ec)) {
+    if (auto row = LoadRun(p, "campaign")) {
+      ready_.push_back(*row);
+      return;
+    }
+  }
+  if (!options_.retry_failed && fs::exists(folder_.FailurePath(p.key), ec)) {
+    Result<FailureRecord> record =
+        ReadFailureRecord(folder_.FailurePath(p.key));
+    if (record.ok()) {
+      ready_.push_back(FailedRow(p, *record, "campaign"));
+      return;
+    }
+  }
+  if (options_.cache != nullptr && options_.cache->Find(p.key)) {
+    if (options_.cache->CopyOut(p.key, folder_.RunPath(p.key)).ok()) {
+      if (auto row = LoadRun(p, "cache")) {
+        ready_.push_back(*row);
+        return;
+      }
+    }
+  }
+  queued_.push_back(p);
+  Dispatch();
+}
+
+void PoolEvaluator::Dispatch() {
+  while (!queued_.empty() && pool_->idle_slots() > 0 && !interrupted()) {
+    Pending p = queued_.front();
+    queued_.pop_front();
+    ++p.attempt;
+    pool::Job job;
+    job.id = next_job_++;
+    job.argv = options_.worker_command;
+    for (const std::string& arg :
+         {options_.scenario_path, std::string("--point"),
+          spec::FormatPoint(spec_.design_space, p.request.point),
+          std::string("--seed"), std::to_string(p.seed), std::string("--out"),
+          folder_.RunPath(p.key), std::string("--expect-key"), p.key}) {
+      job.argv.push_back(arg);
+    }
+    job.log_path = folder_.LogPath(p.key, p.attempt);
+    job.timeout_s = options_.run_timeout_s;
+    if (Status s = pool_->Submit(job); !s.ok()) {
+      pool::JobResult failed;
+      failed.id = job.id;
+      failed.outcome = pool::Outcome::kExitError;
+      failed.stderr_tail = s.message();
+      running_[job.id] = p;
+      Finish(failed);
+      continue;
+    }
+    running_[job.id] = p;
+  }
+}
+
+void PoolEvaluator::Finish(const pool::JobResult& result) {
+  auto it = running_.find(result.id);
+  if (it == running_.end()) return;
+  Pending p = it->second;
+  running_.erase(it);
+  if (result.outcome == pool::Outcome::kCancelled) return;
+  std::string detail;
+  if (result.outcome == pool::Outcome::kOk) {
+    if (auto row = LoadRun(p, "simulated")) {
+      row->wall_s = result.wall_s;
+      if (options_.cache != nullptr) {
+        // A cache that cannot be written costs reuse, not the result.
+        if (Status s = options_.cache->Insert(p.key, folder_.RunPath(p.key));
+            !s.ok()) {
+          std::fprintf(stderr, "warning: cache: %s\n", s.message().c_str());
+        }
+      }
+      ready_.push_back(*row);
+      return;
+    }
+    detail = "the worker succeeded but its run file is unusable";
+  } else {
+    detail = Describe(result, options_.run_timeout_s, options_.memory_mb);
+  }
+  // Bad input (exit 2: the scenario changed under the campaign, a point
+  // outside the space) fails the same way every time: no retry.
+  const bool hopeless =
+      result.outcome == pool::Outcome::kExitError && result.exit_code == 2;
+  if (!hopeless && p.attempt <= options_.retries) {
+    if (options_.on_attempt_failed) {
+      options_.on_attempt_failed(p.request, p.attempt, detail);
+    }
+    queued_.push_front(p);
+    return;
+  }
+  FailureRecord record;
+  record.content_key = p.key;
+  record.point = spec::FormatPoint(spec_.design_space, p.request.point);
+  record.seed = p.seed;
+  record.outcome = result.outcome == pool::Outcome::kOk
+                       ? "unusable_output"
+                       : pool::OutcomeName(result.outcome);
+  record.exit_code = result.exit_code;
+  record.signal = result.signal;
+  record.attempts = p.attempt;
+  record.wall_s = result.wall_s;
+  record.detail = detail;
+  record.stderr_tail = result.stderr_tail;
+  if (Status s = WriteFailureRecord(folder_.FailurePath(p.key), record);
+      !s.ok()) {
+    std::fprintf(stderr, "warning: %s\n", s.message().c_str());
+  }
+  ready_.push_back(FailedRow(p, record, "simulated"));
+}
+
+std::vector<EvaluationRow> PoolEvaluator::Wait() {
+  while (ready_.empty() && !interrupted() &&
+         !(queued_.empty() && running_.empty())) {
+    for (const pool::JobResult& r : pool_->Wait(1.0)) Finish(r);
+    Dispatch();
+  }
+  std::vector<EvaluationRow> rows;
+  rows.swap(ready_);
+  return rows;
+}
+
+void PoolEvaluator::Cancel() {
+  for (const pool::JobResult& r : pool_->CancelAll()) Finish(r);
+  running_.clear();
+  queued_.clear();
+}
+
+}  // namespace adse::campaign

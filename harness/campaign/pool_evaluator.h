@@ -1,0 +1,80 @@
+// The live Evaluator: finds a point's run by content key in the campaign
+// folder or the shared cache, and otherwise runs `adse worker` for it on
+// the pool, retrying failed attempts and recording the ones that fail for
+// good. Internal to harness/campaign.
+#ifndef ADSE_HARNESS_CAMPAIGN_POOL_EVALUATOR_H_
+#define ADSE_HARNESS_CAMPAIGN_POOL_EVALUATOR_H_
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "harness/campaign/explorer.h"
+#include "harness/campaign/run_store.h"
+#include "harness/pool/worker_pool.h"
+#include "harness/spec/spec.h"
+
+namespace adse::campaign {
+
+struct PoolEvaluatorOptions {
+  std::vector<std::string> worker_command;  // before the worker's arguments
+  std::string scenario_path;                // absolute
+  int retries = 1;
+  double run_timeout_s = 900.0;
+  int memory_mb = 4096;
+  bool retry_failed = false;
+  const RunCache* cache = nullptr;  // null: no shared cache
+  std::function<void(const EvalRequest&, int attempt, const std::string&)>
+      on_attempt_failed;
+};
+
+class PoolEvaluator : public Evaluator {
+ public:
+  PoolEvaluator(const spec::Spec& spec, const CampaignFolder& folder,
+                pool::WorkerPool* pool, PoolEvaluatorOptions options);
+
+  int capacity() const override;
+  void Start(const EvalRequest& request) override;
+  int outstanding() const override;
+  std::vector<EvaluationRow> Wait() override;
+  bool interrupted() const override;
+
+  // Kills running attempts (their points stay unevaluated: no run file,
+  // no failure record) and forgets queued ones.
+  void Cancel();
+
+ private:
+  struct Pending {
+    EvalRequest request;
+    std::string key;
+    uint64_t seed = 0;
+    int attempt = 0;  // 1-based once started
+  };
+
+  // A row from an existing run file; nullopt when the file is unusable
+  // (then it is moved aside and the point simulated again).
+  std::optional<EvaluationRow> LoadRun(const Pending& p,
+                                       const std::string& source);
+  EvaluationRow FailedRow(const Pending& p, const FailureRecord& record,
+                          const std::string& source) const;
+  void Dispatch();
+  void Finish(const pool::JobResult& result);
+
+  const spec::Spec& spec_;
+  const CampaignFolder& folder_;
+  pool::WorkerPool* pool_;
+  PoolEvaluatorOptions options_;
+  std::deque<Pending> queued_;
+  std::map<uint64_t, Pending> running_;  // job id -> attempt
+  uint64_t next_job_ = 1;
+  std::vector<EvaluationRow> ready_;
+};
+
+}  // namespace adse::campaign
+
+#endif  // ADSE_HARNESS_CAMPAIGN_POOL_EVALUATOR_H_

@@ -1,0 +1,111 @@
+#include "harness/campaign/replay.h"
+
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "harness/spec/spec_parser.h"
+
+namespace adse::campaign {
+namespace fs = std::filesystem;
+
+Result<Recording> LoadRecording(const std::string& folder_or_file) {
+  std::error_code ec;
+  const std::string path = fs::is_directory(folder_or_file, ec)
+                               ? folder_or_file + "/campaign.h5"
+                               : folder_or_file;
+  Result<runfile::CampaignIndex> index = runfile::ReadCampaignIndex(path);
+  if (!index.ok()) return index.status();
+  spec::ParseOptions parse;
+  parse.check_files = false;  // only the space, objectives and constraints
+  Result<spec::Spec> spec =
+      spec::ParseSpec(index->scenario_text,
+                      path + " (scenario stored in the index)", "", parse);
+  if (!spec.ok()) return spec.status();
+  Recording recording{std::move(spec).value(), std::move(index->evaluations)};
+  if (recording.rows.empty()) {
+    return Status::InvalidArgument(path + ": the campaign has no evaluations");
+  }
+  return recording;
+}
+
+RecordingEvaluator::RecordingEvaluator(const Recording* recording)
+    : recording_(recording) {}
+
+void RecordingEvaluator::Start(const EvalRequest& request) {
+  for (const EvaluationRow& recorded : recording_->rows) {
+    if (analysis::SameDesignPoint(recorded.point, request.point)) {
+      EvaluationRow row = recorded;
+      row.index = request.index;
+      row.iteration = request.iteration;
+      row.source = "recording";
+      ready_.push_back(row);
+      return;
+    }
+  }
+  ++missing_;
+  EvaluationRow row;
+  row.index = request.index;
+  row.iteration = request.iteration;
+  row.point = request.point;
+  row.status = "failed";
+  row.reason = "not recorded";
+  row.source = "recording";
+  row.bottlenecks_json = "[]";
+  ready_.push_back(row);
+}
+
+std::vector<EvaluationRow> RecordingEvaluator::Wait() {
+  std::vector<EvaluationRow> rows;
+  rows.swap(ready_);
+  return rows;
+}
+
+Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
+                         uint64_t seed, int budget) {
+  spec::Spec spec = recording.spec;
+  spec.exploration.strategy = name;
+  spec.exploration.seed = seed;
+  if (budget > 0) spec.exploration.budget = budget;
+  Result<std::unique_ptr<explore::Strategy>> strategy =
+      explore::CreateStrategy(name, {&spec});
+  if (!strategy.ok()) return strategy.status();
+  RecordingEvaluator evaluator(&recording);
+  const ExplorationResult result = Explore(spec, **strategy, evaluator);
+
+  std::vector<analysis::Evaluation> found, reference;
+  for (const EvaluationRow& row : result.evaluations) {
+    found.push_back(ParetoEvaluation(spec, row));
+  }
+  for (const EvaluationRow& row : recording.rows) {
+    reference.push_back(ParetoEvaluation(spec, row));
+  }
+  const analysis::SearchQuality quality =
+      analysis::CompareToReference(found, reference);
+
+  ReplayRun run;
+  run.strategy = name;
+  run.seed = seed;
+  run.evaluations = static_cast<int>(result.evaluations.size());
+  run.missing = evaluator.missing();
+  run.true_pareto_found = quality.true_pareto_points_found;
+  run.front_size = quality.true_front_size;
+  run.hypervolume_ratio = quality.hypervolume_ratio;
+  // The evaluation at which the first true Pareto point arrived.
+  const std::vector<int> true_front = analysis::ParetoFront(reference);
+  for (size_t i = 0; i < found.size() && run.first_true_pareto_at == 0; ++i) {
+    for (int t : true_front) {
+      if (reference[t].feasible &&
+          analysis::SameDesignPoint(found[i].point, reference[t].point)) {
+        run.first_true_pareto_at = static_cast<int>(i) + 1;
+        break;
+      }
+    }
+  }
+  for (const EvaluationRow& row : result.evaluations) {
+    run.proposals.push_back(row.point);
+  }
+  return run;
+}
+
+}  // namespace adse::campaign

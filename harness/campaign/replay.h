@@ -1,0 +1,65 @@
+// Replay: runs strategies against a recorded campaign's results instead of
+// simulating, to compare strategies over many seeds in seconds. A point
+// the recording lacks is told as failed ("not recorded") and counted.
+#ifndef ADSE_HARNESS_CAMPAIGN_REPLAY_H_
+#define ADSE_HARNESS_CAMPAIGN_REPLAY_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "analysis/runfile/campaign_file.h"
+#include "harness/campaign/explorer.h"
+#include "harness/spec/spec.h"
+#include "stack/base/status.h"
+
+namespace adse::campaign {
+
+// A recorded campaign: its scenario and every evaluated row.
+struct Recording {
+  spec::Spec spec;  // parsed from the scenario text stored in campaign.h5
+  std::vector<EvaluationRow> rows;
+};
+
+// Reads <folder>/campaign.h5 (or a campaign.h5 path). Errors name the file.
+Result<Recording> LoadRecording(const std::string& folder_or_file);
+
+// Answers evaluations from a recording, one at a time.
+class RecordingEvaluator : public Evaluator {
+ public:
+  explicit RecordingEvaluator(const Recording* recording);
+  int capacity() const override { return 1; }
+  void Start(const EvalRequest& request) override;
+  int outstanding() const override { return static_cast<int>(ready_.size()); }
+  std::vector<EvaluationRow> Wait() override;
+  bool interrupted() const override { return false; }
+  int missing() const { return missing_; }
+
+ private:
+  const Recording* recording_;
+  std::vector<EvaluationRow> ready_;
+  int missing_ = 0;
+};
+
+struct ReplayRun {
+  std::string strategy;
+  uint64_t seed = 0;
+  int evaluations = 0;
+  int missing = 0;            // proposed points the recording lacks
+  int true_pareto_found = 0;  // of the recording's front
+  int front_size = 0;         // the recording's front
+  double hypervolume_ratio = 0.0;
+  // Evaluation index (1-based) of the first true Pareto point, 0 if none.
+  int first_true_pareto_at = 0;
+  std::vector<spec::DesignPoint> proposals;  // in order
+};
+
+// Replays `strategy` with exploration.seed = seed and the given budget
+// (<= 0: the recording's scenario budget) over the recording.
+Result<ReplayRun> Replay(const Recording& recording,
+                         const std::string& strategy, uint64_t seed,
+                         int budget);
+
+}  // namespace adse::campaign
+
+#endif  // ADSE_HARNESS_CAMPAIGN_REPLAY_H_

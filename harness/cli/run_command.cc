@@ -1,0 +1,220 @@
+// `adse run`: a campaign, with a progress bar on a terminal and plain log
+// lines otherwise. Exit 0 when the campaign finished (failed runs are in
+// the report), 2 for bad input, 1 for other errors, 128 + signal when
+// stopped by Ctrl-C / SIGTERM (run the same command again to resume).
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "harness/campaign/campaign.h"
+#include "harness/cli/cli_support.h"
+#include "harness/cli/commands.h"
+#include "harness/spec/spec_parser.h"
+#include "stack/base/files.h"
+
+namespace adse::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string Eta(double s) {
+  if (!std::isfinite(s) || s < 0) return "--";
+  const int total = static_cast<int>(std::lround(s));
+  if (total < 60) return fmt::format("{}s", total);
+  if (total < 3600) return fmt::format("{}m{:02d}s", total / 60, total % 60);
+  return fmt::format("{}h{:02d}m", total / 3600, (total / 60) % 60);
+}
+
+// Progress of a campaign on stderr: a redrawn bar on a terminal, one line
+// per event otherwise. Failures are always printed as they happen.
+class Progress : public campaign::ExplorerListener {
+ public:
+  Progress(const spec::Spec& spec, int budget, bool tty, bool quiet)
+      : spec_(spec), budget_(budget), tty_(tty), quiet_(quiet) {}
+
+  void set_workers(int workers) { workers_ = workers; }
+
+  void OnProposed(const explore::Strategy& strategy,
+                  const runfile::IterationRow& it,
+                  const std::vector<spec::DesignPoint>& points) override {
+    proposed_ += static_cast<int>(points.size());
+    if (!quiet_ && !tty_ && !it.rationale.empty()) {
+      std::fprintf(stderr, "iteration %lld (%s): %s\n",
+                   static_cast<long long>(it.iteration),
+                   strategy.name().c_str(), it.rationale.c_str());
+    }
+    Draw();
+  }
+
+  void OnEvaluated(const campaign::EvaluationRow& row) override {
+    ++done_;
+    const bool failed = row.status != "complete";
+    if (failed) ++failed_;
+    if (row.source == "simulated") {
+      simulated_wall_s_ += row.wall_s;
+      ++simulated_;
+    }
+    auto cost = row.metrics.find("hardware_cost");
+    if (row.feasible && cost != row.metrics.end() &&
+        cost->second < best_cost_) {
+      best_cost_ = cost->second;
+      best_point_ = spec::FormatPoint(spec_.design_space, row.point);
+    }
+    const std::string point = spec::FormatPoint(spec_.design_space, row.point);
+    std::string line;
+    if (failed) {
+      line = fmt::format(
+          "[{}/{}] FAILED {}: {} ({} attempt(s); see runs/{}.failed.json)",
+          done_, budget_, point, row.reason, row.attempts, row.content_key);
+    } else if (!quiet_ && !tty_) {
+      auto metric = [&row](const char* name) {
+        auto it = row.metrics.find(name);
+        return it == row.metrics.end() ? std::nan("") : it->second;
+      };
+      line = fmt::format(
+          "[{}/{}] {}: {}, nav {:.1f} s, ctrl {:.1f} Hz, cost {:.3g}, {} "
+          "({}{})",
+          done_, budget_, point, row.reason, metric("nav_time_s"),
+          metric("ctrl_rate_hz"), metric("hardware_cost"),
+          row.feasible ? "feasible" : "infeasible", row.source,
+          row.source == "simulated" ? fmt::format(" {:.1f} s", row.wall_s)
+                                    : "");
+    }
+    if (!line.empty() && (failed || !quiet_)) {
+      if (tty_) std::fprintf(stderr, "\r\033[K");
+      std::fprintf(stderr, "%s\n", line.c_str());
+    }
+    Draw();
+  }
+
+  void AttemptFailed(const campaign::EvalRequest& request, int attempt,
+                     const std::string& detail) {
+    if (tty_) std::fprintf(stderr, "\r\033[K");
+    std::fprintf(stderr, "attempt %d of %s failed: %s; retrying\n", attempt,
+                 spec::FormatPoint(spec_.design_space, request.point).c_str(),
+                 detail.c_str());
+    Draw();
+  }
+
+  void Finish() {
+    if (tty_ && !quiet_) std::fprintf(stderr, "\r\033[K");
+  }
+
+ private:
+  void Draw() {
+    if (!tty_ || quiet_) return;
+    const int running = std::max(0, std::min(workers_, proposed_ - done_));
+    constexpr int kWidth = 24;
+    const int filled =
+        budget_ > 0 ? std::min(kWidth, done_ * kWidth / budget_) : 0;
+    const double per_run =
+        simulated_ > 0 ? simulated_wall_s_ / simulated_ : NAN;
+    const double eta =
+        per_run * std::max(0, budget_ - done_) / std::max(1, workers_);
+    std::fprintf(
+        stderr,
+        "\r\033[K[%s%s] %d/%d done, %d running, %d failed, ETA %s, best "
+        "feasible %s",
+        std::string(filled, '#').c_str(),
+        std::string(kWidth - filled, '.').c_str(), done_, budget_, running,
+        failed_, Eta(eta).c_str(),
+        std::isfinite(best_cost_)
+            ? fmt::format("cost {:.3g} ({})", best_cost_, best_point_).c_str()
+            : "none yet");
+    std::fflush(stderr);
+  }
+
+  const spec::Spec& spec_;
+  int budget_;
+  bool tty_, quiet_;
+  int workers_ = 1;
+  int proposed_ = 0, done_ = 0, failed_ = 0, simulated_ = 0;
+  double simulated_wall_s_ = 0.0;
+  double best_cost_ = std::numeric_limits<double>::infinity();
+  std::string best_point_;
+};
+
+}  // namespace
+
+int RunRun(const RunArgs& args) {
+  std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
+  if (!spec) return 2;
+  campaign::CampaignOptions options;
+  options.output_dir = args.out;
+  options.strategy = args.strategy;
+  options.budget = args.budget;
+  options.workers = args.workers;
+  options.isolation = args.isolation;
+  options.use_cache = !args.no_cache;
+  options.cache_dir = args.cache_dir;
+  options.retry_failed = args.retry_failed;
+
+  const int budget = args.budget >= 0 ? args.budget : spec->exploration.budget;
+  const uint64_t space = spec->design_space.Size();
+  Progress progress(*spec, static_cast<int>(std::min<uint64_t>(budget, space)),
+                    ::isatty(STDERR_FILENO) != 0, args.quiet);
+  options.listener = &progress;
+  options.on_attempt_failed = [&progress](const campaign::EvalRequest& r,
+                                          int attempt,
+                                          const std::string& detail) {
+    progress.AttemptFailed(r, attempt, detail);
+  };
+  options.on_pool_ready = [&](int workers, const std::string& isolation,
+                              const std::string& fallback) {
+    progress.set_workers(workers);
+    if (!fallback.empty()) std::fprintf(stderr, "note: %s\n", fallback.c_str());
+    if (!args.quiet)
+      std::fprintf(stderr, "%d worker(s): %s\n", workers, isolation.c_str());
+  };
+
+  Result<campaign::CampaignSummary> summary =
+      campaign::RunCampaign(*spec, options);
+  progress.Finish();
+  if (!summary.ok()) {
+    std::fprintf(stderr, "error: %s\n", summary.status().message().c_str());
+    return ExitCodeFor(summary.status());
+  }
+  const campaign::CampaignSummary& s = *summary;
+  if (args.json) {
+    Result<std::string> text = ReadFile(s.output_dir + "/summary.json");
+    std::printf("%s", text.ok() ? text->c_str() : "{}\n");
+  } else if (!args.quiet) {
+    std::printf(
+        "%s: %zu evaluations (%d simulated, %d reused, %d failed) in %s with "
+        "%d "
+        "worker(s)\n",
+        spec->name.c_str(), s.exploration.evaluations.size(), s.simulated,
+        s.reused, s.failed, Eta(s.wall_s).c_str(), s.workers);
+    std::printf("Pareto front (%zu):\n", s.pareto_front.size());
+    for (int i : s.pareto_front) {
+      const campaign::EvaluationRow& row =
+          s.exploration.evaluations[static_cast<size_t>(i)];
+      auto metric = [&row](const char* name) {
+        auto it = row.metrics.find(name);
+        return it == row.metrics.end() ? std::nan("") : it->second;
+      };
+      std::printf("  %-36s cost %6.3g  nav %6.1f s  ctrl %5.1f Hz%s\n",
+                  spec::FormatPoint(spec->design_space, row.point).c_str(),
+                  metric("hardware_cost"), metric("nav_time_s"),
+                  metric("ctrl_rate_hz"), row.feasible ? "" : "  (infeasible)");
+    }
+    std::printf("report: %s/report.md\n", s.output_dir.c_str());
+  }
+  if (s.interrupted_by != 0) {
+    std::fprintf(stderr,
+                 "stopped by signal %d: %zu evaluations kept; run the same "
+                 "command again to "
+                 "resume\n",
+                 s.interrupted_by, s.exploration.evaluations.size());
+    return 128 + s.interrupted_by;
+  }
+  return 0;
+}
+
+}  // namespace adse::cli

@@ -1,0 +1,341 @@
+// End to end: campaigns of the small robotaxi scenario on real `adse
+// worker` processes — the folder's views, resume after a clean stop and
+// after SIGKILL of the coordinator, the lock, the shared cache, failures
+// with their reasons and retries, and replay against a recording.
+#include "harness/campaign/campaign.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <thread>
+
+#include "analysis/runfile/campaign_file.h"
+#include "harness/campaign/replay.h"
+#include "harness/campaign/run_store.h"
+#include "harness/spec/spec_parser.h"
+#include "stack/base/files.h"
+#include "tests/harness/testing/small_scenario.h"
+
+namespace adse::campaign {
+namespace {
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+const std::string kAdse = std::string(ADSE_BINARY_DIR) + "/bin/adse";
+
+std::string TempDir(const std::string& name) {
+  const std::string dir = fs::temp_directory_path().string() +
+                          "/adse-campaign-" + name + "-" +
+                          std::to_string(::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+CampaignOptions Options(const std::string& out, const std::string& strategy,
+                        int budget) {
+  CampaignOptions o;
+  o.output_dir = out;
+  o.strategy = strategy;
+  o.budget = budget;
+  o.workers = 2;
+  o.use_cache = false;
+  o.worker_command = {kAdse, "worker"};
+  return o;
+}
+
+std::set<std::string> RunFiles(const std::string& folder) {
+  std::set<std::string> keys;
+  if (!fs::is_directory(folder + "/runs")) return keys;
+  for (const auto& e : fs::directory_iterator(folder + "/runs")) {
+    const std::string name = e.path().filename().string();
+    if (name.size() == 64 + 3 && name.substr(64) == ".h5")
+      keys.insert(name.substr(0, 64));
+  }
+  return keys;
+}
+
+std::vector<std::string> IndexKeys(const std::string& folder) {
+  Result<runfile::CampaignIndex> index =
+      runfile::ReadCampaignIndex(folder + "/campaign.h5");
+  EXPECT_TRUE(index.ok()) << index.status().message();
+  std::vector<std::string> keys;
+  if (index.ok()) {
+    for (const auto& row : index->evaluations) keys.push_back(row.content_key);
+  }
+  return keys;
+}
+
+TEST(CampaignTest,
+     ExhaustiveCampaignWritesEveryViewAndASecondRunRepeatsNothing) {
+  const spec::Spec spec = adse::testing::SmallScenario();
+  const std::string out = TempDir("exhaustive");
+  Result<CampaignSummary> first =
+      RunCampaign(spec, Options(out, "exhaustive", 12));
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  EXPECT_EQ(first->exploration.evaluations.size(), 12u);
+  EXPECT_EQ(first->simulated, 12);
+  EXPECT_EQ(first->failed, 0);
+  EXPECT_EQ(RunFiles(out).size(), 12u);
+  EXPECT_FALSE(first->pareto_front.empty());
+  for (const char* view :
+       {"campaign.h5", "report.md", "summary.json", "pareto.png"}) {
+    EXPECT_TRUE(fs::is_regular_file(out + "/" + view)) << view;
+  }
+  const std::string report = ReadFile(out + "/report.md").value();
+  EXPECT_THAT(report, HasSubstr("## Pareto front"));
+  EXPECT_THAT(report, HasSubstr("## Iterations"));
+  EXPECT_THAT(report, HasSubstr("cores=16,freq_ghz=2.1"));
+  // Starved (1 core, 1 GHz) points are infeasible; generous ones feasible.
+  int feasible = 0;
+  for (const EvaluationRow& row : first->exploration.evaluations) {
+    feasible += row.feasible;
+    EXPECT_TRUE(
+        fs::exists(out + "/images/" + row.content_key + "/trajectory.png"));
+    if (row.point.at("cores") == 1 && row.point.at("freq_ghz") == 1.0)
+      EXPECT_FALSE(row.feasible);
+    if (row.point.at("cores") == 16) EXPECT_TRUE(row.feasible) << row.reason;
+  }
+  EXPECT_GT(feasible, 0);
+  EXPECT_EQ(IndexKeys(out).size(), 12u);
+
+  Result<CampaignSummary> second =
+      RunCampaign(spec, Options(out, "exhaustive", 12));
+  ASSERT_TRUE(second.ok()) << second.status().message();
+  EXPECT_EQ(second->simulated, 0);
+  EXPECT_EQ(second->reused, 12);
+  ASSERT_EQ(second->exploration.evaluations.size(), 12u);
+  for (size_t i = 0; i < 12; ++i) {
+    EXPECT_EQ(second->exploration.evaluations[i].content_key,
+              first->exploration.evaluations[i].content_key);
+    EXPECT_EQ(second->exploration.evaluations[i].metrics,
+              first->exploration.evaluations[i].metrics);
+  }
+
+  // Replay of the agent over this recording proposes exactly what a live
+  // agent campaign does when every run comes from the recording's cache.
+  const std::string cache = TempDir("replay-cache");
+  for (const std::string& key : RunFiles(out)) {
+    ASSERT_TRUE(RunCache(cache).Insert(key, out + "/runs/" + key + ".h5").ok());
+  }
+  Result<Recording> recording = LoadRecording(out);
+  ASSERT_TRUE(recording.ok()) << recording.status().message();
+  for (const char* strategy : {"agent", "ga", "random"}) {
+    Result<ReplayRun> replay =
+        Replay(*recording, strategy, spec.exploration.seed, 6);
+    ASSERT_TRUE(replay.ok()) << replay.status().message();
+    EXPECT_EQ(replay->missing, 0);
+    CampaignOptions live =
+        Options(TempDir(std::string("live-") + strategy), strategy, 6);
+    live.use_cache = true;
+    live.cache_dir = cache;
+    Result<CampaignSummary> s = RunCampaign(spec, live);
+    ASSERT_TRUE(s.ok()) << s.status().message();
+    EXPECT_EQ(s->simulated, 0) << strategy << ": every run is in the cache";
+    std::vector<spec::DesignPoint> proposed;
+    for (const EvaluationRow& row : s->exploration.evaluations)
+      proposed.push_back(row.point);
+    EXPECT_EQ(proposed, replay->proposals) << strategy;
+  }
+}
+
+TEST(CampaignTest, ASecondCampaignOnALockedFolderIsRefused) {
+  const spec::Spec spec = adse::testing::SmallScenario();
+  const std::string out = TempDir("locked");
+  Result<CampaignLock> held = CampaignLock::Acquire(out);
+  ASSERT_TRUE(held.ok());
+  Result<CampaignSummary> s = RunCampaign(spec, Options(out, "exhaustive", 2));
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.status().code(), Status::Code::kUnavailable);
+  EXPECT_THAT(s.status().message(), HasSubstr("another adse run"));
+  EXPECT_FALSE(fs::exists(out + "/campaign.h5")) << "nothing was written";
+}
+
+TEST(CampaignTest, TheSharedCacheLetsAnotherCampaignReuseEveryRun) {
+  const spec::Spec spec = adse::testing::SmallScenario();
+  const std::string cache = TempDir("cache");
+  CampaignOptions a = Options(TempDir("cache-a"), "random", 3);
+  a.use_cache = true;
+  a.cache_dir = cache;
+  Result<CampaignSummary> first = RunCampaign(spec, a);
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  EXPECT_EQ(first->simulated, 3);
+  CampaignOptions b = a;
+  b.output_dir = TempDir("cache-b");
+  Result<CampaignSummary> second = RunCampaign(spec, b);
+  ASSERT_TRUE(second.ok()) << second.status().message();
+  EXPECT_EQ(second->simulated, 0);
+  EXPECT_EQ(second->reused, 3);
+  for (const EvaluationRow& row : second->exploration.evaluations)
+    EXPECT_EQ(row.source, "cache");
+  // --no-cache neither reads it nor fills it.
+  CampaignOptions c = b;
+  c.output_dir = TempDir("cache-c");
+  c.use_cache = false;
+  c.budget = 1;
+  Result<CampaignSummary> third = RunCampaign(spec, c);
+  ASSERT_TRUE(third.ok());
+  EXPECT_EQ(third->simulated, 1);
+}
+
+// A worker wrapper that misbehaves for chosen points and otherwise runs
+// the real worker: `kill -9` itself, sleep past the timeout, or allocate
+// far past the memory limit.
+std::string MisbehavingWorker(const std::string& dir) {
+  const std::string path = dir + "/worker.sh";
+  std::ofstream(path)
+      << "#!/bin/sh\n"
+         "# $1 scenario, $2 --point, $3 the point\n"
+         "case \"$3\" in\n"
+         "  cores=4,freq_ghz=1,lidar_hz=7) kill -9 $$ ;;\n"
+         "  cores=4,freq_ghz=1,lidar_hz=14) exec sleep 60 ;;\n"
+         "  cores=4,freq_ghz=2.1,lidar_hz=7) exec python3 -c "
+         "'a = bytearray(1 << 30); a[::4096] = b\"x\" * len(a[::4096]); "
+         "import time; time.sleep(30)' ;;\n"
+         "esac\n"
+         "exec " +
+             kAdse + " worker \"$@\"\n";
+  fs::permissions(path, fs::perms::owner_all);
+  return path;
+}
+
+TEST(CampaignTest,
+     CrashTimeoutAndOutOfMemoryAreRecordedRetriedAndDoNotStopTheCampaign) {
+  spec::Spec spec = adse::testing::SmallScenario();
+  // Four quick points (4 cores take ~3 s each); the worker still checks
+  // them against the file's space, which holds them.
+  spec.design_space.parameters[0].values = {4};
+  spec.harness.run_timeout_s = 8;
+  spec.harness.retries = 1;
+  spec.harness.memory_mb = 400;
+  const std::string out = TempDir("failures");
+  CampaignOptions o = Options(out, "exhaustive", 4);
+  o.worker_command = {"/bin/sh", MisbehavingWorker(out)};
+  std::vector<std::string> attempts;
+  o.on_attempt_failed = [&attempts](const EvalRequest& r, int attempt,
+                                    const std::string& d) {
+    attempts.push_back(d);
+  };
+  Result<CampaignSummary> s = RunCampaign(spec, o);
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->exploration.evaluations.size(), 4u);
+  std::map<std::string, EvaluationRow> by_point;
+  for (const EvaluationRow& row : s->exploration.evaluations) {
+    by_point[spec::FormatPoint(spec.design_space, row.point)] = row;
+  }
+  const EvaluationRow& crashed = by_point.at("cores=4,freq_ghz=1,lidar_hz=7");
+  EXPECT_EQ(crashed.status, "failed");
+  EXPECT_THAT(crashed.reason, HasSubstr("crashed"));
+  EXPECT_THAT(crashed.reason, HasSubstr("signal 9"));
+  EXPECT_EQ(crashed.attempts, 2);
+  const EvaluationRow& slow = by_point.at("cores=4,freq_ghz=1,lidar_hz=14");
+  EXPECT_THAT(slow.reason, HasSubstr("timeout"));
+  EXPECT_EQ(slow.attempts, 2);
+  const EvaluationRow& hungry = by_point.at("cores=4,freq_ghz=2.1,lidar_hz=7");
+  EXPECT_THAT(hungry.reason, HasSubstr("out_of_memory"));
+  EXPECT_EQ(hungry.attempts, 2);
+  const EvaluationRow& fine = by_point.at("cores=4,freq_ghz=2.1,lidar_hz=14");
+  EXPECT_EQ(fine.status, "complete") << fine.reason;
+  EXPECT_EQ(s->failed, 3);
+  EXPECT_EQ(attempts.size(), 3u)
+      << "each failure was retried once, as it happened";
+  for (const char* key_of :
+       {"cores=4,freq_ghz=1,lidar_hz=7", "cores=4,freq_ghz=1,lidar_hz=14"}) {
+    Result<FailureRecord> record = ReadFailureRecord(
+        out + "/runs/" + by_point.at(key_of).content_key + ".failed.json");
+    ASSERT_TRUE(record.ok()) << record.status().message();
+    EXPECT_EQ(record->attempts, 2);
+  }
+  EXPECT_THAT(ReadFile(out + "/report.md").value(), HasSubstr("## Failures"));
+
+  // Failed for good means recorded: a resumed campaign does not rerun
+  // them unless asked to.
+  Result<CampaignSummary> again = RunCampaign(spec, o);
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->simulated, 0);
+  EXPECT_EQ(again->failed, 3);
+}
+
+// Starts `adse run` as a separate process, so that it can be killed.
+pid_t StartAdseRun(const std::vector<std::string>& args,
+                   const std::string& log) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    argv.push_back(const_cast<char*>(kAdse.c_str()));
+    for (const std::string& a : args)
+      argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    FILE* f = std::freopen(log.c_str(), "w", stderr);
+    (void)f;
+    ::execv(kAdse.c_str(), argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+TEST(
+    CampaignTest,
+    CoordinatorKilledMidCampaignThenRestartedEndsWithTheSameRunsAsAnUninterruptedOne) {
+  const std::string scenario = adse::testing::SmallScenarioPath();
+  const std::string killed = TempDir("killed");
+  const std::string whole = TempDir("whole");
+  const std::vector<std::string> common = {
+      "--strategy", "agent", "--budget",   "7",
+      "--workers",  "2",     "--no-cache", "--quiet"};
+  auto args = [&](const std::string& out) {
+    std::vector<std::string> a = {"run", scenario, "-o", out};
+    a.insert(a.end(), common.begin(), common.end());
+    return a;
+  };
+  const pid_t coordinator =
+      StartAdseRun(args(killed), killed + "/stderr-1.log");
+  ASSERT_GT(coordinator, 0);
+  // Kill it once some runs are on disk.
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::seconds(240);
+  while (RunFiles(killed).size() < 3 &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_GE(RunFiles(killed).size(), 3u);
+  ::kill(coordinator, SIGKILL);
+  int status = 0;
+  ::waitpid(coordinator, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status));
+  const std::set<std::string> before = RunFiles(killed);
+
+  const pid_t resumed = StartAdseRun(args(killed), killed + "/stderr-2.log");
+  ::waitpid(resumed, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
+      << ReadFile(killed + "/stderr-2.log").value();
+  const pid_t uninterrupted = StartAdseRun(args(whole), whole + "/stderr.log");
+  ::waitpid(uninterrupted, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+
+  const std::set<std::string> after = RunFiles(killed);
+  EXPECT_EQ(after, RunFiles(whole));
+  EXPECT_EQ(after.size(), 7u);
+  for (const std::string& key : before)
+    EXPECT_TRUE(after.count(key)) << "nothing lost";
+  const std::vector<std::string> index = IndexKeys(killed);
+  EXPECT_EQ(index, IndexKeys(whole)) << "same proposals in the same order";
+  EXPECT_EQ(std::set<std::string>(index.begin(), index.end()).size(),
+            index.size())
+      << "no duplicates";
+  // The resumed coordinator simulated only what was missing.
+  Result<std::string> summary = ReadFile(killed + "/summary.json");
+  ASSERT_TRUE(summary.ok());
+  EXPECT_THAT(*summary,
+              HasSubstr("\"simulated\": " + std::to_string(7 - before.size())));
+}
+
+}  // namespace
+}  // namespace adse::campaign

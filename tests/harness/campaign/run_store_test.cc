@@ -1,0 +1,113 @@
+// The campaign folder's lock, failure records, atomic copies and the shared
+// cache.
+#include "harness/campaign/run_store.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "stack/base/files.h"
+
+namespace adse::campaign {
+namespace {
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+std::string TempDir(const std::string& name) {
+  const std::string dir = fs::temp_directory_path().string() +
+                          "/adse-run-store-" + name + "-" +
+                          std::to_string(::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+TEST(CampaignLockTest, ASecondHolderIsRefusedWithTheFirstOnesPid) {
+  const std::string dir = TempDir("lock");
+  Result<CampaignLock> first = CampaignLock::Acquire(dir);
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  Result<CampaignLock> second = CampaignLock::Acquire(dir);
+  ASSERT_FALSE(second.ok());
+  EXPECT_EQ(second.status().code(), Status::Code::kUnavailable);
+  EXPECT_THAT(second.status().message(),
+              HasSubstr("pid " + std::to_string(::getpid())));
+  EXPECT_THAT(second.status().message(), HasSubstr(dir));
+  { CampaignLock released = std::move(first).value(); }
+  EXPECT_TRUE(CampaignLock::Acquire(dir).ok());
+}
+
+TEST(CampaignLockTest, AHolderKilledOutrightLeavesNoStaleLock) {
+  const std::string dir = TempDir("killed");
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    Result<CampaignLock> lock = CampaignLock::Acquire(dir);
+    if (!lock.ok()) ::_exit(1);
+    ::pause();
+    ::_exit(0);
+  }
+  // Wait until the child holds it.
+  bool held = false;
+  for (int i = 0; i < 200 && !held; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    held = !CampaignLock::Acquire(dir).ok();
+  }
+  ASSERT_TRUE(held) << "the child never took the lock";
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  EXPECT_TRUE(CampaignLock::Acquire(dir).ok());
+}
+
+TEST(FailureRecordTest, RoundTripsAndRejectsDamage) {
+  const std::string dir = TempDir("failure");
+  FailureRecord r;
+  r.content_key = std::string(64, 'a');
+  r.point = "cores=1,freq_ghz=1";
+  r.seed = 7;
+  r.outcome = "timeout";
+  r.signal = 9;
+  r.attempts = 2;
+  r.wall_s = 1.5;
+  r.detail = "killed after run_timeout_s = 1 s";
+  r.stderr_tail = "line 1\n\xff invalid utf-8\n";
+  ASSERT_TRUE(WriteFailureRecord(dir + "/f.json", r).ok());
+  Result<FailureRecord> back = ReadFailureRecord(dir + "/f.json");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->outcome, "timeout");
+  EXPECT_EQ(back->attempts, 2);
+  EXPECT_EQ(back->signal, 9);
+  EXPECT_EQ(back->point, r.point);
+  ASSERT_TRUE(WriteFileAtomic(dir + "/bad.json", "{\"no\": 1}").ok());
+  Result<FailureRecord> bad = ReadFailureRecord(dir + "/bad.json");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.status().code(), Status::Code::kCorruption);
+  EXPECT_THAT(bad.status().message(), HasSubstr("bad.json"));
+}
+
+TEST(RunCacheTest, InsertFindAndCopyOutLeaveNoTemporaries) {
+  const std::string dir = TempDir("cache");
+  ASSERT_TRUE(WriteFileAtomic(dir + "/run.h5", "payload").ok());
+  RunCache cache(dir + "/cache");
+  const std::string key(64, 'b');
+  EXPECT_FALSE(cache.Find(key).has_value());
+  ASSERT_TRUE(cache.Insert(key, dir + "/run.h5").ok());
+  ASSERT_TRUE(cache.Find(key).has_value());
+  ASSERT_TRUE(cache.CopyOut(key, dir + "/campaign/runs/" + key + ".h5").ok());
+  EXPECT_EQ(ReadFile(dir + "/campaign/runs/" + key + ".h5").value(), "payload");
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    EXPECT_EQ(entry.path().string().find(".tmp."), std::string::npos)
+        << entry.path();
+  }
+  EXPECT_FALSE(CopyFileAtomic(dir + "/missing.h5", dir + "/x.h5").ok());
+  EXPECT_FALSE(fs::exists(dir + "/x.h5"));
+}
+
+}  // namespace
+}  // namespace adse::campaign

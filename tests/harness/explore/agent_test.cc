@@ -1,0 +1,515 @@
+// The `agent` strategy: the shared contract (no repeats, budget,
+// determinism, start_from, failed runs, batches, any space), its rationale,
+// and a synthetic study where it must find more of the true Pareto front
+// than random search within a small budget.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "harness/explore/strategy.h"
+#include "harness/spec/spec_parser.h"
+
+namespace adse::explore {
+namespace {
+
+spec::Spec Parse(const std::string& body) {
+  const std::string text = R"(adse: 1
+world: {map: {generate: grid}}
+task: {start: {edge: E0}, goal: {edge: E5, pos_m: 20, lane: 1}}
+)" + body;
+  Result<spec::Spec> spec = spec::ParseSpec(text, "t.yaml", "");
+  EXPECT_TRUE(spec.ok()) << spec.status().message();
+  return spec.ok() ? *spec : spec::Spec();
+}
+
+// 16 x 5 x 2 = 160 points; two objectives, a navigation-time limit.
+spec::Spec MakeSpec(const std::string& exploration) {
+  return Parse(R"(design_space:
+  cores:    {bind: platform.cores,      range: [1, 16]}
+  freq_ghz: {bind: platform.freq_ghz,   values: [1.0, 1.2, 1.5, 1.8, 2.1]}
+  lidar_hz: {bind: stack.lidar.rate_hz, values: [7, 14]}
+objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}, {maximize: ctrl_rate_hz}]
+constraints: [nav_time_s <= 60, completed]
+exploration: )" +
+               exploration + "\n");
+}
+
+// A robotaxi-like analytic model: the stack needs compute that grows with
+// the LiDAR rate; navigation time falls with compute and saturates once
+// the parallel part has enough cores; one core cannot finish.
+Observation Evaluate(const spec::DesignPoint& point) {
+  Observation o;
+  o.point = point;
+  const double cores = point.at("cores");
+  const double freq = point.at("freq_ghz");
+  const double lidar = point.at("lidar_hz");
+  const double load = lidar / 7.0;
+  const double nav =
+      28.0 + 70.0 * load / (std::min(cores, 10.0) * freq) + 10.0 / freq;
+  const bool completed = cores >= 2;
+  o.metrics["completed"] = completed ? 1 : 0;
+  o.metrics["nav_time_s"] = completed ? nav : 600.0;
+  o.metrics["ctrl_rate_hz"] =
+      std::min(30.0, 6.0 * std::min(cores, 6.0) * freq / load);
+  o.metrics["hardware_cost"] = cores * freq;
+  o.feasible = completed && nav <= 60.0;
+  if (!o.feasible) {
+    const bool frequency = 10.0 / freq > 7.0;
+    o.bottlenecks.push_back(
+        {"cpu_bound", "ndt_scan_matcher",
+         frequency ? "higher frequency" : "more cores; lower sensor rate",
+         0.3});
+  }
+  return o;
+}
+
+std::unique_ptr<Strategy> Create(const spec::Spec& spec,
+                                 const std::string& name = "agent") {
+  Result<std::unique_ptr<Strategy>> strategy =
+      CreateStrategy(name, StrategyContext{&spec});
+  EXPECT_TRUE(strategy.ok()) << strategy.status().message();
+  return strategy.ok() ? std::move(*strategy) : nullptr;
+}
+
+// Ask/tell rounds of `batch` until nothing is proposed; returns every
+// proposal in order. `evaluate` may mark runs failed.
+template <typename F>
+std::vector<spec::DesignPoint> Drive(Strategy& strategy, int batch,
+                                     F evaluate) {
+  std::vector<spec::DesignPoint> all;
+  for (int round = 0; round < 1000; ++round) {
+    std::vector<spec::DesignPoint> points = strategy.Ask(batch);
+    EXPECT_LE(static_cast<int>(points.size()), batch);
+    if (points.empty()) break;
+    for (const spec::DesignPoint& point : points) {
+      all.push_back(point);
+      strategy.Tell(evaluate(point));
+    }
+  }
+  return all;
+}
+
+std::vector<spec::DesignPoint> Drive(Strategy& strategy, int batch) {
+  return Drive(strategy, batch, Evaluate);
+}
+
+void ExpectDistinctAndAllowed(const spec::Spec& spec,
+                              const std::vector<spec::DesignPoint>& points) {
+  std::set<spec::DesignPoint> distinct(points.begin(), points.end());
+  EXPECT_EQ(distinct.size(), points.size());
+  for (const spec::DesignPoint& point : points) {
+    EXPECT_TRUE(spec.design_space.Check(point).ok())
+        << spec.design_space.Check(point).message();
+  }
+}
+
+TEST(AgentTest, IsRegisteredAndAdaptive) {
+  const std::vector<std::string>& names = StrategyNames();
+  EXPECT_NE(std::find(names.begin(), names.end(), "agent"), names.end());
+  const spec::Spec spec = MakeSpec("{budget: 5}");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  EXPECT_EQ(strategy->name(), "agent");
+  EXPECT_TRUE(strategy->adaptive());
+  EXPECT_EQ(strategy->RoundSize(3), 3);
+  EXPECT_EQ(strategy->RoundSize(0), 1);
+}
+
+TEST(AgentTest, NeverRepeatsAndSpendsTheBudgetExactly) {
+  const spec::Spec spec = MakeSpec("{budget: 25, seed: 3}");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  const std::vector<spec::DesignPoint> points = Drive(*strategy, 1);
+  EXPECT_EQ(points.size(), 25u);
+  ExpectDistinctAndAllowed(spec, points);
+  EXPECT_TRUE(strategy->Ask(4).empty());
+  EXPECT_NE(strategy->rationale().find("budget"), std::string::npos);
+}
+
+TEST(AgentTest, BudgetLargerThanTheSpaceCoversItOnce) {
+  const spec::Spec spec = Parse(R"(design_space:
+  cores:    {bind: platform.cores,    range: [1, 6]}
+  freq_ghz: {bind: platform.freq_ghz, values: [1.0, 2.0]}
+objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]
+constraints: [nav_time_s <= 60]
+exploration: {budget: 100}
+)");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  const std::vector<spec::DesignPoint> points =
+      Drive(*strategy, 5, [](const spec::DesignPoint& point) {
+        spec::DesignPoint full = point;
+        full["lidar_hz"] = 7;
+        Observation o = Evaluate(full);
+        o.point = point;
+        return o;
+      });
+  EXPECT_EQ(points.size(), 12u);
+  ExpectDistinctAndAllowed(spec, points);
+}
+
+TEST(AgentTest, DeterministicAcrossInstances) {
+  const spec::Spec a = MakeSpec("{budget: 15, seed: 11}");
+  std::unique_ptr<Strategy> first = Create(a);
+  std::unique_ptr<Strategy> again = Create(a);
+  ASSERT_TRUE(first && again);
+  const std::vector<spec::DesignPoint> p1 = Drive(*first, 1);
+  const std::vector<spec::DesignPoint> p2 = Drive(*again, 1);
+  EXPECT_EQ(p1, p2);
+  EXPECT_EQ(first->rationale(), again->rationale());
+  // Batches too, and a replay that re-creates the strategy mid-way.
+  const spec::Spec b = MakeSpec("{budget: 15, seed: 4, batch: 3}");
+  std::unique_ptr<Strategy> third = Create(b);
+  std::unique_ptr<Strategy> fourth = Create(b);
+  EXPECT_EQ(Drive(*third, 3), Drive(*fourth, 3));
+}
+
+TEST(AgentTest, StartsFromStartFrom) {
+  const spec::Spec spec = MakeSpec(
+      "{budget: 6, start_from: {cores: 12, freq_ghz: 1.5, lidar_hz: 14}}");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  const std::vector<spec::DesignPoint> first = strategy->Ask(1);
+  ASSERT_EQ(first.size(), 1u);
+  EXPECT_EQ(first[0], (spec::DesignPoint{
+                          {"cores", 12}, {"freq_ghz", 1.5}, {"lidar_hz", 14}}));
+  EXPECT_NE(strategy->rationale().find("start_from"), std::string::npos);
+}
+
+TEST(AgentTest, WithoutStartFromItStillProposes) {
+  const spec::Spec spec = MakeSpec("{budget: 6}");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  const std::vector<spec::DesignPoint> points = Drive(*strategy, 1);
+  EXPECT_EQ(points.size(), 6u);
+  ExpectDistinctAndAllowed(spec, points);
+}
+
+TEST(AgentTest, ToldPointsAreNeverProposed) {
+  const spec::Spec spec = MakeSpec("{budget: 40, seed: 2}");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  std::set<spec::DesignPoint> told;
+  for (double cores : {2.0, 4.0, 8.0}) {
+    for (double freq : {1.0, 1.2, 1.5, 1.8, 2.1}) {
+      spec::DesignPoint point{
+          {"cores", cores}, {"freq_ghz", freq}, {"lidar_hz", 7}};
+      told.insert(point);
+      strategy->Tell(Evaluate(point));
+    }
+  }
+  const std::vector<spec::DesignPoint> points = Drive(*strategy, 2);
+  EXPECT_EQ(points.size(), 40u);
+  for (const spec::DesignPoint& point : points) {
+    EXPECT_EQ(told.count(point), 0u);
+  }
+}
+
+TEST(AgentTest, FailedRunsAreSurvivedAndTheirNeighboursAvoided) {
+  const spec::Spec spec = MakeSpec(
+      "{budget: 15, seed: 5, start_from: {cores: 8, freq_ghz: 1.5, "
+      "lidar_hz: 7}}");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  // Every run with 3 or fewer cores crashes.
+  auto evaluate = [](const spec::DesignPoint& point) {
+    if (point.at("cores") <= 3) {
+      Observation o;
+      o.point = point;
+      o.failed = true;
+      return o;
+    }
+    return Evaluate(point);
+  };
+  const std::vector<spec::DesignPoint> points = Drive(*strategy, 1, evaluate);
+  EXPECT_EQ(points.size(), 15u);
+  ExpectDistinctAndAllowed(spec, points);
+  int failed = 0;
+  for (const spec::DesignPoint& point : points) {
+    failed += point.at("cores") <= 3 ? 1 : 0;
+  }
+  // Cheap points are tempting, but once some crashed their neighbours are
+  // avoided.
+  EXPECT_LE(failed, 5);
+  // Everything failing is no problem either.
+  std::unique_ptr<Strategy> doomed = Create(spec);
+  std::vector<spec::DesignPoint> all_failed;
+  for (int round = 0; round < 20; ++round) {
+    const std::vector<spec::DesignPoint> points = doomed->Ask(2);
+    if (points.empty()) break;
+    if (round > 0) {
+      EXPECT_NE(doomed->rationale().find("failed"), std::string::npos)
+          << doomed->rationale();
+    }
+    for (const spec::DesignPoint& point : points) {
+      all_failed.push_back(point);
+      Observation o;
+      o.point = point;
+      o.failed = true;
+      doomed->Tell(o);
+    }
+  }
+  EXPECT_EQ(all_failed.size(), 15u);
+  ExpectDistinctAndAllowed(spec, all_failed);
+}
+
+TEST(AgentTest, BatchesAreDistinctAndSpread) {
+  const spec::Spec spec = MakeSpec("{budget: 24, seed: 7, batch: 4}");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  EXPECT_EQ(strategy->RoundSize(4), 4);
+  std::vector<spec::DesignPoint> all;
+  for (int round = 0; round < 6; ++round) {
+    const std::vector<spec::DesignPoint> points = strategy->Ask(4);
+    ASSERT_EQ(points.size(), 4u) << "round " << round;
+    std::set<spec::DesignPoint> distinct(points.begin(), points.end());
+    EXPECT_EQ(distinct.size(), 4u);
+    for (const spec::DesignPoint& point : points) {
+      all.push_back(point);
+      strategy->Tell(Evaluate(point));
+    }
+  }
+  ExpectDistinctAndAllowed(spec, all);
+  EXPECT_TRUE(strategy->Ask(4).empty());
+}
+
+TEST(AgentTest, AskWithoutTellsStillNeverRepeats) {
+  // A caller that asks again before telling: pending points are seen.
+  const spec::Spec spec = MakeSpec("{budget: 9}");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  std::vector<spec::DesignPoint> all;
+  for (int i = 0; i < 5; ++i) {
+    for (const spec::DesignPoint& point : strategy->Ask(2)) {
+      all.push_back(point);
+    }
+  }
+  EXPECT_EQ(all.size(), 9u);
+  ExpectDistinctAndAllowed(spec, all);
+}
+
+TEST(AgentTest, OneParameterSpace) {
+  const spec::Spec spec = Parse(R"(design_space:
+  cores: {bind: platform.cores, range: [1, 40]}
+objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]
+constraints: [nav_time_s <= 60]
+exploration: {budget: 10, start_from: {cores: 20}}
+)");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  const std::vector<spec::DesignPoint> points =
+      Drive(*strategy, 1, [](const spec::DesignPoint& point) {
+        Observation o;
+        o.point = point;
+        const double cores = point.at("cores");
+        const double nav = 30.0 + 200.0 / std::min(cores, 25.0);
+        o.metrics = {{"nav_time_s", nav},
+                     {"hardware_cost", cores * 2.1},
+                     {"completed", 1}};
+        o.feasible = nav <= 60.0;
+        return o;
+      });
+  ASSERT_EQ(points.size(), 10u);
+  ExpectDistinctAndAllowed(spec, points);
+  // The true front is 7..25 cores; the search brackets its cheap end
+  // (7 to 9 cores) and spends most of the budget on the front.
+  int on_front = 0;
+  bool near_boundary = false;
+  for (const spec::DesignPoint& point : points) {
+    const double cores = point.at("cores");
+    on_front += cores >= 7 && cores <= 25 ? 1 : 0;
+    near_boundary = near_boundary || (cores >= 7 && cores <= 9);
+  }
+  EXPECT_GE(on_front, 7);
+  EXPECT_TRUE(near_boundary);
+}
+
+TEST(AgentTest, FourParameterSpaceWithAStackKnob) {
+  const spec::Spec spec = Parse(R"(design_space:
+  cores:    {bind: platform.cores,      range: [1, 12]}
+  freq_ghz: {bind: platform.freq_ghz,   values: [1.0, 1.5, 2.0]}
+  lidar_hz: {bind: stack.lidar.rate_hz, values: [5, 10, 15]}
+  beams:    {bind: stack.lidar.beams,   values: [8, 16, 32]}
+objectives: [{minimize: hardware_cost}, {minimize: deviation_score}]
+constraints: [nav_time_s <= 80, ctrl_rate_hz >= 5]
+exploration: {budget: 20, seed: 9, batch: 2}
+)");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  const std::vector<spec::DesignPoint> points =
+      Drive(*strategy, 2, [](const spec::DesignPoint& point) {
+        Observation o;
+        o.point = point;
+        const double compute = point.at("cores") * point.at("freq_ghz");
+        const double load = point.at("lidar_hz") * point.at("beams") / 80.0;
+        const double nav = 30.0 + 40.0 * load / compute;
+        o.metrics = {{"nav_time_s", nav},
+                     {"ctrl_rate_hz", 30.0 * compute / (compute + load)},
+                     {"deviation_score", 0.05 / std::sqrt(load)},
+                     {"hardware_cost", compute},
+                     {"completed", 1}};
+        o.feasible = nav <= 80.0 && o.metrics["ctrl_rate_hz"] >= 5;
+        return o;
+      });
+  EXPECT_EQ(points.size(), 20u);
+  ExpectDistinctAndAllowed(spec, points);
+}
+
+TEST(AgentTest, OneObjectiveNoConstraintsOrNoObjectivesAtAll) {
+  spec::Spec spec = Parse(R"(design_space:
+  cores:    {bind: platform.cores,    range: [1, 16]}
+  freq_ghz: {bind: platform.freq_ghz, values: [1.0, 1.5, 2.0]}
+objectives: [{minimize: nav_time_s}]
+exploration: {budget: 12, seed: 2}
+)");
+  auto evaluate = [](const spec::DesignPoint& point) {
+    spec::DesignPoint full = point;
+    full["lidar_hz"] = 7;
+    Observation o = Evaluate(full);
+    o.point = point;
+    o.feasible = true;
+    return o;
+  };
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  std::vector<spec::DesignPoint> points = Drive(*strategy, 1, evaluate);
+  EXPECT_EQ(points.size(), 12u);
+  ExpectDistinctAndAllowed(spec, points);
+  // The fastest corner (>= 10 cores at 2 GHz) is found.
+  bool fastest = false;
+  for (const spec::DesignPoint& point : points) {
+    fastest =
+        fastest || (point.at("cores") >= 10 && point.at("freq_ghz") == 2.0);
+  }
+  EXPECT_TRUE(fastest);
+
+  spec.objectives.clear();
+  std::unique_ptr<Strategy> aimless = Create(spec);
+  ASSERT_NE(aimless, nullptr);
+  points = Drive(*aimless, 3, evaluate);
+  EXPECT_EQ(points.size(), 12u);
+  ExpectDistinctAndAllowed(spec, points);
+}
+
+TEST(AgentTest, LargeSpaceIsSampled) {
+  // 28 x 20 x 20 x 20 x 14 = 3.1 million points: sampled, not enumerated.
+  const spec::Spec spec = Parse(R"(design_space:
+  cores:    {bind: platform.cores,        range: [1, 28]}
+  freq_ghz: {bind: platform.freq_ghz,     range: [0.5, 2.4], step: 0.1}
+  lidar_hz: {bind: stack.lidar.rate_hz,   range: [1, 20]}
+  beams:    {bind: stack.lidar.beams,     range: [4, 23]}
+  range_m:  {bind: stack.lidar.range_m,   range: [20, 150], step: 10}
+objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]
+constraints: [nav_time_s <= 80]
+exploration: {budget: 12, seed: 3, batch: 3}
+)");
+  ASSERT_GT(spec.design_space.Size(), 3000000u);
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  const std::vector<spec::DesignPoint> points =
+      Drive(*strategy, 3, [](const spec::DesignPoint& point) {
+        Observation o;
+        o.point = point;
+        const double compute = point.at("cores") * point.at("freq_ghz");
+        const double load = point.at("lidar_hz") * point.at("beams") *
+                            point.at("range_m") / 2000.0;
+        const double nav = 30.0 + 40.0 * load / compute;
+        o.metrics = {
+            {"nav_time_s", nav}, {"hardware_cost", compute}, {"completed", 1}};
+        o.feasible = nav <= 80.0;
+        return o;
+      });
+  EXPECT_EQ(points.size(), 12u);
+  ExpectDistinctAndAllowed(spec, points);
+}
+
+TEST(AgentTest, RationaleNamesTheLastPointAndTheDiagnosis) {
+  const spec::Spec spec = MakeSpec(
+      "{budget: 5, start_from: {cores: 3, freq_ghz: 1.0, lidar_hz: 14}}");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  const std::vector<spec::DesignPoint> first = strategy->Ask(1);
+  ASSERT_EQ(first.size(), 1u);
+  const Observation o = Evaluate(first[0]);
+  ASSERT_FALSE(o.feasible);
+  strategy->Tell(o);
+  ASSERT_EQ(strategy->Ask(1).size(), 1u);
+  const std::string text = strategy->rationale();
+  EXPECT_NE(text.find("3 cores, 1 GHz, lidar_hz 14"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("infeasible"), std::string::npos) << text;
+  EXPECT_NE(text.find("nav_time_s"), std::string::npos) << text;
+  EXPECT_NE(text.find("ndt_scan_matcher"), std::string::npos) << text;
+  EXPECT_NE(text.find("p="), std::string::npos) << text;
+}
+
+// The constraint-aware front of the whole synthetic space.
+std::set<spec::DesignPoint> TrueFront(const spec::Spec& spec) {
+  SpaceGrid grid(spec.design_space);
+  std::vector<std::pair<spec::DesignPoint, std::vector<double>>> feasible;
+  for (uint64_t i = 0; i < grid.size(); ++i) {
+    const Observation o = Evaluate(grid.ToPoint(grid.Decode(i)));
+    if (o.feasible) {
+      feasible.emplace_back(o.point, MinimizationObjectives(spec, o));
+    }
+  }
+  std::set<spec::DesignPoint> front;
+  for (const auto& [point, objectives] : feasible) {
+    bool dominated = false;
+    for (const auto& [other, theirs] : feasible) {
+      bool no_worse = true, better = false;
+      for (size_t j = 0; j < objectives.size(); ++j) {
+        no_worse = no_worse && theirs[j] <= objectives[j];
+        better = better || theirs[j] < objectives[j];
+      }
+      dominated = dominated || (no_worse && better);
+    }
+    if (!dominated) front.insert(point);
+  }
+  return front;
+}
+
+int FrontPointsFound(const std::vector<spec::DesignPoint>& points,
+                     const std::set<spec::DesignPoint>& front) {
+  int found = 0;
+  for (const spec::DesignPoint& point : points) {
+    found += front.count(point) ? 1 : 0;
+  }
+  return found;
+}
+
+TEST(AgentTest, FindsMoreOfTheTrueFrontThanRandomSearch) {
+  const spec::Spec reference = MakeSpec("{budget: 15}");
+  const std::set<spec::DesignPoint> front = TrueFront(reference);
+  ASSERT_GE(front.size(), 10u);
+  int agent_total = 0;
+  int random_total = 0;
+  int agent_worst = 1000;
+  constexpr int kSeeds = 5;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    const spec::Spec spec =
+        MakeSpec("{budget: 15, seed: " + std::to_string(seed) +
+                 ", start_from: {cores: 12, freq_ghz: 1.5, lidar_hz: 14}}");
+    std::unique_ptr<Strategy> agent = Create(spec);
+    std::unique_ptr<Strategy> random = Create(spec, "random");
+    ASSERT_TRUE(agent && random);
+    const int a = FrontPointsFound(Drive(*agent, 1), front);
+    const int r = FrontPointsFound(Drive(*random, 1), front);
+    agent_total += a;
+    random_total += r;
+    agent_worst = std::min(agent_worst, a);
+  }
+  // Most of a 15-point budget lands on the true front, far more than
+  // random search finds.
+  EXPECT_GE(agent_total, kSeeds * 7) << "random: " << random_total;
+  EXPECT_GE(agent_total, 2 * random_total + kSeeds);
+  EXPECT_GE(agent_worst, 5);
+}
+
+}  // namespace
+}  // namespace adse::explore
