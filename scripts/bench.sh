@@ -41,5 +41,8 @@ if [[ "${ADSE_BENCH_SWEEP:-1}" != 0 ]]; then
   echo
   echo "== simulate_sweep"
   ADSE_BIN="${build}/bin/adse" "${root}/tests/bench/simulate_sweep.sh" || status=1
+  echo
+  echo "== campaign_bench"
+  ADSE_BIN="${build}/bin/adse" "${root}/tests/bench/campaign_bench.sh" || status=1
 fi
 exit "${status}"

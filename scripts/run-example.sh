@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds adse and runs the most complete job that
-# exists on the bundled robotaxi scenario: validate it (280-point space),
-# drive its world with a perfect controller while the LiDAR scans, then
-# evaluate its start point in closed loop with the AD stack on the virtual
-# platform. No network and no LLM needed.
+# Installs what is missing, builds adse and runs its main job on the bundled
+# robotaxi scenario: validate it (280-point space), check its world with a
+# perfect controller, then `adse run` — the campaign with the default
+# built-in `agent` strategy (budget 15, worker processes in cgroups where
+# possible), ending with the Pareto front, report.md, pareto.png and
+# campaign.h5 in results/robotaxi-parking-lot/. Finally re-analyses the
+# campaign's run files offline. No network and no LLM needed. Running it
+# again resumes (nothing is simulated twice).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -13,7 +16,7 @@ echo "== adse validate $scenario"
 build/bin/adse validate --quiet "$scenario"
 echo "== adse world $scenario --follow-ideal"
 build/bin/adse world "$scenario" --follow-ideal
-echo "== adse simulate $scenario (exploration.start_from)"
-build/bin/adse simulate "$scenario"
-echo "== adse analyze results/robotaxi-parking-lot/simulate (offline re-analysis)"
-build/bin/adse analyze results/robotaxi-parking-lot/simulate
+echo "== adse run $scenario"
+build/bin/adse run "$scenario"
+echo "== adse analyze results/robotaxi-parking-lot/runs (offline re-analysis)"
+build/bin/adse analyze results/robotaxi-parking-lot/runs | tail -n 2

@@ -10,7 +10,7 @@ PACKAGES=(
   sumo sumo-tools
   libpcl-dev libopencv-dev libceres-dev libhdf5-dev libpagmo-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3-h5py python3-pandas
+  python3-h5py python3-pandas bc
 )
 
 missing=()

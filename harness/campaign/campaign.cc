@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -70,6 +71,20 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
   if (!options.isolation.empty()) spec.harness.isolation = options.isolation;
   if (options.workers >= 0) spec.harness.workers = options.workers;
 
+  if (spec.harness.replicas != 1) {
+    // Not silently ignored: one run per point is all adse run does yet.
+    return Status::InvalidArgument(
+        spec.Where("harness.replicas") +
+        "harness.replicas: adse run evaluates each point once; expected 1, "
+        "found " +
+        std::to_string(spec.harness.replicas));
+  }
+  if (spec.harness.executor != "local") {
+    return Status::InvalidArgument(
+        spec.Where("harness.executor") +
+        "harness.executor: only 'local' is implemented; found '" +
+        spec.harness.executor + "'");
+  }
   Result<std::unique_ptr<explore::Strategy>> strategy =
       explore::CreateStrategy(spec.exploration.strategy, {&spec});
   if (!strategy.ok()) return strategy.status();
@@ -132,7 +147,13 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
   ExplorationResult result = Explore(spec, **strategy, evaluator, &refresher);
   if (result.interrupted) {
     summary.interrupted_by = pool::InterruptRequested();
-    evaluator.Cancel();
+    for (EvaluationRow& row : evaluator.Cancel()) {
+      result.evaluations.push_back(std::move(row));
+    }
+    std::sort(result.evaluations.begin(), result.evaluations.end(),
+              [](const EvaluationRow& a, const EvaluationRow& b) {
+                return a.index < b.index;
+              });
   }
   summary.exploration = std::move(result);
   for (const EvaluationRow& row : summary.exploration.evaluations) {

@@ -2,31 +2,66 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include <nlohmann/json.hpp>
 
 namespace adse::campaign {
 
-EvaluationRow RowFromReport(const report::RunReport& report) {
+namespace {
+
+// One path for live reports and stored ones: both go through the JSON.
+Result<EvaluationRow> RowFromJson(const nlohmann::json& j,
+                                  const std::string& path) {
   EvaluationRow row;
-  row.content_key = report.content_key;
-  row.status = report.status == "complete" ? "complete" : "failed";
-  row.reason = report.termination_reason;
-  row.seed = report.seed;
-  row.point = report.point;
-  row.metrics = report.metrics;
-  row.feasible = report.feasible;
-  nlohmann::json bottlenecks = nlohmann::json::array();
-  for (const report::FindingSummary& f : report.findings) {
-    auto deficit = f.rates_hz.find("deficit");
-    bottlenecks.push_back(
-        {{"kind", f.kind},
-         {"node", f.node},
-         {"remedy", f.remedy},
-         {"severity", deficit == f.rates_hz.end() ? 0.0 : deficit->second}});
+  try {
+    row.content_key = j.at("content_key").get<std::string>();
+    row.status =
+        j.at("status").get<std::string>() == "complete" ? "complete" : "failed";
+    row.reason = j.at("termination_reason").get<std::string>();
+    row.seed = j.at("seed").get<uint64_t>();
+    row.point = j.at("point").get<std::map<std::string, double>>();
+    if (j.contains("metrics")) {
+      for (const auto& [name, value] : j.at("metrics").items()) {
+        row.metrics[name] = value.is_number()
+                                ? value.get<double>()
+                                : std::numeric_limits<double>::quiet_NaN();
+      }
+    }
+    row.feasible = j.at("feasible").get<bool>();
+    nlohmann::json bottlenecks = nlohmann::json::array();
+    for (const nlohmann::json& f : j.at("findings")) {
+      double severity = 0.0;
+      if (f.contains("rates_hz") && f["rates_hz"].contains("deficit") &&
+          f["rates_hz"]["deficit"].is_number()) {
+        severity = f["rates_hz"]["deficit"].get<double>();
+      }
+      bottlenecks.push_back({{"kind", f.value("kind", "")},
+                             {"node", f.value("node", "")},
+                             {"remedy", f.value("remedy", "")},
+                             {"severity", severity}});
+    }
+    row.bottlenecks_json = bottlenecks.dump();
+  } catch (const nlohmann::json::exception& e) {
+    return Status::Corruption(path + ": not a run report: " + e.what());
   }
-  row.bottlenecks_json = bottlenecks.dump();
   return row;
+}
+
+}  // namespace
+
+EvaluationRow RowFromReport(const report::RunReport& report) {
+  // ToJson always yields every field RowFromJson reads.
+  return RowFromJson(report::ToJson(report), "(report)").value();
+}
+
+Result<EvaluationRow> RowFromReportJson(const std::string& text,
+                                        const std::string& path) {
+  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  if (!j.is_object()) {
+    return Status::Corruption(path + ": not a run report (invalid JSON)");
+  }
+  return RowFromJson(j, path);
 }
 
 explore::Observation ObservationFromRow(const EvaluationRow& row) {

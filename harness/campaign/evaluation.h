@@ -23,6 +23,13 @@ using runfile::EvaluationRow;
 // source, attempts and wall time are the caller's.
 EvaluationRow RowFromReport(const report::RunReport& report);
 
+// The same row from a report's JSON (report::ToJson), as a worker writes it
+// next to its run file (runs/<key>.report.json): the coordinator then need
+// not analyse the run again. Corruption naming `path` when the text is not
+// such a report.
+Result<EvaluationRow> RowFromReportJson(const std::string& text,
+                                        const std::string& path);
+
 // What a strategy is told about a row (failed rows: failed = true).
 explore::Observation ObservationFromRow(const EvaluationRow& row);
 

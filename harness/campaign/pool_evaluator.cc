@@ -6,10 +6,13 @@
 
 #include <fmt/format.h>
 
+#include <nlohmann/json.hpp>
+
 #include "analysis/runfile/run_file.h"
 #include "harness/report/run_report.h"
 #include "harness/sim/run_key.h"
 #include "harness/spec/spec_parser.h"
+#include "stack/base/files.h"
 
 namespace adse::campaign {
 namespace fs = std::filesystem;
@@ -69,35 +72,50 @@ bool PoolEvaluator::interrupted() const {
 std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
                                                     const std::string& source) {
   const std::string path = folder_.RunPath(p.key);
-  Result<runfile::RunData> run = runfile::ReadRunFile(path);
-  if (run.ok() && run->content_key != p.key) {
-    run = Status::Corruption(fmt::format("{}: holds run {} (renamed by hand?)",
-                                         path, run->content_key));
-  }
-  report::AnalyzeOptions analyze;
   std::error_code ec;
-  const std::string image_dir = folder_.ImageDir(p.key);
-  // Pictures are drawn once; a resumed campaign reuses them.
-  if (!fs::exists(image_dir + "/trajectory.png", ec)) {
-    fs::create_directories(image_dir, ec);
-    analyze.image_dir = image_dir;
+  std::optional<EvaluationRow> row;
+  // The worker's own analysis, when it left one for this very run.
+  if (fs::exists(path, ec)) {
+    Result<std::string> text = ReadFile(folder_.ReportPath(p.key), 16 << 20);
+    if (text.ok()) {
+      Result<EvaluationRow> stored =
+          RowFromReportJson(*text, folder_.ReportPath(p.key));
+      if (stored.ok() && stored->content_key == p.key) row = *stored;
+    }
   }
-  Result<report::RunReport> report =
-      run.ok() ? report::AnalyzeRun(*run, path, analyze)
-               : Result<report::RunReport>(run.status());
-  if (!report.ok()) {
-    // Keep the evidence, out of the way of the content-keyed name.
-    fs::rename(path, path + ".unreadable", ec);
-    std::fprintf(stderr, "warning: %s is unusable (%s); running it again\n",
-                 path.c_str(), report.status().message().c_str());
-    return std::nullopt;
+  if (!row) {
+    Result<runfile::RunData> run = runfile::ReadRunFile(path);
+    if (run.ok() && run->content_key != p.key) {
+      run = Status::Corruption(fmt::format(
+          "{}: holds run {} (renamed by hand?)", path, run->content_key));
+    }
+    report::AnalyzeOptions analyze;
+    const std::string image_dir = folder_.ImageDir(p.key);
+    // Pictures are drawn once; a resumed campaign reuses them.
+    if (!fs::exists(image_dir + "/trajectory.png", ec)) {
+      fs::create_directories(image_dir, ec);
+      analyze.image_dir = image_dir;
+    }
+    Result<report::RunReport> report =
+        run.ok() ? report::AnalyzeRun(*run, path, analyze)
+                 : Result<report::RunReport>(run.status());
+    if (!report.ok()) {
+      // Keep the evidence, out of the way of the content-keyed name.
+      fs::rename(path, path + ".unreadable", ec);
+      std::fprintf(stderr, "warning: %s is unusable (%s); running it again\n",
+                   path.c_str(), report.status().message().c_str());
+      return std::nullopt;
+    }
+    row = RowFromReport(*report);
+    // Derived data: losing it only costs this analysis again.
+    (void)WriteFileAtomic(folder_.ReportPath(p.key),
+                          report::ToJson(*report).dump(1) + "\n");
   }
-  EvaluationRow row = RowFromReport(*report);
-  row.index = p.request.index;
-  row.iteration = p.request.iteration;
-  row.content_key = p.key;
-  row.source = source;
-  row.attempts = p.attempt;
+  row->index = p.request.index;
+  row->iteration = p.request.iteration;
+  row->content_key = p.key;
+  row->source = source;
+  row->attempts = p.attempt;
   return row;
 }
 
@@ -172,7 +190,9 @@ void PoolEvaluator::Dispatch() {
          {options_.scenario_path, std::string("--point"),
           spec::FormatPoint(spec_.design_space, p.request.point),
           std::string("--seed"), std::to_string(p.seed), std::string("--out"),
-          folder_.RunPath(p.key), std::string("--expect-key"), p.key}) {
+          folder_.RunPath(p.key), std::string("--expect-key"), p.key,
+          std::string("--report"), folder_.ReportPath(p.key),
+          std::string("--image-dir"), folder_.ImageDir(p.key)}) {
       job.argv.push_back(arg);
     }
     job.log_path = folder_.LogPath(p.key, p.attempt);
@@ -256,10 +276,25 @@ std::vector<EvaluationRow> PoolEvaluator::Wait() {
   return rows;
 }
 
-void PoolEvaluator::Cancel() {
-  for (const pool::JobResult& r : pool_->CancelAll()) Finish(r);
+std::vector<EvaluationRow> PoolEvaluator::Cancel() {
+  for (const pool::JobResult& r : pool_->CancelAll()) {
+    auto it = running_.find(r.id);
+    if (it == running_.end()) continue;
+    // A run whose file landed just before the stop is kept, not redone.
+    std::error_code ec;
+    if (fs::exists(folder_.RunPath(it->second.key), ec)) {
+      if (auto row = LoadRun(it->second, "simulated")) {
+        row->wall_s = r.wall_s;
+        ready_.push_back(*row);
+      }
+    }
+    running_.erase(it);
+  }
   running_.clear();
   queued_.clear();
+  std::vector<EvaluationRow> rows;
+  rows.swap(ready_);
+  return rows;
 }
 
 }  // namespace adse::campaign

@@ -44,9 +44,11 @@ class PoolEvaluator : public Evaluator {
   std::vector<EvaluationRow> Wait() override;
   bool interrupted() const override;
 
-  // Kills running attempts (their points stay unevaluated: no run file,
-  // no failure record) and forgets queued ones.
-  void Cancel();
+  // Kills running attempts (their points stay unevaluated: no failure
+  // record) and forgets queued ones. Returns the rows that were complete
+  // but not yet returned by Wait, including runs whose file landed just
+  // before the stop.
+  std::vector<EvaluationRow> Cancel();
 
  private:
   struct Pending {

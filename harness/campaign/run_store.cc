@@ -26,6 +26,9 @@ Status CampaignFolder::Create() const {
 std::string CampaignFolder::RunPath(const std::string& key) const {
   return root_ + "/runs/" + key + ".h5";
 }
+std::string CampaignFolder::ReportPath(const std::string& key) const {
+  return root_ + "/runs/" + key + ".report.json";
+}
 std::string CampaignFolder::FailurePath(const std::string& key) const {
   return root_ + "/runs/" + key + ".failed.json";
 }

@@ -15,6 +15,8 @@ namespace adse::campaign {
 
 // The layout of a campaign folder:
 //   runs/<key>.h5           one complete run (the truth)
+//   runs/<key>.report.json  its analysis (RunReport JSON), rebuilt from the
+//                           run file when missing
 //   runs/<key>.failed.json  a run that failed after its retries
 //   logs/<key>.<attempt>.log  each worker attempt's stdout and stderr
 //   images/<key>/trajectory.png  the run's picture
@@ -28,6 +30,7 @@ class CampaignFolder {
 
   const std::string& root() const { return root_; }
   std::string RunPath(const std::string& key) const;
+  std::string ReportPath(const std::string& key) const;
   std::string FailurePath(const std::string& key) const;
   std::string LogPath(const std::string& key, int attempt) const;
   // Folder of a run's pictures (trajectory.png).

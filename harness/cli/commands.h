@@ -65,6 +65,8 @@ struct WorkerArgs {
   std::optional<uint64_t> seed;  // overrides world.traffic.seed
   std::string out;               // run file to write (atomically)
   std::string expect_key;        // refuse to run when the key differs
+  std::string report;            // also write the RunReport JSON here
+  std::string image_dir;         // draw the trajectory picture here
 };
 int RunWorker(const WorkerArgs& args);
 

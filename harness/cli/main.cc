@@ -125,6 +125,10 @@ int main(int argc, char** argv) {
   worker_cmd->add_option("-o,--out", worker.out, "Run file to write")->required();
   worker_cmd->add_option("--expect-key", worker.expect_key,
                          "Refuse to run unless the run's content key is this");
+  worker_cmd->add_option("--report", worker.report,
+                         "Also write the run's analysis (RunReport JSON) here, after the run file");
+  worker_cmd->add_option("--image-dir", worker.image_dir,
+                         "Draw the trajectory picture (trajectory.png) into this folder");
 
   adse::cli::ExploreArgs explore;
   CLI::App* explore_cmd = app.add_subcommand(

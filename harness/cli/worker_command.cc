@@ -7,6 +7,9 @@
 #include <new>
 
 #include "analysis/runfile/run_file.h"
+#include "stack/base/files.h"
+
+#include <nlohmann/json.hpp>
 #include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
 #include "harness/pool/worker_pool.h"
@@ -53,7 +56,16 @@ int Work(const WorkerArgs& args) {
     return ExitCodeFor(run.status());
   }
   // The analysis' metrics (deviation fit) travel with the run's own.
-  Result<report::RunReport> analysed = report::AnalyzeRun(*run, args.out, {});
+  report::AnalyzeOptions analyze;
+  if (!args.image_dir.empty()) {
+    if (Status s = MakeDirs(args.image_dir); !s.ok()) {
+      std::fprintf(stderr, "error: %s\n", s.message().c_str());
+      return 1;
+    }
+    analyze.image_dir = args.image_dir;
+  }
+  Result<report::RunReport> analysed =
+      report::AnalyzeRun(*run, args.out, analyze);
   if (!analysed.ok()) {
     std::fprintf(stderr, "error: analysing the run: %s\n",
                  analysed.status().message().c_str());

@@ -29,6 +29,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cstdlib>  // DEBUG-REMOVE
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -49,7 +50,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Joint samples of the predicted metrics per candidate.
-constexpr int kSamples = 32;
+constexpr int kSamples = 64;
 // Spaces up to this size are scored exhaustively.
 constexpr uint64_t kEnumerateLimit = 4096;
 // Random candidates drawn in larger spaces (plus neighbours of seen points).
@@ -58,6 +59,16 @@ constexpr int kSampledCandidates = 2000;
 constexpr size_t kNeighbourhoods = 48;
 // The surrogates learn from at most this many (most recent) runs.
 constexpr size_t kMaxModelPoints = 160;
+// Prior slopes of a 0/1 metric (run completed) per unit of a knob that
+// helps, and their sd; a sensor rate the diagnosis of an infeasible run
+// names gets this prior slope (sign from the remedy).
+constexpr double kFlagSlope = 0.3;
+constexpr double kFlagSlopeSd = 0.5;
+constexpr double kRateVote = 0.3;
+// Default GP length scales over normalised knobs: most knobs, and those
+// with at most 3 values.
+constexpr double kLength = 0.25;
+constexpr double kFewValuesLength = 1.0;
 // Prior of a saturating trend's level: this far beyond the best value
 // seen (model units, i.e. log for positive metrics), give or take the sd.
 constexpr double kSaturationRoom = 0.3;
@@ -70,9 +81,9 @@ constexpr double kRunsPrior = 0.9;
 constexpr double kRunsPriorWeight = 0.3;
 // Weight of the (normalised) expected hypervolume gain next to the
 // probability of landing on the predicted front.
-constexpr double kHypervolumeWeight = 0.1;
+constexpr double kHypervolumeWeight = 0.3;
 // How far beyond the best run seen an objective's prediction may go.
-constexpr double kOptimismRoom = 0.1;
+constexpr double kOptimismRoom = 0.05;
 // The metric computed from the cost expression rather than modelled.
 constexpr char kCostMetric[] = "hardware_cost";
 // The flag of a run that reached its goal.
@@ -266,7 +277,7 @@ class ResidualGp {
     double constant2 = 0.01;
     double linear2 = 0.25;
     double signal2 = 0.01;
-    double length = 0.25;
+    std::vector<double> lengths;  // per knob
     double noise2 = 4e-4;
   };
 
@@ -316,14 +327,14 @@ class ResidualGp {
   double Kernel(const std::vector<double>& a,
                 const std::vector<double>& b) const {
     double dot = 0.0;
-    double dist2 = 0.0;
+    double scaled2 = 0.0;
     for (size_t i = 0; i < a.size(); ++i) {
       dot += (a[i] - 0.5) * (b[i] - 0.5);
-      dist2 += (a[i] - b[i]) * (a[i] - b[i]);
+      const double d = (a[i] - b[i]) / hyper_.lengths[i];
+      scaled2 += d * d;
     }
     return hyper_.constant2 + hyper_.linear2 * dot +
-           hyper_.signal2 *
-               std::exp(-dist2 / (2.0 * hyper_.length * hyper_.length));
+           hyper_.signal2 * std::exp(-0.5 * scaled2);
   }
 
   Hyper hyper_;
@@ -350,10 +361,12 @@ class MetricModel {
   MetricSpace space() const { return space_; }
 
   // Fits the trend and the residual GP to (u, value) pairs. `prior_slope`
-  // holds one prior mean per knob in model units (before the direction).
+  // holds one prior mean per knob in model units (before the direction),
+  // `lengths` the GP's default length scale per knob.
   void Fit(const std::vector<std::vector<double>>& u,
            const std::vector<double>& values,
-           const std::vector<double>& prior_slope) {
+           const std::vector<double>& prior_slope,
+           const std::vector<double>& lengths) {
     fitted_ = false;
     points_ = static_cast<int>(values.size());
     if (values.empty()) return;
@@ -391,12 +404,14 @@ class MetricModel {
     const double sigma = space_ == MetricSpace::kLog       ? 0.1
                          : space_ == MetricSpace::kBoolean ? 0.25
                                                            : 0.3;
-    const double slope_size = space_ == MetricSpace::kBoolean ? 0.3 : 1.0;
+    const double slope_size =
+        space_ == MetricSpace::kBoolean ? kFlagSlope : 1.0;
     std::vector<double> mu(dims, 0.0);
     for (size_t i = 0; i < dims; ++i) {
       mu[i] = good_direction * slope_size * prior_slope[i];
     }
-    const double slope_sd = space_ == MetricSpace::kBoolean ? 0.5 : 1.5;
+    const double slope_sd =
+        space_ == MetricSpace::kBoolean ? kFlagSlopeSd : 1.5;
 
     // Metrics that resources improve saturate (navigation time cannot
     // drop below driving the route, the control rate has a cap): the trend
@@ -436,15 +451,15 @@ class MetricModel {
     hyper.constant2 = 0.01;
     hyper.linear2 = space_ == MetricSpace::kBoolean ? 0.1 : 0.3;
     hyper.signal2 = signal * signal;
-    hyper.length = 0.25;
+    hyper.lengths = lengths;
     hyper.noise2 = base_noise * base_noise;
     if (values.size() >= 6) {
       double best = -kInf;
       ResidualGp::Hyper best_hyper = hyper;
-      for (double length : {0.12, 0.25, 0.5}) {
+      for (double scale : {0.5, 1.0, 2.0}) {
         for (double noise : {base_noise, std::max(base_noise, 0.5 * rms)}) {
           ResidualGp::Hyper h = hyper;
-          h.length = length;
+          for (double& length : h.lengths) length *= scale;
           h.noise2 = noise * noise;
           const double ll = gp_.Fit(u, residuals, h);
           if (ll > best + 1e-9) {
@@ -775,6 +790,10 @@ class AgentStrategy : public Strategy {
         knob.u.push_back(hi > lo ? (transform(v) - lo) / (hi - lo) : 0.0);
       }
       knobs_.push_back(std::move(knob));
+      // A knob with few values (a sensor rate of 7 or 14 Hz) is a
+      // modifier more than an axis: its levels share much of their
+      // behaviour, so they stay correlated in the GP.
+      lengths_.push_back(values.size() <= 3 ? kFewValuesLength : kLength);
     }
   }
 
@@ -943,7 +962,7 @@ class AgentStrategy : public Strategy {
       if (role == KnobRole::kCores || role == KnobRole::kFrequency) {
         prior[d] = votes[d] > 0 ? 1.0 : 0.6;
       } else if (role == KnobRole::kRate && votes[d] != 0) {
-        prior[d] = votes[d] > 0 ? 0.3 : -0.3;
+        prior[d] = votes[d] > 0 ? kRateVote : -kRateVote;
       }
     }
     const size_t first = records_.size() > kMaxModelPoints
@@ -981,7 +1000,7 @@ class AgentStrategy : public Strategy {
       if (!model.in_constraint) {
         for (double& s : slope) s *= 0.4;
       }
-      model.Fit(u, values, slope);
+      model.Fit(u, values, slope, lengths_);
     }
     any_failed_ = false;
     for (const Record& record : records_) {
@@ -1280,6 +1299,16 @@ class AgentStrategy : public Strategy {
           best = static_cast<int>(i);
         }
       }
+      if (std::getenv("AGENT_DEBUG") != nullptr) {  // DEBUG-REMOVE
+        for (size_t i = 0; i < candidates.size(); ++i) {  // DEBUG-REMOVE
+          const Candidate& c = candidates[i];  // DEBUG-REMOVE
+          const spec::DesignPoint pt = grid_.ToPoint(c.genes);  // DEBUG-REMOVE
+          if (!(pt.at("cores") <= 4 || c.score >= 0.5 * candidates[best].score)) continue;  // DEBUG-REMOVE
+          std::string ms;  // DEBUG-REMOVE
+          for (size_t m = 0; m < models_.size(); ++m) ms += fmt::format(" {}={:.3g}+-{:.2g}", models_[m].name, models_[m].ToMetric(c.mean[m]), c.sd[m]);  // DEBUG-REMOVE
+          fprintf(stderr, "DBG %s pf=%.2f pfr=%.2f gain=%.3g f=%.2f score=%.3f%s\n", Describe(pt).c_str(), c.p_feasible, c.p_front, c.gain, c.factor, c.score, ms.c_str());  // DEBUG-REMOVE
+        }  // DEBUG-REMOVE
+      }  // DEBUG-REMOVE
       if (best < 0) break;
       const Candidate& pick = candidates[best];
       chosen->push_back(pick.genes);
@@ -1541,6 +1570,7 @@ class AgentStrategy : public Strategy {
   int budget_;
   Random random_;
   std::vector<Knob> knobs_;
+  std::vector<double> lengths_;  // GP length scale per knob
   std::vector<MetricModel> models_;
   bool any_failed_ = false;
   std::vector<spec::Expression> constraints_;

@@ -7,6 +7,7 @@
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/syscall.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -155,6 +156,7 @@ struct ChildPlan {
   cpu_set_t cpus;
   bool limit_address_space = false;
   struct rlimit address_space {};
+  pid_t parent_pid = 0;        // the coordinator, for PR_SET_PDEATHSIG
   int stdin_fd = -1;
   int log_fd = -1;
   int report_fd = -1;  // close-on-exec: EOF tells the parent exec worked
@@ -192,6 +194,10 @@ struct ChildFailure {
   // Its own process group: a timeout kills it with killpg, and Ctrl-C at
   // the terminal reaches only the coordinator, which cancels jobs itself.
   ::setpgid(0, 0);
+  // A coordinator killed outright takes its jobs with it (their unfinished
+  // runs are redone on resume) instead of leaving them to run unwatched.
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != plan.parent_pid) ::_exit(127);  // it died already
   if (::sched_setaffinity(0, sizeof(plan.cpus), &plan.cpus) != 0) {
     FailChild(plan, ChildStage::kAffinity, 0);
   }
@@ -301,6 +307,7 @@ Status PoolImpl::Submit(const Job& job) {
   UniqueFd null(::open("/dev/null", O_RDONLY | O_CLOEXEC));
   std::vector<UniqueFd> procs;
   ChildPlan plan;
+  plan.parent_pid = ::getpid();
   if (groups_) {
     const int flags =
         O_WRONLY | O_CLOEXEC | (groups_->fake() ? O_CREAT | O_TRUNC : 0);

@@ -337,5 +337,44 @@ TEST(
               HasSubstr("\"simulated\": " + std::to_string(7 - before.size())));
 }
 
+TEST(CampaignTest,
+     SigtermStopsTheCampaignKeepsFinishedRunsAndRemovesItsGroups) {
+  const std::string out = TempDir("sigterm");
+  const pid_t coordinator = StartAdseRun(
+      {"run", adse::testing::SmallScenarioPath(), "-o", out, "--strategy",
+       "exhaustive", "--workers", "2", "--no-cache", "--quiet"},
+      out + "-stderr.log");
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::seconds(240);
+  while (RunFiles(out).empty() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_FALSE(RunFiles(out).empty());
+  ::kill(coordinator, SIGTERM);
+  int status = 0;
+  ::waitpid(coordinator, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "ends by itself, not by the signal";
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM);
+  const std::string summary = ReadFile(out + "/summary.json").value();
+  EXPECT_THAT(summary, HasSubstr("\"complete\": false"));
+  EXPECT_THAT(ReadFile(out + "/report.md").value(),
+              HasSubstr("stopped early by signal 15"));
+  const std::vector<std::string> index = IndexKeys(out);
+  EXPECT_EQ(std::set<std::string>(index.begin(), index.end()), RunFiles(out))
+      << "the index lists exactly the finished runs";
+  // No cgroup of that coordinator is left, whichever hierarchy it used.
+  const std::string group = "adse-" + std::to_string(coordinator);
+  for (const char* root : {"/sys/fs/cgroup", "/sys/fs/cgroup/cpuset",
+                           "/sys/fs/cgroup/memory", "/sys/fs/cgroup/pids"}) {
+    if (!fs::is_directory(root)) continue;
+    for (auto it = fs::recursive_directory_iterator(
+             root, fs::directory_options::skip_permission_denied);
+         it != fs::recursive_directory_iterator(); ++it) {
+      if (it.depth() > 3) it.disable_recursion_pending();
+      EXPECT_NE(it->path().filename().string(), group) << it->path();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace adse::campaign

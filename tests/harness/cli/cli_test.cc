@@ -210,3 +210,48 @@ TEST(CliTest, AnalyzeOneRunPrintsDeviationAndDiagnosis) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(CliRunTest, ExploreReplayPrintsADistributionPerStrategy) {
+  const CommandRun run = Adse("explore --replay " + std::string(ADSE_SOURCE_DIR) +
+                              "/tests/data/robotaxi_exhaustive --strategy agent,ga --seeds 3");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("280 recorded evaluations, budget 15, seeds 1..3"), std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("| agent |"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("| ga |"), std::string::npos) << run.out;
+  const CommandRun bad = Adse("explore --replay /nonexistent/campaign");
+  EXPECT_EQ(bad.exit_code, 2) << bad.out;
+  EXPECT_NE(bad.out.find("/nonexistent/campaign"), std::string::npos) << bad.out;
+}
+
+TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
+  const CommandRun isolation = Adse("run " + Small() + " --isolation containers");
+  EXPECT_EQ(isolation.exit_code, 2) << isolation.out;
+  EXPECT_NE(isolation.out.find("--isolation"), std::string::npos) << isolation.out;
+  const std::string file =
+      (fs::temp_directory_path() / "adse_cli_replicas.yaml").string();
+  std::ifstream in(Small());
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream(file) << text << "harness: {replicas: 3}\n";
+  fs::create_directories(fs::temp_directory_path() / "calibration");
+  fs::copy_file(std::string(ADSE_SOURCE_DIR) + "/scenarios/calibration/reference.json",
+                fs::temp_directory_path() / "calibration/reference.json",
+                fs::copy_options::overwrite_existing);
+  const CommandRun replicas = Adse("run " + file + " -o " +
+                                   (fs::temp_directory_path() / "adse_cli_replicas").string());
+  EXPECT_EQ(replicas.exit_code, 2) << replicas.out;
+  EXPECT_NE(replicas.out.find("harness.replicas"), std::string::npos) << replicas.out;
+}
+
+TEST(CliRunTest, WorkerRefusesAScenarioThatChangedUnderItsCampaign) {
+  const std::string out = (fs::temp_directory_path() / "adse_cli_worker.h5").string();
+  const CommandRun run = Adse("worker " + Small() + " --point cores=4,freq_ghz=2.1,lidar_hz=14 -o " +
+                              out + " --expect-key " + std::string(64, '0'));
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("changed since the campaign started"), std::string::npos) << run.out;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace

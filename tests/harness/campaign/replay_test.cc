@@ -1,0 +1,81 @@
+// Strategies replayed against the recorded exhaustive robotaxi campaign
+// (tests/data/robotaxi_exhaustive): the built-in agent's acceptance target
+// — at least the 6 true Pareto points the reference study's LLM agent found
+// with a budget of 15 — and its margin over the GA baseline.
+#include "harness/campaign/replay.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+namespace adse::campaign {
+namespace {
+
+const std::string kRecording =
+    std::string(ADSE_SOURCE_DIR) + "/tests/data/robotaxi_exhaustive";
+
+const Recording& Recorded() {
+  static const Recording* recording = [] {
+    Result<Recording> r = LoadRecording(kRecording);
+    EXPECT_TRUE(r.ok()) << r.status().message();
+    return new Recording(r.ok() ? std::move(r).value() : Recording{});
+  }();
+  return *recording;
+}
+
+TEST(ReplayTest, TheRecordingHoldsTheWholeSpaceWithAFeasibleFront) {
+  ASSERT_EQ(Recorded().rows.size(), 280u);
+  std::set<spec::DesignPoint> points;
+  int feasible = 0;
+  for (const EvaluationRow& row : Recorded().rows) {
+    points.insert(row.point);
+    feasible += row.feasible;
+  }
+  EXPECT_EQ(points.size(), 280u);
+  EXPECT_GT(feasible, 100);
+  EXPECT_LT(feasible, 280) << "starved computers fail the constraints";
+}
+
+TEST(ReplayTest, AgentFindsAtLeastSixTrueParetoPointsWithABudgetOf15) {
+  Result<ReplayRun> run =
+      Replay(Recorded(), "agent", Recorded().spec.exploration.seed, 15);
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  EXPECT_EQ(run->evaluations, 15);
+  EXPECT_EQ(run->missing, 0);
+  EXPECT_GE(run->true_pareto_found, 6) << "front of " << run->front_size;
+}
+
+TEST(ReplayTest, AgentBeatsTheGaBaselineOnAverageOverSeeds) {
+  double agent = 0, ga = 0;
+  constexpr int kSeeds = 8;
+  for (uint64_t seed = 1; seed <= kSeeds; ++seed) {
+    Result<ReplayRun> a = Replay(Recorded(), "agent", seed, 15);
+    Result<ReplayRun> g = Replay(Recorded(), "ga", seed, 15);
+    ASSERT_TRUE(a.ok() && g.ok());
+    EXPECT_GE(a->true_pareto_found, 6) << "seed " << seed;
+    agent += a->true_pareto_found;
+    ga += g->true_pareto_found;
+  }
+  EXPECT_GT(agent / kSeeds, ga / kSeeds + 1.0)
+      << "agent " << agent / kSeeds << ", ga " << ga / kSeeds;
+}
+
+TEST(ReplayTest, ReplayIsDeterministicAndAnUnknownStrategyIsAnError) {
+  Result<ReplayRun> a = Replay(Recorded(), "nsga2", 3, 15);
+  Result<ReplayRun> b = Replay(Recorded(), "nsga2", 3, 15);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->proposals, b->proposals);
+  Result<ReplayRun> bad = Replay(Recorded(), "simulated-annealing", 1, 15);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("valid:"), std::string::npos);
+}
+
+TEST(ReplayTest, AMissingOrDamagedRecordingNamesTheFile) {
+  Result<Recording> missing = LoadRecording("/nonexistent/campaign");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.status().message().find("/nonexistent/campaign"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace adse::campaign
