@@ -82,8 +82,10 @@ constexpr double kRunsPriorWeight = 0.3;
 // Weight of the (normalised) expected hypervolume gain next to the
 // probability of landing on the predicted front.
 constexpr double kHypervolumeWeight = 0.3;
+constexpr double kClampMeanOnly = 0;
+constexpr double kNoiseRoom = 0.3;
 // How far beyond the best run seen an objective's prediction may go.
-constexpr double kOptimismRoom = 0.05;
+constexpr double kOptimismRoom = 0.025;
 // The metric computed from the cost expression rather than modelled.
 constexpr char kCostMetric[] = "hardware_cost";
 // The flag of a run that reached its goal.
@@ -499,13 +501,26 @@ class MetricModel {
   // A model value back in metric units.
   // A sampled value as an objective may use it: no better than the best
   // run seen, by kOptimismRoom (model units).
+  // The same bound on a mean in model units.
+  double BoundedMean(double t, double room = kOptimismRoom) const {
+    if (std::isnan(best_) || good_direction == 0 ||
+        space_ == MetricSpace::kBoolean) {
+      return t;
+    }
+    const double best_t = space_ == MetricSpace::kLog
+                              ? std::log(best_)
+                              : (best_ - shift_) / scale_;
+    const double bound = best_t + good_direction * room;
+    return good_direction < 0 ? std::max(t, bound) : std::min(t, bound);
+  }
+
   double Bounded(double value) const {
     if (std::isnan(best_) || good_direction == 0) return value;
     double bound;
     if (space_ == MetricSpace::kLog) {
-      bound = best_ * std::exp(-good_direction * kOptimismRoom);
+      bound = best_ * std::exp(good_direction * kOptimismRoom);
     } else {
-      bound = best_ - good_direction * kOptimismRoom * scale_;
+      bound = best_ + good_direction * kOptimismRoom * scale_;
     }
     return good_direction < 0 ? std::max(value, bound) : std::min(value, bound);
   }
@@ -1073,7 +1088,13 @@ class AgentStrategy : public Strategy {
       if (objective.metric == kCostMetric) {
         v = c.cost;
       } else if (m >= 0 && models_[m].fitted()) {
-        v = models_[m].Bounded(values[objective.metric]);
+        if (kClampMeanOnly > 0) {
+          v = models_[m].ToMetric(models_[m].BoundedMean(
+              models_[m].BoundedMean(c.mean[m]) + c.sd[m] * z_[s][m],
+              kNoiseRoom));
+        } else {
+          v = models_[m].Bounded(values[objective.metric]);
+        }
       }
       (*objectives)[j] = objective.minimize ? v : -v;
     }
