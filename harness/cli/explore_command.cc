@@ -11,6 +11,7 @@
 #include "harness/campaign/replay.h"
 #include "harness/cli/commands.h"
 #include "harness/explore/strategy.h"
+#include "harness/spec/spec_parser.h"
 
 namespace adse::cli {
 namespace {
@@ -83,7 +84,12 @@ int RunExplore(const ExploreArgs& args) {
         first.push_back(run->first_true_pareto_at);
       front = run->front_size;
       missing += run->missing;
+      nlohmann::json proposals = nlohmann::json::array();
+      for (const spec::DesignPoint& point : run->proposals) {
+        proposals.push_back(spec::FormatPoint(recording->spec.design_space, point));
+      }
       runs.push_back({{"seed", seed},
+                      {"proposals", proposals},
                       {"evaluations", run->evaluations},
                       {"true_pareto_found", run->true_pareto_found},
                       {"hypervolume_ratio", run->hypervolume_ratio},

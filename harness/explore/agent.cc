@@ -29,7 +29,6 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <cstdlib>  // DEBUG-REMOVE
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -81,7 +80,7 @@ constexpr double kRunsPrior = 0.9;
 constexpr double kRunsPriorWeight = 0.3;
 // Weight of the (normalised) expected hypervolume gain next to the
 // probability of landing on the predicted front.
-constexpr double kHypervolumeWeight = 0.3;
+constexpr double kHypervolumeWeight = 0.6;
 constexpr double kClampMeanOnly = 0;
 constexpr double kNoiseRoom = 0.3;
 // How far beyond the best run seen an objective's prediction may go.
@@ -1320,16 +1319,6 @@ class AgentStrategy : public Strategy {
           best = static_cast<int>(i);
         }
       }
-      if (std::getenv("AGENT_DEBUG") != nullptr) {  // DEBUG-REMOVE
-        for (size_t i = 0; i < candidates.size(); ++i) {  // DEBUG-REMOVE
-          const Candidate& c = candidates[i];  // DEBUG-REMOVE
-          const spec::DesignPoint pt = grid_.ToPoint(c.genes);  // DEBUG-REMOVE
-          if (!(pt.at("cores") <= 4 || c.score >= 0.5 * candidates[best].score)) continue;  // DEBUG-REMOVE
-          std::string ms;  // DEBUG-REMOVE
-          for (size_t m = 0; m < models_.size(); ++m) ms += fmt::format(" {}={:.3g}+-{:.2g}", models_[m].name, models_[m].ToMetric(c.mean[m]), c.sd[m]);  // DEBUG-REMOVE
-          fprintf(stderr, "DBG %s pf=%.2f pfr=%.2f gain=%.3g f=%.2f score=%.3f%s\n", Describe(pt).c_str(), c.p_feasible, c.p_front, c.gain, c.factor, c.score, ms.c_str());  // DEBUG-REMOVE
-        }  // DEBUG-REMOVE
-      }  // DEBUG-REMOVE
       if (best < 0) break;
       const Candidate& pick = candidates[best];
       chosen->push_back(pick.genes);
