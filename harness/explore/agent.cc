@@ -80,7 +80,7 @@ constexpr double kRunsPrior = 0.9;
 constexpr double kRunsPriorWeight = 0.3;
 // Weight of the (normalised) expected hypervolume gain next to the
 // probability of landing on the predicted front.
-constexpr double kHypervolumeWeight = 0.6;
+constexpr double kHypervolumeWeight = 0.3;
 constexpr double kClampMeanOnly = 0;
 constexpr double kNoiseRoom = 0.3;
 // How far beyond the best run seen an objective's prediction may go.
