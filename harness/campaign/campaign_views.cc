@@ -24,11 +24,6 @@ std::string Number(double v) {
   return fmt::format("{:.4g}", v);
 }
 
-double Metric(const EvaluationRow& row, const std::string& name) {
-  auto it = row.metrics.find(name);
-  return it == row.metrics.end() ? NAN : it->second;
-}
-
 nlohmann::json RowJson(const spec::Spec& spec, const EvaluationRow& row) {
   nlohmann::json metrics = nlohmann::json::object();
   for (const auto& [name, value] : row.metrics) {
@@ -124,7 +119,8 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s) {
     const EvaluationRow& row = rows[static_cast<size_t>(i)];
     md << "| " << row.index << " | "
        << spec::FormatPoint(spec.design_space, row.point) << " | ";
-    for (const std::string& c : columns) md << Number(Metric(row, c)) << " | ";
+    for (const std::string& c : columns)
+      md << Number(RowMetric(row, c)) << " | ";
     md << (row.feasible ? "yes" : "no") << " | [png](images/" << row.content_key
        << "/trajectory.png) |\n";
   }
@@ -149,9 +145,10 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s) {
     md << fmt::format(
         "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", row.index,
         spec::FormatPoint(spec.design_space, row.point), row.status,
-        Cell(row.reason), row.source, Number(Metric(row, "hardware_cost")),
-        Number(Metric(row, "nav_time_s")), Number(Metric(row, "ctrl_rate_hz")),
-        Number(Metric(row, "deviation_score")), row.feasible ? "yes" : "no");
+        Cell(row.reason), row.source, Number(RowMetric(row, "hardware_cost")),
+        Number(RowMetric(row, "nav_time_s")),
+        Number(RowMetric(row, "ctrl_rate_hz")),
+        Number(RowMetric(row, "deviation_score")), row.feasible ? "yes" : "no");
   }
 
   md << "\n## Failures\n\n";
@@ -243,8 +240,8 @@ Status WriteCampaignViews(const spec::Spec& spec,
   std::vector<analysis::ParetoPlotPoint> plot;
   const std::set<int> on_front(front.begin(), front.end());
   for (size_t i = 0; i < rows.size(); ++i) {
-    const double cost = Metric(rows[i], "hardware_cost");
-    const double nav = Metric(rows[i], "nav_time_s");
+    const double cost = RowMetric(rows[i], "hardware_cost");
+    const double nav = RowMetric(rows[i], "nav_time_s");
     if (!std::isfinite(cost) || !std::isfinite(nav)) continue;
     const bool front_point = on_front.count(static_cast<int>(i)) > 0;
     plot.push_back({cost, nav, rows[i].feasible, front_point,

@@ -64,6 +64,12 @@ Result<EvaluationRow> RowFromReportJson(const std::string& text,
   return RowFromJson(j, path);
 }
 
+double RowMetric(const EvaluationRow& row, const std::string& name) {
+  auto it = row.metrics.find(name);
+  return it == row.metrics.end() ? std::numeric_limits<double>::quiet_NaN()
+                                 : it->second;
+}
+
 explore::Observation ObservationFromRow(const EvaluationRow& row) {
   explore::Observation o;
   o.point = row.point;

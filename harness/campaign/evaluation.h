@@ -30,6 +30,9 @@ EvaluationRow RowFromReport(const report::RunReport& report);
 Result<EvaluationRow> RowFromReportJson(const std::string& text,
                                         const std::string& path);
 
+// A row's metric, NaN when the run has none (failed runs have none).
+double RowMetric(const EvaluationRow& row, const std::string& name);
+
 // What a strategy is told about a row (failed rows: failed = true).
 explore::Observation ObservationFromRow(const EvaluationRow& row);
 

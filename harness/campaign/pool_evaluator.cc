@@ -288,7 +288,6 @@ std::vector<EvaluationRow> PoolEvaluator::Cancel() {
         ready_.push_back(*row);
       }
     }
-    running_.erase(it);
   }
   running_.clear();
   queued_.clear();

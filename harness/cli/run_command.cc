@@ -73,15 +73,11 @@ class Progress : public campaign::ExplorerListener {
           "[{}/{}] FAILED {}: {} ({} attempt(s); see runs/{}.failed.json)",
           done_, budget_, point, row.reason, row.attempts, row.content_key);
     } else if (!quiet_ && !tty_) {
-      auto metric = [&row](const char* name) {
-        auto it = row.metrics.find(name);
-        return it == row.metrics.end() ? std::nan("") : it->second;
-      };
       line = fmt::format(
           "[{}/{}] {}: {}, nav {:.1f} s, ctrl {:.1f} Hz, cost {:.3g}, {} "
           "({}{})",
-          done_, budget_, point, row.reason, metric("nav_time_s"),
-          metric("ctrl_rate_hz"), metric("hardware_cost"),
+          done_, budget_, point, row.reason, campaign::RowMetric(row, "nav_time_s"),
+          campaign::RowMetric(row, "ctrl_rate_hz"), campaign::RowMetric(row, "hardware_cost"),
           row.feasible ? "feasible" : "infeasible", row.source,
           row.source == "simulated" ? fmt::format(" {:.1f} s", row.wall_s)
                                     : "");
@@ -195,14 +191,10 @@ int RunRun(const RunArgs& args) {
     for (int i : s.pareto_front) {
       const campaign::EvaluationRow& row =
           s.exploration.evaluations[static_cast<size_t>(i)];
-      auto metric = [&row](const char* name) {
-        auto it = row.metrics.find(name);
-        return it == row.metrics.end() ? std::nan("") : it->second;
-      };
       std::printf("  %-36s cost %6.3g  nav %6.1f s  ctrl %5.1f Hz%s\n",
                   spec::FormatPoint(spec->design_space, row.point).c_str(),
-                  metric("hardware_cost"), metric("nav_time_s"),
-                  metric("ctrl_rate_hz"), row.feasible ? "" : "  (infeasible)");
+                  campaign::RowMetric(row, "hardware_cost"), campaign::RowMetric(row, "nav_time_s"),
+                  campaign::RowMetric(row, "ctrl_rate_hz"), row.feasible ? "" : "  (infeasible)");
     }
     std::printf("report: %s/report.md\n", s.output_dir.c_str());
   }

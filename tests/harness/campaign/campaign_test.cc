@@ -99,9 +99,12 @@ TEST(CampaignTest,
     feasible += row.feasible;
     EXPECT_TRUE(
         fs::exists(out + "/images/" + row.content_key + "/trajectory.png"));
-    if (row.point.at("cores") == 1 && row.point.at("freq_ghz") == 1.0)
+    if (row.point.at("cores") == 1 && row.point.at("freq_ghz") == 1.0) {
       EXPECT_FALSE(row.feasible);
-    if (row.point.at("cores") == 16) EXPECT_TRUE(row.feasible) << row.reason;
+    }
+    if (row.point.at("cores") == 16) {
+      EXPECT_TRUE(row.feasible) << row.reason;
+    }
   }
   EXPECT_GT(feasible, 0);
   EXPECT_EQ(IndexKeys(out).size(), 12u);
@@ -219,8 +222,8 @@ TEST(CampaignTest,
   CampaignOptions o = Options(out, "exhaustive", 4);
   o.worker_command = {"/bin/sh", MisbehavingWorker(out)};
   std::vector<std::string> attempts;
-  o.on_attempt_failed = [&attempts](const EvalRequest& r, int attempt,
-                                    const std::string& d) {
+  o.on_attempt_failed = [&attempts](const EvalRequest& /*request*/,
+                                    int /*attempt*/, const std::string& d) {
     attempts.push_back(d);
   };
   Result<CampaignSummary> s = RunCampaign(spec, o);

@@ -33,20 +33,26 @@ CommandRun Adse(const std::string& args) {
 std::string Example() { return std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_parking_lot.yaml"; }
 
 // A copy of the robotaxi example with one line replaced.
+// Writes scenario text to the temporary folder as adse_cli_<name>.yaml,
+// with the bundled calibration beside it (the examples name it relative
+// to themselves).
+std::string WriteScenario(const std::string& name, const std::string& text) {
+  const fs::path path = fs::temp_directory_path() / ("adse_cli_" + name + ".yaml");
+  std::ofstream(path) << text;
+  fs::create_directories(fs::temp_directory_path() / "calibration");
+  fs::copy_file(std::string(ADSE_SOURCE_DIR) + "/scenarios/calibration/reference.json",
+                fs::temp_directory_path() / "calibration/reference.json",
+                fs::copy_options::overwrite_existing);
+  return path.string();
+}
+
 std::string Variant(const std::string& name, const std::string& from, const std::string& to) {
   std::ifstream in(Example());
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const size_t at = text.find(from);
   EXPECT_NE(at, std::string::npos) << from;
   if (at != std::string::npos) text.replace(at, from.size(), to);
-  const fs::path path = fs::temp_directory_path() / ("adse_cli_" + name + ".yaml");
-  std::ofstream(path) << text;
-  // The example names its calibration relative to itself.
-  fs::create_directories(fs::temp_directory_path() / "calibration");
-  fs::copy_file(std::string(ADSE_SOURCE_DIR) + "/scenarios/calibration/reference.json",
-                fs::temp_directory_path() / "calibration/reference.json",
-                fs::copy_options::overwrite_existing);
-  return path.string();
+  return WriteScenario(name, text);
 }
 
 TEST(CliTest, ValidateReportsTheRobotaxiSpaceOf280Points) {
@@ -230,15 +236,9 @@ TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
   const CommandRun isolation = Adse("run " + Small() + " --isolation containers");
   EXPECT_EQ(isolation.exit_code, 2) << isolation.out;
   EXPECT_NE(isolation.out.find("--isolation"), std::string::npos) << isolation.out;
-  const std::string file =
-      (fs::temp_directory_path() / "adse_cli_replicas.yaml").string();
   std::ifstream in(Small());
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::ofstream(file) << text << "harness: {replicas: 3}\n";
-  fs::create_directories(fs::temp_directory_path() / "calibration");
-  fs::copy_file(std::string(ADSE_SOURCE_DIR) + "/scenarios/calibration/reference.json",
-                fs::temp_directory_path() / "calibration/reference.json",
-                fs::copy_options::overwrite_existing);
+  const std::string file = WriteScenario("replicas", text + "harness: {replicas: 3}\n");
   const CommandRun replicas = Adse("run " + file + " -o " +
                                    (fs::temp_directory_path() / "adse_cli_replicas").string());
   EXPECT_EQ(replicas.exit_code, 2) << replicas.out;
