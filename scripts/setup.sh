@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   cmake g++ make ccache pkg-config git
   libyaml-cpp-dev libeigen3-dev libmuparser-dev libcli11-dev libfmt-dev
-  libspdlog-dev nlohmann-json3-dev libssl-dev
+  libspdlog-dev nlohmann-json3-dev libssl-dev libcurl4-openssl-dev libcpp-httplib-dev
   sumo sumo-tools
   libpcl-dev libopencv-dev libceres-dev libhdf5-dev libpagmo-dev
   libgtest-dev libgmock-dev libbenchmark-dev
