@@ -225,6 +225,37 @@ Status WriteContents(hid_t file, const CampaignIndex& index) {
           return JoinKeys(r.content_keys);
         })));
   }
+  {
+    const auto& rows = index.llm_exchanges;
+    Result<Handle> group = internal::CreateGroup(file, "llm_exchanges");
+    if (!group.ok()) return group.status();
+    const hid_t g = group->get();
+    using Row = LlmExchangeRow;
+    auto ints = [&](const char* name, int64_t Row::*member) {
+      return WriteColumn(g, name, Gather<int64_t>(rows, [&](const Row& r) { return r.*member; }));
+    };
+    auto strings = [&](const char* name, std::string Row::*member) {
+      return WriteColumn(g, name,
+                         Gather<std::string>(rows, [&](const Row& r) { return r.*member; }));
+    };
+    ADSE_RETURN_IF_ERROR(ints("seq", &Row::seq));
+    ADSE_RETURN_IF_ERROR(ints("iteration", &Row::iteration));
+    ADSE_RETURN_IF_ERROR(strings("agent", &Row::agent));
+    ADSE_RETURN_IF_ERROR(strings("model", &Row::model));
+    ADSE_RETURN_IF_ERROR(strings("backend", &Row::backend));
+    ADSE_RETURN_IF_ERROR(strings("request_sha256", &Row::request_sha256));
+    ADSE_RETURN_IF_ERROR(strings("prompt", &Row::prompt));
+    ADSE_RETURN_IF_ERROR(strings("image_sha256", &Row::image_sha256));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "ok", Gather<uint8_t>(rows, [](const Row& r) { return r.ok ? 1 : 0; })));
+    ADSE_RETURN_IF_ERROR(strings("answer", &Row::answer));
+    ADSE_RETURN_IF_ERROR(strings("error", &Row::error));
+    ADSE_RETURN_IF_ERROR(ints("prompt_tokens", &Row::prompt_tokens));
+    ADSE_RETURN_IF_ERROR(ints("completion_tokens", &Row::completion_tokens));
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "latency_s", Gather<double>(rows, [](const Row& r) { return r.latency_s; })));
+    ADSE_RETURN_IF_ERROR(ints("attempts", &Row::attempts));
+  }
   return Status::Ok();
 }
 
@@ -390,6 +421,49 @@ Status ReadContents(hid_t file, CampaignIndex* index) {
     for (size_t i = 0; i < n; ++i) rows[i].rationale = std::move(column[i]);
     ADSE_RETURN_IF_ERROR(ReadSized(g, path, "content_keys", n, &column));
     for (size_t i = 0; i < n; ++i) rows[i].content_keys = SplitKeys(column[i]);
+  }
+  // Indexes written before LLM campaigns existed have no exchanges group.
+  if (internal::GetObjectKind(file, "/llm_exchanges") != internal::ObjectKind::kMissing) {
+    const std::string path = "/llm_exchanges";
+    Result<Handle> group = internal::OpenGroup(file, path);
+    if (!group.ok()) return group.status();
+    const hid_t g = group->get();
+    using Row = LlmExchangeRow;
+    std::vector<int64_t> numbers;
+    ADSE_RETURN_IF_ERROR(ReadColumn(g, "seq", &numbers));
+    const size_t n = numbers.size();
+    auto& rows = index->llm_exchanges;
+    rows.assign(n, Row{});
+    for (size_t i = 0; i < n; ++i) rows[i].seq = numbers[i];
+    auto ints = [&](const char* name, int64_t Row::*member) {
+      ADSE_RETURN_IF_ERROR(ReadSized(g, path, name, n, &numbers));
+      for (size_t i = 0; i < n; ++i) rows[i].*member = numbers[i];
+      return Status::Ok();
+    };
+    auto strings = [&](const char* name, std::string Row::*member) {
+      std::vector<std::string> column;
+      ADSE_RETURN_IF_ERROR(ReadSized(g, path, name, n, &column));
+      for (size_t i = 0; i < n; ++i) rows[i].*member = std::move(column[i]);
+      return Status::Ok();
+    };
+    ADSE_RETURN_IF_ERROR(ints("iteration", &Row::iteration));
+    ADSE_RETURN_IF_ERROR(strings("agent", &Row::agent));
+    ADSE_RETURN_IF_ERROR(strings("model", &Row::model));
+    ADSE_RETURN_IF_ERROR(strings("backend", &Row::backend));
+    ADSE_RETURN_IF_ERROR(strings("request_sha256", &Row::request_sha256));
+    ADSE_RETURN_IF_ERROR(strings("prompt", &Row::prompt));
+    ADSE_RETURN_IF_ERROR(strings("image_sha256", &Row::image_sha256));
+    ADSE_RETURN_IF_ERROR(strings("answer", &Row::answer));
+    ADSE_RETURN_IF_ERROR(strings("error", &Row::error));
+    ADSE_RETURN_IF_ERROR(ints("prompt_tokens", &Row::prompt_tokens));
+    ADSE_RETURN_IF_ERROR(ints("completion_tokens", &Row::completion_tokens));
+    ADSE_RETURN_IF_ERROR(ints("attempts", &Row::attempts));
+    std::vector<uint8_t> ok;
+    ADSE_RETURN_IF_ERROR(ReadSized(g, path, "ok", n, &ok));
+    for (size_t i = 0; i < n; ++i) rows[i].ok = ok[i] != 0;
+    std::vector<double> latency;
+    ADSE_RETURN_IF_ERROR(ReadSized(g, path, "latency_s", n, &latency));
+    for (size_t i = 0; i < n; ++i) rows[i].latency_s = latency[i];
   }
   return Status::Ok();
 }

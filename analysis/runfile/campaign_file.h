@@ -46,6 +46,22 @@ struct IterationRow {
   std::vector<std::string> content_keys;  // the points proposed
 };
 
+// One exchange with a language model (strategy `llm`), as recorded in the
+// campaign's llm/exchanges.jsonl.
+struct LlmExchangeRow {
+  int64_t seq = 0;
+  int64_t iteration = -1;
+  std::string agent, model, backend, request_sha256;
+  std::string prompt;
+  std::string image_sha256;  // ','-joined
+  bool ok = true;
+  std::string answer;  // when ok
+  std::string error;   // when not: "<code>: <message>"
+  int64_t prompt_tokens = -1, completion_tokens = -1;  // -1: not reported
+  double latency_s = 0.0;
+  int64_t attempts = 0;
+};
+
 struct CampaignIndex {
   std::string scenario_name;
   std::string scenario_text;  // the exact YAML the campaign ran
@@ -59,6 +75,7 @@ struct CampaignIndex {
   std::vector<std::string> metrics;
   std::vector<EvaluationRow> evaluations;
   std::vector<IterationRow> iterations;
+  std::vector<LlmExchangeRow> llm_exchanges;  // empty unless strategy llm
 };
 
 // Writes the index atomically (temporary name, fsync, rename), so a reader

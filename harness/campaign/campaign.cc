@@ -12,6 +12,7 @@
 
 #include "harness/campaign/pool_evaluator.h"
 #include "harness/campaign/run_store.h"
+#include "harness/campaign/strategy_factory.h"
 #include "stack/base/files.h"
 
 namespace adse::campaign {
@@ -85,9 +86,7 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
         "harness.executor: only 'local' is implemented; found '" +
         spec.harness.executor + "'");
   }
-  Result<std::unique_ptr<explore::Strategy>> strategy =
-      explore::CreateStrategy(spec.exploration.strategy, {&spec});
-  if (!strategy.ok()) return strategy.status();
+  ADSE_RETURN_IF_ERROR(CheckStrategyName(spec.exploration.strategy));
   Result<pool::Isolation> isolation =
       pool::ParseIsolation(spec.harness.isolation);
   if (!isolation.ok()) return isolation.status();
@@ -100,6 +99,10 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
   ADSE_RETURN_IF_ERROR(folder.Create());
   Result<CampaignLock> lock = CampaignLock::Acquire(folder.root());
   if (!lock.ok()) return lock.status();
+  // Created under the lock: the llm strategy records into the folder.
+  Result<std::unique_ptr<explore::Strategy>> strategy =
+      CreateCampaignStrategy(spec, folder.root(), /*record=*/true);
+  if (!strategy.ok()) return strategy.status();
 
   pool::PoolOptions pool_options = options.pool;
   pool_options.workers = spec.harness.workers;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -13,11 +14,39 @@
 #include "analysis/runfile/campaign_file.h"
 #include "harness/campaign/campaign.h"
 #include "harness/campaign/run_store.h"
+#include "harness/llm/exchange_log.h"
+#include "harness/llm/llm_strategy.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/files.h"
 
 namespace adse::campaign {
 namespace {
+
+// What the LLM agents did (strategy llm), from the folder's llm/ records.
+struct LlmRecords {
+  std::vector<llm::ExchangeRecord> exchanges;
+  std::vector<llm::LlmEvent> events;
+  std::string problem;  // why a record could not be read
+};
+
+LlmRecords LoadLlmRecords(const std::string& folder) {
+  LlmRecords r;
+  Result<std::vector<llm::ExchangeRecord>> exchanges =
+      llm::LoadExchanges(llm::ExchangesPath(folder));
+  if (exchanges.ok()) {
+    r.exchanges = std::move(*exchanges);
+  } else {
+    r.problem = exchanges.status().message();
+  }
+  Result<std::vector<llm::LlmEvent>> events = llm::LoadEvents(llm::EventsPath(folder));
+  if (events.ok()) {
+    r.events = std::move(*events);
+  } else {
+    r.problem += (r.problem.empty() ? "" : "; ") + events.status().message();
+  }
+  return r;
+}
+
 
 std::string Number(double v) {
   if (std::isnan(v)) return "—";
@@ -70,7 +99,53 @@ std::string Cell(std::string text) {
   return out;
 }
 
-std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s) {
+std::string LlmMarkdown(const LlmRecords& llm) {
+  std::ostringstream md;
+  md << "\n## LLM agents\n\n";
+  if (!llm.problem.empty()) md << "Records could not be read: " << llm.problem << "\n\n";
+  std::map<std::string, int> asked, failed;
+  int64_t prompt_tokens = 0, answer_tokens = 0;
+  double latency = 0.0;
+  int answered = 0;
+  for (const llm::ExchangeRecord& e : llm.exchanges) {
+    ++asked[e.agent];
+    if (!e.ok) ++failed[e.agent];
+    if (e.ok) {
+      ++answered;
+      latency += e.latency_s;
+    }
+    prompt_tokens += std::max<int64_t>(e.prompt_tokens, 0);
+    answer_tokens += std::max<int64_t>(e.completion_tokens, 0);
+  }
+  md << fmt::format(
+      "{} exchanges ({} answered, mean latency {} s), {} prompt and {} answer tokens; "
+      "every exchange is in `llm/exchanges.jsonl` and `campaign.h5` (/llm_exchanges).\n\n",
+      llm.exchanges.size(), answered, Number(answered ? latency / answered : NAN),
+      prompt_tokens, answer_tokens);
+  md << "| agent | requests | failed |\n|---|---|---|\n";
+  for (const auto& [agent, n] : asked) {
+    md << fmt::format("| {} | {} | {} |\n", agent, n, failed[agent]);
+  }
+  std::map<std::string, int> kinds;
+  for (const llm::LlmEvent& e : llm.events) ++kinds[e.kind];
+  md << fmt::format(
+      "\nEvents: {} answers rejected (each got one corrective follow-up), {} iterations "
+      "proposed by the built-in agent instead, {} disagreements with the deterministic "
+      "analysis (the deterministic values were used), {} errors{}.\n\n",
+      kinds["rejected"], kinds["fallback"], kinds["disagreement"], kinds["error"],
+      kinds["converged"] ? ", convergence declared" : "");
+  if (!llm.events.empty()) {
+    md << "| iteration | agent | event | detail |\n|---|---|---|---|\n";
+    for (const llm::LlmEvent& e : llm.events) {
+      md << fmt::format("| {} | {} | {} | {} |\n", e.iteration, e.agent, e.kind,
+                        Cell(e.detail));
+    }
+  }
+  return md.str();
+}
+
+std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
+                           const LlmRecords* llm) {
   const auto& rows = s.exploration.evaluations;
   std::ostringstream md;
   md << "# Campaign: " << spec.name << "\n\n";
@@ -164,6 +239,7 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s) {
         row.content_key, row.content_key);
   }
   if (!any) md << "None.\n";
+  if (llm) md << LlmMarkdown(*llm);
   return md.str();
 }
 
@@ -190,6 +266,31 @@ Status WriteCampaignViews(const spec::Spec& spec,
   index.metrics.assign(metric_names.begin(), metric_names.end());
   index.evaluations = rows;
   index.iterations = summary.exploration.iterations;
+  std::optional<LlmRecords> llm;
+  if (spec.exploration.strategy == "llm") {
+    llm = LoadLlmRecords(folder.root());
+    for (const llm::ExchangeRecord& e : llm->exchanges) {
+      runfile::LlmExchangeRow row;
+      row.seq = e.seq;
+      row.iteration = e.iteration;
+      row.agent = e.agent;
+      row.model = e.model;
+      row.backend = e.backend;
+      row.request_sha256 = e.request_sha256;
+      row.prompt = e.prompt;
+      for (const std::string& h : e.image_sha256) {
+        row.image_sha256 += (row.image_sha256.empty() ? "" : ",") + h;
+      }
+      row.ok = e.ok;
+      row.answer = e.answer;
+      row.error = e.ok ? "" : e.error_code + ": " + e.error;
+      row.prompt_tokens = e.prompt_tokens;
+      row.completion_tokens = e.completion_tokens;
+      row.latency_s = e.latency_s;
+      row.attempts = e.attempts;
+      index.llm_exchanges.push_back(std::move(row));
+    }
+  }
   ADSE_RETURN_IF_ERROR(
       runfile::WriteCampaignIndex(folder.Path("campaign.h5"), index));
 
@@ -231,11 +332,24 @@ Status WriteCampaignViews(const spec::Spec& spec,
                                {"rationale", it.rationale},
                                {"content_keys", it.content_keys}});
   }
+  if (llm) {
+    int fallbacks = 0, rejected = 0, disagreements = 0;
+    for (const llm::LlmEvent& e : llm->events) {
+      fallbacks += e.kind == "fallback";
+      rejected += e.kind == "rejected";
+      disagreements += e.kind == "disagreement";
+    }
+    j["llm"] = {{"exchanges", llm->exchanges.size()},
+                {"rejected_answers", rejected},
+                {"fallback_iterations", fallbacks},
+                {"disagreements", disagreements},
+                {"records", "llm/exchanges.jsonl, llm/memory.jsonl, llm/events.jsonl"}};
+  }
   ADSE_RETURN_IF_ERROR(WriteFileAtomic(
       folder.Path("summary.json"),
       j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"));
   ADSE_RETURN_IF_ERROR(
-      WriteFileAtomic(folder.Path("report.md"), ReportMarkdown(spec, current)));
+      WriteFileAtomic(folder.Path("report.md"), ReportMarkdown(spec, current, llm ? &*llm : nullptr)));
 
   std::vector<analysis::ParetoPlotPoint> plot;
   const std::set<int> on_front(front.begin(), front.end());

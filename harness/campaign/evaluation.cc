@@ -73,6 +73,7 @@ double RowMetric(const EvaluationRow& row, const std::string& name) {
 explore::Observation ObservationFromRow(const EvaluationRow& row) {
   explore::Observation o;
   o.point = row.point;
+  o.key = row.content_key;
   o.failed = row.status != "complete";
   if (o.failed) return o;
   for (const auto& [name, value] : row.metrics) {

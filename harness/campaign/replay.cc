@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "harness/campaign/strategy_factory.h"
 #include "harness/spec/spec_parser.h"
 
 namespace adse::campaign {
@@ -22,7 +23,8 @@ Result<Recording> LoadRecording(const std::string& folder_or_file) {
       spec::ParseSpec(index->scenario_text,
                       path + " (scenario stored in the index)", "", parse);
   if (!spec.ok()) return spec.status();
-  Recording recording{std::move(spec).value(), std::move(index->evaluations)};
+  Recording recording{std::move(spec).value(), std::move(index->evaluations),
+                      fs::absolute(path, ec).parent_path().string()};
   if (recording.rows.empty()) {
     return Status::InvalidArgument(path + ": the campaign has no evaluations");
   }
@@ -68,7 +70,7 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
   spec.exploration.seed = seed;
   if (budget > 0) spec.exploration.budget = budget;
   Result<std::unique_ptr<explore::Strategy>> strategy =
-      explore::CreateStrategy(name, {&spec});
+      CreateCampaignStrategy(spec, recording.folder, /*record=*/false);
   if (!strategy.ok()) return strategy.status();
   RecordingEvaluator evaluator(&recording);
   const ExplorationResult result = Explore(spec, **strategy, evaluator);

@@ -19,6 +19,7 @@ namespace adse::campaign {
 struct Recording {
   spec::Spec spec;  // parsed from the scenario text stored in campaign.h5
   std::vector<EvaluationRow> rows;
+  std::string folder;  // the campaign folder (llm replays read llm/ there)
 };
 
 // Reads <folder>/campaign.h5 (or a campaign.h5 path). Errors name the file.

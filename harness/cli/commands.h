@@ -95,6 +95,22 @@ struct ExploreArgs {
 };
 int RunExplore(const ExploreArgs& args);
 
+struct InterpretArgs {
+  std::string request;           // in plain words
+  std::string out;               // scenario file; empty: stdout
+  std::string backend = "ollama";  // ollama|openai|replay
+  std::string endpoint;          // empty: the backend's default
+  std::string model = "llama3.1";
+  std::string prompts;           // prompt folder; empty: bundled
+  double timeout_s = 120.0;
+  int retries = 2;
+  int max_corrections = 3;
+  std::string record;       // exchanges JSONL; default <out stem>.interpret.jsonl
+  std::string replay_from;  // answer from this record first (replay: only)
+  bool check_world = true;  // validate the map, start and goal in SUMO
+};
+int RunInterpret(const InterpretArgs& args);
+
 }  // namespace adse::cli
 
 #endif  // ADSE_HARNESS_CLI_COMMANDS_H_

@@ -147,6 +147,41 @@ int main(int argc, char** argv) {
   explore_cmd->add_option("--first-seed", explore.first_seed, "First exploration seed");
   explore_cmd->add_flag("--json", explore.json, "Print the results as JSON");
 
+  adse::cli::InterpretArgs interpret;
+  CLI::App* interpret_cmd = app.add_subcommand(
+      "interpret", "Turn a request in plain words into a validated scenario file with the "
+                   "interpretation agent (an LLM: Ollama, an OpenAI-compatible server, or a "
+                   "recorded exchange)");
+  interpret_cmd->add_option("request", interpret.request,
+                            "What to study, e.g. \"robotaxi in a parking lot; cheapest "
+                            "computer that reaches the goal within 60 s\"")
+      ->required();
+  interpret_cmd->add_option("-o,--out", interpret.out,
+                            "Scenario file to write (default: print it)");
+  interpret_cmd->add_option("--backend", interpret.backend, "ollama, openai or replay")
+      ->check(CLI::IsMember({"ollama", "openai", "replay"}));
+  interpret_cmd->add_option("--endpoint", interpret.endpoint,
+                            "Server URL (default: http://127.0.0.1:11434)");
+  interpret_cmd->add_option("--model", interpret.model, "Model name")->capture_default_str();
+  interpret_cmd->add_option("--prompts", interpret.prompts,
+                            "Folder of prompt templates (default: the bundled prompts/)");
+  interpret_cmd->add_option("--timeout", interpret.timeout_s, "Seconds per request")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  interpret_cmd->add_option("--retries", interpret.retries, "HTTP retries per request")
+      ->check(CLI::Range(0, 100))->capture_default_str();
+  interpret_cmd->add_option("--max-corrections", interpret.max_corrections,
+                            "Validation errors sent back to the model at most")
+      ->check(CLI::Range(0, 20))->capture_default_str();
+  interpret_cmd->add_option("--record", interpret.record,
+                            "Where exchanges are recorded (default: <out stem>.interpret.jsonl "
+                            "beside the output)");
+  interpret_cmd->add_option("--replay-from", interpret.replay_from,
+                            "Recorded exchanges (.jsonl) answered first; with --backend replay "
+                            "the only answers")
+      ->check(CLI::ExistingFile);
+  interpret_cmd->add_flag("!--no-world", interpret.check_world,
+                          "Do not load the map in SUMO when validating");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -160,6 +195,7 @@ int main(int argc, char** argv) {
   if (*run_cmd) return adse::cli::RunRun(run);
   if (*worker_cmd) return adse::cli::RunWorker(worker);
   if (*explore_cmd) return adse::cli::RunExplore(explore);
+  if (*interpret_cmd) return adse::cli::RunInterpret(interpret);
   if (*simulate_cmd) return adse::cli::RunSimulate(simulate);
   if (*calibrate_cmd) return adse::cli::RunCalibrate(calibrate);
   if (*schema_check_cmd) return adse::cli::RunSchemaCheck(schema_check);

@@ -48,6 +48,8 @@ struct Observation {
   bool failed = false;    // the run failed (no metrics)
   // The run's diagnosis, most severe first (empty when healthy or failed).
   std::vector<BottleneckHint> bottlenecks;
+  // The run's content key, when it has a run (agents read its report).
+  std::string key;
 };
 
 class Strategy {

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -73,6 +74,19 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run, const std::string& run
   for (const analysis::Finding& f : diagnosis.findings) {
     r.findings.push_back({f.kind, f.node, f.remedy, f.message, f.topics, f.rates_hz});
   }
+  for (const analysis::TopicStats& t : diagnosis.topics) {
+    TopicSummary summary{t.name, t.publisher, t.publish_rate_hz, 0.0, 0};
+    for (size_t i = 0; i < t.subscribers.size(); ++i) {
+      const analysis::SubscriberStats& sub = t.subscribers[i];
+      summary.slowest_take_rate_hz =
+          i == 0 ? sub.take_rate_hz : std::min(summary.slowest_take_rate_hz, sub.take_rate_hz);
+      summary.drops += sub.drops;
+    }
+    r.topics.push_back(summary);
+  }
+  for (const analysis::CallbackStats& c : diagnosis.callbacks) {
+    r.callbacks.push_back({c.name, c.latency_p50_s, c.latency_p99_s, c.utilization});
+  }
 
   // Constraints, from the scenario stored in the run. The files it names
   // (a calibration, a net) need not exist where the run is re-analysed.
@@ -125,6 +139,21 @@ nlohmann::json ToJson(const RunReport& r) {
     j["findings"].push_back({{"kind", f.kind}, {"node", f.node}, {"topics", f.topics},
                              {"rates_hz", f.rates_hz}, {"remedy", f.remedy},
                              {"message", f.message}});
+  }
+  j["trace"]["topics"] = nlohmann::json::array();
+  for (const TopicSummary& t : r.topics) {
+    j["trace"]["topics"].push_back({{"name", t.name},
+                                    {"publisher", t.publisher},
+                                    {"publish_rate_hz", Number(t.publish_rate_hz)},
+                                    {"slowest_take_rate_hz", Number(t.slowest_take_rate_hz)},
+                                    {"drops", t.drops}});
+  }
+  j["trace"]["callbacks"] = nlohmann::json::array();
+  for (const CallbackSummary& c : r.callbacks) {
+    j["trace"]["callbacks"].push_back({{"name", c.name},
+                                       {"latency_p50_s", Number(c.latency_p50_s)},
+                                       {"latency_p99_s", Number(c.latency_p99_s)},
+                                       {"utilization", Number(c.utilization)}});
   }
   j["images"] = r.images;
   return j;

@@ -5,6 +5,7 @@
 #ifndef ADSE_HARNESS_REPORT_RUN_REPORT_H_
 #define ADSE_HARNESS_REPORT_RUN_REPORT_H_
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -37,6 +38,23 @@ struct FindingSummary {
   std::map<std::string, double> rates_hz;
 };
 
+// The trace in numbers, for readers that cannot open the run file (the
+// deciphering agent's text part): rates and drops per topic, latency and
+// load per callback.
+struct TopicSummary {
+  std::string name;
+  std::string publisher;  // "external" for sensors
+  double publish_rate_hz = 0.0;
+  double slowest_take_rate_hz = 0.0;  // over its subscribers; 0 when none
+  int64_t drops = 0;                  // over its subscribers
+};
+struct CallbackSummary {
+  std::string name;  // "<node>/<callback>"
+  double latency_p50_s = 0.0;
+  double latency_p99_s = 0.0;
+  double utilization = 0.0;  // busy core-seconds per second
+};
+
 struct RunReport {
   int report_version = 1;
   std::string run_file;
@@ -58,6 +76,8 @@ struct RunReport {
   double driven_fraction = 0.0;
   std::string deviation_error;
   std::vector<FindingSummary> findings;
+  std::vector<TopicSummary> topics;
+  std::vector<CallbackSummary> callbacks;
   std::map<std::string, std::string> images;  // "trajectory" -> png path
 };
 

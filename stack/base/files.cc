@@ -67,6 +67,27 @@ Status WriteFileAtomic(const std::string& path, const std::string& data) {
   return Status::Ok();
 }
 
+Status AppendLineDurable(const std::string& path, const std::string& line) {
+  const std::string data = line + "\n";
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  if (fd < 0) return Status::IoError(path + ": " + std::strerror(errno));
+  size_t written = 0;
+  while (written < data.size()) {
+    const ssize_t n = ::write(fd, data.data() + written, data.size() - written);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const std::string err = std::strerror(errno);
+      ::close(fd);
+      return Status::IoError(path + ": " + err);
+    }
+    written += static_cast<size_t>(n);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    return Status::IoError(path + ": " + std::strerror(errno));
+  }
+  return Status::Ok();
+}
+
 std::string DefaultCacheDir() {
   if (const char* dir = std::getenv("ADSE_CACHE_DIR"); dir && *dir) return dir;
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) {

@@ -17,6 +17,11 @@ Result<std::string> ReadFile(const std::string& path,
 // renames it over `path`, so readers see the old file or the whole new one.
 Status WriteFileAtomic(const std::string& path, const std::string& data);
 
+// Appends `line` and a newline to `path` (created if missing) in one
+// write and flushes it to disk, so an append-only record survives a crash
+// with at most its last line cut short.
+Status AppendLineDurable(const std::string& path, const std::string& line);
+
 // adse's cache root: $ADSE_CACHE_DIR, else $XDG_CACHE_HOME/adse, else
 // ~/.cache/adse, else <tmp>/adse-cache.
 std::string DefaultCacheDir();

@@ -1,0 +1,46 @@
+#include "harness/campaign/strategy_factory.h"
+
+#include <fmt/format.h>
+
+#include "harness/campaign/run_store.h"
+#include "harness/llm/llm_strategy.h"
+
+namespace adse::campaign {
+
+Status CheckStrategyName(const std::string& name) {
+  if (name == "llm") return Status::Ok();
+  for (const std::string& n : explore::StrategyNames()) {
+    if (n == name) return Status::Ok();
+  }
+  return Status::InvalidArgument(fmt::format("unknown exploration strategy '{}'; valid: {}, llm",
+                                             name, fmt::join(explore::StrategyNames(), ", ")));
+}
+
+Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(const spec::Spec& spec,
+                                                                  const std::string& folder,
+                                                                  bool record) {
+  const std::string& name = spec.exploration.strategy;
+  ADSE_RETURN_IF_ERROR(CheckStrategyName(name));
+  if (name != "llm") return explore::CreateStrategy(name, {&spec});
+
+  spec::Spec llm_spec = spec;
+  if (!record) {
+    // A replay answers every request from the recording's own exchanges.
+    llm_spec.llm.backend = "replay";
+    llm_spec.llm.replay_from = folder;
+  }
+  Result<std::unique_ptr<llm::RecordingBackend>> backend =
+      llm::OpenBackend(llm_spec, record ? folder : "");
+  if (!backend.ok()) return backend.status();
+  const CampaignFolder layout(folder);
+  llm::LlmStrategyOptions options;
+  options.report_path = [layout](const std::string& key) { return layout.ReportPath(key); };
+  options.image_path = [layout](const std::string& key) {
+    return layout.ImageDir(key) + "/trajectory.png";
+  };
+  options.record_dir = record ? folder : "";
+  options.backend = std::move(*backend);
+  return llm::NewLlmStrategy(spec, std::move(options));
+}
+
+}  // namespace adse::campaign

@@ -1,0 +1,62 @@
+#include "harness/llm/jsonl_log.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include "stack/base/files.h"
+
+namespace adse::llm {
+
+Result<JsonlLog> JsonlLog::Open(const std::string& path) {
+  JsonlLog log;
+  log.path_ = path;
+  if (path.empty()) return log;
+  const std::filesystem::path p(path);
+  if (p.has_parent_path()) ADSE_RETURN_IF_ERROR(MakeDirs(p.parent_path().string()));
+  std::error_code ec;
+  if (!std::filesystem::exists(p, ec)) return log;
+  Result<std::string> text = ReadFile(path, size_t{1} << 30);
+  if (!text.ok()) return text.status();
+  const size_t last_newline = text->rfind('\n');
+  const size_t complete = last_newline == std::string::npos ? 0 : last_newline + 1;
+  if (complete < text->size()) {
+    // A crash cut the last append short: that line was never complete.
+    if (::truncate(path.c_str(), static_cast<off_t>(complete)) != 0) {
+      return Status::IoError(path + ": cannot drop its incomplete last line");
+    }
+  }
+  for (size_t i = 0; i < complete; ++i) {
+    if ((*text)[i] == '\n') ++log.existing_;
+  }
+  return log;
+}
+
+Status JsonlLog::Append(const std::string& line) {
+  if (path_.empty()) return Status::Ok();
+  if (written_++ < existing_) return Status::Ok();
+  return AppendLineDurable(path_, line);
+}
+
+Status ReadJsonLines(const std::string& path, const std::string& what,
+                     const std::function<void(const std::string& line)>& parse) {
+  std::ifstream in(path);
+  if (!in) return Status::Ok();
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (lines[i].empty()) continue;
+    try {
+      parse(lines[i]);
+    } catch (const std::exception& e) {
+      if (i + 1 == lines.size()) break;  // cut short by a crash
+      return Status::Corruption(path + ":" + std::to_string(i + 1) + ": not " + what + " (" +
+                                e.what() + ")");
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace adse::llm
