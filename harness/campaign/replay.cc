@@ -74,6 +74,7 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
   if (!strategy.ok()) return strategy.status();
   RecordingEvaluator evaluator(&recording);
   const ExplorationResult result = Explore(spec, **strategy, evaluator);
+  ADSE_RETURN_IF_ERROR((*strategy)->failure());
 
   std::vector<analysis::Evaluation> found, reference;
   for (const EvaluationRow& row : result.evaluations) {

@@ -71,6 +71,10 @@ class Strategy {
   // Points per round for an adaptive strategy, given exploration.batch
   // (GA / NSGA-II: a generation).
   virtual int RoundSize(int batch) const { return batch < 1 ? 1 : batch; }
+  // Why the strategy cannot go on (e.g. an llm replay was asked something
+  // never recorded): it then proposes nothing more, and the campaign stops
+  // with this error, keeping what was evaluated. Ok otherwise.
+  virtual Status failure() const { return Status::Ok(); }
 };
 
 struct StrategyContext {

@@ -95,9 +95,10 @@ class LlmStrategy : public explore::Strategy {
   std::string name() const override { return "llm"; }
   std::string rationale() const override { return rationale_; }
   int RoundSize(int /*batch*/) const override { return 1; }
+  Status failure() const override { return failure_; }
 
   std::vector<spec::DesignPoint> Ask(int k) override {
-    if (k < 1 || converged_ || proposed_ >= budget_) return {};
+    if (k < 1 || converged_ || !failure_.ok() || proposed_ >= budget_) return {};
     ++iteration_;
     options_.backend->set_iteration(iteration_);
 
@@ -115,6 +116,7 @@ class LlmStrategy : public explore::Strategy {
         " naming every design parameter once, with a point not evaluated yet; or with "
         "{\"converged\": true, \"rationale\": \"...\"}.");
     for (const std::string& why : turn.rejected) Event("dse", "rejected", why);
+    if (Fatal(turn, "dse")) return {};
     if (turn.ok && answer.converged) {
       converged_ = true;
       rationale_ = "the DSE agent declared convergence: " + answer.rationale;
@@ -247,6 +249,7 @@ class LlmStrategy : public explore::Strategy {
         "Answer with {\"world\": {\"map\", \"traffic_seed\", \"weather\"}, \"platform\": "
         "{<binding>: <value>}, \"tracing\": {\"record\": [...]}} and no other keys.");
     for (const std::string& why : turn.rejected) Event("command", "rejected", why);
+    if (Fatal(turn, "command")) return;
     if (!turn.ok) {
       Event("command", "error",
             (turn.error.ok() ? "no usable commands" : turn.error.message()) +
@@ -284,6 +287,7 @@ class LlmStrategy : public explore::Strategy {
           },
           "Answer with {\"bottlenecks\": [{\"node\", \"kind\", \"remedy\"}], \"summary\"}.");
       for (const std::string& why : turn.rejected) Event("text", "rejected", why);
+      if (Fatal(turn, "text")) return;
       if (turn.ok) {
         const std::vector<std::string> diffs = CompareTextReading(reading, o.bottlenecks);
         if (!diffs.empty()) {
@@ -319,6 +323,7 @@ class LlmStrategy : public explore::Strategy {
         "Answer with {\"reached_goal\": bool, \"smooth\": bool, \"left_lane\": bool, "
         "\"notes\": \"...\"}.");
     for (const std::string& why : turn.rejected) Event("vision", "rejected", why);
+    if (Fatal(turn, "vision")) return;
     if (turn.ok) {
       const VisionReading truth = VisionFromMetrics(o.metrics);
       const std::vector<std::string> diffs = CompareVisionReading(reading, truth);
@@ -331,6 +336,17 @@ class LlmStrategy : public explore::Strategy {
     } else if (!turn.error.ok()) {
       Event("vision", "error", turn.error.message());
     }
+  }
+
+  // A replay asked something never recorded: going on (with the built-in
+  // agent) would quietly make a different campaign than the recorded one.
+  bool Fatal(const TurnResult& turn, const std::string& agent) {
+    if (turn.error.code() != Status::Code::kNotFound) return false;
+    if (failure_.ok()) {
+      failure_ = turn.error;
+      Event(agent, "error", turn.error.message());
+    }
+    return true;
   }
 
   void Event(const std::string& agent, const std::string& kind, const std::string& detail) {
@@ -361,6 +377,7 @@ class LlmStrategy : public explore::Strategy {
   int64_t iteration_ = -1;
   bool converged_ = false;
   bool record_error_shown_ = false;
+  Status failure_;
   std::string rationale_;
   std::set<spec::DesignPoint> evaluated_;
   std::map<spec::DesignPoint, Proposal> proposals_;

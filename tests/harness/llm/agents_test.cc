@@ -19,8 +19,8 @@ using adse::testing::SmallScenario;
 TEST(DseAnswerTest, AcceptsAPointOfAllowedValuesAndSnapsThem) {
   const spec::Spec spec = SmallScenario();
   Result<DseAnswer> a = ParseDseAnswer(
-      R"({"point": {"cores": 4, "freq_ghz": 2.1000000000001, "lidar_hz": 14},
-          "rationale": "more  cores\nfor NDT", "converged": false})",
+      R"js({"point": {"cores": 4, "freq_ghz": 2.1000000000001, "lidar_hz": 14},
+          "rationale": "more  cores\nfor NDT", "converged": false})js",
       spec.design_space, {});
   ASSERT_TRUE(a.ok()) << a.status().ToString();
   EXPECT_EQ(a->point, SmallPoint(4, 2.1, 14));
@@ -48,18 +48,18 @@ TEST(DseAnswerTest, RefusesEverythingElseWithAnActionableMessage) {
       {"cores=4", "not valid JSON"},
       {"```json\n{\"point\": {}}\n```", "not valid JSON"},
       {"[1, 2]", "one JSON object"},
-      {R"({"point": {"cores": 4, "freq_ghz": 1.0, "lidar_hz": 14}})", "lacks \"rationale\""},
-      {R"({"point": {"cores": 3, "freq_ghz": 1.0, "lidar_hz": 14}, "rationale": "x"})",
+      {R"js({"point": {"cores": 4, "freq_ghz": 1.0, "lidar_hz": 14}})js", "lacks \"rationale\""},
+      {R"js({"point": {"cores": 3, "freq_ghz": 1.0, "lidar_hz": 14}, "rationale": "x"})js",
        "cores=3 is outside the design space; cores takes one of 1, 4, 16"},
-      {R"({"point": {"cores": 4, "freq_ghz": 1.0}, "rationale": "x"})", "lacks lidar_hz"},
-      {R"({"point": {"cores": 4, "freq_ghz": 1.0, "lidar_hz": 14, "gpu": 1}, "rationale": "x"})",
+      {R"js({"point": {"cores": 4, "freq_ghz": 1.0}, "rationale": "x"})js", "lacks lidar_hz"},
+      {R"js({"point": {"cores": 4, "freq_ghz": 1.0, "lidar_hz": 14, "gpu": 1}, "rationale": "x"})js",
        "not a design parameter"},
-      {R"({"point": {"cores": "4", "freq_ghz": 1.0, "lidar_hz": 14}, "rationale": "x"})",
+      {R"js({"point": {"cores": "4", "freq_ghz": 1.0, "lidar_hz": 14}, "rationale": "x"})js",
        "must be a number"},
-      {R"({"point": {"cores": 4, "freq_ghz": 2.1, "lidar_hz": 14}, "rationale": "x"})",
+      {R"js({"point": {"cores": 4, "freq_ghz": 2.1, "lidar_hz": 14}, "rationale": "x"})js",
        "was evaluated already"},
-      {R"({"point": {"cores": 4, "freq_ghz": 2.1, "lidar_hz": 7}, "rationale": "x",
-           "command": "rm -rf /"})",
+      {R"js({"point": {"cores": 4, "freq_ghz": 2.1, "lidar_hz": 7}, "rationale": "x",
+           "command": "rm -rf /"})js",
        "unknown key 'command'"},
   };
   for (const Case& c : cases) {
@@ -72,7 +72,7 @@ TEST(DseAnswerTest, RefusesEverythingElseWithAnActionableMessage) {
 
 TEST(DseAnswerTest, ConvergenceNeedsSomethingEvaluated) {
   const spec::Spec spec = SmallScenario();
-  const char* answer = R"({"converged": true, "rationale": "front found"})";
+  const char* answer = R"js({"converged": true, "rationale": "front found"})js";
   EXPECT_FALSE(ParseDseAnswer(answer, spec.design_space, {}).ok());
   Result<DseAnswer> a = ParseDseAnswer(answer, spec.design_space, {SmallPoint(1, 1.0, 7)});
   ASSERT_TRUE(a.ok());
@@ -83,14 +83,16 @@ TEST(DseAnswerTest, ConvergenceNeedsSomethingEvaluated) {
 TEST(CommandAnswerTest, AcceptsTheSchemaAndComparesWithTheDerivedCommands) {
   const spec::Spec spec = SmallScenario();
   const Commands derived = DeriveCommands(spec, SmallPoint(4, 1.0, 14), 3);
-  EXPECT_EQ(derived.map, "generate parking_lot (rows=2, slots_per_row=8)");
+  EXPECT_THAT(derived.map, ::testing::StartsWith("generate parking_lot ("));
+  EXPECT_THAT(derived.map, HasSubstr("rows=2"));
   EXPECT_EQ(derived.platform.at("platform.cores"), 4);
   EXPECT_EQ(derived.platform.at("stack.lidar.rate_hz"), 14);
-  const std::string agreeing =
-      R"({"world": {"map": "generate parking_lot (rows=2, slots_per_row=8)", "traffic_seed": 3,
+  std::string agreeing =
+      R"js({"world": {"map": "MAP", "traffic_seed": 3,
                     "weather": "clear"},
           "platform": {"platform.cores": 4, "platform.freq_ghz": 1.0, "stack.lidar.rate_hz": 14},
-          "tracing": {"record": ["callbacks", "topics", "trajectory", "controls", "vehicles"]}})";
+          "tracing": {"record": ["callbacks", "topics", "trajectory", "controls", "vehicles"]}})js";
+  agreeing.replace(agreeing.find("MAP"), 3, derived.map);
   Result<Commands> c = ParseCommandAnswer(agreeing, spec);
   ASSERT_TRUE(c.ok()) << c.status().ToString();
   EXPECT_TRUE(CompareCommands(*c, derived).empty());
@@ -107,22 +109,22 @@ TEST(CommandAnswerTest, RefusesShellTextPathsAndUnknownKeys) {
   const spec::Spec spec = SmallScenario();
   const char* cases[] = {
       // A path instead of the scenario's map.
-      R"({"world": {"map": "../../etc/passwd", "traffic_seed": 3, "weather": "clear"},
-          "platform": {}, "tracing": {"record": []}})",
+      R"js({"world": {"map": "../../etc/passwd", "traffic_seed": 3, "weather": "clear"},
+          "platform": {}, "tracing": {"record": []}})js",
       // Shell text in a free slot.
-      R"({"world": {"map": "generate parking_lot (rows=2, slots_per_row=8)", "traffic_seed": 3,
-                    "weather": "clear; rm -rf ~"}, "platform": {}, "tracing": {"record": []}})",
+      R"js({"world": {"map": "generate parking_lot (rows=2, slots_per_row=8)", "traffic_seed": 3,
+                    "weather": "clear; rm -rf ~"}, "platform": {}, "tracing": {"record": []}})js",
       // An output path where none is asked for.
-      R"({"world": {"map": "generate parking_lot (rows=2, slots_per_row=8)", "traffic_seed": 3,
+      R"js({"world": {"map": "generate parking_lot (rows=2, slots_per_row=8)", "traffic_seed": 3,
                     "weather": "clear"}, "platform": {},
-          "tracing": {"record": ["callbacks"], "output": "/tmp/adse-evil.h5"}})",
-      R"({"world": {"map": "generate parking_lot (rows=2, slots_per_row=8)", "traffic_seed": 3,
+          "tracing": {"record": ["callbacks"], "output": "/tmp/adse-evil.h5"}})js",
+      R"js({"world": {"map": "generate parking_lot (rows=2, slots_per_row=8)", "traffic_seed": 3,
                     "weather": "clear"}, "platform": {"platform.cores": "$(reboot)"},
-          "tracing": {"record": []}})",
-      R"({"world": {"map": "generate parking_lot (rows=2, slots_per_row=8)", "traffic_seed": 3,
+          "tracing": {"record": []}})js",
+      R"js({"world": {"map": "generate parking_lot (rows=2, slots_per_row=8)", "traffic_seed": 3,
                     "weather": "clear"}, "platform": {},
-          "tracing": {"record": ["`curl evil`"]}})",
-      R"({"exec": "sh -c id"})",
+          "tracing": {"record": ["`curl evil`"]}})js",
+      R"js({"exec": "sh -c id"})js",
   };
   for (const char* answer : cases) {
     Result<Commands> c = ParseCommandAnswer(answer, spec);
@@ -133,10 +135,10 @@ TEST(CommandAnswerTest, RefusesShellTextPathsAndUnknownKeys) {
 
 TEST(DecipherTest, TextReadingIsComparedByNodeAndKind) {
   Result<TextReading> r = ParseTextReading(
-      R"({"bottlenecks": [{"node": "ndt_scan_matcher", "kind": "cpu_bound",
+      R"js({"bottlenecks": [{"node": "ndt_scan_matcher", "kind": "cpu_bound",
                            "remedy": "higher frequency"},
                           {"node": "planner", "kind": "frequency_bound", "remedy": "x"}],
-          "summary": "NDT falls behind"})");
+          "summary": "NDT falls behind"})js");
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   const std::vector<explore::BottleneckHint> found = {
       {"cpu_bound", "ndt_scan_matcher", "higher frequency", 0.6},
@@ -144,8 +146,8 @@ TEST(DecipherTest, TextReadingIsComparedByNodeAndKind) {
   EXPECT_THAT(CompareTextReading(*r, found),
               ::testing::UnorderedElementsAre("missed cpu_bound euclidean_cluster",
                                               "named frequency_bound planner (not found)"));
-  EXPECT_FALSE(ParseTextReading(R"({"bottlenecks": [{"node": "a", "kind": "slow"}]})").ok());
-  EXPECT_FALSE(ParseTextReading(R"({"summary": "fine"})").ok());
+  EXPECT_FALSE(ParseTextReading(R"js({"bottlenecks": [{"node": "a", "kind": "slow"}]})js").ok());
+  EXPECT_FALSE(ParseTextReading(R"js({"summary": "fine"})js").ok());
 }
 
 TEST(DecipherTest, VisionReadingIsComparedWithTheMetrics) {
@@ -155,20 +157,20 @@ TEST(DecipherTest, VisionReadingIsComparedWithTheMetrics) {
   EXPECT_FALSE(truth.smooth);
   EXPECT_FALSE(truth.left_lane);
   Result<VisionReading> r = ParseVisionReading(
-      R"({"reached_goal": true, "smooth": true, "left_lane": false, "notes": "fine"})");
+      R"js({"reached_goal": true, "smooth": true, "left_lane": false, "notes": "fine"})js");
   ASSERT_TRUE(r.ok());
   EXPECT_THAT(CompareVisionReading(*r, truth), ::testing::ElementsAre("smooth: yes (metrics: no)"));
-  EXPECT_FALSE(ParseVisionReading(R"({"reached_goal": "yes", "smooth": true,
-                                      "left_lane": false})").ok());
+  EXPECT_FALSE(ParseVisionReading(R"js({"reached_goal": "yes", "smooth": true,
+                                      "left_lane": false})js").ok());
 }
 
 TEST(DecipherTest, TraceSummaryReadsTheReportsTrace) {
-  Result<std::string> s = TraceSummaryFromReport(R"({
+  Result<std::string> s = TraceSummaryFromReport(R"js({
     "metrics": {"ctrl_rate_hz": 9.5, "e2e_latency_p50_s": 0.12, "e2e_latency_p99_s": 0.3},
     "trace": {"topics": [{"name": "/points", "publisher": "external", "publish_rate_hz": 14,
                           "slowest_take_rate_hz": 3.5, "drops": 120}],
               "callbacks": [{"name": "ndt/on_points", "latency_p50_s": 0.25,
-                             "latency_p99_s": 0.4, "utilization": 0.98}]}})");
+                             "latency_p99_s": 0.4, "utilization": 0.98}]}})js");
   ASSERT_TRUE(s.ok());
   EXPECT_THAT(*s, HasSubstr("/points (external): 14 Hz, 3.5 Hz, 120 drops"));
   EXPECT_THAT(*s, HasSubstr("ndt/on_points: 250 / 400 ms, 0.98"));
