@@ -180,8 +180,9 @@ Result<ChatReply> RecordingBackend::Chat(const ChatRequest& request) {
         " request (exchange " + std::to_string(r.seq) + ", model " +
         request.model + ", request " + r.request_sha256.substr(0, 12) +
         ") in " + replay_source_ +
-        "; the scenario, the prompts or the evaluated runs differ from the "
-        "recorded campaign");
+        "; something that shapes the request differs from the recording (the "
+        "scenario, its budget, the prompts, the evaluated runs or, for `adse "
+        "interpret`, the request or output file name)");
   } else {
     r.backend = live_->name();
     reply = live_->Chat(request);

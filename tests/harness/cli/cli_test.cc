@@ -10,25 +10,14 @@
 #include <regex>
 #include <sys/wait.h>
 
+#include "tests/harness/testing/adse_command.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandRun {
-  int exit_code;
-  std::string out;  // stdout and stderr
-};
-
-CommandRun Adse(const std::string& args) {
-  const std::string command = std::string(ADSE_BINARY_DIR) + "/bin/adse " + args + " 2>&1";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) out.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using adse::testing::Adse;
+using adse::testing::CommandRun;
 
 std::string Example() { return std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_parking_lot.yaml"; }
 
