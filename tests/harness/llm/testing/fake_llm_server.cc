@@ -341,6 +341,8 @@ Result<std::unique_ptr<FakeLlmServer>> FakeLlmServer::Start(Script script) {
   impl->server.Post(".*", handler);
   // Idle keep-alive connections hold up stop() for this long.
   impl->server.set_keep_alive_timeout(1);
+  // Like real model servers: no Nagle delay between headers and body.
+  impl->server.set_tcp_nodelay(true);
   impl->port = impl->server.bind_to_any_port("127.0.0.1");
   if (impl->port <= 0) {
     return Status::Unavailable("fake LLM server: cannot bind 127.0.0.1");
