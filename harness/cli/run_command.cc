@@ -44,7 +44,11 @@ class Progress : public campaign::ExplorerListener {
                   const runfile::IterationRow& it,
                   const std::vector<spec::DesignPoint>& points) override {
     proposed_ += static_cast<int>(points.size());
-    if (!quiet_ && !tty_ && !it.rationale.empty()) {
+    // An llm iteration the built-in agent had to take over is shown even
+    // under the bar: a model server that is down should not go unnoticed.
+    const bool fallback = it.rationale.rfind("fallback to the built-in agent", 0) == 0;
+    if (!quiet_ && !it.rationale.empty() && (!tty_ || fallback)) {
+      if (tty_) std::fprintf(stderr, "\r\033[K");
       std::fprintf(stderr, "iteration %lld (%s): %s\n",
                    static_cast<long long>(it.iteration),
                    strategy.name().c_str(), it.rationale.c_str());

@@ -234,6 +234,23 @@ TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
   EXPECT_NE(replicas.out.find("harness.replicas"), std::string::npos) << replicas.out;
 }
 
+TEST(CliRunTest, AnLlmCampaignWithItsServerDownSaysSoAndFinishesWithTheBuiltInAgent) {
+  std::ifstream in(Small());
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // Port 9 (discard): nothing listens there.
+  const std::string file = WriteScenario(
+      "llm_down", text + "llm: {endpoint: \"http://127.0.0.1:9\", retries: 0}\n");
+  const std::string out = (fs::temp_directory_path() / "adse_cli_llm_down").string();
+  fs::remove_all(out);
+  const CommandRun run = Adse("run " + file + " --strategy llm --budget 1 -o " + out);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("fallback to the built-in agent"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("cannot reach http://127.0.0.1:9/api/chat"), std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("ollama serve"), std::string::npos) << run.out;
+  EXPECT_TRUE(fs::exists(out + "/llm/exchanges.jsonl"));
+}
+
 TEST(CliRunTest, WorkerRefusesAScenarioThatChangedUnderItsCampaign) {
   const std::string out = (fs::temp_directory_path() / "adse_cli_worker.h5").string();
   const CommandRun run = Adse("worker " + Small() + " --point cores=4,freq_ghz=2.1,lidar_hz=14 -o " +
