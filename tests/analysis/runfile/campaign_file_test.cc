@@ -291,6 +291,63 @@ TEST_P(CampaignFileRoundTripTest, RealisticIndexRoundTripsExactly) {
 INSTANTIATE_TEST_SUITE_P(Rows, CampaignFileRoundTripTest,
                          ::testing::Values(size_t{0}, size_t{1}, size_t{500}));
 
+TEST_F(CampaignFileTest, LlmExchangesRoundTripAndOlderIndexesHaveNone) {
+  CampaignIndex index = MakeIndex(3);
+  LlmExchangeRow a;
+  a.seq = 0;
+  a.iteration = 0;
+  a.agent = "dse";
+  a.model = "deepseek-r1";
+  a.backend = "ollama";
+  a.request_sha256 = Sha256Hex("request");
+  a.prompt = "[system]\nYou are ... ≤ 60 s\n\n[user]\n" + std::string(20000, 'p');
+  a.answer = R"({"point": {"cores": 4}, "rationale": "NDT lags"})";
+  a.prompt_tokens = 5123;
+  a.completion_tokens = 40;
+  a.latency_s = 12.5;
+  a.attempts = 1;
+  LlmExchangeRow b;
+  b.seq = 1;
+  b.iteration = 0;
+  b.agent = "vision";
+  b.model = "mistral-small3.1";
+  b.image_sha256 = Sha256Hex("png") + "," + Sha256Hex("png2");
+  b.ok = false;
+  b.error = "unavailable: did not answer within 120 s";
+  b.attempts = 3;
+  index.llm_exchanges = {a, b};
+  const std::string path = Path("campaign.h5");
+  ASSERT_TRUE(WriteCampaignIndex(path, index).ok());
+  Result<CampaignIndex> back = ReadCampaignIndex(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  ASSERT_EQ(back->llm_exchanges.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    const LlmExchangeRow& w = index.llm_exchanges[i];
+    const LlmExchangeRow& r = back->llm_exchanges[i];
+    EXPECT_EQ(r.seq, w.seq);
+    EXPECT_EQ(r.iteration, w.iteration);
+    EXPECT_EQ(r.agent, w.agent);
+    EXPECT_EQ(r.model, w.model);
+    EXPECT_EQ(r.backend, w.backend);
+    EXPECT_EQ(r.request_sha256, w.request_sha256);
+    EXPECT_EQ(r.prompt, w.prompt);
+    EXPECT_EQ(r.image_sha256, w.image_sha256);
+    EXPECT_EQ(r.ok, w.ok);
+    EXPECT_EQ(r.answer, w.answer);
+    EXPECT_EQ(r.error, w.error);
+    EXPECT_EQ(r.prompt_tokens, w.prompt_tokens);
+    EXPECT_EQ(r.completion_tokens, w.completion_tokens);
+    EXPECT_EQ(r.latency_s, w.latency_s);
+    EXPECT_EQ(r.attempts, w.attempts);
+  }
+  // The recorded robotaxi campaign predates the group.
+  Result<CampaignIndex> old = ReadCampaignIndex(
+      std::string(ADSE_SOURCE_DIR) + "/tests/data/robotaxi_exhaustive/campaign.h5");
+  ASSERT_TRUE(old.ok()) << old.status().ToString();
+  EXPECT_TRUE(old->llm_exchanges.empty());
+  EXPECT_EQ(old->evaluations.size(), 280u);
+}
+
 TEST_F(CampaignFileTest, DiffSeesADifference) {
   // The round-trip check is only as good as Diff.
   const CampaignIndex a = MakeIndex(30);
@@ -689,8 +746,8 @@ TEST_F(CampaignFileTest, SchemaDocumentsEverythingTheWriterWrites) {
       0);
   EXPECT_EQ(written, documented);
 
-  // Every member of /evaluations and /iterations is a documented dataset
-  // or group.
+  // Every member of /evaluations, /iterations and /llm_exchanges is a
+  // documented dataset or group.
   documented.clear();
   for (const auto& dataset : schema.at("datasets")) {
     documented.insert(dataset.at("path").get<std::string>());
@@ -699,7 +756,7 @@ TEST_F(CampaignFileTest, SchemaDocumentsEverythingTheWriterWrites) {
     documented.insert(group.at("path").get<std::string>());
   }
   written.clear();
-  for (const char* group : {"/evaluations", "/iterations"}) {
+  for (const char* group : {"/evaluations", "/iterations", "/llm_exchanges"}) {
     H5G_info_t info;
     ASSERT_GE(H5Gget_info_by_name(raw.get(), group, &info, H5P_DEFAULT), 0);
     for (hsize_t i = 0; i < info.nlinks; ++i) {
@@ -712,7 +769,7 @@ TEST_F(CampaignFileTest, SchemaDocumentsEverythingTheWriterWrites) {
   for (const std::string& name : written) {
     EXPECT_EQ(documented.count(name), 1u) << name << " is not documented";
   }
-  EXPECT_EQ(written.size(), documented.size() - 2)  // minus the two groups
+  EXPECT_EQ(written.size(), documented.size() - 3)  // minus the three groups
       << "documented items missing from the file";
 }
 
