@@ -149,7 +149,8 @@ Result<ChatReply> RecordingBackend::Chat(const ChatRequest& request) {
 
   Result<ChatReply> reply = Status::Internal("no answer");
   auto it = recorded_.find(r.request_sha256);
-  if (it != recorded_.end() && !it->second.empty()) {
+  const bool replayed = it != recorded_.end() && !it->second.empty();
+  if (replayed) {
     const ExchangeRecord old = std::move(it->second.front());
     it->second.pop_front();
     ++replayed_;
@@ -199,8 +200,10 @@ Result<ChatReply> RecordingBackend::Chat(const ChatRequest& request) {
     }
   }
 
-  Status logged =
-      log_.Append(ToJson(r).dump(-1, ' ', false, json::error_handler_t::replace));
+  // A live answer is new whatever the log holds (a resumed session that
+  // asks something the record lacks); a replayed one may be there already.
+  const std::string line = ToJson(r).dump(-1, ' ', false, json::error_handler_t::replace);
+  Status logged = replayed ? log_.Append(line) : log_.AppendNew(line);
   if (!logged.ok()) return logged.WithContext("recording an llm exchange");
   session_.push_back(std::move(r));
   return reply;

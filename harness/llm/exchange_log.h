@@ -56,11 +56,11 @@ Result<std::vector<ExchangeRecord>> LoadExchanges(const std::string& path);
 std::string ExchangesPath(const std::string& campaign_folder);
 
 // A backend that answers from a record first and asks `live` only for
-// requests the record does not hold. The session's n-th exchange (answer
-// or error, replayed or live) is appended to the log unless the log holds
-// n exchanges already: so resuming a campaign from its own log appends only
-// what is new, and replaying another campaign's log into a fresh folder
-// records the whole session there.
+// requests the record does not hold. Live exchanges (answers and errors)
+// are always appended to the log; the session's n-th exchange, when
+// replayed, only if the log does not hold n exchanges already. So resuming
+// a campaign from its own log appends only what is new, and replaying
+// another campaign's log into a fresh folder records the whole session.
 class RecordingBackend : public ChatBackend {
  public:
   // `recorded`: answers to replay (may be empty). `live`: null means

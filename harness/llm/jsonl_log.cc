@@ -40,6 +40,12 @@ Status JsonlLog::Append(const std::string& line) {
   return AppendLineDurable(path_, line);
 }
 
+Status JsonlLog::AppendNew(const std::string& line) {
+  if (path_.empty()) return Status::Ok();
+  ++written_;
+  return AppendLineDurable(path_, line);
+}
+
 Status ReadJsonLines(const std::string& path, const std::string& what,
                      const std::function<void(const std::string& line)>& parse) {
   std::ifstream in(path);

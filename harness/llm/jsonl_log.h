@@ -22,6 +22,9 @@ class JsonlLog {
 
   // Appends `line` unless the file already holds this session's line.
   Status Append(const std::string& line);
+  // Appends `line` whatever the file holds: for what is new by nature
+  // (an answer a model just gave), which must never be lost.
+  Status AppendNew(const std::string& line);
   int64_t existing() const { return existing_; }
   const std::string& path() const { return path_; }
 
