@@ -135,7 +135,7 @@ std::string RecordingBackend::name() const {
 
 Result<ChatReply> RecordingBackend::Chat(const ChatRequest& request) {
   ExchangeRecord r;
-  r.seq = next_seq_++;
+  r.seq = next_seq_;  // counted below once it is an exchange
   r.iteration = iteration_;
   r.agent = request.agent;
   r.model = request.model;
@@ -198,6 +198,7 @@ Result<ChatReply> RecordingBackend::Chat(const ChatRequest& request) {
     }
   }
 
+  ++next_seq_;
   Status logged =
       log_.Append(ToJson(r).dump(-1, ' ', false, json::error_handler_t::replace));
   if (!logged.ok()) return logged.WithContext("recording an llm exchange");
