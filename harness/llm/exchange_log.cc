@@ -135,7 +135,7 @@ std::string RecordingBackend::name() const {
 
 Result<ChatReply> RecordingBackend::Chat(const ChatRequest& request) {
   ExchangeRecord r;
-  r.seq = next_seq_++;
+  r.seq = next_seq_;  // counted below once it is an exchange
   r.iteration = iteration_;
   r.agent = request.agent;
   r.model = request.model;
@@ -200,6 +200,7 @@ Result<ChatReply> RecordingBackend::Chat(const ChatRequest& request) {
     }
   }
 
+  ++next_seq_;
   // A live answer is new whatever the log holds (a resumed session that
   // asks something the record lacks); a replayed one may be there already.
   const std::string line = ToJson(r).dump(-1, ' ', false, json::error_handler_t::replace);

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <vector>
 
 #include "stack/base/files.h"
@@ -48,16 +49,27 @@ Status JsonlLog::AppendNew(const std::string& line) {
 
 Status ReadJsonLines(const std::string& path, const std::string& what,
                      const std::function<void(const std::string& line)>& parse) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) return Status::Ok();
+  const std::string text((std::istreambuf_iterator<char>(in)),
+                         std::istreambuf_iterator<char>());
   std::vector<std::string> lines;
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  for (size_t start = 0; start < text.size();) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    lines.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  // Only a last line without its newline was cut short by a crash (the
+  // same rule as JsonlLog::Open): a complete bad line is corruption, and
+  // JsonlLog would count it as a line the file holds.
+  const bool cut_short = !text.empty() && text.back() != '\n';
   for (size_t i = 0; i < lines.size(); ++i) {
     if (lines[i].empty()) continue;
     try {
       parse(lines[i]);
     } catch (const std::exception& e) {
-      if (i + 1 == lines.size()) break;  // cut short by a crash
+      if (i + 1 == lines.size() && cut_short) break;
       return Status::Corruption(path + ":" + std::to_string(i + 1) + ": not " + what + " (" +
                                 e.what() + ")");
     }

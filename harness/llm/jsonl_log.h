@@ -36,8 +36,8 @@ class JsonlLog {
 
 // Calls `parse` on each non-empty line of `path` (a missing file has
 // none). `parse` throws (e.g. nlohmann::json's exceptions) on a bad line: a
-// last line cut short by a crash is skipped, any other is Corruption
-// naming the file, the line and `what` it should be.
+// last line cut short by a crash (no newline after it) is skipped, any
+// other is Corruption naming the file, the line and `what` it should be.
 Status ReadJsonLines(const std::string& path, const std::string& what,
                      const std::function<void(const std::string& line)>& parse);
 

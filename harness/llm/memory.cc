@@ -42,11 +42,17 @@ std::vector<std::pair<const MemoryRecord*, std::string>> Curate(
     std::string& r = reasons[i];
     r += (r.empty() ? "" : ", ") + why;
   };
+  // Each category's picks, best first.
+  std::vector<std::vector<size_t>> ranked;
   // Orders positions by a key (ties by evaluation order) and takes n.
   auto take = [&](std::vector<size_t> pos, auto key, int n, const char* why) {
     std::stable_sort(pos.begin(), pos.end(),
                      [&](size_t a, size_t b) { return key(a) < key(b); });
-    for (int k = 0; k < n && k < static_cast<int>(pos.size()); ++k) add(pos[k], why);
+    std::vector<size_t>& picks = ranked.emplace_back();
+    for (int k = 0; k < n && k < static_cast<int>(pos.size()); ++k) {
+      add(pos[k], why);
+      picks.push_back(pos[k]);
+    }
   };
   std::vector<size_t> feasible, completed, all, bad;
   for (size_t i = 0; i < records.size(); ++i) {
@@ -70,11 +76,18 @@ std::vector<std::pair<const MemoryRecord*, std::string>> Curate(
   take(bad, [&](size_t i) { return -static_cast<double>(i); }, o.failures,
        "failed or infeasible");
 
-  std::vector<std::pair<const MemoryRecord*, std::string>> out;
-  for (const auto& [i, why] : reasons) {
-    if (static_cast<int>(out.size()) >= o.max_records) break;
-    out.push_back({&records[i], why});
+  // Over the bound, keep the best picks of every category: each one's
+  // first, then each one's second, ... (in category order). Cutting by
+  // evaluation order instead would drop the most recent records first.
+  std::set<size_t> kept;
+  const size_t bound = static_cast<size_t>(std::max(o.max_records, 0));
+  for (size_t rank = 0; kept.size() < std::min(bound, reasons.size()); ++rank) {
+    for (const std::vector<size_t>& picks : ranked) {
+      if (rank < picks.size() && kept.size() < bound) kept.insert(picks[rank]);
+    }
   }
+  std::vector<std::pair<const MemoryRecord*, std::string>> out;
+  for (size_t i : kept) out.push_back({&records[i], reasons[i]});
   return out;
 }
 
@@ -92,11 +105,15 @@ std::string FormatMemory(
       line += "run failed";
     } else {
       line += r->feasible ? "feasible" : "infeasible";
+      std::string metrics;
       for (const auto& [name, value] : r->metrics) {
-        line += fmt::format(" {}={:.4g}", name, value);
+        metrics +=
+            fmt::format("{}{}={:.4g}", metrics.empty() ? "" : " ", name, value);
       }
+      if (!metrics.empty()) line += " | " + metrics;
     }
     if (!r->diagnosis.empty()) line += " | " + r->diagnosis;
+    if (!r->rationale.empty()) line += " | why: " + r->rationale;
     line += " [" + why + "]";
     out += (out.empty() ? "" : "\n") + line;
   }

@@ -39,7 +39,9 @@ struct CurationOptions {
 };
 
 // Picks the subset, each with the reasons it was picked ("cheapest
-// feasible", ...), in evaluation order. Deterministic.
+// feasible", ...), in evaluation order. Deterministic. When the categories
+// pick more than max_records, each category's first pick is kept, then
+// each one's second, and so on (categories in the order above).
 std::vector<std::pair<const MemoryRecord*, std::string>> Curate(
     const std::vector<MemoryRecord>& records, const spec::DesignSpace& space,
     const CurationOptions& options = {});

@@ -91,7 +91,11 @@ Result<PromptSet> PromptSet::Load(const std::string& folder) {
         const std::string key = "# version:";
         if (line.compare(0, key.size(), key) == 0) {
           t.version = line.substr(key.size());
-          t.version.erase(0, t.version.find_first_not_of(' '));
+          const size_t first = t.version.find_first_not_of(" \t\r");
+          const size_t last = t.version.find_last_not_of(" \t\r");
+          t.version = first == std::string::npos
+                          ? ""
+                          : t.version.substr(first, last - first + 1);
         }
         continue;
       }
@@ -116,7 +120,6 @@ Result<PromptSet> PromptSet::Load(const std::string& folder) {
       }
     }
     t.text = std::move(body);
-    if (t.version.empty()) t.version = "unversioned";
     set.templates_[info.name] = std::move(t);
   }
   return set;
@@ -151,8 +154,12 @@ Result<std::string> PromptSet::Render(
 
 std::string PromptSet::Versions() const {
   std::string out;
-  for (const auto& [name, t] : templates_) {
-    out += (out.empty() ? "" : ", ") + name + " v" + t.version;
+  for (const TemplateInfo& info : TemplateCatalog()) {
+    auto it = templates_.find(info.name);
+    if (it == templates_.end()) continue;
+    const std::string& version = it->second.version;
+    out += (out.empty() ? "" : ", ") + info.name +
+           (version.empty() ? " unversioned" : " v" + version);
   }
   return out;
 }

@@ -33,13 +33,15 @@ class PromptSet {
   // "# version: N" among them is the template's version.
   static Result<PromptSet> Load(const std::string& folder);
 
-  // The template filled with `values`. InvalidArgument when a placeholder
-  // it uses has no value (a bug: callers pass them all).
+  // The template filled with `values` (each placeholder once; values are
+  // not expanded again). Internal when a placeholder it uses has no value
+  // or no template has that name (a bug: callers pass them all).
   Result<std::string> Render(
       const std::string& name,
       const std::map<std::string, std::string>& values) const;
 
-  // "dse_system v1, dse_step v1, ..." for records and reports.
+  // "dse_system v1, dse_step v1, ..." for records and reports, in catalogue
+  // order ("command unversioned" for a file without "# version:").
   std::string Versions() const;
   const std::string& folder() const { return folder_; }
 
@@ -47,7 +49,7 @@ class PromptSet {
   struct Template {
     std::string path;
     std::string text;
-    std::string version;
+    std::string version;  // empty: the file has no "# version:"
   };
   std::string folder_;
   std::map<std::string, Template> templates_;
