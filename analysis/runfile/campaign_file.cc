@@ -278,6 +278,19 @@ Status ReadSized(hid_t group, const std::string& group_path,
   return Status::Ok();
 }
 
+// Reads column `name` (of T) into `member` of each row; `rows` is sized by
+// the group's first column already.
+template <typename T, typename Row, typename Member>
+Status ReadMember(hid_t group, const std::string& group_path, const std::string& name,
+                  std::vector<Row>* rows, Member Row::*member) {
+  std::vector<T> column;
+  ADSE_RETURN_IF_ERROR(ReadSized(group, group_path, name, rows->size(), &column));
+  for (size_t i = 0; i < rows->size(); ++i) {
+    (*rows)[i].*member = static_cast<Member>(std::move(column[i]));
+  }
+  return Status::Ok();
+}
+
 // The float64 columns of /evaluations/point or /evaluations/metrics into the
 // rows' maps (NaN left out), their order from the `names` attribute.
 Status ReadNumberGroup(hid_t file, const std::string& path,
@@ -366,36 +379,18 @@ Status ReadContents(hid_t file, CampaignIndex* index) {
     rows.assign(n, EvaluationRow{});
     for (size_t i = 0; i < n; ++i) rows[i].index = numbers[i];
 
-    auto ints = [&](const char* name, int64_t EvaluationRow::*member) {
-      ADSE_RETURN_IF_ERROR(ReadSized(g, path, name, n, &numbers));
-      for (size_t i = 0; i < n; ++i) rows[i].*member = numbers[i];
-      return Status::Ok();
-    };
-    auto strings = [&](const char* name, std::string EvaluationRow::*member) {
-      std::vector<std::string> column;
-      ADSE_RETURN_IF_ERROR(ReadSized(g, path, name, n, &column));
-      for (size_t i = 0; i < n; ++i) rows[i].*member = std::move(column[i]);
-      return Status::Ok();
-    };
-    ADSE_RETURN_IF_ERROR(ints("iteration", &EvaluationRow::iteration));
-    ADSE_RETURN_IF_ERROR(strings("content_key", &EvaluationRow::content_key));
-    ADSE_RETURN_IF_ERROR(strings("status", &EvaluationRow::status));
-    ADSE_RETURN_IF_ERROR(strings("reason", &EvaluationRow::reason));
-    ADSE_RETURN_IF_ERROR(strings("source", &EvaluationRow::source));
-    ADSE_RETURN_IF_ERROR(ints("attempts", &EvaluationRow::attempts));
+    using Row = EvaluationRow;
+    ADSE_RETURN_IF_ERROR(ReadMember<int64_t>(g, path, "iteration", &rows, &Row::iteration));
+    ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, "content_key", &rows, &Row::content_key));
+    ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, "status", &rows, &Row::status));
+    ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, "reason", &rows, &Row::reason));
+    ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, "source", &rows, &Row::source));
+    ADSE_RETURN_IF_ERROR(ReadMember<int64_t>(g, path, "attempts", &rows, &Row::attempts));
     ADSE_RETURN_IF_ERROR(
-        strings("bottlenecks_json", &EvaluationRow::bottlenecks_json));
-    {
-      std::vector<double> wall;
-      ADSE_RETURN_IF_ERROR(ReadSized(g, path, "wall_s", n, &wall));
-      for (size_t i = 0; i < n; ++i) rows[i].wall_s = wall[i];
-      std::vector<uint8_t> feasible;
-      ADSE_RETURN_IF_ERROR(ReadSized(g, path, "feasible", n, &feasible));
-      for (size_t i = 0; i < n; ++i) rows[i].feasible = feasible[i] != 0;
-      std::vector<uint64_t> seeds;
-      ADSE_RETURN_IF_ERROR(ReadSized(g, path, "seed", n, &seeds));
-      for (size_t i = 0; i < n; ++i) rows[i].seed = seeds[i];
-    }
+        ReadMember<std::string>(g, path, "bottlenecks_json", &rows, &Row::bottlenecks_json));
+    ADSE_RETURN_IF_ERROR(ReadMember<double>(g, path, "wall_s", &rows, &Row::wall_s));
+    ADSE_RETURN_IF_ERROR(ReadMember<uint8_t>(g, path, "feasible", &rows, &Row::feasible));
+    ADSE_RETURN_IF_ERROR(ReadMember<uint64_t>(g, path, "seed", &rows, &Row::seed));
     ADSE_RETURN_IF_ERROR(ReadNumberGroup(file, path + "/point",
                                          &index->parameters, &rows,
                                          &EvaluationRow::point));
@@ -435,35 +430,20 @@ Status ReadContents(hid_t file, CampaignIndex* index) {
     auto& rows = index->llm_exchanges;
     rows.assign(n, Row{});
     for (size_t i = 0; i < n; ++i) rows[i].seq = numbers[i];
-    auto ints = [&](const char* name, int64_t Row::*member) {
-      ADSE_RETURN_IF_ERROR(ReadSized(g, path, name, n, &numbers));
-      for (size_t i = 0; i < n; ++i) rows[i].*member = numbers[i];
-      return Status::Ok();
-    };
-    auto strings = [&](const char* name, std::string Row::*member) {
-      std::vector<std::string> column;
-      ADSE_RETURN_IF_ERROR(ReadSized(g, path, name, n, &column));
-      for (size_t i = 0; i < n; ++i) rows[i].*member = std::move(column[i]);
-      return Status::Ok();
-    };
-    ADSE_RETURN_IF_ERROR(ints("iteration", &Row::iteration));
-    ADSE_RETURN_IF_ERROR(strings("agent", &Row::agent));
-    ADSE_RETURN_IF_ERROR(strings("model", &Row::model));
-    ADSE_RETURN_IF_ERROR(strings("backend", &Row::backend));
-    ADSE_RETURN_IF_ERROR(strings("request_sha256", &Row::request_sha256));
-    ADSE_RETURN_IF_ERROR(strings("prompt", &Row::prompt));
-    ADSE_RETURN_IF_ERROR(strings("image_sha256", &Row::image_sha256));
-    ADSE_RETURN_IF_ERROR(strings("answer", &Row::answer));
-    ADSE_RETURN_IF_ERROR(strings("error", &Row::error));
-    ADSE_RETURN_IF_ERROR(ints("prompt_tokens", &Row::prompt_tokens));
-    ADSE_RETURN_IF_ERROR(ints("completion_tokens", &Row::completion_tokens));
-    ADSE_RETURN_IF_ERROR(ints("attempts", &Row::attempts));
-    std::vector<uint8_t> ok;
-    ADSE_RETURN_IF_ERROR(ReadSized(g, path, "ok", n, &ok));
-    for (size_t i = 0; i < n; ++i) rows[i].ok = ok[i] != 0;
-    std::vector<double> latency;
-    ADSE_RETURN_IF_ERROR(ReadSized(g, path, "latency_s", n, &latency));
-    for (size_t i = 0; i < n; ++i) rows[i].latency_s = latency[i];
+    for (const auto& [name, member] :
+         {std::pair{"iteration", &Row::iteration}, {"prompt_tokens", &Row::prompt_tokens},
+          {"completion_tokens", &Row::completion_tokens}, {"attempts", &Row::attempts}}) {
+      ADSE_RETURN_IF_ERROR(ReadMember<int64_t>(g, path, name, &rows, member));
+    }
+    for (const auto& [name, member] :
+         {std::pair{"agent", &Row::agent}, {"model", &Row::model}, {"backend", &Row::backend},
+          {"request_sha256", &Row::request_sha256}, {"prompt", &Row::prompt},
+          {"image_sha256", &Row::image_sha256}, {"answer", &Row::answer},
+          {"error", &Row::error}}) {
+      ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, name, &rows, member));
+    }
+    ADSE_RETURN_IF_ERROR(ReadMember<uint8_t>(g, path, "ok", &rows, &Row::ok));
+    ADSE_RETURN_IF_ERROR(ReadMember<double>(g, path, "latency_s", &rows, &Row::latency_s));
   }
   return Status::Ok();
 }

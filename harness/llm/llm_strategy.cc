@@ -1,5 +1,7 @@
 #include "harness/llm/llm_strategy.h"
 
+#include <functional>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -104,38 +106,32 @@ class LlmStrategy : public explore::Strategy {
 
     std::optional<spec::DesignPoint> point;
     std::string proposed_by = "llm";
-    DseAnswer answer;
-    const TurnResult turn = AskWithCorrection(
-        *options_.backend, prompts_, DseRequest(),
+    const Answer<DseAnswer> answer = Turn<DseAnswer>(
+        "dse", DseMessages(),
         [&](const std::string& text) {
-          Result<DseAnswer> parsed = ParseDseAnswer(text, spec_.design_space, evaluated_);
-          if (parsed.ok()) answer = *parsed;
-          return parsed.status();
+          return ParseDseAnswer(text, spec_.design_space, evaluated_);
         },
         "Answer with {\"point\": {<parameter>: <allowed value>, ...}, \"rationale\": \"...\"}"
         " naming every design parameter once, with a point not evaluated yet; or with "
         "{\"converged\": true, \"rationale\": \"...\"}.");
-    for (const std::string& why : turn.rejected) Event("dse", "rejected", why);
-    if (Fatal(turn, "dse")) return {};
-    if (turn.ok && answer.converged) {
+    if (!failure_.ok()) return {};
+    if (answer.value && answer.value->converged) {
       converged_ = true;
-      rationale_ = "the DSE agent declared convergence: " + answer.rationale;
-      Event("dse", "converged", answer.rationale);
+      rationale_ = "the DSE agent declared convergence: " + answer.value->rationale;
+      Event("dse", "converged", answer.value->rationale);
       return {};
     }
-    if (turn.ok) {
-      point = answer.point;
-      rationale_ = answer.rationale;
+    if (answer.value) {
+      point = answer.value->point;
+      rationale_ = answer.value->rationale;
     } else {
-      const std::string reason =
-          turn.error.ok() ? "its answers could not be used (" + turn.rejected.back() + ")"
-                          : "the model could not be asked (" + turn.error.message() + ")";
-      Event("dse", "fallback", "the built-in agent proposes this iteration's point: " + reason);
+      Event("dse", "fallback",
+            "the built-in agent proposes this iteration's point: " + answer.why);
       const std::vector<spec::DesignPoint> fallback = fallback_->Ask(1);
       if (fallback.empty()) return {};
       point = fallback.front();
       proposed_by = "agent";
-      rationale_ = "fallback to the built-in agent, since the DSE agent " + reason +
+      rationale_ = "fallback to the built-in agent, since the DSE agent " + answer.why +
                    ". agent: " + fallback_->rationale();
     }
 
@@ -195,7 +191,7 @@ class LlmStrategy : public explore::Strategy {
     return it == spec_.llm.models.end() ? "" : it->second;
   }
 
-  ChatRequest DseRequest() const {
+  std::vector<ChatMessage> DseMessages() const {
     std::vector<std::string> listed;
     for (const spec::DesignPoint& p : evaluated_) {
       if (listed.size() == kMaxListedPoints) {
@@ -214,11 +210,7 @@ class LlmStrategy : public explore::Strategy {
          {"last_report", first ? "(none)" : last_report_},
          {"memory", FormatMemory(Curate(memory_, spec_.design_space))},
          {"evaluated", listed.empty() ? "(none)" : Lines(listed)}});
-    ChatRequest r;
-    r.agent = "dse";
-    r.model = Model("dse");
-    r.messages = {{"system", system_prompt_, {}}, {"user", step.ok() ? *step : "", {}}};
-    return r;
+    return {{"system", system_prompt_, {}}, {"user", step.ok() ? *step : "", {}}};
   }
 
   void CommandTurn(const spec::DesignPoint& point) {
@@ -234,29 +226,18 @@ class LlmStrategy : public explore::Strategy {
          {"world", fmt::format("map \"{}\", traffic seed {}, weather {}", derived.map,
                                derived.traffic_seed, derived.weather)},
          {"tracing_options", Join(TraceRecordOptions(), ", ")}});
-    ChatRequest r;
-    r.agent = "command";
-    r.model = Model("command");
-    r.messages = {{"user", prompt.ok() ? *prompt : "", {}}};
-    Commands commands;
-    const TurnResult turn = AskWithCorrection(
-        *options_.backend, prompts_, r,
-        [&](const std::string& text) {
-          Result<Commands> parsed = ParseCommandAnswer(text, spec_);
-          if (parsed.ok()) commands = *parsed;
-          return parsed.status();
-        },
+    const Answer<Commands> commands = Turn<Commands>(
+        "command", {{"user", prompt.ok() ? *prompt : "", {}}},
+        [&](const std::string& text) { return ParseCommandAnswer(text, spec_); },
         "Answer with {\"world\": {\"map\", \"traffic_seed\", \"weather\"}, \"platform\": "
         "{<binding>: <value>}, \"tracing\": {\"record\": [...]}} and no other keys.");
-    for (const std::string& why : turn.rejected) Event("command", "rejected", why);
-    if (Fatal(turn, "command")) return;
-    if (!turn.ok) {
+    if (!failure_.ok()) return;
+    if (!commands.value) {
       Event("command", "error",
-            (turn.error.ok() ? "no usable commands" : turn.error.message()) +
-                std::string("; the commands derived from the point are used"));
+            "the command agent " + commands.why + "; the commands derived from the point are used");
       return;
     }
-    const std::vector<std::string> diffs = CompareCommands(commands, derived);
+    const std::vector<std::string> diffs = CompareCommands(*commands.value, derived);
     if (!diffs.empty()) {
       Event("command", "disagreement",
             Join(diffs) + "; the commands derived from the point are used");
@@ -273,31 +254,20 @@ class LlmStrategy : public explore::Strategy {
     if (trace.ok()) {
       Result<std::string> prompt =
           prompts_.Render("decipher_text", {{"point", point}, {"trace_summary", *trace}});
-      ChatRequest r;
-      r.agent = "text";
-      r.model = Model("text");
-      r.messages = {{"user", prompt.ok() ? *prompt : "", {}}};
-      TextReading reading;
-      const TurnResult turn = AskWithCorrection(
-          *options_.backend, prompts_, r,
-          [&](const std::string& text) {
-            Result<TextReading> parsed = ParseTextReading(text);
-            if (parsed.ok()) reading = *parsed;
-            return parsed.status();
-          },
+      const Answer<TextReading> reading = Turn<TextReading>(
+          "text", {{"user", prompt.ok() ? *prompt : "", {}}}, ParseTextReading,
           "Answer with {\"bottlenecks\": [{\"node\", \"kind\", \"remedy\"}], \"summary\"}.");
-      for (const std::string& why : turn.rejected) Event("text", "rejected", why);
-      if (Fatal(turn, "text")) return;
-      if (turn.ok) {
-        const std::vector<std::string> diffs = CompareTextReading(reading, o.bottlenecks);
+      if (!failure_.ok()) return;
+      if (reading.value) {
+        const std::vector<std::string> diffs = CompareTextReading(*reading.value, o.bottlenecks);
         if (!diffs.empty()) {
           Event("text", "disagreement", Join(diffs) + "; the deterministic diagnosis is kept");
           *report += "\ntext agent (disagrees, not used): " + Join(diffs);
-        } else if (!reading.summary.empty()) {
-          *report += "\ntext agent (agrees): " + reading.summary;
+        } else if (!reading.value->summary.empty()) {
+          *report += "\ntext agent (agrees): " + reading.value->summary;
         }
-      } else if (!turn.error.ok()) {
-        Event("text", "error", turn.error.message());
+      } else {
+        Event("text", "error", "the text agent " + reading.why);
       }
     }
 
@@ -308,45 +278,58 @@ class LlmStrategy : public explore::Strategy {
         {{"point", point},
          {"legend", "The picture has its own legend (lanes, ideal path, trajectory, other "
                     "vehicles, start, goal) and corner coordinates in metres."}});
-    ChatRequest r;
-    r.agent = "vision";
-    r.model = Model("vision");
-    r.messages = {{"user", prompt.ok() ? *prompt : "", {*png}}};
-    VisionReading reading;
-    const TurnResult turn = AskWithCorrection(
-        *options_.backend, prompts_, r,
-        [&](const std::string& text) {
-          Result<VisionReading> parsed = ParseVisionReading(text);
-          if (parsed.ok()) reading = *parsed;
-          return parsed.status();
-        },
+    const Answer<VisionReading> reading = Turn<VisionReading>(
+        "vision", {{"user", prompt.ok() ? *prompt : "", {*png}}}, ParseVisionReading,
         "Answer with {\"reached_goal\": bool, \"smooth\": bool, \"left_lane\": bool, "
         "\"notes\": \"...\"}.");
-    for (const std::string& why : turn.rejected) Event("vision", "rejected", why);
-    if (Fatal(turn, "vision")) return;
-    if (turn.ok) {
+    if (!failure_.ok()) return;
+    if (reading.value) {
       const VisionReading truth = VisionFromMetrics(o.metrics);
-      const std::vector<std::string> diffs = CompareVisionReading(reading, truth);
+      const std::vector<std::string> diffs = CompareVisionReading(*reading.value, truth);
       if (!diffs.empty()) {
         Event("vision", "disagreement", Join(diffs) + "; the metrics are kept");
         *report += "\nvision agent (disagrees with the metrics, not used): " + Join(diffs);
-      } else if (!reading.notes.empty()) {
-        *report += "\nvision agent (agrees): " + reading.notes;
+      } else if (!reading.value->notes.empty()) {
+        *report += "\nvision agent (agrees): " + reading.value->notes;
       }
-    } else if (!turn.error.ok()) {
-      Event("vision", "error", turn.error.message());
+    } else {
+      Event("vision", "error", "the vision agent " + reading.why);
     }
   }
 
-  // A replay asked something never recorded: going on (with the built-in
-  // agent) would quietly make a different campaign than the recorded one.
-  bool Fatal(const TurnResult& turn, const std::string& agent) {
-    if (turn.error.code() != Status::Code::kNotFound) return false;
-    if (failure_.ok()) {
+  template <typename T>
+  struct Answer {
+    std::optional<T> value;
+    std::string why;  // when there is none: "its answers could not be used (...)"
+  };
+
+  // One agent's turn: the request, strict parsing with one corrective
+  // follow-up, rejected answers recorded. A replay asked something never
+  // recorded stops the strategy (failure_): going on with the built-in
+  // agent would quietly make a different campaign than the recorded one.
+  template <typename T>
+  Answer<T> Turn(const std::string& agent, std::vector<ChatMessage> messages,
+                 const std::function<Result<T>(const std::string&)>& parse,
+                 const std::string& expected) {
+    const ChatRequest request{agent, Model(agent), std::move(messages), true};
+    Answer<T> out;
+    const TurnResult turn = AskWithCorrection(
+        *options_.backend, prompts_, request,
+        [&](const std::string& text) {
+          Result<T> parsed = parse(text);
+          if (parsed.ok()) out.value = std::move(parsed).value();
+          return parsed.status();
+        },
+        expected);
+    for (const std::string& why : turn.rejected) Event(agent, "rejected", why);
+    if (turn.ok) return out;
+    if (turn.error.code() == Status::Code::kNotFound && failure_.ok()) {
       failure_ = turn.error;
       Event(agent, "error", turn.error.message());
     }
-    return true;
+    out.why = turn.error.ok() ? "its answers could not be used (" + turn.rejected.back() + ")"
+                              : "the model could not be asked (" + turn.error.message() + ")";
+    return out;
   }
 
   void Event(const std::string& agent, const std::string& kind, const std::string& detail) {

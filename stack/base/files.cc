@@ -33,6 +33,33 @@ Result<std::string> ReadFile(const std::string& path, size_t max_bytes) {
   return buffer.str();
 }
 
+namespace {
+
+// Writes all of `data` to `fd`, flushes it to disk and closes it (also on
+// failure); errors name `path`.
+Status WriteAllAndClose(int fd, const std::string& data, const std::string& path) {
+  size_t written = 0;
+  while (written < data.size()) {
+    const ssize_t n = ::write(fd, data.data() + written, data.size() - written);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const std::string err = std::strerror(errno);
+      ::close(fd);
+      return Status::IoError(path + ": " + err);
+    }
+    written += static_cast<size_t>(n);
+  }
+  if (::fsync(fd) != 0) {
+    const std::string err = std::strerror(errno);
+    ::close(fd);
+    return Status::IoError(path + ": " + err);
+  }
+  if (::close(fd) != 0) return Status::IoError(path + ": " + std::strerror(errno));
+  return Status::Ok();
+}
+
+}  // namespace
+
 Status WriteFileAtomic(const std::string& path, const std::string& data) {
   const fs::path target(path);
   if (target.has_parent_path()) {
@@ -42,22 +69,9 @@ Status WriteFileAtomic(const std::string& path, const std::string& data) {
       path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (fd < 0) return Status::IoError(tmp + ": " + std::strerror(errno));
-  size_t written = 0;
-  while (written < data.size()) {
-    const ssize_t n = ::write(fd, data.data() + written, data.size() - written);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const std::string err = std::strerror(errno);
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      return Status::IoError(tmp + ": " + err);
-    }
-    written += static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    const std::string err = std::strerror(errno);
+  if (Status s = WriteAllAndClose(fd, data, tmp); !s.ok()) {
     ::unlink(tmp.c_str());
-    return Status::IoError(tmp + ": " + err);
+    return s;
   }
   if (::rename(tmp.c_str(), path.c_str()) != 0) {
     const std::string err = std::strerror(errno);
@@ -71,21 +85,7 @@ Status AppendLineDurable(const std::string& path, const std::string& line) {
   const std::string data = line + "\n";
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
   if (fd < 0) return Status::IoError(path + ": " + std::strerror(errno));
-  size_t written = 0;
-  while (written < data.size()) {
-    const ssize_t n = ::write(fd, data.data() + written, data.size() - written);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const std::string err = std::strerror(errno);
-      ::close(fd);
-      return Status::IoError(path + ": " + err);
-    }
-    written += static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    return Status::IoError(path + ": " + std::strerror(errno));
-  }
-  return Status::Ok();
+  return WriteAllAndClose(fd, data, path);
 }
 
 std::string DefaultCacheDir() {

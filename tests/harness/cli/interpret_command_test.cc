@@ -12,6 +12,7 @@
 #include "stack/base/files.h"
 #include "tests/harness/llm/testing/fake_llm_server.h"
 #include "tests/harness/testing/adse_command.h"
+#include "tests/harness/testing/temp_files.h"
 
 namespace adse {
 namespace {
@@ -38,11 +39,7 @@ constraints: [nav_time_s <= 60, completed]
 )yaml";
 
 std::string TempDir(const std::string& name) {
-  const std::string dir = fs::temp_directory_path().string() + "/adse-interpret-" + name + "-" +
-                          std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return testing::FreshTempDir("adse-interpret", name);
 }
 
 const char kRequest[] =

@@ -18,34 +18,21 @@
 
 #include "stack/base/hash.h"
 #include "tests/harness/llm/testing/scripted_backend.h"
+#include "tests/harness/testing/temp_files.h"
 
 namespace adse::llm {
 namespace {
 
 namespace fs = std::filesystem;
+using adse::testing::Slurp;
+using adse::testing::WriteRaw;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using testing::ScriptedBackend;
 using ::testing::StartsWith;
 
 std::string TempDir(const std::string& name) {
-  const std::string dir = fs::temp_directory_path().string() +
-                          "/adse-llmunit-exchange-" + name + "-" +
-                          std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-void WriteRaw(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-}
-
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in),
-                     std::istreambuf_iterator<char>());
+  return adse::testing::FreshTempDir("adse-llmunit-exchange", name);
 }
 
 std::vector<std::string> Lines(const std::string& path) {

@@ -15,32 +15,20 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/harness/testing/temp_files.h"
+
 namespace adse::llm {
 namespace {
 
 namespace fs = std::filesystem;
+using adse::testing::Slurp;
+using adse::testing::WriteRaw;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
 std::string TempDir(const std::string& name) {
-  const std::string dir = fs::temp_directory_path().string() +
-                          "/adse-llmunit-jsonl-" + name + "-" +
-                          std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-void WriteRaw(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-}
-
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in),
-                     std::istreambuf_iterator<char>());
+  return adse::testing::FreshTempDir("adse-llmunit-jsonl", name);
 }
 
 // Parses each line as {"n": <int>} and collects the numbers.

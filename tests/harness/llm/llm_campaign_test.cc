@@ -25,6 +25,7 @@
 #include "stack/base/files.h"
 #include "tests/harness/llm/testing/fake_llm_server.h"
 #include "tests/harness/testing/small_scenario.h"
+#include "tests/harness/testing/temp_files.h"
 
 namespace adse::llm {
 namespace {
@@ -38,11 +39,7 @@ using testing::ReceivedRequest;
 const std::string kAdse = std::string(ADSE_BINARY_DIR) + "/bin/adse";
 
 std::string TempDir(const std::string& name) {
-  const std::string dir = fs::temp_directory_path().string() + "/adse-llm-" + name + "-" +
-                          std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return adse::testing::FreshTempDir("adse-llm", name);
 }
 
 std::string PointJson(const spec::DesignPoint& p, const std::string& rationale = "because") {

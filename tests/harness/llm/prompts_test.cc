@@ -1,6 +1,7 @@
 // Prompt templates: the bundled set loads, a broken folder is refused with
 // the file and line to fix, and rendering fills placeholders exactly once.
 #include "harness/llm/prompts.h"
+#include "tests/harness/testing/temp_files.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -15,21 +16,13 @@ namespace adse::llm {
 namespace {
 
 namespace fs = std::filesystem;
+using adse::testing::Slurp;
+using adse::testing::WriteRaw;
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
 std::string TempDir(const std::string& name) {
-  const std::string dir = fs::temp_directory_path().string() +
-                          "/adse-llmunit-prompts-" + name + "-" +
-                          std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-void WriteRaw(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
+  return adse::testing::FreshTempDir("adse-llmunit-prompts", name);
 }
 
 // A copy of the bundled prompts that a test may break.
