@@ -158,7 +158,8 @@ int main(int argc, char** argv) {
       ->required();
   interpret_cmd->add_option("-o,--out", interpret.out,
                             "Scenario file to write (default: print it)");
-  interpret_cmd->add_option("--backend", interpret.backend, "ollama, openai or replay")
+  interpret_cmd->add_option("--backend", interpret.backend,
+                            "ollama, openai (sends $OPENAI_API_KEY when set) or replay")
       ->check(CLI::IsMember({"ollama", "openai", "replay"}));
   interpret_cmd->add_option("--endpoint", interpret.endpoint,
                             "Server URL (default: http://127.0.0.1:11434)");
