@@ -43,7 +43,8 @@ void ExpectValidBash(const std::string& dir, const std::string& name,
 }
 
 TEST(SubmitTest, DryRunOfASweepPrintsAnArrayAndAnIndexJobAndTouchesNothing) {
-  const std::string dir = TestDir("dry-sweep");
+  const TestFolder folder("dry-sweep");
+  const std::string& dir = folder.path();
   const std::string scenario = SmallScenarioIn(
       dir, "{strategy: random, budget: 6}",
       "{memory_mb: 1024, slurm: {shard_size: 2, max_parallel: 2, "
@@ -80,7 +81,8 @@ TEST(SubmitTest, DryRunOfASweepPrintsAnArrayAndAnIndexJobAndTouchesNothing) {
 }
 
 TEST(SubmitTest, DryRunOfAnAdaptiveCampaignSizesTheCoordinatorFromTheScenario) {
-  const std::string dir = TestDir("dry-agent");
+  const TestFolder folder("dry-agent");
+  const std::string& dir = folder.path();
   const std::string scenario = SmallScenarioIn(
       dir, "{strategy: agent, budget: 4, batch: 2}",
       "{workers: 2, cores_per_worker: 2, memory_mb: 1000, "
@@ -106,7 +108,8 @@ TEST(SubmitTest, DryRunOfAnAdaptiveCampaignSizesTheCoordinatorFromTheScenario) {
 }
 
 TEST(SubmitTest, WithoutSbatchOnThePathSubmitSaysWhatIsMissing) {
-  const std::string dir = TestDir("no-sbatch");
+  const TestFolder folder("no-sbatch");
+  const std::string& dir = folder.path();
   const std::string scenario =
       SmallScenarioIn(dir, "{strategy: exhaustive, budget: 2}", "{}");
   const AdseRun run = Adse({"submit", scenario, "-o", dir + "/campaign"},
@@ -118,7 +121,8 @@ TEST(SubmitTest, WithoutSbatchOnThePathSubmitSaysWhatIsMissing) {
 }
 
 TEST(SubmitTest, RunWithExecutorSlurmOutsideAnAllocationIsRefusedBeforeWriting) {
-  const std::string dir = TestDir("no-allocation");
+  const TestFolder folder("no-allocation");
+  const std::string& dir = folder.path();
   const std::string scenario =
       SmallScenarioIn(dir, "{strategy: exhaustive, budget: 1}", "{}");
   AdseRun run = Adse({"run", scenario, "-o", dir + "/campaign", "--executor",
@@ -143,7 +147,8 @@ TEST(SubmitTest, RunWithExecutorSlurmOutsideAnAllocationIsRefusedBeforeWriting) 
 }
 
 TEST(SubmitTest, BadInputIsRefusedNamingTheFieldOrFlag) {
-  const std::string dir = TestDir("bad-input");
+  const TestFolder folder("bad-input");
+  const std::string& dir = folder.path();
   const std::string out = dir + "/campaign";
   const std::string ok =
       SmallScenarioIn(dir, "{strategy: exhaustive, budget: 2}", "{}");
@@ -184,7 +189,8 @@ TEST(SubmitTest, BadInputIsRefusedNamingTheFieldOrFlag) {
 }
 
 TEST(SubmitTest, ShardIndexAndStatusRefuseFoldersTheyCannotUse) {
-  const std::string dir = TestDir("no-plan");
+  const TestFolder folder("no-plan");
+  const std::string& dir = folder.path();
   fs::create_directories(dir + "/campaign/runs");
   AdseRun run = Adse({"shard", dir + "/campaign", "--task", "0"});
   EXPECT_EQ(run.exit_code, 2) << run.output;

@@ -50,15 +50,29 @@ inline AdseRun Adse(const std::vector<std::string>& args,
   return {r->exit_code, r->output};
 }
 
-// A fresh folder for one test, removed first if a failed run left it.
-inline std::string TestDir(const std::string& name) {
-  const std::string dir = std::filesystem::temp_directory_path().string() +
-                          "/adse-slurm-test-" + name + "-" +
-                          std::to_string(::getpid());
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+// A fresh folder for one test (removed first if a failed run left it),
+// removed again at the end unless the test failed: then it is the evidence.
+class TestFolder {
+ public:
+  explicit TestFolder(const std::string& name)
+      : path_(std::filesystem::temp_directory_path().string() +
+              "/adse-slurm-test-" + name + "-" + std::to_string(::getpid())) {
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~TestFolder() {
+    std::error_code ec;
+    if (!::testing::Test::HasFailure()) {
+      std::filesystem::remove_all(path_, ec);
+    }
+  }
+  TestFolder(const TestFolder&) = delete;
+  TestFolder& operator=(const TestFolder&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
 
 // scenarios/robotaxi_small.yaml copied into `dir` (with the calibration it
 // names), its exploration line replaced and `harness` added.
