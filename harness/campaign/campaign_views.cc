@@ -86,8 +86,9 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s) {
   md << fmt::format("- wall time: {}\n", Duration(s.wall_s));
   if (s.interrupted_by != 0) {
     md << fmt::format(
-        "- **stopped early by signal {}{}**: run the same command again to "
-        "resume; finished runs are kept and not repeated\n",
+        "- **stopped early by signal {}{}**: run the same command again "
+        "(`adse run`, or `adse submit` on Slurm) to resume; finished runs "
+        "are kept and not repeated\n",
         s.interrupted_by,
         s.interrupted_by == SIGUSR1 ? " (Slurm's time-limit warning)" : "");
   }

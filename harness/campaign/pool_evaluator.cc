@@ -227,6 +227,13 @@ void PoolEvaluator::Finish(const pool::JobResult& result) {
   Pending p = it->second;
   running_.erase(it);
   if (result.outcome == pool::Outcome::kCancelled) return;
+  // A run that fails while the campaign is being stopped may have failed
+  // because of the stop (its job step killed with the allocation): it is
+  // left unevaluated, to run again on resume, not retried or recorded.
+  if (result.outcome != pool::Outcome::kOk &&
+      pool::InterruptRequested() != 0) {
+    return;
+  }
   std::string detail;
   if (result.outcome == pool::Outcome::kOk) {
     if (auto row = LoadRun(p, "simulated")) {

@@ -136,8 +136,7 @@ Result<FailureRecord> ReadFailureRecord(const std::string& path) {
 Status CopyFileAtomic(const std::string& from, const std::string& to) {
   const fs::path target(to);
   ADSE_RETURN_IF_ERROR(MakeDirs(target.parent_path().string()));
-  const std::string temp =
-      fmt::format("{}.tmp.{}", to, static_cast<long>(::getpid()));
+  const std::string temp = TemporaryPathFor(to);
   std::error_code ec;
   fs::remove(temp, ec);
   fs::create_hard_link(from, temp, ec);

@@ -628,6 +628,14 @@ void ClearInterrupt() {
   if (g_handlers_installed.load()) ArmHandlers();
 }
 
+void RequestInterrupt(int sig) {
+  int expected = 0;
+  g_interrupt.compare_exchange_strong(expected, sig);
+  if (g_wake_fds[1] >= 0) {
+    [[maybe_unused]] const ssize_t n = ::write(g_wake_fds[1], "!", 1);
+  }
+}
+
 void InstallDrainHandler(int sig) {
   std::lock_guard<std::mutex> lock(g_install_mutex);
   if (g_wake_fds[0] < 0 && ::pipe2(g_wake_fds, O_CLOEXEC | O_NONBLOCK) != 0) {

@@ -135,6 +135,10 @@ void InstallInterruptHandlers();
 int InterruptRequested();
 // For tests: forget a recorded interrupt (and re-arm the handlers).
 void ClearInterrupt();
+// Records an interrupt as if `sig` had arrived and wakes any Wait: for a
+// pool that learns that the place its jobs run is going away (a Slurm
+// allocation being cancelled) before the signal reaches the coordinator.
+void RequestInterrupt(int sig);
 
 // Installs a handler for `sig` that asks for a graceful stop rather than an
 // interrupt: propose no more work, let running jobs finish (Slurm's warning

@@ -24,9 +24,9 @@ std::string ShellQuote(const std::string& text);
 // The body lines that run `command` (already quoted) as the job's main
 // process and stay with it: Slurm's time-limit warning (B:USR1, sent to
 // this shell only) is passed on to it; SIGTERM from scancel or the time
-// limit, which Slurm sends to every process of the job, is not forwarded
-// again (adse takes a second one as "stop now") but keeps the shell
-// waiting while adse saves its state. When adse exits 138 (stopped by the
+// limit, which Slurm sends to the batch shell only, is passed on as SIGINT
+// (adse takes a second SIGTERM as "stop at once", and some setups signal
+// every process of the job). When adse exits 138 (stopped by the
 // warning before finishing) the job requeues itself, at most
 // `max_requeues` times, using `requeue_id` (e.g. "$SLURM_JOB_ID").
 std::vector<std::string> SupervisedBody(const std::string& command,

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -22,6 +23,7 @@
 
 #include "harness/slurm/allocation.h"
 #include "harness/slurm/client.h"
+#include "stack/base/subprocess.h"
 
 extern char** environ;
 
@@ -80,6 +82,41 @@ std::string ReadTail(const std::string& path, size_t bytes) {
 // output is never taken for theirs).
 bool IsSlurmLine(const std::string& line) {
   return line.rfind("srun:", 0) == 0 || line.rfind("slurmstepd", 0) == 0;
+}
+
+// Whether srun's output says Slurm itself ended the step or refused it:
+// cancelled, its job gone.
+bool SlurmEndedStep(const std::string& output) {
+  size_t at = 0;
+  while (at < output.size()) {
+    size_t end = output.find('\n', at);
+    if (end == std::string::npos) end = output.size();
+    const std::string line = output.substr(at, end - at);
+    at = end + 1;
+    if (!IsSlurmLine(line)) continue;
+    for (const char* mark :
+         {"CANCELLED AT", "has expired", "Expired or invalid job",
+          "already completing", "Job step aborted", "Unable to create step"}) {
+      if (line.find(mark) != std::string::npos) return true;
+    }
+  }
+  return false;
+}
+
+// Whether the job is no longer running (cancelled, timed out, completing)
+// or unknown, as slurmctld has it: it changes the job's state before it
+// signals the job's processes.
+bool AllocationEnding(const std::string& job_id) {
+  Result<ProcessResult> r =
+      RunProcess({"squeue", "--noheader", "--jobs=" + job_id, "--format=%T"});
+  if (!r.ok()) return false;  // cannot tell: treat the step as failed
+  const size_t begin = r->output.find_first_not_of(" \n");
+  const std::string state =
+      begin == std::string::npos
+          ? ""
+          : r->output.substr(begin, r->output.find_first_of(" \n", begin) -
+                                        begin);
+  return r->exit_code != 0 || state != "RUNNING";
 }
 
 struct ExecFailure {
@@ -308,7 +345,21 @@ pool::JobResult StepPool::Reap(size_t slot) {
         "ignored?)";
   } else {
     ClassifyStepEnd(*r.wait_status, output, &result);
-    if (r.killed_for) result.outcome = *r.killed_for;
+    if (r.killed_for) {
+      result.outcome = *r.killed_for;
+    } else if (result.outcome != pool::Outcome::kOk &&
+               SlurmEndedStep(output) && AllocationEnding(options_.job_id)) {
+      // Slurm cancelled the step with the whole job (scancel, the time
+      // limit): stop the campaign now, before the coordinator's own signal
+      // arrives, rather than retry into a vanishing allocation and record
+      // runs as failed that were merely cut short.
+      result.outcome = pool::Outcome::kCancelled;
+      pool::RequestInterrupt(SIGTERM);
+      std::fprintf(stderr,
+                   "Slurm job %s is ending (cancelled or out of time): "
+                   "stopping; unfinished runs are redone on resume\n",
+                   options_.job_id.c_str());
+    }
   }
   if (r.srun_killed) {
     result.stderr_tail += fmt::format(

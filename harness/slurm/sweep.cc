@@ -1,5 +1,6 @@
 #include "harness/slurm/sweep.h"
 
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
@@ -192,6 +193,25 @@ Result<campaign::CampaignSummary> BuildSweepIndex(
     summary.exploration.iterations.push_back(it);
   }
   summary.unfinished = static_cast<int>(missing.size());
+  // The sweep's span: from the earliest run's start (its file's time less
+  // its wall time) to the last run file; tasks keep no clock of their own.
+  double first_start = 0, last_end = 0;
+  bool any = false;
+  for (const campaign::EvaluationRow& row : summary.exploration.evaluations) {
+    std::error_code ec;
+    const std::string path =
+        campaign::CampaignFolder(campaign_dir).RunPath(row.content_key);
+    const auto written = fs::last_write_time(path, ec);
+    if (ec) continue;
+    const double end = std::chrono::duration<double>(
+                           written.time_since_epoch())
+                           .count();
+    first_start = any ? std::min(first_start, end - row.wall_s)
+                      : end - row.wall_s;
+    last_end = any ? std::max(last_end, end) : end;
+    any = true;
+  }
+  summary.wall_s = any ? last_end - first_start : 0.0;
   for (const campaign::EvaluationRow& row : summary.exploration.evaluations) {
     if (row.status != "complete") ++summary.failed;
     if (row.source == "simulated") {

@@ -136,14 +136,14 @@ class CampaignOnSlurmTest : public ::testing::Test {
 
 TEST_F(CampaignOnSlurmTest, ArraySweepEndsWithTheSameRunsAsALocalCampaign) {
   const std::string scenario = SmallScenarioIn(
-      dir_, "{strategy: random, budget: 6}",
+      dir_, "{strategy: random, budget: 4}",
       "{memory_mb: 1024, slurm: {shard_size: 2, max_parallel: 2, "
       "signal_lead_s: 60}}");
   const std::string out = dir_ + "/sweep";
   const json submitted = Submit(scenario, out);
-  EXPECT_EQ(submitted["points"], 6);
-  EXPECT_EQ(submitted["shards"], 3);
-  EXPECT_EQ(submitted["submitted_shards"], json({0, 1, 2}));
+  EXPECT_EQ(submitted["points"], 4);
+  EXPECT_EQ(submitted["shards"], 2);
+  EXPECT_EQ(submitted["submitted_shards"], json({0, 1}));
   const std::string array = JobOf(submitted, "array");
   const std::string index = JobOf(submitted, "index");
   ASSERT_FALSE(array.empty());
@@ -170,20 +170,20 @@ TEST_F(CampaignOnSlurmTest, ArraySweepEndsWithTheSameRunsAsALocalCampaign) {
   }
   WaitForJob(index);
   EXPECT_TRUE(saw_running_point) << "adse status never showed a running step";
-  EXPECT_EQ(cluster_->JobState(array), "COMPLETED,COMPLETED,COMPLETED");
+  EXPECT_EQ(cluster_->JobState(array), "COMPLETED,COMPLETED");
   EXPECT_EQ(cluster_->JobState(index), "COMPLETED");
 
   const json summary = ReadJson(out + "/summary.json");
   EXPECT_EQ(summary["complete"], true);
-  EXPECT_EQ(summary["counts"]["evaluations"], 6);
-  EXPECT_EQ(summary["counts"]["simulated"], 6);
+  EXPECT_EQ(summary["counts"]["evaluations"], 4);
+  EXPECT_EQ(summary["counts"]["simulated"], 4);
   EXPECT_EQ(summary["counts"]["failed"], 0);
   const json st = StatusOf(out);
   EXPECT_EQ(st["kind"], "sweep");
-  EXPECT_EQ(st["counts"], json({{"done", 6}, {"failed", 0}, {"running", 0},
+  EXPECT_EQ(st["counts"], json({{"done", 4}, {"failed", 0}, {"running", 0},
                                 {"pending", 0}}));
   ASSERT_EQ(st["jobs"].size(), 2u);
-  EXPECT_EQ(st["jobs"][0]["tasks"].size(), 3u);
+  EXPECT_EQ(st["jobs"][0]["tasks"].size(), 2u);
 
   // The same sweep as a local campaign: the same runs, in the same order,
   // with the same metrics (the counted cost model is deterministic).
@@ -193,9 +193,9 @@ TEST_F(CampaignOnSlurmTest, ArraySweepEndsWithTheSameRunsAsALocalCampaign) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const runfile::CampaignIndex slurm_index = Index(out);
   const runfile::CampaignIndex local_index = Index(local);
-  ASSERT_EQ(slurm_index.evaluations.size(), 6u);
-  ASSERT_EQ(local_index.evaluations.size(), 6u);
-  for (size_t i = 0; i < 6; ++i) {
+  ASSERT_EQ(slurm_index.evaluations.size(), 4u);
+  ASSERT_EQ(local_index.evaluations.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
     const runfile::EvaluationRow& a = slurm_index.evaluations[i];
     const runfile::EvaluationRow& b = local_index.evaluations[i];
     EXPECT_EQ(a.content_key, b.content_key) << i;
@@ -212,12 +212,12 @@ TEST_F(CampaignOnSlurmTest, ArraySweepEndsWithTheSameRunsAsALocalCampaign) {
 
   // Submitted again when finished: nothing to simulate, only the index.
   const json resubmitted = Submit(scenario, out);
-  EXPECT_EQ(resubmitted["finished_points"], 6);
+  EXPECT_EQ(resubmitted["finished_points"], 4);
   EXPECT_TRUE(resubmitted["submitted_shards"].empty());
   EXPECT_TRUE(JobOf(resubmitted, "array").empty());
   WaitForJob(JobOf(resubmitted, "index"));
   EXPECT_EQ(cluster_->JobState(JobOf(resubmitted, "index")), "COMPLETED");
-  EXPECT_EQ(ReadJson(out + "/summary.json")["counts"]["evaluations"], 6);
+  EXPECT_EQ(ReadJson(out + "/summary.json")["counts"]["evaluations"], 4);
 }
 
 TEST_F(CampaignOnSlurmTest,
