@@ -352,8 +352,14 @@ TEST_F(CampaignOnSlurmTest,
   const std::string out = dir_ + "/warned";
   const std::string job = JobOf(Submit(scenario, out), "coordinator");
   ASSERT_FALSE(job.empty());
-  ASSERT_TRUE(Eventually([&] { return RunFiles(out).size() >= 2; },
-                         kJobTimeoutS));
+  // Warn while the second round's steps run.
+  const auto second_round_running = [&] {
+    if (RunFiles(out).size() != 2) return false;
+    Result<std::vector<StepState>> steps = QuerySteps({job});
+    return steps.ok() && steps->size() == 2;
+  };
+  ASSERT_TRUE(Eventually(second_round_running, kJobTimeoutS, 0.05))
+      << cluster_->LogTail();
   // What --signal=B:USR1@<s> does before the time limit.
   Result<ProcessResult> warn =
       cluster_->Run({"scancel", "--batch", "--signal=USR1", job});
@@ -369,9 +375,9 @@ TEST_F(CampaignOnSlurmTest,
   EXPECT_THAT(log, HasSubstr("adse: exit status 138"));
   EXPECT_THAT(log, HasSubstr("requeueing " + job));
   const auto at_requeue = RunFiles(out);
-  EXPECT_EQ(at_requeue.size() % 2, 0u)
-      << "a round that was running when the warning came was finished";
-  EXPECT_LT(at_requeue.size(), 6u);
+  EXPECT_EQ(at_requeue.size(), 4u)
+      << "the round running at the warning finishes; no new one starts";
+  EXPECT_THAT(log.substr(log.find("time-limit warning")), HasSubstr("[4/6]"));
   EXPECT_EQ(FailureRecords(out), 0);
   // A requeued job waits ~2 minutes before it may start again.
   Result<ProcessResult> now = cluster_->Run(
