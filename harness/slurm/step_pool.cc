@@ -17,6 +17,7 @@
 #include <cstring>
 #include <filesystem>
 #include <optional>
+#include <sstream>
 #include <utility>
 
 #include <fmt/format.h>
@@ -107,16 +108,18 @@ bool SlurmEndedStep(const std::string& output) {
 // or unknown, as slurmctld has it: it changes the job's state before it
 // signals the job's processes.
 bool AllocationEnding(const std::string& job_id) {
-  Result<ProcessResult> r =
-      RunProcess({"squeue", "--noheader", "--jobs=" + job_id, "--format=%T"});
+  // %A is the job's own id; for an array task's job, --jobs may also list
+  // the array's other tasks.
+  Result<ProcessResult> r = RunProcess(
+      {"squeue", "--noheader", "--jobs=" + job_id, "--format=%A %T"});
   if (!r.ok()) return false;  // cannot tell: treat the step as failed
-  const size_t begin = r->output.find_first_not_of(" \n");
-  const std::string state =
-      begin == std::string::npos
-          ? ""
-          : r->output.substr(begin, r->output.find_first_of(" \n", begin) -
-                                        begin);
-  return r->exit_code != 0 || state != "RUNNING";
+  if (r->exit_code != 0) return true;  // "Invalid job id": it is gone
+  std::istringstream lines(r->output);
+  std::string id, state;
+  while (lines >> id >> state) {
+    if (id == job_id) return state != "RUNNING";
+  }
+  return true;
 }
 
 struct ExecFailure {

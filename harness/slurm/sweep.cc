@@ -9,6 +9,7 @@
 
 #include "harness/campaign/run_store.h"
 #include "harness/sim/run_key.h"
+#include "harness/slurm/allocation.h"
 #include "harness/slurm/records.h"
 #include "harness/slurm/step_pool.h"
 #include "harness/spec/spec_parser.h"
@@ -98,6 +99,17 @@ Result<ShardSummary> RunShard(const ShardOptions& options) {
       peek.ok() ? peek->ShardRange(task) : std::pair<size_t, size_t>{0, 0};
   Result<LoadedPlan> loaded = LoadPlan(options.campaign_dir, begin, end);
   if (!loaded.ok()) return loaded.status();
+  if (!options.local) {
+    Result<std::optional<Allocation>> allocation = CurrentAllocation();
+    if (!allocation.ok()) return allocation.status();
+    if (!allocation->has_value()) {
+      return Status::InvalidArgument(
+          "adse shard runs its points as Slurm job steps and needs an "
+          "allocation (it is what the job array's tasks run), but "
+          "SLURM_JOB_ID is not set: use --local to run the shard's points "
+          "in worker processes here");
+    }
+  }
 
   ShardSummary summary;
   summary.task = task;
