@@ -25,12 +25,11 @@ class ShardProgress : public campaign::ExplorerListener {
     for (const auto& [name, value] : row.point) {
       point += fmt::format("{}{}={:g}", point.empty() ? "" : ",", name, value);
     }
-    std::fprintf(stderr, "[%d] %s%s: %s (%s%s)\n", done_,
-                 failed ? "FAILED " : "", point.c_str(), row.reason.c_str(),
-                 row.source.c_str(),
-                 row.source == "simulated"
-                     ? fmt::format(" {:.1f} s", row.wall_s).c_str()
-                     : "");
+    std::fprintf(
+        stderr, "[%d] %s%s: %s (%s%s)\n", done_, failed ? "FAILED " : "",
+        point.c_str(), row.reason.c_str(), row.source.c_str(),
+        row.source == "simulated" ? fmt::format(" {:.1f} s", row.wall_s).c_str()
+                                  : "");
   }
 
  private:

@@ -63,9 +63,10 @@ int RunSubmit(const SubmitArgs& args) {
   }
   if (args.dry_run) {
     for (const slurm::SubmittedScript& s : r.scripts) {
-      std::printf("# ---- %s script (dry run: not written, not submitted) "
-                  "----\n%s\n",
-                  s.kind.c_str(), s.text.c_str());
+      std::printf(
+          "# ---- %s script (dry run: not written, not submitted) "
+          "----\n%s\n",
+          s.kind.c_str(), s.text.c_str());
     }
   }
   if (r.adaptive) {

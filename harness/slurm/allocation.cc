@@ -1,6 +1,7 @@
 #include "harness/slurm/allocation.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 
 #include <fmt/format.h>
@@ -19,19 +20,28 @@ std::optional<int64_t> ParseCount(const std::string& text) {
 
 // Memory as Slurm exports it: megabytes, possibly with a unit suffix.
 std::optional<int64_t> ParseMegabytes(std::string text) {
-  int64_t scale = 1;
-  if (!text.empty()) {
-    switch (text.back()) {
-      case 'K': case 'k': scale = -1024; text.pop_back(); break;
-      case 'M': case 'm': text.pop_back(); break;
-      case 'G': case 'g': scale = 1024; text.pop_back(); break;
-      case 'T': case 't': scale = 1024 * 1024; text.pop_back(); break;
-      default: break;
+  int64_t multiply = 1, divide = 1;
+  if (!text.empty() && std::isalpha(static_cast<unsigned char>(text.back()))) {
+    switch (std::toupper(static_cast<unsigned char>(text.back()))) {
+      case 'K':
+        divide = 1024;
+        break;
+      case 'M':
+        break;
+      case 'G':
+        multiply = 1024;
+        break;
+      case 'T':
+        multiply = 1024 * 1024;
+        break;
+      default:
+        return std::nullopt;
     }
+    text.pop_back();
   }
   std::optional<int64_t> value = ParseCount(text);
   if (!value) return std::nullopt;
-  return scale < 0 ? *value / -scale : *value * scale;
+  return *value * multiply / divide;
 }
 
 }  // namespace
@@ -117,12 +127,13 @@ Result<std::optional<Allocation>> CurrentAllocation(const Environment& env) {
     if (text.empty()) continue;
     std::optional<int64_t> mb = ParseMegabytes(text);
     if (!mb) {
-      return Status::InvalidArgument(fmt::format(
-          "{}: expected megabytes, found '{}'", name, text));
+      return Status::InvalidArgument(
+          fmt::format("{}: expected megabytes, found '{}'", name, text));
     }
     *field = *mb;
   }
-  if (std::optional<int64_t> restarts = ParseCount(value("SLURM_RESTART_COUNT"))) {
+  if (std::optional<int64_t> restarts =
+          ParseCount(value("SLURM_RESTART_COUNT"))) {
     a.restart_count = static_cast<int>(std::min<int64_t>(*restarts, 1 << 30));
   }
   return std::optional<Allocation>(a);

@@ -6,9 +6,9 @@ namespace adse::slurm {
 
 std::string ShellQuote(const std::string& text) {
   const bool safe =
-      !text.empty() &&
-      text.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUV"
-                             "WXYZ0123456789_-./=:,+%@") == std::string::npos;
+      !text.empty() && text.find_first_not_of(
+                           "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUV"
+                           "WXYZ0123456789_-./=:,+%@") == std::string::npos;
   if (safe) return text;
   std::string quoted = "'";
   for (char c : text) {

@@ -77,9 +77,8 @@ Result<std::string> SubmitBatchScript(const std::string& script_path) {
   if (!r.ok()) return r.status();
   const std::string out = Trim(r->output);
   // --parsable prints "<id>" or "<id>;<cluster>" on the last line.
-  std::string last = out.substr(out.rfind('\n') == std::string::npos
-                                    ? 0
-                                    : out.rfind('\n') + 1);
+  std::string last = out.substr(
+      out.rfind('\n') == std::string::npos ? 0 : out.rfind('\n') + 1);
   last = last.substr(0, last.find(';'));
   if (r->exit_code != 0 || last.empty() ||
       last.find_first_not_of("0123456789") != std::string::npos) {
@@ -118,15 +117,16 @@ Result<std::vector<JobState>> QueryJobs(const std::vector<std::string>& ids) {
   if (!missing.empty() && FindProgram("sacct")) {
     Result<ProcessResult> acct =
         RunProcess({"sacct", "--noheader", "--parsable2", "--allocations",
-                    "--jobs=" + missing, "--format=JobID,JobIDRaw,State,"
-                                          "Elapsed,ExitCode"});
+                    "--jobs=" + missing,
+                    "--format=JobID,JobIDRaw,State,"
+                    "Elapsed,ExitCode"});
     if (acct.ok() && acct->exit_code == 0) {
       for (const std::string& line : Split(acct->output, '\n')) {
         const std::vector<std::string> f = Split(Trim(line), '|');
         if (f.size() < 5 || !Belongs(f[0], wanted)) continue;
         // "CANCELLED by 0" -> "CANCELLED".
-        states.push_back({f[0], f[1], f[2].substr(0, f[2].find(' ')), "",
-                          f[3], f[4]});
+        states.push_back(
+            {f[0], f[1], f[2].substr(0, f[2].find(' ')), "", f[3], f[4]});
       }
     }
   }
@@ -142,7 +142,8 @@ Result<std::vector<StepState>> QuerySteps(const std::vector<std::string>& ids) {
   Result<ProcessResult> r =
       Run({"squeue", "--noheader", "--steps", "--format=%i|%j|%M|%N"});
   if (!r.ok()) return r.status();
-  if (r->exit_code != 0) return Status::IoError("squeue failed: " + Trim(r->output));
+  if (r->exit_code != 0)
+    return Status::IoError("squeue failed: " + Trim(r->output));
   for (const std::string& line : Split(r->output, '\n')) {
     const std::vector<std::string> f = Split(Trim(line), '|');
     if (f.size() < 4 || !Belongs(f[0], wanted)) continue;
@@ -157,9 +158,9 @@ Result<std::vector<StepState>> QuerySteps(const std::vector<std::string>& ids) {
 
 bool IsActiveState(const std::string& state) {
   static const std::set<std::string> kActive = {
-      "PENDING",    "RUNNING",      "REQUEUED",  "REQUEUE_FED", "REQUEUE_HOLD",
-      "RESIZING",   "SUSPENDED",    "COMPLETING", "CONFIGURING", "STAGE_OUT",
-      "SIGNALING",  "STOPPED",      "RESV_DEL_HOLD"};
+      "PENDING",   "RUNNING",   "REQUEUED",     "REQUEUE_FED", "REQUEUE_HOLD",
+      "RESIZING",  "SUSPENDED", "COMPLETING",   "CONFIGURING", "STAGE_OUT",
+      "SIGNALING", "STOPPED",   "RESV_DEL_HOLD"};
   return kActive.count(state) > 0;
 }
 

@@ -23,11 +23,11 @@ std::optional<std::string> FindProgram(const std::string& name);
 Result<std::string> SubmitBatchScript(const std::string& script_path);
 
 struct JobState {
-  std::string id;       // as squeue shows it: "123", or "123_4" for a task
-  std::string job_id;   // the unique job id (an array task has its own)
-  std::string state;    // PENDING, RUNNING, COMPLETED, CANCELLED, ...
-  std::string reason;   // why pending, or "None"
-  std::string elapsed;  // run time so far
+  std::string id;         // as squeue shows it: "123", or "123_4" for a task
+  std::string job_id;     // the unique job id (an array task has its own)
+  std::string state;      // PENDING, RUNNING, COMPLETED, CANCELLED, ...
+  std::string reason;     // why pending, or "None"
+  std::string elapsed;    // run time so far
   std::string exit_code;  // "0:0" (only from sacct)
 };
 
@@ -38,8 +38,8 @@ struct JobState {
 Result<std::vector<JobState>> QueryJobs(const std::vector<std::string>& ids);
 
 struct StepState {
-  std::string id;       // "123.4" or "123_4.0"
-  std::string name;     // srun --job-name: adse-<key prefix>
+  std::string id;    // "123.4" or "123_4.0"
+  std::string name;  // srun --job-name: adse-<key prefix>
   std::string elapsed;
   std::string nodes;
 };

@@ -79,8 +79,7 @@ Result<SweepPlan> ReadSweepPlan(const std::string& campaign_dir) {
   std::error_code ec;
   if (!fs::exists(path, ec)) {
     return Status::NotFound(fmt::format(
-        "{}: no sweep plan (written by adse submit for a static sweep)",
-        path));
+        "{}: no sweep plan (written by adse submit for a static sweep)", path));
   }
   Result<json> j = ReadJson(path);
   if (!j.ok()) return j.status();
@@ -191,9 +190,8 @@ Status WriteShardResults(const std::string& campaign_dir, int task,
   }
   json out = json::object();
   for (const auto& [key, r] : merged) {
-    out[key] = {{"source", r.source},
-                {"attempts", r.attempts},
-                {"wall_s", r.wall_s}};
+    out[key] = {
+        {"source", r.source}, {"attempts", r.attempts}, {"wall_s", r.wall_s}};
   }
   return WriteJson(ShardPath(campaign_dir, task),
                    {{"task", task}, {"results", out}});

@@ -38,7 +38,7 @@ struct SweepPlan {
   int shard_size = 1;      // points per array task
   int steps_per_task = 1;  // steps each task runs at once
   bool use_cache = true;
-  std::string cache_dir;   // empty: the scenario's / the user's default
+  std::string cache_dir;  // empty: the scenario's / the user's default
   std::vector<PlannedPoint> points;
 
   int shards() const;
@@ -52,11 +52,11 @@ Status WriteSweepPlan(const std::string& campaign_dir, const SweepPlan& plan);
 Result<SweepPlan> ReadSweepPlan(const std::string& campaign_dir);
 
 struct SubmittedJob {
-  int submission = 0;    // 1 for the first adse submit, 2 for the next, ...
-  std::string time;      // UTC, ISO 8601
-  std::string kind;      // "coordinator", "array" or "index"
+  int submission = 0;  // 1 for the first adse submit, 2 for the next, ...
+  std::string time;    // UTC, ISO 8601
+  std::string kind;    // "coordinator", "array" or "index"
   std::string job_id;
-  std::string script;    // path relative to the campaign folder
+  std::string script;       // path relative to the campaign folder
   std::vector<int> shards;  // array tasks submitted (kind "array")
 };
 

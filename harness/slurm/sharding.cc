@@ -35,9 +35,9 @@ Sharding ChooseSharding(const ShardingInput& in) {
                  ? 0
                  : static_cast<int>((points + s.shard_size - 1) / s.shard_size);
   if (s.shards > max_tasks) {
-    s.explanation += fmt::format(
-        "; {} shards exceed MaxArraySize {}: raise shard_size", s.shards,
-        max_tasks);
+    s.explanation +=
+        fmt::format("; {} shards exceed MaxArraySize {}: raise shard_size",
+                    s.shards, max_tasks);
   }
   return s;
 }

@@ -23,10 +23,10 @@ inline constexpr int kDefaultMaxArraySize = 1001;
 
 struct ShardingInput {
   int64_t points = 0;
-  int steps_per_task = 1;         // runs each task has going at once
-  double run_estimate_s = 60.0;   // harness.slurm.run_estimate_s
+  int steps_per_task = 1;        // runs each task has going at once
+  double run_estimate_s = 60.0;  // harness.slurm.run_estimate_s
   int max_array_size = kDefaultMaxArraySize;
-  int fixed_shard_size = 0;       // harness.slurm.shard_size; 0: the rule
+  int fixed_shard_size = 0;  // harness.slurm.shard_size; 0: the rule
 };
 
 struct Sharding {

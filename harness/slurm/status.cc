@@ -123,17 +123,16 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
       js.job = job;
       if (states.ok()) {
         for (const JobState& s : *states) {
-          if (s.id == job.job_id ||
-              s.id.rfind(job.job_id + "_", 0) == 0) {
+          if (s.id == job.job_id || s.id.rfind(job.job_id + "_", 0) == 0) {
             js.tasks.push_back(s);
             js.active = js.active || IsActiveState(s.state);
           }
         }
       }
-      js.summary = !states.ok()          ? "unknown"
+      js.summary = !states.ok()       ? "unknown"
                    : js.tasks.empty() ? "not known to Slurm any more "
-                                         "(finished; no accounting to say "
-                                         "how)"
+                                        "(finished; no accounting to say "
+                                        "how)"
                                       : Summarise(js.tasks);
       st.jobs.push_back(js);
     }
@@ -185,16 +184,17 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
 std::string FormatStatus(const CampaignStatus& st) {
   std::string out;
   const std::string what =
-      st.kind == "sweep"         ? fmt::format("a static sweep ({}) of {} points "
-                                               "as a Slurm job array",
-                                               st.strategy, st.total)
-      : st.kind == "coordinator" ? fmt::format("strategy {} with a "
-                                               "coordinator on Slurm",
-                                               st.strategy)
-                                 : fmt::format("a local campaign{}",
-                                               st.strategy.empty()
-                                                   ? ""
-                                                   : " (" + st.strategy + ")");
+      st.kind == "sweep" ? fmt::format(
+                               "a static sweep ({}) of {} points "
+                               "as a Slurm job array",
+                               st.strategy, st.total)
+      : st.kind == "coordinator"
+          ? fmt::format(
+                "strategy {} with a "
+                "coordinator on Slurm",
+                st.strategy)
+          : fmt::format("a local campaign{}",
+                        st.strategy.empty() ? "" : " (" + st.strategy + ")");
   out += fmt::format("campaign: {}\n  {}\n", st.folder, what);
   if (!st.scenario.empty()) out += fmt::format("  scenario: {}\n", st.scenario);
   out += fmt::format("runs: {} done, {} failed, {} running, {} pending{}\n",
@@ -204,8 +204,8 @@ std::string FormatStatus(const CampaignStatus& st) {
     out += "running steps:\n";
     for (const RunningStep& r : st.running_steps) {
       out += fmt::format("  {:<12} {:<36} {} on {}\n", r.step_id,
-                         r.point.empty() ? "run " + r.key : r.point,
-                         r.elapsed, r.nodes);
+                         r.point.empty() ? "run " + r.key : r.point, r.elapsed,
+                         r.nodes);
     }
   }
   if (!st.jobs.empty()) {
@@ -215,9 +215,8 @@ std::string FormatStatus(const CampaignStatus& st) {
       if (!j.job.shards.empty()) {
         shards = fmt::format(", {} shard(s)", j.job.shards.size());
       }
-      out += fmt::format("  #{} {:<11} {:<8} {}{} ({})\n", j.job.submission,
-                         j.job.kind, j.job.job_id, j.summary, shards,
-                         j.job.script);
+      out += fmt::format("  {} job {} ({}{}): {}\n", j.job.kind, j.job.job_id,
+                         j.job.script, shards, j.summary);
     }
   }
   if (!st.lock_holder.empty()) {
@@ -263,23 +262,23 @@ std::string StatusJson(const CampaignStatus& st) {
                     {"active", j.active},
                     {"tasks", tasks}});
   }
-  const json j = {{"folder", st.folder},
-                  {"scenario", st.scenario},
-                  {"strategy", st.strategy},
-                  {"kind", st.kind},
-                  {"total", st.total},
-                  {"counts",
-                   {{"done", st.done},
-                    {"failed", st.failed},
-                    {"running", st.running},
-                    {"pending", st.pending}}},
-                  {"running", running},
-                  {"jobs", jobs},
-                  {"lock_holder", st.lock_holder},
-                  {"views", st.has_views ? (st.views_complete ? "complete"
-                                                              : "incomplete")
-                                         : "none"},
-                  {"notes", st.notes}};
+  const json j = {
+      {"folder", st.folder},
+      {"scenario", st.scenario},
+      {"strategy", st.strategy},
+      {"kind", st.kind},
+      {"total", st.total},
+      {"counts",
+       {{"done", st.done},
+        {"failed", st.failed},
+        {"running", st.running},
+        {"pending", st.pending}}},
+      {"running", running},
+      {"jobs", jobs},
+      {"lock_holder", st.lock_holder},
+      {"views",
+       st.has_views ? (st.views_complete ? "complete" : "incomplete") : "none"},
+      {"notes", st.notes}};
   return j.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
 }
 

@@ -41,7 +41,7 @@ struct CampaignStatus {
   int done = 0, failed = 0, running = 0, pending = 0;
   std::vector<RunningStep> running_steps;
   std::vector<JobStatus> jobs;
-  std::string lock_holder;  // who holds (or last held) the campaign lock
+  std::string lock_holder;      // who holds (or last held) the campaign lock
   bool views_complete = false;  // summary.json says the campaign finished
   bool has_views = false;
   std::vector<std::string> notes;

@@ -10,9 +10,9 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <cstdio>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -112,7 +112,7 @@ bool AllocationEnding(const std::string& job_id) {
   // the array's other tasks.
   Result<ProcessResult> r = RunProcess(
       {"squeue", "--noheader", "--jobs=" + job_id, "--format=%A %T"});
-  if (!r.ok()) return false;  // cannot tell: treat the step as failed
+  if (!r.ok()) return false;           // cannot tell: treat the step as failed
   if (r->exit_code != 0) return true;  // "Invalid job id": it is gone
   std::istringstream lines(r->output);
   std::string id, state;
@@ -147,8 +147,8 @@ struct ChildPlan {
   if (::getppid() != plan.parent_pid) ::_exit(127);
   struct sigaction default_action {};
   default_action.sa_handler = SIG_DFL;
-  for (int sig : {SIGINT, SIGTERM, SIGUSR1, SIGPIPE, SIGCHLD, SIGHUP,
-                  SIGQUIT}) {
+  for (int sig :
+       {SIGINT, SIGTERM, SIGUSR1, SIGPIPE, SIGCHLD, SIGHUP, SIGQUIT}) {
     ::sigaction(sig, &default_action, nullptr);
   }
   sigset_t none;
@@ -194,12 +194,11 @@ class StepPool : public pool::WorkerPool {
                       [](const std::optional<Running>& s) { return !s; }));
   }
   std::string isolation_description() const override {
-    return fmt::format(
-        "Slurm job steps (srun --exact -n1 -c{} --mem={}M){}",
-        options_.cores_per_step, options_.memory_mb,
-        options_.allocation_description.empty()
-            ? ""
-            : " in " + options_.allocation_description);
+    return fmt::format("Slurm job steps (srun --exact -n1 -c{} --mem={}M){}",
+                       options_.cores_per_step, options_.memory_mb,
+                       options_.allocation_description.empty()
+                           ? ""
+                           : " in " + options_.allocation_description);
   }
   std::string fallback_reason() const override { return ""; }
 
@@ -350,8 +349,8 @@ pool::JobResult StepPool::Reap(size_t slot) {
     ClassifyStepEnd(*r.wait_status, output, &result);
     if (r.killed_for) {
       result.outcome = *r.killed_for;
-    } else if (result.outcome != pool::Outcome::kOk &&
-               SlurmEndedStep(output) && AllocationEnding(options_.job_id)) {
+    } else if (result.outcome != pool::Outcome::kOk && SlurmEndedStep(output) &&
+               AllocationEnding(options_.job_id)) {
       // Slurm cancelled the step with the whole job (scancel, the time
       // limit): stop the campaign now, before the coordinator's own signal
       // arrives, rather than retry into a vanishing allocation and record
@@ -449,8 +448,8 @@ std::vector<std::string> SrunCommand(const StepPoolOptions& options,
       "--nodes=1",
       fmt::format("--cpus-per-task={}", options.cores_per_step),
       fmt::format("--mem={}M", options.memory_mb),
-      "--job-name=" + (job.name.empty() ? fmt::format("adse-{}", job.id)
-                                        : job.name),
+      "--job-name=" +
+          (job.name.empty() ? fmt::format("adse-{}", job.id) : job.name),
       // One SIGINT cancels the step (the pool's timeout and cancel path).
       "--quit-on-interrupt",
   };

@@ -47,8 +47,8 @@ struct SubmitOptions {
 };
 
 struct SubmittedScript {
-  std::string kind;    // "coordinator", "array" or "index"
-  std::string path;    // where it was written; empty in a dry run
+  std::string kind;  // "coordinator", "array" or "index"
+  std::string path;  // where it was written; empty in a dry run
   std::string text;
   std::string job_id;  // empty in a dry run
 };

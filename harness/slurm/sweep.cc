@@ -91,9 +91,9 @@ Result<ShardSummary> RunShard(const ShardOptions& options) {
   }
   const int shards = peek.ok() ? peek->shards() : 0;
   if (peek.ok() && (task < 0 || task >= shards)) {
-    return Status::InvalidArgument(fmt::format(
-        "--task: expected a shard of {} (0 to {}), found {}",
-        options.campaign_dir, shards - 1, task));
+    return Status::InvalidArgument(
+        fmt::format("--task: expected a shard of {} (0 to {}), found {}",
+                    options.campaign_dir, shards - 1, task));
   }
   const auto [begin, end] =
       peek.ok() ? peek->ShardRange(task) : std::pair<size_t, size_t>{0, 0};
@@ -134,8 +134,7 @@ Result<ShardSummary> RunShard(const ShardOptions& options) {
     spec.harness.executor = "slurm";
     o.make_pool = CreateAllocationPool;
     o.drain_signal = SIGUSR1;
-    o.drain_grace_s =
-        std::max(0, spec.harness.slurm.signal_lead_s - 30);
+    o.drain_grace_s = std::max(0, spec.harness.slurm.signal_lead_s - 30);
   }
   Result<campaign::CampaignSummary> done =
       campaign::EvaluatePoints(spec, summary.points, o);
@@ -215,11 +214,10 @@ Result<campaign::CampaignSummary> BuildSweepIndex(
         campaign::CampaignFolder(campaign_dir).RunPath(row.content_key);
     const auto written = fs::last_write_time(path, ec);
     if (ec) continue;
-    const double end = std::chrono::duration<double>(
-                           written.time_since_epoch())
-                           .count();
-    first_start = any ? std::min(first_start, end - row.wall_s)
-                      : end - row.wall_s;
+    const double end =
+        std::chrono::duration<double>(written.time_since_epoch()).count();
+    first_start =
+        any ? std::min(first_start, end - row.wall_s) : end - row.wall_s;
     last_end = any ? std::max(last_end, end) : end;
     any = true;
   }

@@ -94,15 +94,16 @@ BENCHMARK(BM_LocalWorkerRoundTrip)
 void BM_SubmitToFirstRunStarted(benchmark::State& state) {
   const bool sweep = state.range(0) == 0;
   state.SetLabel(sweep ? "job array (exhaustive)" : "coordinator (agent)");
-  const std::string scenario = SmallScenarioIn(
-      g_dir, sweep ? "{strategy: exhaustive, budget: 1}"
-                   : "{strategy: agent, budget: 1}",
-      "{memory_mb: 1024, slurm: {signal_lead_s: 60}}");
+  const std::string scenario =
+      SmallScenarioIn(g_dir,
+                      sweep ? "{strategy: exhaustive, budget: 1}"
+                            : "{strategy: agent, budget: 1}",
+                      "{memory_mb: 1024, slurm: {signal_lead_s: 60}}");
   int n = 0;
   double submit_s = 0;  // adse submit alone, summed
   for (auto _ : state) {
-    const std::string out = g_dir + (sweep ? "/array-" : "/coordinator-") +
-                            std::to_string(++n);
+    const std::string out =
+        g_dir + (sweep ? "/array-" : "/coordinator-") + std::to_string(++n);
     const auto start = Clock::now();
     const AdseRun run = Adse({"submit", scenario, "-o", out, "--no-cache"});
     submit_s += std::chrono::duration<double>(Clock::now() - start).count();
@@ -129,9 +130,10 @@ void BM_SubmitToFirstRunStarted(benchmark::State& state) {
     (void)g_cluster->Run({"scancel", "--name=adse-robotaxi-small"});
     (void)g_cluster->Run({"scancel", "--name=adse-robotaxi-small-index"});
     for (int i = 0; i < 200; ++i) {
-      Result<ProcessResult> left = g_cluster->Run(
-          {"squeue", "--noheader", "--name=adse-robotaxi-small,"
-                                   "adse-robotaxi-small-index"});
+      Result<ProcessResult> left =
+          g_cluster->Run({"squeue", "--noheader",
+                          "--name=adse-robotaxi-small,"
+                          "adse-robotaxi-small-index"});
       if (left.ok() &&
           left->output.find_first_not_of(" \n") == std::string::npos) {
         break;
@@ -160,18 +162,19 @@ int main(int argc, char** argv) {
   }
   adse::Result<std::unique_ptr<SlurmCluster>> cluster = SlurmCluster::Start();
   if (!cluster.ok()) {
-    std::fprintf(stderr, "slurm_bench: %s\n", cluster.status().message().c_str());
+    std::fprintf(stderr, "slurm_bench: %s\n",
+                 cluster.status().message().c_str());
     return 1;
   }
   g_cluster = cluster->get();
   TestFolder folder("bench");
   g_dir = folder.path();
-  adse::Result<adse::ProcessResult> r = g_cluster->Run(
-      {"salloc", "--no-shell", "--ntasks=1", "--cpus-per-task=1",
-       "--mem=500M", "--time=30"});
+  adse::Result<adse::ProcessResult> r =
+      g_cluster->Run({"salloc", "--no-shell", "--ntasks=1", "--cpus-per-task=1",
+                      "--mem=500M", "--time=30"});
   std::smatch m;
-  if (!r.ok() || !std::regex_search(r->output, m,
-                                    std::regex("allocation (\\d+)"))) {
+  if (!r.ok() ||
+      !std::regex_search(r->output, m, std::regex("allocation (\\d+)"))) {
     std::fprintf(stderr, "slurm_bench: salloc failed: %s\n",
                  r.ok() ? r->output.c_str() : r.status().message().c_str());
     return 1;

@@ -58,8 +58,7 @@ Supervised StartSupervised(const std::string& name, const std::string& child) {
   // scontrol stands in for Slurm's: it records what it was asked.
   script.body = {"scontrol() { echo \"scontrol $*\"; }",
                  "SLURM_RESTART_COUNT=0"};
-  for (const std::string& line :
-       SupervisedBody(child, "$SLURM_JOB_ID", 10)) {
+  for (const std::string& line : SupervisedBody(child, "$SLURM_JOB_ID", 10)) {
     script.body.push_back(line);
   }
   std::ofstream(s.dir + "/job.sh") << RenderScript(script);

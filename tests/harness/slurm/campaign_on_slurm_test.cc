@@ -52,10 +52,9 @@ class CampaignOnSlurmTest : public ::testing::Test {
     const AdseRun run =
         Adse({"submit", scenario, "-o", out, "--json", "--no-cache"});
     EXPECT_EQ(run.exit_code, 0) << run.output;
-    const json j = json::parse(run.output.substr(
-                                   std::min(run.output.find('{'),
-                                            run.output.size())),
-                               nullptr, false);
+    const json j = json::parse(
+        run.output.substr(std::min(run.output.find('{'), run.output.size())),
+        nullptr, false);
     EXPECT_FALSE(j.is_discarded()) << run.output;
     return j.is_discarded() ? json::object() : j;
   }
@@ -148,8 +147,9 @@ TEST_F(CampaignOnSlurmTest, ArraySweepEndsWithTheSameRunsAsALocalCampaign) {
   const std::string index = JobOf(submitted, "index");
   ASSERT_FALSE(array.empty());
   ASSERT_FALSE(index.empty());
-  for (const char* file : {"/slurm/plan.json", "/slurm/jobs.json",
-                           "/slurm/001-array.sbatch", "/slurm/001-index.sbatch"}) {
+  for (const char* file :
+       {"/slurm/plan.json", "/slurm/jobs.json", "/slurm/001-array.sbatch",
+        "/slurm/001-index.sbatch"}) {
     EXPECT_TRUE(fs::exists(out + file)) << file << " is on record";
   }
 
@@ -180,16 +180,16 @@ TEST_F(CampaignOnSlurmTest, ArraySweepEndsWithTheSameRunsAsALocalCampaign) {
   EXPECT_EQ(summary["counts"]["failed"], 0);
   const json st = StatusOf(out);
   EXPECT_EQ(st["kind"], "sweep");
-  EXPECT_EQ(st["counts"], json({{"done", 4}, {"failed", 0}, {"running", 0},
-                                {"pending", 0}}));
+  EXPECT_EQ(st["counts"],
+            json({{"done", 4}, {"failed", 0}, {"running", 0}, {"pending", 0}}));
   ASSERT_EQ(st["jobs"].size(), 2u);
   EXPECT_EQ(st["jobs"][0]["tasks"].size(), 2u);
 
   // The same sweep as a local campaign: the same runs, in the same order,
   // with the same metrics (the counted cost model is deterministic).
   const std::string local = dir_ + "/local";
-  const AdseRun run = Adse({"run", scenario, "-o", local, "--workers", "2",
-                            "--no-cache", "-q"});
+  const AdseRun run = Adse(
+      {"run", scenario, "-o", local, "--workers", "2", "--no-cache", "-q"});
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const runfile::CampaignIndex slurm_index = Index(out);
   const runfile::CampaignIndex local_index = Index(local);
@@ -258,12 +258,14 @@ TEST_F(CampaignOnSlurmTest,
   EXPECT_EQ(summary["counts"]["simulated"], 4);
   EXPECT_THAT(summary["isolation"].get<std::string>(),
               HasSubstr("Slurm job steps (srun --exact -n1 -c1 --mem=1024M) "
-                        "in job " + job));
+                        "in job " +
+                        job));
   EXPECT_EQ(summary["workers"], 2);
 }
 
-TEST_F(CampaignOnSlurmTest,
-       CancellingTheCoordinatorMidCampaignThenResubmittingLosesAndRepeatsNothing) {
+TEST_F(
+    CampaignOnSlurmTest,
+    CancellingTheCoordinatorMidCampaignThenResubmittingLosesAndRepeatsNothing) {
   const std::string scenario = SmallScenarioIn(
       dir_, "{strategy: agent, budget: 4, batch: 2}",
       "{workers: 2, memory_mb: 1024, slurm: {signal_lead_s: 60}}");
@@ -271,8 +273,8 @@ TEST_F(CampaignOnSlurmTest,
   const std::string first = JobOf(Submit(scenario, out), "coordinator");
   ASSERT_FALSE(first.empty());
   // Cancel once the first round has landed, while the second runs.
-  ASSERT_TRUE(Eventually([&] { return RunFiles(out).size() >= 2; },
-                         kJobTimeoutS))
+  ASSERT_TRUE(
+      Eventually([&] { return RunFiles(out).size() >= 2; }, kJobTimeoutS))
       << cluster_->LogTail();
   Result<ProcessResult> cancel = cluster_->Run({"scancel", first});
   ASSERT_TRUE(cancel.ok() && cancel->exit_code == 0);
@@ -305,7 +307,8 @@ TEST_F(CampaignOnSlurmTest,
   EXPECT_EQ(summary["complete"], true);
   EXPECT_EQ(summary["counts"]["evaluations"], 4);
   EXPECT_EQ(summary["counts"]["reused"], static_cast<int>(before.size()));
-  EXPECT_EQ(summary["counts"]["simulated"], 4 - static_cast<int>(before.size()));
+  EXPECT_EQ(summary["counts"]["simulated"],
+            4 - static_cast<int>(before.size()));
   std::set<std::string> keys;
   for (const runfile::EvaluationRow& row : Index(out).evaluations) {
     keys.insert(row.content_key);
@@ -344,8 +347,9 @@ TEST_F(CampaignOnSlurmTest, AStepKilledForMemoryIsRecordedAsOutOfMemory) {
   EXPECT_EQ(StatusOf(out)["counts"]["failed"], 1);
 }
 
-TEST_F(CampaignOnSlurmTest,
-       TheTimeLimitWarningLetsRunningStepsFinishAndTheRequeuedJobEndsTheCampaign) {
+TEST_F(
+    CampaignOnSlurmTest,
+    TheTimeLimitWarningLetsRunningStepsFinishAndTheRequeuedJobEndsTheCampaign) {
   const std::string scenario = SmallScenarioIn(
       dir_, "{strategy: agent, budget: 6, batch: 2}",
       "{workers: 2, memory_mb: 1024, slurm: {signal_lead_s: 60}}");
@@ -366,8 +370,8 @@ TEST_F(CampaignOnSlurmTest,
   ASSERT_TRUE(warn.ok() && warn->exit_code == 0);
   // The coordinator stops proposing, lets its steps finish, exits 138 and
   // the job requeues itself.
-  ASSERT_TRUE(Eventually(
-      [&] { return cluster_->JobState(job) == "PENDING"; }, kJobTimeoutS, 0.2))
+  ASSERT_TRUE(Eventually([&] { return cluster_->JobState(job) == "PENDING"; },
+                         kJobTimeoutS, 0.2))
       << cluster_->JobState(job);
   const std::string log =
       ReadFile(out + "/slurm/logs/coordinator-" + job + ".out").value();
@@ -380,8 +384,8 @@ TEST_F(CampaignOnSlurmTest,
   EXPECT_THAT(log.substr(log.find("time-limit warning")), HasSubstr("[4/6]"));
   EXPECT_EQ(FailureRecords(out), 0);
   // A requeued job waits ~2 minutes before it may start again.
-  Result<ProcessResult> now = cluster_->Run(
-      {"scontrol", "update", "JobId=" + job, "StartTime=now"});
+  Result<ProcessResult> now =
+      cluster_->Run({"scontrol", "update", "JobId=" + job, "StartTime=now"});
   ASSERT_TRUE(now.ok() && now->exit_code == 0) << now->output;
   WaitForJob(job);
   EXPECT_EQ(cluster_->JobState(job), "COMPLETED");

@@ -38,7 +38,8 @@ TEST(StepEndTest, TheWorkersOwnWordsAreNotTakenForSlurms) {
 
 TEST(StepEndTest, ExitStatusesSignalsAndTimeLimits) {
   EXPECT_EQ(Classify(Exited(0), "").outcome, pool::Outcome::kOk);
-  pool::JobResult r = Classify(Exited(3), "srun: error: vm: task 0: Exited with exit code 3\n");
+  pool::JobResult r =
+      Classify(Exited(3), "srun: error: vm: task 0: Exited with exit code 3\n");
   EXPECT_EQ(r.outcome, pool::Outcome::kOutOfMemory);  // adse worker's bad_alloc
   r = Classify(Exited(2), "error: --point: no such parameter\n");
   EXPECT_EQ(r.outcome, pool::Outcome::kExitError);

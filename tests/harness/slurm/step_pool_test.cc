@@ -38,8 +38,8 @@ class StepPoolTest : public ::testing::Test {
     ASSERT_TRUE(r.ok() && r->exit_code == 0)
         << (r.ok() ? r->output : r.status().message());
     std::smatch m;
-    ASSERT_TRUE(std::regex_search(r->output, m,
-                                  std::regex("allocation (\\d+)")))
+    ASSERT_TRUE(
+        std::regex_search(r->output, m, std::regex("allocation (\\d+)")))
         << r->output;
     job_ = m[1];
     options_.job_id = job_;

@@ -20,8 +20,8 @@ using ::testing::Not;
 
 std::map<std::string, std::string> DryRunScripts(const AdseRun& run) {
   std::map<std::string, std::string> scripts;
-  const nlohmann::json j = nlohmann::json::parse(run.output.substr(
-      run.output.find('{')), nullptr, false);
+  const nlohmann::json j = nlohmann::json::parse(
+      run.output.substr(run.output.find('{')), nullptr, false);
   EXPECT_FALSE(j.is_discarded()) << run.output;
   if (j.is_discarded()) return scripts;
   for (const auto& s : j["scripts"]) {
@@ -68,12 +68,14 @@ TEST(SubmitTest, DryRunOfASweepPrintsAnArrayAndAnIndexJobAndTouchesNothing) {
         "--task \"$SLURM_ARRAY_TASK_ID\"", "scontrol requeue"}) {
     EXPECT_THAT(array, HasSubstr(line));
   }
-  EXPECT_THAT(array, HasSubstr("--output=" + out + "/slurm/logs/shard-%A_%a.out"));
+  EXPECT_THAT(array,
+              HasSubstr("--output=" + out + "/slurm/logs/shard-%A_%a.out"));
   EXPECT_THAT(array, HasSubstr("\" shard " + out));
   // sbatch stops reading #SBATCH lines at the first command.
   EXPECT_LT(array.rfind("#SBATCH"), array.find("set -u"));
   const std::string& index = scripts["index"];
-  EXPECT_THAT(index, HasSubstr("#SBATCH --dependency=afterany:<array-job-id>\n"));
+  EXPECT_THAT(index,
+              HasSubstr("#SBATCH --dependency=afterany:<array-job-id>\n"));
   EXPECT_THAT(index, HasSubstr("\" index " + out));
   ExpectValidBash(dir, "array", array);
   ExpectValidBash(dir, "index", index);
@@ -83,10 +85,10 @@ TEST(SubmitTest, DryRunOfASweepPrintsAnArrayAndAnIndexJobAndTouchesNothing) {
 TEST(SubmitTest, DryRunOfAnAdaptiveCampaignSizesTheCoordinatorFromTheScenario) {
   const TestFolder folder("dry-agent");
   const std::string& dir = folder.path();
-  const std::string scenario = SmallScenarioIn(
-      dir, "{strategy: agent, budget: 4, batch: 2}",
-      "{workers: 2, cores_per_worker: 2, memory_mb: 1000, "
-      "slurm: {account: lab, time_limit: \"1-00:00:00\"}}");
+  const std::string scenario =
+      SmallScenarioIn(dir, "{strategy: agent, budget: 4, batch: 2}",
+                      "{workers: 2, cores_per_worker: 2, memory_mb: 1000, "
+                      "slurm: {account: lab, time_limit: \"1-00:00:00\"}}");
   const AdseRun run = Adse({"submit", scenario, "-o", dir + "/campaign",
                             "--dry-run", "--json", "--no-cache"});
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -120,14 +122,15 @@ TEST(SubmitTest, WithoutSbatchOnThePathSubmitSaysWhatIsMissing) {
   EXPECT_FALSE(fs::exists(dir + "/campaign"));
 }
 
-TEST(SubmitTest, RunWithExecutorSlurmOutsideAnAllocationIsRefusedBeforeWriting) {
+TEST(SubmitTest,
+     RunWithExecutorSlurmOutsideAnAllocationIsRefusedBeforeWriting) {
   const TestFolder folder("no-allocation");
   const std::string& dir = folder.path();
   const std::string scenario =
       SmallScenarioIn(dir, "{strategy: exhaustive, budget: 1}", "{}");
-  AdseRun run = Adse({"run", scenario, "-o", dir + "/campaign", "--executor",
-                      "slurm"},
-                     {"SLURM_JOB_ID="});
+  AdseRun run =
+      Adse({"run", scenario, "-o", dir + "/campaign", "--executor", "slurm"},
+           {"SLURM_JOB_ID="});
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_THAT(run.output, HasSubstr("--executor slurm"));
   EXPECT_THAT(run.output, HasSubstr("SLURM_JOB_ID is not set"));
@@ -152,8 +155,8 @@ TEST(SubmitTest, BadInputIsRefusedNamingTheFieldOrFlag) {
   const std::string out = dir + "/campaign";
   const std::string ok =
       SmallScenarioIn(dir, "{strategy: exhaustive, budget: 2}", "{}");
-  AdseRun run = Adse({"submit", ok, "-o", out, "--dry-run",
-                      "--sbatch-arg=--array=0-9"});
+  AdseRun run =
+      Adse({"submit", ok, "-o", out, "--dry-run", "--sbatch-arg=--array=0-9"});
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.output, HasSubstr("--sbatch-arg: --array is set by adse "
                                     "submit itself"));
@@ -162,7 +165,8 @@ TEST(SubmitTest, BadInputIsRefusedNamingTheFieldOrFlag) {
   EXPECT_THAT(run.output, HasSubstr("starting with '-'"));
   run = Adse({"submit", ok, "-o", out, "--dry-run", "--strategy", "annealing"});
   EXPECT_EQ(run.exit_code, 2);
-  EXPECT_THAT(run.output, HasSubstr("unknown exploration strategy 'annealing'"));
+  EXPECT_THAT(run.output,
+              HasSubstr("unknown exploration strategy 'annealing'"));
 
   std::string bad = SmallScenarioIn(
       dir, "{strategy: exhaustive, budget: 2}",

@@ -19,8 +19,8 @@
 namespace adse::slurm::testing {
 namespace {
 
-using ::testing::HasSubstr;
 using nlohmann::json;
+using ::testing::HasSubstr;
 
 // The plan adse submit would write for these points, one per shard.
 void WritePlan(const std::string& scenario, const std::string& campaign,
@@ -70,7 +70,8 @@ TEST(SweepTest, ALocalShardRunsItsPointsAndTheIndexNamesWhatIsMissing) {
   run = Adse({"index", campaign});
   EXPECT_EQ(run.exit_code, 1) << run.output;
   EXPECT_THAT(run.output, HasSubstr("1 planned point(s) have no result"));
-  const json summary = json::parse(ReadFile(campaign + "/summary.json").value());
+  const json summary =
+      json::parse(ReadFile(campaign + "/summary.json").value());
   EXPECT_EQ(summary["complete"], false);
   EXPECT_EQ(summary["unfinished"], 1);
   ASSERT_EQ(summary["evaluations"].size(), 1u);
@@ -82,8 +83,8 @@ TEST(SweepTest, ALocalShardRunsItsPointsAndTheIndexNamesWhatIsMissing) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const json st = json::parse(run.output);
   EXPECT_EQ(st["kind"], "sweep");
-  EXPECT_EQ(st["counts"], json({{"done", 1}, {"failed", 0}, {"running", 0},
-                                {"pending", 1}}));
+  EXPECT_EQ(st["counts"],
+            json({{"done", 1}, {"failed", 0}, {"running", 0}, {"pending", 1}}));
 
   // The scenario edited after planning: its keys no longer match.
   std::string text = ReadFile(scenario).value();

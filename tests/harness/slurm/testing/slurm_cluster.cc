@@ -32,10 +32,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-const char* const kPrograms[] = {"munged",  "slurmctld", "slurmd",
-                                 "sbatch",  "srun",      "squeue",
-                                 "scancel", "scontrol",  "sinfo",
-                                 "salloc",  "setpriv"};
+const char* const kPrograms[] = {"munged", "slurmctld", "slurmd",  "sbatch",
+                                 "srun",   "squeue",    "scancel", "scontrol",
+                                 "sinfo",  "salloc",    "setpriv"};
 
 // A TCP port nothing listens on right now (the kernel's choice).
 int FreePort() {
@@ -47,8 +46,7 @@ int FreePort() {
   address.sin_port = 0;
   socklen_t length = sizeof(address);
   int port = -1;
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) ==
-          0 &&
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) == 0 &&
       ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0) {
     port = ntohs(address.sin_port);
   }
@@ -60,10 +58,11 @@ int FreePort() {
 // should this process die first.
 pid_t Launch(const std::vector<std::string>& argv, const std::string& log) {
   std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  for (const std::string& a : argv)
+    args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
-  const int out = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC,
-                         0644);
+  const int out =
+      ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid == 0) {
@@ -120,7 +119,8 @@ std::map<std::string, std::string> Fields(const std::string& line) {
   std::string word;
   while (in >> word) {
     const size_t eq = word.find('=');
-    if (eq != std::string::npos) fields[word.substr(0, eq)] = word.substr(eq + 1);
+    if (eq != std::string::npos)
+      fields[word.substr(0, eq)] = word.substr(eq + 1);
   }
   return fields;
 }
@@ -181,7 +181,8 @@ Status SlurmCluster::Launch() {
   }
   if (::chown(munge_dir.c_str(), munge->pw_uid, munge->pw_gid) != 0 ||
       ::chown(key.c_str(), munge->pw_uid, munge->pw_gid) != 0 ||
-      ::chmod(munge_dir.c_str(), 0755) != 0 || ::chmod(key.c_str(), 0400) != 0) {
+      ::chmod(munge_dir.c_str(), 0755) != 0 ||
+      ::chmod(key.c_str(), 0400) != 0) {
     return Status::IoError("cannot hand the munge key to the munge user: " +
                            std::string(std::strerror(errno)));
   }
@@ -194,8 +195,8 @@ Status SlurmCluster::Launch() {
        "--seed-file=" + munge_dir + "/munged.seed"},
       dir_ + "/log/munged.out");
   for (auto until = Clock::now() + std::chrono::seconds(10);
-       !fs::exists(socket); std::this_thread::sleep_for(
-           std::chrono::milliseconds(20))) {
+       !fs::exists(socket);
+       std::this_thread::sleep_for(std::chrono::milliseconds(20))) {
     if (Clock::now() > until || Exited(munged_)) {
       munged_ = -1;
       return Status::Unavailable("munged did not start:\n" +
@@ -205,9 +206,9 @@ Status SlurmCluster::Launch() {
 
   Result<ProcessResult> probe = RunProcess({"slurmd", "-C"});
   if (!probe.ok() || probe->exit_code != 0) {
-    return Status::Unavailable("slurmd -C failed: " +
-                               (probe.ok() ? probe->output
-                                           : probe.status().message()));
+    return Status::Unavailable(
+        "slurmd -C failed: " +
+        (probe.ok() ? probe->output : probe.status().message()));
   }
   std::map<std::string, std::string> hw =
       Fields(probe->output.substr(0, probe->output.find('\n')));
@@ -319,8 +320,8 @@ void SlurmCluster::Stop() {
         while (Clock::now() < until) {
           Result<ProcessResult> left =
               Run({"squeue", "--noheader", "--format=%A"});
-          if (!left.ok() || left->output.find_first_not_of(" \n") ==
-                                std::string::npos) {
+          if (!left.ok() ||
+              left->output.find_first_not_of(" \n") == std::string::npos) {
             break;
           }
           std::this_thread::sleep_for(std::chrono::milliseconds(200));
@@ -364,13 +365,13 @@ Status SlurmCluster::WaitForJobEnd(const std::string& job_id,
     bool active = false;
     std::istringstream in(states);
     std::string state;
-    while (std::getline(in, state, ',')) active = active || IsActiveState(state);
+    while (std::getline(in, state, ','))
+      active = active || IsActiveState(state);
     if (!active) return Status::Ok();
     std::this_thread::sleep_for(std::chrono::milliseconds(250));
   }
-  return Status::Unavailable(fmt::format(
-      "job {} still {} after {:g} s\n{}", job_id, states, timeout_s,
-      LogTail()));
+  return Status::Unavailable(fmt::format("job {} still {} after {:g} s\n{}",
+                                         job_id, states, timeout_s, LogTail()));
 }
 
 std::string SlurmCluster::LogTail() const {
