@@ -32,6 +32,14 @@ std::string Trim(const std::string& s) {
   return s.substr(begin, end - begin + 1);
 }
 
+// The last line of a tool's output: where Slurm's clients say why they
+// failed.
+std::string LastLine(const std::string& s) {
+  const std::string t = Trim(s);
+  const size_t newline = t.rfind('\n');
+  return newline == std::string::npos ? t : t.substr(newline + 1);
+}
+
 // Whether a squeue/sacct id ("123", "123_4", "123_[5-9]", "123.batch")
 // belongs to one of `ids`.
 bool Belongs(const std::string& id, const std::set<std::string>& ids) {
@@ -107,7 +115,7 @@ Result<std::vector<JobState>> QueryJobs(const std::vector<std::string>& ids) {
       seen.insert(f[0].substr(0, f[0].find('_')));
     }
   } else if (r->output.find("Invalid job id") == std::string::npos) {
-    return Status::IoError("squeue failed: " + Trim(r->output));
+    return Status::IoError("squeue failed: " + LastLine(r->output));
   }
   // Jobs squeue has forgotten: ask accounting, where there is any.
   std::string missing;
@@ -142,8 +150,9 @@ Result<std::vector<StepState>> QuerySteps(const std::vector<std::string>& ids) {
   Result<ProcessResult> r =
       Run({"squeue", "--noheader", "--steps", "--format=%i|%j|%M|%N"});
   if (!r.ok()) return r.status();
-  if (r->exit_code != 0)
-    return Status::IoError("squeue failed: " + Trim(r->output));
+  if (r->exit_code != 0) {
+    return Status::IoError("squeue failed: " + LastLine(r->output));
+  }
   for (const std::string& line : Split(r->output, '\n')) {
     const std::vector<std::string> f = Split(Trim(line), '|');
     if (f.size() < 4 || !Belongs(f[0], wanted)) continue;
