@@ -11,6 +11,7 @@ PACKAGES=(
   libpcl-dev libopencv-dev libceres-dev libhdf5-dev libpagmo-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-h5py python3-pandas bc
+  slurm-wlm munge
 )
 
 missing=()

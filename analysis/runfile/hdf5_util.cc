@@ -495,8 +495,7 @@ Status WriteFileAtomically(
   if (target.has_parent_path()) {
     ADSE_RETURN_IF_ERROR(MakeDirs(target.parent_path().string()));
   }
-  const std::string tmp =
-      path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
+  const std::string tmp = TemporaryPathFor(path);
   Status status;
   {
     Hdf5Session session;

@@ -24,9 +24,10 @@ inline constexpr size_t kIdBytes = 64;     // vehicle ids, collision other_id
 inline constexpr size_t kNameBytes = 128;  // node, callback and topic names
 inline constexpr size_t kKindBytes = 32;   // callback kind
 
-// Writes `run` to `<path>.tmp.<pid>`, flushes it to disk and renames it over
-// `path` (creating parent folders), so readers see either the old file or
-// the whole new one and a crash never leaves a file that looks complete.
+// Writes `run` to `<path>.tmp.<host>.<pid>`, flushes it to disk and
+// renames it over `path` (creating parent folders), so readers see either
+// the old file or the whole new one and a crash never leaves a file that
+// looks complete.
 // The root attribute `status` is written last. InvalidArgument if
 // run.status is not "complete"/"failed", a topic event has an unknown kind
 // or a non-empty scenario_hash is not the sha256 of scenario_text; IoError

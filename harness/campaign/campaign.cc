@@ -63,9 +63,11 @@ class ViewRefresher : public ExplorerListener {
 
 }  // namespace
 
-Result<CampaignSummary> RunCampaign(const spec::Spec& input,
-                                    const CampaignOptions& options) {
-  const auto started = Clock::now();
+namespace {
+
+// The spec with the options' overrides applied, or why it cannot run.
+Result<spec::Spec> Overridden(const spec::Spec& input,
+                              const CampaignOptions& options) {
   spec::Spec spec = input;
   if (!options.strategy.empty()) spec.exploration.strategy = options.strategy;
   if (options.budget >= 0) spec.exploration.budget = options.budget;
@@ -80,56 +82,64 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
         "found " +
         std::to_string(spec.harness.replicas));
   }
-  if (spec.harness.executor != "local") {
+  if (spec.harness.executor != "local" && !options.make_pool) {
     return Status::InvalidArgument(
-        spec.Where("harness.executor") +
-        "harness.executor: only 'local' is implemented; found '" +
-        spec.harness.executor + "'");
+        spec.Where("harness.executor") + "harness.executor: '" +
+        spec.harness.executor +
+        "' runs need a pool for it: adse run --executor slurm inside a Slurm "
+        "allocation, or adse submit");
   }
-  ADSE_RETURN_IF_ERROR(CheckStrategyName(spec.exploration.strategy));
-  Result<pool::Isolation> isolation =
-      pool::ParseIsolation(spec.harness.isolation);
-  if (!isolation.ok()) return isolation.status();
+  return spec;
+}
 
-  CampaignSummary summary;
-  summary.output_dir =
-      options.output_dir.empty() ? spec.ResolvedOutput() : options.output_dir;
-  summary.strategy = spec.exploration.strategy;
-  const CampaignFolder folder(summary.output_dir);
-  ADSE_RETURN_IF_ERROR(folder.Create());
-  Result<CampaignLock> lock = CampaignLock::Acquire(folder.root());
-  if (!lock.ok()) return lock.status();
-  // Created under the lock: the llm strategy records into the folder.
-  Result<std::unique_ptr<explore::Strategy>> strategy =
-      CreateCampaignStrategy(spec, folder.root(), /*record=*/true);
-  if (!strategy.ok()) return strategy.status();
-
-  pool::PoolOptions pool_options = options.pool;
-  pool_options.workers = spec.harness.workers;
-  pool_options.cores_per_worker = spec.harness.cores_per_worker;
-  pool_options.memory_mb = spec.harness.memory_mb;
-  pool_options.isolation = *isolation;
+// The pool the campaign's runs go to; fills the summary's pool fields.
+Result<std::unique_ptr<pool::WorkerPool>> MakePool(
+    const spec::Spec& spec, const CampaignOptions& options,
+    CampaignSummary* summary) {
   Result<std::unique_ptr<pool::WorkerPool>> pool =
-      pool::WorkerPool::Create(pool_options);
+      Status::Internal("no pool made");
+  if (options.make_pool) {
+    pool = options.make_pool(spec);
+  } else {
+    Result<pool::Isolation> isolation =
+        pool::ParseIsolation(spec.harness.isolation);
+    if (!isolation.ok()) return isolation.status();
+    pool::PoolOptions pool_options = options.pool;
+    pool_options.workers = spec.harness.workers;
+    pool_options.cores_per_worker = spec.harness.cores_per_worker;
+    pool_options.memory_mb = spec.harness.memory_mb;
+    pool_options.isolation = *isolation;
+    pool = pool::WorkerPool::Create(pool_options);
+  }
   if (!pool.ok()) return pool.status();
-  summary.isolation = (*pool)->isolation_description();
-  summary.isolation_note = (*pool)->fallback_reason();
-  summary.workers = (*pool)->slots();
+  summary->isolation = (*pool)->isolation_description();
+  summary->isolation_note = (*pool)->fallback_reason();
+  summary->workers = (*pool)->slots();
   if (options.on_pool_ready) {
-    options.on_pool_ready(summary.workers, summary.isolation,
-                          summary.isolation_note);
+    options.on_pool_ready(summary->workers, summary->isolation,
+                          summary->isolation_note);
   }
   pool::InstallInterruptHandlers();
-
-  std::optional<RunCache> cache;
-  if (options.use_cache) {
-    std::string dir = options.cache_dir;
-    if (dir.empty()) dir = spec.harness.cache_dir;
-    if (dir.empty()) dir = DefaultCacheDir() + "/runs";
-    ADSE_RETURN_IF_ERROR(MakeDirs(dir));
-    cache.emplace(dir);
+  if (options.drain_signal != 0) {
+    pool::InstallDrainHandler(options.drain_signal);
   }
+  return pool;
+}
 
+Status OpenCache(const spec::Spec& spec, const CampaignOptions& options,
+                 std::optional<RunCache>* cache) {
+  if (!options.use_cache) return Status::Ok();
+  std::string dir = options.cache_dir;
+  if (dir.empty()) dir = spec.harness.cache_dir;
+  if (dir.empty()) dir = DefaultCacheDir() + "/runs";
+  ADSE_RETURN_IF_ERROR(MakeDirs(dir));
+  cache->emplace(dir);
+  return Status::Ok();
+}
+
+PoolEvaluatorOptions EvaluatorOptions(const spec::Spec& spec,
+                                      const CampaignOptions& options,
+                                      const std::optional<RunCache>& cache) {
   PoolEvaluatorOptions evaluator_options;
   evaluator_options.worker_command = options.worker_command;
   if (evaluator_options.worker_command.empty()) {
@@ -144,12 +154,67 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
   evaluator_options.retry_failed = options.retry_failed;
   evaluator_options.cache = cache ? &*cache : nullptr;
   evaluator_options.on_attempt_failed = options.on_attempt_failed;
-  PoolEvaluator evaluator(spec, folder, pool->get(), evaluator_options);
+  evaluator_options.drain_grace_s = options.drain_grace_s;
+  return evaluator_options;
+}
+
+// The signal that stopped a session early: an interrupt, else a drain.
+int StopSignal() {
+  const int interrupt = pool::InterruptRequested();
+  return interrupt != 0 ? interrupt : pool::DrainRequested();
+}
+
+void CountSources(CampaignSummary* summary) {
+  for (const EvaluationRow& row : summary->exploration.evaluations) {
+    if (row.status != "complete") ++summary->failed;
+    if (row.source == "simulated") {
+      ++summary->simulated;
+    } else {
+      ++summary->reused;
+    }
+  }
+}
+
+}  // namespace
+
+Result<CampaignSummary> RunCampaign(const spec::Spec& input,
+                                    const CampaignOptions& options) {
+  const auto started = Clock::now();
+  Result<spec::Spec> overridden = Overridden(input, options);
+  if (!overridden.ok()) return overridden.status();
+  const spec::Spec& spec = *overridden;
+  ADSE_RETURN_IF_ERROR(CheckStrategyName(spec.exploration.strategy));
+  if (!options.make_pool) {
+    Result<pool::Isolation> isolation =
+        pool::ParseIsolation(spec.harness.isolation);
+    if (!isolation.ok()) return isolation.status();
+  }
+
+  CampaignSummary summary;
+  summary.output_dir =
+      options.output_dir.empty() ? spec.ResolvedOutput() : options.output_dir;
+  summary.strategy = spec.exploration.strategy;
+  const CampaignFolder folder(summary.output_dir);
+  ADSE_RETURN_IF_ERROR(folder.Create());
+  Result<CampaignLock> lock = CampaignLock::Acquire(folder.root());
+  if (!lock.ok()) return lock.status();
+  // Created under the lock: the llm strategy records into the folder.
+  Result<std::unique_ptr<explore::Strategy>> strategy =
+      CreateCampaignStrategy(spec, folder.root(), /*record=*/true);
+  if (!strategy.ok()) return strategy.status();
+
+  Result<std::unique_ptr<pool::WorkerPool>> pool =
+      MakePool(spec, options, &summary);
+  if (!pool.ok()) return pool.status();
+  std::optional<RunCache> cache;
+  ADSE_RETURN_IF_ERROR(OpenCache(spec, options, &cache));
+  PoolEvaluator evaluator(spec, folder, pool->get(),
+                          EvaluatorOptions(spec, options, cache));
 
   ViewRefresher refresher(spec, &summary, options.listener);
   ExplorationResult result = Explore(spec, **strategy, evaluator, &refresher);
   if (result.interrupted) {
-    summary.interrupted_by = pool::InterruptRequested();
+    summary.interrupted_by = StopSignal();
     for (EvaluationRow& row : evaluator.Cancel()) {
       result.evaluations.push_back(std::move(row));
     }
@@ -157,16 +222,17 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
               [](const EvaluationRow& a, const EvaluationRow& b) {
                 return a.index < b.index;
               });
-  }
-  summary.exploration = std::move(result);
-  for (const EvaluationRow& row : summary.exploration.evaluations) {
-    if (row.status != "complete") ++summary.failed;
-    if (row.source == "simulated") {
-      ++summary.simulated;
-    } else {
-      ++summary.reused;
+    // A drain that came after the last proposal stopped nothing.
+    const uint64_t planned = std::min<uint64_t>(
+        static_cast<uint64_t>(std::max(0, spec.exploration.budget)),
+        spec.design_space.Size());
+    if (pool::InterruptRequested() == 0 &&
+        result.evaluations.size() >= planned) {
+      summary.interrupted_by = 0;
     }
   }
+  summary.exploration = std::move(result);
+  CountSources(&summary);
   summary.pareto_front = ParetoFrontOf(spec, summary.exploration.evaluations);
   summary.wall_s =
       std::chrono::duration<double>(Clock::now() - started).count();
@@ -177,6 +243,71 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
         summary.exploration.evaluations.size(), summary.output_dir));
   }
   return summary;
+}
+
+Result<CampaignSummary> EvaluatePoints(const spec::Spec& input,
+                                       const std::vector<EvalRequest>& points,
+                                       const CampaignOptions& options) {
+  const auto started = Clock::now();
+  Result<spec::Spec> overridden = Overridden(input, options);
+  if (!overridden.ok()) return overridden.status();
+  const spec::Spec& spec = *overridden;
+
+  CampaignSummary summary;
+  summary.output_dir =
+      options.output_dir.empty() ? spec.ResolvedOutput() : options.output_dir;
+  summary.strategy = spec.exploration.strategy;
+  const CampaignFolder folder(summary.output_dir);
+  ADSE_RETURN_IF_ERROR(folder.Create());
+  Result<std::unique_ptr<pool::WorkerPool>> pool =
+      MakePool(spec, options, &summary);
+  if (!pool.ok()) return pool.status();
+  std::optional<RunCache> cache;
+  ADSE_RETURN_IF_ERROR(OpenCache(spec, options, &cache));
+  PoolEvaluator evaluator(spec, folder, pool->get(),
+                          EvaluatorOptions(spec, options, cache));
+
+  std::vector<EvaluationRow>& rows = summary.exploration.evaluations;
+  auto take = [&](std::vector<EvaluationRow> done) {
+    for (EvaluationRow& row : done) {
+      if (options.listener != nullptr) options.listener->OnEvaluated(row);
+      rows.push_back(std::move(row));
+    }
+  };
+  // Start them all: the evaluator queues what the pool cannot take yet.
+  for (const EvalRequest& request : points) {
+    if (evaluator.interrupted()) break;
+    evaluator.Start(request);
+  }
+  while (evaluator.outstanding() > 0) {
+    std::vector<EvaluationRow> done = evaluator.Wait();
+    if (done.empty() && evaluator.interrupted()) break;
+    take(std::move(done));
+  }
+  if (evaluator.interrupted()) {
+    take(evaluator.Cancel());
+    if (rows.size() < points.size()) summary.interrupted_by = StopSignal();
+  }
+  std::sort(rows.begin(), rows.end(),
+            [](const EvaluationRow& a, const EvaluationRow& b) {
+              return a.index < b.index;
+            });
+  CountSources(&summary);
+  summary.wall_s =
+      std::chrono::duration<double>(Clock::now() - started).count();
+  return summary;
+}
+
+std::optional<EvaluationRow> RecordedRow(const spec::Spec& spec,
+                                         const std::string& folder,
+                                         const EvalRequest& request,
+                                         bool retry_failed) {
+  const CampaignFolder campaign_folder(folder);
+  PoolEvaluatorOptions options;
+  options.retry_failed = retry_failed;
+  // No pool: Recorded only looks at the folder.
+  PoolEvaluator evaluator(spec, campaign_folder, nullptr, options);
+  return evaluator.Recorded(request);
 }
 
 }  // namespace adse::campaign

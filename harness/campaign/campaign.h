@@ -8,6 +8,8 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +51,16 @@ struct CampaignOptions {
   std::function<void(int workers, const std::string& isolation,
                      const std::string& fallback)>
       on_pool_ready;
+  // Makes the pool runs go to, from the spec with the overrides above
+  // applied; empty: the local pool (harness.workers, isolation). adse run
+  // --executor slurm passes harness/slurm's job-step pool.
+  std::function<Result<std::unique_ptr<pool::WorkerPool>>(const spec::Spec&)>
+      make_pool;
+  // A signal (e.g. SIGUSR1) asking for a graceful stop: propose nothing
+  // more, let running runs finish for up to drain_grace_s, then stop as
+  // after Ctrl-C. 0: none.
+  int drain_signal = 0;
+  double drain_grace_s = 0.0;
 };
 
 struct CampaignSummary {
@@ -63,6 +75,9 @@ struct CampaignSummary {
   double wall_s = 0.0;
   // The signal that stopped the campaign early, or 0.
   int interrupted_by = 0;
+  // Points planned but without a result (a static sweep whose array tasks
+  // have not all finished); 0 for a campaign run by adse run.
+  int unfinished = 0;
 };
 
 // Runs (or resumes) the campaign of `spec`. Errors: InvalidArgument for
@@ -71,6 +86,23 @@ struct CampaignSummary {
 // written. Failed runs do not make it fail: they are in the summary.
 Result<CampaignSummary> RunCampaign(const spec::Spec& spec,
                                     const CampaignOptions& options);
+
+// Evaluates a fixed list of points (each request's index and iteration are
+// kept) like a campaign does — from the folder, the shared cache, or the
+// pool, with retries and failure records — but without a strategy, lock or
+// views: a shard of a static sweep, where array tasks share the folder.
+// Rows come back by index; points an interrupt or drain left unevaluated
+// have none (summary.interrupted_by says why).
+Result<CampaignSummary> EvaluatePoints(const spec::Spec& spec,
+                                       const std::vector<EvalRequest>& points,
+                                       const CampaignOptions& options);
+
+// The row of a point whose run (or failure record, unless retry_failed) is
+// already in `folder`, found by content key; nullopt when there is none.
+std::optional<EvaluationRow> RecordedRow(const spec::Spec& spec,
+                                         const std::string& folder,
+                                         const EvalRequest& request,
+                                         bool retry_failed = false);
 
 // Rebuilds campaign.h5, report.md, summary.json and pareto.png from an
 // exploration's rows (also done by RunCampaign as it goes).

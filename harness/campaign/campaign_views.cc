@@ -1,6 +1,7 @@
 // The campaign folder's views, all rebuilt from the evaluation rows:
 // campaign.h5 (index), summary.json, report.md and pareto.png.
 #include <algorithm>
+#include <csignal>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -160,9 +161,18 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
   md << fmt::format("- wall time: {}\n", Duration(s.wall_s));
   if (s.interrupted_by != 0) {
     md << fmt::format(
-        "- **stopped early by signal {}**: run the same command again to "
-        "resume; finished runs are kept and not repeated\n",
-        s.interrupted_by);
+        "- **stopped early by signal {}{}**: run the same command again "
+        "(`adse run`, or `adse submit` on Slurm) to resume; finished runs "
+        "are kept and not repeated\n",
+        s.interrupted_by,
+        s.interrupted_by == SIGUSR1 ? " (Slurm's time-limit warning)" : "");
+  }
+  if (s.unfinished > 0) {
+    md << fmt::format(
+        "- **incomplete: {} planned point(s) have no result yet** (array "
+        "tasks unfinished or cancelled): `adse submit` again runs only "
+        "those\n",
+        s.unfinished);
   }
   std::vector<std::string> objectives;
   for (const spec::Objective& o : spec.objectives) {
@@ -310,7 +320,8 @@ Status WriteCampaignViews(const spec::Spec& spec,
   j["isolation_note"] = summary.isolation_note;
   j["wall_s"] = summary.wall_s;
   j["interrupted_by_signal"] = summary.interrupted_by;
-  j["complete"] = summary.interrupted_by == 0;
+  j["unfinished"] = summary.unfinished;
+  j["complete"] = summary.interrupted_by == 0 && summary.unfinished == 0;
   j["counts"] = {{"evaluations", rows.size()},
                  {"simulated", summary.simulated},
                  {"reused", summary.reused},

@@ -1,5 +1,6 @@
 #include "harness/campaign/pool_evaluator.h"
 
+#include <algorithm>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
@@ -66,7 +67,7 @@ int PoolEvaluator::outstanding() const {
 }
 
 bool PoolEvaluator::interrupted() const {
-  return pool::InterruptRequested() != 0;
+  return pool::InterruptRequested() != 0 || pool::DrainRequested() != 0;
 }
 
 std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
@@ -137,34 +138,42 @@ EvaluationRow PoolEvaluator::FailedRow(const Pending& p,
   return row;
 }
 
-void PoolEvaluator::Start(const EvalRequest& request) {
-  Pending p;
-  p.request = request;
-  p.seed = spec_.world.traffic.seed;
-  Result<std::string> key = sim::RunKey(spec_, request.point, p.seed);
+std::optional<EvaluationRow> PoolEvaluator::Prepare(const EvalRequest& request,
+                                                    Pending* p) {
+  p->request = request;
+  p->seed = spec_.world.traffic.seed;
+  Result<std::string> key = sim::RunKey(spec_, request.point, p->seed);
   if (!key.ok()) {
     // Only an unreadable input file makes this fail; no run can help.
     FailureRecord record;
     record.outcome = "input_error";
     record.detail = key.status().message();
-    ready_.push_back(FailedRow(p, record, "campaign"));
-    return;
+    return FailedRow(*p, record, "campaign");
   }
-  p.key = *key;
+  p->key = *key;
   std::error_code ec;
-  if (fs::exists(folder_.RunPath(p.key), ec)) {
-    if (auto row = LoadRun(p, "campaign")) {
-      ready_.push_back(*row);
-      return;
-    }
+  if (fs::exists(folder_.RunPath(p->key), ec)) {
+    if (auto row = LoadRun(*p, "campaign")) return row;
   }
-  if (!options_.retry_failed && fs::exists(folder_.FailurePath(p.key), ec)) {
+  if (!options_.retry_failed && fs::exists(folder_.FailurePath(p->key), ec)) {
     Result<FailureRecord> record =
-        ReadFailureRecord(folder_.FailurePath(p.key));
-    if (record.ok()) {
-      ready_.push_back(FailedRow(p, *record, "campaign"));
-      return;
-    }
+        ReadFailureRecord(folder_.FailurePath(p->key));
+    if (record.ok()) return FailedRow(*p, *record, "campaign");
+  }
+  return std::nullopt;
+}
+
+std::optional<EvaluationRow> PoolEvaluator::Recorded(
+    const EvalRequest& request) {
+  Pending p;
+  return Prepare(request, &p);
+}
+
+void PoolEvaluator::Start(const EvalRequest& request) {
+  Pending p;
+  if (std::optional<EvaluationRow> known = Prepare(request, &p)) {
+    ready_.push_back(*known);
+    return;
   }
   if (options_.cache != nullptr && options_.cache->Find(p.key)) {
     if (options_.cache->CopyOut(p.key, folder_.RunPath(p.key)).ok()) {
@@ -197,6 +206,8 @@ void PoolEvaluator::Dispatch() {
     }
     job.log_path = folder_.LogPath(p.key, p.attempt);
     job.timeout_s = options_.run_timeout_s;
+    // Enough of the key to find the run from the scheduler's queue.
+    job.name = "adse-" + p.key.substr(0, 16);
     if (Status s = pool_->Submit(job); !s.ok()) {
       pool::JobResult failed;
       failed.id = job.id;
@@ -216,6 +227,13 @@ void PoolEvaluator::Finish(const pool::JobResult& result) {
   Pending p = it->second;
   running_.erase(it);
   if (result.outcome == pool::Outcome::kCancelled) return;
+  // A run that fails while the campaign is being stopped may have failed
+  // because of the stop (its job step killed with the allocation): it is
+  // left unevaluated, to run again on resume, not retried or recorded.
+  if (result.outcome != pool::Outcome::kOk &&
+      pool::InterruptRequested() != 0) {
+    return;
+  }
   std::string detail;
   if (result.outcome == pool::Outcome::kOk) {
     if (auto row = LoadRun(p, "simulated")) {
@@ -266,8 +284,20 @@ void PoolEvaluator::Finish(const pool::JobResult& result) {
 }
 
 std::vector<EvaluationRow> PoolEvaluator::Wait() {
-  while (ready_.empty() && !interrupted() &&
-         !(queued_.empty() && running_.empty())) {
+  while (ready_.empty() && !(queued_.empty() && running_.empty())) {
+    if (pool::InterruptRequested() != 0) break;
+    if (pool::DrainRequested() != 0) {
+      // Start nothing more; what runs may finish within the grace period.
+      queued_.clear();
+      const auto now = std::chrono::steady_clock::now();
+      if (!drain_deadline_) {
+        drain_deadline_ =
+            now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                      std::chrono::duration<double>(
+                          std::max(0.0, options_.drain_grace_s)));
+      }
+      if (running_.empty() || now >= *drain_deadline_) break;
+    }
     for (const pool::JobResult& r : pool_->Wait(1.0)) Finish(r);
     Dispatch();
   }

@@ -5,6 +5,7 @@
 #ifndef ADSE_HARNESS_CAMPAIGN_POOL_EVALUATOR_H_
 #define ADSE_HARNESS_CAMPAIGN_POOL_EVALUATOR_H_
 
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -29,6 +30,9 @@ struct PoolEvaluatorOptions {
   int memory_mb = 4096;
   bool retry_failed = false;
   const RunCache* cache = nullptr;  // null: no shared cache
+  // After a drain request (pool::DrainRequested) running attempts may
+  // finish for this long; then they are cancelled like after an interrupt.
+  double drain_grace_s = 0.0;
   std::function<void(const EvalRequest&, int attempt, const std::string&)>
       on_attempt_failed;
 };
@@ -50,6 +54,10 @@ class PoolEvaluator : public Evaluator {
   // before the stop.
   std::vector<EvaluationRow> Cancel();
 
+  // The row of a point whose run or failure record is already in the
+  // folder (nothing is started; the pool may be null), else nullopt.
+  std::optional<EvaluationRow> Recorded(const EvalRequest& request);
+
  private:
   struct Pending {
     EvalRequest request;
@@ -58,6 +66,9 @@ class PoolEvaluator : public Evaluator {
     int attempt = 0;  // 1-based once started
   };
 
+  // Fills `p` for `request`; returns the row when the result is already
+  // known (in the folder, or the key cannot be computed).
+  std::optional<EvaluationRow> Prepare(const EvalRequest& request, Pending* p);
   // A row from an existing run file; nullopt when the file is unusable
   // (then it is moved aside and the point simulated again).
   std::optional<EvaluationRow> LoadRun(const Pending& p,
@@ -75,6 +86,8 @@ class PoolEvaluator : public Evaluator {
   std::map<uint64_t, Pending> running_;  // job id -> attempt
   uint64_t next_job_ = 1;
   std::vector<EvaluationRow> ready_;
+  // When a drain request stops waiting for running attempts.
+  std::optional<std::chrono::steady_clock::time_point> drain_deadline_;
 };
 
 }  // namespace adse::campaign

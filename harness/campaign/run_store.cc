@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 
@@ -65,7 +66,12 @@ Result<CampaignLock> CampaignLock::Acquire(const std::string& folder) {
   }
   char host[256] = {};
   ::gethostname(host, sizeof(host) - 1);
-  const std::string who = fmt::format("pid {} on {}\n", ::getpid(), host);
+  const char* job = std::getenv("SLURM_JOB_ID");
+  const std::string who =
+      fmt::format("pid {} on {}{}\n", ::getpid(), host,
+                  job != nullptr && *job != '\0'
+                      ? fmt::format(" (Slurm job {})", job)
+                      : std::string());
   if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, who.data(), who.size(), 0) !=
                                      static_cast<ssize_t>(who.size())) {
     // The holder text is informational; the lock itself is what counts.
@@ -130,8 +136,7 @@ Result<FailureRecord> ReadFailureRecord(const std::string& path) {
 Status CopyFileAtomic(const std::string& from, const std::string& to) {
   const fs::path target(to);
   ADSE_RETURN_IF_ERROR(MakeDirs(target.parent_path().string()));
-  const std::string temp =
-      fmt::format("{}.tmp.{}", to, static_cast<long>(::getpid()));
+  const std::string temp = TemporaryPathFor(to);
   std::error_code ec;
   fs::remove(temp, ec);
   fs::create_hard_link(from, temp, ec);

@@ -16,6 +16,15 @@ Status CheckStrategyName(const std::string& name) {
                                              name, fmt::join(explore::StrategyNames(), ", ")));
 }
 
+Result<bool> StrategyIsAdaptive(const spec::Spec& spec) {
+  const std::string& name = spec.exploration.strategy;
+  ADSE_RETURN_IF_ERROR(CheckStrategyName(name));
+  if (name == "llm") return true;
+  Result<std::unique_ptr<explore::Strategy>> strategy = explore::CreateStrategy(name, {&spec});
+  if (!strategy.ok()) return strategy.status();
+  return (*strategy)->adaptive();
+}
+
 Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(const spec::Spec& spec,
                                                                   const std::string& folder,
                                                                   bool record) {

@@ -82,6 +82,7 @@ struct RunArgs {
   bool retry_failed = false;
   bool quiet = false;
   bool json = false;
+  std::string executor;    // overrides harness.executor: local | slurm
 };
 int RunRun(const RunArgs& args);
 
@@ -110,6 +111,39 @@ struct InterpretArgs {
   bool check_world = true;  // validate the map, start and goal in SUMO
 };
 int RunInterpret(const InterpretArgs& args);
+
+struct SubmitArgs {
+  std::string scenario;
+  std::string out;                       // campaign folder
+  std::string strategy;                  // overrides exploration.strategy
+  int budget = -1;                       // overrides exploration.budget
+  bool dry_run = false;                  // print the scripts only
+  std::vector<std::string> sbatch_args;  // more #SBATCH options
+  bool no_cache = false;
+  std::string cache_dir;
+  bool json = false;
+};
+int RunSubmit(const SubmitArgs& args);
+
+struct StatusArgs {
+  std::string campaign;  // campaign folder
+  bool json = false;
+};
+int RunStatus(const StatusArgs& args);
+
+struct ShardArgs {
+  std::string campaign;  // campaign folder with slurm/plan.json
+  int task = -1;         // -1: SLURM_ARRAY_TASK_ID
+  bool local = false;    // local worker processes instead of job steps
+  bool quiet = false;
+};
+int RunShard(const ShardArgs& args);
+
+struct IndexArgs {
+  std::string campaign;  // campaign folder with slurm/plan.json
+  bool json = false;
+};
+int RunIndex(const IndexArgs& args);
 
 }  // namespace adse::cli
 

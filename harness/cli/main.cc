@@ -113,6 +113,10 @@ int main(int argc, char** argv) {
                     "Run again points whose runs failed for good in an earlier session");
   run_cmd->add_flag("-q,--quiet", run.quiet, "Only failures and errors on stderr");
   run_cmd->add_flag("--json", run.json, "Print summary.json on stdout at the end");
+  run_cmd->add_option("--executor", run.executor,
+                      "Override harness.executor: local (worker processes here) or slurm "
+                      "(each run a job step, srun, inside the current Slurm allocation)")
+      ->check(CLI::IsMember({"local", "slurm"}));
 
   adse::cli::WorkerArgs worker;
   uint64_t worker_seed = 0;
@@ -183,6 +187,59 @@ int main(int argc, char** argv) {
   interpret_cmd->add_flag("!--no-world", interpret.check_world,
                           "Do not load the map in SUMO when validating");
 
+  adse::cli::SubmitArgs submit;
+  CLI::App* submit_cmd = app.add_subcommand(
+      "submit", "Hand the campaign to Slurm (from a login node): adaptive strategies as one "
+                "batch job running the coordinator, whose runs are job steps; static sweeps "
+                "(exhaustive, random) as a job array of shards plus an index job after it. "
+                "The scripts go to <campaign>/slurm/. Submit again to continue after a cancel "
+                "or time limit: finished runs are not repeated.");
+  submit_cmd->add_option("scenario", submit.scenario, "Scenario YAML file")->required();
+  submit_cmd->add_option("-o,--out", submit.out,
+                         "Campaign folder on a shared filesystem (default: the scenario's "
+                         "output)");
+  submit_cmd->add_option("--strategy", submit.strategy, "Override exploration.strategy");
+  submit_cmd->add_option("--budget", submit.budget, "Override exploration.budget")
+      ->check(CLI::NonNegativeNumber);
+  submit_cmd->add_flag("--dry-run", submit.dry_run,
+                       "Print the sbatch scripts; write and submit nothing");
+  submit_cmd->add_option("--sbatch-arg", submit.sbatch_args,
+                         "Another sbatch option for every script, e.g. --sbatch-arg=--qos=long "
+                         "(repeatable; after adse's own #SBATCH lines, so it wins)")
+      ->allow_extra_args(false);
+  submit_cmd->add_flag("--no-cache", submit.no_cache,
+                       "The jobs neither read nor fill the shared evaluation cache");
+  submit_cmd->add_option("--cache-dir", submit.cache_dir, "Override harness.cache_dir");
+  submit_cmd->add_flag("--json", submit.json, "Print what was submitted as JSON");
+
+  adse::cli::StatusArgs status;
+  CLI::App* status_cmd = app.add_subcommand(
+      "status", "Show a campaign's runs (done, failed, running, pending) and the Slurm jobs "
+                "submitted for it with their states");
+  status_cmd->add_option("campaign", status.campaign, "Campaign folder")->required();
+  status_cmd->add_flag("--json", status.json, "Print the status as JSON");
+
+  adse::cli::ShardArgs shard;
+  CLI::App* shard_cmd = app.add_subcommand(
+      "shard", "Run one shard of a submitted sweep (what each job-array task runs): its "
+               "points without a result, as job steps in this allocation");
+  shard_cmd->add_option("campaign", shard.campaign, "Campaign folder (with slurm/plan.json)")
+      ->required();
+  shard_cmd->add_option("--task", shard.task, "Shard number (default: $SLURM_ARRAY_TASK_ID)")
+      ->check(CLI::NonNegativeNumber);
+  shard_cmd->add_flag("--local", shard.local,
+                      "Run the points in local worker processes instead of job steps");
+  shard_cmd->add_flag("-q,--quiet", shard.quiet, "Only failures and errors on stderr");
+
+  adse::cli::IndexArgs index;
+  CLI::App* index_cmd = app.add_subcommand(
+      "index", "Build a submitted sweep's campaign.h5, report.md, summary.json and "
+               "pareto.png from its run files (the job adse submit queues after the array); "
+               "exit 1 while points lack a result");
+  index_cmd->add_option("campaign", index.campaign, "Campaign folder (with slurm/plan.json)")
+      ->required();
+  index_cmd->add_flag("--json", index.json, "Print summary.json on stdout");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -194,6 +251,10 @@ int main(int argc, char** argv) {
   if (simulate_seed_opt->count() > 0) simulate.seed = simulate_seed;
   if (worker_seed_opt->count() > 0) worker.seed = worker_seed;
   if (*run_cmd) return adse::cli::RunRun(run);
+  if (*submit_cmd) return adse::cli::RunSubmit(submit);
+  if (*status_cmd) return adse::cli::RunStatus(status);
+  if (*shard_cmd) return adse::cli::RunShard(shard);
+  if (*index_cmd) return adse::cli::RunIndex(index);
   if (*worker_cmd) return adse::cli::RunWorker(worker);
   if (*explore_cmd) return adse::cli::RunExplore(explore);
   if (*interpret_cmd) return adse::cli::RunInterpret(interpret);

@@ -4,7 +4,9 @@
 // stopped by Ctrl-C / SIGTERM (run the same command again to resume).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -13,6 +15,8 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/campaign/campaign.h"
+#include "harness/slurm/allocation.h"
+#include "harness/slurm/step_pool.h"
 #include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
 #include "harness/spec/spec_parser.h"
@@ -145,7 +149,34 @@ class Progress : public campaign::ExplorerListener {
 int RunRun(const RunArgs& args) {
   std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
   if (!spec) return 2;
+  if (!args.executor.empty()) spec->harness.executor = args.executor;
   campaign::CampaignOptions options;
+  if (spec->harness.executor == "slurm") {
+    // Checked before the campaign folder is touched.
+    Result<std::optional<slurm::Allocation>> allocation =
+        slurm::CurrentAllocation();
+    if (!allocation.ok() || !allocation->has_value()) {
+      std::fprintf(
+          stderr, "error: %s\n",
+          allocation.ok()
+              ? (std::string(args.executor.empty()
+                                 ? spec->Where("harness.executor") +
+                                       "harness.executor: 'slurm'"
+                                 : "--executor slurm") +
+                 " runs each design point as a Slurm job step (srun) and "
+                 "needs an allocation, but SLURM_JOB_ID is not set: submit "
+                 "the campaign with `adse submit` from a login node, run "
+                 "adse run inside salloc or sbatch, or use --executor local")
+                    .c_str()
+              : allocation.status().message().c_str());
+      return 2;
+    }
+    options.make_pool = slurm::CreateAllocationPool;
+    // Slurm's warning before the time limit (sbatch --signal=B:USR1@<s>).
+    options.drain_signal = SIGUSR1;
+    options.drain_grace_s =
+        std::max(0, spec->harness.slurm.signal_lead_s - 30);
+  }
   options.output_dir = args.out;
   options.strategy = args.strategy;
   options.budget = args.budget;

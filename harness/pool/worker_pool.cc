@@ -58,6 +58,17 @@ void OnInterrupt(int sig) {
   errno = saved_errno;
 }
 
+std::atomic<int> g_drain{0};
+
+void OnDrain(int sig) {
+  const int saved_errno = errno;
+  g_drain.store(sig);
+  if (g_wake_fds[1] >= 0) {
+    [[maybe_unused]] const ssize_t n = ::write(g_wake_fds[1], "!", 1);
+  }
+  errno = saved_errno;
+}
+
 void ArmHandlers() {
   struct sigaction action {};
   action.sa_handler = OnInterrupt;
@@ -616,5 +627,29 @@ void ClearInterrupt() {
   DrainWakePipe();
   if (g_handlers_installed.load()) ArmHandlers();
 }
+
+void RequestInterrupt(int sig) {
+  int expected = 0;
+  g_interrupt.compare_exchange_strong(expected, sig);
+  if (g_wake_fds[1] >= 0) {
+    [[maybe_unused]] const ssize_t n = ::write(g_wake_fds[1], "!", 1);
+  }
+}
+
+void InstallDrainHandler(int sig) {
+  std::lock_guard<std::mutex> lock(g_install_mutex);
+  if (g_wake_fds[0] < 0 && ::pipe2(g_wake_fds, O_CLOEXEC | O_NONBLOCK) != 0) {
+    g_wake_fds[0] = g_wake_fds[1] = -1;  // Wait then notices by polling
+  }
+  struct sigaction action {};
+  action.sa_handler = OnDrain;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESTART;
+  ::sigaction(sig, &action, nullptr);
+}
+
+int DrainRequested() { return g_drain.load(); }
+
+void ClearDrain() { g_drain.store(0); }
 
 }  // namespace adse::pool

@@ -63,6 +63,9 @@ struct Job {
   // must exist). stdin is /dev/null.
   std::string log_path;
   double timeout_s = 0.0;  // 0: no limit
+  // What a scheduler shows for the job (srun --job-name); "" lets the pool
+  // choose. The local pool does not use it.
+  std::string name;
 };
 
 enum class Outcome {
@@ -132,6 +135,20 @@ void InstallInterruptHandlers();
 int InterruptRequested();
 // For tests: forget a recorded interrupt (and re-arm the handlers).
 void ClearInterrupt();
+// Records an interrupt as if `sig` had arrived and wakes any Wait: for a
+// pool that learns that the place its jobs run is going away (a Slurm
+// allocation being cancelled) before the signal reaches the coordinator.
+void RequestInterrupt(int sig);
+
+// Installs a handler for `sig` that asks for a graceful stop rather than an
+// interrupt: propose no more work, let running jobs finish (Slurm's warning
+// before a time limit, `sbatch --signal=B:USR1@<s>`). Idempotent; unlike
+// the interrupt handlers it stays armed.
+void InstallDrainHandler(int sig);
+// The drain signal received, or 0.
+int DrainRequested();
+// For tests: forget a recorded drain request.
+void ClearDrain();
 
 }  // namespace adse::pool
 

@@ -111,6 +111,11 @@ struct SlurmOptions {
   int max_parallel = 0;    // array throttle; 0: no limit
   int shard_size = 0;      // points per array task; 0: automatic
   std::vector<std::string> extra_args;
+  // Seconds before the time limit at which Slurm warns adse
+  // (--signal=B:USR1@<s>); running steps get this minus 30 s to finish.
+  int signal_lead_s = 300;
+  // Expected seconds per run, for the automatic shard size.
+  double run_estimate_s = 60.0;
 };
 
 struct HarnessOptions {

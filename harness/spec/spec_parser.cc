@@ -63,7 +63,8 @@ const std::vector<std::string> kHarnessKeys = {
     "replicas", "isolation",        "executor",  "cache_dir",     "slurm"};
 const std::vector<std::string> kSlurmKeys = {
     "partition",  "account",      "nodes",      "cpus",
-    "time_limit", "max_parallel", "shard_size", "extra_args"};
+    "time_limit", "max_parallel", "shard_size", "extra_args",
+    "signal_lead_s", "run_estimate_s"};
 
 const std::vector<std::string> kWeathers = {"clear", "rain", "fog"};
 const std::vector<std::string> kTaskKinds = {"lane_driving", "valet_parking"};
@@ -1499,12 +1500,30 @@ void SpecReader::ReadSlurm(const Val& v) {
   if (const Val* e = f.Get("shard_size")) {
     ReadInt(*e, &s.shard_size, Bounds::Closed(0, 1e9));
   }
+  if (const Val* e = f.Get("signal_lead_s")) {
+    ReadInt(*e, &s.signal_lead_s, Bounds::Closed(0, 65535));
+  }
+  if (const Val* e = f.Get("run_estimate_s")) {
+    ReadNumber(*e, &s.run_estimate_s, Bounds::Positive());
+  }
   if (const Val* e = f.Get("extra_args")) {
     std::vector<Val> items;
     if (ReadList(*e, &items, "a list of sbatch arguments")) {
       for (const Val& item : items) {
         std::string arg;
-        if (ReadString(item, &arg, "an sbatch argument, e.g. --qos=long")) {
+        const std::string expected = "an sbatch option, e.g. --qos=long";
+        if (!ReadString(item, &arg, expected)) continue;
+        // adse sets these itself; one given here would fight it.
+        const std::string name = arg.substr(0, arg.find('='));
+        if (arg.size() < 2 || arg[0] != '-' ||
+            arg.find_first_of("\n\r") != std::string::npos) {
+          Error(item, expected + " (one line, starting with '-')");
+        } else if (name == "--array" || name == "-a" ||
+                   name == "--dependency" || name == "-d" ||
+                   name == "--wrap" || name == "--parsable") {
+          Error(item, expected + "; " + name +
+                          " is set by adse submit itself");
+        } else {
           s.extra_args.push_back(arg);
         }
       }
@@ -1916,6 +1935,9 @@ std::string NormalizedYaml(const Spec& spec) {
       << s.time_limit;
   out << YAML::Key << "max_parallel" << YAML::Value << s.max_parallel;
   out << YAML::Key << "shard_size" << YAML::Value << s.shard_size;
+  out << YAML::Key << "signal_lead_s" << YAML::Value << s.signal_lead_s;
+  out << YAML::Key << "run_estimate_s" << YAML::Value;
+  EmitNumber(out, s.run_estimate_s);
   out << YAML::Key << "extra_args" << YAML::Value << YAML::Flow
       << YAML::BeginSeq;
   for (const std::string& arg : s.extra_args) {

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -65,8 +66,7 @@ Status WriteFileAtomic(const std::string& path, const std::string& data) {
   if (target.has_parent_path()) {
     ADSE_RETURN_IF_ERROR(MakeDirs(target.parent_path().string()));
   }
-  const std::string tmp =
-      path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
+  const std::string tmp = TemporaryPathFor(path);
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (fd < 0) return Status::IoError(tmp + ": " + std::strerror(errno));
   if (Status s = WriteAllAndClose(fd, data, tmp); !s.ok()) {
@@ -104,6 +104,21 @@ Status MakeDirs(const std::string& path) {
   fs::create_directories(path, ec);
   if (ec) return Status::IoError(path + ": cannot create folder: " + ec.message());
   return Status::Ok();
+}
+
+std::string TemporaryPathFor(const std::string& path) {
+  char host[256] = {};
+  if (::gethostname(host, sizeof(host) - 1) != 0 || host[0] == '\0') {
+    std::snprintf(host, sizeof(host), "host");
+  }
+  // A hostname is a file-name-safe label; keep only its first part.
+  std::string name(host);
+  name = name.substr(0, name.find('.'));
+  for (char& c : name) {
+    if (c == '/') c = '_';
+  }
+  return path + ".tmp." + name + "." +
+         std::to_string(static_cast<long>(::getpid()));
 }
 
 }  // namespace adse

@@ -29,6 +29,11 @@ std::string DefaultCacheDir();
 // Creates `path` and its parents. Ok when it exists already.
 Status MakeDirs(const std::string& path);
 
+// The temporary name a file is written under before it is renamed to
+// `path`: "<path>.tmp.<host>.<pid>", unique among the writers that share a
+// folder on a network filesystem (pids repeat across hosts).
+std::string TemporaryPathFor(const std::string& path);
+
 }  // namespace adse
 
 #endif  // ADSE_STACK_BASE_FILES_H_

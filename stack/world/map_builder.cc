@@ -257,8 +257,9 @@ Result<MapArtifacts> PrepareMap(const MapOptions& options,
   // Build in a private folder and rename it into place: concurrent builders
   // of the same map race harmlessly and nobody sees a half-built map.
   ADSE_RETURN_IF_ERROR(MakeDirs(cache_dir + "/maps"));
-  const std::string tmp =
-      out.cache_folder + ".tmp." + std::to_string(static_cast<long>(::getpid()));
+  // Host and pid: builders on different nodes may share the cache (a
+  // home folder on NFS) and pids repeat across hosts.
+  const std::string tmp = TemporaryPathFor(out.cache_folder);
   fs::remove_all(tmp, ec);
   ADSE_RETURN_IF_ERROR(MakeDirs(tmp));
   Status status = Generate(options, tmp);
@@ -267,8 +268,12 @@ Result<MapArtifacts> PrepareMap(const MapOptions& options,
     fs::remove_all(tmp, ec);
     return status.WithContext("generating map '" + options.generator + "'");
   }
-  // A folder without DONE is the leftover of a crashed build.
-  if (fs::exists(out.cache_folder, ec)) fs::remove_all(out.cache_folder, ec);
+  // A folder without DONE is the leftover of a crashed build; one with DONE
+  // was finished meanwhile by another builder and may be in use: keep it.
+  if (fs::exists(out.cache_folder, ec) &&
+      !fs::exists(out.cache_folder + "/DONE", ec)) {
+    fs::remove_all(out.cache_folder, ec);
+  }
   fs::rename(tmp, out.cache_folder, ec);
   if (ec) {
     // Another process finished first; its copy is as good as ours.

@@ -344,6 +344,21 @@ TEST(SpecErrorsTest, SlurmTimeLimit) {
               "harness.slurm.time_limit", 10, "a Slurm time limit");
 }
 
+TEST(SpecErrorsTest, SlurmExtraArgsAndSignalLead) {
+  ExpectError(std::string(kHead) + "harness:\n  slurm: {extra_args: [qos]}\n",
+              "harness.slurm.extra_args[0]", 10, "starting with '-'");
+  ExpectError(
+      std::string(kHead) + "harness:\n  slurm: {extra_args: [--array=1-9]}\n",
+      "harness.slurm.extra_args[0]", 10,
+      "--array is set by adse submit itself");
+  ExpectError(
+      std::string(kHead) + "harness:\n  slurm: {signal_lead_s: 70000}\n",
+      "harness.slurm.signal_lead_s", 10);
+  ExpectError(
+      std::string(kHead) + "harness:\n  slurm: {run_estimate_s: 0}\n",
+      "harness.slurm.run_estimate_s", 10);
+}
+
 TEST(SpecErrorsTest, AllErrorsAreCollectedInFileOrder) {
   const std::string message = ErrorOf(std::string(kHead) +
                                       "harness: {memory_mb: 0}\n"

@@ -300,7 +300,7 @@ cost: "2 * cores + hz / 10"
 constraints: ["collisions == 0", "nav_time_s <= 400 && completed"]
 exploration: {strategy: ga, seed: 18446744073709551615, population: 12}
 llm: {backend: openai, endpoint: "https://api.example.com/v1", models: {dse: "gpt: 4o"}}
-harness: {workers: 3, executor: slurm, slurm: {partition: gpu, time_limit: "1-00:30", extra_args: ["--qos=long", "#x"]}}
+harness: {workers: 3, executor: slurm, slurm: {partition: gpu, time_limit: "1-00:30", extra_args: ["--qos=long", "--comment=#x #y"]}}
 output: /tmp/adse out/x
 )";
   Result<Spec> first = ParseSpec(text, "edge.yaml", dir);
@@ -322,7 +322,7 @@ output: /tmp/adse out/x
   EXPECT_EQ(again->llm.models.at("dse"), "gpt: 4o");
   EXPECT_EQ(again->harness.workers, 3);
   EXPECT_EQ(again->harness.slurm.extra_args,
-            (std::vector<std::string>{"--qos=long", "#x"}));
+            (std::vector<std::string>{"--qos=long", "--comment=#x #y"}));
   EXPECT_EQ(again->output, "/tmp/adse out/x");
   EXPECT_EQ(again->constraints[1], "nav_time_s <= 400 && completed");
   fs::remove_all(dir);

@@ -1,0 +1,285 @@
+#include "harness/slurm/status.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "harness/campaign/run_store.h"
+#include "stack/base/files.h"
+
+namespace adse::slurm {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+bool IsKey(const std::string& s) {
+  return s.size() == 64 &&
+         s.find_first_not_of("0123456789abcdef") == std::string::npos;
+}
+
+// Content keys of the complete runs and of the failure records in runs/.
+void ScanRuns(const std::string& folder, std::set<std::string>* runs,
+              std::set<std::string>* failures) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(folder + "/runs", ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() == 64 + 3 && name.compare(64, 3, ".h5") == 0 &&
+        IsKey(name.substr(0, 64))) {
+      runs->insert(name.substr(0, 64));
+    } else if (name.size() == 64 + 12 &&
+               name.compare(64, 12, ".failed.json") == 0 &&
+               IsKey(name.substr(0, 64))) {
+      failures->insert(name.substr(0, 64));
+    }
+  }
+}
+
+std::string Summarise(const std::vector<JobState>& tasks) {
+  std::map<std::string, int> counts;
+  for (const JobState& t : tasks) ++counts[t.state];
+  if (tasks.size() == 1) {
+    const JobState& t = tasks[0];
+    std::string text = t.state;
+    if (!t.reason.empty() && t.reason != "None" && t.state == "PENDING") {
+      text += " (" + t.reason + ")";
+    }
+    if (!t.exit_code.empty()) text += ", exit " + t.exit_code;
+    return text;
+  }
+  std::vector<std::string> parts;
+  for (const auto& [state, n] : counts) {
+    parts.push_back(fmt::format("{} {}", n, state));
+  }
+  return fmt::format("{} tasks: {}", tasks.size(), fmt::join(parts, ", "));
+}
+
+}  // namespace
+
+Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
+  std::error_code ec;
+  const std::string folder =
+      fs::absolute(folder_in, ec).lexically_normal().string();
+  CampaignStatus st;
+  st.folder = folder;
+  if (!fs::is_directory(folder + "/runs", ec) &&
+      !fs::is_directory(SlurmDir(folder), ec)) {
+    return Status::NotFound(fmt::format(
+        "{}: not a campaign folder (no runs/ or slurm/ in it)", folder_in));
+  }
+  std::set<std::string> runs, failures;
+  ScanRuns(folder, &runs, &failures);
+
+  Result<JobLog> log = ReadJobLog(folder);
+  if (!log.ok()) return log.status();
+  Result<SweepPlan> plan = ReadSweepPlan(folder);
+  if (!plan.ok() && plan.status().code() != Status::Code::kNotFound) {
+    return plan.status();
+  }
+  st.scenario = log->scenario;
+  st.strategy = log->strategy;
+  st.total = log->budget;
+  st.kind = log->jobs.empty() ? "local" : "coordinator";
+  if (plan.ok()) {
+    st.kind = "sweep";
+    st.scenario = plan->scenario;
+    st.strategy = plan->strategy;
+    st.total = static_cast<int>(plan->points.size());
+  }
+  Result<std::string> summary_text = ReadFile(folder + "/summary.json");
+  if (summary_text.ok()) {
+    const json j = json::parse(*summary_text, nullptr, false);
+    if (j.is_object()) {
+      st.has_views = true;
+      st.views_complete = j.value("complete", false);
+      if (st.strategy.empty()) st.strategy = j.value("strategy", "");
+      if (st.scenario.empty()) st.scenario = j.value("scenario_file", "");
+      if (st.total == 0) st.total = j.value("budget", 0);
+    }
+  }
+  Result<std::string> holder = ReadFile(folder + "/.lock", 4096);
+  if (holder.ok()) {
+    st.lock_holder = *holder;
+    while (!st.lock_holder.empty() && st.lock_holder.back() == '\n') {
+      st.lock_holder.pop_back();
+    }
+  }
+
+  // Jobs and their steps, from Slurm.
+  std::vector<std::string> ids;
+  for (const SubmittedJob& job : log->jobs) ids.push_back(job.job_id);
+  std::vector<StepState> steps;
+  if (!ids.empty()) {
+    Result<std::vector<JobState>> states = QueryJobs(ids);
+    if (!states.ok()) {
+      st.notes.push_back("job states unknown: " + states.status().message());
+    }
+    for (const SubmittedJob& job : log->jobs) {
+      JobStatus js;
+      js.job = job;
+      if (states.ok()) {
+        for (const JobState& s : *states) {
+          if (s.id == job.job_id || s.id.rfind(job.job_id + "_", 0) == 0) {
+            js.tasks.push_back(s);
+            js.active = js.active || IsActiveState(s.state);
+          }
+        }
+      }
+      js.summary = !states.ok()       ? "unknown"
+                   : js.tasks.empty() ? "not known to Slurm any more "
+                                        "(finished; no accounting to say "
+                                        "how)"
+                                      : Summarise(js.tasks);
+      st.jobs.push_back(js);
+    }
+    Result<std::vector<StepState>> found = QuerySteps(ids);
+    if (found.ok()) {
+      steps = *found;
+    } else if (states.ok()) {
+      st.notes.push_back("running steps unknown: " + found.status().message());
+    }
+  }
+  std::map<std::string, std::string> point_of;  // key -> point text
+  if (plan.ok()) {
+    for (const PlannedPoint& p : plan->points) point_of[p.key] = p.point;
+  }
+  std::set<std::string> running_keys;
+  for (const StepState& step : steps) {
+    if (step.name.rfind("adse-", 0) != 0) continue;
+    RunningStep r{step.id, step.name.substr(5), "", step.elapsed, step.nodes};
+    for (const auto& [key, point] : point_of) {
+      if (!r.key.empty() && key.rfind(r.key, 0) == 0) {
+        r.point = point;
+        running_keys.insert(key);
+      }
+    }
+    st.running_steps.push_back(r);
+  }
+
+  if (plan.ok()) {
+    for (const PlannedPoint& p : plan->points) {
+      if (runs.count(p.key)) {
+        ++st.done;
+      } else if (failures.count(p.key)) {
+        ++st.failed;
+      } else if (running_keys.count(p.key)) {
+        ++st.running;
+      } else {
+        ++st.pending;
+      }
+    }
+  } else {
+    st.done = static_cast<int>(runs.size());
+    for (const std::string& key : failures) st.failed += runs.count(key) == 0;
+    st.running = static_cast<int>(st.running_steps.size());
+    st.pending = std::max(0, st.total - st.done - st.failed - st.running);
+  }
+  return st;
+}
+
+std::string FormatStatus(const CampaignStatus& st) {
+  std::string out;
+  const std::string what =
+      st.kind == "sweep" ? fmt::format(
+                               "a static sweep ({}) of {} points "
+                               "as a Slurm job array",
+                               st.strategy, st.total)
+      : st.kind == "coordinator"
+          ? fmt::format(
+                "strategy {} with a "
+                "coordinator on Slurm",
+                st.strategy)
+          : fmt::format("a local campaign{}",
+                        st.strategy.empty() ? "" : " (" + st.strategy + ")");
+  out += fmt::format("campaign: {}\n  {}\n", st.folder, what);
+  if (!st.scenario.empty()) out += fmt::format("  scenario: {}\n", st.scenario);
+  out += fmt::format("runs: {} done, {} failed, {} running, {} pending{}\n",
+                     st.done, st.failed, st.running, st.pending,
+                     st.total > 0 ? fmt::format(" (of {})", st.total) : "");
+  if (!st.running_steps.empty()) {
+    out += "running steps:\n";
+    for (const RunningStep& r : st.running_steps) {
+      out += fmt::format("  {:<12} {:<36} {} on {}\n", r.step_id,
+                         r.point.empty() ? "run " + r.key : r.point, r.elapsed,
+                         r.nodes);
+    }
+  }
+  if (!st.jobs.empty()) {
+    out += "Slurm jobs:\n";
+    for (const JobStatus& j : st.jobs) {
+      std::string shards;
+      if (!j.job.shards.empty()) {
+        shards = fmt::format(", {} shard(s)", j.job.shards.size());
+      }
+      out += fmt::format("  {} job {} ({}{}): {}\n", j.job.kind, j.job.job_id,
+                         j.job.script, shards, j.summary);
+    }
+  }
+  if (!st.lock_holder.empty()) {
+    out += fmt::format("campaign lock: {}\n", st.lock_holder);
+  }
+  if (st.has_views) {
+    out += fmt::format("views: {} (report.md, campaign.h5)\n",
+                       st.views_complete ? "complete" : "not complete yet");
+  } else {
+    out += "views: none yet\n";
+  }
+  for (const std::string& note : st.notes) out += "note: " + note + "\n";
+  return out;
+}
+
+std::string StatusJson(const CampaignStatus& st) {
+  json running = json::array();
+  for (const RunningStep& r : st.running_steps) {
+    running.push_back({{"step", r.step_id},
+                       {"key_prefix", r.key},
+                       {"point", r.point},
+                       {"elapsed", r.elapsed},
+                       {"nodes", r.nodes}});
+  }
+  json jobs = json::array();
+  for (const JobStatus& j : st.jobs) {
+    json tasks = json::array();
+    for (const JobState& t : j.tasks) {
+      tasks.push_back({{"id", t.id},
+                       {"job_id", t.job_id},
+                       {"state", t.state},
+                       {"reason", t.reason},
+                       {"elapsed", t.elapsed},
+                       {"exit_code", t.exit_code}});
+    }
+    jobs.push_back({{"submission", j.job.submission},
+                    {"time", j.job.time},
+                    {"kind", j.job.kind},
+                    {"job_id", j.job.job_id},
+                    {"script", j.job.script},
+                    {"shards", j.job.shards},
+                    {"state", j.summary},
+                    {"active", j.active},
+                    {"tasks", tasks}});
+  }
+  const json j = {
+      {"folder", st.folder},
+      {"scenario", st.scenario},
+      {"strategy", st.strategy},
+      {"kind", st.kind},
+      {"total", st.total},
+      {"counts",
+       {{"done", st.done},
+        {"failed", st.failed},
+        {"running", st.running},
+        {"pending", st.pending}}},
+      {"running", running},
+      {"jobs", jobs},
+      {"lock_holder", st.lock_holder},
+      {"views",
+       st.has_views ? (st.views_complete ? "complete" : "incomplete") : "none"},
+      {"notes", st.notes}};
+  return j.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
+}
+
+}  // namespace adse::slurm

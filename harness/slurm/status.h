@@ -1,0 +1,58 @@
+// `adse status <campaign>`: how far a campaign is — runs done, failed,
+// running and pending — and the Slurm jobs submitted for it with their
+// states, read from the campaign folder and from squeue (sacct where the
+// cluster keeps accounting). Works for local campaigns too (no jobs).
+#ifndef ADSE_HARNESS_SLURM_STATUS_H_
+#define ADSE_HARNESS_SLURM_STATUS_H_
+
+#include <string>
+#include <vector>
+
+#include "harness/slurm/client.h"
+#include "harness/slurm/records.h"
+#include "stack/base/status.h"
+
+namespace adse::slurm {
+
+struct RunningStep {
+  std::string step_id;  // "123.4", "123_2.0"
+  std::string key;      // content key prefix from the step's name
+  std::string point;    // when the plan names it
+  std::string elapsed;
+  std::string nodes;
+};
+
+struct JobStatus {
+  SubmittedJob job;
+  // One line: "RUNNING", "3 COMPLETED, 1 RUNNING", or "not known to
+  // Slurm any more (finished)".
+  std::string summary;
+  bool active = false;
+  std::vector<JobState> tasks;
+};
+
+struct CampaignStatus {
+  std::string folder;
+  std::string scenario;
+  std::string strategy;
+  // "sweep" (job array), "coordinator" (adaptive, on Slurm) or "local".
+  std::string kind;
+  int total = 0;  // planned points, or the budget; 0 when unknown
+  int done = 0, failed = 0, running = 0, pending = 0;
+  std::vector<RunningStep> running_steps;
+  std::vector<JobStatus> jobs;
+  std::string lock_holder;      // who holds (or last held) the campaign lock
+  bool views_complete = false;  // summary.json says the campaign finished
+  bool has_views = false;
+  std::vector<std::string> notes;
+};
+
+// NotFound when the folder is not a campaign folder.
+Result<CampaignStatus> ReadCampaignStatus(const std::string& folder);
+
+std::string FormatStatus(const CampaignStatus& status);
+std::string StatusJson(const CampaignStatus& status);
+
+}  // namespace adse::slurm
+
+#endif  // ADSE_HARNESS_SLURM_STATUS_H_
