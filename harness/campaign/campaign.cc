@@ -14,6 +14,7 @@
 #include "harness/campaign/run_store.h"
 #include "harness/campaign/strategy_factory.h"
 #include "stack/base/files.h"
+#include "stack/base/subprocess.h"
 
 namespace adse::campaign {
 namespace fs = std::filesystem;
@@ -21,13 +22,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// The running executable, for the default worker command.
-std::string SelfExecutable() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? std::string("adse") : self.string();
-}
 
 // Keeps the folder's views fresh while the campaign runs (at most every
 // few seconds; they are rebuilt in full at the end) and forwards events.

@@ -80,9 +80,7 @@ int RunInterpret(const InterpretArgs& args) {
   const std::string shown = out.empty() ? "scenario.yaml" : fs::path(out).filename().string();
   const std::string check =
       (fs::path(folder) / fmt::format(".{}.interpret-check-{}.yaml", shown, ::getpid())).string();
-  std::string self = "/proc/self/exe";
-  std::error_code ec;
-  if (fs::path exe = fs::read_symlink("/proc/self/exe", ec); !ec) self = exe.string();
+  const std::string self = SelfExecutable();
   llm::InterpretOptions options;
   options.model = args.model;
   options.max_corrections = args.max_corrections;

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "stack/base/files.h"
+#include "stack/base/subprocess.h"
 
 namespace adse::llm {
 namespace fs = std::filesystem;
@@ -29,15 +30,12 @@ const std::vector<TemplateInfo>& TemplateCatalog() {
 }
 
 std::string DefaultPromptsDir() {
-  std::error_code ec;
   // An installed binary looks beside itself first: <prefix>/bin/adse ->
   // <prefix>/share/adse/prompts.
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    const fs::path installed =
-        exe.parent_path().parent_path() / "share" / "adse" / "prompts";
-    if (fs::is_directory(installed, ec)) return installed.string();
-  }
+  const fs::path installed =
+      fs::path(SelfExecutable()).parent_path().parent_path() / "share" / "adse" / "prompts";
+  std::error_code ec;
+  if (fs::is_directory(installed, ec)) return installed.string();
   return ADSE_PROMPTS_DIR;
 }
 

@@ -14,6 +14,7 @@
 #include "harness/sim/calibration.h"
 #include "harness/sim/run_key.h"
 #include "stack/algorithms/command_gate.h"
+#include "stack/base/clock.h"
 #include "stack/base/hash.h"
 #include "stack/base/random.h"
 #include "stack/nodes/ad_stack.h"
@@ -39,15 +40,6 @@ std::string HostDescription() {
     }
   }
   return fmt::format("{}; {}; {} cores", name, cpu, std::thread::hardware_concurrency());
-}
-
-std::string UtcNow() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  ::gmtime_r(&now, &tm);
-  char text[32];
-  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return text;
 }
 
 }  // namespace
@@ -215,7 +207,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
   run.scenario_hash = Sha256Hex(spec.source_text);
   run.adse_version = ADSE_VERSION;
   run.host = HostDescription();
-  run.created_utc = UtcNow();
+  run.created_utc = UtcTimestamp();
   run.seed = seed;
   run.design_point = point;
   if (Result<std::string> key = RunKey(spec, point, seed); key.ok()) run.content_key = *key;

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <initializer_list>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -79,29 +80,29 @@ std::string ReadTail(const std::string& path, size_t bytes) {
   return tail;
 }
 
-// Whether a line of the log is srun's or slurmstepd's (the worker's own
-// output is never taken for theirs).
-bool IsSlurmLine(const std::string& line) {
-  return line.rfind("srun:", 0) == 0 || line.rfind("slurmstepd", 0) == 0;
-}
-
-// Whether srun's output says Slurm itself ended the step or refused it:
-// cancelled, its job gone.
-bool SlurmEndedStep(const std::string& output) {
+// Whether any line of the log that is srun's or slurmstepd's (the
+// worker's own output is never taken for theirs) contains one of `marks`.
+bool SlurmSays(const std::string& output, std::initializer_list<const char*> marks) {
   size_t at = 0;
   while (at < output.size()) {
     size_t end = output.find('\n', at);
     if (end == std::string::npos) end = output.size();
     const std::string line = output.substr(at, end - at);
     at = end + 1;
-    if (!IsSlurmLine(line)) continue;
-    for (const char* mark :
-         {"CANCELLED AT", "has expired", "Expired or invalid job",
-          "already completing", "Job step aborted", "Unable to create step"}) {
+    if (line.rfind("srun:", 0) != 0 && line.rfind("slurmstepd", 0) != 0) continue;
+    for (const char* mark : marks) {
       if (line.find(mark) != std::string::npos) return true;
     }
   }
   return false;
+}
+
+// Whether srun's output says Slurm itself ended the step or refused it:
+// cancelled, its job gone.
+bool SlurmEndedStep(const std::string& output) {
+  return SlurmSays(output, {"CANCELLED AT", "has expired", "Expired or invalid job",
+                            "already completing", "Job step aborted",
+                            "Unable to create step"});
 }
 
 // Whether the job is no longer running (cancelled, timed out, completing)
@@ -465,26 +466,10 @@ std::vector<std::string> SrunCommand(const StepPoolOptions& options,
 
 void ClassifyStepEnd(int wait_status, const std::string& output,
                      pool::JobResult* result) {
-  bool oom = false;
-  bool time_limit = false;
-  size_t at = 0;
-  while (at < output.size()) {
-    size_t end = output.find('\n', at);
-    if (end == std::string::npos) end = output.size();
-    const std::string line = output.substr(at, end - at);
-    at = end + 1;
-    if (!IsSlurmLine(line)) continue;
-    if (line.find("Out Of Memory") != std::string::npos ||
-        line.find("oom-kill") != std::string::npos ||
-        line.find("oom_kill") != std::string::npos ||
-        line.find("Exceeded job memory limit") != std::string::npos ||
-        line.find("Exceeded step memory limit") != std::string::npos) {
-      oom = true;
-    }
-    if (line.find("DUE TO TIME LIMIT") != std::string::npos) {
-      time_limit = true;
-    }
-  }
+  const bool oom = SlurmSays(output, {"Out Of Memory", "oom-kill", "oom_kill",
+                                      "Exceeded job memory limit",
+                                      "Exceeded step memory limit"});
+  const bool time_limit = SlurmSays(output, {"DUE TO TIME LIMIT"});
   result->exit_code = -1;
   result->signal = 0;
   if (WIFSIGNALED(wait_status)) {

@@ -19,27 +19,14 @@
 #include "harness/slurm/records.h"
 #include "harness/slurm/sharding.h"
 #include "harness/spec/spec_parser.h"
+#include "stack/base/clock.h"
 #include "stack/base/files.h"
+#include "stack/base/subprocess.h"
 
 namespace adse::slurm {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string NowUtc() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  ::gmtime_r(&now, &tm);
-  char text[32];
-  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return text;
-}
-
-std::string SelfExecutable() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? std::string("adse") : self.string();
-}
 
 std::string Absolute(const std::string& path) {
   std::error_code ec;
@@ -436,7 +423,7 @@ Result<SubmitResult> Submit(const spec::Spec& input,
                                                  : options.output_dir);
   c.adse = options.adse_path.empty() ? SelfExecutable()
                                      : Absolute(options.adse_path);
-  c.time = NowUtc();
+  c.time = UtcTimestamp();
 
   SubmitResult result;
   result.output_dir = c.folder;

@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 
 extern char** environ;
 
@@ -71,6 +72,12 @@ Status RunChecked(const std::vector<std::string>& argv) {
   const std::string how = r->signal ? "was killed by signal " + std::to_string(r->signal)
                                     : "exited with status " + std::to_string(r->exit_code);
   return Status::IoError(argv[0] + " " + how + ":\n" + tail);
+}
+
+std::string SelfExecutable() {
+  std::error_code ec;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string("adse") : self.string();
 }
 
 }  // namespace adse

@@ -24,6 +24,10 @@ Result<ProcessResult> RunProcess(const std::vector<std::string>& argv,
 // the exit status and the last lines of its output.
 Status RunChecked(const std::vector<std::string>& argv);
 
+// The running program's path (/proc/self/exe), for starting adse again
+// (workers, validation); "adse" (looked up on PATH) when it cannot be read.
+std::string SelfExecutable();
+
 }  // namespace adse
 
 #endif  // ADSE_STACK_BASE_SUBPROCESS_H_

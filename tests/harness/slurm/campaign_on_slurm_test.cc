@@ -352,7 +352,7 @@ TEST_F(
     TheTimeLimitWarningLetsRunningStepsFinishAndTheRequeuedJobEndsTheCampaign) {
   const std::string scenario = SmallScenarioIn(
       dir_, "{strategy: agent, budget: 6, batch: 2}",
-      "{workers: 2, memory_mb: 1024, slurm: {signal_lead_s: 60}}");
+      "{workers: 2, memory_mb: 1024, slurm: {signal_lead_s: 150}}");
   const std::string out = dir_ + "/warned";
   const std::string job = JobOf(Submit(scenario, out), "coordinator");
   ASSERT_FALSE(job.empty());
