@@ -7,7 +7,6 @@
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/syscall.h>
-#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,6 +22,7 @@
 #include <fmt/format.h>
 
 #include "harness/pool/cgroup.h"
+#include "harness/pool/child.h"
 
 namespace adse::pool {
 namespace {
@@ -37,9 +37,6 @@ constexpr int64_t kAddressSpaceHeadroomMb = 512;
 constexpr size_t kStderrTailBytes = 2048;
 // Without pidfds (Linux < 5.3) Wait polls the children at this interval.
 constexpr auto kPollInterval = std::chrono::milliseconds(2);
-#ifndef CLOSE_RANGE_CLOEXEC
-#define CLOSE_RANGE_CLOEXEC (1U << 2)
-#endif
 
 // ---- Interrupts -----------------------------------------------------------
 
@@ -202,13 +199,9 @@ struct ChildFailure {
       FailChild(plan, ChildStage::kJoinCgroup, static_cast<int>(i));
     }
   }
-  // Its own process group: a timeout kills it with killpg, and Ctrl-C at
-  // the terminal reaches only the coordinator, which cancels jobs itself.
-  ::setpgid(0, 0);
   // A coordinator killed outright takes its jobs with it (their unfinished
   // runs are redone on resume) instead of leaving them to run unwatched.
-  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-  if (::getppid() != plan.parent_pid) ::_exit(127);  // it died already
+  if (!PrepareChild(plan.parent_pid, SIGKILL, plan.stdin_fd, plan.log_fd)) ::_exit(127);
   if (::sched_setaffinity(0, sizeof(plan.cpus), &plan.cpus) != 0) {
     FailChild(plan, ChildStage::kAffinity, 0);
   }
@@ -216,22 +209,6 @@ struct ChildFailure {
       ::setrlimit(RLIMIT_AS, &plan.address_space) != 0) {
     FailChild(plan, ChildStage::kRlimit, 0);
   }
-  // The coordinator's handlers and blocked signals are not the job's.
-  struct sigaction default_action {};
-  default_action.sa_handler = SIG_DFL;
-  for (int sig : {SIGINT, SIGTERM, SIGPIPE, SIGCHLD, SIGHUP, SIGQUIT}) {
-    ::sigaction(sig, &default_action, nullptr);
-  }
-  sigset_t none;
-  sigemptyset(&none);
-  ::sigprocmask(SIG_SETMASK, &none, nullptr);
-  ::dup2(plan.stdin_fd, STDIN_FILENO);
-  ::dup2(plan.log_fd, STDOUT_FILENO);
-  ::dup2(plan.log_fd, STDERR_FILENO);
-#ifdef SYS_close_range
-  // Descriptors other code of the coordinator opened without O_CLOEXEC.
-  ::syscall(SYS_close_range, 3U, ~0U, CLOSE_RANGE_CLOEXEC);
-#endif
   ::execv(plan.argv[0], plan.argv.data());
   FailChild(plan, ChildStage::kExec, 0);
 }

@@ -2,9 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
-#include <sys/prctl.h>
 #include <sys/stat.h>
-#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,6 +21,7 @@
 
 #include <fmt/format.h>
 
+#include "harness/pool/child.h"
 #include "harness/slurm/allocation.h"
 #include "harness/slurm/client.h"
 #include "stack/base/subprocess.h"
@@ -40,9 +39,6 @@ constexpr size_t kClassifyTailBytes = 16384;
 // Wait checks its steps this often (runs last seconds to hours; srun
 // itself takes ~0.1 s to launch a step).
 constexpr auto kPollInterval = std::chrono::milliseconds(20);
-#ifndef CLOSE_RANGE_CLOEXEC
-#define CLOSE_RANGE_CLOEXEC (1U << 2)
-#endif
 
 double Seconds(Clock::duration d) {
   return std::chrono::duration<double>(d).count();
@@ -139,28 +135,11 @@ struct ChildPlan {
 };
 
 [[noreturn]] void RunChild(const ChildPlan& plan) {
-  // Its own process group, so that Ctrl-C at a terminal reaches only the
-  // coordinator, which cancels steps itself.
-  ::setpgid(0, 0);
   // A coordinator that dies takes its steps with it: on SIGTERM srun
   // cancels its step (on SIGKILL it could not, and the step would run on).
-  ::prctl(PR_SET_PDEATHSIG, SIGTERM);
-  if (::getppid() != plan.parent_pid) ::_exit(127);
-  struct sigaction default_action {};
-  default_action.sa_handler = SIG_DFL;
-  for (int sig :
-       {SIGINT, SIGTERM, SIGUSR1, SIGPIPE, SIGCHLD, SIGHUP, SIGQUIT}) {
-    ::sigaction(sig, &default_action, nullptr);
+  if (!pool::PrepareChild(plan.parent_pid, SIGTERM, plan.stdin_fd, plan.log_fd)) {
+    ::_exit(127);
   }
-  sigset_t none;
-  sigemptyset(&none);
-  ::sigprocmask(SIG_SETMASK, &none, nullptr);
-  ::dup2(plan.stdin_fd, STDIN_FILENO);
-  ::dup2(plan.log_fd, STDOUT_FILENO);
-  ::dup2(plan.log_fd, STDERR_FILENO);
-#ifdef SYS_close_range
-  ::syscall(SYS_close_range, 3U, ~0U, CLOSE_RANGE_CLOEXEC);
-#endif
   ::execve(plan.argv[0], plan.argv.data(), plan.envp.data());
   const ExecFailure failure{errno};
   [[maybe_unused]] const ssize_t n =
