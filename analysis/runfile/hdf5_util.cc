@@ -193,20 +193,25 @@ Status ReadNumericColumn(hid_t parent, const std::string& name,
   return Status::Ok();
 }
 
-// Reads a 1-D array of strings (variable or fixed length) from an attribute
-// or dataset: `is_attr` picks H5Aread/H5Dread.
-Result<std::vector<std::string>> ReadStringArray(hid_t obj, bool is_attr,
-                                                 const std::string& what) {
+// Reads the strings (variable or fixed length) of an attribute or dataset:
+// `is_attr` picks H5Aread/H5Dread; `array` wants a 1-D array, otherwise
+// exactly one string.
+Result<std::vector<std::string>> ReadStrings(hid_t obj, bool is_attr,
+                                             const std::string& what,
+                                             bool array) {
   Handle type(is_attr ? H5Aget_type(obj) : H5Dget_type(obj));
   Handle space(is_attr ? H5Aget_space(obj) : H5Dget_space(obj));
   if (!type.valid() || !space.valid()) return ReadHdf5Error(what, "type");
   const H5T_class_t type_class = H5Tget_class(type.get());
   if (type_class != H5T_STRING) {
     return ReadError(what + " is " + TypeClassName(type_class) +
-                     ", expected strings");
+                     (array ? ", expected strings" : ", expected a string"));
   }
-  if (H5Sget_simple_extent_ndims(space.get()) != 1) {
+  if (array && H5Sget_simple_extent_ndims(space.get()) != 1) {
     return ReadError(what + ": expected a 1-D array of strings");
+  }
+  if (!array && H5Sget_simple_extent_npoints(space.get()) != 1) {
+    return ReadError(what + " is not a single string");
   }
   const hssize_t points = H5Sget_simple_extent_npoints(space.get());
   if (points < 0) return ReadHdf5Error(what, "shape");
@@ -350,38 +355,10 @@ Result<T> ReadNumericAttr(hid_t loc, const std::string& name, hid_t mem_type) {
 // or dataset: `is_attr` picks H5Aread/H5Dread.
 Result<std::string> ReadScalarString(hid_t obj, bool is_attr,
                                      const std::string& what) {
-  Handle type(is_attr ? H5Aget_type(obj) : H5Dget_type(obj));
-  Handle space(is_attr ? H5Aget_space(obj) : H5Dget_space(obj));
-  if (!type.valid() || !space.valid()) return ReadHdf5Error(what, "type");
-  const H5T_class_t type_class = H5Tget_class(type.get());
-  if (type_class != H5T_STRING) {
-    return ReadError(what + " is " + TypeClassName(type_class) +
-                     ", expected a string");
-  }
-  if (H5Sget_simple_extent_npoints(space.get()) != 1) {
-    return ReadError(what + " is not a single string");
-  }
-  const htri_t variable = H5Tis_variable_str(type.get());
-  if (variable < 0) return ReadHdf5Error(what, "type");
-  if (variable > 0) {
-    Handle mem_type(H5Tcopy(type.get()));  // keeps the file's charset
-    char* text = nullptr;
-    const herr_t rc = is_attr ? H5Aread(obj, mem_type.get(), &text)
-                              : H5Dread(obj, mem_type.get(), H5S_ALL, H5S_ALL,
-                                        H5P_DEFAULT, &text);
-    if (rc < 0) return ReadHdf5Error(what, "reading");
-    std::string value = text != nullptr ? std::string(text) : std::string();
-    if (text != nullptr) H5free_memory(text);
-    return value;
-  }
-  const size_t size = H5Tget_size(type.get());
-  if (size == 0) return ReadHdf5Error(what, "type size");
-  std::vector<char> buffer(size + 1, '\0');
-  const herr_t rc = is_attr ? H5Aread(obj, type.get(), buffer.data())
-                            : H5Dread(obj, type.get(), H5S_ALL, H5S_ALL,
-                                      H5P_DEFAULT, buffer.data());
-  if (rc < 0) return ReadHdf5Error(what, "reading");
-  return std::string(buffer.data(), ::strnlen(buffer.data(), size));
+  Result<std::vector<std::string>> one =
+      ReadStrings(obj, is_attr, what, /*array=*/false);
+  if (!one.ok()) return one.status();
+  return std::move(one->front());
 }
 
 // Creates (replacing) an attribute and writes its value(s): a scalar when
@@ -709,8 +686,9 @@ Result<std::vector<std::string>> ReadStringListAttr(hid_t loc,
                                                     const std::string& name) {
   Result<Handle> attr = OpenAttr(loc, name);
   if (!attr.ok()) return attr.status();
-  return ReadStringArray(attr->get(), /*is_attr=*/true,
-                         PathOf(loc, "") + ": attribute '" + name + "'");
+  return ReadStrings(attr->get(), /*is_attr=*/true,
+                     PathOf(loc, "") + ": attribute '" + name + "'",
+                     /*array=*/true);
 }
 
 Result<std::string> ReadStringAttr(hid_t loc, const std::string& name) {
@@ -835,7 +813,8 @@ Status ReadColumn(hid_t parent, const std::string& name,
   Result<OpenColumn> column = OpenColumnDataset(parent, name, H5T_STRING);
   if (!column.ok()) return column.status();
   return Assign(
-      ReadStringArray(column->dataset.get(), /*is_attr=*/false, column->what),
+      ReadStrings(column->dataset.get(), /*is_attr=*/false, column->what,
+                  /*array=*/true),
       out);
 }
 

@@ -93,7 +93,7 @@ std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
     report::AnalyzeOptions analyze;
     const std::string image_dir = folder_.ImageDir(p.key);
     // Pictures are drawn once; a resumed campaign reuses them.
-    if (!fs::exists(image_dir + "/trajectory.png", ec)) {
+    if (!fs::exists(folder_.TrajectoryImagePath(p.key), ec)) {
       fs::create_directories(image_dir, ec);
       analyze.image_dir = image_dir;
     }

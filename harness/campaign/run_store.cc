@@ -40,6 +40,10 @@ std::string CampaignFolder::ImageDir(const std::string& key) const {
   return root_ + "/images/" + key;
 }
 
+std::string CampaignFolder::TrajectoryImagePath(const std::string& key) const {
+  return ImageDir(key) + "/trajectory.png";
+}
+
 Result<CampaignLock> CampaignLock::Acquire(const std::string& folder) {
   const std::string path = folder + "/.lock";
   const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);

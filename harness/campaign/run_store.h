@@ -33,8 +33,9 @@ class CampaignFolder {
   std::string ReportPath(const std::string& key) const;
   std::string FailurePath(const std::string& key) const;
   std::string LogPath(const std::string& key, int attempt) const;
-  // Folder of a run's pictures (trajectory.png).
+  // Folder of a run's pictures, and its trajectory picture in it.
   std::string ImageDir(const std::string& key) const;
+  std::string TrajectoryImagePath(const std::string& key) const;
   std::string Path(const std::string& name) const { return root_ + "/" + name; }
 
  private:

@@ -45,7 +45,7 @@ Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(const spec::Sp
   llm::LlmStrategyOptions options;
   options.report_path = [layout](const std::string& key) { return layout.ReportPath(key); };
   options.image_path = [layout](const std::string& key) {
-    return layout.ImageDir(key) + "/trajectory.png";
+    return layout.TrajectoryImagePath(key);
   };
   options.record_dir = record ? folder : "";
   options.backend = std::move(*backend);

@@ -50,7 +50,7 @@ class Progress : public campaign::ExplorerListener {
     proposed_ += static_cast<int>(points.size());
     // An llm iteration the built-in agent had to take over is shown even
     // under the bar: a model server that is down should not go unnoticed.
-    const bool fallback = it.rationale.rfind("fallback to the built-in agent", 0) == 0;
+    const bool fallback = strategy.fell_back();
     if (!quiet_ && !it.rationale.empty() && (!tty_ || fallback)) {
       if (tty_) std::fprintf(stderr, "\r\033[K");
       std::fprintf(stderr, "iteration %lld (%s): %s\n",

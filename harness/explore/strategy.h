@@ -62,6 +62,10 @@ class Strategy {
   virtual std::string name() const = 0;
   // A short written reason for the last Ask (for the report), may be empty.
   virtual std::string rationale() const { return {}; }
+  // Whether the last Ask did not go as the strategy meant (the llm
+  // strategy's built-in agent standing in for its model): progress output
+  // shows that round's rationale even under a progress bar.
+  virtual bool fell_back() const { return false; }
   // Whether proposals depend on what Tell reported. A non-adaptive
   // strategy (exhaustive, random) may be asked whenever a worker is free;
   // an adaptive one is asked in rounds of RoundSize points whose Tells all

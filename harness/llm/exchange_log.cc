@@ -82,17 +82,35 @@ ExchangeRecord FromJson(const json& j) {
 
 }  // namespace
 
-std::string RequestHash(const ChatRequest& request) {
+namespace {
+
+// Every image's SHA-256, in message order (hashed once per request).
+std::vector<std::string> ImageHashes(const ChatRequest& request) {
+  std::vector<std::string> hashes;
+  for (const ChatMessage& m : request.messages) {
+    for (const std::string& png : m.images_png) hashes.push_back(Sha256Hex(png));
+  }
+  return hashes;
+}
+
+std::string RequestHash(const ChatRequest& request, const std::vector<std::string>& images) {
   ContentHasher h;
   h.Add(std::string_view("adse-llm-request-1"))
       .Add(request.agent)
       .Add(request.model)
       .Add(static_cast<long long>(request.json));
+  size_t image = 0;
   for (const ChatMessage& m : request.messages) {
     h.Add(m.role).Add(m.text).Add(static_cast<long long>(m.images_png.size()));
-    for (const std::string& png : m.images_png) h.Add(Sha256Hex(png));
+    for (size_t i = 0; i < m.images_png.size(); ++i) h.Add(images[image++]);
   }
   return h.Hex();
+}
+
+}  // namespace
+
+std::string RequestHash(const ChatRequest& request) {
+  return RequestHash(request, ImageHashes(request));
 }
 
 std::string Transcript(const ChatRequest& request) {
@@ -139,13 +157,9 @@ Result<ChatReply> RecordingBackend::Chat(const ChatRequest& request) {
   r.iteration = iteration_;
   r.agent = request.agent;
   r.model = request.model;
-  r.request_sha256 = RequestHash(request);
+  r.image_sha256 = ImageHashes(request);
+  r.request_sha256 = RequestHash(request, r.image_sha256);
   r.prompt = Transcript(request);
-  for (const ChatMessage& m : request.messages) {
-    for (const std::string& png : m.images_png) {
-      r.image_sha256.push_back(Sha256Hex(png));
-    }
-  }
 
   Result<ChatReply> reply = Status::Internal("no answer");
   auto it = recorded_.find(r.request_sha256);

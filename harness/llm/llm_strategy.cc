@@ -96,12 +96,14 @@ class LlmStrategy : public explore::Strategy {
 
   std::string name() const override { return "llm"; }
   std::string rationale() const override { return rationale_; }
+  bool fell_back() const override { return fell_back_; }
   int RoundSize(int /*batch*/) const override { return 1; }
   Status failure() const override { return failure_; }
 
   std::vector<spec::DesignPoint> Ask(int k) override {
     if (k < 1 || converged_ || !failure_.ok() || proposed_ >= budget_) return {};
     ++iteration_;
+    fell_back_ = false;
     options_.backend->set_iteration(iteration_);
 
     std::optional<spec::DesignPoint> point;
@@ -131,6 +133,7 @@ class LlmStrategy : public explore::Strategy {
       if (fallback.empty()) return {};
       point = fallback.front();
       proposed_by = "agent";
+      fell_back_ = true;
       rationale_ = "fallback to the built-in agent, since the DSE agent " + answer.why +
                    ". agent: " + fallback_->rationale();
     }
@@ -359,6 +362,7 @@ class LlmStrategy : public explore::Strategy {
   uint64_t proposed_ = 0;
   int64_t iteration_ = -1;
   bool converged_ = false;
+  bool fell_back_ = false;  // the last Ask's point is the built-in agent's
   bool record_error_shown_ = false;
   Status failure_;
   std::string rationale_;

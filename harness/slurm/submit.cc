@@ -53,19 +53,14 @@ Status CheckSbatchArg(const std::string& arg) {
   return Status::Ok();
 }
 
-// Directives every script shares: where it runs and what it may use.
-std::vector<std::string> SiteDirectives(const spec::Spec& spec) {
-  std::vector<std::string> d;
+// Directives every script ends with: where it runs and what it may use,
+// then the scenario's extra_args and --sbatch-arg (last, so they win).
+void AddSiteAndUserDirectives(const spec::Spec& spec, const SubmitOptions& options,
+                              std::vector<std::string>* d) {
   const spec::SlurmOptions& s = spec.harness.slurm;
-  if (!s.partition.empty()) d.push_back("--partition=" + s.partition);
-  if (!s.account.empty()) d.push_back("--account=" + s.account);
-  return d;
-}
-
-void AddUserDirectives(const spec::Spec& spec, const SubmitOptions& options,
-                       std::vector<std::string>* d) {
-  for (const std::string& arg : spec.harness.slurm.extra_args)
-    d->push_back(arg);
+  if (!s.partition.empty()) d->push_back("--partition=" + s.partition);
+  if (!s.account.empty()) d->push_back("--account=" + s.account);
+  for (const std::string& arg : s.extra_args) d->push_back(arg);
   for (const std::string& arg : options.sbatch_args) d->push_back(arg);
 }
 
@@ -151,10 +146,7 @@ BatchScript CoordinatorScript(const Context& c, int steps, int tasks,
       "--open-mode=append",
       "--output=" + SlurmDir(c.folder) + "/logs/coordinator-%j.out",
   };
-  for (const std::string& d : SiteDirectives(spec)) {
-    script.directives.push_back(d);
-  }
-  AddUserDirectives(spec, c.options, &script.directives);
+  AddSiteAndUserDirectives(spec, c.options, &script.directives);
   std::string command = "\"$adse\" run " + ShellQuote(c.scenario) + " -o " +
                         ShellQuote(c.folder) + " --executor slurm";
   if (!c.options.strategy.empty()) {
@@ -210,10 +202,7 @@ BatchScript ArrayScript(const Context& c, const SweepPlan& plan,
       "--open-mode=append",
       "--output=" + SlurmDir(c.folder) + "/logs/shard-%A_%a.out",
   };
-  for (const std::string& d : SiteDirectives(spec)) {
-    script.directives.push_back(d);
-  }
-  AddUserDirectives(spec, c.options, &script.directives);
+  AddSiteAndUserDirectives(spec, c.options, &script.directives);
   script.body = {
       "set -u",
       "adse=" + ShellQuote(c.adse),
@@ -260,10 +249,7 @@ BatchScript IndexScript(const Context& c, const std::string& after_job) {
   if (!after_job.empty()) {
     script.directives.push_back("--dependency=afterany:" + after_job);
   }
-  for (const std::string& d : SiteDirectives(spec)) {
-    script.directives.push_back(d);
-  }
-  AddUserDirectives(spec, c.options, &script.directives);
+  AddSiteAndUserDirectives(spec, c.options, &script.directives);
   script.body = {
       "set -u",
       "adse=" + ShellQuote(c.adse),

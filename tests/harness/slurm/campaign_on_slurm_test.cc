@@ -383,12 +383,16 @@ TEST_F(
       << "the round running at the warning finishes; no new one starts";
   EXPECT_THAT(log.substr(log.find("time-limit warning")), HasSubstr("[4/6]"));
   EXPECT_EQ(FailureRecords(out), 0);
-  // A requeued job waits ~2 minutes before it may start again.
+  // A requeued job waits ~2 minutes before it may start again. Forced to
+  // start at once, it must not start within the second slurmd revoked the
+  // old instance's credential: slurmd compares at one-second resolution
+  // and kills the new batch job ("Job credential revoked"), seen here.
+  std::this_thread::sleep_for(std::chrono::seconds(2));
   Result<ProcessResult> now =
       cluster_->Run({"scontrol", "update", "JobId=" + job, "StartTime=now"});
   ASSERT_TRUE(now.ok() && now->exit_code == 0) << now->output;
   WaitForJob(job);
-  EXPECT_EQ(cluster_->JobState(job), "COMPLETED");
+  EXPECT_EQ(cluster_->JobState(job), "COMPLETED") << cluster_->LogTail();
   const auto after = RunFiles(out);
   EXPECT_EQ(after.size(), 6u);
   for (const auto& [key, file] : at_requeue) EXPECT_EQ(after.at(key), file);
