@@ -4,7 +4,7 @@
 set -euo pipefail
 
 PACKAGES=(
-  cmake g++ make ccache pkg-config git
+  cmake g++ make ccache pkg-config git clang-format
   libyaml-cpp-dev libeigen3-dev libmuparser-dev libcli11-dev libfmt-dev
   libspdlog-dev nlohmann-json3-dev libssl-dev libcurl4-openssl-dev libcpp-httplib-dev
   sumo sumo-tools

@@ -23,6 +23,8 @@
 
 #include "harness/pool/cgroup.h"
 #include "harness/pool/child.h"
+#include "harness/pool/child_log.h"
+#include "stack/base/clock.h"
 
 namespace adse::pool {
 namespace {
@@ -108,16 +110,6 @@ class UniqueFd {
   int fd_;
 };
 
-double Seconds(Clock::duration d) {
-  return std::chrono::duration<double>(d).count();
-}
-
-// Clamped to a year, so that huge limits cannot overflow the clock.
-Clock::duration FromSeconds(double s) {
-  return std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(std::clamp(s, 0.0, 365 * 86400.0)));
-}
-
 int PidfdOpen(pid_t pid) {
 #ifdef SYS_pidfd_open
   return static_cast<int>(::syscall(SYS_pidfd_open, pid, 0));
@@ -125,32 +117,6 @@ int PidfdOpen(pid_t pid) {
   (void)pid;
   return -1;
 #endif
-}
-
-// The last kStderrTailBytes of the log, from a line start where possible.
-std::string ReadTail(const std::string& path) {
-  UniqueFd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
-  struct stat st;
-  if (fd.get() < 0 || ::fstat(fd.get(), &st) != 0) return "";
-  const off_t start =
-      std::max<off_t>(0, st.st_size - static_cast<off_t>(kStderrTailBytes));
-  std::string tail(static_cast<size_t>(st.st_size - start), '\0');
-  size_t got = 0;
-  while (got < tail.size()) {
-    const ssize_t n = ::pread(fd.get(), &tail[got], tail.size() - got,
-                              start + static_cast<off_t>(got));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    got += static_cast<size_t>(n);
-  }
-  tail.resize(got);
-  if (start > 0) {
-    const size_t newline = tail.find('\n');
-    if (newline != std::string::npos && newline + 1 < tail.size()) {
-      tail.erase(0, newline + 1);
-    }
-  }
-  return tail;
 }
 
 // ---- The child between fork and exec --------------------------------------
@@ -341,7 +307,7 @@ Status PoolImpl::Submit(const Job& job) {
   running.oom_kills_before = groups_ ? groups_->OomKills(slot) : -1;
   running.start = Clock::now();
   if (job.timeout_s > 0) {
-    running.deadline = running.start + FromSeconds(job.timeout_s);
+    running.deadline = running.start + SteadyFromSeconds(job.timeout_s);
   }
   const pid_t pid = ::fork();
   if (pid < 0) {
@@ -419,8 +385,8 @@ JobResult PoolImpl::Reap(int slot) {
   JobResult result;
   result.id = r.job.id;
   result.slot = slot;
-  result.wall_s = Seconds(end - r.start);
-  result.stderr_tail = ReadTail(r.job.log_path);
+  result.wall_s = SteadySeconds(end - r.start);
+  result.stderr_tail = ReadLogTail(r.job.log_path, kStderrTailBytes);
   if (waited < 0) {
     result.outcome = r.killed_for.value_or(Outcome::kExitError);
     result.stderr_tail +=
@@ -448,7 +414,7 @@ JobResult PoolImpl::Reap(int slot) {
 }
 
 std::vector<JobResult> PoolImpl::Wait(double max_wait_s) {
-  const auto until = Clock::now() + FromSeconds(max_wait_s);
+  const auto until = Clock::now() + SteadyFromSeconds(max_wait_s);
   for (;;) {
     std::vector<JobResult> done;
     for (size_t i = 0; i < slots_.size(); ++i) {

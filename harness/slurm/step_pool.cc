@@ -22,8 +22,10 @@
 #include <fmt/format.h>
 
 #include "harness/pool/child.h"
+#include "harness/pool/child_log.h"
 #include "harness/slurm/allocation.h"
 #include "harness/slurm/client.h"
+#include "stack/base/clock.h"
 #include "stack/base/subprocess.h"
 
 extern char** environ;
@@ -39,42 +41,6 @@ constexpr size_t kClassifyTailBytes = 16384;
 // Wait checks its steps this often (runs last seconds to hours; srun
 // itself takes ~0.1 s to launch a step).
 constexpr auto kPollInterval = std::chrono::milliseconds(20);
-
-double Seconds(Clock::duration d) {
-  return std::chrono::duration<double>(d).count();
-}
-
-Clock::duration FromSeconds(double s) {
-  return std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(std::clamp(s, 0.0, 365 * 86400.0)));
-}
-
-std::string ReadTail(const std::string& path, size_t bytes) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return "";
-  struct stat st;
-  std::string tail;
-  if (::fstat(fd, &st) == 0) {
-    const off_t start =
-        std::max<off_t>(0, st.st_size - static_cast<off_t>(bytes));
-    tail.resize(static_cast<size_t>(st.st_size - start));
-    size_t got = 0;
-    while (got < tail.size()) {
-      const ssize_t n = ::pread(fd, &tail[got], tail.size() - got,
-                                start + static_cast<off_t>(got));
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) break;
-      got += static_cast<size_t>(n);
-    }
-    tail.resize(got);
-    if (start > 0) {
-      const size_t newline = tail.find('\n');
-      if (newline != std::string::npos) tail.erase(0, newline + 1);
-    }
-  }
-  ::close(fd);
-  return tail;
-}
 
 // Whether any line of the log that is srun's or slurmstepd's (the
 // worker's own output is never taken for theirs) contains one of `marks`.
@@ -250,7 +216,7 @@ Status StepPool::Submit(const pool::Job& job) {
   running.job = job;
   running.start = Clock::now();
   if (job.timeout_s > 0) {
-    running.deadline = running.start + FromSeconds(job.timeout_s);
+    running.deadline = running.start + SteadyFromSeconds(job.timeout_s);
   }
   const pid_t pid = ::fork();
   if (pid == 0) RunChild(plan);
@@ -315,8 +281,8 @@ pool::JobResult StepPool::Reap(size_t slot) {
   pool::JobResult result;
   result.id = r.job.id;
   result.slot = static_cast<int>(slot);
-  result.wall_s = Seconds(Clock::now() - r.start);
-  const std::string output = ReadTail(r.job.log_path, kClassifyTailBytes);
+  result.wall_s = SteadySeconds(Clock::now() - r.start);
+  const std::string output = pool::ReadLogTail(r.job.log_path, kClassifyTailBytes);
   result.stderr_tail = output.size() > kStderrTailBytes
                            ? output.substr(output.size() - kStderrTailBytes)
                            : output;
@@ -354,7 +320,7 @@ pool::JobResult StepPool::Reap(size_t slot) {
 }
 
 std::vector<pool::JobResult> StepPool::Wait(double max_wait_s) {
-  const auto until = Clock::now() + FromSeconds(max_wait_s);
+  const auto until = Clock::now() + SteadyFromSeconds(max_wait_s);
   for (;;) {
     std::vector<pool::JobResult> done;
     const auto now = Clock::now();
@@ -369,7 +335,7 @@ std::vector<pool::JobResult> StepPool::Wait(double max_wait_s) {
         Cancel(r, pool::Outcome::kTimeout);
       }
       if (r.cancel_sent && !r.srun_killed &&
-          now - *r.cancel_sent >= FromSeconds(options_.cancel_grace_s)) {
+          now - *r.cancel_sent >= SteadyFromSeconds(options_.cancel_grace_s)) {
         ::kill(r.pid, SIGKILL);
         r.srun_killed = true;
       }
@@ -394,7 +360,7 @@ std::vector<pool::JobResult> StepPool::CancelAll() {
   for (std::optional<Running>& slot : slots_) {
     if (slot && !Collect(*slot)) Cancel(*slot, pool::Outcome::kCancelled);
   }
-  const auto give_up = Clock::now() + FromSeconds(options_.cancel_grace_s);
+  const auto give_up = Clock::now() + SteadyFromSeconds(options_.cancel_grace_s);
   for (;;) {
     bool running = false;
     for (size_t i = 0; i < slots_.size(); ++i) {
