@@ -10,16 +10,19 @@ namespace adse::analysis {
 double Percentile(std::vector<double> values, double q) {
   if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::sort(values.begin(), values.end());
-  const double pos = std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1);
+  const double pos =
+      std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1);
   const size_t lo = static_cast<size_t>(std::floor(pos));
   const size_t hi = std::min(lo + 1, values.size() - 1);
-  return values[lo] + (pos - static_cast<double>(lo)) * (values[hi] - values[lo]);
+  return values[lo] +
+         (pos - static_cast<double>(lo)) * (values[hi] - values[lo]);
 }
 
-std::map<std::string, double> ComputeRunMetrics(const runfile::RunData& run,
-                                                const RunMetricsOptions& options) {
+std::map<std::string, double> ComputeRunMetrics(
+    const runfile::RunData& run, const RunMetricsOptions& options) {
   std::map<std::string, double> m;
-  const bool completed = run.status == "complete" && run.termination_reason == "goal_reached";
+  const bool completed =
+      run.status == "complete" && run.termination_reason == "goal_reached";
   const double end_s = run.ego.empty() ? 0.0 : run.ego.back().t_s;
   m["completed"] = completed ? 1.0 : 0.0;
   m["nav_time_s"] = end_s;
@@ -35,20 +38,23 @@ std::map<std::string, double> ComputeRunMetrics(const runfile::RunData& run,
   int64_t control_count = 0, drops = 0, lidar_drops = 0;
   for (const stack::TopicEvent& e : run.trace.topic_events) {
     if (e.t_s > end_s) continue;
-    if (e.kind == stack::TopicEvent::kPublish && e.topic == control) ++control_count;
+    if (e.kind == stack::TopicEvent::kPublish && e.topic == control)
+      ++control_count;
     if (e.kind == stack::TopicEvent::kDrop) {
       ++drops;
       if (e.topic == lidar) ++lidar_drops;
     }
   }
-  m["ctrl_rate_hz"] = end_s > 0 ? static_cast<double>(control_count) / end_s : 0.0;
+  m["ctrl_rate_hz"] =
+      end_s > 0 ? static_cast<double>(control_count) / end_s : 0.0;
   m["dropped_messages"] = static_cast<double>(drops);
   m["lidar_frames_dropped"] = static_cast<double>(lidar_drops);
 
   std::vector<double> latencies;
   latencies.reserve(run.controls.size());
   for (const runfile::ControlSample& c : run.controls) {
-    if (c.t_s <= end_s && c.stamp_s >= 0.0) latencies.push_back(c.t_s - c.stamp_s);
+    if (c.t_s <= end_s && c.stamp_s >= 0.0)
+      latencies.push_back(c.t_s - c.stamp_s);
   }
   m["e2e_latency_p50_s"] = Percentile(latencies, 0.5);
   m["e2e_latency_p99_s"] = Percentile(latencies, 0.99);
@@ -63,7 +69,8 @@ std::map<std::string, double> ComputeRunMetrics(const runfile::RunData& run,
   if (auto it = run.platform.find("cores"); it != run.platform.end()) {
     cores = std::atof(it->second.c_str());
   }
-  m["cpu_utilization"] = (cores > 0 && end_s > 0) ? busy_core_s / (cores * end_s) : 0.0;
+  m["cpu_utilization"] =
+      (cores > 0 && end_s > 0) ? busy_core_s / (cores * end_s) : 0.0;
   return m;
 }
 

@@ -232,11 +232,14 @@ Status WriteContents(hid_t file, const CampaignIndex& index) {
     const hid_t g = group->get();
     using Row = LlmExchangeRow;
     auto ints = [&](const char* name, int64_t Row::*member) {
-      return WriteColumn(g, name, Gather<int64_t>(rows, [&](const Row& r) { return r.*member; }));
+      return WriteColumn(g, name, Gather<int64_t>(rows, [&](const Row& r) {
+                           return r.*member;
+                         }));
     };
     auto strings = [&](const char* name, std::string Row::*member) {
-      return WriteColumn(g, name,
-                         Gather<std::string>(rows, [&](const Row& r) { return r.*member; }));
+      return WriteColumn(g, name, Gather<std::string>(rows, [&](const Row& r) {
+                           return r.*member;
+                         }));
     };
     ADSE_RETURN_IF_ERROR(ints("seq", &Row::seq));
     ADSE_RETURN_IF_ERROR(ints("iteration", &Row::iteration));
@@ -247,13 +250,15 @@ Status WriteContents(hid_t file, const CampaignIndex& index) {
     ADSE_RETURN_IF_ERROR(strings("prompt", &Row::prompt));
     ADSE_RETURN_IF_ERROR(strings("image_sha256", &Row::image_sha256));
     ADSE_RETURN_IF_ERROR(WriteColumn(
-        g, "ok", Gather<uint8_t>(rows, [](const Row& r) { return r.ok ? 1 : 0; })));
+        g, "ok",
+        Gather<uint8_t>(rows, [](const Row& r) { return r.ok ? 1 : 0; })));
     ADSE_RETURN_IF_ERROR(strings("answer", &Row::answer));
     ADSE_RETURN_IF_ERROR(strings("error", &Row::error));
     ADSE_RETURN_IF_ERROR(ints("prompt_tokens", &Row::prompt_tokens));
     ADSE_RETURN_IF_ERROR(ints("completion_tokens", &Row::completion_tokens));
     ADSE_RETURN_IF_ERROR(WriteColumn(
-        g, "latency_s", Gather<double>(rows, [](const Row& r) { return r.latency_s; })));
+        g, "latency_s",
+        Gather<double>(rows, [](const Row& r) { return r.latency_s; })));
     ADSE_RETURN_IF_ERROR(ints("attempts", &Row::attempts));
   }
   return Status::Ok();
@@ -281,10 +286,12 @@ Status ReadSized(hid_t group, const std::string& group_path,
 // Reads column `name` (of T) into `member` of each row; `rows` is sized by
 // the group's first column already.
 template <typename T, typename Row, typename Member>
-Status ReadMember(hid_t group, const std::string& group_path, const std::string& name,
-                  std::vector<Row>* rows, Member Row::*member) {
+Status ReadMember(hid_t group, const std::string& group_path,
+                  const std::string& name, std::vector<Row>* rows,
+                  Member Row::*member) {
   std::vector<T> column;
-  ADSE_RETURN_IF_ERROR(ReadSized(group, group_path, name, rows->size(), &column));
+  ADSE_RETURN_IF_ERROR(
+      ReadSized(group, group_path, name, rows->size(), &column));
   for (size_t i = 0; i < rows->size(); ++i) {
     (*rows)[i].*member = static_cast<Member>(std::move(column[i]));
   }
@@ -380,17 +387,26 @@ Status ReadContents(hid_t file, CampaignIndex* index) {
     for (size_t i = 0; i < n; ++i) rows[i].index = numbers[i];
 
     using Row = EvaluationRow;
-    ADSE_RETURN_IF_ERROR(ReadMember<int64_t>(g, path, "iteration", &rows, &Row::iteration));
-    ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, "content_key", &rows, &Row::content_key));
-    ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, "status", &rows, &Row::status));
-    ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, "reason", &rows, &Row::reason));
-    ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, "source", &rows, &Row::source));
-    ADSE_RETURN_IF_ERROR(ReadMember<int64_t>(g, path, "attempts", &rows, &Row::attempts));
     ADSE_RETURN_IF_ERROR(
-        ReadMember<std::string>(g, path, "bottlenecks_json", &rows, &Row::bottlenecks_json));
-    ADSE_RETURN_IF_ERROR(ReadMember<double>(g, path, "wall_s", &rows, &Row::wall_s));
-    ADSE_RETURN_IF_ERROR(ReadMember<uint8_t>(g, path, "feasible", &rows, &Row::feasible));
-    ADSE_RETURN_IF_ERROR(ReadMember<uint64_t>(g, path, "seed", &rows, &Row::seed));
+        ReadMember<int64_t>(g, path, "iteration", &rows, &Row::iteration));
+    ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, "content_key", &rows,
+                                                 &Row::content_key));
+    ADSE_RETURN_IF_ERROR(
+        ReadMember<std::string>(g, path, "status", &rows, &Row::status));
+    ADSE_RETURN_IF_ERROR(
+        ReadMember<std::string>(g, path, "reason", &rows, &Row::reason));
+    ADSE_RETURN_IF_ERROR(
+        ReadMember<std::string>(g, path, "source", &rows, &Row::source));
+    ADSE_RETURN_IF_ERROR(
+        ReadMember<int64_t>(g, path, "attempts", &rows, &Row::attempts));
+    ADSE_RETURN_IF_ERROR(ReadMember<std::string>(
+        g, path, "bottlenecks_json", &rows, &Row::bottlenecks_json));
+    ADSE_RETURN_IF_ERROR(
+        ReadMember<double>(g, path, "wall_s", &rows, &Row::wall_s));
+    ADSE_RETURN_IF_ERROR(
+        ReadMember<uint8_t>(g, path, "feasible", &rows, &Row::feasible));
+    ADSE_RETURN_IF_ERROR(
+        ReadMember<uint64_t>(g, path, "seed", &rows, &Row::seed));
     ADSE_RETURN_IF_ERROR(ReadNumberGroup(file, path + "/point",
                                          &index->parameters, &rows,
                                          &EvaluationRow::point));
@@ -418,7 +434,8 @@ Status ReadContents(hid_t file, CampaignIndex* index) {
     for (size_t i = 0; i < n; ++i) rows[i].content_keys = SplitKeys(column[i]);
   }
   // Indexes written before LLM campaigns existed have no exchanges group.
-  if (internal::GetObjectKind(file, "/llm_exchanges") != internal::ObjectKind::kMissing) {
+  if (internal::GetObjectKind(file, "/llm_exchanges") !=
+      internal::ObjectKind::kMissing) {
     const std::string path = "/llm_exchanges";
     Result<Handle> group = internal::OpenGroup(file, path);
     if (!group.ok()) return group.status();
@@ -431,19 +448,26 @@ Status ReadContents(hid_t file, CampaignIndex* index) {
     rows.assign(n, Row{});
     for (size_t i = 0; i < n; ++i) rows[i].seq = numbers[i];
     for (const auto& [name, member] :
-         {std::pair{"iteration", &Row::iteration}, {"prompt_tokens", &Row::prompt_tokens},
-          {"completion_tokens", &Row::completion_tokens}, {"attempts", &Row::attempts}}) {
+         {std::pair{"iteration", &Row::iteration},
+          {"prompt_tokens", &Row::prompt_tokens},
+          {"completion_tokens", &Row::completion_tokens},
+          {"attempts", &Row::attempts}}) {
       ADSE_RETURN_IF_ERROR(ReadMember<int64_t>(g, path, name, &rows, member));
     }
-    for (const auto& [name, member] :
-         {std::pair{"agent", &Row::agent}, {"model", &Row::model}, {"backend", &Row::backend},
-          {"request_sha256", &Row::request_sha256}, {"prompt", &Row::prompt},
-          {"image_sha256", &Row::image_sha256}, {"answer", &Row::answer},
-          {"error", &Row::error}}) {
-      ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, name, &rows, member));
+    for (const auto& [name, member] : {std::pair{"agent", &Row::agent},
+                                       {"model", &Row::model},
+                                       {"backend", &Row::backend},
+                                       {"request_sha256", &Row::request_sha256},
+                                       {"prompt", &Row::prompt},
+                                       {"image_sha256", &Row::image_sha256},
+                                       {"answer", &Row::answer},
+                                       {"error", &Row::error}}) {
+      ADSE_RETURN_IF_ERROR(
+          ReadMember<std::string>(g, path, name, &rows, member));
     }
     ADSE_RETURN_IF_ERROR(ReadMember<uint8_t>(g, path, "ok", &rows, &Row::ok));
-    ADSE_RETURN_IF_ERROR(ReadMember<double>(g, path, "latency_s", &rows, &Row::latency_s));
+    ADSE_RETURN_IF_ERROR(
+        ReadMember<double>(g, path, "latency_s", &rows, &Row::latency_s));
   }
   return Status::Ok();
 }

@@ -18,8 +18,8 @@ namespace adse::runfile {
 inline constexpr int kCampaignSchemaVersion = 1;
 
 struct EvaluationRow {
-  int64_t index = 0;      // evaluation number, 0-based, in proposal order
-  int64_t iteration = 0;  // the round that proposed it
+  int64_t index = 0;        // evaluation number, 0-based, in proposal order
+  int64_t iteration = 0;    // the round that proposed it
   std::string content_key;  // 64 hex; the run file is runs/<key>.h5
   // "complete" (a run file exists) | "failed" (no run after retries)
   std::string status;
@@ -30,7 +30,7 @@ struct EvaluationRow {
   // "simulated" | "campaign" (already in runs/) | "cache" (shared cache)
   std::string source;
   int64_t attempts = 0;
-  double wall_s = 0.0;     // worker wall time of the last attempt
+  double wall_s = 0.0;  // worker wall time of the last attempt
   bool feasible = false;
   uint64_t seed = 0;
   std::map<std::string, double> point;    // design parameter -> value

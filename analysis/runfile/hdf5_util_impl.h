@@ -73,10 +73,10 @@ std::string TakeHdf5Error();
 Status SyncPath(const std::string& path, bool directory);
 
 // Writes a new HDF5 file at `path` atomically: creates the parent folders,
-// creates `<path>.tmp.<host>.<pid>` (MakeFileAccessProps), calls `write_contents`
-// on it inside an Hdf5Session, closes (flushes) and fsyncs it, renames it
-// over `path` and fsyncs the folder. So readers see the old file or the
-// whole new one. Errors of `write_contents` get the temporary's name as
+// creates `<path>.tmp.<host>.<pid>` (MakeFileAccessProps), calls
+// `write_contents` on it inside an Hdf5Session, closes (flushes) and fsyncs it,
+// renames it over `path` and fsyncs the folder. So readers see the old file or
+// the whole new one. Errors of `write_contents` get the temporary's name as
 // context; file system failures are IoError. No temporary is left behind on
 // failure.
 Status WriteFileAtomically(

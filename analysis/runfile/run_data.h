@@ -36,8 +36,8 @@ struct VehicleSample {
 
 // A control command as the vehicle received it.
 struct ControlSample {
-  double t_s;        // publish time
-  double stamp_s;    // originating sensor time
+  double t_s;      // publish time
+  double stamp_s;  // originating sensor time
   double accel_mps2, steer_rad;
 };
 
@@ -56,24 +56,25 @@ struct NamedCallback {
 
 struct RunData {
   // Identity and provenance (root attributes).
-  std::string status = "complete";       // complete | failed
-  std::string termination_reason;        // goal_reached | timeout | ... | error text
+  std::string status = "complete";  // complete | failed
+  std::string termination_reason;   // goal_reached | timeout | ... | error text
   std::string scenario_name;
-  std::string scenario_text;             // the scenario file, verbatim
-  std::string scenario_hash;             // sha256 of scenario_text
-  std::string content_key;               // run key (empty until the harness sets it)
+  std::string scenario_text;  // the scenario file, verbatim
+  std::string scenario_hash;  // sha256 of scenario_text
+  std::string content_key;    // run key (empty until the harness sets it)
   std::string adse_version;
-  std::string host;                      // hostname, CPU model, cores
-  std::string created_utc;               // ISO 8601
+  std::string host;         // hostname, CPU model, cores
+  std::string created_utc;  // ISO 8601
   uint64_t seed = 0;
   std::map<std::string, double> design_point;
-  std::map<std::string, std::string> platform;  // kind, cores, freq_ghz, cost_model, ...
+  std::map<std::string, std::string>
+      platform;  // kind, cores, freq_ghz, cost_model, ...
 
   // World.
   std::vector<EgoSample> ego;
   std::vector<PathPoint> ideal_path;
   double lane_width_m = 3.5;
-  std::vector<LanePoint> lanes;          // may be empty (not recorded)
+  std::vector<LanePoint> lanes;  // may be empty (not recorded)
   std::vector<VehicleSample> vehicles;
   std::vector<CollisionEvent> collisions;
 

@@ -232,9 +232,10 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
       std::chrono::duration<double>(Clock::now() - started).count();
   ADSE_RETURN_IF_ERROR(WriteCampaignViews(spec, summary));
   if (Status failed = (*strategy)->failure(); !failed.ok()) {
-    return failed.WithContext(fmt::format(
-        "the {} strategy cannot go on ({} evaluations kept in {})", summary.strategy,
-        summary.exploration.evaluations.size(), summary.output_dir));
+    return failed.WithContext(
+        fmt::format("the {} strategy cannot go on ({} evaluations kept in {})",
+                    summary.strategy, summary.exploration.evaluations.size(),
+                    summary.output_dir));
   }
   return summary;
 }

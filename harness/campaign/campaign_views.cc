@@ -1,8 +1,8 @@
 // The campaign folder's views, all rebuilt from the evaluation rows:
 // campaign.h5 (index), summary.json, report.md and pareto.png.
 #include <algorithm>
-#include <csignal>
 #include <cmath>
+#include <csignal>
 #include <map>
 #include <optional>
 #include <set>
@@ -39,7 +39,8 @@ LlmRecords LoadLlmRecords(const std::string& folder) {
   } else {
     r.problem = exchanges.status().message();
   }
-  Result<std::vector<llm::LlmEvent>> events = llm::LoadEvents(llm::EventsPath(folder));
+  Result<std::vector<llm::LlmEvent>> events =
+      llm::LoadEvents(llm::EventsPath(folder));
   if (events.ok()) {
     r.events = std::move(*events);
   } else {
@@ -47,7 +48,6 @@ LlmRecords LoadLlmRecords(const std::string& folder) {
   }
   return r;
 }
-
 
 std::string Number(double v) {
   if (std::isnan(v)) return "—";
@@ -103,7 +103,8 @@ std::string Cell(std::string text) {
 std::string LlmMarkdown(const LlmRecords& llm) {
   std::ostringstream md;
   md << "\n## LLM agents\n\n";
-  if (!llm.problem.empty()) md << "Records could not be read: " << llm.problem << "\n\n";
+  if (!llm.problem.empty())
+    md << "Records could not be read: " << llm.problem << "\n\n";
   std::map<std::string, int> asked, failed;
   int64_t prompt_tokens = 0, answer_tokens = 0;
   double latency = 0.0;
@@ -119,10 +120,13 @@ std::string LlmMarkdown(const LlmRecords& llm) {
     answer_tokens += std::max<int64_t>(e.completion_tokens, 0);
   }
   md << fmt::format(
-      "{} exchanges ({} answered, mean latency {} s), {} prompt and {} answer tokens; "
-      "every exchange is in `llm/exchanges.jsonl` and `campaign.h5` (/llm_exchanges).\n\n",
-      llm.exchanges.size(), answered, Number(answered ? latency / answered : NAN),
-      prompt_tokens, answer_tokens);
+      "{} exchanges ({} answered, mean latency {} s), {} prompt and {} answer "
+      "tokens; "
+      "every exchange is in `llm/exchanges.jsonl` and `campaign.h5` "
+      "(/llm_exchanges).\n\n",
+      llm.exchanges.size(), answered,
+      Number(answered ? latency / answered : NAN), prompt_tokens,
+      answer_tokens);
   md << "| agent | requests | failed |\n|---|---|---|\n";
   for (const auto& [agent, n] : asked) {
     md << fmt::format("| {} | {} | {} |\n", agent, n, failed[agent]);
@@ -130,11 +134,13 @@ std::string LlmMarkdown(const LlmRecords& llm) {
   std::map<std::string, int> kinds;
   for (const llm::LlmEvent& e : llm.events) ++kinds[e.kind];
   md << fmt::format(
-      "\nEvents: {} answers rejected (each got one corrective follow-up), {} iterations "
-      "proposed by the built-in agent instead, {} disagreements with the deterministic "
+      "\nEvents: {} answers rejected (each got one corrective follow-up), {} "
+      "iterations "
+      "proposed by the built-in agent instead, {} disagreements with the "
+      "deterministic "
       "analysis (the deterministic values were used), {} errors{}.\n\n",
-      kinds["rejected"], kinds["fallback"], kinds["disagreement"], kinds["error"],
-      kinds["converged"] ? ", convergence declared" : "");
+      kinds["rejected"], kinds["fallback"], kinds["disagreement"],
+      kinds["error"], kinds["converged"] ? ", convergence declared" : "");
   if (!llm.events.empty()) {
     md << "| iteration | agent | event | detail |\n|---|---|---|---|\n";
     for (const llm::LlmEvent& e : llm.events) {
@@ -350,17 +356,19 @@ Status WriteCampaignViews(const spec::Spec& spec,
       rejected += e.kind == "rejected";
       disagreements += e.kind == "disagreement";
     }
-    j["llm"] = {{"exchanges", llm->exchanges.size()},
-                {"rejected_answers", rejected},
-                {"fallback_iterations", fallbacks},
-                {"disagreements", disagreements},
-                {"records", "llm/exchanges.jsonl, llm/memory.jsonl, llm/events.jsonl"}};
+    j["llm"] = {
+        {"exchanges", llm->exchanges.size()},
+        {"rejected_answers", rejected},
+        {"fallback_iterations", fallbacks},
+        {"disagreements", disagreements},
+        {"records", "llm/exchanges.jsonl, llm/memory.jsonl, llm/events.jsonl"}};
   }
   ADSE_RETURN_IF_ERROR(WriteFileAtomic(
       folder.Path("summary.json"),
       j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"));
   ADSE_RETURN_IF_ERROR(
-      WriteFileAtomic(folder.Path("report.md"), ReportMarkdown(spec, current, llm ? &*llm : nullptr)));
+      WriteFileAtomic(folder.Path("report.md"),
+                      ReportMarkdown(spec, current, llm ? &*llm : nullptr)));
 
   std::vector<analysis::ParetoPlotPoint> plot;
   const std::set<int> on_front(front.begin(), front.end());

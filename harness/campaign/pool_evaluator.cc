@@ -230,8 +230,7 @@ void PoolEvaluator::Finish(const pool::JobResult& result) {
   // A run that fails while the campaign is being stopped may have failed
   // because of the stop (its job step killed with the allocation): it is
   // left unevaluated, to run again on resume, not retried or recorded.
-  if (result.outcome != pool::Outcome::kOk &&
-      pool::InterruptRequested() != 0) {
+  if (result.outcome != pool::Outcome::kOk && pool::InterruptRequested() != 0) {
     return;
   }
   std::string detail;
@@ -292,9 +291,10 @@ std::vector<EvaluationRow> PoolEvaluator::Wait() {
       const auto now = std::chrono::steady_clock::now();
       if (!drain_deadline_) {
         drain_deadline_ =
-            now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                      std::chrono::duration<double>(
-                          std::max(0.0, options_.drain_grace_s)));
+            now +
+            std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                std::chrono::duration<double>(
+                    std::max(0.0, options_.drain_grace_s)));
       }
       if (running_.empty() || now >= *drain_deadline_) break;
     }

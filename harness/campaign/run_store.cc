@@ -71,11 +71,10 @@ Result<CampaignLock> CampaignLock::Acquire(const std::string& folder) {
   char host[256] = {};
   ::gethostname(host, sizeof(host) - 1);
   const char* job = std::getenv("SLURM_JOB_ID");
-  const std::string who =
-      fmt::format("pid {} on {}{}\n", ::getpid(), host,
-                  job != nullptr && *job != '\0'
-                      ? fmt::format(" (Slurm job {})", job)
-                      : std::string());
+  const std::string who = fmt::format("pid {} on {}{}\n", ::getpid(), host,
+                                      job != nullptr && *job != '\0'
+                                          ? fmt::format(" (Slurm job {})", job)
+                                          : std::string());
   if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, who.data(), who.size(), 0) !=
                                      static_cast<ssize_t>(who.size())) {
     // The holder text is informational; the lock itself is what counts.

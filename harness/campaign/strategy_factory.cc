@@ -12,22 +12,23 @@ Status CheckStrategyName(const std::string& name) {
   for (const std::string& n : explore::StrategyNames()) {
     if (n == name) return Status::Ok();
   }
-  return Status::InvalidArgument(fmt::format("unknown exploration strategy '{}'; valid: {}, llm",
-                                             name, fmt::join(explore::StrategyNames(), ", ")));
+  return Status::InvalidArgument(
+      fmt::format("unknown exploration strategy '{}'; valid: {}, llm", name,
+                  fmt::join(explore::StrategyNames(), ", ")));
 }
 
 Result<bool> StrategyIsAdaptive(const spec::Spec& spec) {
   const std::string& name = spec.exploration.strategy;
   ADSE_RETURN_IF_ERROR(CheckStrategyName(name));
   if (name == "llm") return true;
-  Result<std::unique_ptr<explore::Strategy>> strategy = explore::CreateStrategy(name, {&spec});
+  Result<std::unique_ptr<explore::Strategy>> strategy =
+      explore::CreateStrategy(name, {&spec});
   if (!strategy.ok()) return strategy.status();
   return (*strategy)->adaptive();
 }
 
-Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(const spec::Spec& spec,
-                                                                  const std::string& folder,
-                                                                  bool record) {
+Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(
+    const spec::Spec& spec, const std::string& folder, bool record) {
   const std::string& name = spec.exploration.strategy;
   ADSE_RETURN_IF_ERROR(CheckStrategyName(name));
   if (name != "llm") return explore::CreateStrategy(name, {&spec});
@@ -43,7 +44,9 @@ Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(const spec::Sp
   if (!backend.ok()) return backend.status();
   const CampaignFolder layout(folder);
   llm::LlmStrategyOptions options;
-  options.report_path = [layout](const std::string& key) { return layout.ReportPath(key); };
+  options.report_path = [layout](const std::string& key) {
+    return layout.ReportPath(key);
+  };
   options.image_path = [layout](const std::string& key) {
     return layout.TrajectoryImagePath(key);
   };

@@ -24,9 +24,8 @@ Result<bool> StrategyIsAdaptive(const spec::Spec& spec);
 // `folder`: the campaign folder runs are read from. `record`: the llm
 // agents record into it (live campaigns) or only read it (replay, where
 // their answers come from the folder's own record).
-Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(const spec::Spec& spec,
-                                                                  const std::string& folder,
-                                                                  bool record);
+Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(
+    const spec::Spec& spec, const std::string& folder, bool record);
 
 }  // namespace adse::campaign
 

@@ -31,7 +31,8 @@ std::string NextVersion(const fs::path& root) {
   if (fs::is_directory(root, ec)) {
     for (const auto& e : fs::directory_iterator(root, ec)) {
       const std::string name = e.path().filename().string();
-      if (name.size() > 1 && name[0] == 'v') last = std::max(last, std::atoi(name.c_str() + 1));
+      if (name.size() > 1 && name[0] == 'v')
+        last = std::max(last, std::atoi(name.c_str() + 1));
     }
   }
   return (root / fmt::format("v{}", last + 1)).string();
@@ -44,7 +45,8 @@ std::vector<std::string> RunFilesIn(const fs::path& folder) {
        it != fs::recursive_directory_iterator(); it.increment(ec)) {
     if (ec) break;
     const std::string name = it->path().filename().string();
-    if (it->is_directory() && (name == "analysis" || name.ends_with(".analysis"))) {
+    if (it->is_directory() &&
+        (name == "analysis" || name.ends_with(".analysis"))) {
       it.disable_recursion_pending();
       continue;
     }
@@ -65,14 +67,16 @@ struct ObjectiveSet {
 
 ObjectiveSet ObjectivesOf(const runfile::RunData& run) {
   ObjectiveSet set;
-  Result<spec::Spec> spec = spec::ParseSpec(run.scenario_text, "stored scenario", ".");
+  Result<spec::Spec> spec =
+      spec::ParseSpec(run.scenario_text, "stored scenario", ".");
   if (spec.ok()) {
     for (const spec::Objective& o : spec->objectives) {
       set.names.push_back(o.metric);
       set.maximize.push_back(!o.minimize);
     }
   }
-  if (set.names.empty()) set = {{"hardware_cost", "nav_time_s"}, {false, false}};
+  if (set.names.empty())
+    set = {{"hardware_cost", "nav_time_s"}, {false, false}};
   return set;
 }
 
@@ -94,7 +98,9 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
       if (doc.contains("runs")) return doc;
       return nlohmann::json{{"runs", nlohmann::json::array({doc})}};
     }
-    std::fprintf(stderr, "error: %s: no summary.json or report.json (expected an analysis version folder)\n",
+    std::fprintf(stderr,
+                 "error: %s: no summary.json or report.json (expected an "
+                 "analysis version folder)\n",
                  dir.c_str());
     return std::nullopt;
   };
@@ -102,7 +108,8 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
   if (!a || !b) return 2;
   auto key = [](const nlohmann::json& r) {
     std::string k;
-    for (const auto& [name, value] : r["point"].items()) k += fmt::format("{}={} ", name, value.dump());
+    for (const auto& [name, value] : r["point"].items())
+      k += fmt::format("{}={} ", name, value.dump());
     return k + "seed=" + r["seed"].dump();
   };
   std::map<std::string, nlohmann::json> in_a, in_b;
@@ -114,20 +121,25 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
   for (const auto& [k, _] : in_b) keys.insert(k);
   for (const std::string& k : keys) {
     nlohmann::json change = {{"point", k}};
-    if (!in_a.count(k)) change["change"] = "only in B";
-    else if (!in_b.count(k)) change["change"] = "only in A";
+    if (!in_a.count(k))
+      change["change"] = "only in B";
+    else if (!in_b.count(k))
+      change["change"] = "only in A";
     else {
       const auto& ra = in_a[k];
       const auto& rb = in_b[k];
-      if (ra["feasible"] != rb["feasible"]) change["feasible"] = {ra["feasible"], rb["feasible"]};
+      if (ra["feasible"] != rb["feasible"])
+        change["feasible"] = {ra["feasible"], rb["feasible"]};
       if (ra.value("on_front", false) != rb.value("on_front", false)) {
-        change["on_front"] = {ra.value("on_front", false), rb.value("on_front", false)};
+        change["on_front"] = {ra.value("on_front", false),
+                              rb.value("on_front", false)};
       }
       for (const auto& [m, va] : ra["metrics"].items()) {
         const auto vb = rb["metrics"].value(m, nlohmann::json(nullptr));
         if (va.is_number() && vb.is_number()) {
           const double x = va.get<double>(), y = vb.get<double>();
-          if (std::abs(x - y) > 1e-9 * std::max(1.0, std::abs(x))) change["metrics"][m] = {x, y};
+          if (std::abs(x - y) > 1e-9 * std::max(1.0, std::abs(x)))
+            change["metrics"][m] = {x, y};
         } else if (va != vb) {
           change["metrics"][m] = {va, vb};
         }
@@ -137,11 +149,15 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
     changes.push_back(change);
   }
   if (json) {
-    std::printf("%s\n", nlohmann::json{{"a", a_path}, {"b", b_path}, {"changes", changes}}.dump(2).c_str());
+    std::printf(
+        "%s\n",
+        nlohmann::json{{"a", a_path}, {"b", b_path}, {"changes", changes}}
+            .dump(2)
+            .c_str());
     return 0;
   }
-  std::printf("A = %s\nB = %s\n%zu of %zu points changed\n", a_path.c_str(), b_path.c_str(),
-              changes.size(), keys.size());
+  std::printf("A = %s\nB = %s\n%zu of %zu points changed\n", a_path.c_str(),
+              b_path.c_str(), changes.size(), keys.size());
   for (const auto& c : changes) std::printf("  %s\n", c.dump().c_str());
   return 0;
 }
@@ -151,7 +167,8 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
 int RunAnalyze(const AnalyzeArgs& args) {
   if (!args.diff.empty()) {
     if (args.diff.size() != 2) {
-      std::fprintf(stderr, "error: --diff takes two analysis folders: --diff A B\n");
+      std::fprintf(stderr,
+                   "error: --diff takes two analysis folders: --diff A B\n");
       return 2;
     }
     return Diff(args.diff[0], args.diff[1], args.json);
@@ -160,9 +177,13 @@ int RunAnalyze(const AnalyzeArgs& args) {
   for (const std::string& t : args.thresholds) {
     const size_t eq = t.find('=');
     char* end = nullptr;
-    const double value = eq == std::string::npos ? 0.0 : std::strtod(t.c_str() + eq + 1, &end);
-    if (eq == std::string::npos || end == nullptr || *end != '\0' || eq + 1 == t.size()) {
-      std::fprintf(stderr, "error: --threshold %s: expected NAME=VALUE with a number\n", t.c_str());
+    const double value =
+        eq == std::string::npos ? 0.0 : std::strtod(t.c_str() + eq + 1, &end);
+    if (eq == std::string::npos || end == nullptr || *end != '\0' ||
+        eq + 1 == t.size()) {
+      std::fprintf(stderr,
+                   "error: --threshold %s: expected NAME=VALUE with a number\n",
+                   t.c_str());
       return 2;
     }
     options.thresholds[t.substr(0, eq)] = value;
@@ -172,17 +193,21 @@ int RunAnalyze(const AnalyzeArgs& args) {
     std::error_code ec;
     const bool folder = fs::is_directory(target, ec);
     if (!folder && !fs::exists(target, ec)) {
-      std::fprintf(stderr, "error: %s: no such file or folder\n", target.c_str());
+      std::fprintf(stderr, "error: %s: no such file or folder\n",
+                   target.c_str());
       exit_code = 2;
       continue;
     }
-    const std::vector<std::string> files = folder ? RunFilesIn(target) : std::vector<std::string>{target};
+    const std::vector<std::string> files =
+        folder ? RunFilesIn(target) : std::vector<std::string>{target};
     if (files.empty()) {
-      std::fprintf(stderr, "error: %s: no run files (*.h5) in it\n", target.c_str());
+      std::fprintf(stderr, "error: %s: no run files (*.h5) in it\n",
+                   target.c_str());
       exit_code = 2;
       continue;
     }
-    nlohmann::json summary = {{"analysis_of", target}, {"runs", nlohmann::json::array()}};
+    nlohmann::json summary = {{"analysis_of", target},
+                              {"runs", nlohmann::json::array()}};
     std::vector<analysis::Evaluation> evals;
     std::vector<nlohmann::json*> rows;
     std::optional<ObjectiveSet> objectives;
@@ -190,19 +215,23 @@ int RunAnalyze(const AnalyzeArgs& args) {
       Result<runfile::RunData> run = runfile::ReadRunFile(file);
       if (!run.ok()) {
         // A broken file never stops the rest.
-        std::fprintf(stderr, "skipped %s: %s\n", file.c_str(), run.status().message().c_str());
+        std::fprintf(stderr, "skipped %s: %s\n", file.c_str(),
+                     run.status().message().c_str());
         exit_code = 2;
         continue;
       }
-      const std::string version = NextVersion(file.substr(0, file.size() - 3) + ".analysis");
+      const std::string version =
+          NextVersion(file.substr(0, file.size() - 3) + ".analysis");
       options.image_dir = version;
       if (Status s = MakeDirs(version); !s.ok()) {
         std::fprintf(stderr, "error: %s\n", s.message().c_str());
         return 1;
       }
-      Result<report::RunReport> report = report::AnalyzeRun(*run, file, options);
+      Result<report::RunReport> report =
+          report::AnalyzeRun(*run, file, options);
       if (!report.ok()) {
-        std::fprintf(stderr, "error: %s: %s\n", file.c_str(), report.status().message().c_str());
+        std::fprintf(stderr, "error: %s: %s\n", file.c_str(),
+                     report.status().message().c_str());
         fs::remove_all(version, ec);
         return ExitCodeFor(report.status());
       }
@@ -215,8 +244,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
         if (args.json) {
           std::printf("%s\n", doc.dump(2).c_str());
         } else {
-          std::printf("%s\n%swrote %s\n", file.c_str(), report::FormatSummary(*report).c_str(),
-                      version.c_str());
+          std::printf("%s\n%swrote %s\n", file.c_str(),
+                      report::FormatSummary(*report).c_str(), version.c_str());
         }
         continue;
       }
@@ -243,8 +272,9 @@ int RunAnalyze(const AnalyzeArgs& args) {
       const auto& m = r["metrics"];
       if (m.value("hardware_cost", nlohmann::json()).is_number() &&
           m.value("nav_time_s", nlohmann::json()).is_number()) {
-        plot.push_back({m["hardware_cost"].get<double>(), m["nav_time_s"].get<double>(),
-                        r["feasible"].get<bool>(), r["on_front"].get<bool>(), ""});
+        plot.push_back(
+            {m["hardware_cost"].get<double>(), m["nav_time_s"].get<double>(),
+             r["feasible"].get<bool>(), r["on_front"].get<bool>(), ""});
       }
     }
     summary["objectives"] = objectives->names;
@@ -256,8 +286,11 @@ int RunAnalyze(const AnalyzeArgs& args) {
     }
     if (!plot.empty()) {
       analysis::ParetoPlotOptions plot_options;
-      plot_options.title = fmt::format("{} runs, {} on the front", evals.size(), front.size());
-      if (analysis::RenderParetoPlot(plot, version + "/pareto.png", plot_options).ok()) {
+      plot_options.title =
+          fmt::format("{} runs, {} on the front", evals.size(), front.size());
+      if (analysis::RenderParetoPlot(plot, version + "/pareto.png",
+                                     plot_options)
+              .ok()) {
         summary["images"]["pareto"] = version + "/pareto.png";
       }
     }
@@ -268,9 +301,11 @@ int RunAnalyze(const AnalyzeArgs& args) {
     if (args.json) {
       std::printf("%s\n", summary.dump(2).c_str());
     } else {
-      std::printf("%s: %zu runs analysed, %zu on the Pareto front (%s)\nwrote %s\n", target.c_str(),
-                  evals.size(), front.size(), fmt::format("{}", fmt::join(objectives->names, ", ")).c_str(),
-                  version.c_str());
+      std::printf(
+          "%s: %zu runs analysed, %zu on the Pareto front (%s)\nwrote %s\n",
+          target.c_str(), evals.size(), front.size(),
+          fmt::format("{}", fmt::join(objectives->names, ", ")).c_str(),
+          version.c_str());
     }
   }
   return exit_code;

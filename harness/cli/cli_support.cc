@@ -34,9 +34,9 @@ void ReportError(const spec::Spec& spec, const Status& status) {
       }
     }
   }
-  const std::string where = field.empty() ? spec.source_path + ": " : spec.Where(field);
+  const std::string where =
+      field.empty() ? spec.source_path + ": " : spec.Where(field);
   std::fprintf(stderr, "%serror: %s\n", where.c_str(), message.c_str());
 }
-
 
 }  // namespace adse::cli

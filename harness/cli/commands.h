@@ -20,19 +20,19 @@ int RunValidate(const ValidateArgs& args);
 struct WorldArgs {
   std::string scenario;
   bool follow_ideal = false;
-  std::string out;                 // default: <output>/world-check
-  std::optional<uint64_t> seed;    // overrides world.traffic.seed
-  bool scan = true;                // simulate the LiDAR while driving
-  int save_every_nth_scan = 10;    // PCD files kept; 0: none
+  std::string out;               // default: <output>/world-check
+  std::optional<uint64_t> seed;  // overrides world.traffic.seed
+  bool scan = true;              // simulate the LiDAR while driving
+  int save_every_nth_scan = 10;  // PCD files kept; 0: none
   bool json = false;
 };
 int RunWorld(const WorldArgs& args);
 
 struct SimulateArgs {
   std::string scenario;
-  std::string point;              // "cores=4,freq_ghz=1.2"; empty: start_from
-  std::optional<uint64_t> seed;   // overrides world.traffic.seed
-  std::string out;                // default: <output>/simulate/<point>.h5
+  std::string point;             // "cores=4,freq_ghz=1.2"; empty: start_from
+  std::optional<uint64_t> seed;  // overrides world.traffic.seed
+  std::string out;               // default: <output>/simulate/<point>.h5
   bool json = false;
   bool quiet = false;
 };
@@ -40,8 +40,8 @@ int RunSimulate(const SimulateArgs& args);
 
 struct CalibrateArgs {
   std::string scenario;
-  std::string point;     // empty: start_from
-  int runs = 2;          // measured runs fitted together (seeds seed, seed+1, ...)
+  std::string point;  // empty: start_from
+  int runs = 2;       // measured runs fitted together (seeds seed, seed+1, ...)
   std::string out = "calibration.json";
 };
 int RunCalibrate(const CalibrateArgs& args);
@@ -72,17 +72,17 @@ int RunWorker(const WorkerArgs& args);
 
 struct RunArgs {
   std::string scenario;
-  std::string out;         // campaign folder; default: the scenario's output
-  std::string strategy;    // overrides exploration.strategy
-  int budget = -1;         // overrides exploration.budget
-  int workers = -1;        // overrides harness.workers (0: auto)
-  std::string isolation;   // overrides harness.isolation
+  std::string out;        // campaign folder; default: the scenario's output
+  std::string strategy;   // overrides exploration.strategy
+  int budget = -1;        // overrides exploration.budget
+  int workers = -1;       // overrides harness.workers (0: auto)
+  std::string isolation;  // overrides harness.isolation
   bool no_cache = false;
-  std::string cache_dir;   // overrides harness.cache_dir
+  std::string cache_dir;  // overrides harness.cache_dir
   bool retry_failed = false;
   bool quiet = false;
   bool json = false;
-  std::string executor;    // overrides harness.executor: local | slurm
+  std::string executor;  // overrides harness.executor: local | slurm
 };
 int RunRun(const RunArgs& args);
 
@@ -97,16 +97,16 @@ struct ExploreArgs {
 int RunExplore(const ExploreArgs& args);
 
 struct InterpretArgs {
-  std::string request;           // in plain words
-  std::string out;               // scenario file; empty: stdout
+  std::string request;             // in plain words
+  std::string out;                 // scenario file; empty: stdout
   std::string backend = "ollama";  // ollama|openai|replay
-  std::string endpoint;          // empty: the backend's default
+  std::string endpoint;            // empty: the backend's default
   std::string model = "llama3.1";
-  std::string prompts;           // prompt folder; empty: bundled
+  std::string prompts;  // prompt folder; empty: bundled
   double timeout_s = 120.0;
   int retries = 2;
   int max_corrections = 3;
-  std::string record;       // exchanges JSONL; default <out stem>.interpret.jsonl
+  std::string record;  // exchanges JSONL; default <out stem>.interpret.jsonl
   std::string replay_from;  // answer from this record first (replay: only)
   bool check_world = true;  // validate the map, start and goal in SUMO
 };

@@ -86,7 +86,8 @@ int RunExplore(const ExploreArgs& args) {
       missing += run->missing;
       nlohmann::json proposals = nlohmann::json::array();
       for (const spec::DesignPoint& point : run->proposals) {
-        proposals.push_back(spec::FormatPoint(recording->spec.design_space, point));
+        proposals.push_back(
+            spec::FormatPoint(recording->spec.design_space, point));
       }
       runs.push_back({{"seed", seed},
                       {"proposals", proposals},

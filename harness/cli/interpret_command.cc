@@ -23,8 +23,10 @@ namespace fs = std::filesystem;
 namespace {
 
 // Replaces every occurrence of `from` in `text`.
-std::string ReplaceAll(std::string text, const std::string& from, const std::string& to) {
-  for (size_t pos = 0; (pos = text.find(from, pos)) != std::string::npos; pos += to.size()) {
+std::string ReplaceAll(std::string text, const std::string& from,
+                       const std::string& to) {
+  for (size_t pos = 0; (pos = text.find(from, pos)) != std::string::npos;
+       pos += to.size()) {
     text.replace(pos, from.size(), to);
   }
   return text;
@@ -34,9 +36,11 @@ std::string ReplaceAll(std::string text, const std::string& from, const std::str
 
 int RunInterpret(const InterpretArgs& args) {
   if (args.request.find_first_not_of(" \t\r\n") == std::string::npos) {
-    std::fprintf(stderr, "adse interpret: the request is empty; say what to study, e.g. "
-                         "\"robotaxi in a parking lot, cheapest computer that reaches the "
-                         "goal within 60 s\"\n");
+    std::fprintf(
+        stderr,
+        "adse interpret: the request is empty; say what to study, e.g. "
+        "\"robotaxi in a parking lot, cheapest computer that reaches the "
+        "goal within 60 s\"\n");
     return 2;
   }
   spec::LlmOptions llm;
@@ -45,26 +49,33 @@ int RunInterpret(const InterpretArgs& args) {
   llm.timeout_s = args.timeout_s;
   llm.retries = args.retries;
   if (args.backend == "replay" && args.replay_from.empty()) {
-    std::fprintf(stderr, "adse interpret: --backend replay needs --replay-from <exchanges.jsonl>\n");
+    std::fprintf(stderr,
+                 "adse interpret: --backend replay needs --replay-from "
+                 "<exchanges.jsonl>\n");
     return 2;
   }
-  const std::string out = args.out.empty() ? "" : fs::absolute(args.out).lexically_normal().string();
+  const std::string out =
+      args.out.empty() ? ""
+                       : fs::absolute(args.out).lexically_normal().string();
   const std::string folder = out.empty() ? fs::current_path().string()
                                          : fs::path(out).parent_path().string();
   std::string record = args.record;
   if (record.empty() && !out.empty()) {
-    record = (fs::path(out).parent_path() / (fs::path(out).stem().string() + ".interpret.jsonl"))
+    record = (fs::path(out).parent_path() /
+              (fs::path(out).stem().string() + ".interpret.jsonl"))
                  .string();
   }
   Result<std::unique_ptr<llm::RecordingBackend>> backend =
       llm::OpenRecordingBackend(llm, args.replay_from, record);
   if (!backend.ok()) {
-    std::fprintf(stderr, "adse interpret: %s\n", backend.status().message().c_str());
+    std::fprintf(stderr, "adse interpret: %s\n",
+                 backend.status().message().c_str());
     return ExitCodeFor(backend.status());
   }
   Result<llm::PromptSet> prompts = llm::PromptSet::Load(args.prompts);
   if (!prompts.ok()) {
-    std::fprintf(stderr, "adse interpret: %s\n", prompts.status().message().c_str());
+    std::fprintf(stderr, "adse interpret: %s\n",
+                 prompts.status().message().c_str());
     return 2;
   }
   if (!out.empty()) {
@@ -77,9 +88,12 @@ int RunInterpret(const InterpretArgs& args) {
 
   // The candidate is validated where it will live, so that relative paths
   // resolve the same; the hidden file is removed whatever happens.
-  const std::string shown = out.empty() ? "scenario.yaml" : fs::path(out).filename().string();
+  const std::string shown =
+      out.empty() ? "scenario.yaml" : fs::path(out).filename().string();
   const std::string check =
-      (fs::path(folder) / fmt::format(".{}.interpret-check-{}.yaml", shown, ::getpid())).string();
+      (fs::path(folder) /
+       fmt::format(".{}.interpret-check-{}.yaml", shown, ::getpid()))
+          .string();
   const std::string self = SelfExecutable();
   llm::InterpretOptions options;
   options.model = args.model;
@@ -94,26 +108,32 @@ int RunInterpret(const InterpretArgs& args) {
     if (result->exit_code == 0) return Status::Ok();
     return Status::InvalidArgument(ReplaceAll(result->output, check, shown));
   };
-  std::fprintf(stderr, "adse interpret: asking %s (%s) ...\n", args.model.c_str(),
-               args.backend.c_str());
+  std::fprintf(stderr, "adse interpret: asking %s (%s) ...\n",
+               args.model.c_str(), args.backend.c_str());
   Result<llm::InterpretResult> result =
       llm::Interpret(args.request, **backend, *prompts, options);
   ::unlink(check.c_str());
   if (!result.ok()) {
-    std::fprintf(stderr, "adse interpret: %s\n", result.status().message().c_str());
-    if (!record.empty()) std::fprintf(stderr, "exchanges recorded in %s\n", record.c_str());
+    std::fprintf(stderr, "adse interpret: %s\n",
+                 result.status().message().c_str());
+    if (!record.empty())
+      std::fprintf(stderr, "exchanges recorded in %s\n", record.c_str());
     return ExitCodeFor(result.status());
   }
   for (const std::string& d : result->dropped) {
-    std::fprintf(stderr, "adse interpret: dropped section '%s' (a model does not choose it)\n",
-                 d.c_str());
+    std::fprintf(
+        stderr,
+        "adse interpret: dropped section '%s' (a model does not choose it)\n",
+        d.c_str());
   }
   for (const std::string& d : result->defaults) {
-    std::fprintf(stderr, "adse interpret: the request did not say; default used: %s\n",
+    std::fprintf(stderr,
+                 "adse interpret: the request did not say; default used: %s\n",
                  d.c_str());
   }
-  const std::string text = "# Written by `adse interpret` from the request:\n#   " +
-                           ReplaceAll(args.request, "\n", "\n#   ") + "\n" + result->yaml;
+  const std::string text =
+      "# Written by `adse interpret` from the request:\n#   " +
+      ReplaceAll(args.request, "\n", "\n#   ") + "\n" + result->yaml;
   if (out.empty()) {
     std::fputs(text.c_str(), stdout);
   } else {
@@ -122,10 +142,12 @@ int RunInterpret(const InterpretArgs& args) {
       std::fprintf(stderr, "adse interpret: %s\n", written.message().c_str());
       return 1;
     }
-    std::fprintf(stderr, "adse interpret: wrote %s (%d answers, %zu corrected)\n", out.c_str(),
-                 result->answers, result->rejected.size());
+    std::fprintf(stderr,
+                 "adse interpret: wrote %s (%d answers, %zu corrected)\n",
+                 out.c_str(), result->answers, result->rejected.size());
   }
-  if (!record.empty()) std::fprintf(stderr, "exchanges recorded in %s\n", record.c_str());
+  if (!record.empty())
+    std::fprintf(stderr, "exchanges recorded in %s\n", record.c_str());
   return 0;
 }
 

@@ -15,8 +15,9 @@ int main(int argc, char** argv) {
 
   adse::cli::ValidateArgs validate;
   CLI::App* validate_cmd = app.add_subcommand(
-      "validate", "Check a scenario file; print it normalised and the size of "
-                  "its design space");
+      "validate",
+      "Check a scenario file; print it normalised and the size of "
+      "its design space");
   validate_cmd->add_option("scenario", validate.scenario, "Scenario YAML file")
       ->required();
   validate_cmd->add_flag("!--no-world", validate.check_world,
@@ -27,9 +28,10 @@ int main(int argc, char** argv) {
   adse::cli::WorldArgs world;
   uint64_t seed = 0;
   CLI::App* world_cmd = app.add_subcommand(
-      "world", "Check the simulated world alone: load the map, plan the ideal "
-               "path and, with --follow-ideal, drive it with a perfect "
-               "controller while the LiDAR scans");
+      "world",
+      "Check the simulated world alone: load the map, plan the ideal "
+      "path and, with --follow-ideal, drive it with a perfect "
+      "controller while the LiDAR scans");
   world_cmd->add_option("scenario", world.scenario, "Scenario YAML file")
       ->required();
   world_cmd->add_flag("--follow-ideal", world.follow_ideal,
@@ -39,204 +41,295 @@ int main(int argc, char** argv) {
   CLI::Option* seed_opt = world_cmd->add_option(
       "--seed", seed, "Traffic seed (overrides world.traffic.seed)");
   world_cmd->add_flag("!--no-scan", world.scan, "Do not simulate the LiDAR");
-  world_cmd->add_option("--save-scans", world.save_every_nth_scan,
-                        "Keep every Nth scan as a PCD file (0: none)")
+  world_cmd
+      ->add_option("--save-scans", world.save_every_nth_scan,
+                   "Keep every Nth scan as a PCD file (0: none)")
       ->check(CLI::NonNegativeNumber);
   world_cmd->add_flag("--json", world.json, "Print the summary as JSON");
 
   adse::cli::SimulateArgs simulate;
   uint64_t simulate_seed = 0;
   CLI::App* simulate_cmd = app.add_subcommand(
-      "simulate", "Drive one design point in closed loop (world + stack on the "
-                  "virtual platform) and print its metrics");
-  simulate_cmd->add_option("scenario", simulate.scenario, "Scenario YAML file")->required();
-  simulate_cmd->add_option("-p,--point", simulate.point,
-                           "Design point, e.g. cores=4,freq_ghz=1.2,lidar_hz=14 "
-                           "(default: exploration.start_from)");
+      "simulate",
+      "Drive one design point in closed loop (world + stack on the "
+      "virtual platform) and print its metrics");
+  simulate_cmd->add_option("scenario", simulate.scenario, "Scenario YAML file")
+      ->required();
+  simulate_cmd->add_option(
+      "-p,--point", simulate.point,
+      "Design point, e.g. cores=4,freq_ghz=1.2,lidar_hz=14 "
+      "(default: exploration.start_from)");
   CLI::Option* simulate_seed_opt = simulate_cmd->add_option(
-      "--seed", simulate_seed, "Traffic and sensor seed (overrides world.traffic.seed)");
+      "--seed", simulate_seed,
+      "Traffic and sensor seed (overrides world.traffic.seed)");
   simulate_cmd->add_option("-o,--out", simulate.out,
                            "Run file (default: <output>/simulate/<point>.h5)");
-  simulate_cmd->add_flag("--json", simulate.json, "Print metrics and timings as JSON");
+  simulate_cmd->add_flag("--json", simulate.json,
+                         "Print metrics and timings as JSON");
   simulate_cmd->add_flag("-q,--quiet", simulate.quiet, "No progress line");
 
   adse::cli::CalibrateArgs calibrate;
   CLI::App* calibrate_cmd = app.add_subcommand(
-      "calibrate", "Fit the `counted` cost model's per-callback costs on this host "
-                   "from measured runs");
-  calibrate_cmd->add_option("scenario", calibrate.scenario, "Scenario YAML file")->required();
-  calibrate_cmd->add_option("-p,--point", calibrate.point,
-                            "Design point to run (default: exploration.start_from)");
+      "calibrate",
+      "Fit the `counted` cost model's per-callback costs on this host "
+      "from measured runs");
+  calibrate_cmd
+      ->add_option("scenario", calibrate.scenario, "Scenario YAML file")
+      ->required();
+  calibrate_cmd->add_option(
+      "-p,--point", calibrate.point,
+      "Design point to run (default: exploration.start_from)");
   calibrate_cmd->add_option("--runs", calibrate.runs, "Measured runs to fit")
       ->check(CLI::Range(1, 100));
-  calibrate_cmd->add_option("-o,--out", calibrate.out, "Calibration file to write");
+  calibrate_cmd->add_option("-o,--out", calibrate.out,
+                            "Calibration file to write");
 
   adse::cli::SchemaCheckArgs schema_check;
   CLI::App* schema_cmd = app.add_subcommand("schema", "Run-file schema tools");
   schema_cmd->require_subcommand(1);
   CLI::App* schema_check_cmd = schema_cmd->add_subcommand(
       "check", "Check run files against results-schema/run.schema.json");
-  schema_check_cmd->add_option("files", schema_check.files, "Run files (.h5)")->required();
+  schema_check_cmd->add_option("files", schema_check.files, "Run files (.h5)")
+      ->required();
 
   adse::cli::AnalyzeArgs analyze;
   CLI::App* analyze_cmd = app.add_subcommand(
-      "analyze", "Recompute metrics, deviation, diagnosis, pictures and the Pareto front from "
-                 "run files, into a new analysis version next to them (raw data is never "
-                 "rewritten); exit 2 if any file could not be read");
-  analyze_cmd->add_option("targets", analyze.targets, "Run files (.h5) or folders of them");
+      "analyze",
+      "Recompute metrics, deviation, diagnosis, pictures and the Pareto front "
+      "from "
+      "run files, into a new analysis version next to them (raw data is never "
+      "rewritten); exit 2 if any file could not be read");
+  analyze_cmd->add_option("targets", analyze.targets,
+                          "Run files (.h5) or folders of them");
   analyze_cmd->add_option("--threshold", analyze.thresholds,
                           "Diagnosis option NAME=VALUE (repeatable), e.g. "
                           "frequency_bound_fraction=0.2");
-  analyze_cmd->add_option("--diff", analyze.diff, "Compare two analysis version folders: --diff A B")
+  analyze_cmd
+      ->add_option("--diff", analyze.diff,
+                   "Compare two analysis version folders: --diff A B")
       ->expected(2);
   analyze_cmd->add_flag("--json", analyze.json, "Print the report(s) as JSON");
 
   adse::cli::RunArgs run;
-  CLI::App* run_cmd = app.add_subcommand(
-      "run", "Explore the scenario's design space within its budget: runs go to a pool of "
-             "worker processes (cgroup-limited), results to the campaign folder (runs/, "
-             "campaign.h5, report.md, pareto.png, summary.json). Run it again to resume.");
-  run_cmd->add_option("scenario", run.scenario, "Scenario YAML file")->required();
-  run_cmd->add_option("-o,--out", run.out, "Campaign folder (default: the scenario's output)");
-  run_cmd->add_option("--strategy", run.strategy,
-                      "Override exploration.strategy: exhaustive, random, ga, nsga2, agent");
-  run_cmd->add_option("--budget", run.budget, "Override exploration.budget (evaluations)")
+  CLI::App* run_cmd =
+      app.add_subcommand("run",
+                         "Explore the scenario's design space within its "
+                         "budget: runs go to a pool of "
+                         "worker processes (cgroup-limited), results to the "
+                         "campaign folder (runs/, "
+                         "campaign.h5, report.md, pareto.png, summary.json). "
+                         "Run it again to resume.");
+  run_cmd->add_option("scenario", run.scenario, "Scenario YAML file")
+      ->required();
+  run_cmd->add_option("-o,--out", run.out,
+                      "Campaign folder (default: the scenario's output)");
+  run_cmd->add_option(
+      "--strategy", run.strategy,
+      "Override exploration.strategy: exhaustive, random, ga, nsga2, agent");
+  run_cmd
+      ->add_option("--budget", run.budget,
+                   "Override exploration.budget (evaluations)")
       ->check(CLI::NonNegativeNumber);
-  run_cmd->add_option("--workers", run.workers, "Override harness.workers (0: auto)")
+  run_cmd
+      ->add_option("--workers", run.workers,
+                   "Override harness.workers (0: auto)")
       ->check(CLI::NonNegativeNumber);
-  run_cmd->add_option("--isolation", run.isolation, "Override harness.isolation")
+  run_cmd
+      ->add_option("--isolation", run.isolation, "Override harness.isolation")
       ->check(CLI::IsMember({"auto", "cgroup", "affinity"}));
   run_cmd->add_flag("--no-cache", run.no_cache,
                     "Neither read nor fill the shared evaluation cache");
-  run_cmd->add_option("--cache-dir", run.cache_dir, "Override harness.cache_dir");
-  run_cmd->add_flag("--retry-failed", run.retry_failed,
-                    "Run again points whose runs failed for good in an earlier session");
-  run_cmd->add_flag("-q,--quiet", run.quiet, "Only failures and errors on stderr");
-  run_cmd->add_flag("--json", run.json, "Print summary.json on stdout at the end");
-  run_cmd->add_option("--executor", run.executor,
-                      "Override harness.executor: local (worker processes here) or slurm "
-                      "(each run a job step, srun, inside the current Slurm allocation)")
+  run_cmd->add_option("--cache-dir", run.cache_dir,
+                      "Override harness.cache_dir");
+  run_cmd->add_flag(
+      "--retry-failed", run.retry_failed,
+      "Run again points whose runs failed for good in an earlier session");
+  run_cmd->add_flag("-q,--quiet", run.quiet,
+                    "Only failures and errors on stderr");
+  run_cmd->add_flag("--json", run.json,
+                    "Print summary.json on stdout at the end");
+  run_cmd
+      ->add_option(
+          "--executor", run.executor,
+          "Override harness.executor: local (worker processes here) or slurm "
+          "(each run a job step, srun, inside the current Slurm allocation)")
       ->check(CLI::IsMember({"local", "slurm"}));
 
   adse::cli::WorkerArgs worker;
   uint64_t worker_seed = 0;
   CLI::App* worker_cmd = app.add_subcommand(
-      "worker", "Run one design point in this process and write its run file (what the "
-                "campaign's pool starts; rarely used by hand)");
-  worker_cmd->add_option("scenario", worker.scenario, "Scenario YAML file")->required();
-  worker_cmd->add_option("-p,--point", worker.point, "Design point")->required();
-  CLI::Option* worker_seed_opt = worker_cmd->add_option("--seed", worker_seed, "Traffic seed");
-  worker_cmd->add_option("-o,--out", worker.out, "Run file to write")->required();
+      "worker",
+      "Run one design point in this process and write its run file (what the "
+      "campaign's pool starts; rarely used by hand)");
+  worker_cmd->add_option("scenario", worker.scenario, "Scenario YAML file")
+      ->required();
+  worker_cmd->add_option("-p,--point", worker.point, "Design point")
+      ->required();
+  CLI::Option* worker_seed_opt =
+      worker_cmd->add_option("--seed", worker_seed, "Traffic seed");
+  worker_cmd->add_option("-o,--out", worker.out, "Run file to write")
+      ->required();
   worker_cmd->add_option("--expect-key", worker.expect_key,
                          "Refuse to run unless the run's content key is this");
   worker_cmd->add_option("--report", worker.report,
-                         "Also write the run's analysis (RunReport JSON) here, after the run file");
-  worker_cmd->add_option("--image-dir", worker.image_dir,
-                         "Draw the trajectory picture (trajectory.png) into this folder");
+                         "Also write the run's analysis (RunReport JSON) here, "
+                         "after the run file");
+  worker_cmd->add_option(
+      "--image-dir", worker.image_dir,
+      "Draw the trajectory picture (trajectory.png) into this folder");
 
   adse::cli::ExploreArgs explore;
   CLI::App* explore_cmd = app.add_subcommand(
-      "explore", "Compare strategies without simulating: replay them against a recorded "
-                 "campaign over many seeds");
-  explore_cmd->add_option("--replay", explore.replay, "Recorded campaign folder (campaign.h5)")
+      "explore",
+      "Compare strategies without simulating: replay them against a recorded "
+      "campaign over many seeds");
+  explore_cmd
+      ->add_option("--replay", explore.replay,
+                   "Recorded campaign folder (campaign.h5)")
       ->required();
-  explore_cmd->add_option("--strategy", explore.strategies,
-                          "Strategies, comma-separated (default: all)")
+  explore_cmd
+      ->add_option("--strategy", explore.strategies,
+                   "Strategies, comma-separated (default: all)")
       ->delimiter(',');
-  explore_cmd->add_option("--budget", explore.budget, "Evaluations per replay (default: the "
-                                                      "recorded scenario's budget)")
+  explore_cmd
+      ->add_option("--budget", explore.budget,
+                   "Evaluations per replay (default: the "
+                   "recorded scenario's budget)")
       ->check(CLI::PositiveNumber);
   explore_cmd->add_option("--seeds", explore.seeds, "Seeds per strategy")
       ->check(CLI::Range(1, 100000));
-  explore_cmd->add_option("--first-seed", explore.first_seed, "First exploration seed");
+  explore_cmd->add_option("--first-seed", explore.first_seed,
+                          "First exploration seed");
   explore_cmd->add_flag("--json", explore.json, "Print the results as JSON");
 
   adse::cli::InterpretArgs interpret;
   CLI::App* interpret_cmd = app.add_subcommand(
-      "interpret", "Turn a request in plain words into a validated scenario file with the "
-                   "interpretation agent (an LLM: Ollama, an OpenAI-compatible server, or a "
-                   "recorded exchange)");
-  interpret_cmd->add_option("request", interpret.request,
-                            "What to study, e.g. \"robotaxi in a parking lot; cheapest "
-                            "computer that reaches the goal within 60 s\"")
+      "interpret",
+      "Turn a request in plain words into a validated scenario file with the "
+      "interpretation agent (an LLM: Ollama, an OpenAI-compatible server, or a "
+      "recorded exchange)");
+  interpret_cmd
+      ->add_option("request", interpret.request,
+                   "What to study, e.g. \"robotaxi in a parking lot; cheapest "
+                   "computer that reaches the goal within 60 s\"")
       ->required();
   interpret_cmd->add_option("-o,--out", interpret.out,
                             "Scenario file to write (default: print it)");
-  interpret_cmd->add_option("--backend", interpret.backend,
-                            "ollama, openai (sends $OPENAI_API_KEY when set) or replay")
+  interpret_cmd
+      ->add_option("--backend", interpret.backend,
+                   "ollama, openai (sends $OPENAI_API_KEY when set) or replay")
       ->check(CLI::IsMember({"ollama", "openai", "replay"}));
   interpret_cmd->add_option("--endpoint", interpret.endpoint,
                             "Server URL (default: http://127.0.0.1:11434)");
-  interpret_cmd->add_option("--model", interpret.model, "Model name")->capture_default_str();
-  interpret_cmd->add_option("--prompts", interpret.prompts,
-                            "Folder of prompt templates (default: the bundled prompts/)");
-  interpret_cmd->add_option("--timeout", interpret.timeout_s, "Seconds per request")
-      ->check(CLI::PositiveNumber)->capture_default_str();
-  interpret_cmd->add_option("--retries", interpret.retries, "HTTP retries per request")
-      ->check(CLI::Range(0, 100))->capture_default_str();
-  interpret_cmd->add_option("--max-corrections", interpret.max_corrections,
-                            "Validation errors sent back to the model at most")
-      ->check(CLI::Range(0, 20))->capture_default_str();
-  interpret_cmd->add_option("--record", interpret.record,
-                            "Where exchanges are recorded (default: <out stem>.interpret.jsonl "
-                            "beside the output)");
-  interpret_cmd->add_option("--replay-from", interpret.replay_from,
-                            "Recorded exchanges (.jsonl) answered first; with --backend replay "
-                            "the only answers")
+  interpret_cmd->add_option("--model", interpret.model, "Model name")
+      ->capture_default_str();
+  interpret_cmd->add_option(
+      "--prompts", interpret.prompts,
+      "Folder of prompt templates (default: the bundled prompts/)");
+  interpret_cmd
+      ->add_option("--timeout", interpret.timeout_s, "Seconds per request")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  interpret_cmd
+      ->add_option("--retries", interpret.retries, "HTTP retries per request")
+      ->check(CLI::Range(0, 100))
+      ->capture_default_str();
+  interpret_cmd
+      ->add_option("--max-corrections", interpret.max_corrections,
+                   "Validation errors sent back to the model at most")
+      ->check(CLI::Range(0, 20))
+      ->capture_default_str();
+  interpret_cmd->add_option(
+      "--record", interpret.record,
+      "Where exchanges are recorded (default: <out stem>.interpret.jsonl "
+      "beside the output)");
+  interpret_cmd
+      ->add_option(
+          "--replay-from", interpret.replay_from,
+          "Recorded exchanges (.jsonl) answered first; with --backend replay "
+          "the only answers")
       ->check(CLI::ExistingFile);
   interpret_cmd->add_flag("!--no-world", interpret.check_world,
                           "Do not load the map in SUMO when validating");
 
   adse::cli::SubmitArgs submit;
-  CLI::App* submit_cmd = app.add_subcommand(
-      "submit", "Hand the campaign to Slurm (from a login node): adaptive strategies as one "
-                "batch job running the coordinator, whose runs are job steps; static sweeps "
-                "(exhaustive, random) as a job array of shards plus an index job after it. "
-                "The scripts go to <campaign>/slurm/. Submit again to continue after a cancel "
-                "or time limit: finished runs are not repeated.");
-  submit_cmd->add_option("scenario", submit.scenario, "Scenario YAML file")->required();
-  submit_cmd->add_option("-o,--out", submit.out,
-                         "Campaign folder on a shared filesystem (default: the scenario's "
-                         "output)");
-  submit_cmd->add_option("--strategy", submit.strategy, "Override exploration.strategy");
-  submit_cmd->add_option("--budget", submit.budget, "Override exploration.budget")
+  CLI::App* submit_cmd =
+      app.add_subcommand("submit",
+                         "Hand the campaign to Slurm (from a login node): "
+                         "adaptive strategies as one "
+                         "batch job running the coordinator, whose runs are "
+                         "job steps; static sweeps "
+                         "(exhaustive, random) as a job array of shards plus "
+                         "an index job after it. "
+                         "The scripts go to <campaign>/slurm/. Submit again to "
+                         "continue after a cancel "
+                         "or time limit: finished runs are not repeated.");
+  submit_cmd->add_option("scenario", submit.scenario, "Scenario YAML file")
+      ->required();
+  submit_cmd->add_option(
+      "-o,--out", submit.out,
+      "Campaign folder on a shared filesystem (default: the scenario's "
+      "output)");
+  submit_cmd->add_option("--strategy", submit.strategy,
+                         "Override exploration.strategy");
+  submit_cmd
+      ->add_option("--budget", submit.budget, "Override exploration.budget")
       ->check(CLI::NonNegativeNumber);
   submit_cmd->add_flag("--dry-run", submit.dry_run,
                        "Print the sbatch scripts; write and submit nothing");
-  submit_cmd->add_option("--sbatch-arg", submit.sbatch_args,
-                         "Another sbatch option for every script, e.g. --sbatch-arg=--qos=long "
-                         "(repeatable; after adse's own #SBATCH lines, so it wins)")
+  submit_cmd
+      ->add_option("--sbatch-arg", submit.sbatch_args,
+                   "Another sbatch option for every script, e.g. "
+                   "--sbatch-arg=--qos=long "
+                   "(repeatable; after adse's own #SBATCH lines, so it wins)")
       ->allow_extra_args(false);
-  submit_cmd->add_flag("--no-cache", submit.no_cache,
-                       "The jobs neither read nor fill the shared evaluation cache");
-  submit_cmd->add_option("--cache-dir", submit.cache_dir, "Override harness.cache_dir");
-  submit_cmd->add_flag("--json", submit.json, "Print what was submitted as JSON");
+  submit_cmd->add_flag(
+      "--no-cache", submit.no_cache,
+      "The jobs neither read nor fill the shared evaluation cache");
+  submit_cmd->add_option("--cache-dir", submit.cache_dir,
+                         "Override harness.cache_dir");
+  submit_cmd->add_flag("--json", submit.json,
+                       "Print what was submitted as JSON");
 
   adse::cli::StatusArgs status;
-  CLI::App* status_cmd = app.add_subcommand(
-      "status", "Show a campaign's runs (done, failed, running, pending) and the Slurm jobs "
-                "submitted for it with their states");
-  status_cmd->add_option("campaign", status.campaign, "Campaign folder")->required();
+  CLI::App* status_cmd =
+      app.add_subcommand("status",
+                         "Show a campaign's runs (done, failed, running, "
+                         "pending) and the Slurm jobs "
+                         "submitted for it with their states");
+  status_cmd->add_option("campaign", status.campaign, "Campaign folder")
+      ->required();
   status_cmd->add_flag("--json", status.json, "Print the status as JSON");
 
   adse::cli::ShardArgs shard;
   CLI::App* shard_cmd = app.add_subcommand(
-      "shard", "Run one shard of a submitted sweep (what each job-array task runs): its "
-               "points without a result, as job steps in this allocation");
-  shard_cmd->add_option("campaign", shard.campaign, "Campaign folder (with slurm/plan.json)")
+      "shard",
+      "Run one shard of a submitted sweep (what each job-array task runs): its "
+      "points without a result, as job steps in this allocation");
+  shard_cmd
+      ->add_option("campaign", shard.campaign,
+                   "Campaign folder (with slurm/plan.json)")
       ->required();
-  shard_cmd->add_option("--task", shard.task, "Shard number (default: $SLURM_ARRAY_TASK_ID)")
+  shard_cmd
+      ->add_option("--task", shard.task,
+                   "Shard number (default: $SLURM_ARRAY_TASK_ID)")
       ->check(CLI::NonNegativeNumber);
-  shard_cmd->add_flag("--local", shard.local,
-                      "Run the points in local worker processes instead of job steps");
-  shard_cmd->add_flag("-q,--quiet", shard.quiet, "Only failures and errors on stderr");
+  shard_cmd->add_flag(
+      "--local", shard.local,
+      "Run the points in local worker processes instead of job steps");
+  shard_cmd->add_flag("-q,--quiet", shard.quiet,
+                      "Only failures and errors on stderr");
 
   adse::cli::IndexArgs index;
   CLI::App* index_cmd = app.add_subcommand(
-      "index", "Build a submitted sweep's campaign.h5, report.md, summary.json and "
-               "pareto.png from its run files (the job adse submit queues after the array); "
-               "exit 1 while points lack a result");
-  index_cmd->add_option("campaign", index.campaign, "Campaign folder (with slurm/plan.json)")
+      "index",
+      "Build a submitted sweep's campaign.h5, report.md, summary.json and "
+      "pareto.png from its run files (the job adse submit queues after the "
+      "array); "
+      "exit 1 while points lack a result");
+  index_cmd
+      ->add_option("campaign", index.campaign,
+                   "Campaign folder (with slurm/plan.json)")
       ->required();
   index_cmd->add_flag("--json", index.json, "Print summary.json on stdout");
 
@@ -263,7 +356,8 @@ int main(int argc, char** argv) {
   if (*schema_check_cmd) return adse::cli::RunSchemaCheck(schema_check);
   if (*analyze_cmd) {
     if (analyze.targets.empty() && analyze.diff.empty()) {
-      std::fprintf(stderr, "error: analyze needs run files or folders, or --diff A B\n");
+      std::fprintf(
+          stderr, "error: analyze needs run files or folders, or --diff A B\n");
       return 2;
     }
     return adse::cli::RunAnalyze(analyze);

@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <csignal>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <limits>
 
@@ -15,10 +15,10 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/campaign/campaign.h"
-#include "harness/slurm/allocation.h"
-#include "harness/slurm/step_pool.h"
 #include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
+#include "harness/slurm/allocation.h"
+#include "harness/slurm/step_pool.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/files.h"
 
@@ -84,8 +84,10 @@ class Progress : public campaign::ExplorerListener {
       line = fmt::format(
           "[{}/{}] {}: {}, nav {:.1f} s, ctrl {:.1f} Hz, cost {:.3g}, {} "
           "({}{})",
-          done_, budget_, point, row.reason, campaign::RowMetric(row, "nav_time_s"),
-          campaign::RowMetric(row, "ctrl_rate_hz"), campaign::RowMetric(row, "hardware_cost"),
+          done_, budget_, point, row.reason,
+          campaign::RowMetric(row, "nav_time_s"),
+          campaign::RowMetric(row, "ctrl_rate_hz"),
+          campaign::RowMetric(row, "hardware_cost"),
           row.feasible ? "feasible" : "infeasible", row.source,
           row.source == "simulated" ? fmt::format(" {:.1f} s", row.wall_s)
                                     : "");
@@ -174,8 +176,7 @@ int RunRun(const RunArgs& args) {
     options.make_pool = slurm::CreateAllocationPool;
     // Slurm's warning before the time limit (sbatch --signal=B:USR1@<s>).
     options.drain_signal = SIGUSR1;
-    options.drain_grace_s =
-        std::max(0, spec->harness.slurm.signal_lead_s - 30);
+    options.drain_grace_s = std::max(0, spec->harness.slurm.signal_lead_s - 30);
   }
   options.output_dir = args.out;
   options.strategy = args.strategy;
@@ -228,8 +229,10 @@ int RunRun(const RunArgs& args) {
           s.exploration.evaluations[static_cast<size_t>(i)];
       std::printf("  %-36s cost %6.3g  nav %6.1f s  ctrl %5.1f Hz%s\n",
                   spec::FormatPoint(spec->design_space, row.point).c_str(),
-                  campaign::RowMetric(row, "hardware_cost"), campaign::RowMetric(row, "nav_time_s"),
-                  campaign::RowMetric(row, "ctrl_rate_hz"), row.feasible ? "" : "  (infeasible)");
+                  campaign::RowMetric(row, "hardware_cost"),
+                  campaign::RowMetric(row, "nav_time_s"),
+                  campaign::RowMetric(row, "ctrl_rate_hz"),
+                  row.feasible ? "" : "  (infeasible)");
     }
     std::printf("report: %s/report.md\n", s.output_dir.c_str());
   }

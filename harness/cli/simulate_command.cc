@@ -19,20 +19,25 @@ namespace adse::cli {
 namespace {
 
 // The point from --point, or the scenario's exploration.start_from.
-std::optional<spec::DesignPoint> ResolvePoint(const spec::Spec& spec, const std::string& text) {
+std::optional<spec::DesignPoint> ResolvePoint(const spec::Spec& spec,
+                                              const std::string& text) {
   if (text.empty()) {
-    if (!spec.exploration.start_from.empty()) return spec.exploration.start_from;
+    if (!spec.exploration.start_from.empty())
+      return spec.exploration.start_from;
     std::string names;
     for (const auto& p : spec.design_space.parameters) {
       names += (names.empty() ? "" : ",") + p.name + "=<value>";
     }
-    std::fprintf(stderr, "error: --point is required (the scenario has no exploration.start_from): --point %s\n",
+    std::fprintf(stderr,
+                 "error: --point is required (the scenario has no "
+                 "exploration.start_from): --point %s\n",
                  names.c_str());
     return std::nullopt;
   }
   Result<spec::DesignPoint> point = spec::ParsePoint(spec.design_space, text);
   if (!point.ok()) {
-    std::fprintf(stderr, "error: --point: %s\n", point.status().message().c_str());
+    std::fprintf(stderr, "error: --point: %s\n",
+                 point.status().message().c_str());
     return std::nullopt;
   }
   return std::move(point).value();
@@ -63,44 +68,57 @@ int RunSimulate(const SimulateArgs& args) {
   const bool tty = ::isatty(STDERR_FILENO) && !args.quiet;
   if (tty) {
     options.progress = [](double t, double timeout) {
-      std::fprintf(stderr, "\rsimulating: t = %6.1f s of at most %.0f s", t, timeout);
+      std::fprintf(stderr, "\rsimulating: t = %6.1f s of at most %.0f s", t,
+                   timeout);
       std::fflush(stderr);
     };
   }
   sim::SimulationStats stats;
-  Result<runfile::RunData> run = sim::SimulatePoint(*spec, *point, options, &stats);
+  Result<runfile::RunData> run =
+      sim::SimulatePoint(*spec, *point, options, &stats);
   if (tty) std::fprintf(stderr, "\r%60s\r", "");
   if (!run.ok()) {
     ReportError(*spec, run.status());
     return ExitCodeFor(run.status());
   }
-  const std::string out = args.out.empty()
-                              ? spec->output + "/simulate/" + PointSlug(*point) + ".h5"
-                              : args.out;
+  const std::string out =
+      args.out.empty() ? spec->output + "/simulate/" + PointSlug(*point) + ".h5"
+                       : args.out;
   // The analysis (deviation fit, diagnosis) of the fresh run; its metrics
   // are stored with the run's own.
-  Result<report::RunReport> analysed = report::AnalyzeRun(*run, out, report::AnalyzeOptions{});
+  Result<report::RunReport> analysed =
+      report::AnalyzeRun(*run, out, report::AnalyzeOptions{});
   if (!analysed.ok()) {
-    std::fprintf(stderr, "error: analysing the run: %s\n", analysed.status().message().c_str());
+    std::fprintf(stderr, "error: analysing the run: %s\n",
+                 analysed.status().message().c_str());
     return 1;
   }
-  for (const auto& [name, value] : analysed->metrics) run->metrics.emplace(name, value);
+  for (const auto& [name, value] : analysed->metrics)
+    run->metrics.emplace(name, value);
   const auto t0 = std::chrono::steady_clock::now();
   Status written = runfile::WriteRunFile(out, *run);
   const double write_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
+          .count();
   if (!written.ok()) {
-    std::fprintf(stderr, "error: writing %s: %s\n", out.c_str(), written.message().c_str());
+    std::fprintf(stderr, "error: writing %s: %s\n", out.c_str(),
+                 written.message().c_str());
     return 1;
   }
   if (args.json) {
     nlohmann::json doc = report::ToJson(*analysed);
-    auto number = [](double v) { return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v); };
-    doc["timing_s"] = {{"wall", stats.wall_s + write_s}, {"setup", stats.setup_s},
+    auto number = [](double v) {
+      return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v);
+    };
+    doc["timing_s"] = {{"wall", stats.wall_s + write_s},
+                       {"setup", stats.setup_s},
                        {"stack_and_executor", stats.stack_and_executor_s},
-                       {"stack_cpu", number(stats.stack_cpu_s)}, {"executor", number(stats.executor_s)},
-                       {"world", stats.world_s}, {"lidar", stats.lidar_s},
-                       {"hdf5_write", write_s}, {"simulated", stats.simulated_s}};
+                       {"stack_cpu", number(stats.stack_cpu_s)},
+                       {"executor", number(stats.executor_s)},
+                       {"world", stats.world_s},
+                       {"lidar", stats.lidar_s},
+                       {"hdf5_write", write_s},
+                       {"simulated", stats.simulated_s}};
     std::printf("%s\n", doc.dump(2).c_str());
     return 0;
   }
@@ -108,11 +126,14 @@ int RunSimulate(const SimulateArgs& args) {
               static_cast<unsigned long long>(run->seed));
   std::fputs(report::FormatSummary(*analysed).c_str(), stdout);
   std::printf("run file    %s\n", out.c_str());
-  std::printf("wall time   %.2f s for %.1f s simulated: stack+executor %.2f s (stack %s, executor %s), "
-              "world %.2f s, LiDAR %.2f s, HDF5 %.2f s\n",
-              stats.wall_s + write_s, stats.simulated_s, stats.stack_and_executor_s,
-              FormatMetric(stats.stack_cpu_s).c_str(), FormatMetric(stats.executor_s).c_str(),
-              stats.world_s, stats.lidar_s, write_s);
+  std::printf(
+      "wall time   %.2f s for %.1f s simulated: stack+executor %.2f s (stack "
+      "%s, executor %s), "
+      "world %.2f s, LiDAR %.2f s, HDF5 %.2f s\n",
+      stats.wall_s + write_s, stats.simulated_s, stats.stack_and_executor_s,
+      FormatMetric(stats.stack_cpu_s).c_str(),
+      FormatMetric(stats.executor_s).c_str(), stats.world_s, stats.lidar_s,
+      write_s);
   return 0;
 }
 
@@ -138,14 +159,16 @@ int RunCalibrate(const CalibrateArgs& args) {
   std::vector<const runfile::RunData*> pointers;
   for (const auto& r : runs) pointers.push_back(&r);
   const sim::Calibration calibration = sim::FitCalibration(pointers);
-  Status written = sim::WriteCalibration(args.out, calibration, runs.front().host);
+  Status written =
+      sim::WriteCalibration(args.out, calibration, runs.front().host);
   if (!written.ok()) {
     std::fprintf(stderr, "error: %s\n", written.message().c_str());
     return 1;
   }
   std::printf("%-45s %12s %14s\n", "callback", "fixed_ms", "per_unit_us");
   for (const auto& [name, cost] : calibration) {
-    std::printf("%-45s %12.3f %14.4f\n", name.c_str(), cost.fixed_s * 1e3, cost.per_unit_s * 1e6);
+    std::printf("%-45s %12.3f %14.4f\n", name.c_str(), cost.fixed_s * 1e3,
+                cost.per_unit_s * 1e6);
   }
   std::printf("wrote %s (%d runs)\n", args.out.c_str(), args.runs);
   return 0;
@@ -164,7 +187,8 @@ int RunSchemaCheck(const SchemaCheckArgs& args) {
     if (problems.empty()) {
       std::fprintf(stderr, "%s: %s\n", file.c_str(), status.message().c_str());
     }
-    for (const std::string& p : problems) std::fprintf(stderr, "%s: %s\n", file.c_str(), p.c_str());
+    for (const std::string& p : problems)
+      std::fprintf(stderr, "%s: %s\n", file.c_str(), p.c_str());
   }
   return worst;
 }

@@ -30,8 +30,8 @@ Status WriteText(const std::string& path, const std::string& text) {
 std::string PathCsv(const world::Path2& path) {
   std::string csv = "s_m,x_m,y_m\n";
   for (size_t i = 0; i < path.points.size(); ++i) {
-    csv += fmt::format("{:.3f},{:.3f},{:.3f}\n", path.s_m[i], path.points[i].x(),
-                       path.points[i].y());
+    csv += fmt::format("{:.3f},{:.3f},{:.3f}\n", path.s_m[i],
+                       path.points[i].x(), path.points[i].y());
   }
   return csv;
 }
@@ -55,12 +55,16 @@ int RunWorld(const WorldArgs& args) {
   summary["map"] = {{"net", w.map().net_path},
                     {"polygons", w.map().polygons_path},
                     {"key", w.map().key}};
-  summary["start"] = {{"edge", w.start().edge}, {"lane", w.start().lane},
+  summary["start"] = {{"edge", w.start().edge},
+                      {"lane", w.start().lane},
                       {"pos_m", w.start().pos_m},
-                      {"x_m", w.start().xy.x()}, {"y_m", w.start().xy.y()}};
-  summary["goal"] = {{"edge", w.goal().edge}, {"lane", w.goal().lane},
+                      {"x_m", w.start().xy.x()},
+                      {"y_m", w.start().xy.y()}};
+  summary["goal"] = {{"edge", w.goal().edge},
+                     {"lane", w.goal().lane},
                      {"pos_m", w.goal().pos_m},
-                     {"x_m", w.goal().xy.x()}, {"y_m", w.goal().xy.y()}};
+                     {"x_m", w.goal().xy.x()},
+                     {"y_m", w.goal().xy.y()}};
   summary["route_edges"] = w.route_edges();
   summary["ideal_path_length_m"] = w.ideal_path().length_m();
   summary["lane_width_m"] = w.lane_width_m();
@@ -72,21 +76,25 @@ int RunWorld(const WorldArgs& args) {
   summary["traffic_seed"] = setup.world.traffic.seed;
 
   if (!args.follow_ideal) {
-    std::printf("%s\n", args.json ? summary.dump(2).c_str()
-                                  : fmt::format("world of {}: route {} edges, ideal path {:.1f} m, "
-                                                "{} obstacles, {} parked cars of {} slots",
-                                                spec->name, w.route_edges().size(),
-                                                w.ideal_path().length_m(),
-                                                w.scene().obstacles().size(), parked,
-                                                w.scene().parking_slots().size())
-                                        .c_str());
+    std::printf(
+        "%s\n",
+        args.json ? summary.dump(2).c_str()
+                  : fmt::format(
+                        "world of {}: route {} edges, ideal path {:.1f} m, "
+                        "{} obstacles, {} parked cars of {} slots",
+                        spec->name, w.route_edges().size(),
+                        w.ideal_path().length_m(), w.scene().obstacles().size(),
+                        parked, w.scene().parking_slots().size())
+                        .c_str());
     return 0;
   }
 
   // Everything goes into a private folder renamed into place at the end, so
   // an interrupted check never leaves output that looks complete.
-  const std::string out = args.out.empty() ? spec->output + "/world-check" : args.out;
-  const std::string tmp = out + ".tmp." + std::to_string(static_cast<long>(::getpid()));
+  const std::string out =
+      args.out.empty() ? spec->output + "/world-check" : args.out;
+  const std::string tmp =
+      out + ".tmp." + std::to_string(static_cast<long>(::getpid()));
   std::error_code ec;
   fs::remove_all(tmp, ec);
   Status status = MakeDirs(tmp + "/scans");
@@ -95,8 +103,9 @@ int RunWorld(const WorldArgs& args) {
     return 1;
   }
 
-  world::LidarSimulator lidar(&w.scene(), spec->stack.Lidar(), setup.world.weather,
-                              Random::DeriveSeed(setup.world.traffic.seed, "lidar"));
+  world::LidarSimulator lidar(
+      &w.scene(), spec->stack.Lidar(), setup.world.weather,
+      Random::DeriveSeed(setup.world.traffic.seed, "lidar"));
   world::IdealDriverOptions options;
   options.speed_limit_mps = spec->task.speed_limit_kmh / 3.6;
   options.timeout_s = spec->task.timeout_s;
@@ -106,30 +115,35 @@ int RunWorld(const WorldArgs& args) {
   Status scan_status;
   auto on_scan = [&](const world::PointCloud& cloud, const world::Pose2& pose) {
     std::string file;
-    if (args.save_every_nth_scan > 0 && scan_number % args.save_every_nth_scan == 0) {
+    if (args.save_every_nth_scan > 0 &&
+        scan_number % args.save_every_nth_scan == 0) {
       file = fmt::format("scans/scan_{:05d}.pcd", scan_number);
       std::vector<Eigen::Vector3f> points = cloud.points;
       Status s = world::WritePcd(tmp + "/" + file, points);
       if (!s.ok() && scan_status.ok()) scan_status = s;
     }
-    scan_index += fmt::format("{:.3f},{:.3f},{:.3f},{:.4f},{},{}\n", cloud.stamp_s, pose.x_m,
-                              pose.y_m, pose.yaw_rad, cloud.points.size(), file);
+    scan_index += fmt::format("{:.3f},{:.3f},{:.3f},{:.4f},{},{}\n",
+                              cloud.stamp_s, pose.x_m, pose.y_m, pose.yaw_rad,
+                              cloud.points.size(), file);
     ++scan_number;
   };
-  std::fprintf(stderr, "driving %.1f m of ideal path with a perfect controller...\n",
+  std::fprintf(stderr,
+               "driving %.1f m of ideal path with a perfect controller...\n",
                w.ideal_path().length_m());
   Result<world::IdealDriveReport> report =
       world::DriveIdealPath(w, args.scan ? &lidar : nullptr, options, on_scan);
   if (!report.ok() || !scan_status.ok()) {
     fs::remove_all(tmp, ec);
-    std::fprintf(stderr, "error: %s\n",
-                 (!report.ok() ? report.status() : scan_status).message().c_str());
+    std::fprintf(
+        stderr, "error: %s\n",
+        (!report.ok() ? report.status() : scan_status).message().c_str());
     return 1;
   }
   std::string trajectory = "t_s,x_m,y_m,yaw_rad,v_mps,steer_rad,accel_mps2\n";
   for (const auto& s : report->trajectory) {
-    trajectory += fmt::format("{:.3f},{:.4f},{:.4f},{:.5f},{:.4f},{:.5f},{:.4f}\n", s.t_s,
-                              s.x_m, s.y_m, s.yaw_rad, s.v_mps, s.steer_rad, s.accel_mps2);
+    trajectory += fmt::format(
+        "{:.3f},{:.4f},{:.4f},{:.5f},{:.4f},{:.5f},{:.4f}\n", s.t_s, s.x_m,
+        s.y_m, s.yaw_rad, s.v_mps, s.steer_rad, s.accel_mps2);
   }
   summary["reached_goal"] = report->reached_goal;
   summary["time_s"] = report->time_s;
@@ -140,7 +154,9 @@ int RunWorld(const WorldArgs& args) {
   summary["lidar_ms_per_scan"] =
       report->scans ? 1e3 * report->lidar_wall_s / report->scans : 0.0;
   summary["world_ms_per_step"] =
-      report->trajectory.empty() ? 0.0 : 1e3 * report->world_wall_s / report->trajectory.size();
+      report->trajectory.empty()
+          ? 0.0
+          : 1e3 * report->world_wall_s / report->trajectory.size();
   for (const auto& [name, text] :
        {std::pair<std::string, std::string>{"trajectory.csv", trajectory},
         {"ideal_path.csv", PathCsv(w.ideal_path())},
@@ -151,7 +167,9 @@ int RunWorld(const WorldArgs& args) {
   }
   if (status.ok()) {
     fs::remove_all(out, ec);
-    fs::create_directories(fs::path(out).parent_path().empty() ? "." : fs::path(out).parent_path(), ec);
+    fs::create_directories(
+        fs::path(out).parent_path().empty() ? "." : fs::path(out).parent_path(),
+        ec);
     fs::rename(tmp, out, ec);
     if (ec) status = Status::IoError(out + ": " + ec.message());
   }
@@ -164,11 +182,14 @@ int RunWorld(const WorldArgs& args) {
     std::printf("%s\n", summary.dump(2).c_str());
   } else {
     std::printf(
-        "%s: %s in %.1f s, %d collisions, max distance from the ideal path %.2f m, "
+        "%s: %s in %.1f s, %d collisions, max distance from the ideal path "
+        "%.2f m, "
         "%d scans (%.0f points, %.2f ms each), world step %.2f ms\nwrote %s\n",
-        spec->name.c_str(), report->reached_goal ? "reached the goal" : "did NOT reach the goal",
-        report->time_s, report->collisions, report->max_lateral_error_m, report->scans,
-        report->mean_points_per_scan, summary["lidar_ms_per_scan"].get<double>(),
+        spec->name.c_str(),
+        report->reached_goal ? "reached the goal" : "did NOT reach the goal",
+        report->time_s, report->collisions, report->max_lateral_error_m,
+        report->scans, report->mean_points_per_scan,
+        summary["lidar_ms_per_scan"].get<double>(),
         summary["world_ms_per_step"].get<double>(), out.c_str());
   }
   return report->reached_goal ? 0 : 1;

@@ -33,9 +33,9 @@ namespace adse::explore {
 
 // A bottleneck found in a run (a summary of analysis/diagnosis's Finding).
 struct BottleneckHint {
-  std::string kind;    // "cpu_bound" | "frequency_bound"
-  std::string node;    // the node that cannot keep up / is input-limited
-  std::string remedy;  // e.g. "higher frequency; more cores"
+  std::string kind;       // "cpu_bound" | "frequency_bound"
+  std::string node;       // the node that cannot keep up / is input-limited
+  std::string remedy;     // e.g. "higher frequency; more cores"
   double severity = 0.0;  // relative deficit
 };
 

@@ -35,13 +35,14 @@ Result<DseAnswer> ParseDseAnswer(const std::string& answer,
                                  const spec::DesignSpace& space,
                                  const std::set<spec::DesignPoint>& evaluated);
 
-// ---- Command agent -----------------------------------------------------------
+// ---- Command agent
+// -----------------------------------------------------------
 struct Commands {
   std::string map;  // MapDescription of the scenario
   int64_t traffic_seed = 0;
-  std::string weather;                      // clear|rain|fog
-  std::map<std::string, double> platform;   // binding -> value
-  std::vector<std::string> record;          // tracing: what to record
+  std::string weather;                     // clear|rain|fog
+  std::map<std::string, double> platform;  // binding -> value
+  std::vector<std::string> record;         // tracing: what to record
 };
 // What the tracer can record (every item is recorded in any case: the
 // analysis needs all of them).
@@ -61,7 +62,8 @@ Result<Commands> ParseCommandAnswer(const std::string& answer,
 std::vector<std::string> CompareCommands(const Commands& agent,
                                          const Commands& derived);
 
-// ---- Deciphering agent -------------------------------------------------------
+// ---- Deciphering agent
+// -------------------------------------------------------
 struct TextReading {
   struct Claim {
     std::string node, kind, remedy;
@@ -88,14 +90,15 @@ Result<VisionReading> ParseVisionReading(const std::string& answer);
 inline constexpr double kSmoothZigzagIndex = 0.35;  // a weave under ~6 s
 inline constexpr double kHalfLaneWidthM = 1.75;
 VisionReading VisionFromMetrics(const std::map<std::string, double>& metrics);
-std::vector<std::string> CompareVisionReading(const VisionReading& reading,
-                                              const VisionReading& deterministic);
+std::vector<std::string> CompareVisionReading(
+    const VisionReading& reading, const VisionReading& deterministic);
 
 // The trace summary the text part reads, from a RunReport JSON text (its
 // "trace" and "metrics"); NotFound when the report has no trace.
 Result<std::string> TraceSummaryFromReport(const std::string& report_json);
 
-// ---- One turn -----------------------------------------------------------------
+// ---- One turn
+// -----------------------------------------------------------------
 struct TurnResult {
   bool ok = false;
   std::string answer;                 // the accepted answer
@@ -105,10 +108,10 @@ struct TurnResult {
 // Sends `request`; when `accept` refuses the answer, sends one corrective
 // follow-up (the correction template with the problem and `expected`) and
 // tries the second answer. Never more than two requests.
-TurnResult AskWithCorrection(ChatBackend& backend, const PromptSet& prompts,
-                             ChatRequest request,
-                             const std::function<Status(const std::string&)>& accept,
-                             const std::string& expected);
+TurnResult AskWithCorrection(
+    ChatBackend& backend, const PromptSet& prompts, ChatRequest request,
+    const std::function<Status(const std::string&)>& accept,
+    const std::string& expected);
 
 // Free text from a model, made safe to show in reports: control characters
 // dropped, whitespace collapsed, at most `max_chars`.

@@ -14,7 +14,7 @@
 namespace adse::llm {
 
 struct ChatMessage {
-  std::string role;                     // "system" | "user" | "assistant"
+  std::string role;  // "system" | "user" | "assistant"
   std::string text;
   std::vector<std::string> images_png;  // raw PNG bytes (vision models)
 };
@@ -27,11 +27,11 @@ struct ChatRequest {
 };
 
 struct ChatReply {
-  std::string text;               // the assistant message's content
-  int64_t prompt_tokens = -1;     // -1: the server did not say
+  std::string text;            // the assistant message's content
+  int64_t prompt_tokens = -1;  // -1: the server did not say
   int64_t completion_tokens = -1;
-  double latency_s = 0.0;         // wall time of the successful attempt
-  int attempts = 1;               // HTTP attempts made (retries + 1)
+  double latency_s = 0.0;  // wall time of the successful attempt
+  int attempts = 1;        // HTTP attempts made (retries + 1)
 };
 
 // One exchange at a time; not thread-safe.

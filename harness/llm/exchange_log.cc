@@ -15,13 +15,20 @@ using nlohmann::json;
 
 const char* CodeName(Status::Code code) {
   switch (code) {
-    case Status::Code::kOk: return "ok";
-    case Status::Code::kInvalidArgument: return "invalid_argument";
-    case Status::Code::kNotFound: return "not_found";
-    case Status::Code::kCorruption: return "corruption";
-    case Status::Code::kIoError: return "io_error";
-    case Status::Code::kUnavailable: return "unavailable";
-    case Status::Code::kInternal: return "internal";
+    case Status::Code::kOk:
+      return "ok";
+    case Status::Code::kInvalidArgument:
+      return "invalid_argument";
+    case Status::Code::kNotFound:
+      return "not_found";
+    case Status::Code::kCorruption:
+      return "corruption";
+    case Status::Code::kIoError:
+      return "io_error";
+    case Status::Code::kUnavailable:
+      return "unavailable";
+    case Status::Code::kInternal:
+      return "internal";
   }
   return "internal";
 }
@@ -88,12 +95,14 @@ namespace {
 std::vector<std::string> ImageHashes(const ChatRequest& request) {
   std::vector<std::string> hashes;
   for (const ChatMessage& m : request.messages) {
-    for (const std::string& png : m.images_png) hashes.push_back(Sha256Hex(png));
+    for (const std::string& png : m.images_png)
+      hashes.push_back(Sha256Hex(png));
   }
   return hashes;
 }
 
-std::string RequestHash(const ChatRequest& request, const std::vector<std::string>& images) {
+std::string RequestHash(const ChatRequest& request,
+                        const std::vector<std::string>& images) {
   ContentHasher h;
   h.Add(std::string_view("adse-llm-request-1"))
       .Add(request.agent)
@@ -132,16 +141,19 @@ std::string ExchangesPath(const std::string& campaign_folder) {
 
 Result<std::vector<ExchangeRecord>> LoadExchanges(const std::string& path) {
   std::vector<ExchangeRecord> records;
-  ADSE_RETURN_IF_ERROR(ReadJsonLines(path, "an exchange record", [&](const std::string& line) {
-    records.push_back(FromJson(json::parse(line)));
-  }));
+  ADSE_RETURN_IF_ERROR(
+      ReadJsonLines(path, "an exchange record", [&](const std::string& line) {
+        records.push_back(FromJson(json::parse(line)));
+      }));
   return records;
 }
 
 RecordingBackend::RecordingBackend(std::vector<ExchangeRecord> recorded,
                                    std::unique_ptr<ChatBackend> live,
                                    JsonlLog log, std::string replay_source)
-    : live_(std::move(live)), log_(std::move(log)), replay_source_(std::move(replay_source)) {
+    : live_(std::move(live)),
+      log_(std::move(log)),
+      replay_source_(std::move(replay_source)) {
   for (ExchangeRecord& r : recorded) {
     recorded_[r.request_sha256].push_back(std::move(r));
   }
@@ -217,17 +229,17 @@ Result<ChatReply> RecordingBackend::Chat(const ChatRequest& request) {
   ++next_seq_;
   // A live answer is new whatever the log holds (a resumed session that
   // asks something the record lacks); a replayed one may be there already.
-  const std::string line = ToJson(r).dump(-1, ' ', false, json::error_handler_t::replace);
+  const std::string line =
+      ToJson(r).dump(-1, ' ', false, json::error_handler_t::replace);
   Status logged = replayed ? log_.Append(line) : log_.AppendNew(line);
   if (!logged.ok()) return logged.WithContext("recording an llm exchange");
   session_.push_back(std::move(r));
   return reply;
 }
 
-Result<std::unique_ptr<RecordingBackend>> OpenRecordingBackend(const spec::LlmOptions& llm,
-                                                               const std::string& replay_file,
-                                                               const std::string& log_file,
-                                                               const std::string& where) {
+Result<std::unique_ptr<RecordingBackend>> OpenRecordingBackend(
+    const spec::LlmOptions& llm, const std::string& replay_file,
+    const std::string& log_file, const std::string& where) {
   // Opened first: it drops a line cut short by a crash before it is read.
   Result<JsonlLog> log = JsonlLog::Open(log_file);
   if (!log.ok()) return log.status();
@@ -239,13 +251,14 @@ Result<std::unique_ptr<RecordingBackend>> OpenRecordingBackend(const spec::LlmOp
   }
   if (llm.backend == "replay") {
     if (recorded.empty()) {
-      return Status::NotFound(where + "llm.replay_from: " +
-                              (replay_file.empty() ? std::string("no record given")
-                                                   : replay_file + " holds no recorded exchanges") +
-                              " (expected the record of a run with an llm backend)");
+      return Status::NotFound(
+          where + "llm.replay_from: " +
+          (replay_file.empty() ? std::string("no record given")
+                               : replay_file + " holds no recorded exchanges") +
+          " (expected the record of a run with an llm backend)");
     }
-    return std::make_unique<RecordingBackend>(std::move(recorded), nullptr, std::move(*log),
-                                              replay_file);
+    return std::make_unique<RecordingBackend>(std::move(recorded), nullptr,
+                                              std::move(*log), replay_file);
   }
   HttpBackendOptions http;
   http.api = llm.backend;
@@ -253,12 +266,13 @@ Result<std::unique_ptr<RecordingBackend>> OpenRecordingBackend(const spec::LlmOp
   http.timeout_s = llm.timeout_s;
   http.retries = llm.retries;
   if (llm.backend == "openai") {
-    if (const char* key = std::getenv(llm.api_key_env.c_str()); key && *key) http.api_key = key;
+    if (const char* key = std::getenv(llm.api_key_env.c_str()); key && *key)
+      http.api_key = key;
   }
   Result<std::unique_ptr<ChatBackend>> live = NewHttpBackend(http);
   if (!live.ok()) return live.status().WithContext(where + "llm");
-  return std::make_unique<RecordingBackend>(std::move(recorded), std::move(*live),
-                                            std::move(*log), replay_file);
+  return std::make_unique<RecordingBackend>(
+      std::move(recorded), std::move(*live), std::move(*log), replay_file);
 }
 
 }  // namespace adse::llm

@@ -95,10 +95,9 @@ class RecordingBackend : public ChatBackend {
 // from it first; with `backend: replay` only from it, and it must hold
 // exchanges (NotFound otherwise). `where` prefixes errors about the options
 // ("scenario.yaml:12:3: ").
-Result<std::unique_ptr<RecordingBackend>> OpenRecordingBackend(const spec::LlmOptions& llm,
-                                                               const std::string& replay_file,
-                                                               const std::string& log_file,
-                                                               const std::string& where = "");
+Result<std::unique_ptr<RecordingBackend>> OpenRecordingBackend(
+    const spec::LlmOptions& llm, const std::string& replay_file,
+    const std::string& log_file, const std::string& where = "");
 
 }  // namespace adse::llm
 

@@ -31,10 +31,13 @@ constraints: [nav_time_s <= 60, completed]
 exploration: {strategy: agent, budget: 12})";
 
 const char kMaps[] =
-    "- {generate: parking_lot, params: {rows: R, slots_per_row: S}}: a parking lot with R "
-    "rows of S slots (aisles run along y; lanes are 3.5 m wide; with rows: 2 and "
+    "- {generate: parking_lot, params: {rows: R, slots_per_row: S}}: a parking "
+    "lot with R "
+    "rows of S slots (aisles run along y; lanes are 3.5 m wide; with rows: 2 "
+    "and "
     "slots_per_row: 8 the drive from (8.0, -1.75) to (10.0, 29.75) is valid)\n"
-    "- {generate: grid, params: {number: N, length_m: L, lanes: K}}: a town grid of N by N "
+    "- {generate: grid, params: {number: N, length_m: L, lanes: K}}: a town "
+    "grid of N by N "
     "junctions L metres apart, K lanes per direction\n"
     "- {net: <path to a SUMO .net.xml>}: an existing SUMO network";
 
@@ -56,7 +59,7 @@ std::string StripFence(std::string text) {
 
 const std::vector<std::string>& InterpretableSections() {
   static const std::vector<std::string> kSections = {
-      "adse",       "name", "world",      "task",        "platform",
+      "adse",         "name", "world",      "task",        "platform",
       "design_space", "cost", "objectives", "constraints", "exploration"};
   return kSections;
 }
@@ -73,8 +76,10 @@ const std::vector<std::pair<std::string, std::string>>& InterpretDefaults() {
   return kDefaults;
 }
 
-Result<InterpretResult> Interpret(const std::string& request, ChatBackend& backend,
-                                  const PromptSet& prompts, const InterpretOptions& options) {
+Result<InterpretResult> Interpret(const std::string& request,
+                                  ChatBackend& backend,
+                                  const PromptSet& prompts,
+                                  const InterpretOptions& options) {
   if (!options.validate) return Status::Internal("interpret: no validator");
   std::string metrics;
   for (const spec::MetricInfo& m : spec::KnownMetrics()) {
@@ -84,12 +89,12 @@ Result<InterpretResult> Interpret(const std::string& request, ChatBackend& backe
   for (const auto& [section, yaml] : InterpretDefaults()) {
     defaults += "\n  " + section + ": " + yaml;
   }
-  Result<std::string> prompt = prompts.Render(
-      "interpret", {{"request", request},
-                    {"maps", kMaps},
-                    {"metrics", metrics},
-                    {"defaults", defaults},
-                    {"example", kExample}});
+  Result<std::string> prompt =
+      prompts.Render("interpret", {{"request", request},
+                                   {"maps", kMaps},
+                                   {"metrics", metrics},
+                                   {"defaults", defaults},
+                                   {"example", kExample}});
   if (!prompt.ok()) return prompt.status();
 
   ChatRequest chat;
@@ -154,14 +159,16 @@ Result<InterpretResult> Interpret(const std::string& request, ChatBackend& backe
     Result<std::string> correction = prompts.Render(
         "correction",
         {{"problem", problem},
-         {"expected", "Answer with the whole corrected scenario file, as YAML only."}});
+         {"expected",
+          "Answer with the whole corrected scenario file, as YAML only."}});
     if (!correction.ok()) return correction.status();
     chat.messages.push_back({"assistant", answer.substr(0, 20000), {}});
     chat.messages.push_back({"user", *correction, {}});
   }
   return Status::InvalidArgument(
-      "the interpretation agent gave no valid scenario in " + std::to_string(out.answers) +
-      " answers (" + std::to_string(options.max_corrections) +
+      "the interpretation agent gave no valid scenario in " +
+      std::to_string(out.answers) + " answers (" +
+      std::to_string(options.max_corrections) +
       " corrections); the last problem:\n" + last_problem);
 }
 

@@ -42,8 +42,10 @@ const std::vector<std::pair<std::string, std::string>>& InterpretDefaults();
 
 // Unavailable etc. from the backend; InvalidArgument with the last
 // validation errors when the model never produced a valid scenario.
-Result<InterpretResult> Interpret(const std::string& request, ChatBackend& backend,
-                                  const PromptSet& prompts, const InterpretOptions& options);
+Result<InterpretResult> Interpret(const std::string& request,
+                                  ChatBackend& backend,
+                                  const PromptSet& prompts,
+                                  const InterpretOptions& options);
 
 }  // namespace adse::llm
 

@@ -16,13 +16,15 @@ Result<JsonlLog> JsonlLog::Open(const std::string& path) {
   log.path_ = path;
   if (path.empty()) return log;
   const std::filesystem::path p(path);
-  if (p.has_parent_path()) ADSE_RETURN_IF_ERROR(MakeDirs(p.parent_path().string()));
+  if (p.has_parent_path())
+    ADSE_RETURN_IF_ERROR(MakeDirs(p.parent_path().string()));
   std::error_code ec;
   if (!std::filesystem::exists(p, ec)) return log;
   Result<std::string> text = ReadFile(path, size_t{1} << 30);
   if (!text.ok()) return text.status();
   const size_t last_newline = text->rfind('\n');
-  const size_t complete = last_newline == std::string::npos ? 0 : last_newline + 1;
+  const size_t complete =
+      last_newline == std::string::npos ? 0 : last_newline + 1;
   if (complete < text->size()) {
     // A crash cut the last append short: that line was never complete.
     if (::truncate(path.c_str(), static_cast<off_t>(complete)) != 0) {
@@ -47,8 +49,9 @@ Status JsonlLog::AppendNew(const std::string& line) {
   return AppendLineDurable(path_, line);
 }
 
-Status ReadJsonLines(const std::string& path, const std::string& what,
-                     const std::function<void(const std::string& line)>& parse) {
+Status ReadJsonLines(
+    const std::string& path, const std::string& what,
+    const std::function<void(const std::string& line)>& parse) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::Ok();
   const std::string text((std::istreambuf_iterator<char>(in)),
@@ -70,8 +73,8 @@ Status ReadJsonLines(const std::string& path, const std::string& what,
       parse(lines[i]);
     } catch (const std::exception& e) {
       if (i + 1 == lines.size() && cut_short) break;
-      return Status::Corruption(path + ":" + std::to_string(i + 1) + ": not " + what + " (" +
-                                e.what() + ")");
+      return Status::Corruption(path + ":" + std::to_string(i + 1) + ": not " +
+                                what + " (" + e.what() + ")");
     }
   }
   return Status::Ok();

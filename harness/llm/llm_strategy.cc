@@ -27,15 +27,18 @@ const char* const kMemoryMetrics[] = {"completed", "nav_time_s", "ctrl_rate_hz",
 constexpr size_t kMaxListedPoints = 200;
 
 std::string Place(const world::Location& l) {
-  if (l.by_edge) return fmt::format("edge {} at {:g} m (lane {})", l.edge, l.pos_m, l.lane);
+  if (l.by_edge)
+    return fmt::format("edge {} at {:g} m (lane {})", l.edge, l.pos_m, l.lane);
   return fmt::format("({:g}, {:g}) m", l.x_m, l.y_m);
 }
 
 std::string TaskText(const spec::Spec& s) {
   const world::TaskOptions& t = s.task;
-  return fmt::format("{} from {} to {} on map {}, speed limit {:g} km/h, abandoned after {:g} s",
-                     world::TaskKindName(t.kind), Place(t.start), Place(t.goal),
-                     MapDescription(s), t.speed_limit_kmh, t.timeout_s);
+  return fmt::format(
+      "{} from {} to {} on map {}, speed limit {:g} km/h, abandoned after {:g} "
+      "s",
+      world::TaskKindName(t.kind), Place(t.start), Place(t.goal),
+      MapDescription(s), t.speed_limit_kmh, t.timeout_s);
 }
 
 std::string Lines(const std::vector<std::string>& items) {
@@ -48,7 +51,8 @@ std::string SpaceText(const spec::DesignSpace& space) {
   std::vector<std::string> lines;
   for (const spec::DesignParameter& p : space.parameters) {
     std::string values;
-    for (double v : p.values) values += fmt::format("{}{:g}", values.empty() ? "" : ", ", v);
+    for (double v : p.values)
+      values += fmt::format("{}{:g}", values.empty() ? "" : ", ", v);
     lines.push_back(fmt::format("{} (sets {}): {}", p.name, p.bind, values));
   }
   return Lines(lines);
@@ -66,13 +70,15 @@ std::string DiagnosisText(const std::vector<explore::BottleneckHint>& hints) {
   if (hints.empty()) return "no bottleneck found";
   std::string out;
   for (const explore::BottleneckHint& h : hints) {
-    out += fmt::format("{}{} {} (deficit {:.0f} %, remedy: {})", out.empty() ? "" : "; ",
-                       h.kind, h.node, 100.0 * h.severity, h.remedy);
+    out += fmt::format("{}{} {} (deficit {:.0f} %, remedy: {})",
+                       out.empty() ? "" : "; ", h.kind, h.node,
+                       100.0 * h.severity, h.remedy);
   }
   return out;
 }
 
-std::string Join(const std::vector<std::string>& items, const char* sep = "; ") {
+std::string Join(const std::vector<std::string>& items,
+                 const char* sep = "; ") {
   std::string out;
   for (const std::string& i : items) out += (out.empty() ? "" : sep) + i;
   return out;
@@ -80,8 +86,9 @@ std::string Join(const std::vector<std::string>& items, const char* sep = "; ") 
 
 class LlmStrategy : public explore::Strategy {
  public:
-  LlmStrategy(const spec::Spec& spec, LlmStrategyOptions options, PromptSet prompts,
-              JsonlLog memory_log, JsonlLog events_log, std::string system_prompt)
+  LlmStrategy(const spec::Spec& spec, LlmStrategyOptions options,
+              PromptSet prompts, JsonlLog memory_log, JsonlLog events_log,
+              std::string system_prompt)
       : spec_(spec),
         options_(std::move(options)),
         prompts_(std::move(prompts)),
@@ -90,8 +97,8 @@ class LlmStrategy : public explore::Strategy {
         system_prompt_(std::move(system_prompt)),
         fallback_(explore::NewAgentStrategy(spec)) {
     const uint64_t size = spec.design_space.Size();
-    budget_ = std::min<uint64_t>(static_cast<uint64_t>(std::max(spec.exploration.budget, 0)),
-                                 size);
+    budget_ = std::min<uint64_t>(
+        static_cast<uint64_t>(std::max(spec.exploration.budget, 0)), size);
   }
 
   std::string name() const override { return "llm"; }
@@ -101,7 +108,8 @@ class LlmStrategy : public explore::Strategy {
   Status failure() const override { return failure_; }
 
   std::vector<spec::DesignPoint> Ask(int k) override {
-    if (k < 1 || converged_ || !failure_.ok() || proposed_ >= budget_) return {};
+    if (k < 1 || converged_ || !failure_.ok() || proposed_ >= budget_)
+      return {};
     ++iteration_;
     fell_back_ = false;
     options_.backend->set_iteration(iteration_);
@@ -113,13 +121,16 @@ class LlmStrategy : public explore::Strategy {
         [&](const std::string& text) {
           return ParseDseAnswer(text, spec_.design_space, evaluated_);
         },
-        "Answer with {\"point\": {<parameter>: <allowed value>, ...}, \"rationale\": \"...\"}"
-        " naming every design parameter once, with a point not evaluated yet; or with "
+        "Answer with {\"point\": {<parameter>: <allowed value>, ...}, "
+        "\"rationale\": \"...\"}"
+        " naming every design parameter once, with a point not evaluated yet; "
+        "or with "
         "{\"converged\": true, \"rationale\": \"...\"}.");
     if (!failure_.ok()) return {};
     if (answer.value && answer.value->converged) {
       converged_ = true;
-      rationale_ = "the DSE agent declared convergence: " + answer.value->rationale;
+      rationale_ =
+          "the DSE agent declared convergence: " + answer.value->rationale;
       Event("dse", "converged", answer.value->rationale);
       return {};
     }
@@ -127,15 +138,16 @@ class LlmStrategy : public explore::Strategy {
       point = answer.value->point;
       rationale_ = answer.value->rationale;
     } else {
-      Event("dse", "fallback",
-            "the built-in agent proposes this iteration's point: " + answer.why);
+      Event(
+          "dse", "fallback",
+          "the built-in agent proposes this iteration's point: " + answer.why);
       const std::vector<spec::DesignPoint> fallback = fallback_->Ask(1);
       if (fallback.empty()) return {};
       point = fallback.front();
       proposed_by = "agent";
       fell_back_ = true;
-      rationale_ = "fallback to the built-in agent, since the DSE agent " + answer.why +
-                   ". agent: " + fallback_->rationale();
+      rationale_ = "fallback to the built-in agent, since the DSE agent " +
+                   answer.why + ". agent: " + fallback_->rationale();
     }
 
     CommandTurn(*point);
@@ -161,7 +173,8 @@ class LlmStrategy : public explore::Strategy {
     record.feasible = o.feasible && !o.failed;
     for (const auto& [name, value] : o.metrics) {
       bool wanted = false;
-      for (const spec::Objective& obj : spec_.objectives) wanted |= obj.metric == name;
+      for (const spec::Objective& obj : spec_.objectives)
+        wanted |= obj.metric == name;
       for (const char* m : kMemoryMetrics) wanted |= name == m;
       if (wanted) record.metrics[name] = value;
     }
@@ -169,11 +182,12 @@ class LlmStrategy : public explore::Strategy {
 
     last_point_ = spec::FormatPoint(spec_.design_space, o.point);
     if (o.failed) {
-      last_result_ = "the run failed (crash, timeout or out of memory); no metrics";
+      last_result_ =
+          "the run failed (crash, timeout or out of memory); no metrics";
       last_report_ = "no trace: the run failed";
     } else {
-      last_result_ = std::string(record.feasible ? "feasible" : "infeasible") + "; " +
-                     MetricsText(record.metrics);
+      last_result_ = std::string(record.feasible ? "feasible" : "infeasible") +
+                     "; " + MetricsText(record.metrics);
       last_report_ = "diagnosis: " + DiagnosisText(o.bottlenecks);
       options_.backend->set_iteration(record.iteration);
       if (!o.key.empty()) Decipher(o, &last_report_);
@@ -198,7 +212,8 @@ class LlmStrategy : public explore::Strategy {
     std::vector<std::string> listed;
     for (const spec::DesignPoint& p : evaluated_) {
       if (listed.size() == kMaxListedPoints) {
-        listed.push_back(fmt::format("... and {} more", evaluated_.size() - kMaxListedPoints));
+        listed.push_back(fmt::format("... and {} more",
+                                     evaluated_.size() - kMaxListedPoints));
         break;
       }
       listed.push_back(spec::FormatPoint(spec_.design_space, p));
@@ -208,16 +223,19 @@ class LlmStrategy : public explore::Strategy {
         "dse_step",
         {{"iteration", std::to_string(iteration_)},
          {"remaining", std::to_string(budget_ - proposed_)},
-         {"last_point", first ? "(none yet: this is the first proposal)" : last_point_},
+         {"last_point",
+          first ? "(none yet: this is the first proposal)" : last_point_},
          {"last_result", first ? "(none)" : last_result_},
          {"last_report", first ? "(none)" : last_report_},
          {"memory", FormatMemory(Curate(memory_, spec_.design_space))},
          {"evaluated", listed.empty() ? "(none)" : Lines(listed)}});
-    return {{"system", system_prompt_, {}}, {"user", step.ok() ? *step : "", {}}};
+    return {{"system", system_prompt_, {}},
+            {"user", step.ok() ? *step : "", {}}};
   }
 
   void CommandTurn(const spec::DesignPoint& point) {
-    const Commands derived = DeriveCommands(spec_, point, spec_.world.traffic.seed);
+    const Commands derived =
+        DeriveCommands(spec_, point, spec_.world.traffic.seed);
     std::string bindings;
     for (const spec::DesignParameter& p : spec_.design_space.parameters) {
       bindings += (bindings.empty() ? "" : ", ") + p.name + " -> " + p.bind;
@@ -226,21 +244,28 @@ class LlmStrategy : public explore::Strategy {
         "command",
         {{"point", spec::FormatPoint(spec_.design_space, point)},
          {"bindings", bindings},
-         {"world", fmt::format("map \"{}\", traffic seed {}, weather {}", derived.map,
-                               derived.traffic_seed, derived.weather)},
+         {"world",
+          fmt::format("map \"{}\", traffic seed {}, weather {}", derived.map,
+                      derived.traffic_seed, derived.weather)},
          {"tracing_options", Join(TraceRecordOptions(), ", ")}});
     const Answer<Commands> commands = Turn<Commands>(
         "command", {{"user", prompt.ok() ? *prompt : "", {}}},
-        [&](const std::string& text) { return ParseCommandAnswer(text, spec_); },
-        "Answer with {\"world\": {\"map\", \"traffic_seed\", \"weather\"}, \"platform\": "
-        "{<binding>: <value>}, \"tracing\": {\"record\": [...]}} and no other keys.");
+        [&](const std::string& text) {
+          return ParseCommandAnswer(text, spec_);
+        },
+        "Answer with {\"world\": {\"map\", \"traffic_seed\", \"weather\"}, "
+        "\"platform\": "
+        "{<binding>: <value>}, \"tracing\": {\"record\": [...]}} and no other "
+        "keys.");
     if (!failure_.ok()) return;
     if (!commands.value) {
       Event("command", "error",
-            "the command agent " + commands.why + "; the commands derived from the point are used");
+            "the command agent " + commands.why +
+                "; the commands derived from the point are used");
       return;
     }
-    const std::vector<std::string> diffs = CompareCommands(*commands.value, derived);
+    const std::vector<std::string> diffs =
+        CompareCommands(*commands.value, derived);
     if (!diffs.empty()) {
       Event("command", "disagreement",
             Join(diffs) + "; the commands derived from the point are used");
@@ -251,20 +276,25 @@ class LlmStrategy : public explore::Strategy {
   // the deterministic analysis, which is what `report` keeps.
   void Decipher(const explore::Observation& o, std::string* report) {
     const std::string point = spec::FormatPoint(spec_.design_space, o.point);
-    Result<std::string> report_json = ReadFile(options_.report_path(o.key), 16u << 20);
-    Result<std::string> trace = report_json.ok() ? TraceSummaryFromReport(*report_json)
-                                                 : Result<std::string>(report_json.status());
+    Result<std::string> report_json =
+        ReadFile(options_.report_path(o.key), 16u << 20);
+    Result<std::string> trace = report_json.ok()
+                                    ? TraceSummaryFromReport(*report_json)
+                                    : Result<std::string>(report_json.status());
     if (trace.ok()) {
-      Result<std::string> prompt =
-          prompts_.Render("decipher_text", {{"point", point}, {"trace_summary", *trace}});
+      Result<std::string> prompt = prompts_.Render(
+          "decipher_text", {{"point", point}, {"trace_summary", *trace}});
       const Answer<TextReading> reading = Turn<TextReading>(
           "text", {{"user", prompt.ok() ? *prompt : "", {}}}, ParseTextReading,
-          "Answer with {\"bottlenecks\": [{\"node\", \"kind\", \"remedy\"}], \"summary\"}.");
+          "Answer with {\"bottlenecks\": [{\"node\", \"kind\", \"remedy\"}], "
+          "\"summary\"}.");
       if (!failure_.ok()) return;
       if (reading.value) {
-        const std::vector<std::string> diffs = CompareTextReading(*reading.value, o.bottlenecks);
+        const std::vector<std::string> diffs =
+            CompareTextReading(*reading.value, o.bottlenecks);
         if (!diffs.empty()) {
-          Event("text", "disagreement", Join(diffs) + "; the deterministic diagnosis is kept");
+          Event("text", "disagreement",
+                Join(diffs) + "; the deterministic diagnosis is kept");
           *report += "\ntext agent (disagrees, not used): " + Join(diffs);
         } else if (!reading.value->summary.empty()) {
           *report += "\ntext agent (agrees): " + reading.value->summary;
@@ -279,19 +309,25 @@ class LlmStrategy : public explore::Strategy {
     Result<std::string> prompt = prompts_.Render(
         "decipher_vision",
         {{"point", point},
-         {"legend", "The picture has its own legend (lanes, ideal path, trajectory, other "
-                    "vehicles, start, goal) and corner coordinates in metres."}});
+         {"legend",
+          "The picture has its own legend (lanes, ideal path, trajectory, "
+          "other "
+          "vehicles, start, goal) and corner coordinates in metres."}});
     const Answer<VisionReading> reading = Turn<VisionReading>(
-        "vision", {{"user", prompt.ok() ? *prompt : "", {*png}}}, ParseVisionReading,
-        "Answer with {\"reached_goal\": bool, \"smooth\": bool, \"left_lane\": bool, "
+        "vision", {{"user", prompt.ok() ? *prompt : "", {*png}}},
+        ParseVisionReading,
+        "Answer with {\"reached_goal\": bool, \"smooth\": bool, \"left_lane\": "
+        "bool, "
         "\"notes\": \"...\"}.");
     if (!failure_.ok()) return;
     if (reading.value) {
       const VisionReading truth = VisionFromMetrics(o.metrics);
-      const std::vector<std::string> diffs = CompareVisionReading(*reading.value, truth);
+      const std::vector<std::string> diffs =
+          CompareVisionReading(*reading.value, truth);
       if (!diffs.empty()) {
         Event("vision", "disagreement", Join(diffs) + "; the metrics are kept");
-        *report += "\nvision agent (disagrees with the metrics, not used): " + Join(diffs);
+        *report += "\nvision agent (disagrees with the metrics, not used): " +
+                   Join(diffs);
       } else if (!reading.value->notes.empty()) {
         *report += "\nvision agent (agrees): " + reading.value->notes;
       }
@@ -303,7 +339,8 @@ class LlmStrategy : public explore::Strategy {
   template <typename T>
   struct Answer {
     std::optional<T> value;
-    std::string why;  // when there is none: "its answers could not be used (...)"
+    std::string
+        why;  // when there is none: "its answers could not be used (...)"
   };
 
   // One agent's turn: the request, strict parsing with one corrective
@@ -330,13 +367,18 @@ class LlmStrategy : public explore::Strategy {
       failure_ = turn.error;
       Event(agent, "error", turn.error.message());
     }
-    out.why = turn.error.ok() ? "its answers could not be used (" + turn.rejected.back() + ")"
-                              : "the model could not be asked (" + turn.error.message() + ")";
+    out.why =
+        turn.error.ok()
+            ? "its answers could not be used (" + turn.rejected.back() + ")"
+            : "the model could not be asked (" + turn.error.message() + ")";
     return out;
   }
 
-  void Event(const std::string& agent, const std::string& kind, const std::string& detail) {
-    const json j = {{"iteration", iteration_}, {"agent", agent}, {"kind", kind},
+  void Event(const std::string& agent, const std::string& kind,
+             const std::string& detail) {
+    const json j = {{"iteration", iteration_},
+                    {"agent", agent},
+                    {"kind", kind},
                     {"detail", SanitizeText(detail, 1000)}};
     Record(events_log_, j.dump(-1, ' ', false, json::error_handler_t::replace));
   }
@@ -374,8 +416,8 @@ class LlmStrategy : public explore::Strategy {
 
 }  // namespace
 
-Result<std::unique_ptr<RecordingBackend>> OpenBackend(const spec::Spec& spec,
-                                                      const std::string& record_dir) {
+Result<std::unique_ptr<RecordingBackend>> OpenBackend(
+    const spec::Spec& spec, const std::string& record_dir) {
   const std::string own = record_dir.empty() ? "" : ExchangesPath(record_dir);
   // With a live model, a resumed campaign first hears again what its
   // models said before.
@@ -384,15 +426,17 @@ Result<std::unique_ptr<RecordingBackend>> OpenBackend(const spec::Spec& spec,
   return OpenRecordingBackend(spec.llm, replay, own, spec.Where("llm"));
 }
 
-Result<std::unique_ptr<explore::Strategy>> NewLlmStrategy(const spec::Spec& spec,
-                                                          LlmStrategyOptions options) {
-  if (!options.backend) return Status::InvalidArgument("llm strategy: no model backend");
+Result<std::unique_ptr<explore::Strategy>> NewLlmStrategy(
+    const spec::Spec& spec, LlmStrategyOptions options) {
+  if (!options.backend)
+    return Status::InvalidArgument("llm strategy: no model backend");
   if (!options.report_path || !options.image_path) {
     return Status::InvalidArgument("llm strategy: no way to find run reports");
   }
   if (spec.design_space.parameters.empty()) {
-    return Status::InvalidArgument(spec.Where("design_space") +
-                                   "design_space: the llm strategy needs a design space");
+    return Status::InvalidArgument(
+        spec.Where("design_space") +
+        "design_space: the llm strategy needs a design space");
   }
   Result<PromptSet> prompts = PromptSet::Load(spec.llm.prompts);
   if (!prompts.ok()) return prompts.status();
@@ -416,9 +460,9 @@ Result<std::unique_ptr<explore::Strategy>> NewLlmStrategy(const spec::Spec& spec
                      {"design_space", SpaceText(spec.design_space)},
                      {"budget", std::to_string(spec.exploration.budget)}});
   if (!system.ok()) return system.status();
-  return std::unique_ptr<explore::Strategy>(
-      new LlmStrategy(spec, std::move(options), std::move(*prompts), std::move(*memory),
-                      std::move(*events), std::move(*system)));
+  return std::unique_ptr<explore::Strategy>(new LlmStrategy(
+      spec, std::move(options), std::move(*prompts), std::move(*memory),
+      std::move(*events), std::move(*system)));
 }
 
 std::string EventsPath(const std::string& campaign_folder) {
@@ -427,11 +471,14 @@ std::string EventsPath(const std::string& campaign_folder) {
 
 Result<std::vector<LlmEvent>> LoadEvents(const std::string& path) {
   std::vector<LlmEvent> events;
-  ADSE_RETURN_IF_ERROR(ReadJsonLines(path, "an llm event", [&](const std::string& line) {
-    const json j = json::parse(line);
-    events.push_back({j.at("iteration").get<int64_t>(), j.at("agent").get<std::string>(),
-                      j.at("kind").get<std::string>(), j.at("detail").get<std::string>()});
-  }));
+  ADSE_RETURN_IF_ERROR(
+      ReadJsonLines(path, "an llm event", [&](const std::string& line) {
+        const json j = json::parse(line);
+        events.push_back({j.at("iteration").get<int64_t>(),
+                          j.at("agent").get<std::string>(),
+                          j.at("kind").get<std::string>(),
+                          j.at("detail").get<std::string>()});
+      }));
   return events;
 }
 

@@ -28,8 +28,8 @@ namespace adse::llm {
 // recorded). Exchanges already recorded there are answered from the
 // record first, so a resumed campaign re-proposes what it proposed before.
 // With `backend: replay` every answer comes from `llm.replay_from`.
-Result<std::unique_ptr<RecordingBackend>> OpenBackend(const spec::Spec& spec,
-                                                      const std::string& record_dir);
+Result<std::unique_ptr<RecordingBackend>> OpenBackend(
+    const spec::Spec& spec, const std::string& record_dir);
 
 struct LlmStrategyOptions {
   // A run's RunReport JSON and trajectory picture, by content key.
@@ -43,8 +43,8 @@ struct LlmStrategyOptions {
 };
 
 // InvalidArgument when the prompts cannot be loaded or no backend is given.
-Result<std::unique_ptr<explore::Strategy>> NewLlmStrategy(const spec::Spec& spec,
-                                                          LlmStrategyOptions options);
+Result<std::unique_ptr<explore::Strategy>> NewLlmStrategy(
+    const spec::Spec& spec, LlmStrategyOptions options);
 
 // What happened in the agents' rounds, for reports: one event per
 // rejected answer, fallback, disagreement or convergence.

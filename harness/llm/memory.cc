@@ -15,9 +15,11 @@ namespace {
 
 using nlohmann::json;
 
-double MetricOr(const MemoryRecord& r, const std::string& name, double fallback) {
+double MetricOr(const MemoryRecord& r, const std::string& name,
+                double fallback) {
   auto it = r.metrics.find(name);
-  return it == r.metrics.end() || !std::isfinite(it->second) ? fallback : it->second;
+  return it == r.metrics.end() || !std::isfinite(it->second) ? fallback
+                                                             : it->second;
 }
 
 // Distance in grid steps (sum over parameters of |index difference|).
@@ -59,22 +61,32 @@ std::vector<std::pair<const MemoryRecord*, std::string>> Curate(
     const MemoryRecord& r = records[i];
     all.push_back(i);
     if (r.feasible && !r.failed) feasible.push_back(i);
-    if (!r.failed && MetricOr(r, "completed", 0.0) > 0.5) completed.push_back(i);
+    if (!r.failed && MetricOr(r, "completed", 0.0) > 0.5)
+      completed.push_back(i);
     if (r.failed || !r.feasible) bad.push_back(i);
   }
-  take(feasible, [&](size_t i) { return MetricOr(records[i], o.cost_metric, 1e300); },
-       o.cheapest_feasible, "cheapest feasible");
-  take(completed, [&](size_t i) { return MetricOr(records[i], o.time_metric, 1e300); },
-       o.fastest, "fastest");
-  take(all, [&](size_t i) { return -static_cast<double>(i); }, o.most_recent, "most recent");
+  take(
+      feasible,
+      [&](size_t i) { return MetricOr(records[i], o.cost_metric, 1e300); },
+      o.cheapest_feasible, "cheapest feasible");
+  take(
+      completed,
+      [&](size_t i) { return MetricOr(records[i], o.time_metric, 1e300); },
+      o.fastest, "fastest");
+  take(
+      all, [&](size_t i) { return -static_cast<double>(i); }, o.most_recent,
+      "most recent");
   if (!records.empty()) {
     const spec::DesignPoint& last = records.back().point;
     std::vector<size_t> others(all.begin(), all.end() - 1);
-    take(others, [&](size_t i) { return GridDistance(space, records[i].point, last); },
-         o.nearest, "near the last point");
+    take(
+        others,
+        [&](size_t i) { return GridDistance(space, records[i].point, last); },
+        o.nearest, "near the last point");
   }
-  take(bad, [&](size_t i) { return -static_cast<double>(i); }, o.failures,
-       "failed or infeasible");
+  take(
+      bad, [&](size_t i) { return -static_cast<double>(i); }, o.failures,
+      "failed or infeasible");
 
   // Over the bound, keep the best picks of every category: each one's
   // first, then each one's second, ... (in category order). Cutting by
@@ -129,30 +141,35 @@ std::string MemoryLine(const MemoryRecord& r) {
   for (const auto& [name, value] : r.metrics) {
     if (std::isfinite(value)) metrics[name] = value;
   }
-  const json j = {{"index", r.index},         {"iteration", r.iteration},
-                  {"point", r.point},         {"metrics", metrics},
-                  {"feasible", r.feasible},   {"failed", r.failed},
-                  {"diagnosis", r.diagnosis}, {"rationale", r.rationale},
+  const json j = {{"index", r.index},
+                  {"iteration", r.iteration},
+                  {"point", r.point},
+                  {"metrics", metrics},
+                  {"feasible", r.feasible},
+                  {"failed", r.failed},
+                  {"diagnosis", r.diagnosis},
+                  {"rationale", r.rationale},
                   {"proposed_by", r.proposed_by}};
   return j.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
 Result<std::vector<MemoryRecord>> LoadMemory(const std::string& path) {
   std::vector<MemoryRecord> records;
-  ADSE_RETURN_IF_ERROR(ReadJsonLines(path, "a memory record", [&](const std::string& line) {
-    const json j = json::parse(line);
-    MemoryRecord r;
-    r.index = j.at("index").get<int64_t>();
-    r.iteration = j.at("iteration").get<int64_t>();
-    r.point = j.at("point").get<spec::DesignPoint>();
-    r.metrics = j.at("metrics").get<std::map<std::string, double>>();
-    r.feasible = j.at("feasible").get<bool>();
-    r.failed = j.at("failed").get<bool>();
-    r.diagnosis = j.value("diagnosis", "");
-    r.rationale = j.value("rationale", "");
-    r.proposed_by = j.value("proposed_by", "");
-    records.push_back(std::move(r));
-  }));
+  ADSE_RETURN_IF_ERROR(
+      ReadJsonLines(path, "a memory record", [&](const std::string& line) {
+        const json j = json::parse(line);
+        MemoryRecord r;
+        r.index = j.at("index").get<int64_t>();
+        r.iteration = j.at("iteration").get<int64_t>();
+        r.point = j.at("point").get<spec::DesignPoint>();
+        r.metrics = j.at("metrics").get<std::map<std::string, double>>();
+        r.feasible = j.at("feasible").get<bool>();
+        r.failed = j.at("failed").get<bool>();
+        r.diagnosis = j.value("diagnosis", "");
+        r.rationale = j.value("rationale", "");
+        r.proposed_by = j.value("proposed_by", "");
+        records.push_back(std::move(r));
+      }));
   return records;
 }
 

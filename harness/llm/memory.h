@@ -30,7 +30,7 @@ struct CurationOptions {
   int cheapest_feasible = 3;
   int fastest = 2;
   int most_recent = 3;
-  int nearest = 3;  // neighbours of the last point, in grid steps
+  int nearest = 3;   // neighbours of the last point, in grid steps
   int failures = 2;  // failed or infeasible, most recent first
   int max_records = 12;
   // The metric that measures speed (smaller is faster).

@@ -33,7 +33,8 @@ std::string DefaultPromptsDir() {
   // An installed binary looks beside itself first: <prefix>/bin/adse ->
   // <prefix>/share/adse/prompts.
   const fs::path installed =
-      fs::path(SelfExecutable()).parent_path().parent_path() / "share" / "adse" / "prompts";
+      fs::path(SelfExecutable()).parent_path().parent_path() / "share" /
+      "adse" / "prompts";
   std::error_code ec;
   if (fs::is_directory(installed, ec)) return installed.string();
   return ADSE_PROMPTS_DIR;
@@ -47,8 +48,8 @@ std::vector<std::pair<std::string, int>> Placeholders(const std::string& text) {
   std::vector<std::pair<std::string, int>> out;
   size_t pos = 0;
   while ((pos = text.find("{{", pos)) != std::string::npos) {
-    const int line =
-        1 + static_cast<int>(std::count(text.begin(), text.begin() + pos, '\n'));
+    const int line = 1 + static_cast<int>(std::count(text.begin(),
+                                                     text.begin() + pos, '\n'));
     const size_t end = text.find("}}", pos + 2);
     const size_t newline = text.find('\n', pos);
     if (end == std::string::npos || end > newline) {
@@ -70,7 +71,8 @@ Result<PromptSet> PromptSet::Load(const std::string& folder) {
     const std::string path = set.folder_ + "/" + info.name + ".txt";
     std::error_code ec;
     if (!fs::exists(path, ec)) {
-      return Status::NotFound(path + ": prompt template missing (a prompts "
+      return Status::NotFound(path +
+                              ": prompt template missing (a prompts "
                               "folder needs one file per role; see "
                               "prompts/README.md)");
     }
@@ -102,9 +104,11 @@ Result<PromptSet> PromptSet::Load(const std::string& folder) {
     }
     while (!body.empty() && body.back() == '\n') body.pop_back();
     for (const auto& [name, line_no] : Placeholders(body)) {
-      const std::string where = path + ":" + std::to_string(line_no + header_lines);
+      const std::string where =
+          path + ":" + std::to_string(line_no + header_lines);
       if (name.empty()) {
-        return Status::InvalidArgument(where + ": '{{' without a closing '}}' "
+        return Status::InvalidArgument(where +
+                                       ": '{{' without a closing '}}' "
                                        "on the same line");
       }
       if (std::find(info.placeholders.begin(), info.placeholders.end(), name) ==
@@ -113,8 +117,9 @@ Result<PromptSet> PromptSet::Load(const std::string& folder) {
         for (const std::string& p : info.placeholders) {
           known += (known.empty() ? "" : ", ") + ("{{" + p + "}}");
         }
-        return Status::InvalidArgument(where + ": unknown placeholder {{" + name +
-                                       "}}; " + info.name + " may use " + known);
+        return Status::InvalidArgument(where + ": unknown placeholder {{" +
+                                       name + "}}; " + info.name + " may use " +
+                                       known);
       }
     }
     t.text = std::move(body);
@@ -140,7 +145,8 @@ Result<std::string> PromptSet::Render(
     const std::string key = text.substr(open + 2, close - open - 2);
     auto value = values.find(key);
     if (value == values.end()) {
-      return Status::Internal(it->second.path + ": no value for {{" + key + "}}");
+      return Status::Internal(it->second.path + ": no value for {{" + key +
+                              "}}");
     }
     out.append(text, pos, open - pos);
     out += value->second;

@@ -13,13 +13,15 @@
 
 namespace adse::pool {
 
-bool PrepareChild(pid_t parent_pid, int death_signal, int stdin_fd, int log_fd) {
+bool PrepareChild(pid_t parent_pid, int death_signal, int stdin_fd,
+                  int log_fd) {
   ::setpgid(0, 0);
   ::prctl(PR_SET_PDEATHSIG, death_signal);
   if (::getppid() != parent_pid) return false;  // it died already
   struct sigaction default_action {};
   default_action.sa_handler = SIG_DFL;
-  for (int sig : {SIGINT, SIGTERM, SIGUSR1, SIGPIPE, SIGCHLD, SIGHUP, SIGQUIT}) {
+  for (int sig :
+       {SIGINT, SIGTERM, SIGUSR1, SIGPIPE, SIGCHLD, SIGHUP, SIGQUIT}) {
     ::sigaction(sig, &default_action, nullptr);
   }
   sigset_t none;

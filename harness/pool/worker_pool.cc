@@ -130,7 +130,7 @@ struct ChildPlan {
   cpu_set_t cpus;
   bool limit_address_space = false;
   struct rlimit address_space {};
-  pid_t parent_pid = 0;        // the coordinator, for PR_SET_PDEATHSIG
+  pid_t parent_pid = 0;  // the coordinator, for PR_SET_PDEATHSIG
   int stdin_fd = -1;
   int log_fd = -1;
   int report_fd = -1;  // close-on-exec: EOF tells the parent exec worked
@@ -167,7 +167,8 @@ struct ChildFailure {
   }
   // A coordinator killed outright takes its jobs with it (their unfinished
   // runs are redone on resume) instead of leaving them to run unwatched.
-  if (!PrepareChild(plan.parent_pid, SIGKILL, plan.stdin_fd, plan.log_fd)) ::_exit(127);
+  if (!PrepareChild(plan.parent_pid, SIGKILL, plan.stdin_fd, plan.log_fd))
+    ::_exit(127);
   if (::sched_setaffinity(0, sizeof(plan.cpus), &plan.cpus) != 0) {
     FailChild(plan, ChildStage::kAffinity, 0);
   }

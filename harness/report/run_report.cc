@@ -21,7 +21,8 @@ nlohmann::json Number(double v) {
 
 }  // namespace
 
-Result<RunReport> AnalyzeRun(const runfile::RunData& run, const std::string& run_file,
+Result<RunReport> AnalyzeRun(const runfile::RunData& run,
+                             const std::string& run_file,
                              const AnalyzeOptions& options) {
   RunReport r;
   r.run_file = run_file;
@@ -42,14 +43,16 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run, const std::string& run
   // Deviation from the ideal path.
   std::vector<Eigen::Vector2d> ideal;
   ideal.reserve(run.ideal_path.size());
-  for (const runfile::PathPoint& p : run.ideal_path) ideal.emplace_back(p.x_m, p.y_m);
+  for (const runfile::PathPoint& p : run.ideal_path)
+    ideal.emplace_back(p.x_m, p.y_m);
   std::vector<analysis::TimedXy> actual;
   actual.reserve(run.ego.size());
-  for (const runfile::EgoSample& s : run.ego) actual.push_back({s.t_s, s.x_m, s.y_m});
+  for (const runfile::EgoSample& s : run.ego)
+    actual.push_back({s.t_s, s.x_m, s.y_m});
   analysis::DeviationOptions deviation_options;
   deviation_options.normalize_by_m = options.deviation_normalize_by_m;
-  Result<analysis::DeviationResult> deviation =
-      analysis::FitDeviation(ideal, actual, run.lane_width_m, deviation_options);
+  Result<analysis::DeviationResult> deviation = analysis::FitDeviation(
+      ideal, actual, run.lane_width_m, deviation_options);
   if (deviation.ok()) {
     r.metrics["deviation_score"] = deviation->deviation_score;
     r.metrics["max_deviation_m"] = deviation->max_deviation_m;
@@ -70,35 +73,40 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run, const std::string& run
   for (const auto& [name, value] : options.thresholds) {
     ADSE_RETURN_IF_ERROR(analysis::SetOption(&diagnosis_options, name, value));
   }
-  const analysis::Diagnosis diagnosis = analysis::Diagnose(run, diagnosis_options);
+  const analysis::Diagnosis diagnosis =
+      analysis::Diagnose(run, diagnosis_options);
   for (const analysis::Finding& f : diagnosis.findings) {
-    r.findings.push_back({f.kind, f.node, f.remedy, f.message, f.topics, f.rates_hz});
+    r.findings.push_back(
+        {f.kind, f.node, f.remedy, f.message, f.topics, f.rates_hz});
   }
   for (const analysis::TopicStats& t : diagnosis.topics) {
     TopicSummary summary{t.name, t.publisher, t.publish_rate_hz, 0.0, 0};
     for (size_t i = 0; i < t.subscribers.size(); ++i) {
       const analysis::SubscriberStats& sub = t.subscribers[i];
       summary.slowest_take_rate_hz =
-          i == 0 ? sub.take_rate_hz : std::min(summary.slowest_take_rate_hz, sub.take_rate_hz);
+          i == 0 ? sub.take_rate_hz
+                 : std::min(summary.slowest_take_rate_hz, sub.take_rate_hz);
       summary.drops += sub.drops;
     }
     r.topics.push_back(summary);
   }
   for (const analysis::CallbackStats& c : diagnosis.callbacks) {
-    r.callbacks.push_back({c.name, c.latency_p50_s, c.latency_p99_s, c.utilization});
+    r.callbacks.push_back(
+        {c.name, c.latency_p50_s, c.latency_p99_s, c.utilization});
   }
 
   // Constraints, from the scenario stored in the run. The files it names
   // (a calibration, a net) need not exist where the run is re-analysed.
   spec::ParseOptions parse_options;
   parse_options.check_files = false;
-  Result<spec::Spec> spec =
-      spec::ParseSpec(run.scenario_text, run.scenario_name + ".yaml (stored in the run)", ".",
-                      parse_options);
+  Result<spec::Spec> spec = spec::ParseSpec(
+      run.scenario_text, run.scenario_name + ".yaml (stored in the run)", ".",
+      parse_options);
   if (spec.ok()) {
     r.feasible = run.status == "complete";
     for (const std::string& c : spec->constraints) {
-      Result<bool> ok = spec::EvaluateConstraint(*spec, c, r.metrics, run.design_point);
+      Result<bool> ok =
+          spec::EvaluateConstraint(*spec, c, r.metrics, run.design_point);
       const bool satisfied = ok.ok() && *ok;
       r.constraints.push_back({c, satisfied});
       r.feasible = r.feasible && satisfied;
@@ -125,35 +133,44 @@ nlohmann::json ToJson(const RunReport& r) {
   j["status"] = r.status;
   j["termination_reason"] = r.termination_reason;
   j["content_key"] = r.content_key;
-  for (const auto& [name, value] : r.metrics) j["metrics"][name] = Number(value);
+  for (const auto& [name, value] : r.metrics)
+    j["metrics"][name] = Number(value);
   j["constraints"] = nlohmann::json::array();
   for (const ConstraintStatus& c : r.constraints) {
-    j["constraints"].push_back({{"expression", c.expression}, {"satisfied", c.satisfied}});
+    j["constraints"].push_back(
+        {{"expression", c.expression}, {"satisfied", c.satisfied}});
   }
-  if (!r.constraints_error.empty()) j["constraints_error"] = r.constraints_error;
+  if (!r.constraints_error.empty())
+    j["constraints_error"] = r.constraints_error;
   j["feasible"] = r.feasible;
-  j["deviation"] = {{"complete", r.deviation_complete}, {"driven_fraction", r.driven_fraction}};
+  j["deviation"] = {{"complete", r.deviation_complete},
+                    {"driven_fraction", r.driven_fraction}};
   if (!r.deviation_error.empty()) j["deviation"]["error"] = r.deviation_error;
   j["findings"] = nlohmann::json::array();
   for (const FindingSummary& f : r.findings) {
-    j["findings"].push_back({{"kind", f.kind}, {"node", f.node}, {"topics", f.topics},
-                             {"rates_hz", f.rates_hz}, {"remedy", f.remedy},
+    j["findings"].push_back({{"kind", f.kind},
+                             {"node", f.node},
+                             {"topics", f.topics},
+                             {"rates_hz", f.rates_hz},
+                             {"remedy", f.remedy},
                              {"message", f.message}});
   }
   j["trace"]["topics"] = nlohmann::json::array();
   for (const TopicSummary& t : r.topics) {
-    j["trace"]["topics"].push_back({{"name", t.name},
-                                    {"publisher", t.publisher},
-                                    {"publish_rate_hz", Number(t.publish_rate_hz)},
-                                    {"slowest_take_rate_hz", Number(t.slowest_take_rate_hz)},
-                                    {"drops", t.drops}});
+    j["trace"]["topics"].push_back(
+        {{"name", t.name},
+         {"publisher", t.publisher},
+         {"publish_rate_hz", Number(t.publish_rate_hz)},
+         {"slowest_take_rate_hz", Number(t.slowest_take_rate_hz)},
+         {"drops", t.drops}});
   }
   j["trace"]["callbacks"] = nlohmann::json::array();
   for (const CallbackSummary& c : r.callbacks) {
-    j["trace"]["callbacks"].push_back({{"name", c.name},
-                                       {"latency_p50_s", Number(c.latency_p50_s)},
-                                       {"latency_p99_s", Number(c.latency_p99_s)},
-                                       {"utilization", Number(c.utilization)}});
+    j["trace"]["callbacks"].push_back(
+        {{"name", c.name},
+         {"latency_p50_s", Number(c.latency_p50_s)},
+         {"latency_p99_s", Number(c.latency_p99_s)},
+         {"utilization", Number(c.utilization)}});
   }
   j["images"] = r.images;
   return j;
@@ -163,28 +180,34 @@ std::string FormatSummary(const RunReport& r) {
   std::string out;
   auto metric = [&](const char* name) {
     auto it = r.metrics.find(name);
-    return it == r.metrics.end() || !std::isfinite(it->second) ? std::string("n/a")
-                                                                : fmt::format("{:.4g}", it->second);
+    return it == r.metrics.end() || !std::isfinite(it->second)
+               ? std::string("n/a")
+               : fmt::format("{:.4g}", it->second);
   };
   out += fmt::format("ended       {} ({})\n", r.termination_reason, r.status);
-  for (const char* name : {"completed", "nav_time_s", "ctrl_rate_hz", "hardware_cost",
-                           "deviation_score", "max_deviation_m", "offset_m", "zigzag_index",
-                           "e2e_latency_p50_s", "e2e_latency_p99_s", "dropped_messages",
-                           "lidar_frames_dropped", "collisions", "cpu_utilization"}) {
+  for (const char* name :
+       {"completed", "nav_time_s", "ctrl_rate_hz", "hardware_cost",
+        "deviation_score", "max_deviation_m", "offset_m", "zigzag_index",
+        "e2e_latency_p50_s", "e2e_latency_p99_s", "dropped_messages",
+        "lidar_frames_dropped", "collisions", "cpu_utilization"}) {
     out += fmt::format("{:<20} {}\n", name, metric(name));
   }
   if (!r.deviation_complete && r.deviation_error.empty()) {
-    out += fmt::format("deviation   scored on the driven part ({:.0f} % of the path)\n",
-                       100 * r.driven_fraction);
+    out += fmt::format(
+        "deviation   scored on the driven part ({:.0f} % of the path)\n",
+        100 * r.driven_fraction);
   }
   for (const ConstraintStatus& c : r.constraints) {
-    out += fmt::format("constraint  {:<24} {}\n", c.expression, c.satisfied ? "ok" : "VIOLATED");
+    out += fmt::format("constraint  {:<24} {}\n", c.expression,
+                       c.satisfied ? "ok" : "VIOLATED");
   }
-  if (!r.constraints_error.empty()) out += "constraints n/a: " + r.constraints_error + "\n";
+  if (!r.constraints_error.empty())
+    out += "constraints n/a: " + r.constraints_error + "\n";
   out += fmt::format("feasible    {}\n", r.feasible ? "yes" : "no");
   if (r.findings.empty()) out += "diagnosis   no bottleneck found\n";
   for (const FindingSummary& f : r.findings) {
-    out += fmt::format("diagnosis   {}: {} (remedy: {})\n", f.kind, f.message, f.remedy);
+    out += fmt::format("diagnosis   {}: {} (remedy: {})\n", f.kind, f.message,
+                       f.remedy);
   }
   return out;
 }

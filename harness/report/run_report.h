@@ -61,7 +61,7 @@ struct RunReport {
   std::string scenario_name;
   std::map<std::string, double> point;
   uint64_t seed = 0;
-  std::string status;              // complete | failed
+  std::string status;  // complete | failed
   std::string termination_reason;
   std::string content_key;
   std::map<std::string, double> metrics;  // run metrics + deviation metrics
@@ -82,7 +82,8 @@ struct RunReport {
 };
 
 // Analyses one run. Fails only on inputs that cannot be analysed at all.
-Result<RunReport> AnalyzeRun(const runfile::RunData& run, const std::string& run_file,
+Result<RunReport> AnalyzeRun(const runfile::RunData& run,
+                             const std::string& run_file,
                              const AnalyzeOptions& options);
 
 nlohmann::json ToJson(const RunReport& report);

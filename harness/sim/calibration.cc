@@ -15,7 +15,9 @@ Calibration FitCalibration(const std::vector<const runfile::RunData*>& runs) {
   std::map<std::string, Sums> sums;
   for (const runfile::RunData* run : runs) {
     for (const stack::CallbackRecord& r : run->trace.callbacks) {
-      if (r.callback < 0 || r.callback >= static_cast<int>(run->callback_info.size())) continue;
+      if (r.callback < 0 ||
+          r.callback >= static_cast<int>(run->callback_info.size()))
+        continue;
       Sums& s = sums[run->callback_info[r.callback].name];
       s.n += 1;
       s.x += r.work_units;
@@ -30,7 +32,8 @@ Calibration FitCalibration(const std::vector<const runfile::RunData*>& runs) {
     const double mean_y = s.y / s.n;
     const double var_x = s.xx / s.n - (s.x / s.n) * (s.x / s.n);
     if (var_x > 1e-12) {
-      cost.per_unit_s = std::max(0.0, (s.xy / s.n - (s.x / s.n) * mean_y) / var_x);
+      cost.per_unit_s =
+          std::max(0.0, (s.xy / s.n - (s.x / s.n) * mean_y) / var_x);
       cost.fixed_s = std::max(0.0, mean_y - cost.per_unit_s * s.x / s.n);
     } else {
       cost.fixed_s = mean_y;  // no variation in work: a constant cost
@@ -46,9 +49,11 @@ Status WriteCalibration(const std::string& path, const Calibration& calibration,
   doc["adse_calibration"] = 1;
   doc["host"] = host;
   doc["note"] =
-      "Costs at the reference frequency: cost_s = fixed_s + per_unit_s * work units.";
+      "Costs at the reference frequency: cost_s = fixed_s + per_unit_s * work "
+      "units.";
   for (const auto& [name, cost] : calibration) {
-    doc["callbacks"][name] = {{"fixed_s", cost.fixed_s}, {"per_unit_s", cost.per_unit_s}};
+    doc["callbacks"][name] = {{"fixed_s", cost.fixed_s},
+                              {"per_unit_s", cost.per_unit_s}};
   }
   return WriteFileAtomic(path, doc.dump(2) + "\n");
 }
@@ -56,12 +61,14 @@ Status WriteCalibration(const std::string& path, const Calibration& calibration,
 Result<Calibration> LoadCalibration(const std::string& path) {
   if (path.empty()) {
     return Status::InvalidArgument(
-        "cost_model counted needs a calibration file (make one with `adse calibrate`, "
+        "cost_model counted needs a calibration file (make one with `adse "
+        "calibrate`, "
         "or name the bundled scenarios/calibration/reference.json)");
   }
   Result<std::string> text = ReadFile(path, 16u << 20);
   if (!text.ok()) return text.status();
-  nlohmann::json doc = nlohmann::json::parse(*text, nullptr, /*allow_exceptions=*/false);
+  nlohmann::json doc =
+      nlohmann::json::parse(*text, nullptr, /*allow_exceptions=*/false);
   if (doc.is_discarded() || !doc.is_object()) {
     return Status::InvalidArgument(path + ": not a JSON object");
   }
@@ -77,10 +84,11 @@ Result<Calibration> LoadCalibration(const std::string& path) {
     const auto fixed = entry.find("fixed_s");
     const auto per_unit = entry.find("per_unit_s");
     if (!entry.is_object() || fixed == entry.end() || per_unit == entry.end() ||
-        !fixed->is_number() || !per_unit->is_number() || fixed->get<double>() < 0 ||
-        per_unit->get<double>() < 0) {
-      return Status::InvalidArgument(path + ": callbacks." + name +
-                                     ": expected {fixed_s: number >= 0, per_unit_s: number >= 0}");
+        !fixed->is_number() || !per_unit->is_number() ||
+        fixed->get<double>() < 0 || per_unit->get<double>() < 0) {
+      return Status::InvalidArgument(
+          path + ": callbacks." + name +
+          ": expected {fixed_s: number >= 0, per_unit_s: number >= 0}");
     }
     cost.fixed_s = fixed->get<double>();
     cost.per_unit_s = per_unit->get<double>();

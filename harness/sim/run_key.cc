@@ -9,7 +9,8 @@ namespace {
 // Bump when the meaning of a run changes without any input changing.
 constexpr char kKeyVersion[] = "adse-run-key-v1";
 
-Status AddFile(ContentHasher* h, const std::string& label, const std::string& path) {
+Status AddFile(ContentHasher* h, const std::string& label,
+               const std::string& path) {
   h->Add(label);
   if (path.empty()) return Status::Ok();
   Result<std::string> bytes = ReadFile(path, 1u << 30);
@@ -29,14 +30,15 @@ void AddLocation(ContentHasher* h, const world::Location& l) {
 
 }  // namespace
 
-Result<std::string> RunKey(const spec::Spec& spec, const spec::DesignPoint& point,
-                           uint64_t seed) {
+Result<std::string> RunKey(const spec::Spec& spec,
+                           const spec::DesignPoint& point, uint64_t seed) {
   ContentHasher h;
   h.Add(kKeyVersion).Add(ADSE_VERSION);
   // World.
   const world::WorldOptions& w = spec.world;
   h.Add("map").Add(w.map.generator);
-  for (const auto& [name, value] : w.map.generator_params) h.Add(name).Add(value);
+  for (const auto& [name, value] : w.map.generator_params)
+    h.Add(name).Add(value);
   ADSE_RETURN_IF_ERROR(AddFile(&h, "world.map.net", w.map.net_path));
   ADSE_RETURN_IF_ERROR(AddFile(&h, "world.map.polygons", w.map.polygons_path));
   h.Add("traffic").Add(w.traffic.parked_occupancy);
@@ -52,7 +54,8 @@ Result<std::string> RunKey(const spec::Spec& spec, const spec::DesignPoint& poin
   h.Add(t.goal_tolerance_m).Add(t.speed_limit_kmh).Add(t.timeout_s);
   // Stack: every knob's effective value, so a changed default changes keys.
   h.Add("stack");
-  for (const KnobInfo& knob : StackKnobs()) h.Add(knob.path).Add(spec.stack.Get(knob.path));
+  for (const KnobInfo& knob : StackKnobs())
+    h.Add(knob.path).Add(spec.stack.Get(knob.path));
   // Platform.
   const spec::PlatformOptions& p = spec.platform;
   h.Add("platform").Add(static_cast<long long>(p.kind)).Add(p.reference_ghz);

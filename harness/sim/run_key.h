@@ -17,8 +17,8 @@ namespace adse::sim {
 // 64 hex characters. Files the run reads (a given net, its polygons, the
 // calibration) enter by content, so editing one changes the key. Fails
 // only when such a file cannot be read.
-Result<std::string> RunKey(const spec::Spec& spec, const spec::DesignPoint& point,
-                           uint64_t seed);
+Result<std::string> RunKey(const spec::Spec& spec,
+                           const spec::DesignPoint& point, uint64_t seed);
 
 }  // namespace adse::sim
 

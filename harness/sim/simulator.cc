@@ -10,9 +10,9 @@
 #include <thread>
 
 #include "analysis/metrics/run_metrics.h"
-#include "harness/spec/spec_parser.h"
 #include "harness/sim/calibration.h"
 #include "harness/sim/run_key.h"
+#include "harness/spec/spec_parser.h"
 #include "stack/algorithms/command_gate.h"
 #include "stack/base/clock.h"
 #include "stack/base/hash.h"
@@ -26,7 +26,9 @@ namespace adse::sim {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+double Seconds(Clock::duration d) {
+  return std::chrono::duration<double>(d).count();
+}
 
 std::string HostDescription() {
   char name[256] = {0};
@@ -39,7 +41,8 @@ std::string HostDescription() {
       break;
     }
   }
-  return fmt::format("{}; {}; {} cores", name, cpu, std::thread::hardware_concurrency());
+  return fmt::format("{}; {}; {} cores", name, cpu,
+                     std::thread::hardware_concurrency());
 }
 
 }  // namespace
@@ -52,8 +55,10 @@ world::WorldSetup WorldSetupFromSpec(const spec::Spec& spec) {
   return setup;
 }
 
-Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::DesignPoint& point,
-                                       const SimulateOptions& options, SimulationStats* stats_out) {
+Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
+                                       const spec::DesignPoint& point,
+                                       const SimulateOptions& options,
+                                       SimulationStats* stats_out) {
   const auto t_begin = Clock::now();
   SimulationStats stats;
   Result<spec::PointConfig> config = spec::ApplyPoint(spec, point);
@@ -69,9 +74,11 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
   world::World& w = **opened;
 
   Result<std::string> cloud_path = w.MapCloudPath();
-  if (!cloud_path.ok()) return cloud_path.status().WithContext("localization map");
+  if (!cloud_path.ok())
+    return cloud_path.status().WithContext("localization map");
   Result<std::vector<Eigen::Vector3f>> map_cloud = world::ReadPcd(*cloud_path);
-  if (!map_cloud.ok()) return map_cloud.status().WithContext("localization map");
+  if (!map_cloud.ok())
+    return map_cloud.status().WithContext("localization map");
 
   stack::StackInputs inputs;
   inputs.route = w.ideal_path();
@@ -87,22 +94,27 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
   stack::Graph graph;
   Result<std::unique_ptr<stack::AdStack>> ad_stack =
       stack::AdStack::Build(stack_config, inputs, &graph);
-  if (!ad_stack.ok()) return ad_stack.status().WithContext("building the stack");
+  if (!ad_stack.ok())
+    return ad_stack.status().WithContext("building the stack");
   const stack::StackTopics topics = (*ad_stack)->topics();
 
   runfile::RunData run;
   // The vehicle side: the safety gate between the computer and the actuators.
   algorithms::CommandGateParams gate_params;
   gate_params.stale_after_s = stack_config.Get("control.stale_after_s");
-  gate_params.emergency_decel_mps2 = stack_config.Get("control.emergency_decel_mps2");
+  gate_params.emergency_decel_mps2 =
+      stack_config.Get("control.emergency_decel_mps2");
   algorithms::CommandGate gate(gate_params);
-  graph.AddSink<stack::ControlMsg>(topics.control, [&](const stack::ControlMsg& m, double t_s) {
+  graph.AddSink<stack::ControlMsg>(topics.control, [&](const stack::ControlMsg&
+                                                           m,
+                                                       double t_s) {
     gate.OnCommand(t_s, m.accel_mps2, m.steer_rad);
     run.controls.push_back({t_s, m.header.stamp_s, m.accel_mps2, m.steer_rad});
   });
-  graph.AddSink<stack::PoseMsg>(topics.pose, [&](const stack::PoseMsg& m, double t_s) {
-    gate.OnLocalization(t_s, m.valid);
-  });
+  graph.AddSink<stack::PoseMsg>(topics.pose,
+                                [&](const stack::PoseMsg& m, double t_s) {
+                                  gate.OnLocalization(t_s, m.valid);
+                                });
 
   // The executor takes the graph as it is now: sinks must be added first.
   stack::VirtualPlatformOptions vp;
@@ -114,10 +126,12 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
     vp.cost_model = stack::CostModelKind::kCounted;
     Result<std::map<std::string, stack::CountedCost>> calibration =
         LoadCalibration(platform.calibration);
-    if (!calibration.ok()) return calibration.status().WithContext("platform.calibration");
+    if (!calibration.ok())
+      return calibration.status().WithContext("platform.calibration");
     vp.counted = std::move(calibration).value();
   }
-  Result<std::unique_ptr<stack::Executor>> made = stack::CreateVirtualExecutor(&graph, vp);
+  Result<std::unique_ptr<stack::Executor>> made =
+      stack::CreateVirtualExecutor(&graph, vp);
   if (!made.ok()) return made.status().WithContext("platform");
   stack::Executor& executor = **made;
 
@@ -127,7 +141,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
   Random odometry_noise(Random::DeriveSeed(seed, "odometry"));
   const double lidar_period = 1.0 / lidar_params.rate_hz;
   const double odometry_period = 1.0 / stack_config.Get("odometry.rate_hz");
-  double next_lidar = 0.0, next_odometry = 0.0, next_vehicles = 0.0, next_progress = 0.0;
+  double next_lidar = 0.0, next_odometry = 0.0, next_vehicles = 0.0,
+         next_progress = 0.0;
   stats.setup_s = Seconds(Clock::now() - t_begin);
 
   const double dt = w.step_s();
@@ -135,7 +150,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
   std::string reason = "timeout";
   auto record_ego = [&] {
     const world::VehicleState& s = w.ego();
-    run.ego.push_back({w.time_s(), s.x_m, s.y_m, s.yaw_rad, s.v_mps, s.steer_rad, s.accel_mps2});
+    run.ego.push_back({w.time_s(), s.x_m, s.y_m, s.yaw_rad, s.v_mps,
+                       s.steer_rad, s.accel_mps2});
   };
   record_ego();
   while (w.time_s() < timeout - 1e-9) {
@@ -147,33 +163,38 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
       std::vector<world::OrientedBox> boxes;
       boxes.reserve(w.others().size());
       for (const world::OtherVehicle& v : w.others()) boxes.push_back(v.box);
-      world::PointCloud scan = lidar.Scan({ego.x_m, ego.y_m, ego.yaw_rad}, next_lidar, boxes);
+      world::PointCloud scan =
+          lidar.Scan({ego.x_m, ego.y_m, ego.yaw_rad}, next_lidar, boxes);
       stack::PointCloudMsg msg;
       msg.header.stamp_s = next_lidar;
       msg.points = std::move(scan.points);
       // Sensor frame to vehicle frame: the sensor sits above the rear axle.
-      for (Eigen::Vector3f& p : msg.points) p.z() += static_cast<float>(lidar_params.mount_height_m);
+      for (Eigen::Vector3f& p : msg.points)
+        p.z() += static_cast<float>(lidar_params.mount_height_m);
       stats.lidar_s += Seconds(Clock::now() - t0);
-      executor.PublishExternal(topics.lidar_raw,
-                               std::make_shared<const stack::PointCloudMsg>(std::move(msg)),
-                               next_lidar, std::max(next_lidar, t));
+      executor.PublishExternal(
+          topics.lidar_raw,
+          std::make_shared<const stack::PointCloudMsg>(std::move(msg)),
+          next_lidar, std::max(next_lidar, t));
       next_lidar += lidar_period;
     }
     while (next_odometry < t + dt - 1e-9) {
       stack::OdometryMsg msg;
       msg.header.stamp_s = next_odometry;
       msg.v_mps = ego.v_mps * (1.0 + odometry_noise.Normal(0.0, 0.005));
-      msg.yaw_rate_rps = ego.v_mps * std::tan(ego.steer_rad) / w.ego_limits().wheelbase_m +
-                         odometry_noise.Normal(0.0, 0.002);
+      msg.yaw_rate_rps =
+          ego.v_mps * std::tan(ego.steer_rad) / w.ego_limits().wheelbase_m +
+          odometry_noise.Normal(0.0, 0.002);
       executor.PublishExternal(topics.odometry,
-                               std::make_shared<const stack::OdometryMsg>(msg), next_odometry,
-                               std::max(next_odometry, t));
+                               std::make_shared<const stack::OdometryMsg>(msg),
+                               next_odometry, std::max(next_odometry, t));
       next_odometry += odometry_period;
     }
     const auto t_exec = Clock::now();
     Status advanced = executor.AdvanceTo(t + dt);
     stats.executor_s += Seconds(Clock::now() - t_exec);
-    if (!advanced.ok()) return advanced.WithContext(fmt::format("stack at t={:.2f} s", t));
+    if (!advanced.ok())
+      return advanced.WithContext(fmt::format("stack at t={:.2f} s", t));
 
     const algorithms::GateOutput command = gate.Output(t + dt);
     const auto t_world = Clock::now();
@@ -181,11 +202,13 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
     stats.world_s += Seconds(Clock::now() - t_world);
     if (!stepped.ok()) return stepped;
     record_ego();
-    for (const std::string& id : w.new_contacts()) run.collisions.push_back({w.time_s(), id});
+    for (const std::string& id : w.new_contacts())
+      run.collisions.push_back({w.time_s(), id});
     if (w.time_s() + 1e-9 >= next_vehicles) {
       for (const world::OtherVehicle& v : w.others()) {
-        run.vehicles.push_back({w.time_s(), v.id, v.box.center.x(), v.box.center.y(), v.box.yaw_rad,
-                                v.speed_mps, v.box.length_m, v.box.width_m});
+        run.vehicles.push_back({w.time_s(), v.id, v.box.center.x(),
+                                v.box.center.y(), v.box.yaw_rad, v.speed_mps,
+                                v.box.length_m, v.box.width_m});
       }
       next_vehicles += options.vehicle_record_period_s;
     }
@@ -210,16 +233,21 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
   run.created_utc = UtcTimestamp();
   run.seed = seed;
   run.design_point = point;
-  if (Result<std::string> key = RunKey(spec, point, seed); key.ok()) run.content_key = *key;
-  run.platform = {{"kind", platform.kind == spec::PlatformKind::kVirtual ? "virtual" : "cgroup"},
-                  {"cores", std::to_string(platform.cores)},
-                  {"freq_ghz", fmt::format("{}", platform.freq_ghz)},
-                  {"reference_ghz", fmt::format("{}", platform.reference_ghz)},
-                  {"cost_model", platform.cost_model == spec::CostModel::kCounted ? "counted"
-                                                                                  : "measured"},
-                  {"cost_scale", fmt::format("{}", platform.cost_scale)}};
+  if (Result<std::string> key = RunKey(spec, point, seed); key.ok())
+    run.content_key = *key;
+  run.platform = {
+      {"kind",
+       platform.kind == spec::PlatformKind::kVirtual ? "virtual" : "cgroup"},
+      {"cores", std::to_string(platform.cores)},
+      {"freq_ghz", fmt::format("{}", platform.freq_ghz)},
+      {"reference_ghz", fmt::format("{}", platform.reference_ghz)},
+      {"cost_model", platform.cost_model == spec::CostModel::kCounted
+                         ? "counted"
+                         : "measured"},
+      {"cost_scale", fmt::format("{}", platform.cost_scale)}};
   for (size_t i = 0; i < w.ideal_path().points.size(); ++i) {
-    run.ideal_path.push_back({w.ideal_path().s_m[i], w.ideal_path().points[i].x(),
+    run.ideal_path.push_back({w.ideal_path().s_m[i],
+                              w.ideal_path().points[i].x(),
                               w.ideal_path().points[i].y()});
   }
   run.lane_width_m = w.lane_width_m();
@@ -229,11 +257,14 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
       run.lanes.push_back({static_cast<int32_t>(i), p.x(), p.y()});
     }
   }
-  for (const stack::NodeSpec& n : graph.nodes()) run.node_names.push_back(n.name);
-  for (const stack::TopicSpec& t : graph.topics()) run.topic_names.push_back(t.name);
+  for (const stack::NodeSpec& n : graph.nodes())
+    run.node_names.push_back(n.name);
+  for (const stack::TopicSpec& t : graph.topics())
+    run.topic_names.push_back(t.name);
   for (const stack::CallbackSpec& c : graph.callbacks()) {
     run.callback_info.push_back(
-        {c.name, c.node, c.kind == stack::CallbackSpec::Kind::kTimer ? "timer" : "subscription",
+        {c.name, c.node,
+         c.kind == stack::CallbackSpec::Kind::kTimer ? "timer" : "subscription",
          c.topic, c.period_s});
   }
   run.trace = executor.trace();
@@ -242,7 +273,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec, const spec::Desig
   // callbacks' host CPU time, so only then can the two be told apart.
   stats.stack_and_executor_s = stats.executor_s;
   if (vp.cost_model == stack::CostModelKind::kMeasured) {
-    for (const stack::CallbackRecord& r : run.trace.callbacks) stats.stack_cpu_s += r.host_cpu_s;
+    for (const stack::CallbackRecord& r : run.trace.callbacks)
+      stats.stack_cpu_s += r.host_cpu_s;
     stats.executor_s = std::max(0.0, stats.executor_s - stats.stack_cpu_s);
   } else {
     stats.stack_cpu_s = std::nan("");

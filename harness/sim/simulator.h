@@ -26,16 +26,16 @@ struct SimulateOptions {
 
 // Where the wall time of a run went (for the benchmark and --json).
 struct SimulationStats {
-  double wall_s = 0.0;         // the whole SimulatePoint call
-  double setup_s = 0.0;        // world open, map cloud, stack build
+  double wall_s = 0.0;                // the whole SimulatePoint call
+  double setup_s = 0.0;               // world open, map cloud, stack build
   double stack_and_executor_s = 0.0;  // wall time inside the executor
   // The split of that time, known for the measured cost model only (NaN
   // for counted runs, which do not time their callbacks).
-  double stack_cpu_s = 0.0;    // the stack's callbacks (host thread CPU)
-  double executor_s = 0.0;     // executor and trace bookkeeping
-  double world_s = 0.0;        // SUMO steps and ego dynamics
-  double lidar_s = 0.0;        // ray casting
-  double simulated_s = 0.0;    // simulated time covered
+  double stack_cpu_s = 0.0;  // the stack's callbacks (host thread CPU)
+  double executor_s = 0.0;   // executor and trace bookkeeping
+  double world_s = 0.0;      // SUMO steps and ego dynamics
+  double lidar_s = 0.0;      // ray casting
+  double simulated_s = 0.0;  // simulated time covered
 };
 
 // The world and task of a scenario, ready for World::Open.

@@ -9,12 +9,12 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
-#include <initializer_list>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <initializer_list>
 #include <optional>
 #include <sstream>
 #include <utility>
@@ -44,14 +44,16 @@ constexpr auto kPollInterval = std::chrono::milliseconds(20);
 
 // Whether any line of the log that is srun's or slurmstepd's (the
 // worker's own output is never taken for theirs) contains one of `marks`.
-bool SlurmSays(const std::string& output, std::initializer_list<const char*> marks) {
+bool SlurmSays(const std::string& output,
+               std::initializer_list<const char*> marks) {
   size_t at = 0;
   while (at < output.size()) {
     size_t end = output.find('\n', at);
     if (end == std::string::npos) end = output.size();
     const std::string line = output.substr(at, end - at);
     at = end + 1;
-    if (line.rfind("srun:", 0) != 0 && line.rfind("slurmstepd", 0) != 0) continue;
+    if (line.rfind("srun:", 0) != 0 && line.rfind("slurmstepd", 0) != 0)
+      continue;
     for (const char* mark : marks) {
       if (line.find(mark) != std::string::npos) return true;
     }
@@ -62,9 +64,9 @@ bool SlurmSays(const std::string& output, std::initializer_list<const char*> mar
 // Whether srun's output says Slurm itself ended the step or refused it:
 // cancelled, its job gone.
 bool SlurmEndedStep(const std::string& output) {
-  return SlurmSays(output, {"CANCELLED AT", "has expired", "Expired or invalid job",
-                            "already completing", "Job step aborted",
-                            "Unable to create step"});
+  return SlurmSays(output, {"CANCELLED AT", "has expired",
+                            "Expired or invalid job", "already completing",
+                            "Job step aborted", "Unable to create step"});
 }
 
 // Whether the job is no longer running (cancelled, timed out, completing)
@@ -103,7 +105,8 @@ struct ChildPlan {
 [[noreturn]] void RunChild(const ChildPlan& plan) {
   // A coordinator that dies takes its steps with it: on SIGTERM srun
   // cancels its step (on SIGKILL it could not, and the step would run on).
-  if (!pool::PrepareChild(plan.parent_pid, SIGTERM, plan.stdin_fd, plan.log_fd)) {
+  if (!pool::PrepareChild(plan.parent_pid, SIGTERM, plan.stdin_fd,
+                          plan.log_fd)) {
     ::_exit(127);
   }
   ::execve(plan.argv[0], plan.argv.data(), plan.envp.data());
@@ -282,7 +285,8 @@ pool::JobResult StepPool::Reap(size_t slot) {
   result.id = r.job.id;
   result.slot = static_cast<int>(slot);
   result.wall_s = SteadySeconds(Clock::now() - r.start);
-  const std::string output = pool::ReadLogTail(r.job.log_path, kClassifyTailBytes);
+  const std::string output =
+      pool::ReadLogTail(r.job.log_path, kClassifyTailBytes);
   result.stderr_tail = output.size() > kStderrTailBytes
                            ? output.substr(output.size() - kStderrTailBytes)
                            : output;
@@ -360,7 +364,8 @@ std::vector<pool::JobResult> StepPool::CancelAll() {
   for (std::optional<Running>& slot : slots_) {
     if (slot && !Collect(*slot)) Cancel(*slot, pool::Outcome::kCancelled);
   }
-  const auto give_up = Clock::now() + SteadyFromSeconds(options_.cancel_grace_s);
+  const auto give_up =
+      Clock::now() + SteadyFromSeconds(options_.cancel_grace_s);
   for (;;) {
     bool running = false;
     for (size_t i = 0; i < slots_.size(); ++i) {
@@ -411,9 +416,9 @@ std::vector<std::string> SrunCommand(const StepPoolOptions& options,
 
 void ClassifyStepEnd(int wait_status, const std::string& output,
                      pool::JobResult* result) {
-  const bool oom = SlurmSays(output, {"Out Of Memory", "oom-kill", "oom_kill",
-                                      "Exceeded job memory limit",
-                                      "Exceeded step memory limit"});
+  const bool oom = SlurmSays(
+      output, {"Out Of Memory", "oom-kill", "oom_kill",
+               "Exceeded job memory limit", "Exceeded step memory limit"});
   const bool time_limit = SlurmSays(output, {"DUE TO TIME LIMIT"});
   result->exit_code = -1;
   result->signal = 0;

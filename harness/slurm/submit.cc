@@ -55,7 +55,8 @@ Status CheckSbatchArg(const std::string& arg) {
 
 // Directives every script ends with: where it runs and what it may use,
 // then the scenario's extra_args and --sbatch-arg (last, so they win).
-void AddSiteAndUserDirectives(const spec::Spec& spec, const SubmitOptions& options,
+void AddSiteAndUserDirectives(const spec::Spec& spec,
+                              const SubmitOptions& options,
                               std::vector<std::string>* d) {
   const spec::SlurmOptions& s = spec.harness.slurm;
   if (!s.partition.empty()) d->push_back("--partition=" + s.partition);
@@ -446,9 +447,7 @@ Result<SubmitResult> Submit(const spec::Spec& input,
 
   if (result.adaptive) {
     const spec::HarnessOptions& h = spec.harness;
-    result.steps_at_once = h.workers > 0
-                               ? h.workers
-                               : round_size;
+    result.steps_at_once = h.workers > 0 ? h.workers : round_size;
     const int tasks = slurm.cpus > 0
                           ? std::max(1, slurm.cpus / h.cores_per_worker)
                           : result.steps_at_once;
@@ -470,8 +469,7 @@ Result<SubmitResult> Submit(const spec::Spec& input,
       result.notes.push_back(fmt::format(
           "{} steps at once, but strategy {} proposes {} point(s) per round "
           "(exploration.batch): some CPUs will idle",
-          tasks, spec.exploration.strategy,
-          round_size));
+          tasks, spec.exploration.strategy, round_size));
     }
     SubmittedScript script;
     script.kind = "coordinator";

@@ -18,8 +18,8 @@ namespace adse::spec {
 using DesignPoint = std::map<std::string, double>;
 
 struct DesignParameter {
-  std::string name;   // key under design_space:
-  std::string bind;   // "platform.cores", "stack.lidar.rate_hz", ...
+  std::string name;  // key under design_space:
+  std::string bind;  // "platform.cores", "stack.lidar.rate_hz", ...
   // The allowed values, ascending and distinct. A `range: [lo, hi]` with an
   // optional `step` (default 1) is expanded here.
   std::vector<double> values;
@@ -83,7 +83,7 @@ struct ExplorationOptions {
   int budget = 15;                 // evaluations, replicas not counted
   int batch = 1;                   // points proposed per round
   uint64_t seed = 1;
-  DesignPoint start_from;          // empty: the strategy chooses
+  DesignPoint start_from;  // empty: the strategy chooses
   // GA / NSGA-II settings.
   int population = 8;
   double crossover_rate = 0.9;
@@ -106,10 +106,10 @@ struct SlurmOptions {
   std::string partition;
   std::string account;
   int nodes = 1;
-  int cpus = 0;            // 0: workers * cores_per_worker
+  int cpus = 0;  // 0: workers * cores_per_worker
   std::string time_limit = "02:00:00";
-  int max_parallel = 0;    // array throttle; 0: no limit
-  int shard_size = 0;      // points per array task; 0: automatic
+  int max_parallel = 0;  // array throttle; 0: no limit
+  int shard_size = 0;    // points per array task; 0: automatic
   std::vector<std::string> extra_args;
   // Seconds before the time limit at which Slurm warns adse
   // (--signal=B:USR1@<s>); running steps get this minus 30 s to finish.
@@ -119,7 +119,7 @@ struct SlurmOptions {
 };
 
 struct HarnessOptions {
-  int workers = 0;          // 0 means auto: host cores / cores_per_worker
+  int workers = 0;  // 0 means auto: host cores / cores_per_worker
   int cores_per_worker = 1;
   int memory_mb = 4096;
   double run_timeout_s = 900.0;

@@ -47,8 +47,8 @@ const std::vector<std::string> kStartKeys = {"x", "y", "edge", "pos_m", "lane"};
 const std::vector<std::string> kGoalKeys = {"x",     "y",    "edge",
                                             "pos_m", "lane", "tolerance_m"};
 const std::vector<std::string> kPlatformKeys = {
-    "kind", "reference_ghz", "cost_model", "calibration", "cores", "freq_ghz",
-    "cost_scale"};
+    "kind",  "reference_ghz", "cost_model", "calibration",
+    "cores", "freq_ghz",      "cost_scale"};
 const std::vector<std::string> kParameterKeys = {"bind", "range", "values",
                                                  "step"};
 const std::vector<std::string> kObjectiveKeys = {"minimize", "maximize"};
@@ -62,8 +62,8 @@ const std::vector<std::string> kHarnessKeys = {
     "workers",  "cores_per_worker", "memory_mb", "run_timeout_s", "retries",
     "replicas", "isolation",        "executor",  "cache_dir",     "slurm"};
 const std::vector<std::string> kSlurmKeys = {
-    "partition",  "account",      "nodes",      "cpus",
-    "time_limit", "max_parallel", "shard_size", "extra_args",
+    "partition",     "account",       "nodes",      "cpus",
+    "time_limit",    "max_parallel",  "shard_size", "extra_args",
     "signal_lead_s", "run_estimate_s"};
 
 const std::vector<std::string> kWeathers = {"clear", "rain", "fog"};
@@ -1519,10 +1519,9 @@ void SpecReader::ReadSlurm(const Val& v) {
             arg.find_first_of("\n\r") != std::string::npos) {
           Error(item, expected + " (one line, starting with '-')");
         } else if (name == "--array" || name == "-a" ||
-                   name == "--dependency" || name == "-d" ||
-                   name == "--wrap" || name == "--parsable") {
-          Error(item, expected + "; " + name +
-                          " is set by adse submit itself");
+                   name == "--dependency" || name == "-d" || name == "--wrap" ||
+                   name == "--parsable") {
+          Error(item, expected + "; " + name + " is set by adse submit itself");
         } else {
           s.extra_args.push_back(arg);
         }

@@ -6,9 +6,12 @@ namespace adse::algorithms {
 
 int64_t MapFilter::Key(double x, double y, double z) const {
   // 21 bits per axis: +-1M voxels, far beyond any map.
-  const int64_t ix = static_cast<int64_t>(std::floor(x / params_.voxel_m)) + (1 << 20);
-  const int64_t iy = static_cast<int64_t>(std::floor(y / params_.voxel_m)) + (1 << 20);
-  const int64_t iz = static_cast<int64_t>(std::floor(z / params_.voxel_m)) + (1 << 20);
+  const int64_t ix =
+      static_cast<int64_t>(std::floor(x / params_.voxel_m)) + (1 << 20);
+  const int64_t iy =
+      static_cast<int64_t>(std::floor(y / params_.voxel_m)) + (1 << 20);
+  const int64_t iz =
+      static_cast<int64_t>(std::floor(z / params_.voxel_m)) + (1 << 20);
   return (ix << 42) | (iy << 21) | iz;
 }
 
@@ -16,7 +19,8 @@ void MapFilter::SetMap(const std::vector<Eigen::Vector3f>& map_points) {
   voxels_.clear();
   std::unordered_set<int64_t> occupied;
   occupied.reserve(map_points.size());
-  for (const Eigen::Vector3f& p : map_points) occupied.insert(Key(p.x(), p.y(), p.z()));
+  for (const Eigen::Vector3f& p : map_points)
+    occupied.insert(Key(p.x(), p.y(), p.z()));
   voxels_.reserve(occupied.size() * 8);
   const double v = params_.voxel_m;
   for (const Eigen::Vector3f& p : map_points) {
@@ -31,8 +35,9 @@ void MapFilter::SetMap(const std::vector<Eigen::Vector3f>& map_points) {
   }
 }
 
-std::vector<Eigen::Vector3f> MapFilter::Filter(const std::vector<Eigen::Vector3f>& points,
-                                               const world::Pose2& pose) const {
+std::vector<Eigen::Vector3f> MapFilter::Filter(
+    const std::vector<Eigen::Vector3f>& points,
+    const world::Pose2& pose) const {
   std::vector<Eigen::Vector3f> out;
   out.reserve(points.size());
   const double c = std::cos(pose.yaw_rad), s = std::sin(pose.yaw_rad);

@@ -27,8 +27,9 @@ class MapFilter {
   void SetMap(const std::vector<Eigen::Vector3f>& map_points);
 
   // Points (vehicle frame) the map does not explain, given the vehicle pose.
-  std::vector<Eigen::Vector3f> Filter(const std::vector<Eigen::Vector3f>& points,
-                                      const world::Pose2& pose) const;
+  std::vector<Eigen::Vector3f> Filter(
+      const std::vector<Eigen::Vector3f>& points,
+      const world::Pose2& pose) const;
 
   size_t voxels() const { return voxels_.size(); }
 

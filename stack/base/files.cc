@@ -38,7 +38,8 @@ namespace {
 
 // Writes all of `data` to `fd`, flushes it to disk and closes it (also on
 // failure); errors name `path`.
-Status WriteAllAndClose(int fd, const std::string& data, const std::string& path) {
+Status WriteAllAndClose(int fd, const std::string& data,
+                        const std::string& path) {
   size_t written = 0;
   while (written < data.size()) {
     const ssize_t n = ::write(fd, data.data() + written, data.size() - written);
@@ -55,7 +56,8 @@ Status WriteAllAndClose(int fd, const std::string& data, const std::string& path
     ::close(fd);
     return Status::IoError(path + ": " + err);
   }
-  if (::close(fd) != 0) return Status::IoError(path + ": " + std::strerror(errno));
+  if (::close(fd) != 0)
+    return Status::IoError(path + ": " + std::strerror(errno));
   return Status::Ok();
 }
 
@@ -102,7 +104,8 @@ std::string DefaultCacheDir() {
 Status MakeDirs(const std::string& path) {
   std::error_code ec;
   fs::create_directories(path, ec);
-  if (ec) return Status::IoError(path + ": cannot create folder: " + ec.message());
+  if (ec)
+    return Status::IoError(path + ": cannot create folder: " + ec.message());
   return Status::Ok();
 }
 

@@ -88,9 +88,9 @@ class Result {
 }  // namespace adse
 
 // Returns early from the enclosing function when `expr` is not ok.
-#define ADSE_RETURN_IF_ERROR(expr)        \
-  do {                                    \
-    ::adse::Status adse_status_ = (expr); \
+#define ADSE_RETURN_IF_ERROR(expr)               \
+  do {                                           \
+    ::adse::Status adse_status_ = (expr);        \
     if (!adse_status_.ok()) return adse_status_; \
   } while (0)
 

@@ -25,16 +25,18 @@ Result<ProcessResult> RunProcess(const std::vector<std::string>& argv,
   posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDOUT_FILENO);
   posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDERR_FILENO);
   std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  for (const std::string& a : argv)
+    args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
   pid_t pid = 0;
-  const int rc = ::posix_spawnp(&pid, args[0], &actions, nullptr, args.data(),
-                                environ);
+  const int rc =
+      ::posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   ::close(pipe_fds[1]);
   if (rc != 0) {
     ::close(pipe_fds[0]);
-    return Status::IoError("cannot start " + argv[0] + ": " + std::strerror(rc));
+    return Status::IoError("cannot start " + argv[0] + ": " +
+                           std::strerror(rc));
   }
   ProcessResult result;
   char buffer[4096];
@@ -52,7 +54,8 @@ Result<ProcessResult> RunProcess(const std::vector<std::string>& argv,
   int wstatus = 0;
   while (::waitpid(pid, &wstatus, 0) < 0) {
     if (errno != EINTR) {
-      return Status::IoError("waitpid " + argv[0] + ": " + std::strerror(errno));
+      return Status::IoError("waitpid " + argv[0] + ": " +
+                             std::strerror(errno));
     }
   }
   if (result.output.size() > max_output_bytes) {
@@ -69,14 +72,16 @@ Status RunChecked(const std::vector<std::string>& argv) {
   if (r->exit_code == 0) return Status::Ok();
   std::string tail = r->output;
   if (tail.size() > 2000) tail = "..." + tail.substr(tail.size() - 2000);
-  const std::string how = r->signal ? "was killed by signal " + std::to_string(r->signal)
-                                    : "exited with status " + std::to_string(r->exit_code);
+  const std::string how =
+      r->signal ? "was killed by signal " + std::to_string(r->signal)
+                : "exited with status " + std::to_string(r->exit_code);
   return Status::IoError(argv[0] + " " + how + ":\n" + tail);
 }
 
 std::string SelfExecutable() {
   std::error_code ec;
-  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  const std::filesystem::path self =
+      std::filesystem::read_symlink("/proc/self/exe", ec);
   return ec ? std::string("adse") : self.string();
 }
 

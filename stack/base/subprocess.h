@@ -10,9 +10,9 @@
 namespace adse {
 
 struct ProcessResult {
-  int exit_code = -1;   // exit status, or -1 when killed by a signal
-  int signal = 0;       // the signal that ended it, or 0
-  std::string output;   // stdout and stderr, interleaved (tail kept)
+  int exit_code = -1;  // exit status, or -1 when killed by a signal
+  int signal = 0;      // the signal that ended it, or 0
+  std::string output;  // stdout and stderr, interleaved (tail kept)
 };
 
 // Runs argv[0] (searched on PATH) and waits. An error Status only when the

@@ -10,33 +10,42 @@ const std::vector<KnobInfo>& StackKnobs() {
   static const std::vector<KnobInfo> kKnobs = [] {
     const world::LidarParams d;
     return std::vector<KnobInfo>{
-        {"lidar.rate_hz", false, 0.5, 100.0, d.rate_hz, "LiDAR scans per second, Hz"},
-        {"lidar.beams", true, 1, 128, static_cast<double>(d.beams), "vertical channels"},
+        {"lidar.rate_hz", false, 0.5, 100.0, d.rate_hz,
+         "LiDAR scans per second, Hz"},
+        {"lidar.beams", true, 1, 128, static_cast<double>(d.beams),
+         "vertical channels"},
         {"lidar.horizontal_resolution_deg", false, 0.05, 10.0,
          d.horizontal_resolution_deg, "azimuth step, degrees"},
-        {"lidar.range_m", false, 1.0, 300.0, d.range_m, "maximum range in clear weather, m"},
+        {"lidar.range_m", false, 1.0, 300.0, d.range_m,
+         "maximum range in clear weather, m"},
         {"lidar.vertical_fov_up_deg", false, -30.0, 45.0, d.vertical_fov_up_deg,
          "elevation of the top beam, degrees"},
-        {"lidar.vertical_fov_down_deg", false, -45.0, 30.0, d.vertical_fov_down_deg,
-         "elevation of the bottom beam, degrees"},
+        {"lidar.vertical_fov_down_deg", false, -45.0, 30.0,
+         d.vertical_fov_down_deg, "elevation of the bottom beam, degrees"},
         {"lidar.mount_height_m", false, 0.3, 5.0, d.mount_height_m,
          "sensor height above the ground, m"},
         {"lidar.range_noise_stddev_m", false, 0.0, 1.0, d.range_noise_stddev_m,
          "range noise in clear weather, m"},
         // Wheel odometry from the vehicle.
-        {"odometry.rate_hz", false, 1.0, 200.0, 50.0, "wheel odometry messages per second, Hz"},
+        {"odometry.rate_hz", false, 1.0, 200.0, 50.0,
+         "wheel odometry messages per second, Hz"},
         // Localization.
         {"localization.voxel_leaf_m", false, 0.1, 5.0, 1.0,
          "voxel size of the scan given to NDT, m"},
-        {"localization.ndt_resolution_m", false, 0.5, 10.0, 2.0, "NDT cell size, m"},
-        {"localization.ndt_max_iterations", true, 1, 200, 30, "NDT iteration limit"},
+        {"localization.ndt_resolution_m", false, 0.5, 10.0, 2.0,
+         "NDT cell size, m"},
+        {"localization.ndt_max_iterations", true, 1, 200, 30,
+         "NDT iteration limit"},
         {"localization.ndt_max_fitness", false, 0.01, 100.0, 0.5,
-         "NDT fitness score (mean squared match distance, m^2) above which a match is rejected"},
+         "NDT fitness score (mean squared match distance, m^2) above which a "
+         "match is rejected"},
         {"localization.ndt_threads", true, 1, 256, 8,
          "cores the data-parallel NDT can use"},
-        {"localization.ekf_rate_hz", false, 1.0, 500.0, 50.0, "EKF output rate, Hz"},
+        {"localization.ekf_rate_hz", false, 1.0, 500.0, 50.0,
+         "EKF output rate, Hz"},
         {"localization.lost_after_s", false, 0.1, 60.0, 3.0,
-         "time without an accepted NDT match after which localization is lost, s"},
+         "time without an accepted NDT match after which localization is lost, "
+         "s"},
         // Perception.
         {"perception.ground_height_m", false, 0.0, 2.0, 0.25,
          "points below this height are ground, m"},
@@ -44,21 +53,27 @@ const std::vector<KnobInfo>& StackKnobs() {
          "obstacle points beyond this range are ignored, m"},
         {"perception.cluster_tolerance_m", false, 0.05, 5.0, 0.7,
          "Euclidean clustering distance, m"},
-        {"perception.min_cluster_points", true, 1, 10000, 5, "smallest cluster kept"},
-        {"perception.threads", true, 1, 256, 4, "cores the data-parallel clustering can use"},
+        {"perception.min_cluster_points", true, 1, 10000, 5,
+         "smallest cluster kept"},
+        {"perception.threads", true, 1, 256, 4,
+         "cores the data-parallel clustering can use"},
         {"perception.max_object_size_m", false, 1.0, 100.0, 12.0,
          "clusters longer than this are static structure, not objects, m"},
         // Planning.
-        {"planning.rate_hz", false, 0.5, 100.0, 10.0, "behaviour/velocity planner rate, Hz"},
-        {"planning.horizon_m", false, 5.0, 500.0, 50.0, "trajectory length ahead, m"},
+        {"planning.rate_hz", false, 0.5, 100.0, 10.0,
+         "behaviour/velocity planner rate, Hz"},
+        {"planning.horizon_m", false, 5.0, 500.0, 50.0,
+         "trajectory length ahead, m"},
         {"planning.corridor_half_width_m", false, 0.5, 5.0, 1.5,
          "obstacles closer than this to the path stop the car, m"},
         {"planning.stop_margin_m", false, 0.5, 30.0, 5.0,
          "distance kept to an obstacle in the path, m"},
         {"planning.max_lateral_accel_mps2", false, 0.1, 10.0, 2.0,
          "lateral acceleration limit in curves, m/s^2"},
-        {"planning.max_accel_mps2", false, 0.1, 10.0, 1.5, "acceleration limit, m/s^2"},
-        {"planning.max_decel_mps2", false, 0.1, 10.0, 2.5, "comfortable deceleration, m/s^2"},
+        {"planning.max_accel_mps2", false, 0.1, 10.0, 1.5,
+         "acceleration limit, m/s^2"},
+        {"planning.max_decel_mps2", false, 0.1, 10.0, 2.5,
+         "comfortable deceleration, m/s^2"},
         // Control.
         {"control.rate_hz", false, 1.0, 500.0, 30.0,
          "trajectory follower rate (control-command topic), Hz"},
@@ -83,13 +98,14 @@ const KnobInfo* FindStackKnob(const std::string& path) {
 Status StackConfig::Set(const std::string& path, double value) {
   const KnobInfo* knob = FindStackKnob(path);
   if (knob == nullptr) {
-    return Status::InvalidArgument("stack." + path + " is not a stack parameter");
+    return Status::InvalidArgument("stack." + path +
+                                   " is not a stack parameter");
   }
   if (!std::isfinite(value) || value < knob->min_value ||
       value > knob->max_value) {
-    return Status::InvalidArgument(fmt::format(
-        "stack.{} must be in [{}, {}] ({}), found {}", path, knob->min_value,
-        knob->max_value, knob->doc, value));
+    return Status::InvalidArgument(
+        fmt::format("stack.{} must be in [{}, {}] ({}), found {}", path,
+                    knob->min_value, knob->max_value, knob->doc, value));
   }
   if (knob->integer && value != std::floor(value)) {
     return Status::InvalidArgument(

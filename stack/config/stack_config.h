@@ -15,12 +15,12 @@
 namespace adse {
 
 struct KnobInfo {
-  std::string path;       // "lidar.rate_hz" (without the `stack.` prefix)
-  bool integer = false;   // only whole numbers allowed
+  std::string path;      // "lidar.rate_hz" (without the `stack.` prefix)
+  bool integer = false;  // only whole numbers allowed
   double min_value = 0.0;
   double max_value = 0.0;
   double default_value = 0.0;
-  std::string doc;        // one line, with the unit
+  std::string doc;  // one line, with the unit
 };
 
 // Every knob the stack has, in a stable order.

@@ -32,8 +32,8 @@ double WrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
 // Trajectory points as the planning and control algorithms take them; the
 // speed can be capped on the way.
-std::vector<algo::PlannedPoint> ToPlanned(const std::vector<TrajectoryPoint>& points,
-                                          double max_v_mps = INFINITY) {
+std::vector<algo::PlannedPoint> ToPlanned(
+    const std::vector<TrajectoryPoint>& points, double max_v_mps = INFINITY) {
   std::vector<algo::PlannedPoint> out;
   out.reserve(points.size());
   for (const TrajectoryPoint& p : points) {
@@ -122,37 +122,42 @@ Status Stack::Build(Graph* g) {
 void Stack::BuildSensing(Graph* g) {
   // LiDAR driver: range and ego-body crop of the raw scan.
   crop_.max_range_m = config_.Get("lidar.range_m");
-  crop_.ego_x_max_m = inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2 + 0.2;
-  crop_.ego_x_min_m = inputs_.wheelbase_m / 2 - inputs_.vehicle_length_m / 2 - 0.2;
+  crop_.ego_x_max_m =
+      inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2 + 0.2;
+  crop_.ego_x_min_m =
+      inputs_.wheelbase_m / 2 - inputs_.vehicle_length_m / 2 - 0.2;
   crop_.ego_half_width_m = inputs_.vehicle_width_m / 2 + 0.2;
   const int node = g->AddNode("lidar_driver");
-  g->Subscribe<PointCloudMsg>(node, topics_.lidar_raw, "points_raw", 1,
-                              [this](const PointCloudMsg& in, CallbackContext& ctx) {
-                                PointCloudMsg out;
-                                out.header = in.header;
-                                out.points = algo::CropPoints(in.points, crop_);
-                                ctx.ReportWork({static_cast<double>(in.points.size()), 0.0, 1});
-                                ctx.Publish(points_, std::move(out));
-                              });
+  g->Subscribe<PointCloudMsg>(
+      node, topics_.lidar_raw, "points_raw", 1,
+      [this](const PointCloudMsg& in, CallbackContext& ctx) {
+        PointCloudMsg out;
+        out.header = in.header;
+        out.points = algo::CropPoints(in.points, crop_);
+        ctx.ReportWork({static_cast<double>(in.points.size()), 0.0, 1});
+        ctx.Publish(points_, std::move(out));
+      });
 }
 
 Status Stack::BuildLocalization(Graph* g) {
   // Voxel filter feeding the scan matcher.
   const double leaf = config_.Get("localization.voxel_leaf_m");
   const int voxel = g->AddNode("voxel_filter");
-  g->Subscribe<PointCloudMsg>(voxel, points_, "points", 1,
-                              [this, leaf](const PointCloudMsg& in, CallbackContext& ctx) {
-                                PointCloudMsg out;
-                                out.header = in.header;
-                                out.points = algo::VoxelDownsample(in.points, leaf);
-                                ctx.ReportWork({static_cast<double>(in.points.size()), 0.0, 1});
-                                ctx.Publish(downsampled_, std::move(out));
-                              });
+  g->Subscribe<PointCloudMsg>(
+      voxel, points_, "points", 1,
+      [this, leaf](const PointCloudMsg& in, CallbackContext& ctx) {
+        PointCloudMsg out;
+        out.header = in.header;
+        out.points = algo::VoxelDownsample(in.points, leaf);
+        ctx.ReportWork({static_cast<double>(in.points.size()), 0.0, 1});
+        ctx.Publish(downsampled_, std::move(out));
+      });
 
   // NDT scan matching against the map cloud, guessed from the EKF.
   algo::NdtParams ndt_params;
   ndt_params.resolution_m = config_.Get("localization.ndt_resolution_m");
-  ndt_params.max_iterations = static_cast<int>(config_.Get("localization.ndt_max_iterations"));
+  ndt_params.max_iterations =
+      static_cast<int>(config_.Get("localization.ndt_max_iterations"));
   ndt_params.max_fitness_m2 = config_.Get("localization.ndt_max_fitness");
   ndt_ = std::make_unique<algo::NdtMatcher>(ndt_params);
   ADSE_RETURN_IF_ERROR(ndt_->SetMap(inputs_.map_cloud));
@@ -186,9 +191,11 @@ Status Stack::BuildLocalization(Graph* g) {
         if (r.ok()) {
           out.pose = r->pose;
           out.fitness = r->fitness_score_m2;
-          ctx.ReportWork({static_cast<double>(r->work_units), kNdtParallelFraction, threads});
+          ctx.ReportWork({static_cast<double>(r->work_units),
+                          kNdtParallelFraction, threads});
         }
-        out.covariance = Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.01 * 0.01).asDiagonal();
+        out.covariance =
+            Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.01 * 0.01).asDiagonal();
         ctx.Publish(ndt_pose_, std::move(out));
       });
 
@@ -198,14 +205,16 @@ Status Stack::BuildLocalization(Graph* g) {
   ekf_ = algo::Ekf(ekf_params);
   ekf_.Initialize(inputs_.initial_pose, 0.0, 0.0);
   const int ekf_node = g->AddNode("ekf_localizer");
-  g->Subscribe<OdometryMsg>(ekf_node, topics_.odometry, "odometry", 10,
-                            [this](const OdometryMsg& in, CallbackContext& ctx) {
-                              ekf_.Predict(std::max(0.0, ctx.now_s() - ekf_last_t_));
-                              ekf_last_t_ = ctx.now_s();
-                              ekf_.UpdateOdometry(in.v_mps, in.yaw_rate_rps, 0.05, 0.01);
-                            });
+  g->Subscribe<OdometryMsg>(
+      ekf_node, topics_.odometry, "odometry", 10,
+      [this](const OdometryMsg& in, CallbackContext& ctx) {
+        ekf_.Predict(std::max(0.0, ctx.now_s() - ekf_last_t_));
+        ekf_last_t_ = ctx.now_s();
+        ekf_.UpdateOdometry(in.v_mps, in.yaw_rate_rps, 0.05, 0.01);
+      });
   g->Subscribe<PoseMsg>(
-      ekf_node, ndt_pose_, "ndt_pose", 1, [this](const PoseMsg& in, CallbackContext& ctx) {
+      ekf_node, ndt_pose_, "ndt_pose", 1,
+      [this](const PoseMsg& in, CallbackContext& ctx) {
         if (!in.valid) return;
         ekf_.Predict(std::max(0.0, ctx.now_s() - ekf_last_t_));
         ekf_last_t_ = ctx.now_s();
@@ -218,21 +227,25 @@ Status Stack::BuildLocalization(Graph* g) {
         if (then != ekf_history_.end()) {
           const world::Pose2 now = ekf_.pose();
           const double dyaw = WrapAngle(now.yaw_rad - then->pose.yaw_rad);
-          const Eigen::Vector2d moved_world(now.x_m - then->pose.x_m, now.y_m - then->pose.y_m);
+          const Eigen::Vector2d moved_world(now.x_m - then->pose.x_m,
+                                            now.y_m - then->pose.y_m);
           const double c = std::cos(measured.yaw_rad - then->pose.yaw_rad);
           const double s = std::sin(measured.yaw_rad - then->pose.yaw_rad);
           measured.x_m += c * moved_world.x() - s * moved_world.y();
           measured.y_m += s * moved_world.x() + c * moved_world.y();
           measured.yaw_rad = WrapAngle(measured.yaw_rad + dyaw);
         }
-        if (ekf_.UpdatePose(measured, in.covariance)) ekf_stamp_ = in.header.stamp_s;
+        if (ekf_.UpdatePose(measured, in.covariance))
+          ekf_stamp_ = in.header.stamp_s;
       });
-  g->AddTimer(ekf_node, "publish", 1.0 / config_.Get("localization.ekf_rate_hz"),
+  g->AddTimer(ekf_node, "publish",
+              1.0 / config_.Get("localization.ekf_rate_hz"),
               [this](CallbackContext& ctx) {
                 ekf_.Predict(std::max(0.0, ctx.now_s() - ekf_last_t_));
                 ekf_last_t_ = ctx.now_s();
                 ekf_history_.push_back({ctx.now_s(), ekf_.pose()});
-                while (ekf_history_.size() > 1 && ekf_history_.front().t_s < ctx.now_s() - 3.0) {
+                while (ekf_history_.size() > 1 &&
+                       ekf_history_.front().t_s < ctx.now_s() - 3.0) {
                   ekf_history_.pop_front();
                 }
                 PoseMsg out;
@@ -252,8 +265,9 @@ void Stack::BuildPerception(Graph* g) {
   const double max_range = config_.Get("perception.max_range_m");
   map_filter_.SetMap(inputs_.map_cloud);
   const int ground_node = g->AddNode("ground_filter");
-  g->Subscribe<PoseMsg>(ground_node, topics_.pose, "pose", 1,
-                        [this](const PoseMsg& in, CallbackContext&) { ground_pose_ = in; });
+  g->Subscribe<PoseMsg>(
+      ground_node, topics_.pose, "pose", 1,
+      [this](const PoseMsg& in, CallbackContext&) { ground_pose_ = in; });
   g->Subscribe<PointCloudMsg>(
       ground_node, points_, "points", 1,
       [this, ground, max_range](const PointCloudMsg& in, CallbackContext& ctx) {
@@ -269,28 +283,34 @@ void Stack::BuildPerception(Graph* g) {
         out.header = in.header;
         out.points = map_filter_.Filter(
             near, ground_pose_ ? ground_pose_->pose : inputs_.initial_pose);
-        ctx.ReportWork({static_cast<double>(r.work_units + near.size()), 0.0, 1});
+        ctx.ReportWork(
+            {static_cast<double>(r.work_units + near.size()), 0.0, 1});
         ctx.Publish(obstacle_points_, std::move(out));
       });
 
   algo::ClusteringParams clustering;
   clustering.tolerance_m = config_.Get("perception.cluster_tolerance_m");
-  clustering.min_points = static_cast<int>(config_.Get("perception.min_cluster_points"));
+  clustering.min_points =
+      static_cast<int>(config_.Get("perception.min_cluster_points"));
   const int threads = static_cast<int>(config_.Get("perception.threads"));
   const double max_object_m = config_.Get("perception.max_object_size_m");
   const int cluster_node = g->AddNode("euclidean_cluster");
-  g->Subscribe<PoseMsg>(cluster_node, topics_.pose, "pose", 1,
-                        [this](const PoseMsg& in, CallbackContext&) { cluster_pose_ = in; });
+  g->Subscribe<PoseMsg>(
+      cluster_node, topics_.pose, "pose", 1,
+      [this](const PoseMsg& in, CallbackContext&) { cluster_pose_ = in; });
   g->Subscribe<PointCloudMsg>(
       cluster_node, obstacle_points_, "points", 1,
-      [this, clustering, threads, max_object_m](const PointCloudMsg& in, CallbackContext& ctx) {
+      [this, clustering, threads, max_object_m](const PointCloudMsg& in,
+                                                CallbackContext& ctx) {
         // Downsample first, as production clustering pipelines do: object
         // shapes survive a 0.2 m grid and the clustering cost drops.
-        const std::vector<Eigen::Vector3f> sparse = algo::VoxelDownsample(in.points, 0.2);
+        const std::vector<Eigen::Vector3f> sparse =
+            algo::VoxelDownsample(in.points, 0.2);
         algo::DetectionResult r = algo::DetectObjects(sparse, clustering);
         ObjectsMsg out;
         out.header = in.header;
-        const world::Pose2 pose = cluster_pose_ ? cluster_pose_->pose : inputs_.initial_pose;
+        const world::Pose2 pose =
+            cluster_pose_ ? cluster_pose_->pose : inputs_.initial_pose;
         for (const algo::Detection& d : r.detections) {
           // Clusters larger than any vehicle are static structure (a wall's
           // corner fits a box spanning the road); the map, not the object
@@ -303,38 +323,41 @@ void Stack::BuildPerception(Graph* g) {
           o.width_m = m.width_m;
           out.objects.push_back(o);
         }
-        ctx.ReportWork({static_cast<double>(r.work_units), kClusteringParallelFraction, threads});
+        ctx.ReportWork({static_cast<double>(r.work_units),
+                        kClusteringParallelFraction, threads});
         ctx.Publish(detections_, std::move(out));
       });
 
   tracker_ = std::make_unique<algo::Tracker>();
   const int tracker_node = g->AddNode("multi_object_tracker");
-  g->Subscribe<ObjectsMsg>(tracker_node, detections_, "detections", 1,
-                           [this](const ObjectsMsg& in, CallbackContext& ctx) {
-                             std::vector<algo::Detection> detections;
-                             for (const TrackedObject& o : in.objects) {
-                               algo::Detection d;
-                               d.center = o.position;
-                               d.length_m = o.length_m;
-                               d.width_m = o.width_m;
-                               detections.push_back(d);
-                             }
-                             tracker_->Update(in.header.stamp_s, detections);
-                             ObjectsMsg out;
-                             out.header = in.header;
-                             for (const algo::Track& t : tracker_->ConfirmedTracks()) {
-                               TrackedObject o;
-                               o.id = t.id;
-                               o.position = t.position;
-                               o.velocity = t.velocity;
-                               o.length_m = t.length_m;
-                               o.width_m = t.width_m;
-                               o.age = t.age;
-                               out.objects.push_back(o);
-                             }
-                             ctx.ReportWork({static_cast<double>(tracker_->last_work_units()), 0.0, 1});
-                             ctx.Publish(topics_.objects, std::move(out));
-                           });
+  g->Subscribe<ObjectsMsg>(
+      tracker_node, detections_, "detections", 1,
+      [this](const ObjectsMsg& in, CallbackContext& ctx) {
+        std::vector<algo::Detection> detections;
+        for (const TrackedObject& o : in.objects) {
+          algo::Detection d;
+          d.center = o.position;
+          d.length_m = o.length_m;
+          d.width_m = o.width_m;
+          detections.push_back(d);
+        }
+        tracker_->Update(in.header.stamp_s, detections);
+        ObjectsMsg out;
+        out.header = in.header;
+        for (const algo::Track& t : tracker_->ConfirmedTracks()) {
+          TrackedObject o;
+          o.id = t.id;
+          o.position = t.position;
+          o.velocity = t.velocity;
+          o.length_m = t.length_m;
+          o.width_m = t.width_m;
+          o.age = t.age;
+          out.objects.push_back(o);
+        }
+        ctx.ReportWork(
+            {static_cast<double>(tracker_->last_work_units()), 0.0, 1});
+        ctx.Publish(topics_.objects, std::move(out));
+      });
 }
 
 void Stack::BuildPlanning(Graph* g) {
@@ -351,59 +374,70 @@ void Stack::BuildPlanning(Graph* g) {
   algo::PlannerParams params;
   params.horizon_m = config_.Get("planning.horizon_m");
   params.speed_limit_mps = inputs_.speed_limit_mps;
-  params.max_lateral_accel_mps2 = config_.Get("planning.max_lateral_accel_mps2");
+  params.max_lateral_accel_mps2 =
+      config_.Get("planning.max_lateral_accel_mps2");
   params.corridor_half_width_m = config_.Get("planning.corridor_half_width_m");
   params.stop_margin_m = config_.Get("planning.stop_margin_m");
   params.ego_front_m = inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2;
   planner_ = std::make_unique<algo::BehaviorVelocityPlanner>(params);
   const int node = g->AddNode("behavior_velocity_planner");
-  g->Subscribe<PathMsg>(node, route_, "route", 1, [this](const PathMsg& in, CallbackContext&) {
-    planner_->SetPath(in.path, in.path.points.back());
-    planner_has_route_ = true;
-  });
-  g->Subscribe<PoseMsg>(node, topics_.pose, "pose", 1,
-                        [this](const PoseMsg& in, CallbackContext&) { planner_pose_ = in; });
+  g->Subscribe<PathMsg>(node, route_, "route", 1,
+                        [this](const PathMsg& in, CallbackContext&) {
+                          planner_->SetPath(in.path, in.path.points.back());
+                          planner_has_route_ = true;
+                        });
+  g->Subscribe<PoseMsg>(
+      node, topics_.pose, "pose", 1,
+      [this](const PoseMsg& in, CallbackContext&) { planner_pose_ = in; });
   g->Subscribe<ObjectsMsg>(node, topics_.objects, "objects", 1,
-                           [this](const ObjectsMsg& in, CallbackContext&) { planner_objects_ = in; });
-  g->AddTimer(node, "plan", 1.0 / config_.Get("planning.rate_hz"), [this](CallbackContext& ctx) {
-    if (!planner_has_route_ || !planner_pose_) return;
-    std::vector<algo::PlannerObstacle> obstacles;
-    if (planner_objects_) {
-      for (const TrackedObject& o : planner_objects_->objects) {
-        algo::PlannerObstacle ob;
-        ob.id = o.id;
-        ob.position = o.position;
-        ob.velocity = o.velocity;
-        ob.length_m = o.length_m;
-        ob.width_m = o.width_m;
-        obstacles.push_back(ob);
-      }
-    }
-    const algo::PlannedTrajectory plan = planner_->Plan(planner_pose_->pose, obstacles);
-    TrajectoryMsg out;
-    out.header.stamp_s = planner_pose_->header.stamp_s;
-    out.stop_for_goal = plan.stop_for_goal;
-    out.stop_for_obstacle = plan.stop_for_obstacle;
-    for (const algo::PlannedPoint& p : plan.points) {
-      out.points.push_back({p.x_m, p.y_m, p.yaw_rad, p.s_m, p.v_mps});
-    }
-    ctx.ReportWork({static_cast<double>(plan.work_units), 0.0, 1});
-    ctx.Publish(trajectory_raw_, std::move(out));
-  });
+                           [this](const ObjectsMsg& in, CallbackContext&) {
+                             planner_objects_ = in;
+                           });
+  g->AddTimer(
+      node, "plan", 1.0 / config_.Get("planning.rate_hz"),
+      [this](CallbackContext& ctx) {
+        if (!planner_has_route_ || !planner_pose_) return;
+        std::vector<algo::PlannerObstacle> obstacles;
+        if (planner_objects_) {
+          for (const TrackedObject& o : planner_objects_->objects) {
+            algo::PlannerObstacle ob;
+            ob.id = o.id;
+            ob.position = o.position;
+            ob.velocity = o.velocity;
+            ob.length_m = o.length_m;
+            ob.width_m = o.width_m;
+            obstacles.push_back(ob);
+          }
+        }
+        const algo::PlannedTrajectory plan =
+            planner_->Plan(planner_pose_->pose, obstacles);
+        TrajectoryMsg out;
+        out.header.stamp_s = planner_pose_->header.stamp_s;
+        out.stop_for_goal = plan.stop_for_goal;
+        out.stop_for_obstacle = plan.stop_for_obstacle;
+        for (const algo::PlannedPoint& p : plan.points) {
+          out.points.push_back({p.x_m, p.y_m, p.yaw_rad, p.s_m, p.v_mps});
+        }
+        ctx.ReportWork({static_cast<double>(plan.work_units), 0.0, 1});
+        ctx.Publish(trajectory_raw_, std::move(out));
+      });
 
   algo::SmootherParams smoother;
   smoother.max_accel_mps2 = config_.Get("planning.max_accel_mps2");
   smoother.max_decel_mps2 = config_.Get("planning.max_decel_mps2");
   const int smoother_node = g->AddNode("velocity_smoother");
-  g->Subscribe<PoseMsg>(smoother_node, topics_.pose, "pose", 1,
-                        [this](const PoseMsg& in, CallbackContext&) { smoother_pose_ = in; });
+  g->Subscribe<PoseMsg>(
+      smoother_node, topics_.pose, "pose", 1,
+      [this](const PoseMsg& in, CallbackContext&) { smoother_pose_ = in; });
   g->Subscribe<TrajectoryMsg>(
       smoother_node, trajectory_raw_, "trajectory", 1,
       [this, smoother](const TrajectoryMsg& in, CallbackContext& ctx) {
         std::vector<algo::PlannedPoint> points = ToPlanned(in.points);
-        algo::SmoothVelocity(&points, smoother_pose_ ? smoother_pose_->v_mps : 0.0, smoother);
+        algo::SmoothVelocity(
+            &points, smoother_pose_ ? smoother_pose_->v_mps : 0.0, smoother);
         TrajectoryMsg out = in;
-        for (size_t i = 0; i < points.size(); ++i) out.points[i].v_mps = points[i].v_mps;
+        for (size_t i = 0; i < points.size(); ++i)
+          out.points[i].v_mps = points[i].v_mps;
         ctx.ReportWork({static_cast<double>(points.size()), 0.0, 1});
         ctx.Publish(topics_.trajectory, std::move(out));
       });
@@ -414,49 +448,60 @@ void Stack::BuildControl(Graph* g) {
   params.pure_pursuit.wheelbase_m = inputs_.wheelbase_m;
   follower_ = std::make_unique<algo::TrajectoryFollower>(params);
   const int node = g->AddNode("trajectory_follower");
-  g->Subscribe<PoseMsg>(node, topics_.pose, "pose", 1,
-                        [this](const PoseMsg& in, CallbackContext&) { follower_pose_ = in; });
+  g->Subscribe<PoseMsg>(
+      node, topics_.pose, "pose", 1,
+      [this](const PoseMsg& in, CallbackContext&) { follower_pose_ = in; });
   g->Subscribe<TrajectoryMsg>(
       node, topics_.trajectory, "trajectory", 1,
-      [this](const TrajectoryMsg& in, CallbackContext&) { follower_trajectory_ = in; });
-  const double max_travel_per_fix_m = config_.Get("control.max_travel_per_fix_m");
+      [this](const TrajectoryMsg& in, CallbackContext&) {
+        follower_trajectory_ = in;
+      });
+  const double max_travel_per_fix_m =
+      config_.Get("control.max_travel_per_fix_m");
   g->AddTimer(node, "control", 1.0 / config_.Get("control.rate_hz"),
               [this, max_travel_per_fix_m](CallbackContext& ctx) {
-    ControlMsg out;
-    out.header.stamp_s = follower_pose_ ? follower_pose_->header.stamp_s : -1.0;
-    const double dt = follower_last_t_ < 0 ? 0.0 : ctx.now_s() - follower_last_t_;
-    follower_last_t_ = ctx.now_s();
-    if (!follower_pose_ || !follower_pose_->valid) {
-      // Nothing to steer by: ask for a stop.
-      out.accel_mps2 = -kNoPoseDecelMps2;
-    } else {
-      // Degraded mode: drive no faster than lets the car cover
-      // max_travel_per_fix_m between localization fixes, so a slow scan
-      // matcher still gets a close initial guess (the stack slows down
-      // rather than losing itself).
-      const double fix_age = ctx.now_s() - follower_pose_->header.stamp_s;
-      const double speed_cap = follower_pose_->header.stamp_s < 0
-                                   ? 0.0
-                                   : max_travel_per_fix_m / std::max(fix_age, 1e-3);
-      const std::vector<algo::PlannedPoint> points =
-          follower_trajectory_ ? ToPlanned(follower_trajectory_->points, speed_cap)
-                               : std::vector<algo::PlannedPoint>{};
-      const algo::FollowerCommand c =
-          follower_->Update(follower_pose_->pose, follower_pose_->v_mps, points, dt);
-      out.accel_mps2 = c.accel_mps2;
-      out.steer_rad = c.steer_rad;
-      ctx.ReportWork({static_cast<double>(points.size()), 0.0, 1});
-    }
-    ctx.Publish(topics_.control, std::move(out));
-  });
+                ControlMsg out;
+                out.header.stamp_s =
+                    follower_pose_ ? follower_pose_->header.stamp_s : -1.0;
+                const double dt =
+                    follower_last_t_ < 0 ? 0.0 : ctx.now_s() - follower_last_t_;
+                follower_last_t_ = ctx.now_s();
+                if (!follower_pose_ || !follower_pose_->valid) {
+                  // Nothing to steer by: ask for a stop.
+                  out.accel_mps2 = -kNoPoseDecelMps2;
+                } else {
+                  // Degraded mode: drive no faster than lets the car cover
+                  // max_travel_per_fix_m between localization fixes, so a slow
+                  // scan matcher still gets a close initial guess (the stack
+                  // slows down rather than losing itself).
+                  const double fix_age =
+                      ctx.now_s() - follower_pose_->header.stamp_s;
+                  const double speed_cap =
+                      follower_pose_->header.stamp_s < 0
+                          ? 0.0
+                          : max_travel_per_fix_m / std::max(fix_age, 1e-3);
+                  const std::vector<algo::PlannedPoint> points =
+                      follower_trajectory_
+                          ? ToPlanned(follower_trajectory_->points, speed_cap)
+                          : std::vector<algo::PlannedPoint>{};
+                  const algo::FollowerCommand c = follower_->Update(
+                      follower_pose_->pose, follower_pose_->v_mps, points, dt);
+                  out.accel_mps2 = c.accel_mps2;
+                  out.steer_rad = c.steer_rad;
+                  ctx.ReportWork({static_cast<double>(points.size()), 0.0, 1});
+                }
+                ctx.Publish(topics_.control, std::move(out));
+              });
 }
 
 }  // namespace
 
 Result<std::unique_ptr<AdStack>> AdStack::Build(const StackConfig& config,
-                                                const StackInputs& inputs, Graph* graph) {
+                                                const StackInputs& inputs,
+                                                Graph* graph) {
   if (inputs.route.points.size() < 2) {
-    return Status::InvalidArgument("the stack needs a route of at least two points");
+    return Status::InvalidArgument(
+        "the stack needs a route of at least two points");
   }
   if (inputs.map_cloud.empty()) {
     return Status::InvalidArgument("the stack needs a localization map cloud");

@@ -23,9 +23,9 @@ struct CountedCost {
 enum class CostModelKind { kMeasured, kCounted };
 
 struct VirtualPlatformOptions {
-  int cores = 4;                 // virtual cores
-  double freq_ghz = 2.1;         // their frequency
-  double reference_ghz = 2.1;    // frequency at which host costs count as-is
+  int cores = 4;               // virtual cores
+  double freq_ghz = 2.1;       // their frequency
+  double reference_ghz = 2.1;  // frequency at which host costs count as-is
   CostModelKind cost_model = CostModelKind::kMeasured;
   // kCounted: cost per callback name ("<node>/<callback>"). A callback
   // without an entry costs `default_counted`.

@@ -13,8 +13,14 @@ int FindByName(const std::vector<T>& items, const std::string& name) {
 
 }  // namespace
 
-int Graph::FindTopic(const std::string& name) const { return FindByName(topics_, name); }
-int Graph::FindNode(const std::string& name) const { return FindByName(nodes_, name); }
-int Graph::FindCallback(const std::string& name) const { return FindByName(callbacks_, name); }
+int Graph::FindTopic(const std::string& name) const {
+  return FindByName(topics_, name);
+}
+int Graph::FindNode(const std::string& name) const {
+  return FindByName(nodes_, name);
+}
+int Graph::FindCallback(const std::string& name) const {
+  return FindByName(callbacks_, name);
+}
 
 }  // namespace adse::stack

@@ -40,11 +40,11 @@ struct CallbackSpec {
   enum class Kind { kSubscription, kTimer };
   Kind kind = Kind::kSubscription;
   int node = -1;
-  std::string name;          // "<node>/<callback>" unique in the graph
-  int topic = -1;            // subscriptions: the topic taken from
-  int queue_depth = 1;       // subscriptions: keep-last depth
-  double period_s = 0.0;     // timers
-  double phase_s = 0.0;      // timers: first fire time
+  std::string name;       // "<node>/<callback>" unique in the graph
+  int topic = -1;         // subscriptions: the topic taken from
+  int queue_depth = 1;    // subscriptions: keep-last depth
+  double period_s = 0.0;  // timers
+  double phase_s = 0.0;   // timers: first fire time
   std::function<void(const MessagePtr&, CallbackContext&)> on_message;
   std::function<void(CallbackContext&)> on_timer;
 };

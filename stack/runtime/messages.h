@@ -38,9 +38,9 @@ struct PoseMsg {
   Header header;
   world::Pose2 pose;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
-  double v_mps = 0.0;      // filtered speed (EKF output)
-  double fitness = 0.0;    // scan matcher fitness (NDT), lower is better
-  bool valid = true;       // false: localization lost
+  double v_mps = 0.0;    // filtered speed (EKF output)
+  double fitness = 0.0;  // scan matcher fitness (NDT), lower is better
+  bool valid = true;     // false: localization lost
 };
 
 struct TrackedObject {

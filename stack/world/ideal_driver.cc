@@ -1,8 +1,8 @@
 #include "stack/world/ideal_driver.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
-#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 
@@ -10,7 +10,9 @@ namespace adse::world {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+double Seconds(Clock::duration d) {
+  return std::chrono::duration<double>(d).count();
+}
 
 // Curvature of the path around arc length s, from the heading change over
 // a window (robust to the 0.5 m sampling).
@@ -24,14 +26,16 @@ double CurvatureAt(const Path2& path, double s) {
 
 }  // namespace
 
-double DistanceToPath(const Path2& path, const Eigen::Vector2d& p, double* s_out) {
+double DistanceToPath(const Path2& path, const Eigen::Vector2d& p,
+                      double* s_out) {
   double best = std::numeric_limits<double>::infinity();
   double best_s = 0.0;
   for (size_t i = 0; i + 1 < path.points.size(); ++i) {
     const Eigen::Vector2d a = path.points[i];
     const Eigen::Vector2d ab = path.points[i + 1] - a;
     const double len2 = ab.squaredNorm();
-    const double u = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    const double u =
+        len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
     const double d = (a + u * ab - p).norm();
     if (d < best) {
       best = d;
@@ -81,8 +85,9 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
     }
     // Pure pursuit on the true pose.
     // Shorter lookahead when slow (in curves) keeps corners from being cut.
-    const double lookahead = std::clamp(options.lookahead_time_s * ego.v_mps,
-                                        options.min_lookahead_m, options.lookahead_m);
+    const double lookahead =
+        std::clamp(options.lookahead_time_s * ego.v_mps,
+                   options.min_lookahead_m, options.lookahead_m);
     const Eigen::Vector2d target = path.PointAt(s_progress + lookahead);
     const Eigen::Vector2d local =
         Eigen::Rotation2Dd(-ego.yaw_rad) * (target - pos);
@@ -96,13 +101,14 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
       const double k = CurvatureAt(path, s_progress + ahead);
       if (k > 1e-4) {
         const double v_curve = std::sqrt(options.max_lateral_accel_mps2 / k);
-        const double v_allowed = std::sqrt(v_curve * v_curve +
-                                           2 * options.comfort_decel_mps2 * ahead);
+        const double v_allowed = std::sqrt(
+            v_curve * v_curve + 2 * options.comfort_decel_mps2 * ahead);
         v_target = std::min(v_target, v_allowed);
       }
     }
     const double remaining = std::max(0.0, path.length_m() - s_progress);
-    v_target = std::min(v_target, std::sqrt(2 * options.comfort_decel_mps2 * remaining));
+    v_target = std::min(v_target,
+                        std::sqrt(2 * options.comfort_decel_mps2 * remaining));
     command.accel_mps2 = 1.5 * (v_target - ego.v_mps);
     // Near the goal, brake exactly as much as stopping on it needs; a
     // proportional controller alone lags and overshoots.

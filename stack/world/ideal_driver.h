@@ -15,9 +15,9 @@ namespace adse::world {
 
 struct IdealDriverOptions {
   double speed_limit_mps = 30.0 / 3.6;
-  double lookahead_m = 6.0;      // pure-pursuit lookahead at speed
-  double min_lookahead_m = 2.0;  // and when slow
-  double lookahead_time_s = 0.5; // lookahead = speed x this, within those
+  double lookahead_m = 6.0;       // pure-pursuit lookahead at speed
+  double min_lookahead_m = 2.0;   // and when slow
+  double lookahead_time_s = 0.5;  // lookahead = speed x this, within those
   double max_lateral_accel_mps2 = 2.0;  // sets the speed in curves
   double comfort_decel_mps2 = 2.0;      // braking towards the goal
   double timeout_s = 600.0;
@@ -31,13 +31,13 @@ struct TrajectorySample {
 
 struct IdealDriveReport {
   bool reached_goal = false;
-  double time_s = 0.0;             // time to reach the goal (or timeout)
+  double time_s = 0.0;  // time to reach the goal (or timeout)
   int collisions = 0;
   double max_lateral_error_m = 0;  // distance of the ego from the ideal path
   int scans = 0;
   double mean_points_per_scan = 0.0;
-  double lidar_wall_s = 0.0;       // wall time spent ray casting
-  double world_wall_s = 0.0;       // wall time spent in World::Step
+  double lidar_wall_s = 0.0;  // wall time spent ray casting
+  double world_wall_s = 0.0;  // wall time spent in World::Step
   std::vector<TrajectorySample> trajectory;
 };
 

@@ -16,20 +16,20 @@ namespace adse::world {
 
 // Stack knobs `stack.lidar.*`.
 struct LidarParams {
-  double rate_hz = 10.0;                    // scans per second
-  int beams = 16;                           // vertical channels
-  double horizontal_resolution_deg = 0.4;   // azimuth step
-  double range_m = 60.0;                    // maximum range in clear weather
-  double vertical_fov_up_deg = 15.0;        // elevation of the top beam
-  double vertical_fov_down_deg = -15.0;     // elevation of the bottom beam
-  double mount_height_m = 1.9;              // sensor height above ground
-  double range_noise_stddev_m = 0.02;       // in clear weather
+  double rate_hz = 10.0;                   // scans per second
+  int beams = 16;                          // vertical channels
+  double horizontal_resolution_deg = 0.4;  // azimuth step
+  double range_m = 60.0;                   // maximum range in clear weather
+  double vertical_fov_up_deg = 15.0;       // elevation of the top beam
+  double vertical_fov_down_deg = -15.0;    // elevation of the bottom beam
+  double mount_height_m = 1.9;             // sensor height above ground
+  double range_noise_stddev_m = 0.02;      // in clear weather
 };
 
 // What the weather does to the sensor.
 struct WeatherEffects {
-  double range_factor = 1.0;      // multiplies range_m
-  double extra_noise_m = 0.0;     // added to the range noise stddev
+  double range_factor = 1.0;         // multiplies range_m
+  double extra_noise_m = 0.0;        // added to the range noise stddev
   double dropout_probability = 0.0;  // chance a return is lost
 };
 WeatherEffects EffectsOf(Weather weather);
@@ -45,8 +45,8 @@ struct PointCloud {
 class LidarSimulator {
  public:
   // `scene` may be null (ground and vehicles only); it must outlive this.
-  LidarSimulator(const Scene* scene, const LidarParams& params,
-                 Weather weather, uint64_t seed);
+  LidarSimulator(const Scene* scene, const LidarParams& params, Weather weather,
+                 uint64_t seed);
 
   // One full revolution from `sensor_pose` (at mount height) at time
   // `stamp_s`, seeing the static scene, the ground and `vehicles`.

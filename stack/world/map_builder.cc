@@ -61,7 +61,9 @@ ParkingLotFiles MakeParkingLot(const ParkingLotLayout& p) {
   const double lot_length = p.slots_per_row * p.slot_width_m;
   const double x_max = 2 * margin_x + lot_length;
   // Aisle k's centreline; rows 2k (below) and 2k+1 (above) face it.
-  auto aisle_y = [&](int k) { return ring_half + 2.0 + d + a / 2 + k * (a + 2 * d); };
+  auto aisle_y = [&](int k) {
+    return ring_half + 2.0 + d + a / 2 + k * (a + 2 * d);
+  };
   const bool last_single = p.rows % 2 == 1;
   const double top_rows_edge =
       aisle_y(aisles - 1) + a / 2 + (last_single ? 0.0 : d);
@@ -75,9 +77,10 @@ ParkingLotFiles MakeParkingLot(const ParkingLotLayout& p) {
   for (int k = 0; k < aisles; ++k) ys.push_back(aisle_y(k));
   ys.push_back(y_max);
   for (size_t i = 0; i < ys.size(); ++i) {
-    nodes << fmt::format("  <node id=\"W{0}\" x=\"0\" y=\"{1:.3f}\"/>\n"
-                         "  <node id=\"E{0}\" x=\"{2:.3f}\" y=\"{1:.3f}\"/>\n",
-                         i, ys[i], x_max);
+    nodes << fmt::format(
+        "  <node id=\"W{0}\" x=\"0\" y=\"{1:.3f}\"/>\n"
+        "  <node id=\"E{0}\" x=\"{2:.3f}\" y=\"{1:.3f}\"/>\n",
+        i, ys[i], x_max);
   }
   auto two_way = [&](const std::string& from, const std::string& to,
                      double width) {
@@ -125,7 +128,8 @@ ParkingLotFiles MakeParkingLot(const ParkingLotLayout& p) {
   for (int row = 0; row < p.rows; ++row) {
     const int k = row / 2;
     const bool below = row % 2 == 0;
-    const double y = below ? aisle_y(k) - a / 2 - d / 2 : aisle_y(k) + a / 2 + d / 2;
+    const double y =
+        below ? aisle_y(k) - a / 2 - d / 2 : aisle_y(k) + a / 2 + d / 2;
     add_pole(margin_x - 1.0, y);
     add_pole(margin_x + lot_length + 1.0, y);
   }
@@ -141,15 +145,19 @@ ParkingLotFiles MakeParkingLot(const ParkingLotLayout& p) {
   // Perimeter wall, and a small building (kiosk) by the south-west corner
   // that breaks the symmetry of the lot for the scan matcher.
   const double w = ring_half + 4.0;
-  const std::vector<std::pair<double, double>> wall = {
-      {-w, -w}, {x_max + w, -w}, {x_max + w, y_max + w}, {-w, y_max + w}, {-w, -w}};
+  const std::vector<std::pair<double, double>> wall = {{-w, -w},
+                                                       {x_max + w, -w},
+                                                       {x_max + w, y_max + w},
+                                                       {-w, y_max + w},
+                                                       {-w, -w}};
   for (size_t i = 0; i + 1 < wall.size(); ++i) {
-    polys << Poly(fmt::format("wall_{}", i), "adse.wall", {wall[i], wall[i + 1]},
-                  2.5);
+    polys << Poly(fmt::format("wall_{}", i), "adse.wall",
+                  {wall[i], wall[i + 1]}, 2.5);
   }
-  polys << Poly("kiosk", "building",
-                Rect(margin_x + 2.0, ring_half + 1.0, margin_x + 6.0, ring_half + 1.8),
-                3.0);
+  polys << Poly(
+      "kiosk", "building",
+      Rect(margin_x + 2.0, ring_half + 1.0, margin_x + 6.0, ring_half + 1.8),
+      3.0);
   nodes << "</nodes>\n";
   edges << "</edges>\n";
   polys << "</additional>\n";
@@ -164,10 +172,11 @@ std::string GridBuildings(int number, double length_m, int lanes) {
   int id = 0;
   for (int i = 0; i + 1 < number; ++i) {
     for (int j = 0; j + 1 < number; ++j) {
-      polys << Poly(fmt::format("building_{}", id++), "building",
-                    Rect(i * length_m + inset, j * length_m + inset,
-                         (i + 1) * length_m - inset, (j + 1) * length_m - inset),
-                    10.0);
+      polys << Poly(
+          fmt::format("building_{}", id++), "building",
+          Rect(i * length_m + inset, j * length_m + inset,
+               (i + 1) * length_m - inset, (j + 1) * length_m - inset),
+          10.0);
     }
   }
   polys << "</additional>\n";
@@ -182,11 +191,13 @@ Status Generate(const MapOptions& options, const std::string& folder) {
     layout.rows = static_cast<int>(Param(options, "rows", layout.rows));
     layout.slots_per_row =
         static_cast<int>(Param(options, "slots_per_row", layout.slots_per_row));
-    layout.aisle_width_m = Param(options, "aisle_width_m", layout.aisle_width_m);
+    layout.aisle_width_m =
+        Param(options, "aisle_width_m", layout.aisle_width_m);
     layout.slot_width_m = Param(options, "slot_width_m", layout.slot_width_m);
     layout.slot_depth_m = Param(options, "slot_depth_m", layout.slot_depth_m);
     if (layout.rows < 1 || layout.slots_per_row < 1) {
-      return Status::InvalidArgument("parking_lot needs rows >= 1 and slots_per_row >= 1");
+      return Status::InvalidArgument(
+          "parking_lot needs rows >= 1 and slots_per_row >= 1");
     }
     const ParkingLotFiles files = MakeParkingLot(layout);
     ADSE_RETURN_IF_ERROR(WriteFileAtomic(folder + "/map.nod.xml", files.nodes));
@@ -205,12 +216,11 @@ Status Generate(const MapOptions& options, const std::string& folder) {
     const int lanes = static_cast<int>(Param(options, "lanes", 1));
     ADSE_RETURN_IF_ERROR(
         WriteFileAtomic(poly, GridBuildings(number, length, lanes)));
-    return RunChecked({ADSE_NETGENERATE, "--grid", "--grid.number",
-                       std::to_string(number), "--grid.length",
-                       fmt::format("{}", length), "--default.lanenumber",
-                       std::to_string(lanes), "--default.speed", "13.89",
-                       "--no-turnarounds", "true", "--output-file", net,
-                       "--no-warnings", "true"});
+    return RunChecked(
+        {ADSE_NETGENERATE, "--grid", "--grid.number", std::to_string(number),
+         "--grid.length", fmt::format("{}", length), "--default.lanenumber",
+         std::to_string(lanes), "--default.speed", "13.89", "--no-turnarounds",
+         "true", "--output-file", net, "--no-warnings", "true"});
   }
   return Status::InvalidArgument("unknown map generator '" + options.generator +
                                  "' (expected parking_lot or grid)");
@@ -279,7 +289,8 @@ Result<MapArtifacts> PrepareMap(const MapOptions& options,
     // Another process finished first; its copy is as good as ours.
     fs::remove_all(tmp, ec);
     if (!fs::exists(out.cache_folder + "/DONE", ec)) {
-      return Status::IoError("cannot move generated map into " + out.cache_folder);
+      return Status::IoError("cannot move generated map into " +
+                             out.cache_folder);
     }
   }
   return out;

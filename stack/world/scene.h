@@ -72,7 +72,8 @@ class Scene {
   // h + s tan(e) within the face's z span, at distance s / cos(e) (the
   // same answer CastRay gives), so the grid is walked once per column.
   void CrossingsAlong(const Eigen::Vector2d& origin, const Eigen::Vector2d& dir,
-                      double max_s_m, std::vector<FaceCrossing>* crossings) const;
+                      double max_s_m,
+                      std::vector<FaceCrossing>* crossings) const;
 
   // Axis-aligned bounds of all obstacles: min and max corners.
   Eigen::Vector2d min_corner() const { return min_; }

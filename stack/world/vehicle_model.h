@@ -15,21 +15,21 @@ struct VehicleLimits {
   double max_steer_rad = 0.6;
   double max_steer_rate_rad_per_s = 0.8;
   double max_accel_mps2 = 2.5;
-  double max_decel_mps2 = 6.0;   // positive number
+  double max_decel_mps2 = 6.0;  // positive number
   double max_speed_mps = 20.0;
 };
 
 // What the stack's controller asks for.
 struct ControlCommand {
-  double accel_mps2 = 0.0;   // signed; negative brakes
-  double steer_rad = 0.0;    // front wheel angle target
+  double accel_mps2 = 0.0;  // signed; negative brakes
+  double steer_rad = 0.0;   // front wheel angle target
 };
 
 struct VehicleState {
-  double x_m = 0.0;       // rear axle centre
+  double x_m = 0.0;  // rear axle centre
   double y_m = 0.0;
   double yaw_rad = 0.0;
-  double v_mps = 0.0;     // never negative: no reversing
+  double v_mps = 0.0;  // never negative: no reversing
   double steer_rad = 0.0;
   double accel_mps2 = 0.0;
 };

@@ -7,8 +7,8 @@
 #include <fmt/format.h>
 #include <libsumo/libsumo.h>
 
-#include <Eigen/Geometry>
 #include <unistd.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <atomic>
@@ -117,7 +117,8 @@ Path2 Resample(const std::vector<Vec2>& points, double step) {
   Path2 out;
   const double length = raw.length_m();
   const int n = std::max(1, static_cast<int>(std::ceil(length / step)));
-  for (int i = 0; i <= n; ++i) out.points.push_back(raw.PointAt(length * i / n));
+  for (int i = 0; i <= n; ++i)
+    out.points.push_back(raw.PointAt(length * i / n));
   out.UpdateArcLength();
   return out;
 }
@@ -174,12 +175,23 @@ struct World::Impl {
 
 Status World::Impl::StartSumo() {
   std::vector<std::string> args = {
-      "sumo", "-n", map.net_path, "--step-length",
-      fmt::format("{}", setup.world.step_s), "--seed",
-      std::to_string(setup.world.traffic.seed % 2147483647), "--no-step-log",
-      "true", "--no-warnings", "true",
-      "--collision.action", "none", "--time-to-teleport", "-1",
-      "--ignore-route-errors", "true"};
+      "sumo",
+      "-n",
+      map.net_path,
+      "--step-length",
+      fmt::format("{}", setup.world.step_s),
+      "--seed",
+      std::to_string(setup.world.traffic.seed % 2147483647),
+      "--no-step-log",
+      "true",
+      "--no-warnings",
+      "true",
+      "--collision.action",
+      "none",
+      "--time-to-teleport",
+      "-1",
+      "--ignore-route-errors",
+      "true"};
   if (!map.polygons_path.empty()) {
     args.push_back("--additional-files");
     args.push_back(map.polygons_path);
@@ -190,12 +202,14 @@ Status World::Impl::StartSumo() {
   // SUMO prints the cause of a load failure to stderr and throws a bare
   // "Process Error": capture stderr while it starts and report the cause.
   const std::string log = map.cache_folder + "/sumo-stderr." +
-                          std::to_string(static_cast<long>(::getpid())) + ".log";
+                          std::to_string(static_cast<long>(::getpid())) +
+                          ".log";
   std::fflush(stderr);
   const int saved = ::dup(STDERR_FILENO);
   const int capture = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (capture >= 0) ::dup2(capture, STDERR_FILENO);
-  Status status = Guard("starting SUMO", [&] { libsumo::Simulation::start(args); });
+  Status status =
+      Guard("starting SUMO", [&] { libsumo::Simulation::start(args); });
   std::fflush(stderr);
   if (saved >= 0) {
     ::dup2(saved, STDERR_FILENO);
@@ -203,16 +217,18 @@ Status World::Impl::StartSumo() {
   }
   if (capture >= 0) ::close(capture);
   std::string cause;
-  if (Result<std::string> text = ReadFile(log, 1 << 20); text.ok()) cause = *text;
+  if (Result<std::string> text = ReadFile(log, 1 << 20); text.ok())
+    cause = *text;
   std::error_code ec;
   fs::remove(log, ec);
   if (!status.ok()) {
-    while (!cause.empty() && std::isspace(static_cast<unsigned char>(cause.back()))) {
+    while (!cause.empty() &&
+           std::isspace(static_cast<unsigned char>(cause.back()))) {
       cause.pop_back();
     }
-    return Status::InvalidArgument(fmt::format(
-        "world.map.net: SUMO cannot load '{}': {}", map.net_path,
-        cause.empty() ? status.message() : cause));
+    return Status::InvalidArgument(
+        fmt::format("world.map.net: SUMO cannot load '{}': {}", map.net_path,
+                    cause.empty() ? status.message() : cause));
   }
   sumo_running = true;
   return Status::Ok();
@@ -227,42 +243,47 @@ Result<RoadLocation> World::Impl::Resolve(const Location& location,
       const std::vector<std::string> edges = libsumo::Edge::getIDList();
       if (std::find(edges.begin(), edges.end(), location.edge) == edges.end() ||
           location.edge.empty() || location.edge[0] == ':') {
-        return Status::InvalidArgument(
-            fmt::format("{}.edge: no edge '{}' in the network", field, location.edge));
+        return Status::InvalidArgument(fmt::format(
+            "{}.edge: no edge '{}' in the network", field, location.edge));
       }
       const int lanes = libsumo::Edge::getLaneNumber(location.edge);
       if (location.lane < 0 || location.lane >= lanes) {
-        return Status::InvalidArgument(fmt::format(
-            "{}.lane: edge '{}' has lanes 0..{}, found {}", field,
-            location.edge, lanes - 1, location.lane));
+        return Status::InvalidArgument(
+            fmt::format("{}.lane: edge '{}' has lanes 0..{}, found {}", field,
+                        location.edge, lanes - 1, location.lane));
       }
-      const std::string lane_id = location.edge + "_" + std::to_string(location.lane);
-      const std::vector<std::string> disallowed = libsumo::Lane::getDisallowed(lane_id);
-      if (std::find(disallowed.begin(), disallowed.end(), "passenger") != disallowed.end()) {
+      const std::string lane_id =
+          location.edge + "_" + std::to_string(location.lane);
+      const std::vector<std::string> disallowed =
+          libsumo::Lane::getDisallowed(lane_id);
+      if (std::find(disallowed.begin(), disallowed.end(), "passenger") !=
+          disallowed.end()) {
         return Status::InvalidArgument(fmt::format(
             "{}.edge: lane {} of edge '{}' is closed to passenger cars", field,
             location.lane, location.edge));
       }
       const double length = libsumo::Lane::getLength(lane_id);
       if (location.pos_m < 0 || location.pos_m > length) {
-        return Status::InvalidArgument(fmt::format(
-            "{}.pos_m: edge '{}' is {:.1f} m long, found {}", field,
-            location.edge, length, location.pos_m));
+        return Status::InvalidArgument(
+            fmt::format("{}.pos_m: edge '{}' is {:.1f} m long, found {}", field,
+                        location.edge, length, location.pos_m));
       }
       out.edge = location.edge;
       out.lane = location.lane;
       out.pos_m = location.pos_m;
     } else {
-      const libsumo::TraCIRoadPosition road =
-          libsumo::Simulation::convertRoad(location.x_m, location.y_m, false, "passenger");
+      const libsumo::TraCIRoadPosition road = libsumo::Simulation::convertRoad(
+          location.x_m, location.y_m, false, "passenger");
       if (road.edgeID.empty()) {
-        return Status::InvalidArgument(fmt::format(
-            "{}: ({}, {}) is not near any road of the network", field,
-            location.x_m, location.y_m));
+        return Status::InvalidArgument(
+            fmt::format("{}: ({}, {}) is not near any road of the network",
+                        field, location.x_m, location.y_m));
       }
       std::string lane_id = road.edgeID + "_" + std::to_string(road.laneIndex);
-      const auto snapped = libsumo::Simulation::convert2D(road.edgeID, road.pos, road.laneIndex);
-      const double off = std::hypot(snapped.x - location.x_m, snapped.y - location.y_m);
+      const auto snapped =
+          libsumo::Simulation::convert2D(road.edgeID, road.pos, road.laneIndex);
+      const double off =
+          std::hypot(snapped.x - location.x_m, snapped.y - location.y_m);
       const double half_width = libsumo::Lane::getWidth(lane_id) / 2;
       if (off > half_width + slack_m) {
         return Status::InvalidArgument(fmt::format(
@@ -278,9 +299,9 @@ Result<RoadLocation> World::Impl::Resolve(const Location& location,
       while (!out.edge.empty() && out.edge[0] == ':') {
         const auto links = libsumo::Lane::getLinks(lane_id);
         if (links.empty()) {
-          return Status::InvalidArgument(fmt::format(
-              "{}: ({}, {}) lies inside a junction with no way out", field,
-              location.x_m, location.y_m));
+          return Status::InvalidArgument(
+              fmt::format("{}: ({}, {}) lies inside a junction with no way out",
+                          field, location.x_m, location.y_m));
         }
         lane_id = links.front().approachedLane;
         out.edge = EdgeOfLane(lane_id);
@@ -288,7 +309,8 @@ Result<RoadLocation> World::Impl::Resolve(const Location& location,
         out.pos_m = 0.0;
       }
     }
-    const auto p = libsumo::Simulation::convert2D(out.edge, out.pos_m, out.lane);
+    const auto p =
+        libsumo::Simulation::convert2D(out.edge, out.pos_m, out.lane);
     out.xy = Vec2(p.x, p.y);
   } catch (const std::exception& e) {
     return Status::InvalidArgument(field + ": " + e.what());
@@ -315,7 +337,8 @@ Status World::Impl::PlanRoute() {
         }
       }
       for (const std::string& next : next_edges) {
-        const libsumo::TraCIStage stage = libsumo::Simulation::findRoute(next, goal.edge);
+        const libsumo::TraCIStage stage =
+            libsumo::Simulation::findRoute(next, goal.edge);
         if (!stage.edges.empty() && stage.length < best_length) {
           best_length = stage.length;
           best = {start.edge};
@@ -323,7 +346,8 @@ Status World::Impl::PlanRoute() {
         }
       }
     } else {
-      const libsumo::TraCIStage stage = libsumo::Simulation::findRoute(start.edge, goal.edge);
+      const libsumo::TraCIStage stage =
+          libsumo::Simulation::findRoute(start.edge, goal.edge);
       best = stage.edges;
     }
     if (best.empty()) {
@@ -334,7 +358,8 @@ Status World::Impl::PlanRoute() {
     }
     route = best;
   } catch (const std::exception& e) {
-    return Status::InvalidArgument(std::string("task.goal: routing failed: ") + e.what());
+    return Status::InvalidArgument(std::string("task.goal: routing failed: ") +
+                                   e.what());
   }
   return Status::Ok();
 }
@@ -348,7 +373,8 @@ Status World::Impl::BuildIdealPath() {
     lane[n - 1] = goal.lane;
     std::vector<std::string> via(n);  // internal lane chain start after edge i
     for (size_t i = n - 1; i-- > 0;) {
-      const std::string target = route[i + 1] + "_" + std::to_string(lane[i + 1]);
+      const std::string target =
+          route[i + 1] + "_" + std::to_string(lane[i + 1]);
       const int lanes = libsumo::Edge::getLaneNumber(route[i]);
       int chosen = -1;
       std::string chosen_via;
@@ -356,8 +382,10 @@ Status World::Impl::BuildIdealPath() {
       int fallback = -1;
       for (int l = 0; l < lanes && chosen < 0; ++l) {
         const std::string lane_id = route[i] + "_" + std::to_string(l);
-        const std::vector<std::string> disallowed = libsumo::Lane::getDisallowed(lane_id);
-        if (std::find(disallowed.begin(), disallowed.end(), "passenger") != disallowed.end()) {
+        const std::vector<std::string> disallowed =
+            libsumo::Lane::getDisallowed(lane_id);
+        if (std::find(disallowed.begin(), disallowed.end(), "passenger") !=
+            disallowed.end()) {
           continue;  // sidewalks, bus lanes, ...
         }
         for (const auto& link : libsumo::Lane::getLinks(lane_id)) {
@@ -375,8 +403,9 @@ Status World::Impl::BuildIdealPath() {
       }
       if (chosen < 0) {
         if (fallback < 0) {
-          return Status::Internal(fmt::format("route edge '{}' has no connection to '{}'",
-                                              route[i], route[i + 1]));
+          return Status::Internal(
+              fmt::format("route edge '{}' has no connection to '{}'", route[i],
+                          route[i + 1]));
         }
         // Enter the next edge on another lane; the path changes lanes there.
         chosen = fallback;
@@ -391,7 +420,8 @@ Status World::Impl::BuildIdealPath() {
     std::vector<Vec2> points;
     auto append = [&](const std::vector<Vec2>& part) {
       if (!points.empty() && !part.empty()) {
-        max_join_gap_m = std::max(max_join_gap_m, (part.front() - points.back()).norm());
+        max_join_gap_m =
+            std::max(max_join_gap_m, (part.front() - points.back()).norm());
       }
       points.insert(points.end(), part.begin(), part.end());
     };
@@ -412,7 +442,8 @@ Status World::Impl::BuildIdealPath() {
       const double s0 = i == 0 ? start.pos_m : 0.0;
       const double s1 = i == n - 1 ? goal.pos_m : length;
       width_sum += libsumo::Lane::getWidth(exit_id);
-      std::vector<Vec2> part = Slice(ToPoints(libsumo::Lane::getShape(exit_id)), s0, s1);
+      std::vector<Vec2> part =
+          Slice(ToPoints(libsumo::Lane::getShape(exit_id)), s0, s1);
       if (entry != lane[i]) {
         // A lane change: blend from the entry lane into the exit lane over
         // the middle of the edge.
@@ -445,14 +476,17 @@ Status World::Impl::BuildIdealPath() {
       const ParkingSlot* slot = nullptr;
       const Vec2 target(setup.task.goal.x_m, setup.task.goal.y_m);
       for (const ParkingSlot& s : scene.parking_slots()) {
-        const Eigen::Vector2d local = Eigen::Rotation2Dd(-s.box.yaw_rad) * (target - s.box.center);
-        if (std::abs(local.x()) <= s.box.length_m / 2 && std::abs(local.y()) <= s.box.width_m / 2) {
+        const Eigen::Vector2d local =
+            Eigen::Rotation2Dd(-s.box.yaw_rad) * (target - s.box.center);
+        if (std::abs(local.x()) <= s.box.length_m / 2 &&
+            std::abs(local.y()) <= s.box.width_m / 2) {
           slot = &s;
         }
       }
       if (slot == nullptr) {
         return Status::InvalidArgument(
-            "task.goal: valet_parking needs the goal inside a parking slot of the map");
+            "task.goal: valet_parking needs the goal inside a parking slot of "
+            "the map");
       }
       Path2 road = Resample(points, kResampleStepM);
       const Vec2 p0 = road.points.back();
@@ -469,7 +503,8 @@ Status World::Impl::BuildIdealPath() {
       std::vector<Vec2> leg;
       for (int k = 1; k <= 40; ++k) {
         const double u = k / 40.0;
-        leg.push_back(std::pow(1 - u, 3) * p0 + 3 * std::pow(1 - u, 2) * u * p1 +
+        leg.push_back(std::pow(1 - u, 3) * p0 +
+                      3 * std::pow(1 - u, 2) * u * p1 +
                       3 * (1 - u) * u * u * p2 + std::pow(u, 3) * p3);
       }
       append(leg);
@@ -477,7 +512,8 @@ Status World::Impl::BuildIdealPath() {
     }
     ideal = Resample(points, kResampleStepM);
   } catch (const std::exception& e) {
-    return Status::Internal(std::string("building the ideal path: ") + e.what());
+    return Status::Internal(std::string("building the ideal path: ") +
+                            e.what());
   }
   return Status::Ok();
 }
@@ -491,7 +527,8 @@ Status World::Impl::BuildScene() {
       const std::string type = libsumo::Polygon::getType(id);
       const std::vector<Vec2> shape = ToPoints(libsumo::Polygon::getShape(id));
       if (shape.size() < 2) continue;
-      const std::string height_text = libsumo::Polygon::getParameter(id, "height_m");
+      const std::string height_text =
+          libsumo::Polygon::getParameter(id, "height_m");
       if (type == "adse.parking_slot" && shape.size() >= 4) {
         ParkingSlot slot;
         const Vec2 e1 = shape[1] - shape[0];
@@ -510,10 +547,12 @@ Status World::Impl::BuildScene() {
       Obstacle obstacle;
       obstacle.footprint = shape;
       if (obstacle.footprint.size() > 2 &&
-          (obstacle.footprint.front() - obstacle.footprint.back()).norm() < 1e-6) {
+          (obstacle.footprint.front() - obstacle.footprint.back()).norm() <
+              1e-6) {
         obstacle.footprint.pop_back();  // closed implicitly
       }
-      double height = height_text.empty() ? 0.0 : std::atof(height_text.c_str());
+      double height =
+          height_text.empty() ? 0.0 : std::atof(height_text.c_str());
       if (type == "adse.wall") {
         obstacle.kind = ObstacleKind::kWall;
         if (height <= 0) height = 2.5;
@@ -550,14 +589,17 @@ Status World::Impl::BuildScene() {
                               static_cast<int>(std::floor(p.y() / kCell)));
       };
       for (const std::string& id : lanes) {
-        LaneShape shape{ToPoints(libsumo::Lane::getShape(id)), libsumo::Lane::getWidth(id) / 2};
+        LaneShape shape{ToPoints(libsumo::Lane::getShape(id)),
+                        libsumo::Lane::getWidth(id) / 2};
         const int index = static_cast<int>(shapes.size());
         for (size_t k = 0; k + 1 < shape.points.size(); ++k) {
           const Vec2 a = shape.points[k], b = shape.points[k + 1];
           const int steps = 1 + static_cast<int>((b - a).norm() / (kCell / 2));
           std::set<std::pair<int, int>> cells;
-          for (int j = 0; j <= steps; ++j) cells.insert(cell_of(a + (b - a) * j / steps));
-          for (const auto& c : cells) grid[c].push_back({index, static_cast<int>(k)});
+          for (int j = 0; j <= steps; ++j)
+            cells.insert(cell_of(a + (b - a) * j / steps));
+          for (const auto& c : cells)
+            grid[c].push_back({index, static_cast<int>(k)});
         }
         shapes.push_back(std::move(shape));
       }
@@ -568,10 +610,14 @@ Status World::Impl::BuildScene() {
             auto it = grid.find({cx + dx, cy + dy});
             if (it == grid.end()) continue;
             for (const auto& [lane, k] : it->second) {
-              const Vec2 a = shapes[lane].points[k], b = shapes[lane].points[k + 1];
+              const Vec2 a = shapes[lane].points[k],
+                         b = shapes[lane].points[k + 1];
               const double len2 = (b - a).squaredNorm();
-              const double u = len2 > 0 ? std::clamp((p - a).dot(b - a) / len2, 0.0, 1.0) : 0.0;
-              if ((a + u * (b - a) - p).norm() < shapes[lane].half_width + 0.5) return false;
+              const double u =
+                  len2 > 0 ? std::clamp((p - a).dot(b - a) / len2, 0.0, 1.0)
+                           : 0.0;
+              if ((a + u * (b - a) - p).norm() < shapes[lane].half_width + 0.5)
+                return false;
             }
           }
         }
@@ -579,20 +625,23 @@ Status World::Impl::BuildScene() {
       };
       for (size_t i = 0; i < lanes.size(); ++i) {
         // The rightmost lane of each normal edge carries its roadside.
-        if (lanes[i][0] == ':' || lanes[i].substr(lanes[i].rfind('_')) != "_0") continue;
+        if (lanes[i][0] == ':' || lanes[i].substr(lanes[i].rfind('_')) != "_0")
+          continue;
         Path2 shape;
         shape.points = shapes[i].points;
         shape.UpdateArcLength();
         const double offset = shapes[i].half_width + 1.0;
         for (double s = 10.0; s < shape.length_m() - 5.0; s += 20.0) {
           const double h = shape.HeadingAt(s);
-          const Vec2 p = shape.PointAt(s) + offset * Vec2(std::sin(h), -std::cos(h));
+          const Vec2 p =
+              shape.PointAt(s) + offset * Vec2(std::sin(h), -std::cos(h));
           if (!clear_of_roads(p)) continue;
           Obstacle pole;
           pole.kind = ObstacleKind::kPole;
           pole.z_max_m = 5.0;
           const double r = 0.15;
-          pole.footprint = {p + Vec2(-r, -r), p + Vec2(r, -r), p + Vec2(r, r), p + Vec2(-r, r)};
+          pole.footprint = {p + Vec2(-r, -r), p + Vec2(r, -r), p + Vec2(r, r),
+                            p + Vec2(-r, r)};
           scene.AddObstacle(std::move(pole));
         }
       }
@@ -611,16 +660,17 @@ Status World::Impl::SetUpTraffic() {
       const std::vector<std::string> edges = libsumo::Edge::getIDList();
       for (const std::string* e : {&flow.from_edge, &flow.to_edge}) {
         if (std::find(edges.begin(), edges.end(), *e) == edges.end()) {
-          return Status::InvalidArgument(fmt::format(
-              "{}.{}: no edge '{}' in the network", field,
-              e == &flow.from_edge ? "from" : "to", *e));
+          return Status::InvalidArgument(
+              fmt::format("{}.{}: no edge '{}' in the network", field,
+                          e == &flow.from_edge ? "from" : "to", *e));
         }
       }
       const libsumo::TraCIStage stage =
           libsumo::Simulation::findRoute(flow.from_edge, flow.to_edge);
       if (stage.edges.empty()) {
-        return Status::InvalidArgument(fmt::format(
-            "{}: no route from '{}' to '{}'", field, flow.from_edge, flow.to_edge));
+        return Status::InvalidArgument(
+            fmt::format("{}: no route from '{}' to '{}'", field, flow.from_edge,
+                        flow.to_edge));
       }
       FlowState state;
       state.route_id = fmt::format("adse_flow_{}", i);
@@ -639,8 +689,10 @@ void World::Impl::PushEgo() {
   const OrientedBox body = ego->Body();
   const double yaw = ego->state().yaw_rad;
   // SUMO places vehicles by their front bumper.
-  const Vec2 front = body.center + body.length_m / 2 * Vec2(std::cos(yaw), std::sin(yaw));
-  libsumo::Vehicle::moveToXY(kEgoId, "", -1, front.x(), front.y(), YawToSumoAngle(yaw), 2);
+  const Vec2 front =
+      body.center + body.length_m / 2 * Vec2(std::cos(yaw), std::sin(yaw));
+  libsumo::Vehicle::moveToXY(kEgoId, "", -1, front.x(), front.y(),
+                             YawToSumoAngle(yaw), 2);
 }
 
 Status World::Impl::AddEgo() {
@@ -657,7 +709,8 @@ Status World::Impl::AddEgo() {
     libsumo::VehicleType::setHeight("adse_ego", setup.ego.height_m);
     libsumo::Route::add("adse_ego_route", route);
     libsumo::Vehicle::add(kEgoId, "adse_ego_route", "adse_ego", "now",
-                          std::to_string(start.lane), "base", "0", "current", "max");
+                          std::to_string(start.lane), "base", "0", "current",
+                          "max");
     // The ego is driven by adse, not by SUMO's car-following model.
     libsumo::Vehicle::setSpeedMode(kEgoId, 0);
     libsumo::Vehicle::setLaneChangeMode(kEgoId, 0);
@@ -673,7 +726,8 @@ Status World::Impl::ReadOthers() {
       auto it = dims.find(id);
       if (it == dims.end()) {
         it = dims.emplace(id, Vec2(libsumo::Vehicle::getLength(id),
-                                   libsumo::Vehicle::getWidth(id))).first;
+                                   libsumo::Vehicle::getWidth(id)))
+                 .first;
       }
       const auto p = libsumo::Vehicle::getPosition(id);
       const double yaw = SumoAngleToYaw(libsumo::Vehicle::getAngle(id));
@@ -683,7 +737,8 @@ Status World::Impl::ReadOthers() {
       v.box.length_m = it->second.x();
       v.box.width_m = it->second.y();
       v.box.height_m = 1.5;
-      v.box.center = Vec2(p.x, p.y) - v.box.length_m / 2 * Vec2(std::cos(yaw), std::sin(yaw));
+      v.box.center = Vec2(p.x, p.y) -
+                     v.box.length_m / 2 * Vec2(std::cos(yaw), std::sin(yaw));
       v.speed_mps = libsumo::Vehicle::getSpeed(id);
       others.push_back(v);
     }
@@ -704,26 +759,30 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
   bool expected = false;
   if (!g_world_open.compare_exchange_strong(expected, true)) {
     return Status::Unavailable(
-        "a World is already open in this process (libsumo allows one simulation per process)");
+        "a World is already open in this process (libsumo allows one "
+        "simulation per process)");
   }
   auto impl = std::make_unique<Impl>();
   // Constructed early so that every early return below releases the flag.
   std::unique_ptr<World> world(new World(nullptr));
   impl->setup = setup;
-  const std::string cache_dir = setup.cache_dir.empty() ? DefaultCacheDir() : setup.cache_dir;
+  const std::string cache_dir =
+      setup.cache_dir.empty() ? DefaultCacheDir() : setup.cache_dir;
   Result<MapArtifacts> map = PrepareMap(setup.world.map, cache_dir);
   if (!map.ok()) {
-    return map.status().WithContext(setup.world.map.generator.empty() ? "world.map.net"
-                                                                      : "world.map.generate");
+    return map.status().WithContext(setup.world.map.generator.empty()
+                                        ? "world.map.net"
+                                        : "world.map.generate");
   }
   impl->map = *map;
   ADSE_RETURN_IF_ERROR(impl->StartSumo());
-  Result<RoadLocation> start = impl->Resolve(setup.task.start, "task.start", kOffRoadSlackM);
+  Result<RoadLocation> start =
+      impl->Resolve(setup.task.start, "task.start", kOffRoadSlackM);
   if (!start.ok()) return start.status();
   // A valet goal lies in a slot beside the aisle, so it may be further off.
   const bool valet = setup.task.kind == TaskKind::kValetParking;
-  Result<RoadLocation> goal =
-      impl->Resolve(setup.task.goal, "task.goal", valet ? kValetSlackM : kOffRoadSlackM);
+  Result<RoadLocation> goal = impl->Resolve(
+      setup.task.goal, "task.goal", valet ? kValetSlackM : kOffRoadSlackM);
   if (!goal.ok()) return goal.status();
   impl->start = *start;
   impl->goal = *goal;
@@ -731,14 +790,16 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
     // The road part of a valet route ends on the aisle beside the slot.
     const Location& g = setup.task.goal;
     if (g.by_edge) {
-      return Status::InvalidArgument("task.goal: valet_parking needs the goal as {x, y} inside a slot");
+      return Status::InvalidArgument(
+          "task.goal: valet_parking needs the goal as {x, y} inside a slot");
     }
   }
   ADSE_RETURN_IF_ERROR(impl->PlanRoute());
   ADSE_RETURN_IF_ERROR(impl->BuildScene());
   // Parked cars: a seeded share of the slots, never the valet goal's slot.
   {
-    Random random(Random::DeriveSeed(setup.world.traffic.seed, "traffic.parked"));
+    Random random(
+        Random::DeriveSeed(setup.world.traffic.seed, "traffic.parked"));
     Scene with_cars;
     const Vec2 goal_point(setup.task.goal.x_m, setup.task.goal.y_m);
     for (const Obstacle& o : impl->scene.obstacles()) with_cars.AddObstacle(o);
@@ -747,8 +808,8 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
       const double jitter_x = random.Uniform(-0.15, 0.15);
       const double jitter_y = random.Uniform(-0.15, 0.15);
       const double jitter_yaw = random.Uniform(-0.05, 0.05);
-      const Eigen::Vector2d local =
-          Eigen::Rotation2Dd(-slot.box.yaw_rad) * (goal_point - slot.box.center);
+      const Eigen::Vector2d local = Eigen::Rotation2Dd(-slot.box.yaw_rad) *
+                                    (goal_point - slot.box.center);
       const bool is_goal = setup.task.kind == TaskKind::kValetParking &&
                            std::abs(local.x()) <= slot.box.length_m / 2 &&
                            std::abs(local.y()) <= slot.box.width_m / 2;
@@ -786,8 +847,9 @@ Status World::Step(const ControlCommand& command) {
     for (size_t i = 0; i < w.flows.size(); ++i) {
       Impl::FlowState& flow = w.flows[i];
       if (w.traffic_random->Bernoulli(flow.probability_per_step)) {
-        libsumo::Vehicle::add(fmt::format("flow{}.{}", i, flow.spawned++), flow.route_id,
-                              "DEFAULT_VEHTYPE", "now", "best", "base", "max");
+        libsumo::Vehicle::add(fmt::format("flow{}.{}", i, flow.spawned++),
+                              flow.route_id, "DEFAULT_VEHTYPE", "now", "best",
+                              "base", "max");
       }
     }
     w.PushEgo();
@@ -818,7 +880,9 @@ const VehicleLimits& World::ego_limits() const { return impl_->setup.ego; }
 OrientedBox World::ego_body() const { return impl_->ego->Body(); }
 const std::vector<OtherVehicle>& World::others() const { return impl_->others; }
 int World::collisions() const { return impl_->collisions; }
-const std::vector<std::string>& World::new_contacts() const { return impl_->new_contacts; }
+const std::vector<std::string>& World::new_contacts() const {
+  return impl_->new_contacts;
+}
 double World::distance_to_goal_m() const {
   const VehicleState& s = impl_->ego->state();
   return (Vec2(s.x_m, s.y_m) - impl_->goal_xy).norm();
@@ -827,8 +891,12 @@ bool World::goal_reached() const {
   return distance_to_goal_m() <= impl_->setup.task.goal_tolerance_m;
 }
 const Path2& World::ideal_path() const { return impl_->ideal; }
-const std::vector<std::string>& World::route_edges() const { return impl_->route; }
-double World::ideal_path_max_join_gap_m() const { return impl_->max_join_gap_m; }
+const std::vector<std::string>& World::route_edges() const {
+  return impl_->route;
+}
+double World::ideal_path_max_join_gap_m() const {
+  return impl_->max_join_gap_m;
+}
 double World::lane_width_m() const { return impl_->lane_width_m; }
 const RoadLocation& World::start() const { return impl_->start; }
 const RoadLocation& World::goal() const { return impl_->goal; }
@@ -840,7 +908,8 @@ std::vector<std::vector<Eigen::Vector2d>> World::LaneShapes() const {
   try {
     std::vector<std::string> lanes = libsumo::Lane::getIDList();
     std::sort(lanes.begin(), lanes.end());
-    for (const std::string& id : lanes) out.push_back(ToPoints(libsumo::Lane::getShape(id)));
+    for (const std::string& id : lanes)
+      out.push_back(ToPoints(libsumo::Lane::getShape(id)));
   } catch (const std::exception&) {
   }
   return out;
@@ -850,11 +919,15 @@ Result<std::string> World::MapCloudPath() const {
   const Impl& w = *impl_;
   MapCloudOptions options;
   ContentHasher hasher;
-  hasher.Add("adse-cloud-v1").Add(w.map.key)
+  hasher.Add("adse-cloud-v1")
+      .Add(w.map.key)
       .Add(static_cast<long long>(w.setup.world.traffic.seed))
       .Add(w.setup.world.traffic.parked_occupancy)
-      .Add(options.spacing_m).Add(options.ground_spacing_m).Add(options.ground_margin_m);
-  const std::string path = w.map.cache_folder + "/cloud-" + hasher.Hex().substr(0, 16) + ".pcd";
+      .Add(options.spacing_m)
+      .Add(options.ground_spacing_m)
+      .Add(options.ground_margin_m);
+  const std::string path =
+      w.map.cache_folder + "/cloud-" + hasher.Hex().substr(0, 16) + ".pcd";
   std::error_code ec;
   if (fs::exists(path, ec)) return path;
   ADSE_RETURN_IF_ERROR(WritePcd(path, SampleSceneSurface(w.scene, options)));

@@ -31,11 +31,13 @@ class InstantBackend : public ChatBackend {
     }
     spec::DesignPoint p;
     uint64_t i = next_++;
-    for (auto it = space_->parameters.rbegin(); it != space_->parameters.rend(); ++it) {
+    for (auto it = space_->parameters.rbegin(); it != space_->parameters.rend();
+         ++it) {
       p[it->name] = it->values[i % it->values.size()];
       i /= it->values.size();
     }
-    reply.text = nlohmann::json({{"point", p}, {"rationale", "next in order"}}).dump();
+    reply.text =
+        nlohmann::json({{"point", p}, {"rationale", "next in order"}}).dump();
     return reply;
   }
   std::string name() const override { return "instant"; }
@@ -46,20 +48,23 @@ class InstantBackend : public ChatBackend {
 };
 
 void BM_LlmIteration(benchmark::State& state) {
-  Result<spec::Spec> spec =
-      spec::LoadSpec(std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_parking_lot.yaml");
+  Result<spec::Spec> spec = spec::LoadSpec(
+      std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_parking_lot.yaml");
   if (!spec.ok()) {
     state.SkipWithError(spec.status().ToString().c_str());
     return;
   }
   spec->exploration.budget = 280;
   LlmStrategyOptions options;
-  options.report_path = [](const std::string&) { return std::string("/nonexistent"); };
+  options.report_path = [](const std::string&) {
+    return std::string("/nonexistent");
+  };
   options.image_path = options.report_path;
   options.backend = std::make_unique<RecordingBackend>(
-      std::vector<ExchangeRecord>{}, std::make_unique<InstantBackend>(&spec->design_space),
-      JsonlLog(), "");
-  Result<std::unique_ptr<explore::Strategy>> strategy = NewLlmStrategy(*spec, std::move(options));
+      std::vector<ExchangeRecord>{},
+      std::make_unique<InstantBackend>(&spec->design_space), JsonlLog(), "");
+  Result<std::unique_ptr<explore::Strategy>> strategy =
+      NewLlmStrategy(*spec, std::move(options));
   if (!strategy.ok()) {
     state.SkipWithError(strategy.status().ToString().c_str());
     return;
@@ -74,8 +79,11 @@ void BM_LlmIteration(benchmark::State& state) {
     explore::Observation o;
     o.point = points[0];
     o.feasible = ++n % 3 != 0;
-    o.metrics = {{"completed", 1.0}, {"nav_time_s", 30.0 + n % 17}, {"hardware_cost", n % 23},
-                 {"ctrl_rate_hz", 20.0}, {"deviation_score", 0.1}};
+    o.metrics = {{"completed", 1.0},
+                 {"nav_time_s", 30.0 + n % 17},
+                 {"hardware_cost", n % 23},
+                 {"ctrl_rate_hz", 20.0},
+                 {"deviation_score", 0.1}};
     (*strategy)->Tell(o);
   }
 }
@@ -83,8 +91,9 @@ void BM_LlmIteration(benchmark::State& state) {
 BENCHMARK(BM_LlmIteration)->Iterations(250)->Unit(benchmark::kMillisecond);
 
 void BM_ChatRoundTripOverHttp(benchmark::State& state) {
-  Result<std::unique_ptr<testing::FakeLlmServer>> server = testing::FakeLlmServer::Start(
-      testing::FakeLlmServer::Sequence({{200, R"({"bottlenecks": [], "summary": "ok"})"}}));
+  Result<std::unique_ptr<testing::FakeLlmServer>> server =
+      testing::FakeLlmServer::Start(testing::FakeLlmServer::Sequence(
+          {{200, R"({"bottlenecks": [], "summary": "ok"})"}}));
   if (!server.ok()) {
     state.SkipWithError(server.status().ToString().c_str());
     return;
@@ -92,7 +101,8 @@ void BM_ChatRoundTripOverHttp(benchmark::State& state) {
   HttpBackendOptions http;
   http.endpoint = (*server)->url();
   Result<std::unique_ptr<ChatBackend>> backend = NewHttpBackend(http);
-  ChatRequest request{"text", "m", {{"user", std::string(3000, 'x'), {}}}, true};
+  ChatRequest request{
+      "text", "m", {{"user", std::string(3000, 'x'), {}}}, true};
   for (auto _ : state) {
     Result<ChatReply> reply = (*backend)->Chat(request);
     if (!reply.ok()) state.SkipWithError(reply.status().ToString().c_str());

@@ -16,11 +16,13 @@ World& RobotaxiWorld() {
   static std::unique_ptr<World> world = [] {
     WorldSetup setup;
     setup.world.map.generator = "parking_lot";
-    setup.world.map.generator_params = {{"rows", 6}, {"slots_per_row", 20}, {"aisle_width_m", 7.0}};
+    setup.world.map.generator_params = {
+        {"rows", 6}, {"slots_per_row", 20}, {"aisle_width_m", 7.0}};
     setup.world.traffic.seed = 7;
     setup.world.traffic.parked_occupancy = 0.6;
     // Denser than the example so that steps carry real traffic.
-    setup.world.traffic.flows = {{"E4_W4", "W0_E0", 900.0}, {"W4_E4", "E0_W0", 900.0}};
+    setup.world.traffic.flows = {{"E4_W4", "W0_E0", 900.0},
+                                 {"W4_E4", "E0_W0", 900.0}};
     setup.task.start = Location::Xy(20.0, -1.75);
     setup.task.goal = Location::Xy(15.0, 63.75);
     Result<std::unique_ptr<World>> w = World::Open(setup);
@@ -65,7 +67,10 @@ void BM_LidarScanRobotaxiScene(benchmark::State& state) {
       static_cast<double>(lidar.rays_per_scan()) * state.iterations(),
       benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_LidarScanRobotaxiScene)->Arg(16)->Arg(32)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LidarScanRobotaxiScene)
+    ->Arg(16)
+    ->Arg(32)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace adse::world

@@ -300,7 +300,8 @@ TEST_F(CampaignFileTest, LlmExchangesRoundTripAndOlderIndexesHaveNone) {
   a.model = "deepseek-r1";
   a.backend = "ollama";
   a.request_sha256 = Sha256Hex("request");
-  a.prompt = "[system]\nYou are ... ≤ 60 s\n\n[user]\n" + std::string(20000, 'p');
+  a.prompt =
+      "[system]\nYou are ... ≤ 60 s\n\n[user]\n" + std::string(20000, 'p');
   a.answer = R"({"point": {"cores": 4}, "rationale": "NDT lags"})";
   a.prompt_tokens = 5123;
   a.completion_tokens = 40;
@@ -341,8 +342,9 @@ TEST_F(CampaignFileTest, LlmExchangesRoundTripAndOlderIndexesHaveNone) {
     EXPECT_EQ(r.attempts, w.attempts);
   }
   // The recorded robotaxi campaign predates the group.
-  Result<CampaignIndex> old = ReadCampaignIndex(
-      std::string(ADSE_SOURCE_DIR) + "/tests/data/robotaxi_exhaustive/campaign.h5");
+  Result<CampaignIndex> old =
+      ReadCampaignIndex(std::string(ADSE_SOURCE_DIR) +
+                        "/tests/data/robotaxi_exhaustive/campaign.h5");
   ASSERT_TRUE(old.ok()) << old.status().ToString();
   EXPECT_TRUE(old->llm_exchanges.empty());
   EXPECT_EQ(old->evaluations.size(), 280u);

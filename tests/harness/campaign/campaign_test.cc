@@ -379,9 +379,9 @@ TEST(CampaignTest,
     const std::string own = line.substr(b + 1);
     if (controllers.rfind("name=", 0) == 0) continue;
     controllers = controllers.substr(0, controllers.find(','));
-    for (const std::string& mount :
-         {"/sys/fs/cgroup/" + controllers, std::string("/sys/fs/cgroup/unified"),
-          std::string("/sys/fs/cgroup")}) {
+    for (const std::string& mount : {"/sys/fs/cgroup/" + controllers,
+                                     std::string("/sys/fs/cgroup/unified"),
+                                     std::string("/sys/fs/cgroup")}) {
       for (const std::string& parent : {own, std::string("/")}) {
         const fs::path left = fs::path(mount + parent) / group;
         std::error_code ec;

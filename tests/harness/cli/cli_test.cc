@@ -2,13 +2,13 @@
 // scenario's lines, and the world check's output folder.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
-#include <sys/wait.h>
 
 #include "tests/harness/testing/adse_command.h"
 
@@ -19,25 +19,31 @@ namespace fs = std::filesystem;
 using adse::testing::Adse;
 using adse::testing::CommandRun;
 
-std::string Example() { return std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_parking_lot.yaml"; }
+std::string Example() {
+  return std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_parking_lot.yaml";
+}
 
 // A copy of the robotaxi example with one line replaced.
 // Writes scenario text to the temporary folder as adse_cli_<name>.yaml,
 // with the bundled calibration beside it (the examples name it relative
 // to themselves).
 std::string WriteScenario(const std::string& name, const std::string& text) {
-  const fs::path path = fs::temp_directory_path() / ("adse_cli_" + name + ".yaml");
+  const fs::path path =
+      fs::temp_directory_path() / ("adse_cli_" + name + ".yaml");
   std::ofstream(path) << text;
   fs::create_directories(fs::temp_directory_path() / "calibration");
-  fs::copy_file(std::string(ADSE_SOURCE_DIR) + "/scenarios/calibration/reference.json",
-                fs::temp_directory_path() / "calibration/reference.json",
-                fs::copy_options::overwrite_existing);
+  fs::copy_file(
+      std::string(ADSE_SOURCE_DIR) + "/scenarios/calibration/reference.json",
+      fs::temp_directory_path() / "calibration/reference.json",
+      fs::copy_options::overwrite_existing);
   return path.string();
 }
 
-std::string Variant(const std::string& name, const std::string& from, const std::string& to) {
+std::string Variant(const std::string& name, const std::string& from,
+                    const std::string& to) {
   std::ifstream in(Example());
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string text((std::istreambuf_iterator<char>(in)),
+                   std::istreambuf_iterator<char>());
   const size_t at = text.find(from);
   EXPECT_NE(at, std::string::npos) << from;
   if (at != std::string::npos) text.replace(at, from.size(), to);
@@ -47,13 +53,16 @@ std::string Variant(const std::string& name, const std::string& from, const std:
 TEST(CliTest, ValidateReportsTheRobotaxiSpaceOf280Points) {
   const CommandRun run = Adse("validate --quiet " + Example());
   EXPECT_EQ(run.exit_code, 0) << run.out;
-  EXPECT_NE(run.out.find("design space: 280 points (cores 28 x freq_ghz 5 x lidar_hz 2)"),
-            std::string::npos)
+  EXPECT_NE(
+      run.out.find(
+          "design space: 280 points (cores 28 x freq_ghz 5 x lidar_hz 2)"),
+      std::string::npos)
       << run.out;
 }
 
 TEST(CliTest, ValidatePrintsAReloadableNormalisedSpec) {
-  const CommandRun run = Adse("validate --no-world " + Example() + " 2>/dev/null");
+  const CommandRun run =
+      Adse("validate --no-world " + Example() + " 2>/dev/null");
   ASSERT_EQ(run.exit_code, 0) << run.out;
   const fs::path copy = fs::temp_directory_path() / "adse_cli_normalised.yaml";
   std::ofstream(copy) << run.out;
@@ -63,12 +72,14 @@ TEST(CliTest, ValidatePrintsAReloadableNormalisedSpec) {
 }
 
 TEST(CliTest, StartOffTheRoadIsReportedAtItsLineWithExitCode2) {
-  const std::string file =
-      Variant("offroad", "start: {x: 20.0, y: -1.75}", "start: {x: 20.0, y: 6.0}");
+  const std::string file = Variant("offroad", "start: {x: 20.0, y: -1.75}",
+                                   "start: {x: 20.0, y: 6.0}");
   const CommandRun run = Adse("validate -q " + file);
   EXPECT_EQ(run.exit_code, 2) << run.out;
   // The start is on line 17 of the example.
-  EXPECT_TRUE(std::regex_search(run.out, std::regex("adse_cli_offroad\\.yaml:17:[0-9]+: error: task\\.start")))
+  EXPECT_TRUE(std::regex_search(
+      run.out,
+      std::regex("adse_cli_offroad\\.yaml:17:[0-9]+: error: task\\.start")))
       << run.out;
   EXPECT_NE(run.out.find("off the road network"), std::string::npos) << run.out;
 }
@@ -77,17 +88,23 @@ TEST(CliTest, UnknownFlowEdgeIsReportedAtItsLine) {
   const std::string file = Variant("flow", "from: W4_E4", "from: E9_W9");
   const CommandRun run = Adse("validate -q " + file);
   EXPECT_EQ(run.exit_code, 2) << run.out;
-  EXPECT_NE(run.out.find("world.traffic.flows[0].from: no edge 'E9_W9'"), std::string::npos) << run.out;
-  EXPECT_TRUE(std::regex_search(run.out, std::regex("adse_cli_flow\\.yaml:11:[0-9]+:"))) << run.out;
+  EXPECT_NE(run.out.find("world.traffic.flows[0].from: no edge 'E9_W9'"),
+            std::string::npos)
+      << run.out;
+  EXPECT_TRUE(
+      std::regex_search(run.out, std::regex("adse_cli_flow\\.yaml:11:[0-9]+:")))
+      << run.out;
 }
 
 TEST(CliTest, MisspelledKeyGetsADidYouMeanAndNothingIsWritten) {
   const std::string file = Variant("typo", "weather: clear", "wether: clear");
   const fs::path out = fs::temp_directory_path() / "adse_cli_typo_out";
   fs::remove_all(out);
-  const CommandRun run = Adse("world " + file + " --follow-ideal -o " + out.string());
+  const CommandRun run =
+      Adse("world " + file + " --follow-ideal -o " + out.string());
   EXPECT_EQ(run.exit_code, 2) << run.out;
-  EXPECT_NE(run.out.find("did you mean 'weather'"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("did you mean 'weather'"), std::string::npos)
+      << run.out;
   EXPECT_FALSE(fs::exists(out));
 }
 
@@ -96,7 +113,8 @@ TEST(CliTest, BadFlagsAndMissingFilesExitWith2) {
   EXPECT_EQ(Adse("world " + Example() + " --save-scans -3").exit_code, 2);
   const CommandRun missing = Adse("validate /nonexistent/scenario.yaml");
   EXPECT_EQ(missing.exit_code, 2);
-  EXPECT_NE(missing.out.find("/nonexistent/scenario.yaml"), std::string::npos) << missing.out;
+  EXPECT_NE(missing.out.find("/nonexistent/scenario.yaml"), std::string::npos)
+      << missing.out;
   const CommandRun help = Adse("--help");
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_NE(help.out.find("validate"), std::string::npos);
@@ -105,7 +123,9 @@ TEST(CliTest, BadFlagsAndMissingFilesExitWith2) {
 TEST(CliTest, WorldFollowIdealReachesTheGoalAndWritesWhatItSaw) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_world_check";
   fs::remove_all(out);
-  const CommandRun run = Adse("world " + Example() + " --follow-ideal --json --save-scans 50 -o " + out.string());
+  const CommandRun run =
+      Adse("world " + Example() + " --follow-ideal --json --save-scans 50 -o " +
+           out.string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
   std::ifstream summary_file(out / "summary.json");
   const nlohmann::json summary = nlohmann::json::parse(summary_file);
@@ -115,7 +135,8 @@ TEST(CliTest, WorldFollowIdealReachesTheGoalAndWritesWhatItSaw) {
   // 168 m of path at 30 km/h with four slow corners.
   EXPECT_NEAR(summary["time_s"].get<double>(), 27.0, 6.0);
   // Scans at the scenario's 10 Hz.
-  EXPECT_NEAR(summary["scans"].get<int>(), summary["time_s"].get<double>() * 10, 2);
+  EXPECT_NEAR(summary["scans"].get<int>(), summary["time_s"].get<double>() * 10,
+              2);
   EXPECT_TRUE(fs::exists(out / "trajectory.csv"));
   EXPECT_TRUE(fs::exists(out / "ideal_path.csv"));
   EXPECT_TRUE(fs::exists(out / "scans" / "scan_00000.pcd"));
@@ -123,14 +144,17 @@ TEST(CliTest, WorldFollowIdealReachesTheGoalAndWritesWhatItSaw) {
   EXPECT_FALSE(fs::exists(out / "scans" / "scan_00010.pcd"));
 }
 
-std::string Small() { return std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml"; }
+std::string Small() {
+  return std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml";
+}
 
 TEST(CliTest, SimulateWritesARunFileThatPassesTheSchemaCheck) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_simulate.h5";
   fs::remove(out);
   const CommandRun run =
-      Adse("simulate " + Small() + " --point cores=16,freq_ghz=2.1,lidar_hz=7 --json -q -o " + out.string() +
-           " 2>/dev/null");
+      Adse("simulate " + Small() +
+           " --point cores=16,freq_ghz=2.1,lidar_hz=7 --json -q -o " +
+           out.string() + " 2>/dev/null");
   ASSERT_EQ(run.exit_code, 0) << run.out;
   const nlohmann::json doc = nlohmann::json::parse(run.out);
   EXPECT_EQ(doc["termination_reason"], "goal_reached");
@@ -144,11 +168,13 @@ TEST(CliTest, SimulateWritesARunFileThatPassesTheSchemaCheck) {
 }
 
 TEST(CliTest, SimulateRejectsAPointOutsideTheSpace) {
-  const CommandRun run = Adse("simulate " + Small() + " --point cores=3,freq_ghz=2.1,lidar_hz=7");
+  const CommandRun run =
+      Adse("simulate " + Small() + " --point cores=3,freq_ghz=2.1,lidar_hz=7");
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_NE(run.out.find("cores"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("1, 4, 16"), std::string::npos) << run.out;
-  const CommandRun unknown = Adse("simulate " + Small() + " --point cores=4,freq_ghz=2.1,lidar=7");
+  const CommandRun unknown =
+      Adse("simulate " + Small() + " --point cores=4,freq_ghz=2.1,lidar=7");
   EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
   EXPECT_NE(unknown.out.find("lidar"), std::string::npos) << unknown.out;
 }
@@ -165,29 +191,36 @@ TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
   const fs::path dir = fs::temp_directory_path() / "adse_cli_analyze";
   fs::remove_all(dir);
   fs::create_directories(dir / "runs");
-  const CommandRun sim = Adse("simulate " + Small() + " --point cores=16,freq_ghz=2.1,lidar_hz=7 -q -o " +
-                              (dir / "runs" / "a.h5").string());
+  const CommandRun sim =
+      Adse("simulate " + Small() +
+           " --point cores=16,freq_ghz=2.1,lidar_hz=7 -q -o " +
+           (dir / "runs" / "a.h5").string());
   ASSERT_EQ(sim.exit_code, 0) << sim.out;
   std::ofstream(dir / "runs" / "broken.h5") << "truncated";
   const CommandRun first = Adse("analyze " + dir.string());
   EXPECT_EQ(first.exit_code, 2) << first.out;  // one file could not be read
-  EXPECT_NE(first.out.find("skipped " + (dir / "runs" / "broken.h5").string()), std::string::npos)
+  EXPECT_NE(first.out.find("skipped " + (dir / "runs" / "broken.h5").string()),
+            std::string::npos)
       << first.out;
   EXPECT_NE(first.out.find("1 runs analysed"), std::string::npos) << first.out;
   ASSERT_TRUE(fs::exists(dir / "analysis" / "v1" / "summary.json"));
   EXPECT_TRUE(fs::exists(dir / "analysis" / "v1" / "pareto.png"));
   EXPECT_TRUE(fs::exists(dir / "runs" / "a.analysis" / "v1" / "report.json"));
-  EXPECT_TRUE(fs::exists(dir / "runs" / "a.analysis" / "v1" / "trajectory.png"));
+  EXPECT_TRUE(
+      fs::exists(dir / "runs" / "a.analysis" / "v1" / "trajectory.png"));
   // Raw data is never rewritten; a second analysis is a new version.
   const auto raw_time = fs::last_write_time(dir / "runs" / "a.h5");
   Adse("analyze " + dir.string() + " --threshold frequency_bound_fraction=0.5");
   EXPECT_EQ(fs::last_write_time(dir / "runs" / "a.h5"), raw_time);
   ASSERT_TRUE(fs::exists(dir / "analysis" / "v2" / "summary.json"));
-  const CommandRun diff = Adse("analyze --diff " + (dir / "analysis" / "v1").string() + " " +
-                               (dir / "analysis" / "v2").string());
+  const CommandRun diff =
+      Adse("analyze --diff " + (dir / "analysis" / "v1").string() + " " +
+           (dir / "analysis" / "v2").string());
   EXPECT_EQ(diff.exit_code, 0) << diff.out;
-  EXPECT_NE(diff.out.find("0 of 1 points changed"), std::string::npos) << diff.out;
-  const CommandRun bad = Adse("analyze " + dir.string() + " --threshold nonsense=1");
+  EXPECT_NE(diff.out.find("0 of 1 points changed"), std::string::npos)
+      << diff.out;
+  const CommandRun bad =
+      Adse("analyze " + dir.string() + " --threshold nonsense=1");
   EXPECT_EQ(bad.exit_code, 2) << bad.out;
   EXPECT_NE(bad.out.find("nonsense"), std::string::npos) << bad.out;
 }
@@ -195,9 +228,11 @@ TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
 TEST(CliTest, AnalyzeOneRunPrintsDeviationAndDiagnosis) {
   const fs::path run = fs::temp_directory_path() / "adse_cli_analyze_one.h5";
   fs::remove_all(fs::temp_directory_path() / "adse_cli_analyze_one.analysis");
-  ASSERT_EQ(Adse("simulate " + Small() + " --point cores=1,freq_ghz=1.0,lidar_hz=14 -q -o " + run.string())
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      Adse("simulate " + Small() +
+           " --point cores=1,freq_ghz=1.0,lidar_hz=14 -q -o " + run.string())
+          .exit_code,
+      0);
   const CommandRun r = Adse("analyze " + run.string());
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_NE(r.out.find("deviation_score"), std::string::npos) << r.out;
@@ -209,54 +244,74 @@ TEST(CliTest, AnalyzeOneRunPrintsDeviationAndDiagnosis) {
 namespace {
 
 TEST(CliRunTest, ExploreReplayPrintsADistributionPerStrategy) {
-  const CommandRun run = Adse("explore --replay " + std::string(ADSE_SOURCE_DIR) +
-                              "/tests/data/robotaxi_exhaustive --strategy agent,ga --seeds 3");
+  const CommandRun run =
+      Adse("explore --replay " + std::string(ADSE_SOURCE_DIR) +
+           "/tests/data/robotaxi_exhaustive --strategy agent,ga --seeds 3");
   ASSERT_EQ(run.exit_code, 0) << run.out;
-  EXPECT_NE(run.out.find("280 recorded evaluations, budget 15, seeds 1..3"), std::string::npos)
+  EXPECT_NE(run.out.find("280 recorded evaluations, budget 15, seeds 1..3"),
+            std::string::npos)
       << run.out;
   EXPECT_NE(run.out.find("| agent |"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("| ga |"), std::string::npos) << run.out;
   const CommandRun bad = Adse("explore --replay /nonexistent/campaign");
   EXPECT_EQ(bad.exit_code, 2) << bad.out;
-  EXPECT_NE(bad.out.find("/nonexistent/campaign"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("/nonexistent/campaign"), std::string::npos)
+      << bad.out;
 }
 
 TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
-  const CommandRun isolation = Adse("run " + Small() + " --isolation containers");
+  const CommandRun isolation =
+      Adse("run " + Small() + " --isolation containers");
   EXPECT_EQ(isolation.exit_code, 2) << isolation.out;
-  EXPECT_NE(isolation.out.find("--isolation"), std::string::npos) << isolation.out;
+  EXPECT_NE(isolation.out.find("--isolation"), std::string::npos)
+      << isolation.out;
   std::ifstream in(Small());
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string file = WriteScenario("replicas", text + "harness: {replicas: 3}\n");
-  const CommandRun replicas = Adse("run " + file + " -o " +
-                                   (fs::temp_directory_path() / "adse_cli_replicas").string());
+  std::string text((std::istreambuf_iterator<char>(in)),
+                   std::istreambuf_iterator<char>());
+  const std::string file =
+      WriteScenario("replicas", text + "harness: {replicas: 3}\n");
+  const CommandRun replicas =
+      Adse("run " + file + " -o " +
+           (fs::temp_directory_path() / "adse_cli_replicas").string());
   EXPECT_EQ(replicas.exit_code, 2) << replicas.out;
-  EXPECT_NE(replicas.out.find("harness.replicas"), std::string::npos) << replicas.out;
+  EXPECT_NE(replicas.out.find("harness.replicas"), std::string::npos)
+      << replicas.out;
 }
 
-TEST(CliRunTest, AnLlmCampaignWithItsServerDownSaysSoAndFinishesWithTheBuiltInAgent) {
+TEST(CliRunTest,
+     AnLlmCampaignWithItsServerDownSaysSoAndFinishesWithTheBuiltInAgent) {
   std::ifstream in(Small());
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string text((std::istreambuf_iterator<char>(in)),
+                   std::istreambuf_iterator<char>());
   // Port 9 (discard): nothing listens there.
   const std::string file = WriteScenario(
-      "llm_down", text + "llm: {endpoint: \"http://127.0.0.1:9\", retries: 0}\n");
-  const std::string out = (fs::temp_directory_path() / "adse_cli_llm_down").string();
+      "llm_down",
+      text + "llm: {endpoint: \"http://127.0.0.1:9\", retries: 0}\n");
+  const std::string out =
+      (fs::temp_directory_path() / "adse_cli_llm_down").string();
   fs::remove_all(out);
-  const CommandRun run = Adse("run " + file + " --strategy llm --budget 1 -o " + out);
+  const CommandRun run =
+      Adse("run " + file + " --strategy llm --budget 1 -o " + out);
   ASSERT_EQ(run.exit_code, 0) << run.out;
-  EXPECT_NE(run.out.find("fallback to the built-in agent"), std::string::npos) << run.out;
-  EXPECT_NE(run.out.find("cannot reach http://127.0.0.1:9/api/chat"), std::string::npos)
+  EXPECT_NE(run.out.find("fallback to the built-in agent"), std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("cannot reach http://127.0.0.1:9/api/chat"),
+            std::string::npos)
       << run.out;
   EXPECT_NE(run.out.find("ollama serve"), std::string::npos) << run.out;
   EXPECT_TRUE(fs::exists(out + "/llm/exchanges.jsonl"));
 }
 
 TEST(CliRunTest, WorkerRefusesAScenarioThatChangedUnderItsCampaign) {
-  const std::string out = (fs::temp_directory_path() / "adse_cli_worker.h5").string();
-  const CommandRun run = Adse("worker " + Small() + " --point cores=4,freq_ghz=2.1,lidar_hz=14 -o " +
+  const std::string out =
+      (fs::temp_directory_path() / "adse_cli_worker.h5").string();
+  const CommandRun run = Adse("worker " + Small() +
+                              " --point cores=4,freq_ghz=2.1,lidar_hz=14 -o " +
                               out + " --expect-key " + std::string(64, '0'));
   EXPECT_EQ(run.exit_code, 2) << run.out;
-  EXPECT_NE(run.out.find("changed since the campaign started"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("changed since the campaign started"),
+            std::string::npos)
+      << run.out;
   EXPECT_FALSE(fs::exists(out));
 }
 

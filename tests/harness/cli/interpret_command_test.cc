@@ -17,11 +17,11 @@
 namespace adse {
 namespace {
 namespace fs = std::filesystem;
-using ::testing::HasSubstr;
 using llm::testing::FakeAnswer;
 using llm::testing::FakeLlmServer;
 using testing::Adse;
 using testing::CommandRun;
+using ::testing::HasSubstr;
 
 // The small robotaxi study without design space or objectives.
 const char kValid[] = R"yaml(adse: 1
@@ -43,20 +43,25 @@ std::string TempDir(const std::string& name) {
 }
 
 const char kRequest[] =
-    "\"robotaxi from the lot entrance to the far aisle; cheapest computer that gets there "
+    "\"robotaxi from the lot entrance to the far aisle; cheapest computer that "
+    "gets there "
     "within a minute\"";
 
-TEST(InterpretCommandTest, ValidationErrorsGoBackToTheModelAndDefaultsAreNamed) {
+TEST(InterpretCommandTest,
+     ValidationErrorsGoBackToTheModelAndDefaultsAreNamed) {
   std::string without_task = kValid;
-  without_task.erase(without_task.find("task:"), without_task.find("platform:") -
-                                                     without_task.find("task:"));
-  Result<std::unique_ptr<FakeLlmServer>> server = FakeLlmServer::Start(
-      FakeLlmServer::Sequence({{200, without_task}, {200, std::string(kValid) +
-                                                            "output: /etc/adse-evil\n"}}));
+  without_task.erase(
+      without_task.find("task:"),
+      without_task.find("platform:") - without_task.find("task:"));
+  Result<std::unique_ptr<FakeLlmServer>> server =
+      FakeLlmServer::Start(FakeLlmServer::Sequence(
+          {{200, without_task},
+           {200, std::string(kValid) + "output: /etc/adse-evil\n"}}));
   ASSERT_TRUE(server.ok());
   const std::string dir = TempDir("ok");
-  const CommandRun run = Adse(std::string("interpret ") + kRequest + " -o " + dir +
-                              "/study.yaml --model interp --endpoint " + (*server)->url());
+  const CommandRun run =
+      Adse(std::string("interpret ") + kRequest + " -o " + dir +
+           "/study.yaml --model interp --endpoint " + (*server)->url());
   ASSERT_EQ(run.exit_code, 0) << run.out;
   EXPECT_THAT(run.out, HasSubstr("default used: design_space"));
   EXPECT_THAT(run.out, HasSubstr("default used: objectives"));
@@ -64,13 +69,16 @@ TEST(InterpretCommandTest, ValidationErrorsGoBackToTheModelAndDefaultsAreNamed) 
   EXPECT_THAT(run.out, HasSubstr("2 answers, 1 corrected"));
 
   // The second request told the model what the validator said.
-  const std::vector<llm::testing::ReceivedRequest> requests = (*server)->requests();
+  const std::vector<llm::testing::ReceivedRequest> requests =
+      (*server)->requests();
   ASSERT_EQ(requests.size(), 2u);
   EXPECT_EQ(requests[0].model, "interp");
-  EXPECT_THAT(requests[1].TextOf("user"), HasSubstr("adse's validator reports"));
+  EXPECT_THAT(requests[1].TextOf("user"),
+              HasSubstr("adse's validator reports"));
   EXPECT_THAT(requests[1].TextOf("user"), HasSubstr("study.yaml"));
   EXPECT_THAT(requests[1].TextOf("user"), HasSubstr("task"));
-  EXPECT_THAT(requests[1].TextOf("user"), ::testing::Not(HasSubstr("interpret-check")));
+  EXPECT_THAT(requests[1].TextOf("user"),
+              ::testing::Not(HasSubstr("interpret-check")));
 
   // The file is a valid scenario with the defaults written out, and no
   // leftover from validation sits beside it.
@@ -81,34 +89,41 @@ TEST(InterpretCommandTest, ValidationErrorsGoBackToTheModelAndDefaultsAreNamed) 
   EXPECT_THAT(text, HasSubstr("# Written by `adse interpret`"));
   EXPECT_THAT(text, ::testing::Not(HasSubstr("/etc/adse-evil")));
   std::set<std::string> files;
-  for (const auto& e : fs::directory_iterator(dir)) files.insert(e.path().filename().string());
-  EXPECT_EQ(files, (std::set<std::string>{"study.yaml", "study.interpret.jsonl"}));
+  for (const auto& e : fs::directory_iterator(dir))
+    files.insert(e.path().filename().string());
+  EXPECT_EQ(files,
+            (std::set<std::string>{"study.yaml", "study.interpret.jsonl"}));
 
   // The recorded exchanges answer the same request again with no server.
   server->reset();
   fs::create_directories(dir + "/replayed");
   const CommandRun again =
-      Adse(std::string("interpret ") + kRequest + " -o " + dir + "/replayed/study.yaml " +
-           "--model interp --backend replay --replay-from " + dir + "/study.interpret.jsonl");
+      Adse(std::string("interpret ") + kRequest + " -o " + dir +
+           "/replayed/study.yaml " +
+           "--model interp --backend replay --replay-from " + dir +
+           "/study.interpret.jsonl");
   ASSERT_EQ(again.exit_code, 0) << again.out;
   EXPECT_EQ(ReadFile(dir + "/replayed/study.yaml").value(), text);
   // Another request was never recorded: a clear error, nothing written.
-  const CommandRun other =
-      Adse("interpret 'a grid town instead' -o " + dir + "/replayed/other.yaml " +
-           "--model interp --backend replay --replay-from " + dir + "/study.interpret.jsonl");
+  const CommandRun other = Adse(
+      "interpret 'a grid town instead' -o " + dir + "/replayed/other.yaml " +
+      "--model interp --backend replay --replay-from " + dir +
+      "/study.interpret.jsonl");
   EXPECT_EQ(other.exit_code, 2) << other.out;
-  EXPECT_THAT(other.out, HasSubstr("no recorded answer for this interpretation request"));
+  EXPECT_THAT(other.out,
+              HasSubstr("no recorded answer for this interpretation request"));
   EXPECT_FALSE(fs::exists(dir + "/replayed/other.yaml"));
 }
 
 TEST(InterpretCommandTest, AModelThatNeverGetsItRightWritesNothing) {
-  Result<std::unique_ptr<FakeLlmServer>> server =
-      FakeLlmServer::Start(FakeLlmServer::Sequence({{200, "world: [unclosed"}}));
+  Result<std::unique_ptr<FakeLlmServer>> server = FakeLlmServer::Start(
+      FakeLlmServer::Sequence({{200, "world: [unclosed"}}));
   ASSERT_TRUE(server.ok());
   const std::string dir = TempDir("never");
   const CommandRun run =
-      Adse(std::string("interpret ") + kRequest + " -o " + dir + "/study.yaml --model interp " +
-           "--max-corrections 1 --endpoint " + (*server)->url());
+      Adse(std::string("interpret ") + kRequest + " -o " + dir +
+           "/study.yaml --model interp " + "--max-corrections 1 --endpoint " +
+           (*server)->url());
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_THAT(run.out, HasSubstr("no valid scenario in 2 answers"));
   EXPECT_THAT(run.out, HasSubstr("not valid YAML"));
@@ -118,8 +133,9 @@ TEST(InterpretCommandTest, AModelThatNeverGetsItRightWritesNothing) {
 
 TEST(InterpretCommandTest, AServerThatIsDownIsNamedWithWhatToStart) {
   const std::string dir = TempDir("down");
-  const CommandRun run = Adse(std::string("interpret ") + kRequest + " -o " + dir +
-                              "/study.yaml --retries 0 --endpoint http://127.0.0.1:9");
+  const CommandRun run =
+      Adse(std::string("interpret ") + kRequest + " -o " + dir +
+           "/study.yaml --retries 0 --endpoint http://127.0.0.1:9");
   EXPECT_EQ(run.exit_code, 1) << run.out;
   EXPECT_THAT(run.out, HasSubstr("http://127.0.0.1:9"));
   EXPECT_THAT(run.out, HasSubstr("ollama serve"));

@@ -12,9 +12,9 @@
 namespace adse::llm {
 namespace {
 
-using ::testing::HasSubstr;
 using adse::testing::SmallPoint;
 using adse::testing::SmallScenario;
+using ::testing::HasSubstr;
 
 TEST(DseAnswerTest, AcceptsAPointOfAllowedValuesAndSnapsThem) {
   const spec::Spec spec = SmallScenario();
@@ -31,7 +31,8 @@ TEST(DseAnswerTest, AcceptsAPointOfAllowedValuesAndSnapsThem) {
 TEST(DseAnswerTest, DropsAReasoningBlockBeforeTheJson) {
   const spec::Spec spec = SmallScenario();
   Result<DseAnswer> a = ParseDseAnswer(
-      "<think>let me see {not json}</think>\n{\"point\": {\"cores\": 1, \"freq_ghz\": 1.0, "
+      "<think>let me see {not json}</think>\n{\"point\": {\"cores\": 1, "
+      "\"freq_ghz\": 1.0, "
       "\"lidar_hz\": 7}, \"rationale\": \"cheapest\"}",
       spec.design_space, {});
   ASSERT_TRUE(a.ok()) << a.status().ToString();
@@ -48,10 +49,12 @@ TEST(DseAnswerTest, RefusesEverythingElseWithAnActionableMessage) {
       {"cores=4", "not valid JSON"},
       {"```json\n{\"point\": {}}\n```", "not valid JSON"},
       {"[1, 2]", "one JSON object"},
-      {R"js({"point": {"cores": 4, "freq_ghz": 1.0, "lidar_hz": 14}})js", "lacks \"rationale\""},
+      {R"js({"point": {"cores": 4, "freq_ghz": 1.0, "lidar_hz": 14}})js",
+       "lacks \"rationale\""},
       {R"js({"point": {"cores": 3, "freq_ghz": 1.0, "lidar_hz": 14}, "rationale": "x"})js",
        "cores=3 is outside the design space; cores takes one of 1, 4, 16"},
-      {R"js({"point": {"cores": 4, "freq_ghz": 1.0}, "rationale": "x"})js", "lacks lidar_hz"},
+      {R"js({"point": {"cores": 4, "freq_ghz": 1.0}, "rationale": "x"})js",
+       "lacks lidar_hz"},
       {R"js({"point": {"cores": 4, "freq_ghz": 1.0, "lidar_hz": 14, "gpu": 1}, "rationale": "x"})js",
        "not a design parameter"},
       {R"js({"point": {"cores": "4", "freq_ghz": 1.0, "lidar_hz": 14}, "rationale": "x"})js",
@@ -74,7 +77,8 @@ TEST(DseAnswerTest, ConvergenceNeedsSomethingEvaluated) {
   const spec::Spec spec = SmallScenario();
   const char* answer = R"js({"converged": true, "rationale": "front found"})js";
   EXPECT_FALSE(ParseDseAnswer(answer, spec.design_space, {}).ok());
-  Result<DseAnswer> a = ParseDseAnswer(answer, spec.design_space, {SmallPoint(1, 1.0, 7)});
+  Result<DseAnswer> a =
+      ParseDseAnswer(answer, spec.design_space, {SmallPoint(1, 1.0, 7)});
   ASSERT_TRUE(a.ok());
   EXPECT_TRUE(a->converged);
   EXPECT_TRUE(a->point.empty());
@@ -98,7 +102,8 @@ TEST(CommandAnswerTest, AcceptsTheSchemaAndComparesWithTheDerivedCommands) {
   EXPECT_TRUE(CompareCommands(*c, derived).empty());
 
   std::string wrong = agreeing;
-  wrong.replace(wrong.find("\"platform.cores\": 4"), 19, "\"platform.cores\": 16");
+  wrong.replace(wrong.find("\"platform.cores\": 4"), 19,
+                "\"platform.cores\": 16");
   c = ParseCommandAnswer(wrong, spec);
   ASSERT_TRUE(c.ok());
   EXPECT_THAT(CompareCommands(*c, derived),
@@ -144,9 +149,12 @@ TEST(DecipherTest, TextReadingIsComparedByNodeAndKind) {
       {"cpu_bound", "ndt_scan_matcher", "higher frequency", 0.6},
       {"cpu_bound", "euclidean_cluster", "more cores", 0.3}};
   EXPECT_THAT(CompareTextReading(*r, found),
-              ::testing::UnorderedElementsAre("missed cpu_bound euclidean_cluster",
-                                              "named frequency_bound planner (not found)"));
-  EXPECT_FALSE(ParseTextReading(R"js({"bottlenecks": [{"node": "a", "kind": "slow"}]})js").ok());
+              ::testing::UnorderedElementsAre(
+                  "missed cpu_bound euclidean_cluster",
+                  "named frequency_bound planner (not found)"));
+  EXPECT_FALSE(ParseTextReading(
+                   R"js({"bottlenecks": [{"node": "a", "kind": "slow"}]})js")
+                   .ok());
   EXPECT_FALSE(ParseTextReading(R"js({"summary": "fine"})js").ok());
 }
 
@@ -159,9 +167,11 @@ TEST(DecipherTest, VisionReadingIsComparedWithTheMetrics) {
   Result<VisionReading> r = ParseVisionReading(
       R"js({"reached_goal": true, "smooth": true, "left_lane": false, "notes": "fine"})js");
   ASSERT_TRUE(r.ok());
-  EXPECT_THAT(CompareVisionReading(*r, truth), ::testing::ElementsAre("smooth: yes (metrics: no)"));
+  EXPECT_THAT(CompareVisionReading(*r, truth),
+              ::testing::ElementsAre("smooth: yes (metrics: no)"));
   EXPECT_FALSE(ParseVisionReading(R"js({"reached_goal": "yes", "smooth": true,
-                                      "left_lane": false})js").ok());
+                                      "left_lane": false})js")
+                   .ok());
 }
 
 TEST(DecipherTest, TraceSummaryReadsTheReportsTrace) {
@@ -175,22 +185,27 @@ TEST(DecipherTest, TraceSummaryReadsTheReportsTrace) {
   EXPECT_THAT(*s, HasSubstr("/points (external): 14 Hz, 3.5 Hz, 120 drops"));
   EXPECT_THAT(*s, HasSubstr("ndt/on_points: 250 / 400 ms, 0.98"));
   EXPECT_THAT(*s, HasSubstr("control rate 9.5 Hz"));
-  EXPECT_EQ(TraceSummaryFromReport("{}").status().code(), Status::Code::kNotFound);
+  EXPECT_EQ(TraceSummaryFromReport("{}").status().code(),
+            Status::Code::kNotFound);
 }
 
 TEST(AskWithCorrectionTest, SendsOneCorrectiveFollowUpThenGivesUp) {
   Result<PromptSet> prompts = PromptSet::Load("");
   ASSERT_TRUE(prompts.ok()) << prompts.status().ToString();
   int calls = 0;
-  testing::ScriptedBackend backend([&](const ChatRequest&) -> Result<ChatReply> {
-    ++calls;
-    return testing::ScriptedBackend::Reply(calls == 1 ? "not json" : "{\"ok\": true}");
-  });
+  testing::ScriptedBackend backend(
+      [&](const ChatRequest&) -> Result<ChatReply> {
+        ++calls;
+        return testing::ScriptedBackend::Reply(calls == 1 ? "not json"
+                                                          : "{\"ok\": true}");
+      });
   auto accept = [](const std::string& text) {
-    return text.find("ok") != std::string::npos ? Status::Ok()
-                                                : Status::InvalidArgument("no ok in it");
+    return text.find("ok") != std::string::npos
+               ? Status::Ok()
+               : Status::InvalidArgument("no ok in it");
   };
-  TurnResult t = AskWithCorrection(backend, *prompts, {"dse", "m", {{"user", "hi", {}}}, true},
+  TurnResult t = AskWithCorrection(backend, *prompts,
+                                   {"dse", "m", {{"user", "hi", {}}}, true},
                                    accept, "Say ok.");
   EXPECT_TRUE(t.ok);
   EXPECT_EQ(t.rejected, std::vector<std::string>{"no ok in it"});
@@ -204,8 +219,11 @@ TEST(AskWithCorrectionTest, SendsOneCorrectiveFollowUpThenGivesUp) {
 
   calls = 0;
   testing::ScriptedBackend stubborn(
-      [&](const ChatRequest&) -> Result<ChatReply> { return testing::ScriptedBackend::Reply("no"); });
-  t = AskWithCorrection(stubborn, *prompts, {"dse", "m", {{"user", "hi", {}}}, true}, accept, "");
+      [&](const ChatRequest&) -> Result<ChatReply> {
+        return testing::ScriptedBackend::Reply("no");
+      });
+  t = AskWithCorrection(stubborn, *prompts,
+                        {"dse", "m", {{"user", "hi", {}}}, true}, accept, "");
   EXPECT_FALSE(t.ok);
   EXPECT_TRUE(t.error.ok());
   EXPECT_EQ(t.rejected.size(), 2u);
@@ -214,7 +232,8 @@ TEST(AskWithCorrectionTest, SendsOneCorrectiveFollowUpThenGivesUp) {
   testing::ScriptedBackend down([](const ChatRequest&) -> Result<ChatReply> {
     return Status::Unavailable("cannot reach http://127.0.0.1:1");
   });
-  t = AskWithCorrection(down, *prompts, {"dse", "m", {{"user", "hi", {}}}, true}, accept, "");
+  t = AskWithCorrection(down, *prompts,
+                        {"dse", "m", {{"user", "hi", {}}}, true}, accept, "");
   EXPECT_FALSE(t.ok);
   EXPECT_EQ(t.error.code(), Status::Code::kUnavailable);
   EXPECT_EQ(down.requests().size(), 1u);

@@ -433,7 +433,8 @@ TEST(RecordingBackendTest,
 
 // --- Resuming and replaying into a record --------------------------------
 
-TEST(RecordingBackendTest, AResumedSessionThatAsksSomethingNewRecordsItEvenBeforeTheLogsEnd) {
+TEST(RecordingBackendTest,
+     AResumedSessionThatAsksSomethingNewRecordsItEvenBeforeTheLogsEnd) {
   const std::string path = TempDir("diverge") + "/llm/exchanges.jsonl";
   {
     int calls = 0;
@@ -445,8 +446,8 @@ TEST(RecordingBackendTest, AResumedSessionThatAsksSomethingNewRecordsItEvenBefor
   Result<std::vector<ExchangeRecord>> recorded = LoadExchanges(path);
   ASSERT_TRUE(recorded.ok());
   int live_calls = 0;
-  RecordingBackend second(std::move(*recorded), Counting("b", &live_calls), std::move(log),
-                          path);
+  RecordingBackend second(std::move(*recorded), Counting("b", &live_calls),
+                          std::move(log), path);
   // The session's first request is not the recorded one: a live answer,
   // which the log must keep although it holds two lines already.
   Result<ChatReply> other = second.Chat(Request("other"));

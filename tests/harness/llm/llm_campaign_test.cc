@@ -30,10 +30,10 @@
 namespace adse::llm {
 namespace {
 namespace fs = std::filesystem;
-using ::testing::HasSubstr;
 using adse::testing::SmallPoint;
 using testing::FakeAnswer;
 using testing::FakeLlmServer;
+using ::testing::HasSubstr;
 using testing::ReceivedRequest;
 
 const std::string kAdse = std::string(ADSE_BINARY_DIR) + "/bin/adse";
@@ -42,7 +42,8 @@ std::string TempDir(const std::string& name) {
   return adse::testing::FreshTempDir("adse-llm", name);
 }
 
-std::string PointJson(const spec::DesignPoint& p, const std::string& rationale = "because") {
+std::string PointJson(const spec::DesignPoint& p,
+                      const std::string& rationale = "because") {
   return nlohmann::json({{"point", p}, {"rationale", rationale}}).dump();
 }
 
@@ -68,20 +69,25 @@ FakeLlmServer::Script Script(const spec::Spec& spec, Team* team) {
       const size_t at = text.find("Design point: ") + 14;
       Result<spec::DesignPoint> point = spec::ParsePoint(
           spec.design_space, text.substr(at, text.find('\n', at) - at));
-      const Commands c = DeriveCommands(spec, point.ok() ? *point : spec::DesignPoint{},
-                                        spec.world.traffic.seed);
-      nlohmann::json j = {{"world", {{"map", c.map}, {"traffic_seed", c.traffic_seed},
-                                     {"weather", c.weather}}},
+      const Commands c =
+          DeriveCommands(spec, point.ok() ? *point : spec::DesignPoint{},
+                         spec.world.traffic.seed);
+      nlohmann::json j = {{"world",
+                           {{"map", c.map},
+                            {"traffic_seed", c.traffic_seed},
+                            {"weather", c.weather}}},
                           {"platform", c.platform},
                           {"tracing", {{"record", c.record}}}};
       return {200, j.dump()};
     }
     if (r.model == "text-model") {
-      return {200, R"js({"bottlenecks": [], "summary": "the stack keeps up"})js"};
+      return {200,
+              R"js({"bottlenecks": [], "summary": "the stack keeps up"})js"};
     }
     if (r.model == "vision-model") {
       if (team->vision) return team->vision(r);
-      return {200, R"js({"reached_goal": true, "smooth": true, "left_lane": false,
+      return {200,
+              R"js({"reached_goal": true, "smooth": true, "left_lane": false,
                          "notes": "a clean drive"})js"};
     }
     return {404, "unknown model " + r.model};
@@ -100,9 +106,11 @@ spec::Spec LlmScenario(const std::string& dir, const std::string& url,
   const size_t exploration = text.find("exploration:");
   text.erase(exploration, text.find('\n', exploration) - exploration);
   text += "exploration: {strategy: llm, budget: 2}\n";
-  text += "llm: {backend: " + api + ", endpoint: \"" + url +
-          "\", models: {dse: dse-model, command: command-model, text: text-model, "
-          "vision: vision-model, interpretation: interpretation-model}, " + extra + "}\n";
+  text +=
+      "llm: {backend: " + api + ", endpoint: \"" + url +
+      "\", models: {dse: dse-model, command: command-model, text: text-model, "
+      "vision: vision-model, interpretation: interpretation-model}, " +
+      extra + "}\n";
   const std::string path = dir + "/scenario.yaml";
   EXPECT_TRUE(WriteFileAtomic(path, text).ok());
   Result<spec::Spec> spec = spec::LoadSpec(path);
@@ -111,8 +119,8 @@ spec::Spec LlmScenario(const std::string& dir, const std::string& url,
 }
 
 // The first event of an agent and kind.
-std::string Detail(const std::vector<LlmEvent>& events, const std::string& agent,
-                   const std::string& kind) {
+std::string Detail(const std::vector<LlmEvent>& events,
+                   const std::string& agent, const std::string& kind) {
   for (const LlmEvent& e : events) {
     if (e.agent == agent && e.kind == kind) return e.detail;
   }
@@ -157,17 +165,20 @@ const spec::DesignPoint kP1 = SmallPoint(16, 2.1, 14);
 const spec::DesignPoint kP2 = SmallPoint(16, 2.1, 7);
 const spec::DesignPoint kP3 = SmallPoint(4, 2.1, 14);
 
-TEST(LlmCampaignTest, AShortCampaignAsksEveryAgentRecordsEveryExchangeAndReplaysExactly) {
+TEST(LlmCampaignTest,
+     AShortCampaignAsksEveryAgentRecordsEveryExchangeAndReplaysExactly) {
   const spec::Spec base = adse::testing::SmallScenario();
   Team team;
   team.dse = {{200, PointJson(kP1)}, {200, PointJson(kP2)}};
-  Result<std::unique_ptr<FakeLlmServer>> server = FakeLlmServer::Start(Script(base, &team));
+  Result<std::unique_ptr<FakeLlmServer>> server =
+      FakeLlmServer::Start(Script(base, &team));
   ASSERT_TRUE(server.ok()) << server.status().ToString();
   const std::string dir = TempDir("short");
   const spec::Spec spec = LlmScenario(dir, (*server)->url());
   const std::string out = dir + "/campaign";
 
-  Result<campaign::CampaignSummary> first = campaign::RunCampaign(spec, Options(out, 2));
+  Result<campaign::CampaignSummary> first =
+      campaign::RunCampaign(spec, Options(out, 2));
   ASSERT_TRUE(first.ok()) << first.status().ToString();
   EXPECT_EQ(Points(*first), (std::vector<spec::DesignPoint>{kP1, kP2}));
   EXPECT_EQ(first->failed, 0);
@@ -182,8 +193,9 @@ TEST(LlmCampaignTest, AShortCampaignAsksEveryAgentRecordsEveryExchangeAndReplays
     EXPECT_EQ(e.backend, "ollama");
     EXPECT_GT(e.completion_tokens, 0);
   }
-  EXPECT_EQ(by_agent, (std::map<std::string, int>{
-                          {"command", 2}, {"dse", 2}, {"text", 2}, {"vision", 2}}));
+  EXPECT_EQ(by_agent,
+            (std::map<std::string, int>{
+                {"command", 2}, {"dse", 2}, {"text", 2}, {"vision", 2}}));
   // Ollama was asked not to stream; the vision part got the trajectory PNG.
   int images = 0;
   for (const ReceivedRequest& r : (*server)->requests()) {
@@ -200,15 +212,18 @@ TEST(LlmCampaignTest, AShortCampaignAsksEveryAgentRecordsEveryExchangeAndReplays
   // The DSE agent's second instruction carries the first result and memory.
   const std::string second_step = exchanges[4].prompt;
   EXPECT_EQ(exchanges[4].agent, "dse");
-  EXPECT_THAT(second_step, HasSubstr("Last point evaluated: cores=16,freq_ghz=2.1,lidar_hz=14"));
+  EXPECT_THAT(
+      second_step,
+      HasSubstr("Last point evaluated: cores=16,freq_ghz=2.1,lidar_hz=14"));
   EXPECT_THAT(second_step, HasSubstr("cheapest feasible"));
   // The deciphering agents' readings are compared with the analysis.
   EXPECT_THAT(second_step, HasSubstr("diagnosis: cpu_bound ndt_scan_matcher"));
-  EXPECT_THAT(second_step,
-              HasSubstr("text agent (disagrees, not used): missed cpu_bound ndt_scan_matcher"));
+  EXPECT_THAT(second_step, HasSubstr("text agent (disagrees, not used): missed "
+                                     "cpu_bound ndt_scan_matcher"));
   EXPECT_THAT(second_step, HasSubstr("vision agent (agrees): a clean drive"));
 
-  Result<runfile::CampaignIndex> index = runfile::ReadCampaignIndex(out + "/campaign.h5");
+  Result<runfile::CampaignIndex> index =
+      runfile::ReadCampaignIndex(out + "/campaign.h5");
   ASSERT_TRUE(index.ok()) << index.status().ToString();
   EXPECT_EQ(index->llm_exchanges.size(), 8u);
   EXPECT_EQ(index->llm_exchanges[0].agent, "dse");
@@ -223,7 +238,8 @@ TEST(LlmCampaignTest, AShortCampaignAsksEveryAgentRecordsEveryExchangeAndReplays
   server->reset();
 
   // Resumed in place: every answer comes from the folder's own record.
-  Result<campaign::CampaignSummary> resumed = campaign::RunCampaign(spec, Options(out, 2));
+  Result<campaign::CampaignSummary> resumed =
+      campaign::RunCampaign(spec, Options(out, 2));
   ASSERT_TRUE(resumed.ok()) << resumed.status().ToString();
   EXPECT_EQ(Points(*resumed), Points(*first));
   EXPECT_EQ(resumed->simulated, 0);
@@ -231,10 +247,12 @@ TEST(LlmCampaignTest, AShortCampaignAsksEveryAgentRecordsEveryExchangeAndReplays
 
   // Replayed into a fresh folder with `backend: replay`.
   const std::string replay_dir = TempDir("short-replay");
-  const spec::Spec replay = LlmScenario(replay_dir, "http://127.0.0.1:9", "replay",
-                                        "replay_from: \"" + out + "\"");
+  const spec::Spec replay =
+      LlmScenario(replay_dir, "http://127.0.0.1:9", "replay",
+                  "replay_from: \"" + out + "\"");
   const std::string again = replay_dir + "/campaign";
-  Result<campaign::CampaignSummary> replayed = campaign::RunCampaign(replay, Options(again, 2));
+  Result<campaign::CampaignSummary> replayed =
+      campaign::RunCampaign(replay, Options(again, 2));
   ASSERT_TRUE(replayed.ok()) << replayed.status().ToString();
   EXPECT_EQ(Points(*replayed), Points(*first));
   const std::vector<ExchangeRecord> copied = Exchanges(again);
@@ -255,23 +273,27 @@ TEST(LlmCampaignTest, AShortCampaignAsksEveryAgentRecordsEveryExchangeAndReplays
   // Another budget changes the prompts: the replay stops with a clear
   // error instead of quietly becoming a different campaign.
   const std::string beyond = replay_dir + "/beyond";
-  Result<campaign::CampaignSummary> more = campaign::RunCampaign(replay, Options(beyond, 3));
+  Result<campaign::CampaignSummary> more =
+      campaign::RunCampaign(replay, Options(beyond, 3));
   ASSERT_FALSE(more.ok());
   EXPECT_EQ(more.status().code(), Status::Code::kNotFound);
-  EXPECT_THAT(more.status().message(), HasSubstr("no recorded answer for this dse request"));
+  EXPECT_THAT(more.status().message(),
+              HasSubstr("no recorded answer for this dse request"));
   EXPECT_THAT(more.status().message(), HasSubstr(out + "/llm/exchanges.jsonl"));
   EXPECT_TRUE(fs::exists(beyond + "/report.md"));
 }
 
-TEST(LlmCampaignTest, MalformedJsonGetsOneCorrectionAndTheCorrectedPointIsUsed) {
+TEST(LlmCampaignTest,
+     MalformedJsonGetsOneCorrectionAndTheCorrectedPointIsUsed) {
   const spec::Spec base = adse::testing::SmallScenario();
   Team team;
   team.dse = {{200, "{\"point\": {\"cores\": 16, "}, {200, PointJson(kP1)}};
-  Result<std::unique_ptr<FakeLlmServer>> server = FakeLlmServer::Start(Script(base, &team));
+  Result<std::unique_ptr<FakeLlmServer>> server =
+      FakeLlmServer::Start(Script(base, &team));
   ASSERT_TRUE(server.ok());
   const std::string dir = TempDir("malformed"), out = dir + "/campaign";
-  Result<campaign::CampaignSummary> s =
-      campaign::RunCampaign(LlmScenario(dir, (*server)->url()), Options(out, 1));
+  Result<campaign::CampaignSummary> s = campaign::RunCampaign(
+      LlmScenario(dir, (*server)->url()), Options(out, 1));
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   EXPECT_EQ(Points(*s), std::vector<spec::DesignPoint>{kP1});
   const std::vector<LlmEvent> events = Events(out);
@@ -281,21 +303,26 @@ TEST(LlmCampaignTest, MalformedJsonGetsOneCorrectionAndTheCorrectedPointIsUsed) 
   // The follow-up showed the model its answer and what was wrong.
   const std::vector<ExchangeRecord> x = Exchanges(out);
   ASSERT_GE(x.size(), 2u);
-  EXPECT_THAT(x[1].prompt, HasSubstr("Your answer cannot be used: the answer is not valid JSON"));
-  EXPECT_THAT(ReadFile(out + "/report.md").value(), HasSubstr("1 answers rejected"));
+  EXPECT_THAT(
+      x[1].prompt,
+      HasSubstr("Your answer cannot be used: the answer is not valid JSON"));
+  EXPECT_THAT(ReadFile(out + "/report.md").value(),
+              HasSubstr("1 answers rejected"));
 }
 
-TEST(LlmCampaignTest, APointOutsideTheSpaceTwiceFallsBackToTheBuiltInAgentForThatIteration) {
+TEST(LlmCampaignTest,
+     APointOutsideTheSpaceTwiceFallsBackToTheBuiltInAgentForThatIteration) {
   const spec::Spec base = adse::testing::SmallScenario();
   const std::string outside =
       PointJson({{"cores", 3}, {"freq_ghz", 2.1}, {"lidar_hz", 14}});
   Team team;
   team.dse = {{200, outside}, {200, outside}, {200, PointJson(kP3)}};
-  Result<std::unique_ptr<FakeLlmServer>> server = FakeLlmServer::Start(Script(base, &team));
+  Result<std::unique_ptr<FakeLlmServer>> server =
+      FakeLlmServer::Start(Script(base, &team));
   ASSERT_TRUE(server.ok());
   const std::string dir = TempDir("outside"), out = dir + "/campaign";
-  Result<campaign::CampaignSummary> s =
-      campaign::RunCampaign(LlmScenario(dir, (*server)->url()), Options(out, 2));
+  Result<campaign::CampaignSummary> s = campaign::RunCampaign(
+      LlmScenario(dir, (*server)->url()), Options(out, 2));
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   ASSERT_EQ(s->exploration.evaluations.size(), 2u);
   EXPECT_NE(s->exploration.evaluations[0].point.at("cores"), 3);
@@ -306,7 +333,8 @@ TEST(LlmCampaignTest, APointOutsideTheSpaceTwiceFallsBackToTheBuiltInAgentForTha
   ASSERT_EQ(s->exploration.iterations.size(), 2u);
   EXPECT_THAT(s->exploration.iterations[0].rationale,
               HasSubstr("fallback to the built-in agent"));
-  EXPECT_THAT(s->exploration.iterations[0].rationale, HasSubstr("cores=3 is outside"));
+  EXPECT_THAT(s->exploration.iterations[0].rationale,
+              HasSubstr("cores=3 is outside"));
   EXPECT_THAT(ReadFile(out + "/report.md").value(),
               HasSubstr("1 iterations proposed by the built-in agent instead"));
 }
@@ -314,17 +342,20 @@ TEST(LlmCampaignTest, APointOutsideTheSpaceTwiceFallsBackToTheBuiltInAgentForTha
 TEST(LlmCampaignTest, ARepeatedPointIsRefusedAndCorrected) {
   const spec::Spec base = adse::testing::SmallScenario();
   Team team;
-  team.dse = {{200, PointJson(kP1)}, {200, PointJson(kP1)}, {200, PointJson(kP2)}};
-  Result<std::unique_ptr<FakeLlmServer>> server = FakeLlmServer::Start(Script(base, &team));
+  team.dse = {
+      {200, PointJson(kP1)}, {200, PointJson(kP1)}, {200, PointJson(kP2)}};
+  Result<std::unique_ptr<FakeLlmServer>> server =
+      FakeLlmServer::Start(Script(base, &team));
   ASSERT_TRUE(server.ok());
   const std::string dir = TempDir("repeat"), out = dir + "/campaign";
-  Result<campaign::CampaignSummary> s =
-      campaign::RunCampaign(LlmScenario(dir, (*server)->url()), Options(out, 2));
+  Result<campaign::CampaignSummary> s = campaign::RunCampaign(
+      LlmScenario(dir, (*server)->url()), Options(out, 2));
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   EXPECT_EQ(Points(*s), (std::vector<spec::DesignPoint>{kP1, kP2}));
   const std::vector<LlmEvent> events = Events(out);
   ASSERT_EQ(Count(events, "dse", "rejected"), 1);
-  EXPECT_THAT(Detail(events, "dse", "rejected"), HasSubstr("was evaluated already"));
+  EXPECT_THAT(Detail(events, "dse", "rejected"),
+              HasSubstr("was evaluated already"));
 }
 
 TEST(LlmCampaignTest, ShellTextAndPathsOutsideTheOutputFolderChangeNothing) {
@@ -337,25 +368,31 @@ TEST(LlmCampaignTest, ShellTextAndPathsOutsideTheOutputFolderChangeNothing) {
   nlohmann::json with_output = nlohmann::json::parse(PointJson(kP1));
   with_output["output"] = evil;
   team.dse = {{200, with_output.dump()},
-              {200, PointJson(kP1, "$(touch " + evil + "); rm -rf ~ `touch " + evil + "`")}};
+              {200, PointJson(kP1, "$(touch " + evil + "); rm -rf ~ `touch " +
+                                       evil + "`")}};
   team.command = [&](const ReceivedRequest&) -> FakeAnswer {
-    nlohmann::json j = {{"world", {{"map", "../../" + evil}, {"traffic_seed", 3},
-                                   {"weather", "clear; touch " + evil}}},
-                        {"platform", {{"platform.cores", 16}}},
-                        {"tracing", {{"record", {"callbacks"}}, {"output", evil + ".h5"}}}};
+    nlohmann::json j = {
+        {"world",
+         {{"map", "../../" + evil},
+          {"traffic_seed", 3},
+          {"weather", "clear; touch " + evil}}},
+        {"platform", {{"platform.cores", 16}}},
+        {"tracing", {{"record", {"callbacks"}}, {"output", evil + ".h5"}}}};
     return {200, j.dump()};
   };
-  Result<std::unique_ptr<FakeLlmServer>> server = FakeLlmServer::Start(Script(base, &team));
+  Result<std::unique_ptr<FakeLlmServer>> server =
+      FakeLlmServer::Start(Script(base, &team));
   ASSERT_TRUE(server.ok());
   campaign::CampaignOptions options = Options(out, 1);
   options.use_cache = false;  // nothing at all outside the output folder
-  Result<campaign::CampaignSummary> s =
-      campaign::RunCampaign(LlmScenario(scenario_dir, (*server)->url()), options);
+  Result<campaign::CampaignSummary> s = campaign::RunCampaign(
+      LlmScenario(scenario_dir, (*server)->url()), options);
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   EXPECT_EQ(Points(*s), std::vector<spec::DesignPoint>{kP1});
   // Only the campaign folder was created under root; no file was touched.
   std::set<std::string> entries;
-  for (const auto& e : fs::directory_iterator(root)) entries.insert(e.path().string());
+  for (const auto& e : fs::directory_iterator(root))
+    entries.insert(e.path().string());
   EXPECT_EQ(entries, std::set<std::string>{out});
   EXPECT_FALSE(fs::exists(evil));
   EXPECT_FALSE(fs::exists(evil + ".h5"));
@@ -367,22 +404,27 @@ TEST(LlmCampaignTest, ShellTextAndPathsOutsideTheOutputFolderChangeNothing) {
   EXPECT_THAT(s->exploration.iterations[0].rationale, HasSubstr("$(touch"));
 }
 
-TEST(LlmCampaignTest, ASlowAnswerPastTheTimeoutFallsBackAndTheCampaignFinishes) {
+TEST(LlmCampaignTest,
+     ASlowAnswerPastTheTimeoutFallsBackAndTheCampaignFinishes) {
   const spec::Spec base = adse::testing::SmallScenario();
   Team team;
   FakeAnswer slow{200, PointJson(kP1)};
   slow.delay_s = 3.0;
   team.dse = {slow};
-  Result<std::unique_ptr<FakeLlmServer>> server = FakeLlmServer::Start(Script(base, &team));
+  Result<std::unique_ptr<FakeLlmServer>> server =
+      FakeLlmServer::Start(Script(base, &team));
   ASSERT_TRUE(server.ok());
   const std::string dir = TempDir("slow"), out = dir + "/campaign";
-  const spec::Spec spec = LlmScenario(dir, (*server)->url(), "ollama", "timeout_s: 0.5, retries: 0");
-  Result<campaign::CampaignSummary> s = campaign::RunCampaign(spec, Options(out, 1));
+  const spec::Spec spec = LlmScenario(dir, (*server)->url(), "ollama",
+                                      "timeout_s: 0.5, retries: 0");
+  Result<campaign::CampaignSummary> s =
+      campaign::RunCampaign(spec, Options(out, 1));
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   EXPECT_EQ(s->exploration.evaluations.size(), 1u);
   const std::vector<LlmEvent> events = Events(out);
   ASSERT_EQ(Count(events, "dse", "fallback"), 1);
-  EXPECT_THAT(Detail(events, "dse", "fallback"), HasSubstr("did not answer within 0.5 s"));
+  EXPECT_THAT(Detail(events, "dse", "fallback"),
+              HasSubstr("did not answer within 0.5 s"));
   const std::vector<ExchangeRecord> x = Exchanges(out);
   ASSERT_FALSE(x.empty());
   EXPECT_FALSE(x[0].ok);
@@ -393,11 +435,14 @@ TEST(LlmCampaignTest, AServerErrorThenSuccessIsRetriedOverTheOpenAiApi) {
   const spec::Spec base = adse::testing::SmallScenario();
   Team team;
   team.dse = {{500, "model crashed"}, {200, PointJson(kP1)}};
-  Result<std::unique_ptr<FakeLlmServer>> server = FakeLlmServer::Start(Script(base, &team));
+  Result<std::unique_ptr<FakeLlmServer>> server =
+      FakeLlmServer::Start(Script(base, &team));
   ASSERT_TRUE(server.ok());
   const std::string dir = TempDir("retry"), out = dir + "/campaign";
-  const spec::Spec spec = LlmScenario(dir, (*server)->url(), "openai", "timeout_s: 20, retries: 2");
-  Result<campaign::CampaignSummary> s = campaign::RunCampaign(spec, Options(out, 1));
+  const spec::Spec spec =
+      LlmScenario(dir, (*server)->url(), "openai", "timeout_s: 20, retries: 2");
+  Result<campaign::CampaignSummary> s =
+      campaign::RunCampaign(spec, Options(out, 1));
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   EXPECT_EQ(Points(*s), std::vector<spec::DesignPoint>{kP1});
   const std::vector<ExchangeRecord> x = Exchanges(out);
@@ -421,21 +466,24 @@ TEST(LlmCampaignTest, ATenMegabyteAnswerIsRefusedAndTheAgentTakesOver) {
   huge.raw_body = std::string(1 << 20, 'x');
   huge.raw_body_repeat = 10;
   team.dse = {huge};
-  Result<std::unique_ptr<FakeLlmServer>> server = FakeLlmServer::Start(Script(base, &team));
+  Result<std::unique_ptr<FakeLlmServer>> server =
+      FakeLlmServer::Start(Script(base, &team));
   ASSERT_TRUE(server.ok());
   const std::string dir = TempDir("huge"), out = dir + "/campaign";
-  Result<campaign::CampaignSummary> s =
-      campaign::RunCampaign(LlmScenario(dir, (*server)->url()), Options(out, 1));
+  Result<campaign::CampaignSummary> s = campaign::RunCampaign(
+      LlmScenario(dir, (*server)->url()), Options(out, 1));
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   EXPECT_EQ(s->exploration.evaluations.size(), 1u);
   const std::vector<LlmEvent> events = Events(out);
   ASSERT_EQ(Count(events, "dse", "fallback"), 1);
-  EXPECT_THAT(Detail(events, "dse", "fallback"), HasSubstr("larger than 4 MiB"));
+  EXPECT_THAT(Detail(events, "dse", "fallback"),
+              HasSubstr("larger than 4 MiB"));
   // The record holds the refusal, not the 10 MB.
   EXPECT_LT(fs::file_size(ExchangesPath(out)), 200u * 1024);
 }
 
-TEST(LlmCampaignTest, AVisionAnswerThatContradictsTheMetricsIsRecordedAndTheMetricsWin) {
+TEST(LlmCampaignTest,
+     AVisionAnswerThatContradictsTheMetricsIsRecordedAndTheMetricsWin) {
   const spec::Spec base = adse::testing::SmallScenario();
   Team team;
   team.dse = {{200, PointJson(kP1)}};
@@ -443,11 +491,12 @@ TEST(LlmCampaignTest, AVisionAnswerThatContradictsTheMetricsIsRecordedAndTheMetr
     return {200, R"js({"reached_goal": false, "smooth": true, "left_lane": true,
                        "notes": "it crashed"})js"};
   };
-  Result<std::unique_ptr<FakeLlmServer>> server = FakeLlmServer::Start(Script(base, &team));
+  Result<std::unique_ptr<FakeLlmServer>> server =
+      FakeLlmServer::Start(Script(base, &team));
   ASSERT_TRUE(server.ok());
   const std::string dir = TempDir("vision"), out = dir + "/campaign";
-  Result<campaign::CampaignSummary> s =
-      campaign::RunCampaign(LlmScenario(dir, (*server)->url()), Options(out, 1));
+  Result<campaign::CampaignSummary> s = campaign::RunCampaign(
+      LlmScenario(dir, (*server)->url()), Options(out, 1));
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   ASSERT_EQ(s->exploration.evaluations.size(), 1u);
   EXPECT_TRUE(s->exploration.evaluations[0].feasible);
@@ -455,19 +504,22 @@ TEST(LlmCampaignTest, AVisionAnswerThatContradictsTheMetricsIsRecordedAndTheMetr
   ASSERT_EQ(Count(events, "vision", "disagreement"), 1);
   EXPECT_THAT(Detail(events, "vision", "disagreement"),
               HasSubstr("reached goal: no (metrics: yes)"));
-  EXPECT_THAT(Detail(events, "vision", "disagreement"), HasSubstr("the metrics are kept"));
+  EXPECT_THAT(Detail(events, "vision", "disagreement"),
+              HasSubstr("the metrics are kept"));
 }
 
 TEST(LlmCampaignTest, AnUnreachableServerIsNamedAndTheAgentCarriesTheCampaign) {
   const std::string dir = TempDir("down"), out = dir + "/campaign";
   // The discard port: nothing listens there.
   const spec::Spec spec = LlmScenario(dir, "http://127.0.0.1:9");
-  Result<campaign::CampaignSummary> s = campaign::RunCampaign(spec, Options(out, 1));
+  Result<campaign::CampaignSummary> s =
+      campaign::RunCampaign(spec, Options(out, 1));
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   EXPECT_EQ(s->exploration.evaluations.size(), 1u);
   const std::vector<LlmEvent> events = Events(out);
   ASSERT_EQ(Count(events, "dse", "fallback"), 1);
-  EXPECT_THAT(Detail(events, "dse", "fallback"), HasSubstr("http://127.0.0.1:9"));
+  EXPECT_THAT(Detail(events, "dse", "fallback"),
+              HasSubstr("http://127.0.0.1:9"));
   EXPECT_THAT(Detail(events, "dse", "fallback"), HasSubstr("ollama serve"));
 }
 

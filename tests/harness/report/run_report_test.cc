@@ -17,8 +17,8 @@ namespace {
 using adse::testing::SmallScenario;
 
 RunReport Analyse(double cores, double ghz, double hz) {
-  Result<runfile::RunData> run =
-      sim::SimulatePoint(SmallScenario(), adse::testing::SmallPoint(cores, ghz, hz));
+  Result<runfile::RunData> run = sim::SimulatePoint(
+      SmallScenario(), adse::testing::SmallPoint(cores, ghz, hz));
   EXPECT_TRUE(run.ok()) << run.status().ToString();
   Result<RunReport> report = AnalyzeRun(*run, "memory", AnalyzeOptions{});
   EXPECT_TRUE(report.ok()) << report.status().ToString();
@@ -36,12 +36,15 @@ bool HasCpuBoundAt(const RunReport& r, const std::vector<std::string>& nodes) {
 }
 
 const std::vector<std::string> kLocalizationAndPerception = {
-    "lidar_driver", "voxel_filter", "ndt_scan_matcher", "ground_filter", "euclidean_cluster",
-    "multi_object_tracker", "ekf_localizer"};
+    "lidar_driver",  "voxel_filter",      "ndt_scan_matcher",
+    "ground_filter", "euclidean_cluster", "multi_object_tracker",
+    "ekf_localizer"};
 
-TEST(RunReportTest, StarvedComputerIsDiagnosedCpuBoundAtLocalizationOrPerception) {
+TEST(RunReportTest,
+     StarvedComputerIsDiagnosedCpuBoundAtLocalizationOrPerception) {
   const RunReport r = Analyse(1, 1.0, 14);
-  EXPECT_TRUE(HasCpuBoundAt(r, kLocalizationAndPerception)) << ToJson(r).dump(2);
+  EXPECT_TRUE(HasCpuBoundAt(r, kLocalizationAndPerception))
+      << ToJson(r).dump(2);
   for (const FindingSummary& f : r.findings) {
     EXPECT_FALSE(f.message.empty());
     EXPECT_FALSE(f.remedy.empty());
@@ -52,7 +55,8 @@ TEST(RunReportTest, StarvedComputerIsDiagnosedCpuBoundAtLocalizationOrPerception
 
 TEST(RunReportTest, GenerousComputerIsNotCpuBoundAndDrivesCloseToThePath) {
   const RunReport r = Analyse(16, 2.1, 7);
-  EXPECT_FALSE(HasCpuBoundAt(r, kLocalizationAndPerception)) << ToJson(r).dump(2);
+  EXPECT_FALSE(HasCpuBoundAt(r, kLocalizationAndPerception))
+      << ToJson(r).dump(2);
   EXPECT_TRUE(r.feasible) << ToJson(r).dump(2);
   EXPECT_TRUE(r.deviation_complete);
   // A tracking controller on a good pose stays well within half a lane.
@@ -63,7 +67,8 @@ TEST(RunReportTest, GenerousComputerIsNotCpuBoundAndDrivesCloseToThePath) {
   // not resolve where the run is re-analysed; constraints still evaluate.
   EXPECT_EQ(r.constraints_error, "");
   ASSERT_EQ(r.constraints.size(), 3u);
-  for (const ConstraintStatus& c : r.constraints) EXPECT_TRUE(c.satisfied) << c.expression;
+  for (const ConstraintStatus& c : r.constraints)
+    EXPECT_TRUE(c.satisfied) << c.expression;
   const nlohmann::json j = ToJson(r);
   EXPECT_TRUE(j["metrics"].contains("zigzag_index"));
   EXPECT_EQ(j["point"]["cores"], 16.0);

@@ -8,15 +8,17 @@ namespace adse::sim {
 namespace {
 
 spec::Spec Small() {
-  Result<spec::Spec> spec =
-      spec::LoadSpec(std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml");
+  Result<spec::Spec> spec = spec::LoadSpec(std::string(ADSE_SOURCE_DIR) +
+                                           "/scenarios/robotaxi_small.yaml");
   EXPECT_TRUE(spec.ok()) << spec.status().ToString();
   return std::move(spec).value();
 }
 
-const spec::DesignPoint kPoint = {{"cores", 4}, {"freq_ghz", 2.1}, {"lidar_hz", 7}};
+const spec::DesignPoint kPoint = {
+    {"cores", 4}, {"freq_ghz", 2.1}, {"lidar_hz", 7}};
 
-std::string Key(const spec::Spec& s, const spec::DesignPoint& p = kPoint, uint64_t seed = 3) {
+std::string Key(const spec::Spec& s, const spec::DesignPoint& p = kPoint,
+                uint64_t seed = 3) {
   Result<std::string> key = RunKey(s, p, seed);
   EXPECT_TRUE(key.ok()) << key.status().ToString();
   return key.ok() ? *key : "";
@@ -37,7 +39,8 @@ TEST(RunKeyTest, IgnoresExplorationHarnessAndOutput) {
 TEST(RunKeyTest, ChangesWithWhatChangesARun) {
   const spec::Spec base = Small();
   const std::string key = Key(base);
-  EXPECT_NE(key, Key(base, {{"cores", 16}, {"freq_ghz", 2.1}, {"lidar_hz", 7}}));
+  EXPECT_NE(key,
+            Key(base, {{"cores", 16}, {"freq_ghz", 2.1}, {"lidar_hz", 7}}));
   EXPECT_NE(key, Key(base, kPoint, 4));
   spec::Spec knob = base;
   ASSERT_TRUE(knob.stack.Set("control.rate_hz", 20).ok());
@@ -59,7 +62,8 @@ TEST(RunKeyTest, MissingCalibrationFileIsAnError) {
   s.platform.calibration = "/nonexistent/calibration.json";
   Result<std::string> key = RunKey(s, kPoint, 3);
   ASSERT_FALSE(key.ok());
-  EXPECT_NE(key.status().message().find("platform.calibration"), std::string::npos);
+  EXPECT_NE(key.status().message().find("platform.calibration"),
+            std::string::npos);
 }
 
 }  // namespace

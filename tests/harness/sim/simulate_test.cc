@@ -10,8 +10,8 @@
 #include "analysis/runfile/run_file.h"
 #include "harness/sim/calibration.h"
 #include "harness/spec/spec_parser.h"
-#include "tests/harness/testing/small_scenario.h"
 #include "stack/base/hash.h"
+#include "tests/harness/testing/small_scenario.h"
 
 namespace adse::sim {
 namespace {
@@ -19,9 +19,9 @@ namespace {
 using adse::testing::SmallPoint;
 using adse::testing::SmallScenario;
 
-
 TEST(SimulateTest, GenerousComputerDrivesToTheGoalAtTheNominalControlRate) {
-  Result<runfile::RunData> run = SimulatePoint(SmallScenario(), SmallPoint(16, 2.1, 14));
+  Result<runfile::RunData> run =
+      SimulatePoint(SmallScenario(), SmallPoint(16, 2.1, 14));
   ASSERT_TRUE(run.ok()) << run.status().ToString();
   const auto& m = run->metrics;
   EXPECT_EQ(run->termination_reason, "goal_reached");
@@ -39,8 +39,10 @@ TEST(SimulateTest, GenerousComputerDrivesToTheGoalAtTheNominalControlRate) {
 
 TEST(SimulateTest, StarvedComputerControlsLessOftenAndDropsLidarFrames) {
   const spec::Spec spec = SmallScenario();
-  Result<runfile::RunData> generous = SimulatePoint(spec, SmallPoint(16, 2.1, 14));
-  Result<runfile::RunData> starved = SimulatePoint(spec, SmallPoint(1, 1.0, 14));
+  Result<runfile::RunData> generous =
+      SimulatePoint(spec, SmallPoint(16, 2.1, 14));
+  Result<runfile::RunData> starved =
+      SimulatePoint(spec, SmallPoint(1, 1.0, 14));
   ASSERT_TRUE(generous.ok()) << generous.status().ToString();
   ASSERT_TRUE(starved.ok()) << starved.status().ToString();
   const auto& g = generous->metrics;
@@ -49,28 +51,36 @@ TEST(SimulateTest, StarvedComputerControlsLessOftenAndDropsLidarFrames) {
   EXPECT_GT(s.at("lidar_frames_dropped"), g.at("lidar_frames_dropped"));
   EXPECT_GT(s.at("e2e_latency_p50_s"), g.at("e2e_latency_p50_s"));
   // Slower or not there at all.
-  EXPECT_TRUE(s.at("completed") == 0.0 || s.at("nav_time_s") > g.at("nav_time_s"));
+  EXPECT_TRUE(s.at("completed") == 0.0 ||
+              s.at("nav_time_s") > g.at("nav_time_s"));
 }
 
 TEST(SimulateTest, CountedCostModelGivesIdenticalTraces) {
   spec::Spec spec = SmallScenario();
   // Calibrate from one measured run, then run the counted model twice.
   spec.platform.cost_model = spec::CostModel::kMeasured;
-  Result<runfile::RunData> measured = SimulatePoint(spec, SmallPoint(16, 2.1, 7));
+  Result<runfile::RunData> measured =
+      SimulatePoint(spec, SmallPoint(16, 2.1, 7));
   ASSERT_TRUE(measured.ok()) << measured.status().ToString();
   const Calibration calibration = FitCalibration({&*measured});
-  const std::string path =
-      (std::filesystem::temp_directory_path() / "adse_sim_test_calibration.json").string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            "adse_sim_test_calibration.json")
+                               .string();
   ASSERT_TRUE(WriteCalibration(path, calibration, "test").ok());
   spec.platform.cost_model = spec::CostModel::kCounted;
   spec.platform.calibration = path;
   auto fingerprint = [&](const runfile::RunData& run) {
     ContentHasher h;
     for (const auto& r : run.trace.callbacks) {
-      h.Add(static_cast<long long>(r.callback)).Add(r.start_s).Add(r.end_s).Add(r.cost_s);
+      h.Add(static_cast<long long>(r.callback))
+          .Add(r.start_s)
+          .Add(r.end_s)
+          .Add(r.cost_s);
     }
     for (const auto& e : run.trace.topic_events) {
-      h.Add(static_cast<long long>(e.kind)).Add(static_cast<long long>(e.topic)).Add(e.t_s);
+      h.Add(static_cast<long long>(e.kind))
+          .Add(static_cast<long long>(e.topic))
+          .Add(e.t_s);
     }
     for (const auto& s : run.ego) h.Add(s.x_m).Add(s.y_m).Add(s.v_mps);
     return h.Hex();
@@ -84,10 +94,12 @@ TEST(SimulateTest, CountedCostModelGivesIdenticalTraces) {
 }
 
 TEST(SimulateTest, RunFileIsWrittenAndPassesTheSchemaCheck) {
-  Result<runfile::RunData> run = SimulatePoint(SmallScenario(), SmallPoint(4, 2.1, 7));
+  Result<runfile::RunData> run =
+      SimulatePoint(SmallScenario(), SmallPoint(4, 2.1, 7));
   ASSERT_TRUE(run.ok()) << run.status().ToString();
   const std::string path =
-      (std::filesystem::temp_directory_path() / "adse_sim_test_run.h5").string();
+      (std::filesystem::temp_directory_path() / "adse_sim_test_run.h5")
+          .string();
   ASSERT_TRUE(runfile::WriteRunFile(path, *run).ok());
   std::vector<std::string> problems;
   EXPECT_TRUE(runfile::CheckRunFile(path, &problems).ok());
@@ -99,10 +111,12 @@ TEST(SimulateTest, RunFileIsWrittenAndPassesTheSchemaCheck) {
 }
 
 TEST(SimulateTest, PointOutsideTheSpaceIsRejected) {
-  Result<runfile::RunData> run = SimulatePoint(SmallScenario(), SmallPoint(3, 2.1, 7));
+  Result<runfile::RunData> run =
+      SimulatePoint(SmallScenario(), SmallPoint(3, 2.1, 7));
   ASSERT_FALSE(run.ok());
   EXPECT_EQ(run.status().code(), Status::Code::kInvalidArgument);
-  EXPECT_NE(run.status().message().find("cores"), std::string::npos) << run.status().message();
+  EXPECT_NE(run.status().message().find("cores"), std::string::npos)
+      << run.status().message();
 }
 
 }  // namespace

@@ -354,9 +354,8 @@ TEST(SpecErrorsTest, SlurmExtraArgsAndSignalLead) {
   ExpectError(
       std::string(kHead) + "harness:\n  slurm: {signal_lead_s: 70000}\n",
       "harness.slurm.signal_lead_s", 10);
-  ExpectError(
-      std::string(kHead) + "harness:\n  slurm: {run_estimate_s: 0}\n",
-      "harness.slurm.run_estimate_s", 10);
+  ExpectError(std::string(kHead) + "harness:\n  slurm: {run_estimate_s: 0}\n",
+              "harness.slurm.run_estimate_s", 10);
 }
 
 TEST(SpecErrorsTest, AllErrorsAreCollectedInFileOrder) {

@@ -24,7 +24,8 @@ inline spec::Spec SmallScenario() {
   return std::move(spec).value();
 }
 
-inline spec::DesignPoint SmallPoint(double cores, double freq_ghz, double lidar_hz) {
+inline spec::DesignPoint SmallPoint(double cores, double freq_ghz,
+                                    double lidar_hz) {
   return {{"cores", cores}, {"freq_ghz", freq_ghz}, {"lidar_hz", lidar_hz}};
 }
 

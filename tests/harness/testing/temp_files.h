@@ -12,10 +12,11 @@
 namespace adse::testing {
 
 // An empty folder <tmp>/<prefix>-<name>-<pid>, emptied if it existed.
-inline std::string FreshTempDir(const std::string& prefix, const std::string& name) {
+inline std::string FreshTempDir(const std::string& prefix,
+                                const std::string& name) {
   namespace fs = std::filesystem;
-  const std::string dir = fs::temp_directory_path().string() + "/" + prefix + "-" + name + "-" +
-                          std::to_string(::getpid());
+  const std::string dir = fs::temp_directory_path().string() + "/" + prefix +
+                          "-" + name + "-" + std::to_string(::getpid());
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -30,7 +31,8 @@ inline void WriteRaw(const std::string& path, const std::string& text) {
 // The whole file; empty when it cannot be read.
 inline std::string Slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return std::string(std::istreambuf_iterator<char>(in),
+                     std::istreambuf_iterator<char>());
 }
 
 }  // namespace adse::testing

@@ -18,10 +18,10 @@ TEST(MapFilterTest, KeepsOnlyWhatTheMapDoesNotExplain) {
   // The vehicle stands at (2, 1) facing +y: map x = 2 - y_v, map y = 1 + x_v.
   const world::Pose2 pose{2.0, 1.0, M_PI / 2};
   std::vector<Eigen::Vector3f> scan;
-  scan.emplace_back(0.0f, -8.0f, 1.0f);   // map (10, 1): on the wall
-  scan.emplace_back(0.5f, -8.2f, 1.5f);   // map (10.2, 1.5): on the wall
-  scan.emplace_back(0.0f, -4.0f, 1.0f);   // map (6, 1): a car in front of it
-  scan.emplace_back(9.0f, -8.0f, 1.0f);   // map (10, 10): beyond the wall's end
+  scan.emplace_back(0.0f, -8.0f, 1.0f);  // map (10, 1): on the wall
+  scan.emplace_back(0.5f, -8.2f, 1.5f);  // map (10.2, 1.5): on the wall
+  scan.emplace_back(0.0f, -4.0f, 1.0f);  // map (6, 1): a car in front of it
+  scan.emplace_back(9.0f, -8.0f, 1.0f);  // map (10, 10): beyond the wall's end
   const std::vector<Eigen::Vector3f> kept = filter.Filter(scan, pose);
   ASSERT_EQ(kept.size(), 2u);
   EXPECT_FLOAT_EQ(kept[0].y(), -4.0f);

@@ -24,10 +24,13 @@ TEST(StatusTest, ExitCodesSeparateBadInputFromFailures) {
 }
 
 TEST(HashTest, Sha256MatchesAKnownVectorAndPartsAreDelimited) {
-  EXPECT_EQ(Sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
-  EXPECT_NE(ContentHasher().Add("ab").Add("c").Hex(), ContentHasher().Add("a").Add("bc").Hex());
+  EXPECT_EQ(Sha256Hex("abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_NE(ContentHasher().Add("ab").Add("c").Hex(),
+            ContentHasher().Add("a").Add("bc").Hex());
   EXPECT_EQ(ContentHasher().Add(0.1).Hex(), ContentHasher().Add(0.1).Hex());
-  EXPECT_NE(ContentHasher().Add(0.1).Hex(), ContentHasher().Add(0.1000000001).Hex());
+  EXPECT_NE(ContentHasher().Add(0.1).Hex(),
+            ContentHasher().Add(0.1000000001).Hex());
 }
 
 TEST(RandomTest, SameSeedSameStreamAndDerivedSeedsDiffer) {
@@ -49,7 +52,8 @@ TEST(RandomTest, SameSeedSameStreamAndDerivedSeedsDiffer) {
     sum2 += x * x;
   }
   EXPECT_NEAR(sum / 20000, 1.0, 0.05);
-  EXPECT_NEAR(std::sqrt(sum2 / 20000 - (sum / 20000) * (sum / 20000)), 2.0, 0.05);
+  EXPECT_NEAR(std::sqrt(sum2 / 20000 - (sum / 20000) * (sum / 20000)), 2.0,
+              0.05);
 }
 
 TEST(FilesTest, AtomicWriteReplacesWholeAndLeavesNoTemporary) {
@@ -62,9 +66,11 @@ TEST(FilesTest, AtomicWriteReplacesWholeAndLeavesNoTemporary) {
   ASSERT_TRUE(text.ok());
   EXPECT_EQ(*text, "second");
   int files = 0;
-  for (const auto& e : fs::directory_iterator(dir / "sub")) files += e.is_regular_file();
+  for (const auto& e : fs::directory_iterator(dir / "sub"))
+    files += e.is_regular_file();
   EXPECT_EQ(files, 1);
-  EXPECT_EQ(ReadFile((dir / "missing").string()).status().code(), Status::Code::kNotFound);
+  EXPECT_EQ(ReadFile((dir / "missing").string()).status().code(),
+            Status::Code::kNotFound);
   EXPECT_EQ(ReadFile(path, 3).status().code(), Status::Code::kInvalidArgument);
 }
 

@@ -22,9 +22,11 @@ TEST(KnobDocsTest, EveryKnobIsInTheScenarioReference) {
     const size_t at = doc.find(row_start);
     ASSERT_NE(at, std::string::npos) << knob.path << " is not documented";
     const std::string row = doc.substr(at, doc.find('\n', at) - at);
-    EXPECT_NE(row.find(fmt::format("| {:g} |", knob.default_value)), std::string::npos)
-        << knob.path << ": the documented default differs from " << knob.default_value
-        << "\n" << row;
+    EXPECT_NE(row.find(fmt::format("| {:g} |", knob.default_value)),
+              std::string::npos)
+        << knob.path << ": the documented default differs from "
+        << knob.default_value << "\n"
+        << row;
   }
 }
 

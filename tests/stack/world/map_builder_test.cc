@@ -49,7 +49,8 @@ TEST(MapBuilderTest, GeneratedParkingLotHasTheRequestedSlots) {
   Result<MapArtifacts> map = PrepareMap(Lot(3), FreshCache("slots"));
   ASSERT_TRUE(map.ok()) << map.status().ToString();
   std::ifstream in(map->polygons_path);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string text((std::istreambuf_iterator<char>(in)),
+                   std::istreambuf_iterator<char>());
   size_t slots = 0;
   for (size_t at = text.find("adse.parking_slot"); at != std::string::npos;
        at = text.find("adse.parking_slot", at + 1)) {
@@ -75,7 +76,8 @@ TEST(MapBuilderTest, GivenNetIsKeyedByItsContent) {
   Result<MapArtifacts> generated = PrepareMap(Lot(2), cache);
   ASSERT_TRUE(generated.ok());
   const fs::path copy = fs::temp_directory_path() / "adse_given.net.xml";
-  fs::copy_file(generated->net_path, copy, fs::copy_options::overwrite_existing);
+  fs::copy_file(generated->net_path, copy,
+                fs::copy_options::overwrite_existing);
   MapOptions given;
   given.net_path = copy.string();
   Result<MapArtifacts> a = PrepareMap(given, cache);
@@ -93,7 +95,8 @@ TEST(MapBuilderTest, MissingNetAndUnknownGeneratorAreErrors) {
   missing.net_path = "/nonexistent/town.net.xml";
   Result<MapArtifacts> a = PrepareMap(missing, FreshCache("missing"));
   ASSERT_FALSE(a.ok());
-  EXPECT_NE(a.status().message().find("/nonexistent/town.net.xml"), std::string::npos);
+  EXPECT_NE(a.status().message().find("/nonexistent/town.net.xml"),
+            std::string::npos);
   MapOptions unknown;
   unknown.generator = "roundabout";
   Result<MapArtifacts> b = PrepareMap(unknown, FreshCache("unknown"));

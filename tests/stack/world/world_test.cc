@@ -22,7 +22,9 @@ namespace {
 
 std::string CacheDir() {
   const char* dir = std::getenv("ADSE_CACHE_DIR");
-  return dir ? dir : (std::filesystem::temp_directory_path() / "adse-test-cache").string();
+  return dir ? dir
+             : (std::filesystem::temp_directory_path() / "adse-test-cache")
+                   .string();
 }
 
 // A small parking lot: one aisle between two rows, ring road around it.
@@ -71,7 +73,8 @@ TEST(WorldTest, GeneratedParkingLotLoadsAndIdealPathIsContinuous) {
 TEST(WorldTest, GridMapLoadsAndRoutes) {
   WorldSetup setup;
   setup.world.map.generator = "grid";
-  setup.world.map.generator_params = {{"number", 3}, {"length_m", 100}, {"lanes", 1}};
+  setup.world.map.generator_params = {
+      {"number", 3}, {"length_m", 100}, {"lanes", 1}};
   setup.task.start = Location::OnEdge("A0B0", 10.0);
   setup.task.goal = Location::OnEdge("C1C2", 50.0);
   setup.cache_dir = CacheDir();
@@ -116,7 +119,8 @@ std::string TrafficFingerprint(uint64_t seed) {
     EXPECT_TRUE((*world)->Step(ControlCommand{}).ok());
     if (i % 20 == 0) {
       for (const OtherVehicle& v : (*world)->others()) {
-        text += v.id + ":" + std::to_string(std::lround(v.box.center.x() * 1000)) + "," +
+        text += v.id + ":" +
+                std::to_string(std::lround(v.box.center.x() * 1000)) + "," +
                 std::to_string(std::lround(v.box.center.y() * 1000)) + ";";
       }
     }
@@ -166,7 +170,8 @@ TEST(WorldTest, LidarSeesSumoVehicles) {
   for (int i = 0; i < 400 && seen == nullptr; ++i) {
     ASSERT_TRUE(w.Step(ControlCommand{}).ok());
     for (const OtherVehicle& v : w.others()) {
-      const double d = (v.box.center - Eigen::Vector2d(w.ego().x_m, w.ego().y_m)).norm();
+      const double d =
+          (v.box.center - Eigen::Vector2d(w.ego().x_m, w.ego().y_m)).norm();
       if (d > 8.0 && d < 25.0) seen = &v;
     }
   }
@@ -183,9 +188,12 @@ TEST(WorldTest, LidarSeesSumoVehicles) {
   for (const Eigen::Vector3f& p : with.points) {
     // Sensor frame -> world frame.
     const double c = std::cos(pose.yaw_rad), s = std::sin(pose.yaw_rad);
-    const Eigen::Vector2d world_xy(pose.x_m + c * p.x() - s * p.y(), pose.y_m + s * p.x() + c * p.y());
-    const Eigen::Vector2d local = Eigen::Rotation2Dd(-box.yaw_rad) * (world_xy - box.center);
-    if (std::abs(local.x()) <= box.length_m / 2 + 0.05 && std::abs(local.y()) <= box.width_m / 2 + 0.05 &&
+    const Eigen::Vector2d world_xy(pose.x_m + c * p.x() - s * p.y(),
+                                   pose.y_m + s * p.x() + c * p.y());
+    const Eigen::Vector2d local =
+        Eigen::Rotation2Dd(-box.yaw_rad) * (world_xy - box.center);
+    if (std::abs(local.x()) <= box.length_m / 2 + 0.05 &&
+        std::abs(local.y()) <= box.width_m / 2 + 0.05 &&
         p.z() > -params.mount_height_m + 0.1) {
       ++on_vehicle;
     }
@@ -209,7 +217,9 @@ TEST(WorldTest, MapCloudIsBuiltOnceAndCached) {
 }
 
 TEST(WorldTest, CorruptNetIsReportedWithSumosCause) {
-  const std::string net = (std::filesystem::temp_directory_path() / "adse_corrupt.net.xml").string();
+  const std::string net =
+      (std::filesystem::temp_directory_path() / "adse_corrupt.net.xml")
+          .string();
   std::ofstream(net) << "<net version=\"1.9\">\n  <edge id=\"a\"\n";
   WorldSetup setup;
   setup.world.map.net_path = net;
@@ -220,7 +230,8 @@ TEST(WorldTest, CorruptNetIsReportedWithSumosCause) {
   ASSERT_FALSE(world.ok());
   EXPECT_EQ(world.status().code(), Status::Code::kInvalidArgument);
   EXPECT_NE(world.status().message().find("world.map.net"), std::string::npos);
-  EXPECT_NE(world.status().message().find("adse_corrupt.net.xml"), std::string::npos);
+  EXPECT_NE(world.status().message().find("adse_corrupt.net.xml"),
+            std::string::npos);
   // SUMO's own reason, not a bare "Process Error".
   EXPECT_EQ(world.status().message().find("Process Error"), std::string::npos)
       << world.status().message();
@@ -246,8 +257,8 @@ TEST(WorldTest, UnreachableGoalIsRejected) {
   std::ofstream(dir / "e.edg.xml") << R"(<edges>
   <edge id="ab" from="a" to="b" numLanes="1"/><edge id="cd" from="c" to="d" numLanes="1"/></edges>)";
   const std::string net = (dir / "islands.net.xml").string();
-  ASSERT_EQ(std::system(("netconvert -n " + (dir / "n.nod.xml").string() + " -e " +
-                         (dir / "e.edg.xml").string() + " -o " + net +
+  ASSERT_EQ(std::system(("netconvert -n " + (dir / "n.nod.xml").string() +
+                         " -e " + (dir / "e.edg.xml").string() + " -o " + net +
                          " --offset.disable-normalization true >/dev/null 2>&1")
                             .c_str()),
             0);
