@@ -88,7 +88,8 @@ struct ParetoPlotPoint {
   double nav_time_s = 0.0;
   bool feasible = true;
   bool on_front = false;
-  std::string label;  // written next to front points, e.g. "6c 1.5GHz 7Hz"
+  std::string label;       // written next to front points, e.g. "6c 1.5GHz 7Hz"
+  bool highlight = false;  // ringed, e.g. the cheapest feasible design
 };
 
 struct ParetoPlotOptions {
@@ -97,15 +98,20 @@ struct ParetoPlotOptions {
   // Constraint lines (e.g. nav_time_s <= 400 as a horizontal line at 400).
   std::vector<double> vertical_lines, horizontal_lines;
   std::string title;
+  // Legend names of the front and of highlighted points.
+  std::string front_name = "Pareto front";
+  std::string highlight_name = "cheapest feasible";
 };
 
 // Scatter of all points (feasible: filled circles; infeasible: grey
-// crosses; front points: in the front colour, a cross if infeasible, labelled)
-// with the front joined by a line in x order, constraint lines dashed, linear
-// axes with ticks and labels, a legend, and the title. Points with a non-finite
-// coordinate cannot be placed: they are left out and counted in a note.
-// InvalidArgument for bad options or no finite point; written like
-// RenderTrajectoryImage.
+// crosses; front points: in the front colour, a cross if infeasible) with
+// the front drawn as a staircase in x order (a min-min front promises
+// nothing between its points), highlighted points ringed, constraint lines
+// dashed, linear axes with ticks and labels, a legend, and the title. Front
+// labels are placed where they overlap nothing; a label without room is
+// left out and counted in a note, as are points with a non-finite
+// coordinate. InvalidArgument for bad options or no finite point; written
+// like RenderTrajectoryImage.
 Status RenderParetoPlot(const std::vector<ParetoPlotPoint>& points,
                         const std::string& png_path,
                         const ParetoPlotOptions& o = {});

@@ -109,6 +109,14 @@ std::optional<EvaluationRow> RecordedRow(const spec::Spec& spec,
 Status WriteCampaignViews(const spec::Spec& spec,
                           const CampaignSummary& summary);
 
+// The views that answer the question (summary.json, report.md, pareto.png),
+// led by the headline (harness/campaign/headline.h), written into `dir`;
+// `image_dir` is where the rows' trajectory pictures are, relative to
+// `dir`. WriteCampaignViews writes them into the campaign folder; adse
+// analyze into an analysis version.
+Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
+                        const std::string& dir, const std::string& image_dir);
+
 }  // namespace adse::campaign
 
 #endif  // ADSE_HARNESS_CAMPAIGN_CAMPAIGN_H_

@@ -11,9 +11,9 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "analysis/pictures/pictures.h"
 #include "analysis/runfile/campaign_file.h"
 #include "harness/campaign/campaign.h"
+#include "harness/campaign/headline.h"
 #include "harness/campaign/run_store.h"
 #include "harness/llm/exchange_log.h"
 #include "harness/llm/llm_strategy.h"
@@ -152,10 +152,14 @@ std::string LlmMarkdown(const LlmRecords& llm) {
 }
 
 std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
+                           const Headline& headline,
+                           const std::string& image_dir,
                            const LlmRecords* llm) {
   const auto& rows = s.exploration.evaluations;
   std::ostringstream md;
   md << "# Campaign: " << spec.name << "\n\n";
+  md << HeadlineMarkdown(spec, rows, headline, image_dir);
+  md << "## Campaign\n\n";
   md << fmt::format("- scenario: `{}`\n", spec.source_path);
   md << fmt::format(
       "- strategy: `{}` (exploration.seed {}), budget {}: {} evaluations, {} "
@@ -199,7 +203,8 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
     }
   }
   const std::set<int> front(s.pareto_front.begin(), s.pareto_front.end());
-  md << "## Pareto front (" << front.size() << " points)\n\n";
+  md << fmt::format("## Pareto front over {} ({} points)\n\n",
+                    fmt::join(objectives, ", "), front.size());
   md << "Constraint-aware and non-dominated over the objectives; infeasible "
         "points appear only when nothing is feasible.\n\n";
   md << "| # | point | " << fmt::format("{}", fmt::join(columns, " | "))
@@ -212,8 +217,8 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
        << spec::FormatPoint(spec.design_space, row.point) << " | ";
     for (const std::string& c : columns)
       md << Number(RowMetric(row, c)) << " | ";
-    md << (row.feasible ? "yes" : "no") << " | [png](images/" << row.content_key
-       << "/trajectory.png) |\n";
+    md << (row.feasible ? "yes" : "no") << " | [png](" << image_dir << "/"
+       << row.content_key << "/trajectory.png) |\n";
   }
 
   md << "\n## Iterations\n\nEach round's proposal and the strategy's "
@@ -310,8 +315,20 @@ Status WriteCampaignViews(const spec::Spec& spec,
   ADSE_RETURN_IF_ERROR(
       runfile::WriteCampaignIndex(folder.Path("campaign.h5"), index));
 
+  return WriteAnswerViews(spec, summary, folder.root(), "images");
+}
+
+Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
+                        const std::string& dir, const std::string& image_dir) {
+  const CampaignFolder folder(dir);
+  const auto& rows = summary.exploration.evaluations;
+  std::optional<LlmRecords> llm;
+  if (spec.exploration.strategy == "llm") {
+    llm = LoadLlmRecords(summary.output_dir);
+  }
   // The front is recomputed so that views written mid-campaign are right.
-  const std::vector<int> front = ParetoFrontOf(spec, rows);
+  const Headline headline = ComputeHeadline(spec, rows);
+  const std::vector<int>& front = headline.front;
   CampaignSummary current = summary;
   current.pareto_front = front;
 
@@ -337,6 +354,13 @@ Status WriteCampaignViews(const spec::Spec& spec,
     j["objectives"].push_back({{"metric", o.metric}, {"minimize", o.minimize}});
   }
   j["constraints"] = spec.constraints;
+  auto row_or_null = [&](int i) {
+    return i < 0 ? nlohmann::json() : RowJson(spec, rows[i]);
+  };
+  j["answer"] = {{"cheapest_feasible", row_or_null(headline.cheapest)},
+                 {"fastest_feasible", row_or_null(headline.fastest)},
+                 {"knee", row_or_null(headline.knee)},
+                 {"cost_time_front", headline.cost_time_front}};
   j["pareto_front"] = nlohmann::json::array();
   for (int i : front) j["pareto_front"].push_back(RowJson(spec, rows[i]));
   j["evaluations"] = nlohmann::json::array();
@@ -368,29 +392,17 @@ Status WriteCampaignViews(const spec::Spec& spec,
       j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"));
   ADSE_RETURN_IF_ERROR(
       WriteFileAtomic(folder.Path("report.md"),
-                      ReportMarkdown(spec, current, llm ? &*llm : nullptr)));
+                      ReportMarkdown(spec, current, headline, image_dir,
+                                     llm ? &*llm : nullptr)));
 
-  std::vector<analysis::ParetoPlotPoint> plot;
-  const std::set<int> on_front(front.begin(), front.end());
-  for (size_t i = 0; i < rows.size(); ++i) {
-    const double cost = RowMetric(rows[i], "hardware_cost");
-    const double nav = RowMetric(rows[i], "nav_time_s");
-    if (!std::isfinite(cost) || !std::isfinite(nav)) continue;
-    const bool front_point = on_front.count(static_cast<int>(i)) > 0;
-    plot.push_back({cost, nav, rows[i].feasible, front_point,
-                    front_point
-                        ? spec::FormatPoint(spec.design_space, rows[i].point)
-                        : std::string()});
-  }
-  if (!plot.empty()) {
-    analysis::ParetoPlotOptions options;
-    options.title =
-        fmt::format("{}: {} evaluations, {} on the front ({})", spec.name,
-                    rows.size(), front.size(), spec.exploration.strategy);
-    // The picture is a convenience: a plot that cannot be drawn (e.g. no
-    // finite point) leaves the other views intact.
-    (void)analysis::RenderParetoPlot(plot, folder.Path("pareto.png"), options);
-  }
+  // The picture is a convenience: a plot that cannot be drawn (e.g. no
+  // finite point) leaves the other views intact.
+  (void)RenderFrontPicture(
+      spec, rows, headline,
+      fmt::format("{}: {} evaluations, {} on the cost-time front ({})",
+                  spec.name, rows.size(), headline.cost_time_front.size(),
+                  spec.exploration.strategy),
+      folder.Path("pareto.png"));
   return Status::Ok();
 }
 

@@ -1,6 +1,7 @@
 // adse analyze: recompute metrics, deviation, diagnosis, pictures and the
-// Pareto front from stored run files, into a new analysis version next to
-// them; or compare two analysis versions.
+// answer (headline and front) from stored run files, into a new analysis
+// version (a campaign's under <campaign>/analysis/vN, a single run file's
+// next to it); or compare two campaigns or analysis versions.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -11,9 +12,12 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "analysis/pareto/pareto.h"
-#include "analysis/pictures/pictures.h"
+#include "analysis/runfile/campaign_file.h"
 #include "analysis/runfile/run_file.h"
+#include "harness/campaign/campaign.h"
+#include "harness/campaign/evaluation.h"
+#include "harness/campaign/headline.h"
+#include "harness/campaign/run_store.h"
 #include "harness/cli/commands.h"
 #include "harness/report/run_report.h"
 #include "harness/spec/spec_parser.h"
@@ -59,48 +63,47 @@ std::vector<std::string> RunFilesIn(const fs::path& folder) {
   return out;
 }
 
-// Objectives in minimisation form from the scenario stored in the runs.
-struct ObjectiveSet {
-  std::vector<std::string> names;
-  std::vector<bool> maximize;
-};
-
-ObjectiveSet ObjectivesOf(const runfile::RunData& run) {
-  ObjectiveSet set;
-  Result<spec::Spec> spec =
-      spec::ParseSpec(run.scenario_text, "stored scenario", ".");
-  if (spec.ok()) {
-    for (const spec::Objective& o : spec->objectives) {
-      set.names.push_back(o.metric);
-      set.maximize.push_back(!o.minimize);
-    }
-  }
-  if (set.names.empty())
-    set = {{"hardware_cost", "nav_time_s"}, {false, false}};
-  return set;
-}
-
 Status WriteJson(const std::string& path, const nlohmann::json& doc) {
   return WriteFileAtomic(path, doc.dump(2) + "\n");
 }
 
 int Diff(const std::string& a_path, const std::string& b_path, bool json) {
+  // A campaign root or an analysis version: its summary.json, whose
+  // evaluations are the runs and pareto_front says which are on the front;
+  // a single run's version: its report.json.
   auto load = [](const std::string& dir) -> std::optional<nlohmann::json> {
     for (const char* name : {"summary.json", "report.json"}) {
       const fs::path p = fs::path(dir) / name;
       Result<std::string> text = ReadFile(p.string());
       if (!text.ok()) continue;
       nlohmann::json doc = nlohmann::json::parse(*text, nullptr, false);
-      if (doc.is_discarded()) {
+      if (doc.is_discarded() || !doc.is_object()) {
         std::fprintf(stderr, "error: %s: not valid JSON\n", p.string().c_str());
         return std::nullopt;
       }
-      if (doc.contains("runs")) return doc;
-      return nlohmann::json{{"runs", nlohmann::json::array({doc})}};
+      if (doc.contains("evaluations") && doc["evaluations"].is_array()) {
+        std::set<std::string> front;
+        for (const auto& r : doc.value("pareto_front", nlohmann::json::array()))
+          front.insert(r.value("content_key", ""));
+        nlohmann::json runs = nlohmann::json::array();
+        for (nlohmann::json r : doc["evaluations"]) {
+          r["on_front"] = front.count(r.value("content_key", "")) > 0;
+          runs.push_back(r);
+        }
+        return nlohmann::json{{"runs", runs}};
+      }
+      if (doc.contains("point")) {
+        return nlohmann::json{{"runs", nlohmann::json::array({doc})}};
+      }
+      std::fprintf(stderr,
+                   "error: %s: neither a campaign summary (evaluations) nor "
+                   "a run report (point)\n",
+                   p.string().c_str());
+      return std::nullopt;
     }
     std::fprintf(stderr,
-                 "error: %s: no summary.json or report.json (expected an "
-                 "analysis version folder)\n",
+                 "error: %s: no summary.json or report.json (expected a "
+                 "campaign folder or an analysis version folder)\n",
                  dir.c_str());
     return std::nullopt;
   };
@@ -110,7 +113,7 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
     std::string k;
     for (const auto& [name, value] : r["point"].items())
       k += fmt::format("{}={} ", name, value.dump());
-    return k + "seed=" + r["seed"].dump();
+    return k;
   };
   std::map<std::string, nlohmann::json> in_a, in_b;
   for (const auto& r : (*a)["runs"]) in_a[key(r)] = r;
@@ -134,8 +137,11 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
         change["on_front"] = {ra.value("on_front", false),
                               rb.value("on_front", false)};
       }
-      for (const auto& [m, va] : ra["metrics"].items()) {
-        const auto vb = rb["metrics"].value(m, nlohmann::json(nullptr));
+      const nlohmann::json none = nlohmann::json::object();
+      const nlohmann::json& ma = ra.contains("metrics") ? ra["metrics"] : none;
+      const nlohmann::json& mb = rb.contains("metrics") ? rb["metrics"] : none;
+      for (const auto& [m, va] : ma.items()) {
+        const auto vb = mb.value(m, nlohmann::json(nullptr));
         if (va.is_number() && vb.is_number()) {
           const double x = va.get<double>(), y = vb.get<double>();
           if (std::abs(x - y) > 1e-9 * std::max(1.0, std::abs(x)))
@@ -160,6 +166,181 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
               b_path.c_str(), changes.size(), keys.size());
   for (const auto& c : changes) std::printf("  %s\n", c.dump().c_str());
   return 0;
+}
+
+// A folder: a campaign (its campaign.h5 names the runs and holds the
+// scenario) or loose run files of one scenario. Every run is analysed
+// again and the answer views are written by the code adse run uses, into
+// <folder>/analysis/vN; the run files are never touched.
+int AnalyzeFolder(const std::string& target,
+                  const report::AnalyzeOptions& base_options, bool json) {
+  const campaign::CampaignFolder folder(target);
+  std::optional<runfile::CampaignIndex> index;
+  std::error_code ec;
+  if (fs::exists(folder.Path("campaign.h5"), ec)) {
+    Result<runfile::CampaignIndex> read =
+        runfile::ReadCampaignIndex(folder.Path("campaign.h5"));
+    if (!read.ok()) {
+      std::fprintf(stderr,
+                   "error: %s: %s (adse run or adse index rebuilds it from "
+                   "the run files)\n",
+                   folder.Path("campaign.h5").c_str(),
+                   read.status().message().c_str());
+      return 2;
+    }
+    index = std::move(*read);
+  }
+  // The runs to analyse, each with the row it had (bookkeeping kept).
+  struct Item {
+    campaign::EvaluationRow row;
+    std::string file;  // empty: a failed run, kept as recorded
+  };
+  std::vector<Item> items;
+  std::string scenario_text, scenario_source;
+  if (index) {
+    scenario_text = index->scenario_text;
+    scenario_source = folder.Path("campaign.h5") + " (stored scenario)";
+    for (const campaign::EvaluationRow& row : index->evaluations) {
+      items.push_back({row, row.status == "complete"
+                                ? folder.RunPath(row.content_key)
+                                : std::string()});
+    }
+  } else {
+    for (const std::string& file : RunFilesIn(target)) {
+      campaign::EvaluationRow row;
+      row.index = static_cast<int64_t>(items.size());
+      row.source = "recorded";
+      items.push_back({row, file});
+    }
+  }
+  if (items.empty()) {
+    std::fprintf(stderr, "error: %s: no run files (*.h5) in it\n",
+                 target.c_str());
+    return 2;
+  }
+  int exit_code = 0;
+  std::vector<std::pair<Item, runfile::RunData>> loaded;
+  // Rows taken as the campaign recorded them: failed runs, and runs whose
+  // file cannot be read (so the campaign's front stays whole).
+  std::vector<campaign::EvaluationRow> recorded_rows;
+  int unreadable = 0;
+  for (Item& item : items) {
+    if (item.file.empty()) {
+      recorded_rows.push_back(item.row);
+      continue;
+    }
+    Result<runfile::RunData> run = runfile::ReadRunFile(item.file);
+    if (!run.ok()) {
+      // A broken file never stops the rest.
+      std::fprintf(stderr, "skipped %s: %s\n", item.file.c_str(),
+                   run.status().message().c_str());
+      exit_code = 2;
+      ++unreadable;
+      if (index) recorded_rows.push_back(item.row);
+      continue;
+    }
+    if (scenario_text.empty()) {
+      scenario_text = run->scenario_text;
+      scenario_source = item.file + " (stored scenario)";
+    } else if (!index && run->scenario_text != scenario_text) {
+      std::fprintf(stderr,
+                   "skipped %s: a different scenario than %s; analyse "
+                   "the folders of different scenarios separately\n",
+                   item.file.c_str(), scenario_source.c_str());
+      exit_code = 2;
+      continue;
+    }
+    loaded.emplace_back(std::move(item), std::move(*run));
+  }
+  if (loaded.empty() && !index) {
+    std::fprintf(stderr, "error: %s: none of its %zu run files could be read\n",
+                 target.c_str(), items.size());
+    return 2;
+  }
+  spec::ParseOptions parse;
+  parse.check_files = false;  // the front needs only the stored text
+  Result<spec::Spec> spec =
+      spec::ParseSpec(scenario_text, scenario_source, ".", parse);
+  if (!spec.ok()) {
+    std::fprintf(stderr, "error: %s: the stored scenario does not parse:\n%s\n",
+                 scenario_source.c_str(), spec.status().message().c_str());
+    return 2;
+  }
+  const std::string version = NextVersion(fs::path(target) / "analysis");
+  if (Status s = MakeDirs(version + "/reports"); !s.ok()) {
+    std::fprintf(stderr, "error: %s\n", s.message().c_str());
+    return 1;
+  }
+  std::vector<campaign::EvaluationRow> rows;
+  for (auto& [item, run] : loaded) {
+    report::AnalyzeOptions options = base_options;
+    const std::string key = run.content_key.empty()
+                                ? fs::path(item.file).stem().string()
+                                : run.content_key;
+    options.image_dir = version + "/images/" + key;
+    if (Status s = MakeDirs(options.image_dir); !s.ok()) {
+      std::fprintf(stderr, "error: %s\n", s.message().c_str());
+      return 1;
+    }
+    Result<report::RunReport> report =
+        report::AnalyzeRun(run, item.file, options);
+    if (!report.ok()) {
+      std::fprintf(stderr, "error: %s: %s\n", item.file.c_str(),
+                   report.status().message().c_str());
+      fs::remove_all(version, ec);
+      return ExitCodeFor(report.status());
+    }
+    if (Status s = WriteJson(version + "/reports/" + key + ".json",
+                             report::ToJson(*report));
+        !s.ok()) {
+      std::fprintf(stderr, "error: %s\n", s.message().c_str());
+      return 1;
+    }
+    campaign::EvaluationRow row = campaign::RowFromReport(*report);
+    row.index = item.row.index;
+    row.iteration = item.row.iteration;
+    row.source = item.row.source;
+    row.attempts = item.row.attempts;
+    row.wall_s = item.row.wall_s;
+    rows.push_back(std::move(row));
+  }
+  rows.insert(rows.end(), recorded_rows.begin(), recorded_rows.end());
+  std::sort(rows.begin(), rows.end(),
+            [](const auto& a, const auto& b) { return a.index < b.index; });
+
+  campaign::CampaignSummary summary;
+  summary.output_dir = target;
+  summary.strategy = index ? index->strategy : spec->exploration.strategy;
+  summary.isolation = index ? index->isolation : std::string();
+  summary.exploration.evaluations = rows;
+  if (index) summary.exploration.iterations = index->iterations;
+  for (const campaign::EvaluationRow& row : rows) {
+    summary.failed += row.status != "complete";
+    summary.reused += row.status == "complete";
+  }
+  if (Status s = campaign::WriteAnswerViews(*spec, summary, version, "images");
+      !s.ok()) {
+    std::fprintf(stderr, "error: %s\n", s.message().c_str());
+    return 1;
+  }
+  if (json) {
+    Result<std::string> text = ReadFile(version + "/summary.json");
+    std::printf("%s", text.ok() ? text->c_str() : "{}\n");
+  } else {
+    std::printf("%s: %zu runs analysed", target.c_str(), loaded.size());
+    if (unreadable > 0 && index) {
+      std::printf(
+          ", %d kept as campaign.h5 recorded them (run file unreadable)",
+          unreadable);
+    }
+    std::printf("\n");
+    std::printf("%s", campaign::HeadlineText(
+                          *spec, rows, campaign::ComputeHeadline(*spec, rows))
+                          .c_str());
+    std::printf("wrote %s (report.md, summary.json, pareto.png)\n",
+                version.c_str());
+  }
+  return exit_code;
 }
 
 }  // namespace
@@ -191,121 +372,49 @@ int RunAnalyze(const AnalyzeArgs& args) {
   int exit_code = 0;
   for (const std::string& target : args.targets) {
     std::error_code ec;
-    const bool folder = fs::is_directory(target, ec);
-    if (!folder && !fs::exists(target, ec)) {
+    if (fs::is_directory(target, ec)) {
+      exit_code =
+          std::max(exit_code, AnalyzeFolder(target, options, args.json));
+      continue;
+    }
+    if (!fs::exists(target, ec)) {
       std::fprintf(stderr, "error: %s: no such file or folder\n",
                    target.c_str());
       exit_code = 2;
       continue;
     }
-    const std::vector<std::string> files =
-        folder ? RunFilesIn(target) : std::vector<std::string>{target};
-    if (files.empty()) {
-      std::fprintf(stderr, "error: %s: no run files (*.h5) in it\n",
-                   target.c_str());
+    const std::string& file = target;
+    Result<runfile::RunData> run = runfile::ReadRunFile(file);
+    if (!run.ok()) {
+      std::fprintf(stderr, "error: %s: %s\n", file.c_str(),
+                   run.status().message().c_str());
       exit_code = 2;
       continue;
     }
-    nlohmann::json summary = {{"analysis_of", target},
-                              {"runs", nlohmann::json::array()}};
-    std::vector<analysis::Evaluation> evals;
-    std::vector<nlohmann::json*> rows;
-    std::optional<ObjectiveSet> objectives;
-    for (const std::string& file : files) {
-      Result<runfile::RunData> run = runfile::ReadRunFile(file);
-      if (!run.ok()) {
-        // A broken file never stops the rest.
-        std::fprintf(stderr, "skipped %s: %s\n", file.c_str(),
-                     run.status().message().c_str());
-        exit_code = 2;
-        continue;
-      }
-      const std::string version =
-          NextVersion(file.substr(0, file.size() - 3) + ".analysis");
-      options.image_dir = version;
-      if (Status s = MakeDirs(version); !s.ok()) {
-        std::fprintf(stderr, "error: %s\n", s.message().c_str());
-        return 1;
-      }
-      Result<report::RunReport> report =
-          report::AnalyzeRun(*run, file, options);
-      if (!report.ok()) {
-        std::fprintf(stderr, "error: %s: %s\n", file.c_str(),
-                     report.status().message().c_str());
-        fs::remove_all(version, ec);
-        return ExitCodeFor(report.status());
-      }
-      const nlohmann::json doc = report::ToJson(*report);
-      if (Status s = WriteJson(version + "/report.json", doc); !s.ok()) {
-        std::fprintf(stderr, "error: %s\n", s.message().c_str());
-        return 1;
-      }
-      if (!folder) {
-        if (args.json) {
-          std::printf("%s\n", doc.dump(2).c_str());
-        } else {
-          std::printf("%s\n%swrote %s\n", file.c_str(),
-                      report::FormatSummary(*report).c_str(), version.c_str());
-        }
-        continue;
-      }
-      if (!objectives) objectives = ObjectivesOf(*run);
-      analysis::Evaluation e;
-      e.point = report->point;
-      e.feasible = report->feasible;
-      for (size_t i = 0; i < objectives->names.size(); ++i) {
-        auto it = report->metrics.find(objectives->names[i]);
-        double v = it == report->metrics.end() ? NAN : it->second;
-        if (!std::isfinite(v)) e.feasible = false, v = 1e300;
-        e.objectives.push_back(objectives->maximize[i] ? -v : v);
-      }
-      evals.push_back(e);
-      summary["runs"].push_back(doc);
-    }
-    if (!folder || evals.empty()) continue;
-    const std::vector<int> front = analysis::ParetoFront(evals);
-    std::set<int> on_front(front.begin(), front.end());
-    std::vector<analysis::ParetoPlotPoint> plot;
-    for (size_t i = 0; i < evals.size(); ++i) {
-      nlohmann::json& r = summary["runs"][i];
-      r["on_front"] = on_front.count(static_cast<int>(i)) > 0;
-      const auto& m = r["metrics"];
-      if (m.value("hardware_cost", nlohmann::json()).is_number() &&
-          m.value("nav_time_s", nlohmann::json()).is_number()) {
-        plot.push_back(
-            {m["hardware_cost"].get<double>(), m["nav_time_s"].get<double>(),
-             r["feasible"].get<bool>(), r["on_front"].get<bool>(), ""});
-      }
-    }
-    summary["objectives"] = objectives->names;
-    summary["pareto_front_size"] = front.size();
-    const std::string version = NextVersion(fs::path(target) / "analysis");
+    const std::string version =
+        NextVersion(file.substr(0, file.size() - 3) + ".analysis");
+    options.image_dir = version;
     if (Status s = MakeDirs(version); !s.ok()) {
       std::fprintf(stderr, "error: %s\n", s.message().c_str());
       return 1;
     }
-    if (!plot.empty()) {
-      analysis::ParetoPlotOptions plot_options;
-      plot_options.title =
-          fmt::format("{} runs, {} on the front", evals.size(), front.size());
-      if (analysis::RenderParetoPlot(plot, version + "/pareto.png",
-                                     plot_options)
-              .ok()) {
-        summary["images"]["pareto"] = version + "/pareto.png";
-      }
+    Result<report::RunReport> report = report::AnalyzeRun(*run, file, options);
+    if (!report.ok()) {
+      std::fprintf(stderr, "error: %s: %s\n", file.c_str(),
+                   report.status().message().c_str());
+      fs::remove_all(version, ec);
+      return ExitCodeFor(report.status());
     }
-    if (Status s = WriteJson(version + "/summary.json", summary); !s.ok()) {
+    const nlohmann::json doc = report::ToJson(*report);
+    if (Status s = WriteJson(version + "/report.json", doc); !s.ok()) {
       std::fprintf(stderr, "error: %s\n", s.message().c_str());
       return 1;
     }
     if (args.json) {
-      std::printf("%s\n", summary.dump(2).c_str());
+      std::printf("%s\n", doc.dump(2).c_str());
     } else {
-      std::printf(
-          "%s: %zu runs analysed, %zu on the Pareto front (%s)\nwrote %s\n",
-          target.c_str(), evals.size(), front.size(),
-          fmt::format("{}", fmt::join(objectives->names, ", ")).c_str(),
-          version.c_str());
+      std::printf("%s\n%swrote %s\n", file.c_str(),
+                  report::FormatSummary(*report).c_str(), version.c_str());
     }
   }
   return exit_code;

@@ -5,6 +5,7 @@
 // 2 bad input.
 #include <cstdio>
 
+#include "harness/campaign/headline.h"
 #include "harness/cli/commands.h"
 #include "harness/slurm/sweep.h"
 #include "stack/base/files.h"
@@ -12,8 +13,9 @@
 namespace adse::cli {
 
 int RunIndex(const IndexArgs& args) {
+  spec::Spec spec;
   Result<campaign::CampaignSummary> summary =
-      slurm::BuildSweepIndex(args.campaign);
+      slurm::BuildSweepIndex(args.campaign, &spec);
   if (!summary.ok()) {
     std::fprintf(stderr, "error: %s\n", summary.status().message().c_str());
     return ExitCodeFor(summary.status());
@@ -23,11 +25,14 @@ int RunIndex(const IndexArgs& args) {
     Result<std::string> text = ReadFile(s.output_dir + "/summary.json");
     std::printf("%s", text.ok() ? text->c_str() : "{}\n");
   } else {
-    std::printf(
-        "%s: %zu evaluations (%d simulated, %d reused, %d failed), %zu on "
-        "the Pareto front\nreport: %s/report.md\n",
-        s.output_dir.c_str(), s.exploration.evaluations.size(), s.simulated,
-        s.reused, s.failed, s.pareto_front.size(), s.output_dir.c_str());
+    const auto& rows = s.exploration.evaluations;
+    std::printf("%s: %zu evaluations (%d simulated, %d reused, %d failed)\n",
+                s.output_dir.c_str(), rows.size(), s.simulated, s.reused,
+                s.failed);
+    std::printf("%s", campaign::HeadlineText(
+                          spec, rows, campaign::ComputeHeadline(spec, rows))
+                          .c_str());
+    std::printf("report: %s/report.md\n", s.output_dir.c_str());
   }
   if (s.unfinished > 0) {
     std::fprintf(stderr,

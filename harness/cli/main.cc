@@ -145,7 +145,8 @@ int main(int argc, char** argv) {
       "--retry-failed", run.retry_failed,
       "Run again points whose runs failed for good in an earlier session");
   run_cmd->add_flag("-q,--quiet", run.quiet,
-                    "Only failures and errors on stderr");
+                    "No progress on stderr, only failures and errors; the "
+                    "answer is still printed");
   run_cmd->add_flag("--json", run.json,
                     "Print summary.json on stdout at the end");
   run_cmd

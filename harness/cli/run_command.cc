@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/campaign/campaign.h"
+#include "harness/campaign/headline.h"
 #include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
 #include "harness/slurm/allocation.h"
@@ -216,24 +217,17 @@ int RunRun(const RunArgs& args) {
   if (args.json) {
     Result<std::string> text = ReadFile(s.output_dir + "/summary.json");
     std::printf("%s", text.ok() ? text->c_str() : "{}\n");
-  } else if (!args.quiet) {
+  } else {
     std::printf(
         "%s: %zu evaluations (%d simulated, %d reused, %d failed) in %s with "
         "%d "
         "worker(s)\n",
         spec->name.c_str(), s.exploration.evaluations.size(), s.simulated,
         s.reused, s.failed, Eta(s.wall_s).c_str(), s.workers);
-    std::printf("Pareto front (%zu):\n", s.pareto_front.size());
-    for (int i : s.pareto_front) {
-      const campaign::EvaluationRow& row =
-          s.exploration.evaluations[static_cast<size_t>(i)];
-      std::printf("  %-36s cost %6.3g  nav %6.1f s  ctrl %5.1f Hz%s\n",
-                  spec::FormatPoint(spec->design_space, row.point).c_str(),
-                  campaign::RowMetric(row, "hardware_cost"),
-                  campaign::RowMetric(row, "nav_time_s"),
-                  campaign::RowMetric(row, "ctrl_rate_hz"),
-                  row.feasible ? "" : "  (infeasible)");
-    }
+    const auto& rows = s.exploration.evaluations;
+    std::printf("%s", campaign::HeadlineText(
+                          *spec, rows, campaign::ComputeHeadline(*spec, rows))
+                          .c_str());
     std::printf("report: %s/report.md\n", s.output_dir.c_str());
   }
   if (s.interrupted_by != 0) {

@@ -154,7 +154,7 @@ Result<ShardSummary> RunShard(const ShardOptions& options) {
 }
 
 Result<campaign::CampaignSummary> BuildSweepIndex(
-    const std::string& campaign_dir) {
+    const std::string& campaign_dir, spec::Spec* spec_out) {
   Result<LoadedPlan> loaded = LoadPlan(campaign_dir, 0, SIZE_MAX);
   if (!loaded.ok()) return loaded.status();
   const SweepPlan& plan = loaded->plan;
@@ -233,6 +233,7 @@ Result<campaign::CampaignSummary> BuildSweepIndex(
   summary.pareto_front =
       campaign::ParetoFrontOf(spec, summary.exploration.evaluations);
   ADSE_RETURN_IF_ERROR(campaign::WriteCampaignViews(spec, summary));
+  if (spec_out != nullptr) *spec_out = spec;
   return summary;
 }
 

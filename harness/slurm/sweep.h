@@ -50,9 +50,10 @@ Result<ShardSummary> RunShard(const ShardOptions& options);
 // Rebuilds campaign.h5, report.md, summary.json and pareto.png of a
 // planned sweep from the run files and failure records in the folder, in
 // plan order; points without either are counted in `unfinished` and named
-// in the report. Takes the campaign lock while it writes.
+// in the report. Takes the campaign lock while it writes. `spec`, when not
+// null, receives the planned scenario (for the headline).
 Result<campaign::CampaignSummary> BuildSweepIndex(
-    const std::string& campaign_dir);
+    const std::string& campaign_dir, spec::Spec* spec = nullptr);
 
 }  // namespace adse::slurm
 

@@ -308,6 +308,32 @@ TEST_F(PictureTest, ParetoPlotRendersPointsFrontAndConstraints) {
   EXPECT_EQ(CountColour(*plain, kConstraintRgb), 0);
 }
 
+TEST_F(PictureTest, ParetoPlotKeepsTheFrontReadableBelowFarOutliers) {
+  // Feasible designs between 30 and 80 s and one timeout at 6000 s: drawn
+  // to scale, the feasible dots would share a few rows at the bottom.
+  std::vector<ParetoPlotPoint> points = {{2, 6000, false, false, ""}};
+  for (int i = 0; i < 6; ++i) {
+    points.push_back({3.0 + i, 80.0 - 10.0 * i, true, false, ""});
+  }
+  ASSERT_TRUE(RenderParetoPlot(points, Path("outlier.png")).ok());
+  Result<RgbImage> img = ReadImage(Path("outlier.png"));
+  ASSERT_TRUE(img.ok());
+  // Rows with a feasible dot: six separate dots of about 9 rows each (and
+  // the legend's sample); squashed, they would share about a dozen rows.
+  int rows_with_dots = 0;
+  for (int r = 0; r < img->height_px; ++r) {
+    for (int c = 0; c < img->width_px; ++c) {
+      if (img->At(c, r) == kFeasibleRgb) {
+        ++rows_with_dots;
+        break;
+      }
+    }
+  }
+  EXPECT_GT(rows_with_dots, 40);
+  // The timeout is still shown, as an arrow on the top edge.
+  EXPECT_GT(CountColour(*img, kInfeasibleRgb), 5);
+}
+
 TEST_F(PictureTest, ParetoPlotEdgeCases) {
   // One point; equal values; non-finite points left out with a note.
   EXPECT_TRUE(

@@ -205,9 +205,18 @@ TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
   EXPECT_NE(first.out.find("1 runs analysed"), std::string::npos) << first.out;
   ASSERT_TRUE(fs::exists(dir / "analysis" / "v1" / "summary.json"));
   EXPECT_TRUE(fs::exists(dir / "analysis" / "v1" / "pareto.png"));
-  EXPECT_TRUE(fs::exists(dir / "runs" / "a.analysis" / "v1" / "report.json"));
-  EXPECT_TRUE(
-      fs::exists(dir / "runs" / "a.analysis" / "v1" / "trajectory.png"));
+  EXPECT_TRUE(fs::exists(dir / "analysis" / "v1" / "report.md"));
+  // Per-run reports and pictures go into the version, never beside the runs.
+  int reports = 0;
+  for (const auto& entry :
+       fs::directory_iterator(dir / "analysis" / "v1" / "reports")) {
+    ++reports;
+    const std::string key = entry.path().stem().string();
+    EXPECT_TRUE(fs::exists(dir / "analysis" / "v1" / "images" / key /
+                           "trajectory.png"));
+  }
+  EXPECT_EQ(reports, 1);
+  EXPECT_FALSE(fs::exists(dir / "runs" / "a.analysis"));
   // Raw data is never rewritten; a second analysis is a new version.
   const auto raw_time = fs::last_write_time(dir / "runs" / "a.h5");
   Adse("analyze " + dir.string() + " --threshold frequency_bound_fraction=0.5");
@@ -300,6 +309,56 @@ TEST(CliRunTest,
       << run.out;
   EXPECT_NE(run.out.find("ollama serve"), std::string::npos) << run.out;
   EXPECT_TRUE(fs::exists(out + "/llm/exchanges.jsonl"));
+}
+
+// The front as printed: the "Pareto front over" line and its indented rows.
+std::string FrontSection(const std::string& out) {
+  size_t at = out.find("Pareto front over");
+  if (at == std::string::npos) return "";
+  std::string section;
+  do {
+    const size_t end = out.find('\n', at);
+    section += out.substr(at, end - at) + "\n";
+    at = end + 1;
+  } while (at < out.size() && out.compare(at, 2, "  ") == 0);
+  return section;
+}
+
+TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
+  const fs::path out = fs::temp_directory_path() / "adse_cli_one_answer";
+  fs::remove_all(out);
+  const CommandRun run =
+      Adse("run " + Small() + " --budget 5 -q -o " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  ASSERT_NE(run.out.find("cheapest feasible"), std::string::npos) << run.out;
+  ASSERT_FALSE(FrontSection(run.out).empty()) << run.out;
+  // From "/", the scenario's relative paths do not resolve; the stored
+  // scenario still decides objectives and constraints.
+  const fs::path here = fs::current_path();
+  fs::current_path("/");
+  const CommandRun analyze = Adse("analyze " + out.string());
+  fs::current_path(here);
+  ASSERT_EQ(analyze.exit_code, 0) << analyze.out;
+  EXPECT_EQ(FrontSection(analyze.out), FrontSection(run.out)) << analyze.out;
+  const size_t cheapest = run.out.find("cheapest feasible");
+  const std::string cheapest_line =
+      run.out.substr(cheapest, run.out.find('\n', cheapest) - cheapest);
+  EXPECT_NE(analyze.out.find(cheapest_line), std::string::npos)
+      << cheapest_line << "\n"
+      << analyze.out;
+  EXPECT_TRUE(fs::exists(out / "analysis" / "v1" / "pareto.png"));
+  EXPECT_TRUE(fs::exists(out / "analysis" / "v1" / "report.md"));
+  EXPECT_FALSE(fs::exists(out / "runs" / "analysis"));
+  ASSERT_EQ(Adse("analyze " + out.string() +
+                 " --threshold frequency_bound_fraction=0.8")
+                .exit_code,
+            0);
+  const CommandRun diff =
+      Adse("analyze --diff " + (out / "analysis" / "v1").string() + " " +
+           (out / "analysis" / "v2").string());
+  EXPECT_EQ(diff.exit_code, 0) << diff.out;
+  EXPECT_NE(diff.out.find("of 5 points changed"), std::string::npos)
+      << diff.out;
 }
 
 TEST(CliRunTest, WorkerRefusesAScenarioThatChangedUnderItsCampaign) {

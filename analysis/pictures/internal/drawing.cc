@@ -1,0 +1,171 @@
+#include "analysis/pictures/internal/drawing.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+#include <vector>
+
+#include "stack/base/files.h"
+
+namespace adse::analysis::internal {
+
+// Hershey fonts only have ASCII: one '?' per non-ASCII character, spaces
+// for control characters.
+std::string Ascii(const std::string& text) {
+  std::string out;
+  for (unsigned char c : text) {
+    if (c >= 0x80) {
+      if (c >= 0xC0) out += '?';  // lead byte; continuation bytes dropped
+    } else if (c < 0x20 || c == 0x7F) {
+      out += ' ';
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out;
+}
+
+cv::Size TextSize(const std::string& text, const Style& s, int* baseline) {
+  return cv::getTextSize(text, kFont, s.font_scale(), s.text_thickness(),
+                         baseline);
+}
+
+// Cuts `text` (ASCII) until it fits in `max_width_px`, marking the cut.
+std::string FitText(std::string text, const Style& s, int max_width_px) {
+  int baseline = 0;
+  if (TextSize(text, s, &baseline).width <= max_width_px) return text;
+  while (!text.empty() &&
+         TextSize(text + "...", s, &baseline).width > max_width_px) {
+    text.pop_back();
+  }
+  return text + "...";
+}
+
+// Draws one line of text with its baseline at `y`, optionally on a white
+// box so it stays legible over drawing; returns its width.
+int DrawText(cv::Mat* img, const std::string& raw, int x, int y, Align align,
+             const Style& s, const cv::Scalar& colour, bool boxed) {
+  const std::string text = FitText(Ascii(raw), s, img->cols - s.Px(16));
+  int baseline = 0;
+  const cv::Size size = TextSize(text, s, &baseline);
+  if (align == Align::kRight) x -= size.width;
+  if (align == Align::kCentre) x -= size.width / 2;
+  x = std::clamp(x, 0, std::max(0, img->cols - size.width));
+  if (boxed) {
+    const int pad = s.Px(2);
+    cv::rectangle(*img,
+                  cv::Rect(x - pad, y - size.height - pad, size.width + 2 * pad,
+                           size.height + baseline + pad),
+                  kWhite, cv::FILLED);
+  }
+  cv::putText(*img, text, cv::Point(x, y), kFont, s.font_scale(), colour,
+              s.text_thickness(), cv::LINE_AA);
+  return size.width;
+}
+
+// Liang-Barsky: clips segment a-b to `box`; false if nothing is inside.
+bool ClipSegment(const cv::Rect2d& box, cv::Point2d* a, cv::Point2d* b) {
+  const double dx = b->x - a->x, dy = b->y - a->y;
+  double t0 = 0.0, t1 = 1.0;
+  const double p[4] = {-dx, dx, -dy, dy};
+  const double q[4] = {a->x - box.x, box.x + box.width - a->x, a->y - box.y,
+                       box.y + box.height - a->y};
+  for (int i = 0; i < 4; ++i) {
+    if (p[i] == 0.0) {
+      if (q[i] < 0.0) return false;
+      continue;
+    }
+    const double t = q[i] / p[i];
+    if (p[i] < 0.0) {
+      t0 = std::max(t0, t);
+    } else {
+      t1 = std::min(t1, t);
+    }
+    if (t0 > t1) return false;
+  }
+  const cv::Point2d start = *a;
+  *a = start + t0 * cv::Point2d(dx, dy);
+  *b = start + t1 * cv::Point2d(dx, dy);
+  return true;
+}
+
+cv::Point Fixed(const cv::Point2d& p) {
+  return cv::Point(static_cast<int>(std::lround(p.x * kShiftScale)),
+                   static_cast<int>(std::lround(p.y * kShiftScale)));
+}
+
+bool Finite(const cv::Point2d& p) {
+  return std::isfinite(p.x) && std::isfinite(p.y);
+}
+
+// A line in pixel coordinates of any size (far off-image ends, non-finite
+// ends are skipped) with sub-pixel precision.
+void DrawSegment(cv::Mat* img, cv::Point2d a, cv::Point2d b,
+                 const cv::Scalar& colour, int thickness, cv::LineTypes type) {
+  if (!Finite(a) || !Finite(b)) return;
+  const double pad = thickness + 2.0;
+  const cv::Rect2d box(-pad, -pad, img->cols + 2 * pad, img->rows + 2 * pad);
+  if (!ClipSegment(box, &a, &b)) return;
+  cv::line(*img, Fixed(a), Fixed(b), colour, thickness, type, kShift);
+}
+
+// A polyline in pixel coordinates; non-finite points break it.
+void DrawPolyline(cv::Mat* img, const std::vector<cv::Point2d>& points,
+                  const cv::Scalar& colour, int thickness, cv::LineTypes type) {
+  if (points.size() == 1) {
+    DrawSegment(img, points[0], points[0], colour, thickness, type);
+  }
+  for (size_t i = 1; i < points.size(); ++i) {
+    DrawSegment(img, points[i - 1], points[i], colour, thickness, type);
+  }
+}
+
+void DrawDashed(cv::Mat* img, cv::Point2d a, cv::Point2d b,
+                const cv::Scalar& colour, int thickness, double dash_px) {
+  const double length = cv::norm(b - a);
+  if (!(length > 0.0)) return;
+  const cv::Point2d step = (b - a) * (1.0 / length);
+  for (double t = 0.0; t < length; t += 2.0 * dash_px) {
+    DrawSegment(img, a + step * t, a + step * std::min(length, t + dash_px),
+                colour, thickness);
+  }
+}
+
+// 1, 2 or 5 times a power of ten, at most `limit` (> 0).
+double NiceBelow(double limit) {
+  const double power = std::pow(10.0, std::floor(std::log10(limit)));
+  for (double m : {5.0, 2.0, 1.0}) {
+    if (m * power <= limit) return m * power;
+  }
+  return power;
+}
+
+// 1, 2 or 5 times a power of ten, nearest above `rough` (> 0).
+double NiceAbove(double rough) {
+  const double power = std::pow(10.0, std::floor(std::log10(rough)));
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (m * power >= rough * (1.0 - 1e-9)) return m * power;
+  }
+  return 10.0 * power;
+}
+
+std::string FormatNumber(double value) { return fmt::format("{:g}", value); }
+
+Status EncodeOk(const cv::Mat& img, std::string* png) {
+  std::vector<uchar> bytes;
+  if (!cv::imencode(".png", img, bytes) || bytes.empty()) {
+    return Status::Internal("PNG encoding failed");
+  }
+  png->assign(bytes.begin(), bytes.end());
+  return Status::Ok();
+}
+
+Status WritePng(Result<std::string> png, const std::string& path) {
+  if (path.empty()) return Status::InvalidArgument("empty PNG path");
+  if (!png.ok()) return png.status().WithContext(path);
+  return WriteFileAtomic(path, *png);
+}
+
+}  // namespace adse::analysis::internal

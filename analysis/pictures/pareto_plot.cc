@@ -1,0 +1,449 @@
+// The Pareto plot: every evaluation by cost and navigation time, the
+// cost-time front as a staircase, its labels placed without overlap.
+#include "analysis/pictures/pictures.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <map>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <utility>
+
+#include "analysis/pictures/internal/drawing.h"
+
+namespace adse::analysis::internal {
+
+constexpr int kMinPlotSidePx = 300;
+// Points more than this many times above the highest point that matters
+// are drawn as arrows on the top edge instead of stretching the axis.
+constexpr double kClipRatio = 2.0;
+
+// ---------------------------------------------------------------------------
+// Pareto plot.
+
+struct Axis {
+  double min = 0.0, max = 1.0, step = 1.0;
+  int decimals = 0;
+};
+
+// Range of `values` padded by 5 %, with 1-2-5 ticks about every 1/6.
+Axis MakeAxis(const std::vector<double>& values) {
+  double lo = values[0], hi = values[0];
+  for (double v : values) {
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  if (!(hi > lo)) {
+    const double half = std::max(std::abs(lo) * 0.1, 1.0);
+    lo -= half;
+    hi += half;
+  }
+  const double pad = 0.05 * (hi - lo);
+  Axis axis;
+  axis.min = lo - pad;
+  axis.max = hi + pad;
+  axis.step = NiceAbove((axis.max - axis.min) / 6.0);
+  axis.decimals =
+      std::max(0, -static_cast<int>(std::floor(std::log10(axis.step) + 1e-9)));
+  return axis;
+}
+
+Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
+                                  const ParetoPlotOptions& o) {
+  for (int side : {o.width_px, o.height_px}) {
+    if (side < kMinPlotSidePx || side > kMaxSidePx) {
+      return Status::InvalidArgument(
+          fmt::format("Pareto plot size {}x{} px is outside {}..{}", o.width_px,
+                      o.height_px, kMinPlotSidePx, kMaxSidePx));
+    }
+  }
+  std::vector<const ParetoPlotPoint*> shown;
+  for (const auto& p : points) {
+    if (std::isfinite(p.cost) && std::isfinite(p.nav_time_s)) {
+      shown.push_back(&p);
+    }
+  }
+  if (shown.empty()) {
+    return Status::InvalidArgument(
+        points.empty() ? "no points to plot"
+                       : "no point with finite cost and time to plot");
+  }
+  const size_t hidden = points.size() - shown.size();
+
+  // Runs that failed badly (a timeout at 600 s) would squash the front
+  // against the axis: when the slowest point is far above everything that
+  // matters (feasible points, the front, the bounds), the axis ends above
+  // those and the rest are drawn as arrows on its top edge.
+  double y_matters = -std::numeric_limits<double>::infinity();
+  double y_all = y_matters;
+  for (const auto* p : shown) {
+    y_all = std::max(y_all, p->nav_time_s);
+    if (p->feasible || p->on_front)
+      y_matters = std::max(y_matters, p->nav_time_s);
+  }
+  for (double v : o.horizontal_lines) {
+    if (std::isfinite(v)) y_matters = std::max(y_matters, v);
+  }
+  const bool clip_y = std::isfinite(y_matters) && y_matters > 0.0 &&
+                      y_all > kClipRatio * y_matters;
+  std::vector<double> xs, ys;
+  size_t above = 0;
+  for (const auto* p : shown) {
+    xs.push_back(p->cost);
+    if (clip_y && p->nav_time_s > y_matters) {
+      ++above;
+    } else {
+      ys.push_back(p->nav_time_s);
+    }
+  }
+  if (clip_y) ys.push_back(y_matters * 1.15);  // room for the arrows
+  for (double v : o.vertical_lines) {
+    if (std::isfinite(v)) xs.push_back(v);
+  }
+  for (double v : o.horizontal_lines) {
+    if (std::isfinite(v)) ys.push_back(v);
+  }
+  const Axis ax = MakeAxis(xs), ay = MakeAxis(ys);
+
+  const Style s{std::clamp(std::min(o.width_px / 1000.0, o.height_px / 700.0),
+                           kMinUi, kMaxUi)};
+  int baseline = 0;
+  const int text_h = TextSize("Ag", s, &baseline).height;
+  const int line_px = text_h + baseline + s.Px(8);
+  // Room on the left for the turned y label and tick labels, on top for
+  // the title and a note, below for tick labels and the x label.
+  const int left = s.Px(58) + line_px;
+  const int top = 2 * line_px + s.Px(6);
+  const int right = o.width_px - s.Px(24);
+  const int bottom = o.height_px - 2 * line_px - s.Px(8);
+  const cv::Rect area(left, top, right - left, bottom - top);
+  auto px = [&](double x, double y) {
+    return cv::Point2d(
+        area.x + (x - ax.min) / (ax.max - ax.min) * area.width,
+        area.y + area.height - (y - ay.min) / (ay.max - ay.min) * area.height);
+  };
+  auto clipped = [&](const ParetoPlotPoint* p) {
+    return p->nav_time_s > ay.max;
+  };
+
+  cv::Mat img(o.height_px, o.width_px, CV_8UC3, Bgr(kBackgroundRgb));
+  const cv::Scalar grid(235, 235, 235);
+
+  // Grid, ticks and tick labels.
+  const int tick = s.Px(5);
+  auto tick_text = [](double v, const Axis& a) {
+    if (std::abs(v) < 1e-9 * a.step) v = 0.0;  // no "-0"
+    return fmt::format("{:.{}f}", v, a.decimals);
+  };
+  for (double k = std::ceil(ax.min / ax.step); k * ax.step <= ax.max; ++k) {
+    const double v = k * ax.step;
+    const double x = px(v, ay.min).x;
+    DrawSegment(&img, {x, double(area.y)}, {x, double(bottom)}, grid, 1);
+    DrawSegment(&img, {x, double(bottom)}, {x, double(bottom + tick)}, kBlack,
+                1);
+    DrawText(&img, tick_text(v, ax), static_cast<int>(x),
+             bottom + tick + text_h + s.Px(4), Align::kCentre, s, kBlack,
+             false);
+  }
+  for (double k = std::ceil(ay.min / ay.step); k * ay.step <= ay.max; ++k) {
+    const double v = k * ay.step;
+    const double y = px(ax.min, v).y;
+    DrawSegment(&img, {double(area.x), y}, {double(right), y}, grid, 1);
+    DrawSegment(&img, {double(area.x - tick), y}, {double(area.x), y}, kBlack,
+                1);
+    DrawText(&img, tick_text(v, ay), area.x - tick - s.Px(4),
+             static_cast<int>(y) + text_h / 2, Align::kRight, s, kBlack, false);
+  }
+
+  // Constraint lines.
+  for (double v : o.vertical_lines) {
+    if (!std::isfinite(v)) continue;
+    DrawDashed(&img, px(v, ay.min), px(v, ay.max), Bgr(kConstraintRgb), s.Px(2),
+               s.Px(8));
+  }
+  for (double v : o.horizontal_lines) {
+    if (!std::isfinite(v)) continue;
+    DrawDashed(&img, px(ax.min, v), px(ax.max, v), Bgr(kConstraintRgb), s.Px(2),
+               s.Px(8));
+  }
+
+  // Points: infeasible, feasible, then the front on top.
+  const int cross = s.Px(5);
+  const int radius = s.Px(4);
+  auto draw_cross = [&](cv::Point2d c, const cv::Scalar& colour) {
+    DrawSegment(&img, c - cv::Point2d(cross, cross),
+                c + cv::Point2d(cross, cross), colour, s.Px(1.5));
+    DrawSegment(&img, c - cv::Point2d(cross, -cross),
+                c + cv::Point2d(cross, -cross), colour, s.Px(1.5));
+  };
+  auto draw_dot = [&](cv::Point2d c, const cv::Scalar& colour, int r) {
+    cv::circle(img, Fixed(c), r * static_cast<int>(kShiftScale), colour,
+               cv::FILLED, cv::LINE_AA, kShift);
+  };
+  for (const auto* p : shown) {
+    if (p->feasible || p->on_front) continue;
+    if (clipped(p)) {
+      // An arrow pointing up out of the plot.
+      const cv::Point2d tip = px(p->cost, ay.max);
+      DrawPolyline(&img,
+                   {tip + cv::Point2d(-cross, 2 * cross), tip,
+                    tip + cv::Point2d(cross, 2 * cross)},
+                   Bgr(kInfeasibleRgb), s.Px(1.5));
+      DrawSegment(&img, tip, tip + cv::Point2d(0, 3 * cross),
+                  Bgr(kInfeasibleRgb), s.Px(1.5));
+    } else {
+      draw_cross(px(p->cost, p->nav_time_s), Bgr(kInfeasibleRgb));
+    }
+  }
+  for (const auto* p : shown) {
+    if (p->feasible && !p->on_front) {
+      draw_dot(px(p->cost, p->nav_time_s), Bgr(kFeasibleRgb), radius);
+    }
+  }
+  std::vector<const ParetoPlotPoint*> front;
+  for (const auto* p : shown) {
+    if (p->on_front) front.push_back(p);
+  }
+  std::stable_sort(
+      front.begin(), front.end(), [](const auto* a, const auto* b) {
+        return a->cost < b->cost ||
+               (a->cost == b->cost && a->nav_time_s < b->nav_time_s);
+      });
+  // The front as a staircase: what it promises holds between its points
+  // only in the dominated sense, so a straight line between them would
+  // claim designs that do not exist.
+  std::vector<cv::Point2d> front_line;
+  for (size_t i = 0; i < front.size(); ++i) {
+    const cv::Point2d c = px(front[i]->cost, front[i]->nav_time_s);
+    if (i > 0) front_line.push_back({c.x, front_line.back().y});
+    front_line.push_back(c);
+  }
+  DrawPolyline(&img, front_line, Bgr(kFrontRgb), s.Px(2));
+  for (const auto* p : front) {
+    const cv::Point2d c = px(p->cost, p->nav_time_s);
+    if (p->feasible) {
+      draw_dot(c, Bgr(kFrontRgb), radius + s.Px(1));
+    } else {
+      draw_cross(c, Bgr(kFrontRgb));
+    }
+    if (p->highlight) {
+      cv::circle(img, Fixed(c),
+                 (radius + s.Px(5)) * static_cast<int>(kShiftScale), kBlack,
+                 s.Px(1.5), cv::LINE_AA, kShift);
+    }
+  }
+  cv::rectangle(img, area, kBlack, 1);
+
+  // Legend.
+  struct Entry {
+    std::string name;
+    std::function<void(cv::Point2d)> sample;
+  };
+  std::vector<Entry> entries = {
+      {"feasible",
+       [&](cv::Point2d c) { draw_dot(c, Bgr(kFeasibleRgb), radius); }},
+      {"infeasible",
+       [&](cv::Point2d c) { draw_cross(c, Bgr(kInfeasibleRgb)); }},
+      {o.front_name, [&](cv::Point2d c) {
+         DrawSegment(&img, c - cv::Point2d(s.Px(12), 0),
+                     c + cv::Point2d(s.Px(12), 0), Bgr(kFrontRgb), s.Px(2));
+         draw_dot(c, Bgr(kFrontRgb), radius + s.Px(1));
+       }}};
+  bool any_highlight = false;
+  for (const auto* p : front) any_highlight = any_highlight || p->highlight;
+  if (any_highlight) {
+    entries.push_back({o.highlight_name, [&](cv::Point2d c) {
+                         draw_dot(c, Bgr(kFrontRgb), radius + s.Px(1));
+                         cv::circle(
+                             img, Fixed(c),
+                             (radius + s.Px(5)) * static_cast<int>(kShiftScale),
+                             kBlack, s.Px(1.5), cv::LINE_AA, kShift);
+                       }});
+  }
+  if (!o.vertical_lines.empty() || !o.horizontal_lines.empty()) {
+    entries.push_back({"constraint bound", [&](cv::Point2d c) {
+                         DrawDashed(&img, c - cv::Point2d(s.Px(12), 0),
+                                    c + cv::Point2d(s.Px(12), 0),
+                                    Bgr(kConstraintRgb), s.Px(2), s.Px(5));
+                       }});
+  }
+  int legend_text_w = 0;
+  for (const auto& e : entries) {
+    legend_text_w =
+        std::max(legend_text_w, TextSize(Ascii(e.name), s, &baseline).width);
+  }
+  const int row = line_px;
+  const int legend_w = s.Px(40) + legend_text_w + s.Px(10);
+  const int legend_h = row * static_cast<int>(entries.size()) + s.Px(6);
+  // The corner covering the fewest markers; top right first, where a
+  // min-min plot's dominated designs are rarest.
+  cv::Rect legend_box;
+  size_t least_covered = std::numeric_limits<size_t>::max();
+  const int inset = s.Px(10);
+  for (const cv::Point& corner :
+       {cv::Point(right - inset - legend_w, area.y + inset),
+        cv::Point(area.x + inset, bottom - inset - legend_h),
+        cv::Point(area.x + inset, area.y + inset),
+        cv::Point(right - inset - legend_w, bottom - inset - legend_h)}) {
+    const cv::Rect box(corner.x, corner.y, legend_w, legend_h);
+    const cv::Rect grown(box.x - radius, box.y - radius, box.width + 2 * radius,
+                         box.height + 2 * radius);
+    size_t covered = 0;
+    for (const auto* p : shown) {
+      const cv::Point2d c = px(p->cost, clipped(p) ? ay.max : p->nav_time_s);
+      covered += grown.contains(
+          cv::Point(static_cast<int>(c.x), static_cast<int>(c.y)));
+    }
+    if (covered < least_covered) {
+      least_covered = covered;
+      legend_box = box;
+    }
+  }
+
+  // Front labels: each tries the places around its point in turn and takes
+  // the first that stays inside the plot and clear of the legend, the other
+  // front markers and the labels already placed; a label with no free
+  // place is left out and counted, never drawn over another.
+  std::vector<cv::Rect> taken = {legend_box};
+  const int marker = radius + s.Px(6);
+  for (const auto* p : front) {
+    const cv::Point2d c = px(p->cost, p->nav_time_s);
+    taken.emplace_back(static_cast<int>(c.x) - marker,
+                       static_cast<int>(c.y) - marker, 2 * marker, 2 * marker);
+  }
+  // The staircase's segments, short of the markers at their ends.
+  for (size_t i = 1; i < front_line.size(); ++i) {
+    const cv::Point2d a = front_line[i - 1], b = front_line[i];
+    const int x0 = static_cast<int>(std::min(a.x, b.x));
+    const int x1 = static_cast<int>(std::max(a.x, b.x));
+    const int y0 = static_cast<int>(std::min(a.y, b.y));
+    const int y1 = static_cast<int>(std::max(a.y, b.y));
+    const int w = s.Px(2);
+    if (x1 - x0 > 2 * marker) {
+      taken.emplace_back(x0 + marker, y0 - w, x1 - x0 - 2 * marker, 2 * w);
+    } else if (y1 - y0 > 2 * marker) {
+      taken.emplace_back(x0 - w, y0 + marker, 2 * w, y1 - y0 - 2 * marker);
+    }
+  }
+  size_t omitted = 0;
+  for (const auto* p : front) {
+    if (p->label.empty()) continue;
+    const cv::Point2d c = px(p->cost, p->nav_time_s);
+    const std::string label = Ascii(p->label);
+    const cv::Size size = TextSize(label, s, &baseline);
+    const int h = size.height + baseline;
+    const int gap = s.Px(8);
+    // Top-left corners of the candidate boxes: right, upper right, lower
+    // right, left, upper left, lower left, above, below.
+    const int cx = static_cast<int>(c.x), cy = static_cast<int>(c.y);
+    const cv::Point candidates[] = {{cx + gap, cy - h / 2},
+                                    {cx + gap, cy - gap - h},
+                                    {cx + gap, cy + gap},
+                                    {cx - gap - size.width, cy - h / 2},
+                                    {cx - gap - size.width, cy - gap - h},
+                                    {cx - gap - size.width, cy + gap},
+                                    {cx - size.width / 2, cy - gap - h},
+                                    {cx - size.width / 2, cy + gap}};
+    bool placed = false;
+    for (const cv::Point& corner : candidates) {
+      const cv::Rect box(corner.x - s.Px(2), corner.y - s.Px(1),
+                         size.width + s.Px(4), h + s.Px(2));
+      if ((box & area) != box) continue;
+      bool clear = true;
+      for (size_t k = 0; k < taken.size() && clear; ++k) {
+        // A point's own marker box is not in the way of its own label.
+        const bool own = (taken[k] & cv::Rect(cx, cy, 1, 1)).area() > 0;
+        clear = own || (box & taken[k]).area() == 0;
+      }
+      if (!clear) continue;
+      // On white, so the dots of other designs under it do not garble it.
+      cv::rectangle(img, box, kWhite, cv::FILLED);
+      DrawText(&img, label, corner.x, corner.y + size.height, Align::kLeft, s,
+               kDarkGrey, false);
+      taken.push_back(box);
+      placed = true;
+      break;
+    }
+    if (!placed) ++omitted;
+  }
+
+  cv::rectangle(img, legend_box, kWhite, cv::FILLED);
+  cv::rectangle(img, legend_box, kDarkGrey, 1);
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const int y = legend_box.y + s.Px(3) + row * static_cast<int>(i) + row / 2;
+    entries[i].sample(cv::Point2d(legend_box.x + s.Px(20), y));
+    DrawText(&img, entries[i].name, legend_box.x + s.Px(40), y + text_h / 2,
+             Align::kLeft, s, kBlack, false);
+  }
+
+  // Title, note and axis labels.
+  DrawText(&img, o.title, o.width_px / 2, line_px - baseline, Align::kCentre, s,
+           kBlack, false);
+  std::string note;
+  if (hidden > 0) {
+    note = fmt::format("{} point(s) with a non-finite cost or time not shown",
+                       hidden);
+  }
+  if (above > 0) {
+    note += fmt::format("{}{} infeasible point(s) above the plot (up to {:g})",
+                        note.empty() ? "" : "; ", above, y_all);
+  }
+  if (omitted > 0) {
+    note += fmt::format("{}{} front label(s) left out for lack of room",
+                        note.empty() ? "" : "; ", omitted);
+  }
+  if (!note.empty()) {
+    DrawText(&img, note, o.width_px / 2, 2 * line_px - baseline, Align::kCentre,
+             s, kDarkGrey, false);
+  }
+  DrawText(&img, o.x_label, area.x + area.width / 2,
+           o.height_px - s.Px(8) - baseline, Align::kCentre, s, kBlack, false);
+  if (!o.y_label.empty()) {
+    // OpenCV draws text horizontally only: draw it on its own strip and
+    // turn the strip.
+    const std::string label = FitText(Ascii(o.y_label), s, area.height);
+    const cv::Size size = TextSize(label, s, &baseline);
+    cv::Mat strip(size.height + baseline + 2, size.width + 2, CV_8UC3,
+                  Bgr(kBackgroundRgb));
+    cv::putText(strip, label, cv::Point(1, size.height + 1), kFont,
+                s.font_scale(), kBlack, s.text_thickness(), cv::LINE_AA);
+    cv::Mat turned;
+    cv::rotate(strip, turned, cv::ROTATE_90_COUNTERCLOCKWISE);
+    const int x = s.Px(6);
+    const int y = std::clamp(area.y + area.height / 2 - turned.rows / 2, 0,
+                             std::max(0, o.height_px - turned.rows));
+    if (x + turned.cols <= o.width_px && y + turned.rows <= o.height_px) {
+      turned.copyTo(img(cv::Rect(x, y, turned.cols, turned.rows)));
+    }
+  }
+
+  std::string png;
+  ADSE_RETURN_IF_ERROR(EncodeOk(img, &png));
+  return png;
+}
+
+}  // namespace adse::analysis::internal
+
+namespace adse::analysis {
+
+Result<std::string> ParetoPlotPng(const std::vector<ParetoPlotPoint>& points,
+                                  const ParetoPlotOptions& o) {
+  return internal::Guarded("Pareto plot",
+                           [&] { return internal::ParetoPngImpl(points, o); });
+}
+
+Status RenderParetoPlot(const std::vector<ParetoPlotPoint>& points,
+                        const std::string& png_path,
+                        const ParetoPlotOptions& o) {
+  if (png_path.empty()) return Status::InvalidArgument("empty PNG path");
+  return internal::WritePng(ParetoPlotPng(points, o), png_path);
+}
+
+}  // namespace adse::analysis

@@ -1,0 +1,249 @@
+#include "harness/campaign/headline.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <regex>
+#include <sstream>
+
+#include "analysis/pictures/pictures.h"
+#include "harness/spec/spec_parser.h"
+
+namespace adse::campaign {
+namespace {
+
+bool Placed(const EvaluationRow& row) {
+  return std::isfinite(RowMetric(row, kCostMetric)) &&
+         std::isfinite(RowMetric(row, kTimeMetric));
+}
+
+int RunsAt(const std::vector<EvaluationRow>& rows, int i) {
+  if (i < 0) return 0;
+  int n = 0;
+  for (const EvaluationRow& row : rows) {
+    n += row.status == "complete" && row.point == rows[i].point;
+  }
+  return n;
+}
+
+// The point's values in space order, "2/1.2/7": short enough to label a
+// plot; the legend names the parameters.
+std::string ShortPoint(const spec::Spec& spec, const EvaluationRow& row) {
+  std::vector<std::string> values;
+  for (const spec::DesignParameter& p : spec.design_space.parameters) {
+    auto it = row.point.find(p.name);
+    if (it != row.point.end())
+      values.push_back(fmt::format("{:g}", it->second));
+  }
+  return fmt::format("{}", fmt::join(values, "/"));
+}
+
+std::string Value(double v, const char* unit) {
+  if (!std::isfinite(v)) return "—";
+  return fmt::format("{:.4g}{}", v, unit);
+}
+
+// "cost 2.4, nav 150.2 s, ctrl 9.8 Hz (1 run)"
+std::string Facts(const std::vector<EvaluationRow>& rows, int i, int runs) {
+  const EvaluationRow& row = rows[i];
+  return fmt::format("cost {}, nav {}, ctrl {} ({})",
+                     Value(RowMetric(row, kCostMetric), ""),
+                     Value(RowMetric(row, kTimeMetric), " s"),
+                     Value(RowMetric(row, "ctrl_rate_hz"), " Hz"),
+                     runs <= 1 ? std::string("1 run, no replicas")
+                               : fmt::format("{} runs at this point", runs));
+}
+
+struct Line {
+  const char* what;
+  int row;
+  int runs;
+};
+
+std::vector<Line> Lines(const Headline& h) {
+  std::vector<Line> lines = {{"cheapest feasible", h.cheapest, h.cheapest_runs},
+                             {"fastest feasible", h.fastest, h.fastest_runs}};
+  if (h.knee >= 0) lines.push_back({"knee of cost-time", h.knee, h.knee_runs});
+  return lines;
+}
+
+}  // namespace
+
+bool SimpleBound(const std::string& constraint, const std::string& metric,
+                 double* bound) {
+  static const std::regex kNameFirst(
+      R"(^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>)\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*$)");
+  static const std::regex kNumberFirst(
+      R"(^\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(<=|>=|<|>)\s*([A-Za-z_][A-Za-z0-9_]*)\s*$)");
+  std::smatch m;
+  if (std::regex_match(constraint, m, kNameFirst) && m[1] == metric) {
+    *bound = std::stod(m[3]);
+    return true;
+  }
+  if (std::regex_match(constraint, m, kNumberFirst) && m[3] == metric) {
+    *bound = std::stod(m[1]);
+    return true;
+  }
+  return false;
+}
+
+Headline ComputeHeadline(const spec::Spec& spec,
+                         const std::vector<EvaluationRow>& rows) {
+  Headline h;
+  h.front = ParetoFrontOf(spec, rows);
+  std::vector<int> feasible;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i].status == "complete" && rows[i].feasible && Placed(rows[i])) {
+      feasible.push_back(static_cast<int>(i));
+    }
+  }
+  auto cost = [&](int i) { return RowMetric(rows[i], kCostMetric); };
+  auto time = [&](int i) { return RowMetric(rows[i], kTimeMetric); };
+  auto by_cost = [&](int a, int b) {
+    return cost(a) != cost(b)   ? cost(a) < cost(b)
+           : time(a) != time(b) ? time(a) < time(b)
+                                : a < b;
+  };
+  std::sort(feasible.begin(), feasible.end(), by_cost);
+  if (feasible.empty()) return h;
+  h.cheapest = feasible.front();
+  h.fastest =
+      *std::min_element(feasible.begin(), feasible.end(), [&](int a, int b) {
+        return time(a) != time(b) ? time(a) < time(b) : by_cost(a, b);
+      });
+  // Sorted by cost, a row is on the 2-D front when it is strictly faster
+  // than every cheaper-or-equal row before it.
+  double best_time = std::numeric_limits<double>::infinity();
+  for (int i : feasible) {
+    if (time(i) < best_time) {
+      h.cost_time_front.push_back(i);
+      best_time = time(i);
+    }
+  }
+  const std::vector<int>& f = h.cost_time_front;
+  if (f.size() >= 3) {
+    const double c0 = cost(f.front()), c1 = cost(f.back());
+    const double t0 = time(f.back()), t1 = time(f.front());
+    double best = 0.0;
+    for (size_t k = 1; k + 1 < f.size(); ++k) {
+      // Scaled, the chord is x + y = 1; the knee bulges farthest below it.
+      const double x = (cost(f[k]) - c0) / (c1 - c0);
+      const double y = (time(f[k]) - t0) / (t1 - t0);
+      if (1.0 - x - y > best) {
+        best = 1.0 - x - y;
+        h.knee = f[k];
+      }
+    }
+  }
+  h.cheapest_runs = RunsAt(rows, h.cheapest);
+  h.fastest_runs = RunsAt(rows, h.fastest);
+  h.knee_runs = RunsAt(rows, h.knee);
+  return h;
+}
+
+std::string HeadlineText(const spec::Spec& spec,
+                         const std::vector<EvaluationRow>& rows,
+                         const Headline& h) {
+  std::ostringstream out;
+  if (h.cheapest < 0) {
+    out << fmt::format(
+        "no feasible design among {} evaluations: every one violates a "
+        "constraint ({})\n",
+        rows.size(), fmt::join(spec.constraints, ", "));
+  }
+  for (const Line& line : Lines(h)) {
+    if (line.row < 0) continue;
+    out << fmt::format(
+        "{:<19} {}  {}\n", line.what,
+        spec::FormatPoint(spec.design_space, rows[line.row].point),
+        Facts(rows, line.row, line.runs));
+  }
+  std::vector<std::string> objectives;
+  for (const spec::Objective& o : spec.objectives)
+    objectives.push_back(o.metric);
+  out << fmt::format("Pareto front over {} ({} of {} evaluations):\n",
+                     fmt::join(objectives, ", "), h.front.size(), rows.size());
+  for (int i : h.front) {
+    const EvaluationRow& row = rows[i];
+    out << fmt::format("  {:<36} cost {:>7}  nav {:>9}  ctrl {:>8}{}\n",
+                       spec::FormatPoint(spec.design_space, row.point),
+                       Value(RowMetric(row, kCostMetric), ""),
+                       Value(RowMetric(row, kTimeMetric), " s"),
+                       Value(RowMetric(row, "ctrl_rate_hz"), " Hz"),
+                       row.feasible ? "" : "  (infeasible)");
+  }
+  return out.str();
+}
+
+std::string HeadlineMarkdown(const spec::Spec& spec,
+                             const std::vector<EvaluationRow>& rows,
+                             const Headline& h, const std::string& image_dir) {
+  std::ostringstream md;
+  md << "## Answer\n\n";
+  if (h.cheapest < 0) {
+    md << fmt::format(
+        "**No feasible design** among {} evaluations: every one violates a "
+        "constraint.\n\n",
+        rows.size());
+  }
+  for (const Line& line : Lines(h)) {
+    if (line.row < 0) continue;
+    const EvaluationRow& row = rows[line.row];
+    std::string what = line.what;
+    what[0] = static_cast<char>(std::toupper(what[0]));
+    md << fmt::format(
+        "- **{}:** `{}` — {}. [trajectory]({}/{}/trajectory.png)\n", what,
+        spec::FormatPoint(spec.design_space, row.point),
+        Facts(rows, line.row, line.runs), image_dir, row.content_key);
+  }
+  if (spec.objectives.size() > 2 ||
+      (spec.objectives.size() == 2 &&
+       !(spec.objectives[0].metric == kCostMetric &&
+         spec.objectives[1].metric == kTimeMetric))) {
+    md << fmt::format(
+        "\nThe picture shows the cost-time view: {} feasible designs "
+        "non-dominated in hardware_cost and nav_time_s. The front over all "
+        "objectives is listed below.\n",
+        h.cost_time_front.size());
+  }
+  md << "\n![cost and navigation time of every evaluation](pareto.png)\n\n";
+  return md.str();
+}
+
+Status RenderFrontPicture(const spec::Spec& spec,
+                          const std::vector<EvaluationRow>& rows,
+                          const Headline& h, const std::string& title,
+                          const std::string& png_path) {
+  std::vector<bool> on_front(rows.size(), false);
+  for (int i : h.cost_time_front) on_front[i] = true;
+  std::vector<analysis::ParetoPlotPoint> plot;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (!Placed(rows[i])) continue;
+    analysis::ParetoPlotPoint p;
+    p.cost = RowMetric(rows[i], kCostMetric);
+    p.nav_time_s = RowMetric(rows[i], kTimeMetric);
+    p.feasible = rows[i].feasible;
+    p.on_front = on_front[i];
+    if (p.on_front) p.label = ShortPoint(spec, rows[i]);
+    p.highlight = static_cast<int>(i) == h.cheapest;
+    plot.push_back(p);
+  }
+  analysis::ParetoPlotOptions options;
+  options.title = title;
+  options.front_name = fmt::format("cost-time front ({})",
+                                   fmt::join(spec.design_space.Names(), "/"));
+  for (const std::string& c : spec.constraints) {
+    double bound = 0.0;
+    if (SimpleBound(c, kTimeMetric, &bound)) {
+      options.horizontal_lines.push_back(bound);
+    }
+    if (SimpleBound(c, kCostMetric, &bound)) {
+      options.vertical_lines.push_back(bound);
+    }
+  }
+  return analysis::RenderParetoPlot(plot, png_path, options);
+}
+
+}  // namespace adse::campaign

@@ -1,0 +1,72 @@
+// The answer a campaign leads with. The user asked for the cheapest
+// computer that still drives well, so every view (terminal, report.md,
+// summary.json, pareto.png, adse analyze) starts with the same three
+// designs, taken from the same front function, before the front itself.
+#ifndef ADSE_HARNESS_CAMPAIGN_HEADLINE_H_
+#define ADSE_HARNESS_CAMPAIGN_HEADLINE_H_
+
+#include <string>
+#include <vector>
+
+#include "harness/campaign/evaluation.h"
+#include "harness/spec/spec.h"
+#include "stack/base/status.h"
+
+namespace adse::campaign {
+
+// The two metrics of the cost-time view; every scenario reports both.
+inline constexpr char kCostMetric[] = "hardware_cost";
+inline constexpr char kTimeMetric[] = "nav_time_s";
+
+struct Headline {
+  // Row indices; -1 when no row qualifies.
+  int cheapest = -1;  // feasible, least hardware_cost (ties: less nav time)
+  int fastest = -1;   // feasible, least nav_time_s (ties: less cost)
+  // The knee of cost_time_front: the point farthest from the chord between
+  // its two ends, both axes scaled to the front's range; -1 with fewer than
+  // three points on that front.
+  int knee = -1;
+  // The scenario's front (ParetoFrontOf: every objective, constraint-aware).
+  std::vector<int> front;
+  // Feasible rows non-dominated in (hardware_cost, nav_time_s), by cost.
+  // Equal to `front` for the usual two objectives; with more objectives it
+  // is the 2-D view, and the n-D front is listed separately.
+  std::vector<int> cost_time_front;
+  // Rows at the same design point as each of cheapest/fastest/knee
+  // (replicas); 1 when the point ran once.
+  int cheapest_runs = 0, fastest_runs = 0, knee_runs = 0;
+};
+
+Headline ComputeHeadline(const spec::Spec& spec,
+                         const std::vector<EvaluationRow>& rows);
+
+// "cheapest feasible: cores=2,freq_ghz=1.2 cost 2.4, nav 150.2 s,
+// ctrl 9.8 Hz (1 run)" and the like, one line per design, then the front;
+// for the terminal.
+std::string HeadlineText(const spec::Spec& spec,
+                         const std::vector<EvaluationRow>& rows,
+                         const Headline& headline);
+// The same as the top section of report.md; `image_dir` is where the rows'
+// trajectory pictures are, relative to the report ("images").
+std::string HeadlineMarkdown(const spec::Spec& spec,
+                             const std::vector<EvaluationRow>& rows,
+                             const Headline& headline,
+                             const std::string& image_dir);
+
+// pareto.png: every row by cost and nav time, the cost-time front as a
+// staircase with its points labelled, the cheapest feasible design ringed,
+// and each simple bound of the constraints on either axis (e.g.
+// `nav_time_s <= 400`) dashed.
+Status RenderFrontPicture(const spec::Spec& spec,
+                          const std::vector<EvaluationRow>& rows,
+                          const Headline& headline, const std::string& title,
+                          const std::string& png_path);
+
+// A constraint of the form `metric OP number` or `number OP metric`
+// (OP one of < <= > >=) on `metric`: its bound. False for anything else.
+bool SimpleBound(const std::string& constraint, const std::string& metric,
+                 double* bound);
+
+}  // namespace adse::campaign
+
+#endif  // ADSE_HARNESS_CAMPAIGN_HEADLINE_H_
