@@ -4,23 +4,21 @@
 
 #include "harness/campaign/run_store.h"
 #include "harness/llm/llm_strategy.h"
+#include "harness/spec/types.h"
 
 namespace adse::campaign {
 
 Status CheckStrategyName(const std::string& name) {
-  if (name == "llm") return Status::Ok();
-  for (const std::string& n : explore::StrategyNames()) {
-    if (n == name) return Status::Ok();
-  }
+  if (spec::IsStrategyName(name)) return Status::Ok();
   return Status::InvalidArgument(
-      fmt::format("unknown exploration strategy '{}'; valid: {}, llm", name,
-                  fmt::join(explore::StrategyNames(), ", ")));
+      fmt::format("unknown exploration strategy '{}'; valid: {}", name,
+                  fmt::join(spec::StrategyNames(), ", ")));
 }
 
 Result<bool> StrategyIsAdaptive(const spec::Spec& spec) {
   const std::string& name = spec.exploration.strategy;
   ADSE_RETURN_IF_ERROR(CheckStrategyName(name));
-  if (name == "llm") return true;
+  if (name == spec::kLlmStrategy) return true;
   Result<std::unique_ptr<explore::Strategy>> strategy =
       explore::CreateStrategy(name, {&spec});
   if (!strategy.ok()) return strategy.status();
@@ -31,7 +29,7 @@ Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(
     const spec::Spec& spec, const std::string& folder, bool record) {
   const std::string& name = spec.exploration.strategy;
   ADSE_RETURN_IF_ERROR(CheckStrategyName(name));
-  if (name != "llm") return explore::CreateStrategy(name, {&spec});
+  if (name != spec::kLlmStrategy) return explore::CreateStrategy(name, {&spec});
 
   spec::Spec llm_spec = spec;
   if (!record) {

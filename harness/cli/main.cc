@@ -3,7 +3,12 @@
 
 #include <cstdio>
 
+#include <fmt/format.h>
+
 #include "harness/cli/commands.h"
+#include "harness/explore/strategy.h"
+#include "harness/pool/worker_pool.h"
+#include "harness/spec/types.h"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -123,9 +128,12 @@ int main(int argc, char** argv) {
       ->required();
   run_cmd->add_option("-o,--out", run.out,
                       "Campaign folder (default: the scenario's output)");
-  run_cmd->add_option(
-      "--strategy", run.strategy,
-      "Override exploration.strategy: exhaustive, random, ga, nsga2, agent");
+  run_cmd
+      ->add_option(
+          "--strategy", run.strategy,
+          "Override exploration.strategy: " +
+              fmt::format("{}", fmt::join(adse::spec::StrategyNames(), ", ")))
+      ->check(CLI::IsMember(adse::spec::StrategyNames()));
   run_cmd
       ->add_option("--budget", run.budget,
                    "Override exploration.budget (evaluations)")
@@ -135,8 +143,11 @@ int main(int argc, char** argv) {
                    "Override harness.workers (0: auto)")
       ->check(CLI::NonNegativeNumber);
   run_cmd
-      ->add_option("--isolation", run.isolation, "Override harness.isolation")
-      ->check(CLI::IsMember({"auto", "cgroup", "affinity"}));
+      ->add_option(
+          "--isolation", run.isolation,
+          "Override harness.isolation: " +
+              fmt::format("{}", fmt::join(adse::pool::IsolationNames(), ", ")))
+      ->check(CLI::IsMember(adse::pool::IsolationNames()));
   run_cmd->add_flag("--no-cache", run.no_cache,
                     "Neither read nor fill the shared evaluation cache");
   run_cmd->add_option("--cache-dir", run.cache_dir,
@@ -154,7 +165,7 @@ int main(int argc, char** argv) {
           "--executor", run.executor,
           "Override harness.executor: local (worker processes here) or slurm "
           "(each run a job step, srun, inside the current Slurm allocation)")
-      ->check(CLI::IsMember({"local", "slurm"}));
+      ->check(CLI::IsMember(adse::spec::ExecutorNames()));
 
   adse::cli::WorkerArgs worker;
   uint64_t worker_seed = 0;
@@ -189,8 +200,12 @@ int main(int argc, char** argv) {
                    "Recorded campaign folder (campaign.h5)")
       ->required();
   explore_cmd
-      ->add_option("--strategy", explore.strategies,
-                   "Strategies, comma-separated (default: all)")
+      ->add_option(
+          "--strategy", explore.strategies,
+          "Strategies, comma-separated, among " +
+              fmt::format("{}",
+                          fmt::join(adse::explore::StrategyNames(), ", ")) +
+              " (default: all)")
       ->delimiter(',');
   explore_cmd
       ->add_option("--budget", explore.budget,
@@ -219,7 +234,7 @@ int main(int argc, char** argv) {
   interpret_cmd
       ->add_option("--backend", interpret.backend,
                    "ollama, openai (sends $OPENAI_API_KEY when set) or replay")
-      ->check(CLI::IsMember({"ollama", "openai", "replay"}));
+      ->check(CLI::IsMember(adse::spec::LlmBackendNames()));
   interpret_cmd->add_option("--endpoint", interpret.endpoint,
                             "Server URL (default: http://127.0.0.1:11434)");
   interpret_cmd->add_option("--model", interpret.model, "Model name")
@@ -271,8 +286,12 @@ int main(int argc, char** argv) {
       "-o,--out", submit.out,
       "Campaign folder on a shared filesystem (default: the scenario's "
       "output)");
-  submit_cmd->add_option("--strategy", submit.strategy,
-                         "Override exploration.strategy");
+  submit_cmd
+      ->add_option(
+          "--strategy", submit.strategy,
+          "Override exploration.strategy: " +
+              fmt::format("{}", fmt::join(adse::spec::StrategyNames(), ", ")))
+      ->check(CLI::IsMember(adse::spec::StrategyNames()));
   submit_cmd
       ->add_option("--budget", submit.budget, "Override exploration.budget")
       ->check(CLI::NonNegativeNumber);

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "harness/spec/spec_parser.h"
+#include "harness/spec/types.h"
 
 namespace adse::explore {
 namespace {
@@ -145,8 +146,14 @@ double ConstraintViolation(const spec::Spec& spec,
 }
 
 const std::vector<std::string>& StrategyNames() {
-  static const std::vector<std::string> kNames = {"exhaustive", "random", "ga",
-                                                  "nsga2", "agent"};
+  // The format's list without the one harness/llm builds.
+  static const std::vector<std::string> kNames = [] {
+    std::vector<std::string> names;
+    for (const std::string& n : spec::StrategyNames()) {
+      if (n != spec::kLlmStrategy) names.push_back(n);
+    }
+    return names;
+  }();
   return kNames;
 }
 

@@ -87,10 +87,11 @@ struct StrategyContext {
   const spec::Spec* spec = nullptr;
 };
 
-// The names CreateStrategy accepts, in the order they are documented.
+// The names CreateStrategy accepts: spec::StrategyNames() without "llm"
+// (which harness/llm builds), in the same order.
 const std::vector<std::string>& StrategyNames();
 
-// Factory keyed by name: "exhaustive", "random", "ga", "nsga2", "agent". An
+// Factory keyed by one of StrategyNames(). An
 // unknown name, a missing spec or an empty design space gives
 // InvalidArgument (the first listing the valid names).
 Result<std::unique_ptr<Strategy>> CreateStrategy(

@@ -226,7 +226,7 @@ Commands DeriveCommands(const spec::Spec& spec, const spec::DesignPoint& point,
   Commands c;
   c.map = MapDescription(spec);
   c.traffic_seed = static_cast<int64_t>(seed);
-  c.weather = world::WeatherName(spec.world.weather);
+  c.weather = world::WeatherToString(spec.world.weather);
   for (const spec::DesignParameter& p : spec.design_space.parameters) {
     auto it = point.find(p.name);
     if (it != point.end()) c.platform[p.bind] = it->second;

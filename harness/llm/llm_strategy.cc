@@ -37,7 +37,7 @@ std::string TaskText(const spec::Spec& s) {
   return fmt::format(
       "{} from {} to {} on map {}, speed limit {:g} km/h, abandoned after {:g} "
       "s",
-      world::TaskKindName(t.kind), Place(t.start), Place(t.goal),
+      world::TaskKindToString(t.kind), Place(t.start), Place(t.goal),
       MapDescription(s), t.speed_limit_kmh, t.timeout_s);
 }
 

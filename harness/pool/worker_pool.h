@@ -13,6 +13,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "stack/base/status.h"
@@ -25,7 +26,11 @@ enum class Isolation {
   kAffinity,  // CPU affinity + rlimits only
 };
 
-// "auto" | "cgroup" | "affinity"; InvalidArgument listing them otherwise.
+// The names, as the scenario's harness.isolation and --isolation take them.
+const char* IsolationToString(Isolation isolation);
+bool StringToIsolation(std::string_view name, Isolation* isolation);
+std::vector<std::string> IsolationNames();
+// StringToIsolation, or InvalidArgument listing the names.
 Result<Isolation> ParseIsolation(const std::string& text);
 
 struct PoolOptions {

@@ -13,6 +13,7 @@
 #include "harness/sim/calibration.h"
 #include "harness/sim/run_key.h"
 #include "harness/spec/spec_parser.h"
+#include "harness/spec/types.h"
 #include "stack/algorithms/command_gate.h"
 #include "stack/base/clock.h"
 #include "stack/base/hash.h"
@@ -235,16 +236,12 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   run.design_point = point;
   if (Result<std::string> key = RunKey(spec, point, seed); key.ok())
     run.content_key = *key;
-  run.platform = {
-      {"kind",
-       platform.kind == spec::PlatformKind::kVirtual ? "virtual" : "cgroup"},
-      {"cores", std::to_string(platform.cores)},
-      {"freq_ghz", fmt::format("{}", platform.freq_ghz)},
-      {"reference_ghz", fmt::format("{}", platform.reference_ghz)},
-      {"cost_model", platform.cost_model == spec::CostModel::kCounted
-                         ? "counted"
-                         : "measured"},
-      {"cost_scale", fmt::format("{}", platform.cost_scale)}};
+  run.platform = {{"kind", spec::PlatformKindToString(platform.kind)},
+                  {"cores", std::to_string(platform.cores)},
+                  {"freq_ghz", fmt::format("{}", platform.freq_ghz)},
+                  {"reference_ghz", fmt::format("{}", platform.reference_ghz)},
+                  {"cost_model", spec::CostModelToString(platform.cost_model)},
+                  {"cost_scale", fmt::format("{}", platform.cost_scale)}};
   for (size_t i = 0; i < w.ideal_path().points.size(); ++i) {
     run.ideal_path.push_back({w.ideal_path().s_m[i],
                               w.ideal_path().points[i].x(),

@@ -44,6 +44,7 @@
 
 #include <fmt/format.h>
 
+#include "stack/base/platform_limits.h"
 #include "stack/runtime/executor.h"
 
 namespace adse::stack {
@@ -51,8 +52,6 @@ namespace {
 
 // Nothing is instantaneous: keeps the clock moving and ends after starts.
 constexpr double kMinCostS = 1e-6;
-// Guards against absurd allocations from a typo; far above any real computer.
-constexpr int kMaxCores = 4096;
 // PublishExternal slightly in the past (rounding in the caller's time
 // arithmetic) is moved to now; further back is a caller bug.
 constexpr double kPastToleranceS = 1e-9;
@@ -621,9 +620,9 @@ Status ValidateGraph(const Graph& graph) {
 }  // namespace
 
 Status ValidateVirtualPlatformOptions(const VirtualPlatformOptions& options) {
-  if (options.cores < 1 || options.cores > kMaxCores) {
+  if (options.cores < 1 || options.cores > kMaxPlatformCores) {
     return Status::InvalidArgument(fmt::format(
-        "cores must be in [1, {}], got {}", kMaxCores, options.cores));
+        "cores must be in [1, {}], got {}", kMaxPlatformCores, options.cores));
   }
   if (!IsFinitePositive(options.freq_ghz)) {
     return Status::InvalidArgument(fmt::format(

@@ -19,12 +19,6 @@ namespace fs = std::filesystem;
 // Bump when generated maps change, so old cache entries are not reused.
 constexpr char kGeneratorVersion[] = "adse-map-v1";
 
-double Param(const MapOptions& options, const std::string& name,
-             double fallback) {
-  auto it = options.generator_params.find(name);
-  return it == options.generator_params.end() ? fallback : it->second;
-}
-
 std::string Poly(const std::string& id, const std::string& type,
                  const std::vector<std::pair<double, double>>& shape,
                  double height_m) {
@@ -188,13 +182,12 @@ Status Generate(const MapOptions& options, const std::string& folder) {
   const std::string poly = folder + "/map.poly.xml";
   if (options.generator == "parking_lot") {
     ParkingLotLayout layout;
-    layout.rows = static_cast<int>(Param(options, "rows", layout.rows));
+    layout.rows = static_cast<int>(MapGeneratorParamValue(options, "rows"));
     layout.slots_per_row =
-        static_cast<int>(Param(options, "slots_per_row", layout.slots_per_row));
-    layout.aisle_width_m =
-        Param(options, "aisle_width_m", layout.aisle_width_m);
-    layout.slot_width_m = Param(options, "slot_width_m", layout.slot_width_m);
-    layout.slot_depth_m = Param(options, "slot_depth_m", layout.slot_depth_m);
+        static_cast<int>(MapGeneratorParamValue(options, "slots_per_row"));
+    layout.aisle_width_m = MapGeneratorParamValue(options, "aisle_width_m");
+    layout.slot_width_m = MapGeneratorParamValue(options, "slot_width_m");
+    layout.slot_depth_m = MapGeneratorParamValue(options, "slot_depth_m");
     if (layout.rows < 1 || layout.slots_per_row < 1) {
       return Status::InvalidArgument(
           "parking_lot needs rows >= 1 and slots_per_row >= 1");
@@ -211,9 +204,11 @@ Status Generate(const MapOptions& options, const std::string& folder) {
                        "true"});
   }
   if (options.generator == "grid") {
-    const int number = static_cast<int>(Param(options, "number", 3));
-    const double length = Param(options, "length_m", 100.0);
-    const int lanes = static_cast<int>(Param(options, "lanes", 1));
+    const int number =
+        static_cast<int>(MapGeneratorParamValue(options, "number"));
+    const double length = MapGeneratorParamValue(options, "length_m");
+    const int lanes =
+        static_cast<int>(MapGeneratorParamValue(options, "lanes"));
     ADSE_RETURN_IF_ERROR(
         WriteFileAtomic(poly, GridBuildings(number, length, lanes)));
     return RunChecked(
@@ -222,8 +217,9 @@ Status Generate(const MapOptions& options, const std::string& folder) {
          std::to_string(lanes), "--default.speed", "13.89", "--no-turnarounds",
          "true", "--output-file", net, "--no-warnings", "true"});
   }
-  return Status::InvalidArgument("unknown map generator '" + options.generator +
-                                 "' (expected parking_lot or grid)");
+  return Status::InvalidArgument(
+      fmt::format("unknown map generator '{}' (expected one of {})",
+                  options.generator, fmt::join(MapGeneratorNames(), ", ")));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace adse::world {
@@ -84,8 +85,35 @@ struct TaskOptions {
   double timeout_s = 1500.0;
 };
 
-const char* WeatherName(Weather weather);
-const char* TaskKindName(TaskKind kind);
+// Names as written in scenario files and run records: the one list each
+// (stack/base/vocabulary.h).
+const char* WeatherToString(Weather weather);
+bool StringToWeather(std::string_view name, Weather* weather);
+std::vector<std::string> WeatherNames();
+
+const char* TaskKindToString(TaskKind kind);
+bool StringToTaskKind(std::string_view name, TaskKind* kind);
+std::vector<std::string> TaskKindNames();
+
+// A parameter of a map generator (`world.map.params`), like a stack knob:
+// the parser's bounds, the generator's default and the docs' row.
+struct MapGeneratorParam {
+  const char* name;
+  bool integer;  // only whole numbers allowed
+  double min_value;
+  double max_value;
+  double default_value;
+  const char* doc;  // one line, with the unit
+};
+
+// The generators, in the order the docs list them: parking_lot, grid.
+std::vector<std::string> MapGeneratorNames();
+// The parameters of `generator`; nullptr for an unknown generator.
+const std::vector<MapGeneratorParam>* MapGeneratorParams(
+    std::string_view generator);
+// `options.generator_params[name]`, or the parameter's default.
+double MapGeneratorParamValue(const MapOptions& options,
+                              const std::string& name);
 
 }  // namespace adse::world
 

@@ -106,7 +106,7 @@ void BM_LidarScan(benchmark::State& state) {
   state.counters["points"] = static_cast<double>(points) / scans;
   state.counters["ms_per_scan"] = 1e3 * seconds / scans;
   state.counters["ns_per_ray"] = 1e9 * seconds / (scans * rays);
-  state.SetLabel(std::string(WeatherName(weather)) + ", " +
+  state.SetLabel(std::string(WeatherToString(weather)) + ", " +
                  std::to_string(scene.obstacles().size()) + " obstacles, " +
                  std::to_string(vehicles.size()) + " vehicles");
 }

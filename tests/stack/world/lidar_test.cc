@@ -344,8 +344,8 @@ TEST(LidarTest, ReturnsNeverExceedRangeInAnyWeather) {
     double farthest = 0.0;
     for (const auto& pt : cloud.points)
       farthest = std::max<double>(farthest, pt.norm());
-    EXPECT_LE(farthest, limit + 1e-4) << WeatherName(w);
-    EXPECT_GT(farthest, 0.8 * limit) << WeatherName(w);
+    EXPECT_LE(farthest, limit + 1e-4) << WeatherToString(w);
+    EXPECT_GT(farthest, 0.8 * limit) << WeatherToString(w);
   }
 }
 

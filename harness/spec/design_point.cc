@@ -1,0 +1,195 @@
+#include "harness/spec/design_point.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "harness/spec/expression.h"
+#include "harness/spec/internal/spec_reader.h"
+#include "harness/spec/text_util.h"
+
+namespace adse::spec {
+
+using internal::kPlatformCores;
+using internal::kPlatformFreq;
+
+std::vector<std::string> CostVariableNames(const DesignSpace& space) {
+  std::vector<std::string> names = space.Names();
+  for (const char* n : {"cores", "freq_ghz"}) {
+    if (std::find(names.begin(), names.end(), n) == names.end()) {
+      names.push_back(n);
+    }
+  }
+  return names;
+}
+
+std::vector<std::string> ConstraintVariableNames(const DesignSpace& space) {
+  std::vector<std::string> names = internal::MetricNames();
+  for (const std::string& n : space.Names()) names.push_back(n);
+  return names;
+}
+
+std::string FormatPoint(const DesignSpace& space, const DesignPoint& point) {
+  std::string text;
+  auto add = [&text](const std::string& name, double value) {
+    text += fmt::format("{}{}={}", text.empty() ? "" : ",", name, value);
+  };
+  for (const DesignParameter& p : space.parameters) {
+    auto it = point.find(p.name);
+    if (it != point.end()) add(p.name, it->second);
+  }
+  for (const auto& [name, value] : point) {
+    if (space.Find(name) == nullptr) add(name, value);
+  }
+  return text;
+}
+
+Result<DesignPoint> ParsePoint(const DesignSpace& space,
+                               std::string_view text) {
+  std::vector<std::string> errors;
+  DesignPoint point;
+  const std::vector<std::string> names = space.Names();
+  auto trim = [](std::string_view s) {
+    const size_t b = s.find_first_not_of(" \t");
+    if (b == std::string_view::npos) return std::string_view();
+    const size_t e = s.find_last_not_of(" \t");
+    return s.substr(b, e - b + 1);
+  };
+  if (trim(text).empty()) {
+    return Status::InvalidArgument(
+        "expected name=value pairs separated by ',' (parameters: " +
+        JoinList(names) + "), found nothing");
+  }
+  size_t start = 0;
+  while (start <= text.size()) {
+    size_t end = text.find(',', start);
+    if (end == std::string_view::npos) end = text.size();
+    const std::string_view item = trim(text.substr(start, end - start));
+    start = end + 1;
+    const size_t eq = item.find('=');
+    if (eq == std::string_view::npos) {
+      errors.push_back("expected name=value, found '" + std::string(item) +
+                       "'");
+      continue;
+    }
+    const std::string name(trim(item.substr(0, eq)));
+    const std::string value_text(trim(item.substr(eq + 1)));
+    const DesignParameter* p = space.Find(name);
+    if (p == nullptr) {
+      errors.push_back("unknown parameter '" + name + "'; parameters: " +
+                       JoinList(names) + DidYouMean(name, names));
+      continue;
+    }
+    if (point.count(name)) {
+      errors.push_back(name + ": expected one value, found it twice");
+      continue;
+    }
+    double value = 0;
+    if (!ParseNumber(value_text, &value)) {
+      errors.push_back(name + ": expected a number, found '" + value_text +
+                       "'");
+      continue;
+    }
+    const int index = p->IndexOf(value);
+    if (index < 0) {
+      errors.push_back(name + ": expected one of " + p->DescribeValues() +
+                       ", found " + value_text);
+      continue;
+    }
+    point[name] = p->values[index];
+  }
+  std::vector<std::string> missing;
+  for (const DesignParameter& p : space.parameters) {
+    if (!point.count(p.name)) {
+      bool mentioned = false;  // already reported with a bad value
+      for (const std::string& e : errors) {
+        if (e.rfind(p.name + ":", 0) == 0) mentioned = true;
+      }
+      if (!mentioned) missing.push_back(p.name);
+    }
+  }
+  if (!missing.empty()) {
+    errors.push_back("missing parameter" +
+                     std::string(missing.size() > 1 ? "s: " : ": ") +
+                     JoinList(missing));
+  }
+  if (errors.empty()) return point;
+  std::string message;
+  for (const std::string& e : errors) {
+    if (!message.empty()) message += '\n';
+    message += e;
+  }
+  return Status::InvalidArgument(message);
+}
+
+namespace {
+
+// Variable values for expressions: the point plus the platform's cores and
+// frequency (from the point when bound).
+std::map<std::string, double> PointVariables(const Spec& spec,
+                                             const DesignPoint& point) {
+  std::map<std::string, double> vars(point.begin(), point.end());
+  const DesignSpace& space = spec.design_space;
+  const DesignParameter* cores = space.FindByBind(kPlatformCores);
+  const DesignParameter* freq = space.FindByBind(kPlatformFreq);
+  vars["cores"] = cores ? point.at(cores->name) : spec.platform.cores;
+  vars["freq_ghz"] = freq ? point.at(freq->name) : spec.platform.freq_ghz;
+  return vars;
+}
+
+}  // namespace
+
+Result<double> EvaluateCost(const Spec& spec, const DesignPoint& point) {
+  ADSE_RETURN_IF_ERROR(spec.design_space.Check(point));
+  Result<Expression> cost =
+      Expression::Parse(spec.cost, CostVariableNames(spec.design_space));
+  if (!cost.ok()) {
+    return Status::InvalidArgument("cost: " + cost.status().message());
+  }
+  Result<double> value = cost->TryEvaluate(PointVariables(spec, point));
+  if (!value.ok()) return value.status();
+  if (!std::isfinite(*value)) {
+    return Status::InvalidArgument("cost: '" + spec.cost +
+                                   "' is not finite at this point");
+  }
+  return *value;
+}
+
+Result<bool> EvaluateConstraint(const Spec& spec, const std::string& constraint,
+                                const std::map<std::string, double>& metrics,
+                                const DesignPoint& point) {
+  Result<Expression> e =
+      Expression::Parse(constraint, ConstraintVariableNames(spec.design_space));
+  if (!e.ok()) {
+    return Status::InvalidArgument("constraint '" + constraint +
+                                   "': " + e.status().message());
+  }
+  std::map<std::string, double> vars = metrics;
+  for (const auto& [name, value] : point) vars[name] = value;
+  Result<double> value = e->TryEvaluate(vars);
+  if (!value.ok()) return value.status();
+  // NaN (a metric without a value, e.g. nav_time_s of a failed run) never
+  // satisfies a constraint.
+  return std::isfinite(*value) && *value != 0.0;
+}
+
+Result<PointConfig> ApplyPoint(const Spec& spec, const DesignPoint& point) {
+  ADSE_RETURN_IF_ERROR(spec.design_space.Check(point));
+  PointConfig config{spec.platform, spec.stack};
+  for (const DesignParameter& p : spec.design_space.parameters) {
+    const double value = point.at(p.name);
+    if (p.bind == kPlatformCores) {
+      config.platform.cores = static_cast<int>(std::lround(value));
+    } else if (p.bind == kPlatformFreq) {
+      config.platform.freq_ghz = value;
+    } else if (p.bind.rfind("stack.", 0) == 0) {
+      ADSE_RETURN_IF_ERROR(config.stack.Set(p.bind.substr(6), value));
+    } else {
+      return Status::InvalidArgument(p.name + ": unknown target " + p.bind);
+    }
+  }
+  return config;
+}
+
+}  // namespace adse::spec

@@ -1,0 +1,54 @@
+// Design points of a spec: parsed from and written as "cores=4,...",
+// priced by the cost expression, checked against constraints and applied
+// to the platform and stack one run uses.
+#ifndef ADSE_HARNESS_SPEC_DESIGN_POINT_H_
+#define ADSE_HARNESS_SPEC_DESIGN_POINT_H_
+
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "harness/spec/spec.h"
+#include "stack/base/status.h"
+
+namespace adse::spec {
+
+// Parses a command-line point "cores=4,freq_ghz=1.2,lidar_hz=14" against
+// the space. Values are snapped to the exact allowed values. Errors name
+// unknown parameters (with a suggestion), values not allowed (with the
+// allowed ones) and missing parameters.
+Result<DesignPoint> ParsePoint(const DesignSpace& space, std::string_view text);
+
+// The inverse of ParsePoint: "cores=4,freq_ghz=1.2,lidar_hz=14", parameters
+// in space order (names the space lacks follow in name order), values in
+// their shortest exact form.
+std::string FormatPoint(const DesignSpace& space, const DesignPoint& point);
+
+// Names the `cost` expression may use: design parameters, `cores`,
+// `freq_ghz`.
+std::vector<std::string> CostVariableNames(const DesignSpace& space);
+// Names constraints may use: known metrics and design parameters.
+std::vector<std::string> ConstraintVariableNames(const DesignSpace& space);
+
+// The hardware cost of a point: the spec's cost expression with the point's
+// values, and `cores`/`freq_ghz` from the point when bound, else from the
+// platform defaults.
+Result<double> EvaluateCost(const Spec& spec, const DesignPoint& point);
+
+// Whether `metrics` (name -> value; booleans as 0/1) and the point satisfy
+// one constraint expression of the spec (true when non-zero).
+Result<bool> EvaluateConstraint(const Spec& spec, const std::string& constraint,
+                                const std::map<std::string, double>& metrics,
+                                const DesignPoint& point);
+
+// A design point applied to the spec: the platform and stack one run uses.
+struct PointConfig {
+  PlatformOptions platform;
+  StackConfig stack;
+};
+Result<PointConfig> ApplyPoint(const Spec& spec, const DesignPoint& point);
+
+}  // namespace adse::spec
+
+#endif  // ADSE_HARNESS_SPEC_DESIGN_POINT_H_

@@ -1,0 +1,69 @@
+#include "harness/spec/types.h"
+
+#include <algorithm>
+
+#include "stack/base/vocabulary.h"
+
+namespace adse::spec {
+namespace {
+
+const std::vector<Term<PlatformKind>>& PlatformKindTerms() {
+  static const std::vector<Term<PlatformKind>> kTerms = {
+      {PlatformKind::kVirtual, "virtual"}, {PlatformKind::kCgroup, "cgroup"}};
+  return kTerms;
+}
+
+const std::vector<Term<CostModel>>& CostModelTerms() {
+  static const std::vector<Term<CostModel>> kTerms = {
+      {CostModel::kMeasured, "measured"}, {CostModel::kCounted, "counted"}};
+  return kTerms;
+}
+
+}  // namespace
+
+const char* PlatformKindToString(PlatformKind kind) {
+  return NameOf(PlatformKindTerms(), kind);
+}
+bool StringToPlatformKind(std::string_view name, PlatformKind* kind) {
+  return ValueOf(PlatformKindTerms(), name, kind);
+}
+std::vector<std::string> PlatformKindNames() {
+  return NamesOf(PlatformKindTerms());
+}
+
+const char* CostModelToString(CostModel model) {
+  return NameOf(CostModelTerms(), model);
+}
+bool StringToCostModel(std::string_view name, CostModel* model) {
+  return ValueOf(CostModelTerms(), name, model);
+}
+std::vector<std::string> CostModelNames() { return NamesOf(CostModelTerms()); }
+
+const std::vector<std::string>& StrategyNames() {
+  static const std::vector<std::string> kNames = {
+      "exhaustive", "random", "ga", "nsga2", "agent", kLlmStrategy};
+  return kNames;
+}
+
+bool IsStrategyName(std::string_view name) {
+  const std::vector<std::string>& names = StrategyNames();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+const std::vector<std::string>& LlmBackendNames() {
+  static const std::vector<std::string> kNames = {"ollama", "openai", "replay"};
+  return kNames;
+}
+
+const std::vector<std::string>& LlmRoleNames() {
+  static const std::vector<std::string> kNames = {"dse", "vision", "text",
+                                                  "command", "interpretation"};
+  return kNames;
+}
+
+const std::vector<std::string>& ExecutorNames() {
+  static const std::vector<std::string> kNames = {"local", "slurm"};
+  return kNames;
+}
+
+}  // namespace adse::spec
