@@ -474,11 +474,12 @@ Status ReadContents(hid_t file, CampaignIndex* index) {
 
 }  // namespace
 
-Status WriteCampaignIndex(const std::string& path, const CampaignIndex& index) {
+Status WriteCampaignIndex(const std::string& path, const CampaignIndex& index,
+                          Env* env) {
   try {
     ADSE_RETURN_IF_ERROR(Validate(index));
     return internal::WriteFileAtomically(
-        path, [&index](hid_t file) { return WriteContents(file, index); });
+        path, [&index](hid_t file) { return WriteContents(file, index); }, env);
   } catch (const std::bad_alloc&) {
     return Status::Internal(path +
                             ": out of memory writing the campaign index");

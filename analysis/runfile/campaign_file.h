@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 
 namespace adse::runfile {
@@ -88,7 +89,8 @@ struct CampaignIndex {
 // not in `parameters`/`metrics` (it would be lost); if an iteration's
 // content key is empty or holds ','; or if a string holds a NUL byte.
 // IoError if the file cannot be written (no temporary is left).
-Status WriteCampaignIndex(const std::string& path, const CampaignIndex& index);
+Status WriteCampaignIndex(const std::string& path, const CampaignIndex& index,
+                          Env* env = Env::Default());
 
 // NotFound / Corruption (naming the file and object) like ReadRunFile:
 // Corruption also for a file whose `kind` is not "adse-campaign" (e.g. a run

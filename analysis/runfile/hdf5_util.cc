@@ -226,15 +226,22 @@ Result<std::vector<std::string>> ReadStrings(hid_t obj, bool is_attr,
     const herr_t rc = is_attr ? H5Aread(obj, mem_type.get(), texts.data())
                               : H5Dread(obj, mem_type.get(), H5S_ALL, H5S_ALL,
                                         H5P_DEFAULT, texts.data());
-    if (rc < 0) return ReadHdf5Error(what, "reading");
-    for (size_t i = 0; i < n; ++i) {
-      if (texts[i] != nullptr) values[i] = texts[i];
+    // Taken before the reclaim, whose call clears HDF5's error stack.
+    const Status status =
+        rc < 0 ? ReadHdf5Error(what, "reading") : Status::Ok();
+    if (status.ok()) {
+      for (size_t i = 0; i < n; ++i) {
+        if (texts[i] != nullptr) values[i] = texts[i];
+      }
     }
+    // Also after a failed read: HDF5 may have filled some strings before
+    // failing on a damaged one, and they are ours to free.
 #if H5_VERSION_GE(1, 12, 0)
     H5Treclaim(mem_type.get(), space.get(), H5P_DEFAULT, texts.data());
 #else
     H5Dvlen_reclaim(mem_type.get(), space.get(), H5P_DEFAULT, texts.data());
 #endif
+    if (!status.ok()) return status;
     return values;
   }
   const size_t width = H5Tget_size(type.get());
@@ -451,26 +458,13 @@ std::string TakeHdf5Error() {
   return descriptions.front() + " (" + descriptions.back() + ")";
 }
 
-Status SyncPath(const std::string& path, bool directory) {
-  const int fd = ::open(path.c_str(), O_RDONLY | (directory ? O_DIRECTORY : 0));
-  if (fd < 0) return Status::IoError(path + ": " + std::strerror(errno));
-  const int rc = ::fsync(fd);
-  const int err = errno;
-  ::close(fd);
-  // Some filesystems refuse fsync on a directory; the rename still holds.
-  if (rc != 0 && !(directory && (err == EINVAL || err == EBADF))) {
-    return Status::IoError(path + ": fsync: " + std::strerror(err));
-  }
-  return Status::Ok();
-}
-
 Status WriteFileAtomically(
     const std::string& path,
-    const std::function<Status(hid_t file)>& write_contents) {
+    const std::function<Status(hid_t file)>& write_contents, Env* env) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   if (target.has_parent_path()) {
-    ADSE_RETURN_IF_ERROR(MakeDirs(target.parent_path().string()));
+    ADSE_RETURN_IF_ERROR(MakeDirs(target.parent_path().string(), env));
   }
   const std::string tmp = TemporaryPathFor(path);
   Status status;
@@ -489,18 +483,11 @@ Status WriteFileAtomically(
       }
     }
   }
-  if (status.ok()) status = SyncPath(tmp, /*directory=*/false);
-  if (status.ok() && ::rename(tmp.c_str(), path.c_str()) != 0) {
-    status = Status::IoError(path + ": rename from " + tmp +
-                             " failed: " + std::strerror(errno));
-  }
   if (!status.ok()) {
-    ::unlink(tmp.c_str());
+    (void)env->RemoveFile(tmp);
     return status;
   }
-  const std::string folder =
-      target.has_parent_path() ? target.parent_path().string() : ".";
-  return SyncPath(folder, /*directory=*/true);
+  return CommitTemporary(tmp, path, env);
 }
 
 Status ReadFileContents(

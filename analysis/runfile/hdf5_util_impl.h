@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 
 namespace adse::runfile::internal {
@@ -68,20 +69,17 @@ std::string TakeHdf5Error();
 // ---------------------------------------------------------------------------
 // Whole files (used by run files and the campaign index alike).
 
-// Makes `path`'s bytes durable (fsync). For a folder, filesystems that refuse
-// fsync on directories are tolerated.
-Status SyncPath(const std::string& path, bool directory);
-
 // Writes a new HDF5 file at `path` atomically: creates the parent folders,
 // creates `<path>.tmp.<host>.<pid>` (MakeFileAccessProps), calls
-// `write_contents` on it inside an Hdf5Session, closes (flushes) and fsyncs it,
-// renames it over `path` and fsyncs the folder. So readers see the old file or
+// `write_contents` on it inside an Hdf5Session, closes it and commits it
+// through `env` (adse::CommitTemporary: fsync, rename over `path`, fsync of
+// the folder). So readers see the old file or
 // the whole new one. Errors of `write_contents` get the temporary's name as
 // context; file system failures are IoError. No temporary is left behind on
 // failure.
 Status WriteFileAtomically(
     const std::string& path,
-    const std::function<Status(hid_t file)>& write_contents);
+    const std::function<Status(hid_t file)>& write_contents, Env* env);
 
 // Opens the HDF5 file `path` read-only and calls `read_contents` inside an
 // Hdf5Session. NotFound if `path` does not exist; InvalidArgument if it is a

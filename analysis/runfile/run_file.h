@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "analysis/runfile/run_data.h"
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 
 namespace adse::runfile {
@@ -32,7 +33,8 @@ inline constexpr size_t kKindBytes = 32;   // callback kind
 // run.status is not "complete"/"failed", a topic event has an unknown kind
 // or a non-empty scenario_hash is not the sha256 of scenario_text; IoError
 // if the file cannot be written (no temporary is left).
-Status WriteRunFile(const std::string& path, const RunData& run);
+Status WriteRunFile(const std::string& path, const RunData& run,
+                    Env* env = Env::Default());
 
 // Reads a whole run file back; WriteRunFile then ReadRunFile is exact except
 // for compound strings longer than their width. NotFound if `path` does not

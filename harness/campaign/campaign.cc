@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <thread>
 
@@ -28,8 +29,8 @@ using Clock = std::chrono::steady_clock;
 class ViewRefresher : public ExplorerListener {
  public:
   ViewRefresher(const spec::Spec& spec, CampaignSummary* summary,
-                ExplorerListener* next)
-      : spec_(spec), summary_(summary), next_(next) {}
+                ExplorerListener* next, Env* env)
+      : spec_(spec), summary_(summary), next_(next), env_(env) {}
 
   void OnProposed(const explore::Strategy& strategy,
                   const runfile::IterationRow& iteration,
@@ -43,8 +44,12 @@ class ViewRefresher : public ExplorerListener {
     const auto now = Clock::now();
     if (now - last_write_ > std::chrono::seconds(3)) {
       last_write_ = now;
-      // Views are conveniences; a failure here is reported at the end.
-      (void)WriteCampaignViews(spec_, *summary_);
+      // The runs are safe in runs/; the views are rebuilt at the end, where
+      // a failure that lasts is an error. Say it now all the same.
+      if (Status s = WriteCampaignViews(spec_, *summary_, env_); !s.ok()) {
+        std::fprintf(stderr, "warning: the campaign views are stale: %s\n",
+                     s.message().c_str());
+      }
     }
   }
 
@@ -52,6 +57,7 @@ class ViewRefresher : public ExplorerListener {
   const spec::Spec& spec_;
   CampaignSummary* summary_;
   ExplorerListener* next_;
+  Env* env_;
   Clock::time_point last_write_ = Clock::now();
 };
 
@@ -126,8 +132,8 @@ Status OpenCache(const spec::Spec& spec, const CampaignOptions& options,
   std::string dir = options.cache_dir;
   if (dir.empty()) dir = spec.harness.cache_dir;
   if (dir.empty()) dir = DefaultCacheDir() + "/runs";
-  ADSE_RETURN_IF_ERROR(MakeDirs(dir));
-  cache->emplace(dir);
+  ADSE_RETURN_IF_ERROR(MakeDirs(dir, options.env));
+  cache->emplace(dir, options.env);
   return Status::Ok();
 }
 
@@ -188,7 +194,7 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
   summary.output_dir =
       options.output_dir.empty() ? spec.ResolvedOutput() : options.output_dir;
   summary.strategy = spec.exploration.strategy;
-  const CampaignFolder folder(summary.output_dir);
+  const CampaignFolder folder(summary.output_dir, options.env);
   ADSE_RETURN_IF_ERROR(folder.Create());
   Result<CampaignLock> lock = CampaignLock::Acquire(folder.root());
   if (!lock.ok()) return lock.status();
@@ -205,7 +211,7 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
   PoolEvaluator evaluator(spec, folder, pool->get(),
                           EvaluatorOptions(spec, options, cache));
 
-  ViewRefresher refresher(spec, &summary, options.listener);
+  ViewRefresher refresher(spec, &summary, options.listener, options.env);
   ExplorationResult result = Explore(spec, **strategy, evaluator, &refresher);
   if (result.interrupted) {
     summary.interrupted_by = StopSignal();
@@ -230,7 +236,7 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
   summary.pareto_front = ParetoFrontOf(spec, summary.exploration.evaluations);
   summary.wall_s =
       std::chrono::duration<double>(Clock::now() - started).count();
-  ADSE_RETURN_IF_ERROR(WriteCampaignViews(spec, summary));
+  ADSE_RETURN_IF_ERROR(WriteCampaignViews(spec, summary, options.env));
   if (Status failed = (*strategy)->failure(); !failed.ok()) {
     return failed.WithContext(
         fmt::format("the {} strategy cannot go on ({} evaluations kept in {})",
@@ -252,7 +258,7 @@ Result<CampaignSummary> EvaluatePoints(const spec::Spec& input,
   summary.output_dir =
       options.output_dir.empty() ? spec.ResolvedOutput() : options.output_dir;
   summary.strategy = spec.exploration.strategy;
-  const CampaignFolder folder(summary.output_dir);
+  const CampaignFolder folder(summary.output_dir, options.env);
   ADSE_RETURN_IF_ERROR(folder.Create());
   Result<std::unique_ptr<pool::WorkerPool>> pool =
       MakePool(spec, options, &summary);

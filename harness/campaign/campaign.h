@@ -17,6 +17,7 @@
 #include "harness/campaign/explorer.h"
 #include "harness/pool/worker_pool.h"
 #include "harness/spec/spec.h"
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 
 namespace adse::campaign {
@@ -61,6 +62,10 @@ struct CampaignOptions {
   // after Ctrl-C. 0: none.
   int drain_signal = 0;
   double drain_grace_s = 0.0;
+  // Everything the coordinator writes (views, failure records, derived
+  // reports, pictures, cache copies) goes through it; tests inject faults.
+  // Worker processes write their run files through the real filesystem.
+  Env* env = Env::Default();
 };
 
 struct CampaignSummary {
@@ -107,7 +112,8 @@ std::optional<EvaluationRow> RecordedRow(const spec::Spec& spec,
 // Rebuilds campaign.h5, report.md, summary.json and pareto.png from an
 // exploration's rows (also done by RunCampaign as it goes).
 Status WriteCampaignViews(const spec::Spec& spec,
-                          const CampaignSummary& summary);
+                          const CampaignSummary& summary,
+                          Env* env = Env::Default());
 
 // The views that answer the question (summary.json, report.md, pareto.png),
 // led by the headline (harness/campaign/headline.h), written into `dir`;
@@ -115,7 +121,8 @@ Status WriteCampaignViews(const spec::Spec& spec,
 // `dir`. WriteCampaignViews writes them into the campaign folder; adse
 // analyze into an analysis version.
 Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
-                        const std::string& dir, const std::string& image_dir);
+                        const std::string& dir, const std::string& image_dir,
+                        Env* env = Env::Default());
 
 }  // namespace adse::campaign
 

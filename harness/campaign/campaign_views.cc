@@ -267,8 +267,8 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
 }  // namespace
 
 Status WriteCampaignViews(const spec::Spec& spec,
-                          const CampaignSummary& summary) {
-  const CampaignFolder folder(summary.output_dir);
+                          const CampaignSummary& summary, Env* env) {
+  const CampaignFolder folder(summary.output_dir, env);
   const auto& rows = summary.exploration.evaluations;
 
   runfile::CampaignIndex index;
@@ -313,14 +313,15 @@ Status WriteCampaignViews(const spec::Spec& spec,
     }
   }
   ADSE_RETURN_IF_ERROR(
-      runfile::WriteCampaignIndex(folder.Path("campaign.h5"), index));
+      runfile::WriteCampaignIndex(folder.Path("campaign.h5"), index, env));
 
-  return WriteAnswerViews(spec, summary, folder.root(), "images");
+  return WriteAnswerViews(spec, summary, folder.root(), "images", env);
 }
 
 Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
-                        const std::string& dir, const std::string& image_dir) {
-  const CampaignFolder folder(dir);
+                        const std::string& dir, const std::string& image_dir,
+                        Env* env) {
+  const CampaignFolder folder(dir, env);
   const auto& rows = summary.exploration.evaluations;
   std::optional<LlmRecords> llm;
   if (spec.exploration.strategy == "llm") {
@@ -389,11 +390,12 @@ Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
   }
   ADSE_RETURN_IF_ERROR(WriteFileAtomic(
       folder.Path("summary.json"),
-      j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"));
-  ADSE_RETURN_IF_ERROR(
-      WriteFileAtomic(folder.Path("report.md"),
-                      ReportMarkdown(spec, current, headline, image_dir,
-                                     llm ? &*llm : nullptr)));
+      j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n",
+      env));
+  ADSE_RETURN_IF_ERROR(WriteFileAtomic(
+      folder.Path("report.md"),
+      ReportMarkdown(spec, current, headline, image_dir, llm ? &*llm : nullptr),
+      env));
 
   // The picture is a convenience: a plot that cannot be drawn (e.g. no
   // finite point) leaves the other views intact.
@@ -402,7 +404,7 @@ Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
       fmt::format("{}: {} evaluations, {} on the cost-time front ({})",
                   spec.name, rows.size(), headline.cost_time_front.size(),
                   spec.exploration.strategy),
-      folder.Path("pareto.png"));
+      folder.Path("pareto.png"), env);
   return Status::Ok();
 }
 

@@ -10,6 +10,7 @@
 
 #include "analysis/pictures/pictures.h"
 #include "harness/spec/spec_parser.h"
+#include "stack/base/files.h"
 
 namespace adse::campaign {
 namespace {
@@ -215,7 +216,7 @@ std::string HeadlineMarkdown(const spec::Spec& spec,
 Status RenderFrontPicture(const spec::Spec& spec,
                           const std::vector<EvaluationRow>& rows,
                           const Headline& h, const std::string& title,
-                          const std::string& png_path) {
+                          const std::string& png_path, Env* env) {
   std::vector<bool> on_front(rows.size(), false);
   for (int i : h.cost_time_front) on_front[i] = true;
   std::vector<analysis::ParetoPlotPoint> plot;
@@ -243,7 +244,9 @@ Status RenderFrontPicture(const spec::Spec& spec,
       options.vertical_lines.push_back(bound);
     }
   }
-  return analysis::RenderParetoPlot(plot, png_path, options);
+  Result<std::string> png = analysis::ParetoPlotPng(plot, options);
+  if (!png.ok()) return png.status();
+  return WriteFileAtomic(png_path, *png, env);
 }
 
 }  // namespace adse::campaign

@@ -10,6 +10,7 @@
 
 #include "harness/campaign/evaluation.h"
 #include "harness/spec/spec.h"
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 
 namespace adse::campaign {
@@ -60,7 +61,8 @@ std::string HeadlineMarkdown(const spec::Spec& spec,
 Status RenderFrontPicture(const spec::Spec& spec,
                           const std::vector<EvaluationRow>& rows,
                           const Headline& headline, const std::string& title,
-                          const std::string& png_path);
+                          const std::string& png_path,
+                          Env* env = Env::Default());
 
 // A constraint of the form `metric OP number` or `number OP metric`
 // (OP one of < <= > >=) on `metric`: its bound. False for anything else.

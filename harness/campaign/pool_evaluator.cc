@@ -94,15 +94,16 @@ std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
     const std::string image_dir = folder_.ImageDir(p.key);
     // Pictures are drawn once; a resumed campaign reuses them.
     if (!fs::exists(folder_.TrajectoryImagePath(p.key), ec)) {
-      fs::create_directories(image_dir, ec);
-      analyze.image_dir = image_dir;
+      if (MakeDirs(image_dir, folder_.env()).ok())
+        analyze.image_dir = image_dir;
+      analyze.env = folder_.env();
     }
     Result<report::RunReport> report =
         run.ok() ? report::AnalyzeRun(*run, path, analyze)
                  : Result<report::RunReport>(run.status());
     if (!report.ok()) {
       // Keep the evidence, out of the way of the content-keyed name.
-      fs::rename(path, path + ".unreadable", ec);
+      (void)folder_.env()->RenameFile(path, path + ".unreadable");
       std::fprintf(stderr, "warning: %s is unusable (%s); running it again\n",
                    path.c_str(), report.status().message().c_str());
       return std::nullopt;
@@ -110,7 +111,8 @@ std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
     row = RowFromReport(*report);
     // Derived data: losing it only costs this analysis again.
     (void)WriteFileAtomic(folder_.ReportPath(p.key),
-                          report::ToJson(*report).dump(1) + "\n");
+                          report::ToJson(*report).dump(1) + "\n",
+                          folder_.env());
   }
   row->index = p.request.index;
   row->iteration = p.request.iteration;
@@ -275,7 +277,8 @@ void PoolEvaluator::Finish(const pool::JobResult& result) {
   record.wall_s = result.wall_s;
   record.detail = detail;
   record.stderr_tail = result.stderr_tail;
-  if (Status s = WriteFailureRecord(folder_.FailurePath(p.key), record);
+  if (Status s =
+          WriteFailureRecord(folder_.FailurePath(p.key), record, folder_.env());
       !s.ok()) {
     std::fprintf(stderr, "warning: %s\n", s.message().c_str());
   }

@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 
 Status CampaignFolder::Create() const {
   for (const char* sub : {"", "/runs", "/logs", "/images"}) {
-    ADSE_RETURN_IF_ERROR(MakeDirs(root_ + sub));
+    ADSE_RETURN_IF_ERROR(MakeDirs(root_ + sub, env_));
   }
   return Status::Ok();
 }
@@ -93,7 +93,8 @@ CampaignLock::~CampaignLock() {
   }
 }
 
-Status WriteFailureRecord(const std::string& path, const FailureRecord& r) {
+Status WriteFailureRecord(const std::string& path, const FailureRecord& r,
+                          Env* env) {
   const nlohmann::json j = {{"content_key", r.content_key},
                             {"point", r.point},
                             {"seed", r.seed},
@@ -107,7 +108,8 @@ Status WriteFailureRecord(const std::string& path, const FailureRecord& r) {
   // Worker output may hold invalid UTF-8; replace rather than fail.
   return WriteFileAtomic(
       path,
-      j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+      j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n",
+      env);
 }
 
 Result<FailureRecord> ReadFailureRecord(const std::string& path) {
@@ -136,25 +138,16 @@ Result<FailureRecord> ReadFailureRecord(const std::string& path) {
   return r;
 }
 
-Status CopyFileAtomic(const std::string& from, const std::string& to) {
-  const fs::path target(to);
-  ADSE_RETURN_IF_ERROR(MakeDirs(target.parent_path().string()));
+Status CopyFileAtomic(const std::string& from, const std::string& to,
+                      Env* env) {
+  ADSE_RETURN_IF_ERROR(MakeDirs(fs::path(to).parent_path().string(), env));
   const std::string temp = TemporaryPathFor(to);
-  std::error_code ec;
-  fs::remove(temp, ec);
-  fs::create_hard_link(from, temp, ec);
-  if (ec) {
-    ec.clear();
-    fs::copy_file(from, temp, fs::copy_options::overwrite_existing, ec);
+  (void)env->RemoveFile(temp);  // left by a crashed copy of this process id
+  if (Status copied = env->CopyFile(from, temp); !copied.ok()) {
+    (void)env->RemoveFile(temp);
+    return copied;
   }
-  if (!ec) fs::rename(temp, to, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(temp, ignored);
-    return Status::IoError(
-        fmt::format("cannot copy {} to {}: {}", from, to, ec.message()));
-  }
-  return Status::Ok();
+  return CommitTemporary(temp, to, env);
 }
 
 std::optional<std::string> RunCache::Find(const std::string& key) const {
@@ -166,12 +159,12 @@ std::optional<std::string> RunCache::Find(const std::string& key) const {
 
 Status RunCache::Insert(const std::string& key,
                         const std::string& run_file) const {
-  return CopyFileAtomic(run_file, dir_ + "/" + key + ".h5");
+  return CopyFileAtomic(run_file, dir_ + "/" + key + ".h5", env_);
 }
 
 Status RunCache::CopyOut(const std::string& key,
                          const std::string& destination) const {
-  return CopyFileAtomic(dir_ + "/" + key + ".h5", destination);
+  return CopyFileAtomic(dir_ + "/" + key + ".h5", destination, env_);
 }
 
 }  // namespace adse::campaign

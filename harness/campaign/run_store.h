@@ -9,6 +9,7 @@
 #include <string>
 
 #include "analysis/runfile/campaign_file.h"
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 
 namespace adse::campaign {
@@ -24,11 +25,14 @@ namespace adse::campaign {
 //   .lock                   held by the running coordinator
 class CampaignFolder {
  public:
-  explicit CampaignFolder(std::string root) : root_(std::move(root)) {}
+  // Everything the coordinator writes into the folder goes through `env`.
+  explicit CampaignFolder(std::string root, Env* env = Env::Default())
+      : root_(std::move(root)), env_(env) {}
   // Creates the folder and its subfolders.
   Status Create() const;
 
   const std::string& root() const { return root_; }
+  Env* env() const { return env_; }
   std::string RunPath(const std::string& key) const;
   std::string ReportPath(const std::string& key) const;
   std::string FailurePath(const std::string& key) const;
@@ -40,6 +44,7 @@ class CampaignFolder {
 
  private:
   std::string root_;
+  Env* env_;
 };
 
 // Exclusive use of a campaign folder by one coordinator: an flock on
@@ -74,7 +79,8 @@ struct FailureRecord {
   std::string detail;  // one line: what happened
   std::string stderr_tail;
 };
-Status WriteFailureRecord(const std::string& path, const FailureRecord& record);
+Status WriteFailureRecord(const std::string& path, const FailureRecord& record,
+                          Env* env = Env::Default());
 Result<FailureRecord> ReadFailureRecord(const std::string& path);
 
 // The shared evaluation cache: <dir>/<key>.h5, filled by every campaign
@@ -82,7 +88,8 @@ Result<FailureRecord> ReadFailureRecord(const std::string& path);
 // the content), so concurrent campaigns can share it without locks.
 class RunCache {
  public:
-  explicit RunCache(std::string dir) : dir_(std::move(dir)) {}
+  explicit RunCache(std::string dir, Env* env = Env::Default())
+      : dir_(std::move(dir)), env_(env) {}
   const std::string& dir() const { return dir_; }
   // The cached file for `key`, if any.
   std::optional<std::string> Find(const std::string& key) const;
@@ -93,11 +100,13 @@ class RunCache {
 
  private:
   std::string dir_;
+  Env* env_;
 };
 
 // Copies `from` to `to` through a temporary name in `to`'s folder (hard
 // link when possible), so `to` never exists half-written.
-Status CopyFileAtomic(const std::string& from, const std::string& to);
+Status CopyFileAtomic(const std::string& from, const std::string& to,
+                      Env* env = Env::Default());
 
 }  // namespace adse::campaign
 

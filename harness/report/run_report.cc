@@ -11,6 +11,7 @@
 #include "analysis/metrics/run_metrics.h"
 #include "analysis/pictures/pictures.h"
 #include "harness/spec/spec_parser.h"
+#include "stack/base/files.h"
 
 namespace adse::report {
 namespace {
@@ -117,8 +118,10 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
 
   if (!options.image_dir.empty()) {
     const std::string png = options.image_dir + "/trajectory.png";
-    Status drawn = analysis::RenderTrajectoryImage(run, png);
-    if (drawn.ok()) r.images["trajectory"] = png;
+    Result<std::string> bytes = analysis::TrajectoryImagePng(run);
+    if (bytes.ok() && WriteFileAtomic(png, *bytes, options.env).ok()) {
+      r.images["trajectory"] = png;
+    }
   }
   return r;
 }

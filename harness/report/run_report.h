@@ -13,6 +13,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "analysis/runfile/run_data.h"
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 
 namespace adse::report {
@@ -25,6 +26,8 @@ struct AnalyzeOptions {
   double deviation_normalize_by_m = 0.0;
   // Folder for pictures; empty: no pictures.
   std::string image_dir;
+  // Where the pictures are written through.
+  Env* env = Env::Default();
 };
 
 struct ConstraintStatus {

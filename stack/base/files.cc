@@ -36,58 +36,38 @@ Result<std::string> ReadFile(const std::string& path, size_t max_bytes) {
 
 namespace {
 
-// Writes all of `data` to `fd`, flushes it to disk and closes it (also on
-// failure); errors name `path`.
-Status WriteAllAndClose(int fd, const std::string& data,
-                        const std::string& path) {
-  size_t written = 0;
-  while (written < data.size()) {
-    const ssize_t n = ::write(fd, data.data() + written, data.size() - written);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const std::string err = std::strerror(errno);
-      ::close(fd);
-      return Status::IoError(path + ": " + err);
-    }
-    written += static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0) {
-    const std::string err = std::strerror(errno);
-    ::close(fd);
-    return Status::IoError(path + ": " + err);
-  }
-  if (::close(fd) != 0)
-    return Status::IoError(path + ": " + std::strerror(errno));
-  return Status::Ok();
+std::string FolderOf(const std::string& path) {
+  const fs::path parent = fs::path(path).parent_path();
+  return parent.empty() ? "." : parent.string();
 }
 
 }  // namespace
 
-Status WriteFileAtomic(const std::string& path, const std::string& data) {
-  const fs::path target(path);
-  if (target.has_parent_path()) {
-    ADSE_RETURN_IF_ERROR(MakeDirs(target.parent_path().string()));
-  }
+Status WriteFileAtomic(const std::string& path, const std::string& data,
+                       Env* env) {
+  ADSE_RETURN_IF_ERROR(env->CreateDir(FolderOf(path)));
   const std::string tmp = TemporaryPathFor(path);
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd < 0) return Status::IoError(tmp + ": " + std::strerror(errno));
-  if (Status s = WriteAllAndClose(fd, data, tmp); !s.ok()) {
-    ::unlink(tmp.c_str());
+  if (Status s = env->WriteFile(tmp, data); !s.ok()) {
+    (void)env->RemoveFile(tmp);
     return s;
   }
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string err = std::strerror(errno);
-    ::unlink(tmp.c_str());
-    return Status::IoError(path + ": rename failed: " + err);
-  }
-  return Status::Ok();
+  return CommitTemporary(tmp, path, env);
 }
 
-Status AppendLineDurable(const std::string& path, const std::string& line) {
-  const std::string data = line + "\n";
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-  if (fd < 0) return Status::IoError(path + ": " + std::strerror(errno));
-  return WriteAllAndClose(fd, data, path);
+Status CommitTemporary(const std::string& temporary, const std::string& path,
+                       Env* env) {
+  Status s = env->SyncFile(temporary);
+  if (s.ok()) s = env->RenameFile(temporary, path);
+  if (!s.ok()) {
+    (void)env->RemoveFile(temporary);
+    return s;
+  }
+  return env->SyncDir(FolderOf(path));
+}
+
+Status AppendLineDurable(const std::string& path, const std::string& line,
+                         Env* env) {
+  return env->AppendFile(path, line + "\n");
 }
 
 std::string DefaultCacheDir() {
@@ -101,12 +81,8 @@ std::string DefaultCacheDir() {
   return (fs::temp_directory_path() / "adse-cache").string();
 }
 
-Status MakeDirs(const std::string& path) {
-  std::error_code ec;
-  fs::create_directories(path, ec);
-  if (ec)
-    return Status::IoError(path + ": cannot create folder: " + ec.message());
-  return Status::Ok();
+Status MakeDirs(const std::string& path, Env* env) {
+  return env->CreateDir(path);
 }
 
 std::string TemporaryPathFor(const std::string& path) {

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <string>
 
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 
 namespace adse {
@@ -13,21 +14,32 @@ namespace adse {
 Result<std::string> ReadFile(const std::string& path,
                              size_t max_bytes = 64u << 20);
 
-// Writes `data` to a temporary name in the target's folder, flushes it and
-// renames it over `path`, so readers see the old file or the whole new one.
-Status WriteFileAtomic(const std::string& path, const std::string& data);
+// Writes `data` to a temporary name in the target's folder
+// (TemporaryPathFor), flushes it and renames it over `path`, so readers see
+// the old file or the whole new one, never a part. No temporary is left on
+// failure, except after a crash between write and rename, and a temporary's
+// name never looks like the file's.
+Status WriteFileAtomic(const std::string& path, const std::string& data,
+                       Env* env = Env::Default());
+
+// The second half of an atomic write: `temporary`, fully written by its
+// writer, is flushed, renamed over `path` and the folder flushed. On failure
+// the temporary is removed.
+Status CommitTemporary(const std::string& temporary, const std::string& path,
+                       Env* env = Env::Default());
 
 // Appends `line` and a newline to `path` (created if missing) in one
 // write and flushes it to disk, so an append-only record survives a crash
 // with at most its last line cut short.
-Status AppendLineDurable(const std::string& path, const std::string& line);
+Status AppendLineDurable(const std::string& path, const std::string& line,
+                         Env* env = Env::Default());
 
 // adse's cache root: $ADSE_CACHE_DIR, else $XDG_CACHE_HOME/adse, else
 // ~/.cache/adse, else <tmp>/adse-cache.
 std::string DefaultCacheDir();
 
 // Creates `path` and its parents. Ok when it exists already.
-Status MakeDirs(const std::string& path);
+Status MakeDirs(const std::string& path, Env* env = Env::Default());
 
 // The temporary name a file is written under before it is renamed to
 // `path`: "<path>.tmp.<host>.<pid>", unique among the writers that share a

@@ -1,0 +1,84 @@
+#include "tests/stack/base/testing/fault_injection_env.h"
+
+#include <cstdlib>
+#include <cstring>
+
+namespace adse::testing {
+
+void FaultInjectionEnv::Inject(const Fault& fault) {
+  std::lock_guard<std::mutex> lock(mu_);
+  faults_.push_back({fault});
+}
+
+int FaultInjectionEnv::failures() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return failures_;
+}
+
+Status FaultInjectionEnv::Check(FaultOp op, const std::string& path,
+                                const char* what) {
+  std::lock_guard<std::mutex> lock(mu_);
+  for (Armed& armed : faults_) {
+    const Fault& f = armed.fault;
+    if (f.op != op || path.find(f.path_contains) == std::string::npos) {
+      continue;
+    }
+    if (armed.seen++ < f.after) continue;
+    if (f.times >= 0 && armed.failed >= f.times) continue;
+    if (f.crash) std::_Exit(kCrashExitCode);
+    ++armed.failed;
+    ++failures_;
+    return Status::IoError(path + ": " + what + ": " + std::strerror(f.error));
+  }
+  return Status::Ok();
+}
+
+Status FaultInjectionEnv::CreateDir(const std::string& path) {
+  ADSE_RETURN_IF_ERROR(
+      Check(FaultOp::kCreateDir, path, "cannot create folder"));
+  return target_->CreateDir(path);
+}
+
+Status FaultInjectionEnv::WriteFile(const std::string& path,
+                                    std::string_view data) {
+  if (Status s = Check(FaultOp::kWriteFile, path, "write"); !s.ok()) {
+    (void)target_->WriteFile(path, data.substr(0, data.size() / 2));
+    return s;
+  }
+  return target_->WriteFile(path, data);
+}
+
+Status FaultInjectionEnv::AppendFile(const std::string& path,
+                                     std::string_view data) {
+  if (Status s = Check(FaultOp::kAppendFile, path, "write"); !s.ok()) {
+    (void)target_->AppendFile(path, data.substr(0, data.size() / 2));
+    return s;
+  }
+  return target_->AppendFile(path, data);
+}
+
+Status FaultInjectionEnv::SyncFile(const std::string& path) {
+  ADSE_RETURN_IF_ERROR(Check(FaultOp::kSyncFile, path, "fsync"));
+  return target_->SyncFile(path);
+}
+
+Status FaultInjectionEnv::SyncDir(const std::string& path) {
+  ADSE_RETURN_IF_ERROR(Check(FaultOp::kSyncDir, path, "fsync"));
+  return target_->SyncDir(path);
+}
+
+Status FaultInjectionEnv::RenameFile(const std::string& from,
+                                     const std::string& to) {
+  ADSE_RETURN_IF_ERROR(
+      Check(FaultOp::kRenameFile, to, ("rename from " + from).c_str()));
+  return target_->RenameFile(from, to);
+}
+
+Status FaultInjectionEnv::CopyFile(const std::string& from,
+                                   const std::string& to) {
+  ADSE_RETURN_IF_ERROR(
+      Check(FaultOp::kCopyFile, to, ("copy from " + from).c_str()));
+  return target_->CopyFile(from, to);
+}
+
+}  // namespace adse::testing
