@@ -27,7 +27,7 @@ Status WriteText(const std::string& path, const std::string& text) {
   return Status::Ok();
 }
 
-std::string PathCsv(const world::Path2& path) {
+std::string PathCsv(const geometry::Path2& path) {
   std::string csv = "s_m,x_m,y_m\n";
   for (size_t i = 0; i < path.points.size(); ++i) {
     csv += fmt::format("{:.3f},{:.3f},{:.3f}\n", path.s_m[i],
@@ -113,7 +113,8 @@ int RunWorld(const WorldArgs& args) {
   std::string scan_index = "t_s,x_m,y_m,yaw_rad,points,file\n";
   int scan_number = 0;
   Status scan_status;
-  auto on_scan = [&](const world::PointCloud& cloud, const world::Pose2& pose) {
+  auto on_scan = [&](const world::PointCloud& cloud,
+                     const geometry::Pose2& pose) {
     std::string file;
     if (args.save_every_nth_scan > 0 &&
         scan_number % args.save_every_nth_scan == 0) {

@@ -161,7 +161,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     // Sensors sample the world as it is at this step.
     while (next_lidar < t + dt - 1e-9) {
       const auto t0 = Clock::now();
-      std::vector<world::OrientedBox> boxes;
+      std::vector<geometry::OrientedBox> boxes;
       boxes.reserve(w.others().size());
       for (const world::OtherVehicle& v : w.others()) boxes.push_back(v.box);
       world::PointCloud scan =

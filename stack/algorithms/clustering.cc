@@ -155,7 +155,7 @@ DetectionResult DetectObjects(const std::vector<Eigen::Vector3f>& points,
 }
 
 Detection ToMapFrame(const Detection& detection,
-                     const world::Pose2& vehicle_pose) {
+                     const geometry::Pose2& vehicle_pose) {
   Detection out = detection;
   const double c = std::cos(vehicle_pose.yaw_rad);
   const double s = std::sin(vehicle_pose.yaw_rad);

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 
 namespace adse::algorithms {
 
@@ -58,7 +58,7 @@ Detection FitBox(const std::vector<Eigen::Vector3f>& points,
 
 // Moves a detection from the vehicle frame to the map frame.
 Detection ToMapFrame(const Detection& detection,
-                     const world::Pose2& vehicle_pose);
+                     const geometry::Pose2& vehicle_pose);
 
 }  // namespace adse::algorithms
 

@@ -43,7 +43,7 @@ double SpeedAt(const std::vector<PlannedPoint>& traj, double s) {
 }  // namespace
 
 PurePursuitOutput PurePursuit::Compute(
-    const world::Pose2& pose, double v_mps,
+    const geometry::Pose2& pose, double v_mps,
     const std::vector<PlannedPoint>& traj) const {
   PurePursuitOutput out;
   if (traj.empty()) return out;
@@ -164,7 +164,7 @@ void TrajectoryFollower::Reset() {
 }
 
 FollowerCommand TrajectoryFollower::Update(
-    const world::Pose2& pose, double v_mps,
+    const geometry::Pose2& pose, double v_mps,
     const std::vector<PlannedPoint>& trajectory, double dt_s) {
   FollowerCommand cmd;
   if (trajectory.empty()) {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "stack/algorithms/planning.h"
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 
 namespace adse::algorithms {
 
@@ -35,7 +35,7 @@ class PurePursuit {
   explicit PurePursuit(const PurePursuitParams& params = {})
       : params_(params) {}
   // `pose` is the rear axle in the trajectory's frame.
-  PurePursuitOutput Compute(const world::Pose2& pose, double v_mps,
+  PurePursuitOutput Compute(const geometry::Pose2& pose, double v_mps,
                             const std::vector<PlannedPoint>& trajectory) const;
   const PurePursuitParams& params() const { return params_; }
 
@@ -100,7 +100,7 @@ class TrajectoryFollower {
   explicit TrajectoryFollower(const FollowerParams& params = {});
   // One control step: pose (rear axle, map frame) and speed now, the
   // latest trajectory, and the time since the previous step.
-  FollowerCommand Update(const world::Pose2& pose, double v_mps,
+  FollowerCommand Update(const geometry::Pose2& pose, double v_mps,
                          const std::vector<PlannedPoint>& trajectory,
                          double dt_s);
   void Reset();

@@ -27,7 +27,7 @@ double SincDerivative(double u) {
 
 Ekf::Ekf(const EkfParams& params) : params_(params) {}
 
-void Ekf::Initialize(const world::Pose2& pose, double v_mps, double t_s) {
+void Ekf::Initialize(const geometry::Pose2& pose, double v_mps, double t_s) {
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   cov.diagonal() << std::pow(params_.initial_position_std_m, 2),
       std::pow(params_.initial_position_std_m, 2),
@@ -35,8 +35,9 @@ void Ekf::Initialize(const world::Pose2& pose, double v_mps, double t_s) {
   Initialize(pose, cov, v_mps, t_s);
 }
 
-void Ekf::Initialize(const world::Pose2& pose, const Eigen::Matrix3d& pose_cov,
-                     double v_mps, double t_s) {
+void Ekf::Initialize(const geometry::Pose2& pose,
+                     const Eigen::Matrix3d& pose_cov, double v_mps,
+                     double t_s) {
   x_ << pose.x_m, pose.y_m, WrapAngle(pose.yaw_rad), v_mps, 0.0;
   p_.setZero();
   p_.topLeftCorner<3, 3>() = pose_cov;
@@ -112,7 +113,7 @@ void Ekf::UpdateOdometry(double v_mps, double yaw_rate_rps, double v_std_mps,
   p_ = i_kh * p_ * i_kh.transpose() + k * r * k.transpose();
 }
 
-bool Ekf::UpdatePose(const world::Pose2& pose, const Eigen::Matrix3d& cov) {
+bool Ekf::UpdatePose(const geometry::Pose2& pose, const Eigen::Matrix3d& cov) {
   if (!initialized_ || (params_.reinit_when_lost && Lost())) {
     // Keep what odometry taught us about speed and turn rate.
     const double v = initialized_ ? x_(kV) : 0.0;
@@ -153,8 +154,8 @@ bool Ekf::Lost() const {
   return PositionStdM() > params_.max_position_std_m;
 }
 
-world::Pose2 Ekf::pose() const {
-  return world::Pose2{x_(kX), x_(kY), x_(kYaw)};
+geometry::Pose2 Ekf::pose() const {
+  return geometry::Pose2{x_(kX), x_(kY), x_(kYaw)};
 }
 
 Eigen::Matrix3d Ekf::PoseCovariance() const { return p_.topLeftCorner<3, 3>(); }

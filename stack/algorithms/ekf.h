@@ -6,7 +6,7 @@
 
 #include <Eigen/Core>
 
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 
 namespace adse::algorithms {
 
@@ -38,8 +38,8 @@ class Ekf {
   explicit Ekf(const EkfParams& params = {});
 
   // Sets the state at time t_s (the filter's clock starts here).
-  void Initialize(const world::Pose2& pose, double v_mps, double t_s);
-  void Initialize(const world::Pose2& pose, const Eigen::Matrix3d& pose_cov,
+  void Initialize(const geometry::Pose2& pose, double v_mps, double t_s);
+  void Initialize(const geometry::Pose2& pose, const Eigen::Matrix3d& pose_cov,
                   double v_mps, double t_s);
   bool initialized() const { return initialized_; }
 
@@ -51,13 +51,13 @@ class Ekf {
   // A pose measurement (e.g. NDT) with covariance over (x, y, yaw).
   // Returns false when it was gated out as an outlier. Uninitialized (or
   // lost, with reinit_when_lost) filters are initialized from it instead.
-  bool UpdatePose(const world::Pose2& pose, const Eigen::Matrix3d& cov);
+  bool UpdatePose(const geometry::Pose2& pose, const Eigen::Matrix3d& cov);
 
   // True before initialization, when no pose update was accepted for
   // lost_after_s, or when the position uncertainty is too large.
   bool Lost() const;
 
-  world::Pose2 pose() const;
+  geometry::Pose2 pose() const;
   double v_mps() const { return x_(kV); }
   double yaw_rate_rps() const { return x_(kYawRate); }
   const State& state() const { return x_; }

@@ -37,7 +37,7 @@ void MapFilter::SetMap(const std::vector<Eigen::Vector3f>& map_points) {
 
 std::vector<Eigen::Vector3f> MapFilter::Filter(
     const std::vector<Eigen::Vector3f>& points,
-    const world::Pose2& pose) const {
+    const geometry::Pose2& pose) const {
   std::vector<Eigen::Vector3f> out;
   out.reserve(points.size());
   const double c = std::cos(pose.yaw_rad), s = std::sin(pose.yaw_rad);

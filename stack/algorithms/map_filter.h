@@ -9,7 +9,7 @@
 #include <unordered_set>
 #include <vector>
 
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 
 namespace adse::algorithms {
 
@@ -29,7 +29,7 @@ class MapFilter {
   // Points (vehicle frame) the map does not explain, given the vehicle pose.
   std::vector<Eigen::Vector3f> Filter(
       const std::vector<Eigen::Vector3f>& points,
-      const world::Pose2& pose) const;
+      const geometry::Pose2& pose) const;
 
   size_t voxels() const { return voxels_.size(); }
 

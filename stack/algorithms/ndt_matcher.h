@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "stack/base/status.h"
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 
 namespace adse::algorithms {
 
@@ -40,7 +40,7 @@ struct NdtParams {
 
 struct NdtResult {
   // Vehicle pose in the map frame (the scan-to-map transform), planar part.
-  world::Pose2 pose;
+  geometry::Pose2 pose;
   double z_m = 0.0;  // height of the transform (ground should give ~0)
   // Full scan-to-map transform, z and roll/pitch free.
   Eigen::Matrix4f transform = Eigen::Matrix4f::Identity();
@@ -73,7 +73,7 @@ class NdtMatcher {
   // (z = 0, no roll/pitch). Errors: no map, an empty scan, a PCL failure.
   // A bad match is not an error: it comes back with accepted == false.
   Result<NdtResult> Align(const std::vector<Eigen::Vector3f>& scan,
-                          const world::Pose2& initial_guess);
+                          const geometry::Pose2& initial_guess);
 
   const NdtParams& params() const { return params_; }
 

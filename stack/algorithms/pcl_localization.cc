@@ -108,7 +108,7 @@ Status NdtMatcher::SetMap(const std::vector<Eigen::Vector3f>& map_points) {
 }
 
 Result<NdtResult> NdtMatcher::Align(const std::vector<Eigen::Vector3f>& scan,
-                                    const world::Pose2& initial_guess) {
+                                    const geometry::Pose2& initial_guess) {
   if (!has_map()) return Status::Unavailable("NDT has no map");
   Cloud::Ptr source = ToCloud(scan);
   if (source->empty()) {

@@ -11,7 +11,7 @@ namespace {
 constexpr double kPassTieM = 1.0;
 
 // Segment i of the path holds arc length s ([s_m[i], s_m[i+1]]).
-size_t SegmentIndex(const world::Path2& path, double s) {
+size_t SegmentIndex(const geometry::Path2& path, double s) {
   const auto it = std::upper_bound(path.s_m.begin(), path.s_m.end(), s);
   size_t i = static_cast<size_t>(it - path.s_m.begin());
   i = i == 0 ? 0 : i - 1;
@@ -20,7 +20,7 @@ size_t SegmentIndex(const world::Path2& path, double s) {
 
 }  // namespace
 
-void BehaviorVelocityPlanner::SetPath(const world::Path2& path,
+void BehaviorVelocityPlanner::SetPath(const geometry::Path2& path,
                                       std::optional<Eigen::Vector2d> goal) {
   path_ = path;
   if (path_.s_m.size() != path_.points.size()) path_.UpdateArcLength();
@@ -118,7 +118,8 @@ double BehaviorVelocityPlanner::CurvatureAt(double s) const {
 }
 
 PlannedTrajectory BehaviorVelocityPlanner::Plan(
-    const world::Pose2& pose, const std::vector<PlannerObstacle>& obstacles) {
+    const geometry::Pose2& pose,
+    const std::vector<PlannerObstacle>& obstacles) {
   PlannedTrajectory out;
   if (!has_path()) return out;
   const Eigen::Vector2d ego(pose.x_m, pose.y_m);

@@ -8,7 +8,7 @@
 #include <optional>
 #include <vector>
 
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 
 namespace adse::algorithms {
 
@@ -72,7 +72,7 @@ class BehaviorVelocityPlanner {
 
   // A new reference path; progress restarts. The goal is projected on the
   // path (default: its end) and the ego stops there.
-  void SetPath(const world::Path2& path,
+  void SetPath(const geometry::Path2& path,
                std::optional<Eigen::Vector2d> goal = std::nullopt);
   bool has_path() const { return path_.points.size() >= 2; }
   double goal_s_m() const { return goal_s_m_; }
@@ -80,7 +80,7 @@ class BehaviorVelocityPlanner {
   // Trajectory ahead of `pose` (rear axle, map frame) with raw target
   // speeds (steps to 0 at stops; SmoothVelocity makes them drivable).
   // Empty without a path.
-  PlannedTrajectory Plan(const world::Pose2& pose,
+  PlannedTrajectory Plan(const geometry::Pose2& pose,
                          const std::vector<PlannerObstacle>& obstacles);
 
   // Progress along the path (never decreases until SetPath).
@@ -96,7 +96,7 @@ class BehaviorVelocityPlanner {
   double CurvatureAt(double s) const;
 
   PlannerParams params_;
-  world::Path2 path_;
+  geometry::Path2 path_;
   double goal_s_m_ = 0.0;
   double last_s_m_ = 0.0;
   bool has_progress_ = false;

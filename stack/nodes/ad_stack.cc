@@ -79,7 +79,7 @@ class Stack final : public AdStack {
   double ekf_stamp_ = -1.0;  // stamp of the newest fused NDT pose
   struct PoseAt {
     double t_s;
-    world::Pose2 pose;
+    geometry::Pose2 pose;
   };
   std::deque<PoseAt> ekf_history_;
   algo::MapFilter map_filter_;
@@ -175,7 +175,7 @@ Status Stack::BuildLocalization(Graph* g) {
   g->Subscribe<PointCloudMsg>(
       ndt_node, downsampled_, "points", 1,
       [this, threads](const PointCloudMsg& in, CallbackContext& ctx) {
-        world::Pose2 guess = inputs_.initial_pose;
+        geometry::Pose2 guess = inputs_.initial_pose;
         if (ndt_latest_ekf_) {
           // Move the EKF pose back to the scan's time along its motion.
           const PoseMsg& e = *ndt_latest_ekf_;
@@ -220,12 +220,12 @@ Status Stack::BuildLocalization(Graph* g) {
         ekf_last_t_ = ctx.now_s();
         // The match describes the scan's time: carry it forward by the motion
         // the EKF saw since then.
-        world::Pose2 measured = in.pose;
+        geometry::Pose2 measured = in.pose;
         const auto then = std::lower_bound(
             ekf_history_.begin(), ekf_history_.end(), in.header.stamp_s,
             [](const PoseAt& p, double t) { return p.t_s < t; });
         if (then != ekf_history_.end()) {
-          const world::Pose2 now = ekf_.pose();
+          const geometry::Pose2 now = ekf_.pose();
           const double dyaw = WrapAngle(now.yaw_rad - then->pose.yaw_rad);
           const Eigen::Vector2d moved_world(now.x_m - then->pose.x_m,
                                             now.y_m - then->pose.y_m);
@@ -309,7 +309,7 @@ void Stack::BuildPerception(Graph* g) {
         algo::DetectionResult r = algo::DetectObjects(sparse, clustering);
         ObjectsMsg out;
         out.header = in.header;
-        const world::Pose2 pose =
+        const geometry::Pose2 pose =
             cluster_pose_ ? cluster_pose_->pose : inputs_.initial_pose;
         for (const algo::Detection& d : r.detections) {
           // Clusters larger than any vehicle are static structure (a wall's

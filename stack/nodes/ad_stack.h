@@ -12,18 +12,18 @@
 
 #include "stack/base/status.h"
 #include "stack/config/stack_config.h"
+#include "stack/geometry/geometry.h"
 #include "stack/runtime/graph.h"
-#include "stack/world/geometry.h"
 
 namespace adse::stack {
 
 // What the car's computer knows before it drives: its map, its mission and
 // its own body. Never the ground truth of the run.
 struct StackInputs {
-  world::Path2 route;  // mission planner's route from map and goal
+  geometry::Path2 route;  // mission planner's route from map and goal
   double lane_width_m = 3.5;
   std::vector<Eigen::Vector3f> map_cloud;  // localization map (map frame)
-  world::Pose2 initial_pose;  // given at start, as an operator does
+  geometry::Pose2 initial_pose;  // given at start, as an operator does
   double speed_limit_mps = 30.0 / 3.6;
   double goal_tolerance_m = 2.0;
   double wheelbase_m = 2.7;

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 
 namespace adse::stack {
 
@@ -36,7 +36,7 @@ struct OdometryMsg {
 // A pose estimate in the map frame with its covariance (x, y, yaw).
 struct PoseMsg {
   Header header;
-  world::Pose2 pose;
+  geometry::Pose2 pose;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   double v_mps = 0.0;    // filtered speed (EKF output)
   double fitness = 0.0;  // scan matcher fitness (NDT), lower is better
@@ -60,7 +60,7 @@ struct ObjectsMsg {
 // The route as a reference path in the map frame.
 struct PathMsg {
   Header header;
-  world::Path2 path;
+  geometry::Path2 path;
 };
 
 struct TrajectoryPoint {

@@ -16,7 +16,7 @@ double Seconds(Clock::duration d) {
 
 // Curvature of the path around arc length s, from the heading change over
 // a window (robust to the 0.5 m sampling).
-double CurvatureAt(const Path2& path, double s) {
+double CurvatureAt(const geometry::Path2& path, double s) {
   const double ds = 2.0;
   double dh = path.HeadingAt(std::min(s + ds, path.length_m())) -
               path.HeadingAt(std::max(s - ds, 0.0));
@@ -26,7 +26,7 @@ double CurvatureAt(const Path2& path, double s) {
 
 }  // namespace
 
-double DistanceToPath(const Path2& path, const Eigen::Vector2d& p,
+double DistanceToPath(const geometry::Path2& path, const Eigen::Vector2d& p,
                       double* s_out) {
   double best = std::numeric_limits<double>::infinity();
   double best_s = 0.0;
@@ -51,7 +51,7 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
                                         const IdealDriverOptions& options,
                                         const ScanCallback& on_scan) {
   IdealDriveReport report;
-  const Path2& path = world.ideal_path();
+  const geometry::Path2& path = world.ideal_path();
   const double dt = world.step_s();
   const VehicleLimits& limits = world.ego_limits();
   const double scan_period = lidar ? 1.0 / lidar->params().rate_hz : 0.0;
@@ -73,9 +73,9 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
     }
     if (lidar && options.scan && world.time_s() + 1e-9 >= next_scan_t) {
       const auto t0 = Clock::now();
-      std::vector<OrientedBox> boxes;
+      std::vector<geometry::OrientedBox> boxes;
       for (const OtherVehicle& v : world.others()) boxes.push_back(v.box);
-      const Pose2 pose{ego.x_m, ego.y_m, ego.yaw_rad};
+      const geometry::Pose2 pose{ego.x_m, ego.y_m, ego.yaw_rad};
       PointCloud cloud = lidar->Scan(pose, world.time_s(), boxes);
       report.lidar_wall_s += Seconds(Clock::now() - t0);
       point_sum += static_cast<double>(cloud.points.size());

@@ -42,14 +42,15 @@ struct IdealDriveReport {
 };
 
 // Called after every LiDAR scan with the scan and the pose it was taken at.
-using ScanCallback = std::function<void(const PointCloud&, const Pose2&)>;
+using ScanCallback =
+    std::function<void(const PointCloud&, const geometry::Pose2&)>;
 
 Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
                                         const IdealDriverOptions& options,
                                         const ScanCallback& on_scan = nullptr);
 
 // Distance from `p` to the polyline, and the arc length of the closest point.
-double DistanceToPath(const Path2& path, const Eigen::Vector2d& p,
+double DistanceToPath(const geometry::Path2& path, const Eigen::Vector2d& p,
                       double* s_out = nullptr);
 
 }  // namespace adse::world

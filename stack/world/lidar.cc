@@ -102,8 +102,9 @@ int LidarSimulator::rays_per_scan() const {
   return static_cast<int>(elevations_rad_.size() * azimuth_cos_.size());
 }
 
-PointCloud LidarSimulator::Scan(const Pose2& sensor_pose, double stamp_s,
-                                const std::vector<OrientedBox>& vehicles) {
+PointCloud LidarSimulator::Scan(
+    const geometry::Pose2& sensor_pose, double stamp_s,
+    const std::vector<geometry::OrientedBox>& vehicles) {
   PointCloud cloud;
   cloud.stamp_s = stamp_s;
   cloud.points.reserve(rays_per_scan());
@@ -123,7 +124,7 @@ PointCloud LidarSimulator::Scan(const Pose2& sensor_pose, double stamp_s,
   // Vehicles that can be reached, with the azimuth columns they can cover,
   // so each ray tests only the one or two boxes in its direction.
   in_view_.clear();
-  for (const OrientedBox& box : vehicles) {
+  for (const geometry::OrientedBox& box : vehicles) {
     const Eigen::Vector2d rel =
         box.center - Eigen::Vector2d(sensor_pose.x_m, sensor_pose.y_m);
     // Every point of the footprint is within half a diagonal of its centre,
@@ -149,7 +150,7 @@ PointCloud LidarSimulator::Scan(const Pose2& sensor_pose, double stamp_s,
           std::atan2(rel.y(), rel.x()) - sensor_pose.yaw_rad;
       const double center_abs = std::atan2(rel.y(), rel.x());
       double lo = 0.0, hi = 0.0;
-      for (const Eigen::Vector2d& c : BoxCorners(box)) {
+      for (const Eigen::Vector2d& c : geometry::BoxCorners(box)) {
         const Eigen::Vector2d r =
             c - Eigen::Vector2d(sensor_pose.x_m, sensor_pose.y_m);
         const double d = WrapPi(std::atan2(r.y(), r.x()) - center_abs);

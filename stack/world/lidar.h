@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "stack/base/random.h"
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 #include "stack/world/scene.h"
 #include "stack/world/world_options.h"
 
@@ -52,8 +52,8 @@ class LidarSimulator {
   // `stamp_s`, seeing the static scene, the ground and `vehicles`.
   // `vehicles` should not hold the ego: a box containing the sensor is
   // ignored, but one below it would show its roof.
-  PointCloud Scan(const Pose2& sensor_pose, double stamp_s,
-                  const std::vector<OrientedBox>& vehicles);
+  PointCloud Scan(const geometry::Pose2& sensor_pose, double stamp_s,
+                  const std::vector<geometry::OrientedBox>& vehicles);
 
   const LidarParams& params() const { return params_; }
   int rays_per_scan() const;

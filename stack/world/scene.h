@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 
 namespace adse::world {
 
@@ -40,7 +40,7 @@ struct FaceCrossing {
 
 // A parking slot (for parked cars and valet goals).
 struct ParkingSlot {
-  OrientedBox box;  // slot rectangle; length along the slot's depth
+  geometry::OrientedBox box;  // slot rectangle; length along the slot's depth
   bool occupied = false;
 };
 

@@ -51,10 +51,10 @@ void BicycleModel::Step(const ControlCommand& command, double dt_s) {
   state_.accel_mps2 = (v1 - v0) / dt_s;
 }
 
-OrientedBox BicycleModel::Body() const {
+geometry::OrientedBox BicycleModel::Body() const {
   // The state is the rear axle centre; the body centre is taken half a
   // wheelbase ahead of it, i.e. equal front and rear overhangs.
-  OrientedBox box;
+  geometry::OrientedBox box;
   const double half_wb = 0.5 * limits_.wheelbase_m;
   box.center = Eigen::Vector2d(state_.x_m + half_wb * std::cos(state_.yaw_rad),
                                state_.y_m + half_wb * std::sin(state_.yaw_rad));

@@ -3,7 +3,7 @@
 #ifndef ADSE_STACK_WORLD_VEHICLE_MODEL_H_
 #define ADSE_STACK_WORLD_VEHICLE_MODEL_H_
 
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 
 namespace adse::world {
 
@@ -45,7 +45,7 @@ class BicycleModel {
   const VehicleState& state() const { return state_; }
   const VehicleLimits& limits() const { return limits_; }
   // The body as a box (centre is half a wheelbase ahead of the rear axle).
-  OrientedBox Body() const;
+  geometry::OrientedBox Body() const;
 
  private:
   VehicleLimits limits_;

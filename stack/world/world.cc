@@ -93,7 +93,7 @@ std::vector<std::string> InternalChain(const std::string& via,
 
 // Part of `shape` between arc lengths s0 and s1.
 std::vector<Vec2> Slice(const std::vector<Vec2>& shape, double s0, double s1) {
-  Path2 path;
+  geometry::Path2 path;
   path.points = shape;
   path.UpdateArcLength();
   s0 = std::clamp(s0, 0.0, path.length_m());
@@ -106,15 +106,15 @@ std::vector<Vec2> Slice(const std::vector<Vec2>& shape, double s0, double s1) {
   return out;
 }
 
-Path2 Resample(const std::vector<Vec2>& points, double step) {
-  Path2 raw;
+geometry::Path2 Resample(const std::vector<Vec2>& points, double step) {
+  geometry::Path2 raw;
   for (const Vec2& p : points) {
     if (raw.points.empty() || (p - raw.points.back()).norm() > 1e-6) {
       raw.points.push_back(p);
     }
   }
   raw.UpdateArcLength();
-  Path2 out;
+  geometry::Path2 out;
   const double length = raw.length_m();
   const int n = std::max(1, static_cast<int>(std::ceil(length / step)));
   for (int i = 0; i <= n; ++i)
@@ -131,7 +131,7 @@ struct World::Impl {
   RoadLocation start, goal;
   Vec2 goal_xy = Vec2::Zero();  // final target (inside a slot when valet)
   std::vector<std::string> route;
-  Path2 ideal;
+  geometry::Path2 ideal;
   double lane_width_m = 3.2;
   double max_join_gap_m = 0.0;
   Scene scene;
@@ -447,7 +447,7 @@ Status World::Impl::BuildIdealPath() {
       if (entry != lane[i]) {
         // A lane change: blend from the entry lane into the exit lane over
         // the middle of the edge.
-        Path2 from, to;
+        geometry::Path2 from, to;
         from.points = ToPoints(libsumo::Lane::getShape(entry_id));
         from.UpdateArcLength();
         to.points = ToPoints(libsumo::Lane::getShape(exit_id));
@@ -488,7 +488,7 @@ Status World::Impl::BuildIdealPath() {
             "task.goal: valet_parking needs the goal inside a parking slot of "
             "the map");
       }
-      Path2 road = Resample(points, kResampleStepM);
+      geometry::Path2 road = Resample(points, kResampleStepM);
       const Vec2 p0 = road.points.back();
       const double h0 = road.HeadingAt(road.length_m());
       const Vec2 t0(std::cos(h0), std::sin(h0));
@@ -627,7 +627,7 @@ Status World::Impl::BuildScene() {
         // The rightmost lane of each normal edge carries its roadside.
         if (lanes[i][0] == ':' || lanes[i].substr(lanes[i].rfind('_')) != "_0")
           continue;
-        Path2 shape;
+        geometry::Path2 shape;
         shape.points = shapes[i].points;
         shape.UpdateArcLength();
         const double offset = shapes[i].half_width + 1.0;
@@ -686,7 +686,7 @@ Status World::Impl::SetUpTraffic() {
 }
 
 void World::Impl::PushEgo() {
-  const OrientedBox body = ego->Body();
+  const geometry::OrientedBox body = ego->Body();
   const double yaw = ego->state().yaw_rad;
   // SUMO places vehicles by their front bumper.
   const Vec2 front =
@@ -815,7 +815,7 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
                            std::abs(local.y()) <= slot.box.width_m / 2;
       if (draw && !is_goal) {
         slot.occupied = true;
-        OrientedBox car;
+        geometry::OrientedBox car;
         car.center = slot.box.center + Vec2(jitter_x, jitter_y);
         car.yaw_rad = slot.box.yaw_rad + jitter_yaw;
         car.length_m = std::min(4.5, slot.box.length_m - 0.4);
@@ -823,7 +823,7 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
         car.height_m = 1.5;
         Obstacle obstacle;
         obstacle.kind = ObstacleKind::kParkedCar;
-        obstacle.footprint = BoxCorners(car);
+        obstacle.footprint = geometry::BoxCorners(car);
         obstacle.z_max_m = car.height_m;
         with_cars.AddObstacle(std::move(obstacle));
       }
@@ -857,11 +857,11 @@ Status World::Step(const ControlCommand& command) {
     w.time_s += dt;
     Status read = w.ReadOthers();
     if (!read.ok()) throw std::runtime_error(read.message());
-    const OrientedBox body = w.ego->Body();
+    const geometry::OrientedBox body = w.ego->Body();
     std::set<std::string> contact;
     w.new_contacts.clear();
     for (const OtherVehicle& v : w.others) {
-      if (BoxesOverlap(body, v.box)) {
+      if (geometry::BoxesOverlap(body, v.box)) {
         contact.insert(v.id);
         if (!w.in_contact.count(v.id)) {
           ++w.collisions;
@@ -877,7 +877,7 @@ double World::time_s() const { return impl_->time_s; }
 double World::step_s() const { return impl_->setup.world.step_s; }
 const VehicleState& World::ego() const { return impl_->ego->state(); }
 const VehicleLimits& World::ego_limits() const { return impl_->setup.ego; }
-OrientedBox World::ego_body() const { return impl_->ego->Body(); }
+geometry::OrientedBox World::ego_body() const { return impl_->ego->Body(); }
 const std::vector<OtherVehicle>& World::others() const { return impl_->others; }
 int World::collisions() const { return impl_->collisions; }
 const std::vector<std::string>& World::new_contacts() const {
@@ -890,7 +890,7 @@ double World::distance_to_goal_m() const {
 bool World::goal_reached() const {
   return distance_to_goal_m() <= impl_->setup.task.goal_tolerance_m;
 }
-const Path2& World::ideal_path() const { return impl_->ideal; }
+const geometry::Path2& World::ideal_path() const { return impl_->ideal; }
 const std::vector<std::string>& World::route_edges() const {
   return impl_->route;
 }

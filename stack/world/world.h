@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "stack/base/status.h"
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 #include "stack/world/map_builder.h"
 #include "stack/world/scene.h"
 #include "stack/world/vehicle_model.h"
@@ -36,7 +36,7 @@ struct RoadLocation {
 
 struct OtherVehicle {
   std::string id;
-  OrientedBox box;
+  geometry::OrientedBox box;
   double speed_mps = 0.0;
 };
 
@@ -56,7 +56,7 @@ class World {
   double step_s() const;
   const VehicleState& ego() const;
   const VehicleLimits& ego_limits() const;
-  OrientedBox ego_body() const;
+  geometry::OrientedBox ego_body() const;
   // Other vehicles as of the last step.
   const std::vector<OtherVehicle>& others() const;
   // Collision events so far (ego overlapping another vehicle, counted once
@@ -67,7 +67,7 @@ class World {
   bool goal_reached() const;
   double distance_to_goal_m() const;
 
-  const Path2& ideal_path() const;
+  const geometry::Path2& ideal_path() const;
   const std::vector<std::string>& route_edges() const;
   // Largest gap between consecutive lane pieces (lanes and junction lanes)
   // joined into the ideal path, before resampling: a continuity check.

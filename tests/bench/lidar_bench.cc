@@ -36,10 +36,10 @@ Scene ParkingLot() {
     const double y = 8 + row * 10.5;
     for (int slot = 0; slot < 25; ++slot) {
       if (rng.Uniform() < 0.2) continue;
-      OrientedBox car;
+      geometry::OrientedBox car;
       car.center = {10 + slot * 4.0, y};
       car.yaw_rad = M_PI / 2 + rng.Uniform(-0.05, 0.05);
-      scene.AddObstacle(Prism(BoxCorners(car), rng.Uniform(1.4, 1.9),
+      scene.AddObstacle(Prism(geometry::BoxCorners(car), rng.Uniform(1.4, 1.9),
                               ObstacleKind::kParkedCar));
     }
     for (int k = 0; k < 7; ++k) {  // lamp posts: octagons, 6 m
@@ -67,10 +67,10 @@ Scene ParkingLot() {
   return scene;
 }
 
-std::vector<OrientedBox> MovingVehicles() {
-  std::vector<OrientedBox> v;
+std::vector<geometry::OrientedBox> MovingVehicles() {
+  std::vector<geometry::OrientedBox> v;
   for (int i = 0; i < 10; ++i) {
-    OrientedBox b;
+    geometry::OrientedBox b;
     b.center = {12 + i * 10.0, 13.25 + (i % 3) * 10.5};
     b.yaw_rad = (i % 2) ? 0.0 : M_PI;
     v.push_back(b);
@@ -86,7 +86,7 @@ void BM_LidarScan(benchmark::State& state) {
   const auto weather = static_cast<Weather>(state.range(1));
   LidarSimulator lidar(&scene, params, weather, 7);
   // Drive along an aisle so caches see a moving sensor.
-  std::vector<Pose2> poses;
+  std::vector<geometry::Pose2> poses;
   for (int i = 0; i < 16; ++i) poses.push_back({20.0 + 5 * i, 34.0, 0.1 * i});
   size_t points = 0, scans = 0;
   double seconds = 0;

@@ -52,9 +52,10 @@ void BM_LidarScanRobotaxiScene(benchmark::State& state) {
   LidarParams params;
   params.beams = static_cast<int>(state.range(0));
   LidarSimulator lidar(&world.scene(), params, Weather::kClear, 1);
-  std::vector<OrientedBox> boxes;
+  std::vector<geometry::OrientedBox> boxes;
   for (const OtherVehicle& v : world.others()) boxes.push_back(v.box);
-  const Pose2 pose{world.ego().x_m, world.ego().y_m, world.ego().yaw_rad};
+  const geometry::Pose2 pose{world.ego().x_m, world.ego().y_m,
+                             world.ego().yaw_rad};
   size_t points = 0;
   for (auto _ : state) {
     PointCloud cloud = lidar.Scan(pose, 0.0, boxes);

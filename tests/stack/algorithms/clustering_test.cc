@@ -135,7 +135,7 @@ TEST(ToMapFrame, RotatesAndTranslates) {
   Detection d;
   d.center = {2.0, 1.0};
   d.yaw_rad = 0.1;
-  const Detection m = ToMapFrame(d, world::Pose2{10.0, 5.0, kPi / 2});
+  const Detection m = ToMapFrame(d, geometry::Pose2{10.0, 5.0, kPi / 2});
   EXPECT_NEAR(m.center.x(), 9.0, 1e-9);
   EXPECT_NEAR(m.center.y(), 7.0, 1e-9);
   EXPECT_NEAR(AngleDiffHalfTurn(m.yaw_rad, 0.1 + kPi / 2), 0.0, 1e-9);

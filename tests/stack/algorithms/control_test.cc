@@ -33,7 +33,7 @@ TEST(PurePursuit, KnownGeometry) {
   PurePursuit pp(params);
   // Trajectory 1 m to the left: the lookahead point is (sqrt(15), 1).
   const PurePursuitOutput out =
-      pp.Compute(world::Pose2{0, 0, 0}, 0.0, Line(1.0, 5.0, 30));
+      pp.Compute(geometry::Pose2{0, 0, 0}, 0.0, Line(1.0, 5.0, 30));
   ASSERT_TRUE(out.valid);
   EXPECT_NEAR(out.lookahead_m, 4.0, 1e-12);
   EXPECT_NEAR(out.target.x(), std::sqrt(15.0), 1e-9);
@@ -42,21 +42,22 @@ TEST(PurePursuit, KnownGeometry) {
   EXPECT_NEAR(out.steer_rad, std::atan(2.7 * 0.125), 1e-9);
   EXPECT_NEAR(out.lateral_error_m, -1.0, 1e-9);  // we are right of it
   // Lookahead grows with speed and is clamped.
-  EXPECT_NEAR(pp.Compute(world::Pose2{}, 10.0, Line(0, 5, 30)).lookahead_m, 8.0,
-              1e-12);
-  EXPECT_NEAR(pp.Compute(world::Pose2{}, 50.0, Line(0, 5, 30)).lookahead_m,
+  EXPECT_NEAR(pp.Compute(geometry::Pose2{}, 10.0, Line(0, 5, 30)).lookahead_m,
+              8.0, 1e-12);
+  EXPECT_NEAR(pp.Compute(geometry::Pose2{}, 50.0, Line(0, 5, 30)).lookahead_m,
               15.0, 1e-12);
   // Steering is limited.
   const PurePursuitOutput sharp =
-      pp.Compute(world::Pose2{0, 0, -kPi / 2}, 0.0, Line(0, 5, 30));
+      pp.Compute(geometry::Pose2{0, 0, -kPi / 2}, 0.0, Line(0, 5, 30));
   EXPECT_NEAR(sharp.steer_rad, params.max_steer_rad, 1e-12);
-  EXPECT_FALSE(pp.Compute(world::Pose2{}, 0.0, {}).valid);
+  EXPECT_FALSE(pp.Compute(geometry::Pose2{}, 0.0, {}).valid);
 }
 
 TEST(PurePursuit, PastTheEndExtrapolates) {
   PurePursuit pp;
   const auto line = Line(0.0, 0.0, 5);  // x = 0 .. 4
-  const PurePursuitOutput out = pp.Compute(world::Pose2{6, 0.5, 0}, 0.0, line);
+  const PurePursuitOutput out =
+      pp.Compute(geometry::Pose2{6, 0.5, 0}, 0.0, line);
   EXPECT_TRUE(out.past_end);
   EXPECT_GT(out.target.x(), 6.0);  // ahead, on the extended line
   EXPECT_NEAR(out.target.y(), 0.0, 1e-9);
@@ -75,7 +76,8 @@ TEST(PurePursuit, UTurnTrajectoryKeepsItsFirstLeg) {
     traj.push_back(p);
   }
   PurePursuit pp;
-  const PurePursuitOutput out = pp.Compute(world::Pose2{2, 1.4, 0}, 0.0, traj);
+  const PurePursuitOutput out =
+      pp.Compute(geometry::Pose2{2, 1.4, 0}, 0.0, traj);
   EXPECT_LE(out.nearest_index, 3u);
   EXPECT_NEAR(out.lateral_error_m, 1.4, 1e-9);
   EXPECT_LT(out.steer_rad, 0.0);  // back down to the first leg
@@ -114,7 +116,7 @@ struct Sim {
                const FollowerParams& follower_params = {})
       : planner(planner_params), follower(follower_params) {}
 
-  world::Pose2 Pose() const {
+  geometry::Pose2 Pose() const {
     return {car.state().x_m, car.state().y_m, car.state().yaw_rad};
   }
   // Runs for duration_s; plans at 10 Hz, controls at 50 Hz.
@@ -137,7 +139,7 @@ struct Sim {
 
 TEST(TrajectoryFollower, TracksACircleOfRadius20) {
   // Three laps of a circle (0.5 m chords) centred at (0, 20).
-  world::Path2 path;
+  geometry::Path2 path;
   const double r = 20.0;
   for (int i = 0; i <= 3 * 252; ++i) {
     const double a = -kPi / 2 + i * 0.025;
@@ -166,7 +168,7 @@ TEST(TrajectoryFollower, TracksACircleOfRadius20) {
 }
 
 TEST(TrajectoryFollower, StopsAtGoalAndHolds) {
-  world::Path2 path;
+  geometry::Path2 path;
   for (double x = 0; x <= 40; x += 2) path.points.emplace_back(x, 0);
   path.UpdateArcLength();
   Sim sim;
@@ -183,7 +185,7 @@ TEST(TrajectoryFollower, StopsAtGoalAndHolds) {
 }
 
 TEST(TrajectoryFollower, StopsBeforeObstacleWithMargin) {
-  world::Path2 path;
+  geometry::Path2 path;
   for (double x = 0; x <= 200; x += 5) path.points.emplace_back(x, 0);
   path.UpdateArcLength();
   Sim sim;
@@ -207,15 +209,15 @@ TEST(TrajectoryFollower, StopsBeforeObstacleWithMargin) {
 TEST(TrajectoryFollower, BrakesWithoutTrajectory) {
   FollowerParams params;
   TrajectoryFollower follower(params);
-  follower.Update(world::Pose2{0, 0.5, 0}, 3.0, Line(0, 5, 20), 0.02);
-  const FollowerCommand cmd = follower.Update(world::Pose2{}, 3.0, {}, 0.02);
+  follower.Update(geometry::Pose2{0, 0.5, 0}, 3.0, Line(0, 5, 20), 0.02);
+  const FollowerCommand cmd = follower.Update(geometry::Pose2{}, 3.0, {}, 0.02);
   EXPECT_TRUE(cmd.no_trajectory);
   EXPECT_TRUE(cmd.stopping);
   EXPECT_DOUBLE_EQ(cmd.accel_mps2, -params.no_trajectory_decel_mps2);
   EXPECT_LT(cmd.steer_rad, 0.0);  // held from the last command
   // A trajectory that says stop here: brakes, even at standstill.
   const FollowerCommand hold =
-      follower.Update(world::Pose2{}, 0.0, Line(0, 0, 20), 0.02);
+      follower.Update(geometry::Pose2{}, 0.0, Line(0, 0, 20), 0.02);
   EXPECT_TRUE(hold.stopping);
   EXPECT_LT(hold.accel_mps2, 0.0);
 }

@@ -20,15 +20,15 @@ Eigen::Matrix3d PoseCov(double pos_std, double yaw_std) {
 TEST(Ekf, ConvergesToPoseUpdates) {
   Ekf ekf;
   EXPECT_TRUE(ekf.Lost());  // not initialized
-  ekf.Initialize(world::Pose2{0, 0, 0}, 0.0, 0.0);
+  ekf.Initialize(geometry::Pose2{0, 0, 0}, 0.0, 0.0);
   Random random(2);
-  const world::Pose2 truth{1.0, 2.0, 0.1};
+  const geometry::Pose2 truth{1.0, 2.0, 0.1};
   for (int k = 0; k < 100; ++k) {
     ekf.Predict(0.1);
     ekf.UpdateOdometry(0.0, 0.0, 0.05, 0.01);  // standing still
-    const world::Pose2 meas{truth.x_m + random.Normal(0, 0.05),
-                            truth.y_m + random.Normal(0, 0.05),
-                            truth.yaw_rad + random.Normal(0, 0.01)};
+    const geometry::Pose2 meas{truth.x_m + random.Normal(0, 0.05),
+                               truth.y_m + random.Normal(0, 0.05),
+                               truth.yaw_rad + random.Normal(0, 0.01)};
     EXPECT_TRUE(ekf.UpdatePose(meas, PoseCov(0.1, 0.02))) << "at " << k;
   }
   EXPECT_NEAR(ekf.pose().x_m, truth.x_m, 0.05);
@@ -44,7 +44,7 @@ TEST(Ekf, DeadReckoningIntegratesACircle) {
   params.lost_after_s = 100.0;  // no pose updates in this test
   params.max_position_std_m = 100.0;
   Ekf ekf(params);
-  ekf.Initialize(world::Pose2{0, 0, 0}, 5.0, 0.0);
+  ekf.Initialize(geometry::Pose2{0, 0, 0}, 5.0, 0.0);
   const double v = 5.0, w = 0.25;  // radius 20 m, centre (0, 20)
   const double dt = 0.02;
   const int steps = static_cast<int>(std::round(2 * kPi / w / dt));
@@ -72,25 +72,26 @@ TEST(Ekf, DeadReckoningIntegratesACircle) {
 
 TEST(Ekf, RejectsOutlierPose) {
   Ekf ekf;
-  ekf.Initialize(world::Pose2{10, 5, 0.5}, PoseCov(0.1, 0.01), 0.0, 0.0);
+  ekf.Initialize(geometry::Pose2{10, 5, 0.5}, PoseCov(0.1, 0.01), 0.0, 0.0);
   for (int k = 0; k < 20; ++k) {
     ekf.Predict(0.1);
-    ASSERT_TRUE(ekf.UpdatePose(world::Pose2{10, 5, 0.5}, PoseCov(0.1, 0.01)));
+    ASSERT_TRUE(
+        ekf.UpdatePose(geometry::Pose2{10, 5, 0.5}, PoseCov(0.1, 0.01)));
   }
-  const world::Pose2 before = ekf.pose();
+  const geometry::Pose2 before = ekf.pose();
   // A scan match 3 m off (a wrong local minimum) is rejected.
   ekf.Predict(0.1);
-  EXPECT_FALSE(ekf.UpdatePose(world::Pose2{13, 5, 0.5}, PoseCov(0.1, 0.01)));
+  EXPECT_FALSE(ekf.UpdatePose(geometry::Pose2{13, 5, 0.5}, PoseCov(0.1, 0.01)));
   EXPECT_GT(ekf.last_mahalanobis2(), 16.27);
   EXPECT_EQ(ekf.rejected_pose_updates(), 1);
   EXPECT_NEAR(ekf.pose().x_m, before.x_m, 1e-9);
   // So is a yaw outlier, even across the +-pi wrap it is measured right.
   EXPECT_FALSE(
-      ekf.UpdatePose(world::Pose2{10, 5, 0.5 + 0.5}, PoseCov(0.1, 0.01)));
+      ekf.UpdatePose(geometry::Pose2{10, 5, 0.5 + 0.5}, PoseCov(0.1, 0.01)));
   Ekf wrap;
-  wrap.Initialize(world::Pose2{0, 0, kPi - 0.01}, PoseCov(0.1, 0.02), 0, 0);
+  wrap.Initialize(geometry::Pose2{0, 0, kPi - 0.01}, PoseCov(0.1, 0.02), 0, 0);
   EXPECT_TRUE(
-      wrap.UpdatePose(world::Pose2{0, 0, -kPi + 0.01}, PoseCov(0.1, 0.02)));
+      wrap.UpdatePose(geometry::Pose2{0, 0, -kPi + 0.01}, PoseCov(0.1, 0.02)));
   EXPECT_LT(wrap.last_mahalanobis2(), 1.0);
 }
 
@@ -98,13 +99,13 @@ TEST(Ekf, LostAfterTimeoutAndReinitialized) {
   EkfParams params;
   params.lost_after_s = 1.0;
   Ekf ekf(params);
-  ekf.Initialize(world::Pose2{0, 0, 0}, PoseCov(0.1, 0.01), 2.0, 0.0);
+  ekf.Initialize(geometry::Pose2{0, 0, 0}, PoseCov(0.1, 0.01), 2.0, 0.0);
   for (int k = 0; k < 9; ++k) ekf.Predict(0.1);
   EXPECT_FALSE(ekf.Lost());
   ekf.Predict(0.2);
   EXPECT_TRUE(ekf.Lost());
   // While lost, a pose far from the estimate re-initializes the filter.
-  EXPECT_TRUE(ekf.UpdatePose(world::Pose2{50, 50, 1.0}, PoseCov(0.2, 0.02)));
+  EXPECT_TRUE(ekf.UpdatePose(geometry::Pose2{50, 50, 1.0}, PoseCov(0.2, 0.02)));
   EXPECT_FALSE(ekf.Lost());
   EXPECT_NEAR(ekf.pose().x_m, 50.0, 1e-9);
   EXPECT_NEAR(ekf.v_mps(), 2.0, 0.5);  // speed kept from before
@@ -117,7 +118,7 @@ TEST(Ekf, LostWhenPositionUncertaintyGrows) {
   params.position_noise_mps = 0.5;
   params.initial_speed_std_mps = 0.01;  // else speed doubt dominates
   Ekf ekf(params);
-  ekf.Initialize(world::Pose2{0, 0, 0}, PoseCov(0.1, 0.01), 0.0, 0.0);
+  ekf.Initialize(geometry::Pose2{0, 0, 0}, PoseCov(0.1, 0.01), 0.0, 0.0);
   EXPECT_FALSE(ekf.Lost());
   int k = 0;
   while (!ekf.Lost() && k < 1000) {

@@ -16,7 +16,7 @@ TEST(MapFilterTest, KeepsOnlyWhatTheMapDoesNotExplain) {
   MapFilter filter;
   filter.SetMap(map);
   // The vehicle stands at (2, 1) facing +y: map x = 2 - y_v, map y = 1 + x_v.
-  const world::Pose2 pose{2.0, 1.0, M_PI / 2};
+  const geometry::Pose2 pose{2.0, 1.0, M_PI / 2};
   std::vector<Eigen::Vector3f> scan;
   scan.emplace_back(0.0f, -8.0f, 1.0f);  // map (10, 1): on the wall
   scan.emplace_back(0.5f, -8.2f, 1.5f);  // map (10.2, 1.5): on the wall

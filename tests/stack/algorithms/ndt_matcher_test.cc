@@ -58,7 +58,7 @@ Points ParkingLotMap() {
 }
 
 // Map points near `truth` seen from the vehicle there: vehicle frame.
-Points ScanAt(const Points& map, const world::Pose2& truth, double range_m,
+Points ScanAt(const Points& map, const geometry::Pose2& truth, double range_m,
               uint64_t seed) {
   Random random(seed);
   const Eigen::Isometry3f t =
@@ -82,9 +82,9 @@ TEST(NdtMatcher, RecoversKnownOffset) {
   ASSERT_GT(map.size(), 3000u);
   NdtMatcher ndt;
   ASSERT_TRUE(ndt.SetMap(map).ok());
-  const world::Pose2 truth{0.8, -0.5, 4.0 * kDeg};
+  const geometry::Pose2 truth{0.8, -0.5, 4.0 * kDeg};
   const Points scan = VoxelDownsample(ScanAt(map, truth, 30.0, 7), 0.5);
-  auto result = ndt.Align(scan, world::Pose2{});
+  auto result = ndt.Align(scan, geometry::Pose2{});
   ASSERT_TRUE(result.ok()) << result.status().ToString();
   EXPECT_NEAR(result->pose.x_m, truth.x_m, 0.1);
   EXPECT_NEAR(result->pose.y_m, truth.y_m, 0.1);
@@ -107,11 +107,11 @@ TEST(NdtMatcher, FarWrongGuessIsNotAccepted) {
   const Points map = ParkingLotMap();
   NdtMatcher ndt;
   ASSERT_TRUE(ndt.SetMap(map).ok());
-  const world::Pose2 truth{0.8, -0.5, 4.0 * kDeg};
+  const geometry::Pose2 truth{0.8, -0.5, 4.0 * kDeg};
   const Points scan = VoxelDownsample(ScanAt(map, truth, 30.0, 7), 0.5);
-  for (const world::Pose2 guess :
-       {world::Pose2{10.8, -0.5, 4.0 * kDeg}, world::Pose2{0.8, 9.5, 0.0},
-        world::Pose2{-9.2, -0.5, 0.2}}) {
+  for (const geometry::Pose2 guess :
+       {geometry::Pose2{10.8, -0.5, 4.0 * kDeg}, geometry::Pose2{0.8, 9.5, 0.0},
+        geometry::Pose2{-9.2, -0.5, 0.2}}) {
     auto result = ndt.Align(scan, guess);
     ASSERT_TRUE(result.ok());
     const double err =
@@ -128,15 +128,15 @@ TEST(NdtMatcher, FarWrongGuessIsNotAccepted) {
 TEST(NdtMatcher, ErrorsWithoutMapOrScan) {
   NdtMatcher ndt;
   EXPECT_FALSE(ndt.has_map());
-  auto no_map = ndt.Align({{1, 2, 3}}, world::Pose2{});
+  auto no_map = ndt.Align({{1, 2, 3}}, geometry::Pose2{});
   EXPECT_EQ(no_map.status().code(), Status::Code::kUnavailable);
   EXPECT_EQ(ndt.SetMap({{1, 2, 3}}).code(), Status::Code::kInvalidArgument);
   ASSERT_TRUE(ndt.SetMap(ParkingLotMap()).ok());
   EXPECT_TRUE(ndt.has_map());
-  auto empty = ndt.Align({}, world::Pose2{});
+  auto empty = ndt.Align({}, geometry::Pose2{});
   EXPECT_EQ(empty.status().code(), Status::Code::kInvalidArgument);
   const float nan = std::nanf("");
-  auto all_nan = ndt.Align({{nan, 0, 0}}, world::Pose2{});
+  auto all_nan = ndt.Align({{nan, 0, 0}}, geometry::Pose2{});
   EXPECT_EQ(all_nan.status().code(), Status::Code::kInvalidArgument);
 }
 
@@ -189,9 +189,9 @@ TEST(NdtMatcher, AlignsSimulatedLidarScan) {
 
   world::LidarParams lidar_params;
   world::LidarSimulator lidar(&scene, lidar_params, world::Weather::kClear, 3);
-  const world::Pose2 truth{1.3, 0.4, -6.0 * kDeg};
+  const geometry::Pose2 truth{1.3, 0.4, -6.0 * kDeg};
   // A moving car nearby that the map does not hold.
-  const world::OrientedBox other{Eigen::Vector2d(8, 2), 0.1, 4.5, 1.8, 1.5};
+  const geometry::OrientedBox other{Eigen::Vector2d(8, 2), 0.1, 4.5, 1.8, 1.5};
   const world::PointCloud cloud = lidar.Scan(truth, 0.0, {other});
   Points scan;
   for (const Eigen::Vector3f& p : cloud.points) {
@@ -208,7 +208,7 @@ TEST(NdtMatcher, AlignsSimulatedLidarScan) {
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
   };
-  auto timed = [&](const world::Pose2& guess, NdtResult* out) {
+  auto timed = [&](const geometry::Pose2& guess, NdtResult* out) {
     double total_ms = 0.0;
     constexpr int kRuns = 5;
     for (int i = 0; i < kRuns; ++i) {
@@ -221,7 +221,7 @@ TEST(NdtMatcher, AlignsSimulatedLidarScan) {
     return total_ms / kRuns;
   };
   NdtResult result;
-  const double far_ms = timed(world::Pose2{0.0, 0.0, 0.0}, &result);
+  const double far_ms = timed(geometry::Pose2{0.0, 0.0, 0.0}, &result);
   std::cout << "map " << map.size() << " points (SetMap " << set_map_ms
             << " ms); scan " << scan.size() << " -> " << filtered.size()
             << " points; from 1.3 m off: " << far_ms << " ms CPU, "
@@ -234,9 +234,10 @@ TEST(NdtMatcher, AlignsSimulatedLidarScan) {
   EXPECT_TRUE(result.accepted);
   EXPECT_LT(result.fitness_score_m2, 0.3);
 
-  const double near_ms = timed(world::Pose2{truth.x_m + 0.1, truth.y_m - 0.05,
-                                            truth.yaw_rad + 0.5 * kDeg},
-                               &result);
+  const double near_ms =
+      timed(geometry::Pose2{truth.x_m + 0.1, truth.y_m - 0.05,
+                            truth.yaw_rad + 0.5 * kDeg},
+            &result);
   std::cout << "from 0.1 m off: " << near_ms << " ms CPU, " << result.iterations
             << " iterations\n";
   EXPECT_NEAR(result.pose.x_m, truth.x_m, 0.1);
@@ -245,8 +246,8 @@ TEST(NdtMatcher, AlignsSimulatedLidarScan) {
 
   // From ~10 m off, NDT (at most ~3 m of 0.1 m steps) ends at a wrong pose
   // that PCL calls converged; the scores reject it.
-  for (const world::Pose2& guess :
-       {world::Pose2{-8.7, 0.4, 0.0}, world::Pose2{1.3, 10.4, 0.0}}) {
+  for (const geometry::Pose2& guess :
+       {geometry::Pose2{-8.7, 0.4, 0.0}, geometry::Pose2{1.3, 10.4, 0.0}}) {
     auto wrong = ndt.Align(filtered, guess);
     ASSERT_TRUE(wrong.ok());
     EXPECT_GT(
@@ -259,7 +260,7 @@ TEST(NdtMatcher, AlignsSimulatedLidarScan) {
   // Shifted 10 m along the parked-car rows the scene nearly repeats
   // (long walls, ground, regularly spaced cars): the scores cannot tell,
   // and the EKF's Mahalanobis gate is what rejects such a jump.
-  auto aliased = ndt.Align(filtered, world::Pose2{11.3, 0.4, -6.0 * kDeg});
+  auto aliased = ndt.Align(filtered, geometry::Pose2{11.3, 0.4, -6.0 * kDeg});
   ASSERT_TRUE(aliased.ok());
   std::cout << "aliased: pose (" << aliased->pose.x_m << ", "
             << aliased->pose.y_m << ") fitness " << aliased->fitness_score_m2

@@ -9,14 +9,14 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-world::Path2 Polyline(std::vector<Eigen::Vector2d> points) {
-  world::Path2 path;
+geometry::Path2 Polyline(std::vector<Eigen::Vector2d> points) {
+  geometry::Path2 path;
   path.points = std::move(points);
   path.UpdateArcLength();
   return path;
 }
 
-world::Path2 Straight(double length_m, double step_m) {
+geometry::Path2 Straight(double length_m, double step_m) {
   std::vector<Eigen::Vector2d> pts;
   for (double x = 0.0; x <= length_m + 1e-9; x += step_m)
     pts.emplace_back(x, 0);
@@ -35,7 +35,8 @@ PlannerObstacle Car(int id, double x, double y) {
 TEST(BehaviorVelocityPlanner, FreeRoadAtSpeedLimit) {
   BehaviorVelocityPlanner planner;
   planner.SetPath(Straight(200, 5));
-  const PlannedTrajectory traj = planner.Plan(world::Pose2{10.2, 0.3, 0}, {});
+  const PlannedTrajectory traj =
+      planner.Plan(geometry::Pose2{10.2, 0.3, 0}, {});
   ASSERT_EQ(traj.points.size(), 51u);
   EXPECT_NEAR(traj.ego_s_m, 10.2, 1e-9);
   EXPECT_NEAR(traj.lateral_offset_m, 0.3, 1e-9);
@@ -53,7 +54,7 @@ TEST(BehaviorVelocityPlanner, FreeRoadAtSpeedLimit) {
 TEST(BehaviorVelocityPlanner, StopsAtGoal) {
   BehaviorVelocityPlanner planner;
   planner.SetPath(Straight(100, 5));
-  const PlannedTrajectory traj = planner.Plan(world::Pose2{70, 0, 0}, {});
+  const PlannedTrajectory traj = planner.Plan(geometry::Pose2{70, 0, 0}, {});
   EXPECT_TRUE(traj.stop_for_goal);
   ASSERT_FALSE(traj.points.empty());
   EXPECT_NEAR(traj.points.back().s_m, 100.0, 1e-9);
@@ -61,7 +62,7 @@ TEST(BehaviorVelocityPlanner, StopsAtGoal) {
   EXPECT_GT(traj.points[traj.points.size() - 2].v_mps, 0.0);
   EXPECT_NEAR(traj.stop_s_m, 100.0, 1e-9);
   // Past the goal: one point, speed 0.
-  const PlannedTrajectory after = planner.Plan(world::Pose2{103, 0, 0}, {});
+  const PlannedTrajectory after = planner.Plan(geometry::Pose2{103, 0, 0}, {});
   EXPECT_TRUE(after.stop_for_goal);
   ASSERT_EQ(after.points.size(), 1u);
   EXPECT_EQ(after.points[0].v_mps, 0.0);
@@ -71,7 +72,7 @@ TEST(BehaviorVelocityPlanner, GoalPointProjectedOnPath) {
   BehaviorVelocityPlanner planner;
   planner.SetPath(Straight(100, 5), Eigen::Vector2d(60.0, 0.4));
   EXPECT_NEAR(planner.goal_s_m(), 60.0, 1e-9);
-  const PlannedTrajectory traj = planner.Plan(world::Pose2{30, 0, 0}, {});
+  const PlannedTrajectory traj = planner.Plan(geometry::Pose2{30, 0, 0}, {});
   EXPECT_TRUE(traj.stop_for_goal);
   EXPECT_NEAR(traj.points.back().s_m, 60.0, 1e-9);
   EXPECT_EQ(traj.points.back().v_mps, 0.0);
@@ -82,7 +83,7 @@ TEST(BehaviorVelocityPlanner, StopsBeforeObstacleInCorridor) {
   planner.SetPath(Straight(200, 5));
   const PlannerParams& params = planner.params();
   const PlannedTrajectory traj =
-      planner.Plan(world::Pose2{0, 0, 0}, {Car(7, 40.0, 0.5)});
+      planner.Plan(geometry::Pose2{0, 0, 0}, {Car(7, 40.0, 0.5)});
   EXPECT_TRUE(traj.stop_for_obstacle);
   EXPECT_FALSE(traj.stop_for_goal);
   EXPECT_EQ(traj.obstacle_id, 7);
@@ -110,7 +111,7 @@ TEST(BehaviorVelocityPlanner, IgnoresObstaclesOutsideCorridorOrBehind) {
   planner.SetPath(Straight(200, 5));
   // Next lane (3.5 m over: 3.5 - 0.9 > 1.4) and behind the ego.
   const PlannedTrajectory traj = planner.Plan(
-      world::Pose2{20, 0, 0}, {Car(1, 40.0, 3.5), Car(2, 5.0, 0.0)});
+      geometry::Pose2{20, 0, 0}, {Car(1, 40.0, 3.5), Car(2, 5.0, 0.0)});
   EXPECT_FALSE(traj.stop_for_obstacle);
   EXPECT_EQ(traj.obstacle_id, -1);
   for (const PlannedPoint& p : traj.points) EXPECT_GT(p.v_mps, 0.0);
@@ -118,7 +119,7 @@ TEST(BehaviorVelocityPlanner, IgnoresObstaclesOutsideCorridorOrBehind) {
   PlannerObstacle crossing = Car(3, 40.0, 3.0);
   crossing.yaw_rad = kPi / 2;  // 2.25 m half extent across the path
   EXPECT_TRUE(
-      planner.Plan(world::Pose2{20, 0, 0}, {crossing}).stop_for_obstacle);
+      planner.Plan(geometry::Pose2{20, 0, 0}, {crossing}).stop_for_obstacle);
 }
 
 TEST(BehaviorVelocityPlanner, CurvatureLimitsSpeedInCurve) {
@@ -132,7 +133,7 @@ TEST(BehaviorVelocityPlanner, CurvatureLimitsSpeedInCurve) {
   for (double y = 15; y <= 60; y += 5) pts.emplace_back(60, y);
   BehaviorVelocityPlanner planner;
   planner.SetPath(Polyline(pts));
-  const PlannedTrajectory traj = planner.Plan(world::Pose2{30, 0, 0}, {});
+  const PlannedTrajectory traj = planner.Plan(geometry::Pose2{30, 0, 0}, {});
   const double v_curve =
       std::sqrt(planner.params().max_lateral_accel_mps2 / 0.1);
   bool checked_curve = false;
@@ -154,27 +155,29 @@ TEST(BehaviorVelocityPlanner, ProjectionStaysOnItsLegOfAUTurn) {
   // pose at y = 1.6 but the ego is on the way out.
   BehaviorVelocityPlanner planner;
   planner.SetPath(Polyline({{0, 0}, {50, 0}, {50, 3}, {0, 3}}));
-  planner.Plan(world::Pose2{0, 0, 0}, {});
+  planner.Plan(geometry::Pose2{0, 0, 0}, {});
   for (double x = 2; x <= 30; x += 2) {
-    const PlannedTrajectory traj = planner.Plan(world::Pose2{x, 1.6, 0}, {});
+    const PlannedTrajectory traj = planner.Plan(geometry::Pose2{x, 1.6, 0}, {});
     EXPECT_NEAR(traj.ego_s_m, x, 1e-9);
   }
   // Backward jitter does not move progress back.
-  EXPECT_NEAR(planner.Plan(world::Pose2{29.5, 0, 0}, {}).ego_s_m, 30.0, 1e-9);
+  EXPECT_NEAR(planner.Plan(geometry::Pose2{29.5, 0, 0}, {}).ego_s_m, 30.0,
+              1e-9);
   // Far from the window (e.g. after a relocalization): global search.
-  EXPECT_NEAR(planner.Plan(world::Pose2{10, 3.2, kPi}, {}).ego_s_m, 93.0, 1e-9);
+  EXPECT_NEAR(planner.Plan(geometry::Pose2{10, 3.2, kPi}, {}).ego_s_m, 93.0,
+              1e-9);
 }
 
 TEST(BehaviorVelocityPlanner, EmptyWithoutPath) {
   BehaviorVelocityPlanner planner;
-  EXPECT_TRUE(planner.Plan(world::Pose2{}, {}).points.empty());
+  EXPECT_TRUE(planner.Plan(geometry::Pose2{}, {}).points.empty());
 }
 
 TEST(SmoothVelocity, RespectsAccelAndDecelLimits) {
   BehaviorVelocityPlanner planner;
   planner.SetPath(Straight(200, 5));
   PlannedTrajectory traj =
-      planner.Plan(world::Pose2{0, 0, 0}, {Car(1, 45.0, 0.0)});
+      planner.Plan(geometry::Pose2{0, 0, 0}, {Car(1, 45.0, 0.0)});
   const std::vector<PlannedPoint> raw = traj.points;
   SmootherParams params;
   SmoothVelocity(&traj.points, 0.0, params);
@@ -200,7 +203,7 @@ TEST(SmoothVelocity, RespectsAccelAndDecelLimits) {
   BehaviorVelocityPlanner near_planner;
   near_planner.SetPath(Straight(200, 5));
   PlannedTrajectory near =
-      near_planner.Plan(world::Pose2{0, 0, 0}, {Car(1, 20.0, 0.0)});
+      near_planner.Plan(geometry::Pose2{0, 0, 0}, {Car(1, 20.0, 0.0)});
   SmoothVelocity(&near.points, 10.0, params);
   EXPECT_NEAR(near.points[0].v_mps,
               std::sqrt(2 * params.max_decel_mps2 * near.stop_s_m), 1e-6);

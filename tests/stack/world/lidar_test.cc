@@ -97,7 +97,7 @@ TEST(LidarTest, VehicleBoxShadowsTheWallBehindIt) {
   Scene scene;
   scene.AddObstacle(Wall({20, -50}, {20, 50}, 4.0));
   scene.Finalize();
-  OrientedBox car;
+  geometry::OrientedBox car;
   car.center = {8.0, 0.0};
   car.length_m = 4.0;
   car.width_m = 2.0;
@@ -135,13 +135,13 @@ TEST(LidarTest, VehicleBoxShadowsTheWallBehindIt) {
 }
 
 TEST(LidarTest, RotatedVehicleAndTheSensorsOwnBody) {
-  OrientedBox car;  // long axis along y, centred 8 m to the left
+  geometry::OrientedBox car;  // long axis along y, centred 8 m to the left
   car.center = {0.0, 8.0};
   car.yaw_rad = M_PI / 2;
   car.length_m = 4.0;
   car.width_m = 2.0;
-  car.height_m = 2.5;  // above the sensor: the 0 deg beam hits its side
-  OrientedBox ego;     // a box around the sensor is its own car: ignored
+  car.height_m = 2.5;         // above the sensor: the 0 deg beam hits its side
+  geometry::OrientedBox ego;  // a box around the sensor is its own car: ignored
   ego.center = {0.5, 0.0};
   ego.height_m = 2.0;
   LidarParams p = NoiselessParams();
@@ -163,8 +163,9 @@ TEST(LidarTest, RotatedVehicleAndTheSensorsOwnBody) {
 // box (no culling; entry found by clipping against the box's 6 planes) and
 // the scene through Scene::CastRay.
 std::vector<Eigen::Vector3f> ReferenceScan(
-    const LidarSimulator& lidar, const Pose2& pose,
-    const std::vector<OrientedBox>& boxes, const Scene* scene = nullptr) {
+    const LidarSimulator& lidar, const geometry::Pose2& pose,
+    const std::vector<geometry::OrientedBox>& boxes,
+    const Scene* scene = nullptr) {
   const double h = lidar.params().mount_height_m;
   const double limit = lidar.max_range_m();
   std::vector<Eigen::Vector3f> out;
@@ -177,7 +178,7 @@ std::vector<Eigen::Vector3f> ReferenceScan(
           Eigen::AngleAxisd(pose.yaw_rad, Eigen::Vector3d::UnitZ()) * d_sensor;
       double best = std::numeric_limits<double>::infinity();
       if (e < 0) best = h / -std::sin(e);
-      for (const OrientedBox& b : boxes) {
+      for (const geometry::OrientedBox& b : boxes) {
         const Eigen::AngleAxisd to_box(-b.yaw_rad, Eigen::Vector3d::UnitZ());
         const Eigen::Vector3d o =
             to_box * Eigen::Vector3d(pose.x_m - b.center.x(),
@@ -212,9 +213,9 @@ std::vector<Eigen::Vector3f> ReferenceScan(
 
 TEST(LidarTest, VehiclesMatchAnUnculledReference) {
   Random rng(11);
-  std::vector<OrientedBox> boxes;
+  std::vector<geometry::OrientedBox> boxes;
   for (int i = 0; i < 25; ++i) {
-    OrientedBox b;
+    geometry::OrientedBox b;
     b.center = {rng.Uniform(-40, 40), rng.Uniform(-40, 40)};
     b.yaw_rad = rng.Uniform(-M_PI, M_PI);
     b.length_m = rng.Uniform(3, 12);
@@ -234,7 +235,7 @@ TEST(LidarTest, VehiclesMatchAnUnculledReference) {
   p.beams = 8;
   p.horizontal_resolution_deg = 0.25;
   LidarSimulator lidar(nullptr, p, Weather::kClear, 1);
-  const Pose2 pose{1.0, 2.0, 0.5};
+  const geometry::Pose2 pose{1.0, 2.0, 0.5};
   const auto got = lidar.Scan(pose, 0.0, boxes).points;
   const auto want = ReferenceScan(lidar, pose, boxes);
   ASSERT_EQ(got.size(), want.size());
@@ -255,19 +256,19 @@ TEST(LidarTest, SceneReturnsMatchPerRayCastRay) {
       o.footprint = {
           c, c + Eigen::Vector2d(rng.Uniform(-10, 10), rng.Uniform(-10, 10))};
     } else {
-      OrientedBox b;
+      geometry::OrientedBox b;
       b.center = c;
       b.yaw_rad = rng.Uniform(-M_PI, M_PI);
       b.length_m = rng.Uniform(0.3, 12);
       b.width_m = rng.Uniform(0.3, 6);
-      o.footprint = BoxCorners(b);
+      o.footprint = geometry::BoxCorners(b);
     }
     o.z_min_m = rng.Uniform() < 0.3 ? rng.Uniform(0.5, 3.0) : 0.0;
     o.z_max_m = o.z_min_m + rng.Uniform(0.3, 10.0);
     scene.AddObstacle(o);
   }
   scene.Finalize();
-  std::vector<OrientedBox> boxes;
+  std::vector<geometry::OrientedBox> boxes;
   for (int i = 0; i < 8; ++i) {
     boxes.push_back(
         {Eigen::Vector2d(rng.Uniform(-20, 20), rng.Uniform(-20, 20)),
@@ -280,8 +281,9 @@ TEST(LidarTest, SceneReturnsMatchPerRayCastRay) {
   p.horizontal_resolution_deg = 0.5;
   LidarSimulator lidar(&scene, p, Weather::kClear, 1);
   size_t compared = 0;
-  for (const Pose2 pose : {Pose2{0, 0, 0}, Pose2{13.7, -8.2, 2.1},
-                           Pose2{-75, 10, 0.3}, Pose2{30, 45, -1.2}}) {
+  for (const geometry::Pose2 pose :
+       {geometry::Pose2{0, 0, 0}, geometry::Pose2{13.7, -8.2, 2.1},
+        geometry::Pose2{-75, 10, 0.3}, geometry::Pose2{30, 45, -1.2}}) {
     const auto got = lidar.Scan(pose, 0.0, boxes).points;
     const auto want = ReferenceScan(lidar, pose, boxes, &scene);
     ASSERT_EQ(got.size(), want.size());
@@ -317,12 +319,12 @@ Scene Clutter() {
   Scene scene;
   Random rng(5);
   for (int i = 0; i < 100; ++i) {
-    OrientedBox b;
+    geometry::OrientedBox b;
     b.center = {rng.Uniform(-70, 70), rng.Uniform(-70, 70)};
     if (b.center.norm() < 4) continue;
     b.yaw_rad = rng.Uniform(-M_PI, M_PI);
     Obstacle o;
-    o.footprint = BoxCorners(b);
+    o.footprint = geometry::BoxCorners(b);
     o.z_max_m = rng.Uniform(0.5, 6.0);
     scene.AddObstacle(o);
   }
@@ -431,10 +433,10 @@ TEST(LidarTest, PointsAreInTheSensorFrameOfARotatedPose) {
   Scene scene;
   scene.AddObstacle(Wall({-50, 13}, {50, 13}, 4.0));  // north of the sensor
   scene.Finalize();
-  OrientedBox car;  // west of the sensor
+  geometry::OrientedBox car;  // west of the sensor
   car.center = {-5.0, 3.0};
   car.yaw_rad = 0.3;
-  const Pose2 pose{5.0, 3.0, M_PI / 2};  // facing north
+  const geometry::Pose2 pose{5.0, 3.0, M_PI / 2};  // facing north
   LidarSimulator lidar(&scene, NoiselessParams(), Weather::kClear, 1);
   const PointCloud cloud = lidar.Scan(pose, 0.0, {car});
   // Straight ahead of the sensor (its +x) is the wall, 10 m away.

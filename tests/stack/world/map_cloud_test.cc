@@ -20,12 +20,12 @@ Scene TestScene() {
   wall.footprint = {{-10, 5}, {10, 5.5}};
   wall.z_max_m = 2.5;
   scene.AddObstacle(wall);
-  OrientedBox car;
+  geometry::OrientedBox car;
   car.center = {3, -2};
   car.yaw_rad = 0.4;
   Obstacle parked;
   parked.kind = ObstacleKind::kParkedCar;
-  parked.footprint = BoxCorners(car);
+  parked.footprint = geometry::BoxCorners(car);
   parked.z_max_m = 1.5;
   scene.AddObstacle(parked);
   Obstacle pole;

@@ -57,11 +57,11 @@ Scene RandomScene(uint64_t seed, double cell) {
       o = Wall(c,
                c + Eigen::Vector2d(rng.Uniform(-15, 15), rng.Uniform(-15, 15)));
     } else if (kind == 1) {  // parked car
-      OrientedBox b;
+      geometry::OrientedBox b;
       b.center = c;
       b.yaw_rad = rng.Uniform(-M_PI, M_PI);
       o.kind = ObstacleKind::kParkedCar;
-      o.footprint = BoxCorners(b);
+      o.footprint = geometry::BoxCorners(b);
     } else {  // pole: octagon
       o.kind = ObstacleKind::kPole;
       const double r = rng.Uniform(0.05, 0.5);

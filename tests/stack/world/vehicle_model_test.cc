@@ -99,7 +99,7 @@ TEST(BicycleModelTest, BodyIsCentredHalfAWheelbaseAheadOfTheRearAxle) {
   s.y_m = -4.0;
   s.yaw_rad = M_PI / 2;
   model.Reset(s);
-  const OrientedBox body = model.Body();
+  const geometry::OrientedBox body = model.Body();
   EXPECT_NEAR(body.center.x(), 10.0, 1e-12);
   EXPECT_NEAR(body.center.y(), -4.0 + 1.35, 1e-12);
   EXPECT_DOUBLE_EQ(body.yaw_rad, M_PI / 2);

@@ -46,7 +46,7 @@ TEST(WorldTest, GeneratedParkingLotLoadsAndIdealPathIsContinuous) {
   Result<std::unique_ptr<World>> world = World::Open(SmallLot());
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   const World& w = **world;
-  const Path2& path = w.ideal_path();
+  const geometry::Path2& path = w.ideal_path();
   // East along the south ring, north on the east side, west on the north ring.
   EXPECT_GE(w.route_edges().size(), 3u);
   EXPECT_GT(path.length_m(), 60.0);
@@ -179,12 +179,12 @@ TEST(WorldTest, LidarSeesSumoVehicles) {
   LidarParams params;
   params.range_noise_stddev_m = 0.0;
   LidarSimulator lidar(&w.scene(), params, Weather::kClear, 1);
-  const Pose2 pose{w.ego().x_m, w.ego().y_m, w.ego().yaw_rad};
-  std::vector<OrientedBox> boxes;
+  const geometry::Pose2 pose{w.ego().x_m, w.ego().y_m, w.ego().yaw_rad};
+  std::vector<geometry::OrientedBox> boxes;
   for (const OtherVehicle& v : w.others()) boxes.push_back(v.box);
   const PointCloud with = lidar.Scan(pose, w.time_s(), boxes);
   int on_vehicle = 0;
-  const OrientedBox box = seen->box;
+  const geometry::OrientedBox box = seen->box;
   for (const Eigen::Vector3f& p : with.points) {
     // Sensor frame -> world frame.
     const double c = std::cos(pose.yaw_rad), s = std::sin(pose.yaw_rad);
@@ -289,7 +289,7 @@ TEST(WorldTest, ValetParkingPathEndsInsideTheGoalSlot) {
   setup.task.goal = Location::Xy(18.25, 8.0);
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_TRUE(world.ok()) << world.status().ToString();
-  const Path2& path = (*world)->ideal_path();
+  const geometry::Path2& path = (*world)->ideal_path();
   EXPECT_NEAR(path.points.back().x(), 18.25, 0.1);
   EXPECT_NEAR(path.points.back().y(), 8.0, 0.1);
   EXPECT_LT(path.MaxGap(), 0.51);

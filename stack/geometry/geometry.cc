@@ -1,9 +1,9 @@
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace adse::world {
+namespace adse::geometry {
 namespace {
 
 // Index i of the segment [points[i], points[i+1]] holding arc length s, with
@@ -100,4 +100,4 @@ bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b) {
   return true;
 }
 
-}  // namespace adse::world
+}  // namespace adse::geometry

@@ -1,11 +1,11 @@
 // Plain geometric types shared by the world and the stack (Eigen only).
-#ifndef ADSE_STACK_WORLD_GEOMETRY_H_
-#define ADSE_STACK_WORLD_GEOMETRY_H_
+#ifndef ADSE_STACK_GEOMETRY_GEOMETRY_H_
+#define ADSE_STACK_GEOMETRY_GEOMETRY_H_
 
 #include <Eigen/Core>
 #include <vector>
 
-namespace adse::world {
+namespace adse::geometry {
 
 // Planar pose; yaw counter-clockwise from +x, radians.
 struct Pose2 {
@@ -45,6 +45,6 @@ std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box);
 // True when two oriented boxes overlap (separating axis test).
 bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b);
 
-}  // namespace adse::world
+}  // namespace adse::geometry
 
-#endif  // ADSE_STACK_WORLD_GEOMETRY_H_
+#endif  // ADSE_STACK_GEOMETRY_GEOMETRY_H_

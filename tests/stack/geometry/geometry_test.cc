@@ -1,10 +1,10 @@
-#include "stack/world/geometry.h"
+#include "stack/geometry/geometry.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-namespace adse::world {
+namespace adse::geometry {
 namespace {
 
 OrientedBox Box(double x, double y, double yaw, double length, double width) {
@@ -116,4 +116,4 @@ TEST(Path2Test, RepeatedPointsAndDegenerateInputs) {
 }
 
 }  // namespace
-}  // namespace adse::world
+}  // namespace adse::geometry
