@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "stack/algorithms/point_filters.h"
+
 namespace adse::algorithms {
 namespace {
 
@@ -134,6 +136,12 @@ Detection FitBox(const std::vector<Eigen::Vector3f>& points,
 
 DetectionResult DetectObjects(const std::vector<Eigen::Vector3f>& points,
                               const ClusteringParams& params) {
+  if (params.downsample_leaf_m > 0.0) {
+    ClusteringParams dense = params;
+    dense.downsample_leaf_m = 0.0;
+    return DetectObjects(VoxelDownsample(points, params.downsample_leaf_m),
+                         dense);
+  }
   DetectionResult result;
   result.work_units = static_cast<int64_t>(points.size());
   std::vector<std::vector<int>> clusters;

@@ -5,6 +5,8 @@
 #define ADSE_STACK_ALGORITHMS_EKF_H_
 
 #include <Eigen/Core>
+#include <cstddef>
+#include <deque>
 
 #include "stack/geometry/geometry.h"
 
@@ -18,7 +20,7 @@ struct EkfParams {
   // Pose updates with squared Mahalanobis distance above this are
   // rejected (chi-square, 3 dof: 16.27 is the 99.9 % quantile).
   double gate_chi2 = 16.27;
-  double lost_after_s = 1.0;  // no accepted pose update for this long
+  double lost_after_s = 3.0;  // no accepted pose update for this long
   // Position uncertainty (1 sigma, largest axis) above which we are lost.
   double max_position_std_m = 1.5;
   // A pose update while lost re-initializes pose and covariance instead of
@@ -27,7 +29,18 @@ struct EkfParams {
   double initial_position_std_m = 1.0;  // for Initialize without covariance
   double initial_yaw_std_rad = 0.1;
   double initial_speed_std_mps = 1.0;
+  // Wheel odometry noise (1 sigma) of UpdateOdometry(v, yaw_rate).
+  double odometry_speed_std_mps = 0.05;
+  double odometry_yaw_rate_std_rps = 0.01;
+  // How far back RememberPose keeps poses for delay compensation: longer
+  // than any scan-matching latency that still deserves to be fused.
+  double history_window_s = 3.0;
 };
+
+// `pose` moved straight along its heading at `v_mps` for `dt_s` (negative:
+// back): where a pose stamped earlier is now, to first order.
+geometry::Pose2 PoseAhead(const geometry::Pose2& pose, double v_mps,
+                          double dt_s);
 
 class Ekf {
  public:
@@ -48,10 +61,25 @@ class Ekf {
   // Wheel odometry: measured speed and yaw rate with their 1-sigma noise.
   void UpdateOdometry(double v_mps, double yaw_rate_rps, double v_std_mps,
                       double yaw_rate_std_rps);
+  // The same with the parameters' odometry noise.
+  void UpdateOdometry(double v_mps, double yaw_rate_rps);
   // A pose measurement (e.g. NDT) with covariance over (x, y, yaw).
   // Returns false when it was gated out as an outlier. Uninitialized (or
   // lost, with reinit_when_lost) filters are initialized from it instead.
   bool UpdatePose(const geometry::Pose2& pose, const Eigen::Matrix3d& cov);
+
+  // Remembers the current estimate as the pose at `t_s` (the caller's
+  // clock), for UpdateDelayedPose. Poses more than history_window_s older
+  // than `t_s` are forgotten; the newest is always kept.
+  void RememberPose(double t_s);
+  // A pose measured at `stamp_s`, before now (a scan matched late): carried
+  // forward by the motion the filter estimated since the first remembered
+  // pose at or after `stamp_s`, then fused by UpdatePose. Used as it is
+  // when no remembered pose is that recent.
+  bool UpdateDelayedPose(const geometry::Pose2& pose,
+                         const Eigen::Matrix3d& cov, double stamp_s);
+  // Poses kept by RememberPose.
+  size_t remembered_poses() const { return history_.size(); }
 
   // True before initialization, when no pose update was accepted for
   // lost_after_s, or when the position uncertainty is too large.
@@ -81,6 +109,11 @@ class Ekf {
   double last_pose_t_s_ = 0.0;
   double last_d2_ = 0.0;
   int rejected_ = 0;
+  struct PoseAt {
+    double t_s;
+    geometry::Pose2 pose;
+  };
+  std::deque<PoseAt> history_;  // oldest first
 };
 
 }  // namespace adse::algorithms

@@ -36,6 +36,10 @@ struct NdtParams {
   double min_transform_likelihood = 1.5;
   double outlier_ratio = 0.55;  // NDT's mixture weight for outliers
   int threads = 1;              // hint only; PCL 1.13's NDT is serial
+  // Uncertainty (1 sigma) the pose fusion gives a match: NDT's Hessian is
+  // no calibrated covariance, so a fixed one at the map's accuracy is used.
+  double match_position_std_m = 0.05;
+  double match_yaw_std_rad = 0.01;
 };
 
 struct NdtResult {
@@ -76,6 +80,8 @@ class NdtMatcher {
                           const geometry::Pose2& initial_guess);
 
   const NdtParams& params() const { return params_; }
+  // Covariance over (x, y, yaw) of a match (match_*_std of the params).
+  Eigen::Matrix3d MatchCovariance() const;
 
  private:
   struct Impl;

@@ -75,6 +75,12 @@ NdtMatcher::~NdtMatcher() = default;
 
 bool NdtMatcher::has_map() const { return impl_->map != nullptr; }
 
+Eigen::Matrix3d NdtMatcher::MatchCovariance() const {
+  const double p = params_.match_position_std_m;
+  const double y = params_.match_yaw_std_rad;
+  return Eigen::Vector3d(p * p, p * p, y * y).asDiagonal();
+}
+
 int NdtMatcher::map_size() const {
   return impl_->map ? static_cast<int>(impl_->map->size()) : 0;
 }

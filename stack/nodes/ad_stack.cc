@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <optional>
 
 #include "stack/algorithms/clustering.h"
@@ -27,8 +26,6 @@ constexpr double kNdtParallelFraction = 0.85;
 constexpr double kClusteringParallelFraction = 0.6;
 // Braking asked for while there is no valid pose to steer by.
 constexpr double kNoPoseDecelMps2 = 3.0;
-
-double WrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
 // Trajectory points as the planning and control algorithms take them; the
 // speed can be capped on the way.
@@ -77,11 +74,6 @@ class Stack final : public AdStack {
   algo::Ekf ekf_;
   double ekf_last_t_ = 0.0;
   double ekf_stamp_ = -1.0;  // stamp of the newest fused NDT pose
-  struct PoseAt {
-    double t_s;
-    geometry::Pose2 pose;
-  };
-  std::deque<PoseAt> ekf_history_;
   algo::MapFilter map_filter_;
   std::optional<PoseMsg> ground_pose_;
   std::optional<PoseMsg> cluster_pose_;
@@ -177,12 +169,10 @@ Status Stack::BuildLocalization(Graph* g) {
       [this, threads](const PointCloudMsg& in, CallbackContext& ctx) {
         geometry::Pose2 guess = inputs_.initial_pose;
         if (ndt_latest_ekf_) {
-          // Move the EKF pose back to the scan's time along its motion.
+          // The EKF pose moved to the scan's time along its motion.
           const PoseMsg& e = *ndt_latest_ekf_;
-          const double dt = in.header.stamp_s - ndt_latest_ekf_t_;
-          guess = e.pose;
-          guess.x_m += e.v_mps * dt * std::cos(e.pose.yaw_rad);
-          guess.y_m += e.v_mps * dt * std::sin(e.pose.yaw_rad);
+          guess = algo::PoseAhead(e.pose, e.v_mps,
+                                  in.header.stamp_s - ndt_latest_ekf_t_);
         }
         Result<algo::NdtResult> r = ndt_->Align(in.points, guess);
         PoseMsg out;
@@ -194,8 +184,7 @@ Status Stack::BuildLocalization(Graph* g) {
           ctx.ReportWork({static_cast<double>(r->work_units),
                           kNdtParallelFraction, threads});
         }
-        out.covariance =
-            Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.01 * 0.01).asDiagonal();
+        out.covariance = ndt_->MatchCovariance();
         ctx.Publish(ndt_pose_, std::move(out));
       });
 
@@ -210,7 +199,7 @@ Status Stack::BuildLocalization(Graph* g) {
       [this](const OdometryMsg& in, CallbackContext& ctx) {
         ekf_.Predict(std::max(0.0, ctx.now_s() - ekf_last_t_));
         ekf_last_t_ = ctx.now_s();
-        ekf_.UpdateOdometry(in.v_mps, in.yaw_rate_rps, 0.05, 0.01);
+        ekf_.UpdateOdometry(in.v_mps, in.yaw_rate_rps);
       });
   g->Subscribe<PoseMsg>(
       ekf_node, ndt_pose_, "ndt_pose", 1,
@@ -218,24 +207,8 @@ Status Stack::BuildLocalization(Graph* g) {
         if (!in.valid) return;
         ekf_.Predict(std::max(0.0, ctx.now_s() - ekf_last_t_));
         ekf_last_t_ = ctx.now_s();
-        // The match describes the scan's time: carry it forward by the motion
-        // the EKF saw since then.
-        geometry::Pose2 measured = in.pose;
-        const auto then = std::lower_bound(
-            ekf_history_.begin(), ekf_history_.end(), in.header.stamp_s,
-            [](const PoseAt& p, double t) { return p.t_s < t; });
-        if (then != ekf_history_.end()) {
-          const geometry::Pose2 now = ekf_.pose();
-          const double dyaw = WrapAngle(now.yaw_rad - then->pose.yaw_rad);
-          const Eigen::Vector2d moved_world(now.x_m - then->pose.x_m,
-                                            now.y_m - then->pose.y_m);
-          const double c = std::cos(measured.yaw_rad - then->pose.yaw_rad);
-          const double s = std::sin(measured.yaw_rad - then->pose.yaw_rad);
-          measured.x_m += c * moved_world.x() - s * moved_world.y();
-          measured.y_m += s * moved_world.x() + c * moved_world.y();
-          measured.yaw_rad = WrapAngle(measured.yaw_rad + dyaw);
-        }
-        if (ekf_.UpdatePose(measured, in.covariance))
+        // The match describes the scan's time, not now.
+        if (ekf_.UpdateDelayedPose(in.pose, in.covariance, in.header.stamp_s))
           ekf_stamp_ = in.header.stamp_s;
       });
   g->AddTimer(ekf_node, "publish",
@@ -243,11 +216,7 @@ Status Stack::BuildLocalization(Graph* g) {
               [this](CallbackContext& ctx) {
                 ekf_.Predict(std::max(0.0, ctx.now_s() - ekf_last_t_));
                 ekf_last_t_ = ctx.now_s();
-                ekf_history_.push_back({ctx.now_s(), ekf_.pose()});
-                while (ekf_history_.size() > 1 &&
-                       ekf_history_.front().t_s < ctx.now_s() - 3.0) {
-                  ekf_history_.pop_front();
-                }
+                ekf_.RememberPose(ctx.now_s());
                 PoseMsg out;
                 out.header.stamp_s = ekf_stamp_;
                 out.pose = ekf_.pose();
@@ -302,11 +271,7 @@ void Stack::BuildPerception(Graph* g) {
       cluster_node, obstacle_points_, "points", 1,
       [this, clustering, threads, max_object_m](const PointCloudMsg& in,
                                                 CallbackContext& ctx) {
-        // Downsample first, as production clustering pipelines do: object
-        // shapes survive a 0.2 m grid and the clustering cost drops.
-        const std::vector<Eigen::Vector3f> sparse =
-            algo::VoxelDownsample(in.points, 0.2);
-        algo::DetectionResult r = algo::DetectObjects(sparse, clustering);
+        algo::DetectionResult r = algo::DetectObjects(in.points, clustering);
         ObjectsMsg out;
         out.header = in.header;
         const geometry::Pose2 pose =

@@ -1,5 +1,7 @@
 #include "stack/algorithms/clustering.h"
 
+#include "stack/algorithms/point_filters.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -50,7 +52,11 @@ TEST(DetectObjects, FindsThreeKnownBoxes) {
   std::vector<Eigen::Vector3f> points;
   for (const Truth& t : truth) AddBox(t.c, t.l, t.w, t.yaw, 1.5, 0.1, &points);
   const DetectionResult result = DetectObjects(points, ClusteringParams());
-  EXPECT_EQ(result.work_units, static_cast<int64_t>(points.size()));
+  // Work units: the points clustered, after the default voxel grid.
+  EXPECT_EQ(result.work_units,
+            static_cast<int64_t>(
+                VoxelDownsample(points, ClusteringParams().downsample_leaf_m)
+                    .size()));
   ASSERT_EQ(result.detections.size(), 3u);
   int matched = 0;
   for (const Truth& t : truth) {
@@ -91,6 +97,26 @@ TEST(DetectObjects, DropsNoiseAndIgnoresEmptyInput) {
   std::vector<Eigen::Vector3f> points = {{0, 0, 1}, {5, 5, 1}, {10, 0, 1}};
   EXPECT_TRUE(DetectObjects(points, ClusteringParams()).detections.empty());
   EXPECT_TRUE(DetectObjects({}, ClusteringParams()).detections.empty());
+}
+
+// The voxel grid is part of the algorithm: the same boxes as thinning by
+// hand first, and fewer points clustered than given.
+TEST(DetectObjects, DownsamplesToItsVoxelGridFirst) {
+  std::vector<Eigen::Vector3f> points;
+  AddBox({5.0, 2.0}, 4.5, 1.8, 0.3, 1.5, 0.05, &points);
+  ClusteringParams params;
+  ASSERT_EQ(params.downsample_leaf_m, 0.2);
+  const DetectionResult inside = DetectObjects(points, params);
+  ClusteringParams dense = params;
+  dense.downsample_leaf_m = 0.0;
+  const DetectionResult by_hand =
+      DetectObjects(VoxelDownsample(points, 0.2), dense);
+  ASSERT_EQ(inside.detections.size(), 1u);
+  ASSERT_EQ(by_hand.detections.size(), 1u);
+  EXPECT_EQ(inside.work_units, by_hand.work_units);
+  EXPECT_LT(inside.work_units, static_cast<int64_t>(points.size()));
+  EXPECT_EQ(inside.detections[0].center, by_hand.detections[0].center);
+  EXPECT_EQ(inside.detections[0].length_m, by_hand.detections[0].length_m);
 }
 
 TEST(FitBox, LShapeGivesTheRightOrientation) {

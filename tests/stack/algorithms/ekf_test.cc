@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "stack/base/random.h"
+#include "stack/config/stack_config.h"
 
 namespace adse::algorithms {
 namespace {
@@ -129,6 +130,88 @@ TEST(Ekf, LostWhenPositionUncertaintyGrows) {
   EXPECT_GT(ekf.PositionStdM(), 0.5);
   // ~ (0.5^2 - 0.1^2) / 0.5^2 = 0.96 s of random walk.
   EXPECT_NEAR(k, 10, 2);
+}
+
+TEST(Ekf, PoseAheadMovesAlongTheHeading) {
+  const geometry::Pose2 p = PoseAhead({1.0, 2.0, kPi / 2}, 4.0, 0.5);
+  EXPECT_NEAR(p.x_m, 1.0, 1e-12);
+  EXPECT_NEAR(p.y_m, 4.0, 1e-12);
+  EXPECT_EQ(p.yaw_rad, kPi / 2);
+  const geometry::Pose2 back = PoseAhead({0.0, 0.0, 0.0}, 2.0, -1.0);
+  EXPECT_NEAR(back.x_m, -2.0, 1e-12);
+}
+
+TEST(Ekf, OdometryWithoutNoiseArgumentsUsesTheParameters) {
+  EkfParams params;
+  params.odometry_speed_std_mps = 0.3;
+  params.odometry_yaw_rate_std_rps = 0.04;
+  Ekf a(params), b(params);
+  for (Ekf* e : {&a, &b}) e->Initialize(geometry::Pose2{0, 0, 0}, 1.0, 0.0);
+  a.Predict(0.1);
+  b.Predict(0.1);
+  a.UpdateOdometry(2.0, 0.1);
+  b.UpdateOdometry(2.0, 0.1, 0.3, 0.04);
+  EXPECT_EQ(a.state(), b.state());
+  EXPECT_EQ(a.covariance(), b.covariance());
+}
+
+TEST(Ekf, RemembersPosesForTheHistoryWindowOnly) {
+  EkfParams params;
+  params.history_window_s = 1.0;
+  Ekf ekf(params);
+  ekf.Initialize(geometry::Pose2{0, 0, 0}, 1.0, 0.0);
+  for (int k = 0; k <= 30; ++k) ekf.RememberPose(0.1 * k);
+  // t = 2.0 .. 3.0: eleven poses within one second of the newest.
+  EXPECT_EQ(ekf.remembered_poses(), 11u);
+  EkfParams none;
+  none.history_window_s = 0.0;
+  Ekf newest(none);
+  newest.Initialize(geometry::Pose2{0, 0, 0}, 1.0, 0.0);
+  newest.RememberPose(0.0);
+  newest.RememberPose(1.0);
+  EXPECT_EQ(newest.remembered_poses(), 1u) << "the newest is always kept";
+}
+
+// A vehicle drives straight at 10 m/s; a scan matched at t = 1.0 s arrives
+// at t = 1.3 s. Taken as if it were now, it is 3 m behind and gated out as
+// an outlier; carried forward by the motion since then, it agrees with the
+// truth.
+TEST(Ekf, ADelayedPoseIsCarriedForwardByTheMotionSinceItsStamp) {
+  auto drive = [](Ekf* ekf) {
+    ekf->Initialize(geometry::Pose2{0, 0, 0}, PoseCov(0.05, 0.01), 10.0, 0.0);
+    for (int k = 1; k <= 13; ++k) {
+      ekf->Predict(0.1);
+      ekf->UpdateOdometry(10.0, 0.0);
+      ekf->RememberPose(0.1 * k);
+    }
+  };
+  const geometry::Pose2 at_stamp{10.0, 0.0, 0.0};  // true pose at t = 1.0
+  const double truth_now_x = 13.0;
+  Ekf compensated, naive;
+  drive(&compensated);
+  drive(&naive);
+  ASSERT_TRUE(compensated.UpdateDelayedPose(at_stamp, PoseCov(0.05, 0.01),
+                                            /*stamp_s=*/1.0));
+  EXPECT_NEAR(compensated.pose().x_m, truth_now_x, 0.05);
+  EXPECT_FALSE(naive.UpdatePose(at_stamp, PoseCov(0.05, 0.01)))
+      << "uncompensated, the right match looks like a 3 m outlier";
+
+  // With nothing remembered that recent, the pose is used as it is.
+  Ekf fresh;
+  fresh.Initialize(geometry::Pose2{0, 0, 0}, PoseCov(1.0, 0.1), 0.0, 0.0);
+  ASSERT_TRUE(
+      fresh.UpdateDelayedPose({0.5, 0.0, 0.0}, PoseCov(0.05, 0.01), 5.0));
+  Ekf plain;
+  plain.Initialize(geometry::Pose2{0, 0, 0}, PoseCov(1.0, 0.1), 0.0, 0.0);
+  plain.UpdatePose({0.5, 0.0, 0.0}, PoseCov(0.05, 0.01));
+  EXPECT_EQ(fresh.state(), plain.state());
+}
+
+// The stack's knob and the filter agree on when localization is lost.
+TEST(Ekf, TheLostTimeoutDefaultIsTheKnobDefault) {
+  const KnobInfo* knob = FindStackKnob("localization.lost_after_s");
+  ASSERT_NE(knob, nullptr);
+  EXPECT_EQ(knob->default_value, EkfParams{}.lost_after_s);
 }
 
 }  // namespace

@@ -125,6 +125,17 @@ TEST(NdtMatcher, FarWrongGuessIsNotAccepted) {
   }
 }
 
+TEST(NdtMatcher, MatchCovarianceComesFromTheParameters) {
+  NdtParams params;
+  params.match_position_std_m = 0.2;
+  params.match_yaw_std_rad = 0.03;
+  const Eigen::Matrix3d c = NdtMatcher(params).MatchCovariance();
+  EXPECT_DOUBLE_EQ(c(0, 0), 0.04);
+  EXPECT_DOUBLE_EQ(c(1, 1), 0.04);
+  EXPECT_DOUBLE_EQ(c(2, 2), 0.0009);
+  EXPECT_EQ(c(0, 1), 0.0);
+}
+
 TEST(NdtMatcher, ErrorsWithoutMapOrScan) {
   NdtMatcher ndt;
   EXPECT_FALSE(ndt.has_map());
