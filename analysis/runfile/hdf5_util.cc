@@ -1,4 +1,6 @@
 #include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -490,6 +492,64 @@ Status WriteFileAtomically(
   return CommitTemporary(tmp, path, env);
 }
 
+// The walk mirrors the collection layout of the HDF5 file
+// format (version 1, 8-byte lengths, what adse and h5py write): "GCOL",
+// version, 3 reserved bytes, collection size, then objects of a 16-byte
+// header (index, references, reserved, size) and 8-byte aligned data.
+Status CheckGlobalHeaps(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    return Status::IoError(path + ": cannot read: " + std::strerror(errno));
+  }
+  struct stat info;
+  void* map = MAP_FAILED;
+  size_t n = 0;
+  if (::fstat(fd, &info) == 0 && info.st_size > 0) {
+    n = static_cast<size_t>(info.st_size);
+    map = ::mmap(nullptr, n, PROT_READ, MAP_PRIVATE, fd, 0);
+  }
+  const int error = errno;
+  ::close(fd);  // the mapping stays valid
+  if (n == 0) return Status::Ok();
+  if (map == MAP_FAILED) {
+    return Status::IoError(path + ": cannot read: " + std::strerror(error));
+  }
+  const unsigned char* bytes = static_cast<const unsigned char*>(map);
+  auto u64 = [&](size_t at) {
+    uint64_t v = 0;
+    for (int i = 7; i >= 0; --i) v = (v << 8) | bytes[at + i];
+    return v;
+  };
+  constexpr size_t kHeader = 16, kMinCollection = 4096;
+  Status status;
+  for (size_t at = 0; status.ok() && at + kHeader <= n; ++at) {
+    at = static_cast<size_t>(
+        std::search(bytes + at, bytes + n, "GCOL", "GCOL" + 4) - bytes);
+    if (at + kHeader > n) break;
+    const uint64_t size = u64(at + 8);
+    if (bytes[at + 4] != 1 || size < kMinCollection || size > n - at) {
+      continue;  // not a collection header (e.g. the text "GCOL" in data)
+    }
+    const size_t end = at + static_cast<size_t>(size);
+    for (size_t p = at + kHeader; p + kHeader <= end;) {
+      const unsigned index = bytes[p] | (bytes[p + 1] << 8);
+      const uint64_t object = u64(p + 8);
+      const uint64_t need =
+          index > 0 ? kHeader + ((object + 7) / 8) * 8 : object;
+      if (need == 0) {
+        status = Status::Corruption(
+            path + ": damaged HDF5 global heap at byte " + std::to_string(at) +
+            " (an empty free-space object, which HDF5 cannot read past)");
+        break;
+      }
+      if (need > end - p) break;
+      p += static_cast<size_t>(need);
+    }
+  }
+  ::munmap(map, n);
+  return status;
+}
+
 Status ReadFileContents(
     const std::string& path, const std::string& expected,
     const std::function<Status(hid_t file)>& read_contents) {
@@ -508,6 +568,7 @@ Status ReadFileContents(
   if (is_hdf5 == 0) {
     return Status::Corruption(path + ": not an HDF5 file (no HDF5 signature)");
   }
+  ADSE_RETURN_IF_ERROR(CheckGlobalHeaps(path));
   Handle fapl = MakeFileAccessProps();
   Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get()));
   if (!file.valid()) {

@@ -349,8 +349,11 @@ Status CheckImpl(const std::string& path, const std::string& schema_path,
   {
     internal::Hdf5Session session;
     const htri_t is_hdf5 = internal::IsHdf5File(path);
+    Status heaps;
     if (is_hdf5 <= 0) {
       found.push_back("/: not an HDF5 file");
+    } else if (heaps = internal::CheckGlobalHeaps(path); !heaps.ok()) {
+      found.push_back("/: " + heaps.message());
     } else {
       Handle fapl = internal::MakeFileAccessProps();
       Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get()));

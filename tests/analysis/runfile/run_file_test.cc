@@ -678,6 +678,24 @@ TEST_F(RunFileTest, FileWithoutLanesReadsAsNoLanes) {
   EXPECT_EQ(Diff(run, *back), "");
 }
 
+// Found by fuzz_run_file: libhdf5 1.10 loops forever on a global heap whose
+// free-space object is empty. Every reader refuses the file first.
+TEST(RunFileDamageTest, ADamagedGlobalHeapIsRefusedInsteadOfHangingHdf5) {
+  const std::string path = std::string(ADSE_SOURCE_DIR) +
+                           "/tests/fuzz/regressions/run_file/"
+                           "hdf5_global_heap_loop.h5";
+  Result<RunData> run = ReadRunFile(path);
+  ASSERT_FALSE(run.ok());
+  EXPECT_EQ(run.status().code(), Status::Code::kCorruption);
+  EXPECT_NE(run.status().message().find(path + ": damaged HDF5 global heap"),
+            std::string::npos)
+      << run.status().message();
+  std::vector<std::string> problems;
+  EXPECT_FALSE(CheckRunFile(path, &problems).ok());
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_NE(problems[0].find("damaged HDF5 global heap"), std::string::npos);
+}
+
 TEST_F(RunFileTest, FileWithoutStatusNeverLooksComplete) {
   // What a writer that died before its last step would leave (under its
   // temporary name): everything but the final `status` attribute.
