@@ -192,4 +192,52 @@ Result<PointConfig> ApplyPoint(const Spec& spec, const DesignPoint& point) {
   return config;
 }
 
+double RangeCount(double lo, double hi, double step) {
+  return std::floor((hi - lo) / step + 1e-9) + 1;
+}
+
+std::vector<double> ExpandRange(double lo, double hi, double step) {
+  std::vector<double> values;
+  const double count = RangeCount(lo, hi, step);
+  for (size_t i = 0; i < static_cast<size_t>(count); ++i) {
+    // Multiply rather than accumulate, then round away binary noise.
+    const double raw = lo + static_cast<double>(i) * step;
+    double clean = raw;
+    ParseNumber(fmt::format("{:.12g}", raw), &clean);
+    values.push_back(clean);
+  }
+  return values;
+}
+
+bool RangeOf(const std::vector<double>& values, std::string* lo,
+             std::string* hi, std::string* step) {
+  if (values.size() < 3) return false;
+  double by = values[1] - values[0];
+  ParseNumber(fmt::format("{:.12g}", by), &by);
+  if (!(by > 0)) return false;
+  const std::string lo_text = FormatNumber(values.front());
+  const std::string step_text = FormatNumber(by);
+  double lo_value = 0, step_value = 0;
+  if (!ParseNumber(lo_text, &lo_value) || !ParseNumber(step_text, &step_value))
+    return false;
+  // The last value as the bound, or half a step past it where rounding
+  // would lose the last value.
+  for (const double bound : {values.back(), values.back() + by / 2}) {
+    const std::string hi_text = FormatNumber(bound);
+    double hi_value = 0;
+    if (!ParseNumber(hi_text, &hi_value)) continue;
+    if (RangeCount(lo_value, hi_value, step_value) !=
+        static_cast<double>(values.size())) {
+      continue;
+    }
+    if (ExpandRange(lo_value, hi_value, step_value) == values) {
+      *lo = lo_text;
+      *hi = hi_text;
+      *step = step_text;
+      return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace adse::spec

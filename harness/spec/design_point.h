@@ -14,6 +14,19 @@
 
 namespace adse::spec {
 
+// The values of `range: [lo, hi]` with `step`: lo, lo + step, ... up to hi
+// (within 1e-9 of a step), each cleaned of binary noise (0.1 steps give
+// 0.3, not 0.30000000000000004). The caller bounds the count first with
+// RangeCount.
+double RangeCount(double lo, double hi, double step);
+std::vector<double> ExpandRange(double lo, double hi, double step);
+
+// A range that expands to exactly `values` (three or more, evenly spaced),
+// as the text the scenario format reads back: {lo, hi, step}. False for
+// lists that are not such a progression.
+bool RangeOf(const std::vector<double>& values, std::string* lo,
+             std::string* hi, std::string* step);
+
 // Parses a command-line point "cores=4,freq_ghz=1.2,lidar_hz=14" against
 // the space. Values are snapped to the exact allowed values. Errors name
 // unknown parameters (with a suggestion), values not allowed (with the

@@ -16,6 +16,9 @@
 namespace adse::spec {
 namespace {
 
+// Lists longer than this are written as their range when they are one.
+constexpr size_t kLongList = 64;
+
 template <typename T>
 struct Field {
   const char* key;
@@ -335,6 +338,17 @@ const std::vector<Field<Spec>>& SpecFields() {
            out << YAML::Key << d.name << YAML::Value << YAML::Flow
                << YAML::BeginMap;
            out << YAML::Key << "bind" << YAML::Value << d.bind;
+           // A long regular list is written back as the range it came
+           // from, so the normalised text stays within kMaxSpecBytes.
+           std::string lo, hi, step;
+           if (d.values.size() > kLongList &&
+               RangeOf(d.values, &lo, &hi, &step)) {
+             out << YAML::Key << "range" << YAML::Value << YAML::Flow
+                 << YAML::BeginSeq << lo << hi << YAML::EndSeq;
+             out << YAML::Key << "step" << YAML::Value << step;
+             out << YAML::EndMap;
+             continue;
+           }
            out << YAML::Key << "values" << YAML::Value << YAML::Flow
                << YAML::BeginSeq;
            for (double value : d.values) out << FormatNumber(value);

@@ -140,21 +140,14 @@ void SpecReader::ReadParameter(const std::string& name, const Val& v,
                         FormatNumber(hi)));
       return;
     }
-    const double count = std::floor((hi - lo) / by + 1e-9) + 1;
+    const double count = RangeCount(lo, hi, by);
     if (!(count <= static_cast<double>(kMaxParameterValues))) {
       Error(range->mark, range->path,
             fmt::format("at most {} values", kMaxParameterValues),
             fmt::format("a range of {} values", FormatNumber(count)));
       return;
     }
-    for (size_t i = 0; i < static_cast<size_t>(count); ++i) {
-      // Multiply rather than accumulate, then round away binary noise so
-      // that 0.1 steps give 0.3, not 0.30000000000000004.
-      const double raw = lo + static_cast<double>(i) * by;
-      double clean = raw;
-      ParseNumber(fmt::format("{:.12g}", raw), &clean);
-      p.values.push_back(clean);
-    }
+    p.values = ExpandRange(lo, hi, by);
   } else {
     if (!ReadList(*values, &items, "a list of numbers")) return;
     if (items.empty()) {

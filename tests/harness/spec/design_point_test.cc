@@ -7,6 +7,7 @@
 #include <string>
 
 #include "harness/spec/spec_parser.h"
+#include "harness/spec/text_util.h"
 
 namespace adse::spec {
 namespace {
@@ -199,6 +200,50 @@ TEST(DesignPointTest, ApplyPointSetsPlatformAndStack) {
   EXPECT_NEAR(config->stack.Get("lidar.rate_hz"), 14, kTol);
   EXPECT_NEAR(config->stack.Lidar().rate_hz, 14, kTol);
   EXPECT_FALSE(ApplyPoint(spec, {{"cores", 23}}).ok());
+}
+
+// Every regular list a range expands to is recognised as that range, in
+// text that reads back to exactly the same values.
+TEST(RangeOfTest, ExpandedRangesAreRecognisedAndReadBackExactly) {
+  const struct {
+    double lo, hi, step;
+  } kRanges[] = {{1, 16, 1},    {0.5, 3.0, 0.1},         {2, 300, 0.00350001},
+                 {-5, 5, 0.25}, {1e-3, 2e-3, 1e-5},      {10, 1e5, 7},
+                 {0, 0.9, 0.3}, {1.2, 99.7, 0.123456789}};
+  for (const auto& r : kRanges) {
+    SCOPED_TRACE(r.step);
+    const std::vector<double> values = ExpandRange(r.lo, r.hi, r.step);
+    std::string lo, hi, step;
+    ASSERT_TRUE(RangeOf(values, &lo, &hi, &step));
+    double l = 0, h = 0, s = 0;
+    ASSERT_TRUE(ParseNumber(lo, &l) && ParseNumber(hi, &h) &&
+                ParseNumber(step, &s));
+    EXPECT_EQ(ExpandRange(l, h, s), values);
+  }
+  std::string lo, hi, step;
+  EXPECT_FALSE(RangeOf({1, 2, 4}, &lo, &hi, &step)) << "not evenly spaced";
+  EXPECT_FALSE(RangeOf({1, 2}, &lo, &hi, &step)) << "too short to say";
+}
+
+// A long range normalises to its range, not to 85 000 values, so the
+// normalised text parses back (found by fuzz_spec_parser).
+TEST(RangeOfTest, ALongRangeNormalisesToARangeThatParsesBack) {
+  ParseOptions options;
+  options.check_files = false;
+  Result<Spec> spec = ParseSpec(
+      "adse: 1\nworld: {map: {generate: grid}}\n"
+      "task: {start: {x: 0, y: 0}, goal: {x: 10, y: 0}}\n"
+      "design_space: {r: {bind: stack.lidar.range_m, range: [2, 300], "
+      "step: 0.00350001}}\n",
+      "long.yaml", "", options);
+  ASSERT_TRUE(spec.ok()) << spec.status().message();
+  const std::string normalized = NormalizedYaml(*spec);
+  EXPECT_LT(normalized.size(), 4096u);
+  Result<Spec> again = ParseSpec(normalized, "long.yaml", "", options);
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  EXPECT_EQ(again->design_space.parameters[0].values,
+            spec->design_space.parameters[0].values);
+  EXPECT_EQ(NormalizedYaml(*again), normalized);
 }
 
 }  // namespace
