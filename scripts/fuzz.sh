@@ -13,7 +13,8 @@
 # finds new is kept in build-fuzz/fuzz/<target>/corpus/ for the next run;
 # a crashing input is written to build-fuzz/fuzz/<target>/artifacts/.
 # Exits non-zero if any target reports a crash, leak, timeout or
-# out-of-memory. Needs clang-14 and libclang-rt-14-dev (Debian 12).
+# out-of-memory. Installs clang-14 and libclang-rt-14-dev when missing
+# (scripts/setup.sh --fuzz).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -32,18 +33,16 @@ while [ $# -gt 0 ]; do
 done
 [ ${#targets[@]} -eq 0 ] && targets=(fuzz_spec_parser fuzz_run_file)
 
+scripts/setup.sh --fuzz
 cc=${CC:-clang-14}
 cxx=${CXX:-clang++-14}
-if ! command -v "$cxx" >/dev/null; then
-  echo "fuzz: $cxx not found (apt-get install clang-14 libclang-rt-14-dev)" >&2
-  exit 2
-fi
 
 build=build-fuzz
 if [ ! -f "$build/CMakeCache.txt" ]; then
+  mkdir -p "$build"
   CC="$cc" CXX="$cxx" cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DADSE_FUZZ=ON -DBUILD_TESTING=OFF >"$build.configure.log" 2>&1 || {
-    cat "$build.configure.log" >&2
+    -DADSE_FUZZ=ON -DBUILD_TESTING=OFF >"$build/configure.log" 2>&1 || {
+    cat "$build/configure.log" >&2
     exit 1
   }
 fi
@@ -85,7 +84,7 @@ for target in "${targets[@]}"; do
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$work/log" | tail -1)
   execs=${execs:-0}
   seconds=$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.0f", b - a }')
-  rate=$(awk -v n="$execs" -v s="$seconds" 'BEGIN { printf "%.0f", s > 0 ? n / s : 0 }')
+  rate=$(awk -v n="$execs" -v s="$seconds" 'BEGIN { printf "%.0f", (s > 0 ? n / s : 0) }')
   reports=$(grep -cE 'ERROR: (AddressSanitizer|LeakSanitizer|libFuzzer)|runtime error:|SUMMARY: ' \
     "$work/log" || true)
   if [ "$rc" -ne 0 ] || [ "$reports" -ne 0 ]; then

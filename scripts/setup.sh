@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs adse's build and run dependencies from Debian 12 packages.
 # Idempotent: installs only what is missing; does nothing when all is there.
+#   scripts/setup.sh          what building and testing need
+#   scripts/setup.sh --fuzz   also clang and its sanitizer runtimes (fuzz.sh)
 set -euo pipefail
 
 PACKAGES=(
@@ -13,6 +15,9 @@ PACKAGES=(
   python3-h5py python3-pandas bc
   slurm-wlm munge
 )
+if [ "${1:-}" = "--fuzz" ]; then
+  PACKAGES+=(clang-14 libclang-rt-14-dev)
+fi
 
 missing=()
 for pkg in "${PACKAGES[@]}"; do
