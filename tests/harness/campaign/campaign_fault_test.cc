@@ -4,8 +4,6 @@
 // is not, say which file and why, and let the campaign resume.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <set>
@@ -18,6 +16,7 @@
 #include "harness/campaign/campaign.h"
 #include "stack/base/files.h"
 #include "tests/harness/testing/small_scenario.h"
+#include "tests/harness/testing/temp_files.h"
 #include "tests/stack/base/testing/fault_injection_env.h"
 
 namespace adse::campaign {
@@ -32,12 +31,7 @@ using ::testing::HasSubstr;
 constexpr int kBudget = 3;
 
 std::string TempDir(const std::string& name) {
-  const std::string dir = fs::temp_directory_path().string() +
-                          "/adse-campaign-fault-" + name + "-" +
-                          std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return adse::testing::FreshTempDir("adse-campaign-fault", name);
 }
 
 CampaignOptions Options(const std::string& out, Env* env) {
@@ -168,24 +162,15 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(CampaignCrashTest,
      ACrashBetweenWriteAndRenameLeavesNoCompleteLookingFileAndResumes) {
   const std::string out = TempDir("crash");
-  const pid_t child = ::fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    // The coordinator dies at its first commit of campaign.h5, after the
-    // temporary was written and flushed and before the rename.
-    FaultInjectionEnv env;
-    Fault crash;
-    crash.op = FaultOp::kRenameFile;
-    crash.path_contains = "campaign.h5";
-    crash.crash = true;
-    env.Inject(crash);
-    (void)RunCampaign(adse::testing::SmallScenario(), Options(out, &env));
-    std::_Exit(0);  // not reached
-  }
-  int status = 0;
-  ASSERT_EQ(::waitpid(child, &status, 0), child);
-  ASSERT_TRUE(WIFEXITED(status)) << "status " << status;
-  ASSERT_EQ(WEXITSTATUS(status), testing::kCrashExitCode);
+  // The coordinator dies at its first commit of campaign.h5, after the
+  // temporary was written and flushed and before the rename.
+  ASSERT_EQ(testing::RunUntilCrash(FaultOp::kRenameFile, "campaign.h5",
+                                   [&](Env* env) {
+                                     (void)RunCampaign(
+                                         adse::testing::SmallScenario(),
+                                         Options(out, env));
+                                   }),
+            testing::kCrashExitCode);
 
   EXPECT_FALSE(fs::exists(out + "/campaign.h5"))
       << "the index was never committed";

@@ -5,7 +5,6 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -120,21 +119,12 @@ TEST(AtomicWriteFaultTest, ACrashBetweenWriteAndRenameLeavesTheOldFileWhole) {
   const std::string dir = TempDir("crash");
   const std::string path = dir + "/report.md";
   ASSERT_TRUE(WriteFileAtomic(path, "old\n").ok());
-  const pid_t child = ::fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    FaultInjectionEnv env;
-    Fault crash;
-    crash.op = FaultOp::kRenameFile;
-    crash.crash = true;
-    env.Inject(crash);
-    (void)WriteFileAtomic(path, "new and never committed\n", &env);
-    std::_Exit(0);  // not reached: the rename ends the process
-  }
-  int status = 0;
-  ASSERT_EQ(::waitpid(child, &status, 0), child);
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), testing::kCrashExitCode);
+  EXPECT_EQ(testing::RunUntilCrash(
+                testing::FaultOp::kRenameFile, "",
+                [&](Env* env) {
+                  (void)WriteFileAtomic(path, "new and never committed\n", env);
+                }),
+            testing::kCrashExitCode);
   EXPECT_EQ(ReadFile(path).value(), "old\n");
   // The written temporary is there, under a name that is not the file's.
   const std::vector<std::string> names = Names(dir);

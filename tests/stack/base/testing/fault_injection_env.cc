@@ -1,5 +1,8 @@
 #include "tests/stack/base/testing/fault_injection_env.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cstdlib>
 #include <cstring>
 
@@ -79,6 +82,25 @@ Status FaultInjectionEnv::CopyFile(const std::string& from,
   ADSE_RETURN_IF_ERROR(
       Check(FaultOp::kCopyFile, to, ("copy from " + from).c_str()));
   return target_->CopyFile(from, to);
+}
+
+int RunUntilCrash(FaultOp op, const std::string& path_contains,
+                  const std::function<void(Env* env)>& body) {
+  const pid_t child = ::fork();
+  if (child < 0) return -1;
+  if (child == 0) {
+    FaultInjectionEnv env;
+    Fault crash;
+    crash.op = op;
+    crash.path_contains = path_contains;
+    crash.crash = true;
+    env.Inject(crash);
+    body(&env);
+    std::_Exit(0);
+  }
+  int status = 0;
+  if (::waitpid(child, &status, 0) != child || !WIFEXITED(status)) return -1;
+  return WEXITSTATUS(status);
 }
 
 }  // namespace adse::testing

@@ -7,6 +7,7 @@
 #define ADSE_TESTS_STACK_BASE_TESTING_FAULT_INJECTION_ENV_H_
 
 #include <cerrno>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <string_view>
@@ -44,6 +45,16 @@ struct Fault {
 
 // Exit status of a process that a crash fault ended.
 inline constexpr int kCrashExitCode = 86;
+
+class FaultInjectionEnv;
+
+// Runs `body` in a forked child process, with an Env that ends the child
+// at the first `op` on a path containing `path_contains` (e.g. a rename
+// after the write: a crash between the two). Returns the child's exit
+// status: kCrashExitCode when it died there, 0 when it got through, -1 when
+// it could not be started or was killed by a signal.
+int RunUntilCrash(FaultOp op, const std::string& path_contains,
+                  const std::function<void(Env* env)>& body);
 
 class FaultInjectionEnv : public EnvWrapper {
  public:
