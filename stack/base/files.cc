@@ -1,6 +1,5 @@
 #include "stack/base/files.h"
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
