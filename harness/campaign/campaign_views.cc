@@ -318,6 +318,18 @@ Status WriteCampaignViews(const spec::Spec& spec,
   return WriteAnswerViews(spec, summary, folder.root(), "images", env);
 }
 
+nlohmann::json AnswerJson(const spec::Spec& spec,
+                          const std::vector<EvaluationRow>& rows,
+                          const Headline& headline) {
+  auto row_or_null = [&](int i) {
+    return i < 0 ? nlohmann::json() : RowJson(spec, rows[i]);
+  };
+  return {{"cheapest_feasible", row_or_null(headline.cheapest)},
+          {"fastest_feasible", row_or_null(headline.fastest)},
+          {"knee", row_or_null(headline.knee)},
+          {"cost_time_front", headline.cost_time_front}};
+}
+
 Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
                         const std::string& dir, const std::string& image_dir,
                         Env* env) {
@@ -355,13 +367,7 @@ Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
     j["objectives"].push_back({{"metric", o.metric}, {"minimize", o.minimize}});
   }
   j["constraints"] = spec.constraints;
-  auto row_or_null = [&](int i) {
-    return i < 0 ? nlohmann::json() : RowJson(spec, rows[i]);
-  };
-  j["answer"] = {{"cheapest_feasible", row_or_null(headline.cheapest)},
-                 {"fastest_feasible", row_or_null(headline.fastest)},
-                 {"knee", row_or_null(headline.knee)},
-                 {"cost_time_front", headline.cost_time_front}};
+  j["answer"] = AnswerJson(spec, rows, headline);
   j["pareto_front"] = nlohmann::json::array();
   for (int i : front) j["pareto_front"].push_back(RowJson(spec, rows[i]));
   j["evaluations"] = nlohmann::json::array();

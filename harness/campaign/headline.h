@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "harness/campaign/evaluation.h"
 #include "harness/spec/spec.h"
 #include "stack/base/env.h"
@@ -53,6 +55,13 @@ std::string HeadlineMarkdown(const spec::Spec& spec,
                              const std::vector<EvaluationRow>& rows,
                              const Headline& headline,
                              const std::string& image_dir);
+
+// The headline as summary.json's "answer" (also in `adse status --json`
+// and `adse explore --json`): cheapest, fastest and knee rows, null when
+// none, and the cost-time front's row indices.
+nlohmann::json AnswerJson(const spec::Spec& spec,
+                          const std::vector<EvaluationRow>& rows,
+                          const Headline& headline);
 
 // pareto.png: every row by cost and nav time, the cost-time front as a
 // staircase with its points labelled, the cheapest feasible design ringed,

@@ -95,7 +95,7 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
   run.front_size = quality.true_front_size;
   run.hypervolume_ratio = quality.hypervolume_ratio;
   // The evaluation at which the first true Pareto point arrived.
-  const std::vector<int> true_front = analysis::ParetoFront(reference);
+  const std::vector<int> true_front = ParetoFrontOf(spec, recording.rows);
   for (size_t i = 0; i < found.size() && run.first_true_pareto_at == 0; ++i) {
     for (int t : true_front) {
       if (reference[t].feasible &&

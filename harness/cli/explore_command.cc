@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "harness/campaign/headline.h"
 #include "harness/campaign/replay.h"
 #include "harness/cli/commands.h"
 #include "harness/explore/strategy.h"
@@ -51,13 +52,21 @@ int RunExplore(const ExploreArgs& args) {
                         {"budget", budget},
                         {"seeds", args.seeds},
                         {"strategies", nlohmann::json::object()}};
+  // The recording's own answer, from the same front as adse run's.
+  const campaign::Headline answer =
+      campaign::ComputeHeadline(recording->spec, recording->rows);
+  out["answer"] =
+      campaign::AnswerJson(recording->spec, recording->rows, answer);
   if (!args.json) {
     std::printf(
         "replay of %s: %zu recorded evaluations, budget %d, seeds "
-        "%llu..%llu\n\n",
+        "%llu..%llu\n",
         args.replay.c_str(), recording->rows.size(), budget,
         static_cast<unsigned long long>(args.first_seed),
         static_cast<unsigned long long>(args.first_seed + args.seeds - 1));
+    std::printf("the recording's answer:\n%s\n",
+                campaign::HeadlineText(recording->spec, recording->rows, answer)
+                    .c_str());
     std::printf(
         "| strategy | true Pareto points found (min / median / mean / max) | "
         "of front | "

@@ -1,8 +1,14 @@
 // `adse status`: runs done / failed / running / pending of a campaign and
-// the Slurm jobs submitted for it (harness/slurm/status.h). Exit 0, or 2
-// when the folder is not a campaign.
+// the Slurm jobs submitted for it (harness/slurm/status.h), then the answer
+// so far. Exit 0, or 2 when the folder is not a campaign.
 #include <cstdio>
+#include <filesystem>
+#include <optional>
 
+#include <nlohmann/json.hpp>
+
+#include "harness/campaign/headline.h"
+#include "harness/campaign/replay.h"
 #include "harness/cli/commands.h"
 #include "harness/slurm/status.h"
 
@@ -15,9 +21,37 @@ int RunStatus(const StatusArgs& args) {
     std::fprintf(stderr, "error: %s\n", status.status().message().c_str());
     return ExitCodeFor(status.status());
   }
-  const std::string text =
-      args.json ? slurm::StatusJson(*status) : slurm::FormatStatus(*status);
-  std::fputs(text.c_str(), stdout);
+  // The answer so far, when the campaign has an index: the same headline
+  // as adse run's, from the scenario stored in it.
+  std::optional<campaign::Recording> recorded;
+  std::error_code ec;
+  if (std::filesystem::exists(args.campaign + "/campaign.h5", ec)) {
+    Result<campaign::Recording> r = campaign::LoadRecording(args.campaign);
+    if (r.ok()) {
+      recorded = std::move(*r);
+    } else {
+      std::fprintf(stderr, "warning: no answer: %s\n",
+                   r.status().message().c_str());
+    }
+  }
+  if (args.json) {
+    nlohmann::json j = nlohmann::json::parse(slurm::StatusJson(*status));
+    if (recorded) {
+      j["answer"] = campaign::AnswerJson(
+          recorded->spec, recorded->rows,
+          campaign::ComputeHeadline(recorded->spec, recorded->rows));
+    }
+    std::printf("%s\n", j.dump(2).c_str());
+    return 0;
+  }
+  std::fputs(slurm::FormatStatus(*status).c_str(), stdout);
+  if (recorded) {
+    std::printf("answer so far (campaign.h5):\n%s",
+                campaign::HeadlineText(
+                    recorded->spec, recorded->rows,
+                    campaign::ComputeHeadline(recorded->spec, recorded->rows))
+                    .c_str());
+  }
   return 0;
 }
 

@@ -260,6 +260,12 @@ TEST(CliRunTest, ExploreReplayPrintsADistributionPerStrategy) {
   EXPECT_NE(run.out.find("280 recorded evaluations, budget 15, seeds 1..3"),
             std::string::npos)
       << run.out;
+  // The recording's own answer leads, from the same front as adse run's:
+  // the true cheapest feasible design of the 280-point space.
+  EXPECT_NE(run.out.find("cheapest feasible   cores=2,freq_ghz=1.2,lidar_hz=7"
+                         "  cost 2.4"),
+            std::string::npos)
+      << run.out;
   EXPECT_NE(run.out.find("| agent |"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("| ga |"), std::string::npos) << run.out;
   const CommandRun bad = Adse("explore --replay /nonexistent/campaign");
@@ -346,6 +352,11 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
   EXPECT_NE(analyze.out.find(cheapest_line), std::string::npos)
       << cheapest_line << "\n"
       << analyze.out;
+  // adse status tells the same answer, from the same front.
+  const CommandRun status = Adse("status " + out.string());
+  ASSERT_EQ(status.exit_code, 0) << status.out;
+  EXPECT_NE(status.out.find(cheapest_line), std::string::npos) << status.out;
+  EXPECT_EQ(FrontSection(status.out), FrontSection(run.out)) << status.out;
   EXPECT_TRUE(fs::exists(out / "analysis" / "v1" / "pareto.png"));
   EXPECT_TRUE(fs::exists(out / "analysis" / "v1" / "report.md"));
   EXPECT_FALSE(fs::exists(out / "runs" / "analysis"));
