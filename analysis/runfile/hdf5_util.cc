@@ -542,7 +542,14 @@ Status CheckGlobalHeaps(const std::string& path) {
             " (an empty free-space object, which HDF5 cannot read past)");
         break;
       }
-      if (need > end - p) break;
+      if (need > end - p) {
+        if (p + kHeader > end || index == 0) break;  // trailing free space
+        status = Status::Corruption(
+            path + ": damaged HDF5 global heap at byte " + std::to_string(at) +
+            " (object " + std::to_string(index) + " claims " +
+            std::to_string(object) + " bytes, more than its collection)");
+        break;
+      }
       p += static_cast<size_t>(need);
     }
   }

@@ -93,8 +93,9 @@ Status ReadFileContents(const std::string& path, const std::string& expected,
 // Corruption when `path` holds a global heap collection (where variable-
 // length strings live) that libhdf5 1.10 would loop forever on: one whose
 // free-space object has size 0, so each step of HDF5's parse advances by
-// nothing. Found by fuzz_run_file (tests/fuzz/regressions/README.md);
-// every reader calls it before H5Fopen.
+// nothing, or one whose object claims more bytes than the collection holds
+// (HDF5 then copies overlapping memory). Found by fuzz_run_file
+// (tests/fuzz/regressions/README.md); every reader calls it before H5Fopen.
 Status CheckGlobalHeaps(const std::string& path);
 
 // File access properties: the HDF5 1.10 file format (checksummed metadata)

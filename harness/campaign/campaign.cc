@@ -200,7 +200,7 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
   if (!lock.ok()) return lock.status();
   // Created under the lock: the llm strategy records into the folder.
   Result<std::unique_ptr<explore::Strategy>> strategy =
-      CreateCampaignStrategy(spec, folder.root(), /*record=*/true);
+      CreateCampaignStrategy(spec, folder.root(), /*record=*/true, options.env);
   if (!strategy.ok()) return strategy.status();
 
   Result<std::unique_ptr<pool::WorkerPool>> pool =

@@ -26,7 +26,7 @@ Result<bool> StrategyIsAdaptive(const spec::Spec& spec) {
 }
 
 Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(
-    const spec::Spec& spec, const std::string& folder, bool record) {
+    const spec::Spec& spec, const std::string& folder, bool record, Env* env) {
   const std::string& name = spec.exploration.strategy;
   ADSE_RETURN_IF_ERROR(CheckStrategyName(name));
   if (name != spec::kLlmStrategy) return explore::CreateStrategy(name, {&spec});
@@ -38,7 +38,7 @@ Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(
     llm_spec.llm.replay_from = folder;
   }
   Result<std::unique_ptr<llm::RecordingBackend>> backend =
-      llm::OpenBackend(llm_spec, record ? folder : "");
+      llm::OpenBackend(llm_spec, record ? folder : "", env);
   if (!backend.ok()) return backend.status();
   const CampaignFolder layout(folder);
   llm::LlmStrategyOptions options;
@@ -50,6 +50,7 @@ Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(
   };
   options.record_dir = record ? folder : "";
   options.backend = std::move(*backend);
+  options.env = env;
   return llm::NewLlmStrategy(spec, std::move(options));
 }
 

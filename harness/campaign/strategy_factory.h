@@ -9,6 +9,7 @@
 
 #include "harness/explore/strategy.h"
 #include "harness/spec/spec.h"
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 
 namespace adse::campaign {
@@ -24,8 +25,10 @@ Result<bool> StrategyIsAdaptive(const spec::Spec& spec);
 // `folder`: the campaign folder runs are read from. `record`: the llm
 // agents record into it (live campaigns) or only read it (replay, where
 // their answers come from the folder's own record).
+// The llm agents' records are appended through `env`.
 Result<std::unique_ptr<explore::Strategy>> CreateCampaignStrategy(
-    const spec::Spec& spec, const std::string& folder, bool record);
+    const spec::Spec& spec, const std::string& folder, bool record,
+    Env* env = Env::Default());
 
 }  // namespace adse::campaign
 

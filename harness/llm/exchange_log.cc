@@ -239,9 +239,9 @@ Result<ChatReply> RecordingBackend::Chat(const ChatRequest& request) {
 
 Result<std::unique_ptr<RecordingBackend>> OpenRecordingBackend(
     const spec::LlmOptions& llm, const std::string& replay_file,
-    const std::string& log_file, const std::string& where) {
+    const std::string& log_file, const std::string& where, Env* env) {
   // Opened first: it drops a line cut short by a crash before it is read.
-  Result<JsonlLog> log = JsonlLog::Open(log_file);
+  Result<JsonlLog> log = JsonlLog::Open(log_file, env);
   if (!log.ok()) return log.status();
   std::vector<ExchangeRecord> recorded;
   if (!replay_file.empty()) {

@@ -17,6 +17,7 @@
 #include "harness/llm/chat.h"
 #include "harness/llm/jsonl_log.h"
 #include "harness/spec/spec.h"
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 
 namespace adse::llm {
@@ -97,7 +98,8 @@ class RecordingBackend : public ChatBackend {
 // ("scenario.yaml:12:3: ").
 Result<std::unique_ptr<RecordingBackend>> OpenRecordingBackend(
     const spec::LlmOptions& llm, const std::string& replay_file,
-    const std::string& log_file, const std::string& where = "");
+    const std::string& log_file, const std::string& where = "",
+    Env* env = Env::Default());
 
 }  // namespace adse::llm
 

@@ -11,13 +11,14 @@
 
 namespace adse::llm {
 
-Result<JsonlLog> JsonlLog::Open(const std::string& path) {
+Result<JsonlLog> JsonlLog::Open(const std::string& path, Env* env) {
   JsonlLog log;
   log.path_ = path;
+  log.env_ = env;
   if (path.empty()) return log;
   const std::filesystem::path p(path);
   if (p.has_parent_path())
-    ADSE_RETURN_IF_ERROR(MakeDirs(p.parent_path().string()));
+    ADSE_RETURN_IF_ERROR(MakeDirs(p.parent_path().string(), env));
   std::error_code ec;
   if (!std::filesystem::exists(p, ec)) return log;
   Result<std::string> text = ReadFile(path, size_t{1} << 30);
@@ -40,13 +41,13 @@ Result<JsonlLog> JsonlLog::Open(const std::string& path) {
 Status JsonlLog::Append(const std::string& line) {
   if (path_.empty()) return Status::Ok();
   if (written_++ < existing_) return Status::Ok();
-  return AppendLineDurable(path_, line);
+  return AppendLineDurable(path_, line, env_);
 }
 
 Status JsonlLog::AppendNew(const std::string& line) {
   if (path_.empty()) return Status::Ok();
   ++written_;
-  return AppendLineDurable(path_, line);
+  return AppendLineDurable(path_, line, env_);
 }
 
 Status ReadJsonLines(

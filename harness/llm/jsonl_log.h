@@ -9,6 +9,7 @@
 #include <functional>
 #include <string>
 
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 
 namespace adse::llm {
@@ -17,7 +18,9 @@ class JsonlLog {
  public:
   // An empty path records nothing. Creates the folder; drops a last line
   // cut short by a crash (so the next append starts on a fresh line).
-  static Result<JsonlLog> Open(const std::string& path);
+  // Appends go through `env`.
+  static Result<JsonlLog> Open(const std::string& path,
+                               Env* env = Env::Default());
   JsonlLog() = default;
 
   // Appends `line` unless the file already holds this session's line.
@@ -32,6 +35,7 @@ class JsonlLog {
   std::string path_;
   int64_t existing_ = 0;  // complete lines found at Open
   int64_t written_ = 0;   // lines this session has produced
+  Env* env_ = Env::Default();
 };
 
 // Calls `parse` on each non-empty line of `path` (a missing file has

@@ -417,13 +417,13 @@ class LlmStrategy : public explore::Strategy {
 }  // namespace
 
 Result<std::unique_ptr<RecordingBackend>> OpenBackend(
-    const spec::Spec& spec, const std::string& record_dir) {
+    const spec::Spec& spec, const std::string& record_dir, Env* env) {
   const std::string own = record_dir.empty() ? "" : ExchangesPath(record_dir);
   // With a live model, a resumed campaign first hears again what its
   // models said before.
   const std::string replay =
       spec.llm.backend == "replay" ? ExchangesPath(spec.llm.replay_from) : own;
-  return OpenRecordingBackend(spec.llm, replay, own, spec.Where("llm"));
+  return OpenRecordingBackend(spec.llm, replay, own, spec.Where("llm"), env);
 }
 
 Result<std::unique_ptr<explore::Strategy>> NewLlmStrategy(
@@ -441,9 +441,11 @@ Result<std::unique_ptr<explore::Strategy>> NewLlmStrategy(
   Result<PromptSet> prompts = PromptSet::Load(spec.llm.prompts);
   if (!prompts.ok()) return prompts.status();
   const std::string dir = options.record_dir;
-  Result<JsonlLog> memory = JsonlLog::Open(dir.empty() ? "" : MemoryPath(dir));
+  Result<JsonlLog> memory =
+      JsonlLog::Open(dir.empty() ? "" : MemoryPath(dir), options.env);
   if (!memory.ok()) return memory.status();
-  Result<JsonlLog> events = JsonlLog::Open(dir.empty() ? "" : EventsPath(dir));
+  Result<JsonlLog> events =
+      JsonlLog::Open(dir.empty() ? "" : EventsPath(dir), options.env);
   if (!events.ok()) return events.status();
 
   std::vector<std::string> objectives, constraints;

@@ -19,6 +19,7 @@
 #include "harness/explore/strategy.h"
 #include "harness/llm/exchange_log.h"
 #include "harness/spec/spec.h"
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 
 namespace adse::llm {
@@ -29,7 +30,8 @@ namespace adse::llm {
 // record first, so a resumed campaign re-proposes what it proposed before.
 // With `backend: replay` every answer comes from `llm.replay_from`.
 Result<std::unique_ptr<RecordingBackend>> OpenBackend(
-    const spec::Spec& spec, const std::string& record_dir);
+    const spec::Spec& spec, const std::string& record_dir,
+    Env* env = Env::Default());
 
 struct LlmStrategyOptions {
   // A run's RunReport JSON and trajectory picture, by content key.
@@ -40,6 +42,8 @@ struct LlmStrategyOptions {
   std::string record_dir;
   // The model backend; required.
   std::unique_ptr<RecordingBackend> backend;
+  // Where the records are appended through.
+  Env* env = Env::Default();
 };
 
 // InvalidArgument when the prompts cannot be loaded or no backend is given.

@@ -679,21 +679,32 @@ TEST_F(RunFileTest, FileWithoutLanesReadsAsNoLanes) {
 }
 
 // Found by fuzz_run_file: libhdf5 1.10 loops forever on a global heap whose
-// free-space object is empty. Every reader refuses the file first.
-TEST(RunFileDamageTest, ADamagedGlobalHeapIsRefusedInsteadOfHangingHdf5) {
-  const std::string path = std::string(ADSE_SOURCE_DIR) +
-                           "/tests/fuzz/regressions/run_file/"
-                           "hdf5_global_heap_loop.h5";
-  Result<RunData> run = ReadRunFile(path);
-  ASSERT_FALSE(run.ok());
-  EXPECT_EQ(run.status().code(), Status::Code::kCorruption);
-  EXPECT_NE(run.status().message().find(path + ": damaged HDF5 global heap"),
-            std::string::npos)
-      << run.status().message();
-  std::vector<std::string> problems;
-  EXPECT_FALSE(CheckRunFile(path, &problems).ok());
-  ASSERT_EQ(problems.size(), 1u);
-  EXPECT_NE(problems[0].find("damaged HDF5 global heap"), std::string::npos);
+// free-space object is empty, and copies overlapping memory for an object
+// that claims more than its collection. Every reader refuses both first.
+TEST(RunFileDamageTest, ADamagedGlobalHeapIsRefusedBeforeHdf5ReadsIt) {
+  const std::string dir =
+      std::string(ADSE_SOURCE_DIR) + "/tests/fuzz/regressions/run_file/";
+  const std::pair<const char*, const char*> kCases[] = {
+      {"hdf5_global_heap_loop.h5", "an empty free-space object"},
+      {"hdf5_global_heap_object_past_collection.h5",
+       "more than its collection"},
+  };
+  for (const auto& [file, why] : kCases) {
+    SCOPED_TRACE(file);
+    const std::string path = dir + file;
+    Result<RunData> run = ReadRunFile(path);
+    ASSERT_FALSE(run.ok());
+    EXPECT_EQ(run.status().code(), Status::Code::kCorruption);
+    EXPECT_NE(run.status().message().find(path + ": damaged HDF5 global heap"),
+              std::string::npos)
+        << run.status().message();
+    EXPECT_NE(run.status().message().find(why), std::string::npos)
+        << run.status().message();
+    std::vector<std::string> problems;
+    EXPECT_FALSE(CheckRunFile(path, &problems).ok());
+    ASSERT_EQ(problems.size(), 1u);
+    EXPECT_NE(problems[0].find("damaged HDF5 global heap"), std::string::npos);
+  }
 }
 
 TEST_F(RunFileTest, FileWithoutStatusNeverLooksComplete) {

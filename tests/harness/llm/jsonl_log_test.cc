@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -16,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/harness/testing/temp_files.h"
+#include "tests/stack/base/testing/fault_injection_env.h"
 
 namespace adse::llm {
 namespace {
@@ -156,6 +159,32 @@ TEST(JsonlLogTest, OpenFailsWhenTheFolderCannotBeCreated) {
   ASSERT_FALSE(log.ok());
   EXPECT_EQ(log.status().code(), Status::Code::kIoError);
   EXPECT_THAT(log.status().message(), HasSubstr(dir + "/file/llm"));
+}
+
+TEST(JsonlLogTest, AFullDiskIsAnErrorAndTheHalfLineIsDroppedOnResume) {
+  const std::string path = TempDir("full") + "/log.jsonl";
+  adse::testing::FaultInjectionEnv env;
+  env.Inject({.op = adse::testing::FaultOp::kAppendFile,
+              .path_contains = "log.jsonl",
+              .error = ENOSPC,
+              .after = 1,
+              .times = 1});
+  Result<JsonlLog> log = JsonlLog::Open(path, &env);
+  ASSERT_TRUE(log.ok()) << log.status().ToString();
+  ASSERT_TRUE(log->Append(R"({"n":0})").ok());
+  const Status full = log->Append(R"({"n":1})");
+  ASSERT_FALSE(full.ok());
+  EXPECT_THAT(full.message(), HasSubstr(path));
+  EXPECT_THAT(full.message(), HasSubstr(std::strerror(ENOSPC)));
+
+  // The disk wrote half a line; a resumed session drops it and writes the
+  // line whole.
+  Result<JsonlLog> resumed = JsonlLog::Open(path);
+  ASSERT_TRUE(resumed.ok()) << resumed.status().ToString();
+  EXPECT_EQ(resumed->existing(), 1);
+  ASSERT_TRUE(resumed->Append(R"({"n":0})").ok());
+  ASSERT_TRUE(resumed->Append(R"({"n":1})").ok());
+  EXPECT_EQ(Slurp(path), "{\"n\":0}\n{\"n\":1}\n");
 }
 
 TEST(ReadJsonLinesTest, AMissingFileHasNoLines) {
