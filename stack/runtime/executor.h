@@ -4,11 +4,13 @@
 #ifndef ADSE_STACK_RUNTIME_EXECUTOR_H_
 #define ADSE_STACK_RUNTIME_EXECUTOR_H_
 
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
 
 #include "stack/base/status.h"
+#include "stack/runtime/cost_profile.h"
 #include "stack/runtime/graph.h"
 #include "stack/runtime/trace.h"
 
@@ -31,6 +33,16 @@ struct VirtualPlatformOptions {
   // without an entry costs `default_counted`.
   std::map<std::string, CountedCost> counted;
   CountedCost default_counted{1e-4, 0.0};
+  // kCounted with a profile: each invocation's cost is drawn from the
+  // profile's distribution for its callback (which every callback of the
+  // graph must have), scaled by its work units, its parallel part and
+  // (profile->reference_ghz / freq_ghz)^freq_exponent; `counted`,
+  // `default_counted` and `reference_ghz` are then unused.
+  std::shared_ptr<const CostProfile> profile;
+  // Seeds the draws: invocation i of callback "<name>" draws from a stream
+  // derived from (profile_seed, name, i), so a run is reproducible and one
+  // callback's draws do not depend on how often the others ran.
+  uint64_t profile_seed = 0;
   // Scales every cost: how much heavier the modelled production stack is
   // than adse's own (1 = as measured).
   double cost_scale = 1.0;

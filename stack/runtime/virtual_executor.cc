@@ -27,9 +27,14 @@
 //   (kCounted; host_cpu_s is then recorded as 0 unless
 //   record_host_cpu_when_counted); k = min(max_threads, free cores at start)
 //   cores are held to the end; cost = base * (1 - p + p / k) * reference_ghz /
-//   freq_ghz * cost_scale, at least 1 us. At start + cost the cores are freed,
-//   held publications are released in order (kPublish, per-topic seq from 0)
-//   and the CallbackRecord is appended (records are in completion order).
+//   freq_ghz * cost_scale, at least 1 us. With a cost profile (kCounted),
+//   base = a draw from the callback's quantiles (u from the seeded stream of
+//   this callback and invocation) * units / reference_units (when > 0); p
+//   and max_threads come from the profile; the frequency factor is
+//   (profile reference_ghz / freq_ghz)^freq_exponent * cost_scale. At start +
+//   cost the cores are freed, held publications are released in order
+//   (kPublish, per-topic seq from 0) and the CallbackRecord is appended
+//   (records are in completion order).
 // - AdvanceTo(t) applies events strictly before t, then sets now = t.
 // - Errors (a callback or sink throws, a bad topic) are sticky: AdvanceTo
 //   returns the same Status from then on.
@@ -39,12 +44,16 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "stack/base/platform_limits.h"
+#include "stack/base/random.h"
 #include "stack/runtime/executor.h"
 
 namespace adse::stack {
@@ -64,6 +73,16 @@ double ThreadCpuSeconds() {
 }
 
 bool IsFinitePositive(double v) { return std::isfinite(v) && v > 0.0; }
+
+// Uniform in [0, 1) for draw `i` of a stream: SplitMix64 of (seed, i), so
+// a draw depends only on its own callback's seed and count.
+double DrawUniform(uint64_t seed, uint64_t i) {
+  uint64_t z = seed + (i + 1) * 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return static_cast<double>(z >> 11) * 0x1.0p-53;
+}
 
 Status ValidateCountedCost(const CountedCost& cost, const std::string& field) {
   if (!std::isfinite(cost.fixed_s) || cost.fixed_s < 0.0) {
@@ -129,6 +148,12 @@ struct CallbackState {
   double fire_s = 0.0;
   int64_t next_fire = 0;  // k of the fire at phase + k * period in the heap
   CountedCost counted;
+  // With a cost profile: this callback's entry, its frequency factor, the
+  // seed of its draws and how many it has taken.
+  const CallbackCost* profiled = nullptr;
+  double profile_factor = 1.0;
+  uint64_t draw_seed = 0;
+  uint64_t draws = 0;
   CallbackRecord record;              // the run in progress
   std::vector<HeldPublication> held;  // its publications, until its end
 };
@@ -243,6 +268,7 @@ class VirtualExecutor final : public Executor {
   std::vector<char> node_busy_;
   std::vector<int32_t> core_owner_;  // callback holding each core, or -1
   int free_cores_;
+  std::shared_ptr<const CostProfile> profile_;  // keeps `profiled` valid
 
   VirtualContext context_;
   Trace trace_;
@@ -258,6 +284,7 @@ VirtualExecutor::VirtualExecutor(const Graph* graph,
       measured_(options.cost_model == CostModelKind::kMeasured),
       read_clock_(measured_ || options.record_host_cpu_when_counted),
       free_cores_(options.cores),
+      profile_(options.profile),
       context_(static_cast<int>(graph->topics().size())) {
   const auto& callbacks = graph->callbacks();
   const size_t num_topics = graph->topics().size();
@@ -276,6 +303,14 @@ VirtualExecutor::VirtualExecutor(const Graph* graph,
     auto it = options.counted.find(spec.name);
     st.counted =
         it != options.counted.end() ? it->second : options.default_counted;
+    if (profile_ != nullptr && !measured_) {
+      // CreateVirtualExecutor checked that every callback has an entry.
+      st.profiled = &profile_->callbacks.at(spec.name);
+      st.profile_factor = std::pow(profile_->reference_ghz / options.freq_ghz,
+                                   st.profiled->freq_exponent) *
+                          options.cost_scale;
+      st.draw_seed = Random::DeriveSeed(options.profile_seed, spec.name);
+    }
     if (st.is_timer) {
       PushTimerFire(static_cast<int>(c));
     } else {
@@ -537,13 +572,24 @@ void VirtualExecutor::Start(int c) {
   const double units = std::isfinite(work.units) ? work.units : 0.0;
   double p =
       std::isfinite(work.parallel_fraction) ? work.parallel_fraction : 0.0;
+  int max_threads = work.max_threads;
+  double base_s = 0.0;
+  double factor = freq_factor_;
+  if (measured_) {
+    base_s = host_cpu_s;
+  } else if (st.profiled != nullptr) {
+    const CallbackCost& cost = *st.profiled;
+    base_s = SampleCost(cost, DrawUniform(st.draw_seed, st.draws++));
+    if (cost.reference_units > 0.0) base_s *= units / cost.reference_units;
+    p = cost.parallel_fraction;
+    max_threads = cost.max_threads;
+    factor = st.profile_factor;
+  } else {
+    base_s = st.counted.fixed_s + st.counted.per_unit_s * units;
+  }
   p = std::clamp(p, 0.0, 1.0);
-  const int k = std::max(1, std::min(work.max_threads, free_cores_));
-
-  const double base_s =
-      measured_ ? host_cpu_s
-                : st.counted.fixed_s + st.counted.per_unit_s * units;
-  double cost_s = base_s * (1.0 - p + p / k) * freq_factor_;
+  const int k = std::max(1, std::min(max_threads, free_cores_));
+  double cost_s = base_s * (1.0 - p + p / k) * factor;
   if (!(cost_s >= kMinCostS)) cost_s = kMinCostS;  // also catches NaN
 
   int first_core = -1;
@@ -640,6 +686,9 @@ Status ValidateVirtualPlatformOptions(const VirtualPlatformOptions& options) {
       options.cost_model != CostModelKind::kCounted) {
     return Status::InvalidArgument("cost_model: unknown kind");
   }
+  if (options.profile != nullptr) {
+    ADSE_RETURN_IF_ERROR(ValidateCostProfile(*options.profile));
+  }
   for (const auto& [name, cost] : options.counted) {
     ADSE_RETURN_IF_ERROR(
         ValidateCountedCost(cost, fmt::format("counted[{}]", name)));
@@ -652,6 +701,21 @@ Result<std::unique_ptr<Executor>> CreateVirtualExecutor(
   if (graph == nullptr) return Status::InvalidArgument("graph is null");
   ADSE_RETURN_IF_ERROR(ValidateVirtualPlatformOptions(options));
   ADSE_RETURN_IF_ERROR(ValidateGraph(*graph));
+  if (options.profile != nullptr &&
+      options.cost_model == CostModelKind::kCounted) {
+    // A callback the profile does not cost would be charged nothing: refuse.
+    std::vector<std::string> missing;
+    for (const CallbackSpec& spec : graph->callbacks()) {
+      if (options.profile->callbacks.count(spec.name) == 0) {
+        missing.push_back(spec.name);
+      }
+    }
+    if (!missing.empty()) {
+      return Status::InvalidArgument(
+          fmt::format("cost profile has no entry for callback(s): {}",
+                      fmt::join(missing, ", ")));
+    }
+  }
   return std::unique_ptr<Executor>(new VirtualExecutor(graph, options));
 }
 
