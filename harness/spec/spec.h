@@ -56,11 +56,15 @@ struct PlatformOptions {
   CostModel cost_model = CostModel::kMeasured;
   // Calibration file for cost_model: counted (absolute path; may be empty).
   std::string calibration;
+  // Cost profile for cost_model: counted (absolute path; may be empty):
+  // measured per-callback costs of a production stack, used instead of a
+  // calibration (harness/profile).
+  std::string profile;
   // Defaults when the design space does not bind them.
   int cores = 4;
   double freq_ghz = 2.1;
-  // Multiplies every callback cost: how much heavier the modelled
-  // production stack is than adse's own implementation (1 = as measured).
+  // Multiplies every callback cost: a sensitivity knob (1 = as measured or
+  // as profiled).
   double cost_scale = 1.0;
 };
 

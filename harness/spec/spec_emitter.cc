@@ -230,6 +230,7 @@ const std::vector<Field<PlatformOptions>>& PlatformFields() {
          out << CostModelToString(p.cost_model);
        }},
       QuotedIfSet("calibration", &PlatformOptions::calibration),
+      QuotedIfSet("profile", &PlatformOptions::profile),
       Integer("cores", &PlatformOptions::cores),
       Number("freq_ghz", &PlatformOptions::freq_ghz),
       Number("cost_scale", &PlatformOptions::cost_scale)};

@@ -36,8 +36,8 @@ const std::vector<std::string> kStartKeys = {"x", "y", "edge", "pos_m", "lane"};
 const std::vector<std::string> kGoalKeys = {"x",     "y",    "edge",
                                             "pos_m", "lane", "tolerance_m"};
 const std::vector<std::string> kPlatformKeys = {
-    "kind",  "reference_ghz", "cost_model", "calibration",
-    "cores", "freq_ghz",      "cost_scale"};
+    "kind",    "reference_ghz", "cost_model", "calibration",
+    "profile", "cores",         "freq_ghz",   "cost_scale"};
 
 }  // namespace
 
@@ -501,6 +501,23 @@ void SpecReader::ReadPlatform(const Val& v) {
         Error(
             e->mark, e->path, "an existing calibration file",
             Quote(e->node.Scalar()) + " (no such file: " + p.calibration + ")");
+      }
+    }
+  }
+  if (const Val* e = f.Get("profile")) {
+    if (ReadPath(*e, &p.profile, "a path to a cost profile")) {
+      std::error_code ec;
+      if (check_files_ && !fs::is_regular_file(p.profile, ec)) {
+        Error(e->mark, e->path, "an existing cost profile file",
+              Quote(e->node.Scalar()) + " (no such file: " + p.profile + ")");
+      } else if (p.cost_model != CostModel::kCounted) {
+        Error(e->mark, e->path, "cost_model: counted beside it",
+              "cost_model: " + std::string(CostModelToString(p.cost_model)) +
+                  " (a profile costs the counted model's callbacks)");
+      } else if (!p.calibration.empty()) {
+        Error(e->mark, e->path, "a profile or a calibration, not both",
+              "both (the profile costs every callback; the calibration "
+              "would be unused)");
       }
     }
   }

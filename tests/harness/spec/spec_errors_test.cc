@@ -200,6 +200,31 @@ TEST(SpecErrorsTest, MissingMapFile) {
   EXPECT_THAT(message, HasSubstr("/nonexistent-adse-dir/maps/none.net.xml"));
 }
 
+TEST(SpecErrorsTest, AProfileNeedsTheCountedModelAndNoCalibration) {
+  const std::string dir = ADSE_SOURCE_DIR;  // README.md stands for a file
+  EXPECT_THAT(
+      ErrorOf(std::string(kHead) + "platform: {profile: none.yaml}\n", dir),
+      HasSubstr("platform.profile: expected an existing cost profile "
+                "file, found 'none.yaml' (no such file: " +
+                dir + "/none.yaml)"));
+  EXPECT_THAT(
+      ErrorOf(std::string(kHead) + "platform: {profile: README.md}\n", dir),
+      HasSubstr("platform.profile: expected cost_model: counted beside it, "
+                "found cost_model: measured"));
+  EXPECT_THAT(ErrorOf(std::string(kHead) +
+                          "platform: {cost_model: counted, profile: README.md, "
+                          "calibration: README.md}\n",
+                      dir),
+              HasSubstr("platform.profile: expected a profile or a "
+                        "calibration, not both"));
+  Result<Spec> ok =
+      ParseSpec(std::string(kHead) +
+                    "platform: {cost_model: counted, profile: README.md}\n",
+                "ok.yaml", dir);
+  ASSERT_TRUE(ok.ok()) << ok.status().ToString();
+  EXPECT_EQ(ok->platform.profile, dir + "/README.md");
+}
+
 TEST(SpecErrorsTest, MapFileThatIsNotASumoNetwork) {
   std::string dir = (fs::temp_directory_path() / "adse-spec-XXXXXX").string();
   ASSERT_NE(mkdtemp(dir.data()), nullptr);
