@@ -34,8 +34,9 @@ struct CallbackCost {
   // compute-bound code, lower for memory-bound code whose time the core
   // clock changes less.
   double freq_exponent = 1.0;
-  // Amdahl fraction of the cost that more threads speed up, and the most
-  // threads that part can use (replaces the callback's own WorkReport).
+  // Amdahl fraction of the cost that more threads speed up (replaces the
+  // callback's own WorkReport's), and the most threads that part can use
+  // (the executor takes the smaller of this and the WorkReport's).
   double parallel_fraction = 0.0;
   int max_threads = 1;
 };

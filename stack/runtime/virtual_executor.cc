@@ -30,7 +30,8 @@
 //   freq_ghz * cost_scale, at least 1 us. With a cost profile (kCounted),
 //   base = a draw from the callback's quantiles (u from the seeded stream of
 //   this callback and invocation) * units / reference_units (when > 0); p
-//   and max_threads come from the profile; the frequency factor is
+//   comes from the profile, max_threads is the smaller of the profile's and
+//   the report's; the frequency factor is
 //   (profile reference_ghz / freq_ghz)^freq_exponent * cost_scale. At start +
 //   cost the cores are freed, held publications are released in order
 //   (kPublish, per-topic seq from 0) and the CallbackRecord is appended
@@ -581,8 +582,10 @@ void VirtualExecutor::Start(int c) {
     const CallbackCost& cost = *st.profiled;
     base_s = SampleCost(cost, DrawUniform(st.draw_seed, st.draws++));
     if (cost.reference_units > 0.0) base_s *= units / cost.reference_units;
+    // The source's parallel part, on at most the threads both it scales to
+    // and the callback runs with (e.g. the localization.ndt_threads knob).
     p = cost.parallel_fraction;
-    max_threads = cost.max_threads;
+    max_threads = std::min(cost.max_threads, work.max_threads);
     factor = st.profile_factor;
   } else {
     base_s = st.counted.fixed_s + st.counted.per_unit_s * units;

@@ -107,7 +107,10 @@ struct OneCallback {
     callback = graph.Subscribe<Msg>(
         graph.AddNode("s"), topic, "cb", 1000,
         [](const Msg& m, CallbackContext& ctx) {
-          ctx.ReportWork({.units = static_cast<double>(m.value)});
+          // Runs with up to 6 threads, as a knob like ndt_threads says.
+          ctx.ReportWork({.units = static_cast<double>(m.value),
+                          .parallel_fraction = 0.0,
+                          .max_threads = 6});
         });
     auto profile = std::make_shared<CostProfile>();
     profile->reference_ghz = 4.0;
@@ -162,17 +165,20 @@ TEST(ProfiledCostTest, ScalesWithTheWorkUnitsOfThisInvocation) {
   EXPECT_NEAR(costs[0], 0.025, 1e-12);
 }
 
-TEST(ProfiledCostTest, ItsParallelPartUsesTheFreeCoresUpToItsMaximum) {
+TEST(ProfiledCostTest, ItsParallelPartUsesTheFreeCoresUpToBothMaxima) {
   CallbackCost c = Constant(0.040);
   c.parallel_fraction = 0.75;
-  c.max_threads = 4;
-  for (int cores : {1, 2, 8}) {
-    OneCallback one(c, cores, 4.0, 7);
-    const std::vector<double> costs = one.Costs(1, 0);
-    ASSERT_EQ(costs.size(), 1u);
-    const int k = std::min(cores, 4);
-    EXPECT_NEAR(costs[0], 0.040 * (0.25 + 0.75 / k), 1e-12) << cores;
-    EXPECT_EQ(one.executor->trace().callbacks[0].cores, k);
+  for (int max_threads : {4, 8}) {
+    c.max_threads = max_threads;
+    for (int cores : {1, 2, 8}) {
+      OneCallback one(c, cores, 4.0, 7);
+      const std::vector<double> costs = one.Costs(1, 0);
+      ASSERT_EQ(costs.size(), 1u);
+      // The profile's maximum, the callback's 6 threads, the free cores.
+      const int k = std::min({cores, max_threads, 6});
+      EXPECT_NEAR(costs[0], 0.040 * (0.25 + 0.75 / k), 1e-12) << cores;
+      EXPECT_EQ(one.executor->trace().callbacks[0].cores, k);
+    }
   }
 }
 
