@@ -145,6 +145,18 @@ struct IndexArgs {
 };
 int RunIndex(const IndexArgs& args);
 
+struct ProfileImportArgs {
+  std::string caret;    // CARET report folder (analyze_node/*/stats_node.yaml)
+  std::string mapping;  // adse callback -> CARET callbacks (YAML)
+  std::string out;      // profile file to write (atomically)
+};
+int RunProfileImport(const ProfileImportArgs& args);
+
+struct ProfileShowArgs {
+  std::string profile;  // profile file
+};
+int RunProfileShow(const ProfileShowArgs& args);
+
 }  // namespace adse::cli
 
 #endif  // ADSE_HARNESS_CLI_COMMANDS_H_

@@ -353,6 +353,42 @@ int main(int argc, char** argv) {
       ->required();
   index_cmd->add_flag("--json", index.json, "Print summary.json on stdout");
 
+  adse::cli::ProfileImportArgs profile_import;
+  adse::cli::ProfileShowArgs profile_show;
+  CLI::App* profile_cmd = app.add_subcommand(
+      "profile",
+      "Callback cost profiles (what each callback costs on a reference "
+      "machine, for the counted cost model): import one from a CARET report, "
+      "show one");
+  profile_cmd->require_subcommand(1);
+  CLI::App* profile_import_cmd = profile_cmd->add_subcommand(
+      "import",
+      "Build a cost profile from a CARET report's "
+      "analyze_node/*/stats_node.yaml and a mapping file that names the "
+      "report's callbacks each adse callback stands for; nothing is written "
+      "on error");
+  profile_import_cmd
+      ->add_option("--caret", profile_import.caret,
+                   "CARET report folder (with analyze_node/<area>/"
+                   "stats_node.yaml)")
+      ->required();
+  profile_import_cmd
+      ->add_option("--map", profile_import.mapping,
+                   "Mapping file (adse_profile_mapping: 1), e.g. "
+                   "scenarios/profiles/autoware-2022.12-mapping.yaml")
+      ->required();
+  profile_import_cmd
+      ->add_option("-o,--out", profile_import.out,
+                   "Profile file to write (adse_profile: 1)")
+      ->required();
+  CLI::App* profile_show_cmd = profile_cmd->add_subcommand(
+      "show",
+      "Print a profile's callbacks: p50 and p95 cost, observed rate and load "
+      "(cores busy) at the reference clock, and the total load");
+  profile_show_cmd
+      ->add_option("profile", profile_show.profile, "Profile file (YAML)")
+      ->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -363,6 +399,8 @@ int main(int argc, char** argv) {
   if (seed_opt->count() > 0) world.seed = seed;
   if (simulate_seed_opt->count() > 0) simulate.seed = simulate_seed;
   if (worker_seed_opt->count() > 0) worker.seed = worker_seed;
+  if (*profile_import_cmd) return adse::cli::RunProfileImport(profile_import);
+  if (*profile_show_cmd) return adse::cli::RunProfileShow(profile_show);
   if (*run_cmd) return adse::cli::RunRun(run);
   if (*submit_cmd) return adse::cli::RunSubmit(submit);
   if (*status_cmd) return adse::cli::RunStatus(status);

@@ -62,7 +62,12 @@ Result<std::string> RunKey(const spec::Spec& spec,
   h.Add(static_cast<long long>(p.cost_model)).Add(p.cost_scale);
   h.Add(static_cast<long long>(p.cores)).Add(p.freq_ghz);
   if (p.cost_model == spec::CostModel::kCounted) {
-    ADSE_RETURN_IF_ERROR(AddFile(&h, "platform.calibration", p.calibration));
+    // Keys of calibrated runs stay as they were before profiles existed.
+    if (p.profile.empty()) {
+      ADSE_RETURN_IF_ERROR(AddFile(&h, "platform.calibration", p.calibration));
+    } else {
+      ADSE_RETURN_IF_ERROR(AddFile(&h, "platform.profile", p.profile));
+    }
   }
   // The point (with its bindings: the same name may bind another knob) and
   // the seed.

@@ -7,9 +7,11 @@
 #include <cmath>
 #include <ctime>
 #include <fstream>
+#include <memory>
 #include <thread>
 
 #include "analysis/metrics/run_metrics.h"
+#include "harness/profile/profile.h"
 #include "harness/sim/calibration.h"
 #include "harness/sim/run_key.h"
 #include "harness/spec/spec_parser.h"
@@ -123,7 +125,17 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   vp.freq_ghz = platform.freq_ghz;
   vp.reference_ghz = platform.reference_ghz;
   vp.cost_scale = platform.cost_scale;
-  if (platform.cost_model == spec::CostModel::kCounted) {
+  std::string profile_name;
+  if (platform.cost_model == spec::CostModel::kCounted &&
+      !platform.profile.empty()) {
+    vp.cost_model = stack::CostModelKind::kCounted;
+    Result<profile::Profile> loaded = profile::ReadProfile(platform.profile);
+    if (!loaded.ok()) return loaded.status().WithContext("platform.profile");
+    profile_name = loaded->name;
+    vp.profile =
+        std::make_shared<const stack::CostProfile>(std::move(loaded->costs));
+    vp.profile_seed = Random::DeriveSeed(seed, "cost");
+  } else if (platform.cost_model == spec::CostModel::kCounted) {
     vp.cost_model = stack::CostModelKind::kCounted;
     Result<std::map<std::string, stack::CountedCost>> calibration =
         LoadCalibration(platform.calibration);
@@ -242,6 +254,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
                   {"reference_ghz", fmt::format("{}", platform.reference_ghz)},
                   {"cost_model", spec::CostModelToString(platform.cost_model)},
                   {"cost_scale", fmt::format("{}", platform.cost_scale)}};
+  if (!profile_name.empty()) run.platform["profile"] = profile_name;
   for (size_t i = 0; i < w.ideal_path().points.size(); ++i) {
     run.ideal_path.push_back({w.ideal_path().s_m[i],
                               w.ideal_path().points[i].x(),

@@ -385,4 +385,84 @@ TEST(CliRunTest, WorkerRefusesAScenarioThatChangedUnderItsCampaign) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// `adse profile`: the bundled profile is what importing the trimmed CARET
+// report with the bundled mapping writes; bad input is exit 2 with the file
+// and field named, and nothing written.
+std::string TrimmedCaret() {
+  return std::string(ADSE_SOURCE_DIR) +
+         "/tests/data/caret-autoware-2022.12-trimmed";
+}
+std::string BundledMapping() {
+  return std::string(ADSE_SOURCE_DIR) +
+         "/scenarios/profiles/autoware-2022.12-mapping.yaml";
+}
+
+TEST(CliProfileTest, ImportWritesTheProfileAndShowPrintsItsTotalLoad) {
+  const fs::path out = fs::temp_directory_path() / "adse_cli_profile.yaml";
+  fs::remove(out);
+  const CommandRun import =
+      Adse("profile import --caret " + TrimmedCaret() + " --map " +
+           BundledMapping() + " -o " + out.string());
+  ASSERT_EQ(import.exit_code, 0) << import.out;
+  EXPECT_NE(import.out.find("wrote " + out.string() +
+                            ": profile 'autoware-2022.12-i9-12900kf', 22 "
+                            "callbacks from 34 CARET callbacks; total load"),
+            std::string::npos)
+      << import.out;
+  const CommandRun show = Adse("profile show " + out.string());
+  ASSERT_EQ(show.exit_code, 0) << show.out;
+  EXPECT_TRUE(std::regex_search(
+      show.out, std::regex("total load at 4\\.9 GHz: [0-9]+\\.[0-9]{2} cores "
+                           "busy")))
+      << show.out;
+  EXPECT_NE(show.out.find("ndt_scan_matcher/points"), std::string::npos);
+  const CommandRun bundled =
+      Adse("profile show " + std::string(ADSE_SOURCE_DIR) +
+           "/scenarios/profiles/autoware-2022.12-i9-12900kf.yaml");
+  EXPECT_EQ(bundled.out, show.out);
+}
+
+TEST(CliProfileTest, ImportOfBadInputExitsWith2AndWritesNothing) {
+  const fs::path out = fs::temp_directory_path() / "adse_cli_bad_profile.yaml";
+  fs::remove(out);
+  const CommandRun missing =
+      Adse("profile import --caret /nonexistent/caret --map " +
+           BundledMapping() + " -o " + out.string());
+  EXPECT_EQ(missing.exit_code, 2) << missing.out;
+  EXPECT_NE(missing.out.find("/nonexistent/caret: error: --caret: expected a "
+                             "CARET report folder"),
+            std::string::npos)
+      << missing.out;
+  EXPECT_FALSE(fs::exists(out));
+
+  std::ifstream in(BundledMapping());
+  std::string text((std::istreambuf_iterator<char>(in)),
+                   std::istreambuf_iterator<char>());
+  const std::string from = "top/velodyne_convert_node/callback_0";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), "top/velodyne/callback_0");
+  const fs::path mapping = fs::temp_directory_path() / "adse_cli_mapping.yaml";
+  std::ofstream(mapping) << text;
+  const CommandRun unknown =
+      Adse("profile import --caret " + TrimmedCaret() + " --map " +
+           mapping.string() + " -o " + out.string());
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
+  EXPECT_TRUE(std::regex_search(
+      unknown.out,
+      std::regex("adse_cli_mapping\\.yaml:[0-9]+:[0-9]+: error: "
+                 "callbacks\\.lidar_driver/points_raw\\.sources\\[0\\]")))
+      << unknown.out;
+  EXPECT_NE(unknown.out.find("did you mean "
+                             "'/sensing/lidar/top/velodyne_convert_node/"
+                             "callback_0'"),
+            std::string::npos)
+      << unknown.out;
+  EXPECT_FALSE(fs::exists(out));
+
+  EXPECT_EQ(Adse("profile import --caret " + TrimmedCaret()).exit_code, 2);
+  const CommandRun show = Adse("profile show /nonexistent/profile.yaml");
+  EXPECT_EQ(show.exit_code, 2) << show.out;
+  EXPECT_NE(show.out.find("/nonexistent/profile.yaml"), std::string::npos);
+}
+
 }  // namespace

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include "harness/spec/spec_parser.h"
 
 namespace adse::sim {
@@ -63,6 +66,29 @@ TEST(RunKeyTest, MissingCalibrationFileIsAnError) {
   Result<std::string> key = RunKey(s, kPoint, 3);
   ASSERT_FALSE(key.ok());
   EXPECT_NE(key.status().message().find("platform.calibration"),
+            std::string::npos);
+}
+
+TEST(RunKeyTest, AProfileEntersByContent) {
+  const std::string bundled =
+      std::string(ADSE_SOURCE_DIR) +
+      "/scenarios/profiles/autoware-2022.12-i9-12900kf.yaml";
+  const std::string copy =
+      (std::filesystem::temp_directory_path() / "adse_run_key_profile.yaml")
+          .string();
+  std::filesystem::copy_file(bundled, copy,
+                             std::filesystem::copy_options::overwrite_existing);
+  spec::Spec s = Small();
+  s.platform.calibration.clear();
+  s.platform.profile = copy;
+  const std::string key = Key(s);
+  EXPECT_NE(key, Key(Small()));
+  std::ofstream(copy, std::ios::app) << "# edited\n";
+  EXPECT_NE(key, Key(s));
+  s.platform.profile = "/nonexistent/profile.yaml";
+  Result<std::string> missing = RunKey(s, kPoint, 3);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.status().message().find("platform.profile"),
             std::string::npos);
 }
 

@@ -19,6 +19,35 @@ namespace {
 using adse::testing::SmallPoint;
 using adse::testing::SmallScenario;
 
+// Everything the platform decides and the car does, hashed.
+std::string Fingerprint(const runfile::RunData& run) {
+  ContentHasher h;
+  for (const auto& r : run.trace.callbacks) {
+    h.Add(static_cast<long long>(r.callback))
+        .Add(r.start_s)
+        .Add(r.end_s)
+        .Add(r.cost_s);
+  }
+  for (const auto& e : run.trace.topic_events) {
+    h.Add(static_cast<long long>(e.kind))
+        .Add(static_cast<long long>(e.topic))
+        .Add(e.t_s);
+  }
+  for (const auto& s : run.ego) h.Add(s.x_m).Add(s.y_m).Add(s.v_mps);
+  return h.Hex();
+}
+
+// The small scenario costed by the bundled Autoware profile.
+spec::Spec ProfiledSmallScenario() {
+  spec::Spec spec = SmallScenario();
+  spec.platform.calibration.clear();
+  spec.platform.cost_scale = 1.0;
+  spec.platform.profile =
+      std::string(ADSE_SOURCE_DIR) +
+      "/scenarios/profiles/autoware-2022.12-i9-12900kf.yaml";
+  return spec;
+}
+
 TEST(SimulateTest, GenerousComputerDrivesToTheGoalAtTheNominalControlRate) {
   Result<runfile::RunData> run =
       SimulatePoint(SmallScenario(), SmallPoint(16, 2.1, 14));
@@ -69,28 +98,36 @@ TEST(SimulateTest, CountedCostModelGivesIdenticalTraces) {
   ASSERT_TRUE(WriteCalibration(path, calibration, "test").ok());
   spec.platform.cost_model = spec::CostModel::kCounted;
   spec.platform.calibration = path;
-  auto fingerprint = [&](const runfile::RunData& run) {
-    ContentHasher h;
-    for (const auto& r : run.trace.callbacks) {
-      h.Add(static_cast<long long>(r.callback))
-          .Add(r.start_s)
-          .Add(r.end_s)
-          .Add(r.cost_s);
-    }
-    for (const auto& e : run.trace.topic_events) {
-      h.Add(static_cast<long long>(e.kind))
-          .Add(static_cast<long long>(e.topic))
-          .Add(e.t_s);
-    }
-    for (const auto& s : run.ego) h.Add(s.x_m).Add(s.y_m).Add(s.v_mps);
-    return h.Hex();
-  };
   Result<runfile::RunData> a = SimulatePoint(spec, SmallPoint(4, 1.0, 7));
   Result<runfile::RunData> b = SimulatePoint(spec, SmallPoint(4, 1.0, 7));
   ASSERT_TRUE(a.ok()) << a.status().ToString();
   ASSERT_TRUE(b.ok()) << b.status().ToString();
   EXPECT_GT(a->trace.callbacks.size(), 100u);
-  EXPECT_EQ(fingerprint(*a), fingerprint(*b));
+  EXPECT_EQ(Fingerprint(*a), Fingerprint(*b));
+}
+
+TEST(SimulateTest,
+     AProfiledRunIsReproducibleForItsSeedAndStarvesASmallComputer) {
+  const spec::Spec spec = ProfiledSmallScenario();
+  Result<runfile::RunData> a = SimulatePoint(spec, SmallPoint(16, 2.1, 7));
+  Result<runfile::RunData> b = SimulatePoint(spec, SmallPoint(16, 2.1, 7));
+  SimulateOptions other_seed;
+  other_seed.seed = spec.world.traffic.seed + 1;
+  Result<runfile::RunData> c =
+      SimulatePoint(spec, SmallPoint(16, 2.1, 7), other_seed);
+  Result<runfile::RunData> starved =
+      SimulatePoint(spec, SmallPoint(1, 1.0, 14));
+  ASSERT_TRUE(a.ok()) << a.status().ToString();
+  ASSERT_TRUE(b.ok()) << b.status().ToString();
+  ASSERT_TRUE(c.ok()) << c.status().ToString();
+  ASSERT_TRUE(starved.ok()) << starved.status().ToString();
+  EXPECT_EQ(Fingerprint(*a), Fingerprint(*b));
+  EXPECT_NE(Fingerprint(*a), Fingerprint(*c));  // the draws follow the seed
+  EXPECT_EQ(a->platform.at("profile"), "autoware-2022.12-i9-12900kf");
+  EXPECT_EQ(a->metrics.at("completed"), 1.0);
+  // Autoware's load on one 1 GHz core: the 30 Hz controller starves.
+  EXPECT_LT(starved->metrics.at("ctrl_rate_hz"),
+            0.5 * a->metrics.at("ctrl_rate_hz"));
 }
 
 TEST(SimulateTest, RunFileIsWrittenAndPassesTheSchemaCheck) {
