@@ -25,17 +25,19 @@ std::string Example() {
 
 // A copy of the robotaxi example with one line replaced.
 // Writes scenario text to the temporary folder as adse_cli_<name>.yaml,
-// with the bundled calibration beside it (the examples name it relative
-// to themselves).
+// with the bundled calibration and profile beside it (the examples name
+// them relative to themselves).
 std::string WriteScenario(const std::string& name, const std::string& text) {
   const fs::path path =
       fs::temp_directory_path() / ("adse_cli_" + name + ".yaml");
   std::ofstream(path) << text;
-  fs::create_directories(fs::temp_directory_path() / "calibration");
-  fs::copy_file(
-      std::string(ADSE_SOURCE_DIR) + "/scenarios/calibration/reference.json",
-      fs::temp_directory_path() / "calibration/reference.json",
-      fs::copy_options::overwrite_existing);
+  for (const char* file : {"calibration/reference.json",
+                           "profiles/autoware-2022.12-i9-12900kf.yaml"}) {
+    const fs::path to = fs::temp_directory_path() / file;
+    fs::create_directories(to.parent_path());
+    fs::copy_file(std::string(ADSE_SOURCE_DIR) + "/scenarios/" + file, to,
+                  fs::copy_options::overwrite_existing);
+  }
   return path.string();
 }
 
@@ -334,7 +336,7 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_one_answer";
   fs::remove_all(out);
   const CommandRun run =
-      Adse("run " + Small() + " --budget 5 -q -o " + out.string());
+      Adse("run " + Small() + " --budget 7 -q -o " + out.string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
   ASSERT_NE(run.out.find("cheapest feasible"), std::string::npos) << run.out;
   ASSERT_FALSE(FrontSection(run.out).empty()) << run.out;
@@ -368,7 +370,7 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
       Adse("analyze --diff " + (out / "analysis" / "v1").string() + " " +
            (out / "analysis" / "v2").string());
   EXPECT_EQ(diff.exit_code, 0) << diff.out;
-  EXPECT_NE(diff.out.find("of 5 points changed"), std::string::npos)
+  EXPECT_NE(diff.out.find("of 7 points changed"), std::string::npos)
       << diff.out;
 }
 

@@ -53,10 +53,18 @@ TEST(RunReportTest,
   EXPECT_FALSE(r.feasible);
 }
 
-TEST(RunReportTest, GenerousComputerIsNotCpuBoundAndDrivesCloseToThePath) {
+TEST(RunReportTest,
+     GenerousComputerKeepsUpWithTheScansAndDrivesCloseToThePath) {
   const RunReport r = Analyse(16, 2.1, 7);
-  EXPECT_FALSE(HasCpuBoundAt(r, kLocalizationAndPerception))
-      << ToJson(r).dump(2);
+  // With Autoware's measured costs a node busy with a 40 ms scan misses
+  // some of the 50 Hz poses it samples (keep-last, the latest one wins):
+  // the diagnosis reports that, but no node falls behind the scans.
+  for (const FindingSummary& f : r.findings) {
+    if (f.kind != "cpu_bound") continue;
+    for (const std::string& topic : f.topics) {
+      EXPECT_EQ(topic, "/localization/pose") << ToJson(r).dump(2);
+    }
+  }
   EXPECT_TRUE(r.feasible) << ToJson(r).dump(2);
   EXPECT_TRUE(r.deviation_complete);
   // A tracking controller on a good pose stays well within half a lane.

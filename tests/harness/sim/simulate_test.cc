@@ -61,7 +61,9 @@ TEST(SimulateTest, GenerousComputerDrivesToTheGoalAtTheNominalControlRate) {
   EXPECT_LT(m.at("nav_time_s"), 40.0);
   // The follower runs at control.rate_hz = 30 Hz.
   EXPECT_NEAR(m.at("ctrl_rate_hz"), 30.0, 3.0);
-  EXPECT_LT(m.at("e2e_latency_p99_s"), 0.6);
+  // Autoware's sensing-to-control chain averaged 370 ms (667 ms at worst)
+  // at about 4.9 GHz; at 2.1 GHz its stages take 2.3 times as long.
+  EXPECT_LT(m.at("e2e_latency_p99_s"), 2.0);
   EXPECT_NEAR(m.at("hardware_cost"), 16 * 2.1, 1e-9);
   EXPECT_EQ(run->content_key.size(), 64u);
 }

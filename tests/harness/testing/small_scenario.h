@@ -15,7 +15,7 @@ inline std::string SmallScenarioPath() {
 }
 
 // scenarios/robotaxi_small.yaml, which uses the counted cost model and the
-// bundled calibration: the same answers on any machine and under any load,
+// bundled Autoware profile: the same answers on any machine and under any load,
 // so thresholds cannot flake.
 inline spec::Spec SmallScenario() {
   Result<spec::Spec> spec = spec::LoadSpec(SmallScenarioPath());

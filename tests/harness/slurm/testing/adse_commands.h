@@ -90,10 +90,13 @@ inline std::string SmallScenarioIn(const std::string& dir,
     text.replace(at, from.size(),
                  "exploration: " + exploration + "\nharness: " + harness);
   }
-  fs::create_directories(dir + "/calibration");
-  fs::copy_file(source + "/scenarios/calibration/reference.json",
-                dir + "/calibration/reference.json",
-                fs::copy_options::overwrite_existing);
+  // The files the scenario names relative to itself.
+  for (const char* file : {"calibration/reference.json",
+                           "profiles/autoware-2022.12-i9-12900kf.yaml"}) {
+    fs::create_directories(fs::path(dir + "/" + file).parent_path());
+    fs::copy_file(source + "/scenarios/" + file, dir + "/" + file,
+                  fs::copy_options::overwrite_existing);
+  }
   const std::string path = dir + "/scenario.yaml";
   std::ofstream(path) << text;
   return path;
