@@ -75,12 +75,19 @@ struct MappingEntry {
   int reference_threads = 1;
 };
 
+struct MappingChain {
+  std::string name;    // one of ChainNames()
+  std::string source;  // CARET's target_path_name
+  YAML::Mark mark;
+};
+
 struct Mapping {
   std::unique_ptr<YamlDoc> doc;
   std::string name;
   ProfileSource source;
   double reference_ghz = 0.0;
   std::vector<MappingEntry> callbacks;
+  std::vector<MappingChain> chains;
 };
 
 Status ReadStatsFile(std::unique_ptr<YamlDoc> doc, CaretReport* report) {
@@ -165,8 +172,8 @@ Result<Mapping> ReadMapping(const std::string& path) {
   const YamlDoc& doc = *mapping.doc;
   MapReader root(&doc);
   ADSE_RETURN_IF_ERROR(root.CheckIsMap());
-  ADSE_RETURN_IF_ERROR(root.CheckKeys(
-      {"adse_profile_mapping", "name", "source", "reference", "callbacks"}));
+  ADSE_RETURN_IF_ERROR(root.CheckKeys({"adse_profile_mapping", "name", "source",
+                                       "reference", "callbacks", "chains"}));
   Result<int> version =
       root.Integer("adse_profile_mapping", Range::IntegerAtLeast(0));
   if (!version.ok()) return version.status();
@@ -256,6 +263,17 @@ Result<Mapping> ReadMapping(const std::string& path) {
     e.max_threads = *threads;
     e.reference_threads = *reference_threads;
     mapping.callbacks.push_back(std::move(e));
+  }
+  if (root.Has("chains")) {
+    Result<MapReader> chains = root.Map("chains");
+    if (!chains.ok()) return chains.status();
+    ADSE_RETURN_IF_ERROR(chains->CheckKeys(ChainNames()));
+    for (const std::string& chain : ChainNames()) {
+      if (!chains->Has(chain)) continue;
+      Result<std::string> source = chains->String(chain, std::nullopt, true);
+      if (!source.ok()) return source.status();
+      mapping.chains.push_back({chain, *source, chains->KeyMark(chain)});
+    }
   }
   return mapping;
 }
@@ -370,6 +388,52 @@ Result<Latency> ReadLatency(const CaretCallback& cb) {
   return out;
 }
 
+// The chains the mapping names, from <caret_folder>/analyze_path/
+// stats_path.yaml: a list of {target_path_name, best_avg, best_p95,
+// worst_max, ...} in ms.
+Status ImportChains(const std::string& caret_folder, const Mapping& mapping,
+                    Profile* profile) {
+  if (mapping.chains.empty()) return Status::Ok();
+  const std::string path =
+      (fs::path(caret_folder) / "analyze_path" / "stats_path.yaml").string();
+  Result<YamlDoc> doc =
+      YamlDoc::Load(path, "CARET's path statistics (a list of target paths)");
+  if (!doc.ok()) return doc.status();
+  if (!doc->root().IsSequence()) {
+    return doc->ErrorAt(doc->root(), "(file)",
+                        "a list of target paths (target_path_name, best_avg, "
+                        "best_p95, worst_max)");
+  }
+  std::vector<std::string> names;
+  for (size_t i = 0; i < doc->root().size(); ++i) {
+    const std::string at = fmt::format("[{}]", i);
+    MapReader entry(&*doc, doc->root()[i], at, doc->root()[i].Mark());
+    ADSE_RETURN_IF_ERROR(entry.CheckIsMap());
+    Result<std::string> name = entry.String("target_path_name");
+    if (!name.ok()) return name.status();
+    names.push_back(*name);
+    for (const MappingChain& chain : mapping.chains) {
+      if (chain.source != *name) continue;
+      Result<double> avg = entry.Number("best_avg", Range::NonNegative());
+      Result<double> p95 = entry.Number("best_p95", Range::NonNegative());
+      Result<double> worst = entry.Number("worst_max", Range::NonNegative());
+      for (const auto* r : {&avg, &p95, &worst}) {
+        if (!r->ok()) return r->status();
+      }
+      profile->chains[chain.name] = {*name, *avg, *p95, *worst};
+    }
+  }
+  for (const MappingChain& chain : mapping.chains) {
+    if (profile->chains.count(chain.name) == 0) {
+      return mapping.doc->Error(chain.mark, "chains." + chain.name,
+                                fmt::format("a target_path_name of {}", path),
+                                "'" + chain.source + "', which it lacks" +
+                                    SuggestIds(chain.source, names));
+    }
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Result<Profile> ImportCaret(const std::string& caret_folder,
@@ -427,6 +491,7 @@ Result<Profile> ImportCaret(const std::string& caret_folder,
       profile.costs.callbacks[e.name] = std::move(cost);
       profile.provenance[e.name] = std::move(provenance);
     }
+    ADSE_RETURN_IF_ERROR(ImportChains(caret_folder, *mapping, &profile));
     const Status valid = stack::ValidateCostProfile(profile.costs);
     if (!valid.ok()) return valid.WithContext(mapping_path);
     return profile;

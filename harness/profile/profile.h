@@ -38,6 +38,21 @@ struct CallbackProvenance {
   double avg_ms = 0.0;   // sum of the sources' mean latency, as measured
 };
 
+// The chains whose latency `adse profile check` compares: sensing (a raw
+// scan to the preprocessed cloud), localization (the preprocessed cloud to
+// the fused pose) and sensing_to_control (a scan to the command built on
+// it). The one list of their names.
+const std::vector<std::string>& ChainNames();
+
+// A chain's response time as the source measured it (CARET's path
+// analysis: the "best" case follows the newest input, ms).
+struct ChainReference {
+  std::string source;   // the source's path name, e.g. component_sensing_0
+  double avg_ms = 0.0;  // mean
+  double p95_ms = 0.0;  // 95th percentile
+  double worst_max_ms = 0.0;  // CARET's "worst" case (oldest input), max
+};
+
 struct Profile {
   int format_version = kProfileFormatVersion;
   std::string name;
@@ -45,6 +60,8 @@ struct Profile {
   stack::CostProfile costs;
   // Keyed like costs.callbacks ("<node>/<callback>").
   std::map<std::string, CallbackProvenance> provenance;
+  // Keyed by ChainNames(); may be empty (the source measured no chains).
+  std::map<std::string, ChainReference> chains;
 };
 
 // Reads a profile file. Bad input is InvalidArgument naming the file, the

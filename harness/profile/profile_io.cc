@@ -195,7 +195,7 @@ Result<Profile> ReadProfileDoc(const YamlDoc& doc) {
   MapReader root(&doc);
   ADSE_RETURN_IF_ERROR(root.CheckIsMap());
   ADSE_RETURN_IF_ERROR(root.CheckKeys(
-      {"adse_profile", "name", "source", "reference", "callbacks"}));
+      {"adse_profile", "name", "source", "reference", "callbacks", "chains"}));
   Profile profile;
   Result<int> version = root.Integer("adse_profile", Range::IntegerAtLeast(0));
   if (!version.ok()) return version.status();
@@ -291,6 +291,29 @@ Result<Profile> ReadProfileDoc(const YamlDoc& doc) {
     profile.provenance[key] = std::move(provenance);
   }
 
+  if (root.Has("chains")) {
+    Result<MapReader> chains = root.Map("chains");
+    if (!chains.ok()) return chains.status();
+    ADSE_RETURN_IF_ERROR(chains->CheckKeys(ChainNames()));
+    for (const std::string& name : ChainNames()) {
+      if (!chains->Has(name)) continue;
+      Result<MapReader> chain = chains->Map(name);
+      if (!chain.ok()) return chain.status();
+      ADSE_RETURN_IF_ERROR(
+          chain->CheckKeys({"source", "avg_ms", "p95_ms", "worst_max_ms"}));
+      Result<std::string> source = chain->String("source", std::nullopt, true);
+      if (!source.ok()) return source.status();
+      Result<double> avg = chain->Number("avg_ms", Range::NonNegative());
+      Result<double> p95 = chain->Number("p95_ms", Range::NonNegative());
+      Result<double> worst =
+          chain->Number("worst_max_ms", Range::NonNegative());
+      for (const auto* r : {&avg, &p95, &worst}) {
+        if (!r->ok()) return r->status();
+      }
+      profile.chains[name] = {*source, *avg, *p95, *worst};
+    }
+  }
+
   // The executor's own rules, as a last net; its message names the
   // callback, which locates it in the file.
   const Status valid = stack::ValidateCostProfile(profile.costs);
@@ -381,7 +404,22 @@ Status WriteProfile(const std::string& path, const Profile& profile, Env* env) {
       }
     }
   }
+  if (!profile.chains.empty()) out += "chains:\n";
+  for (const auto& [name, chain] : profile.chains) {
+    out += fmt::format(
+        "  {}: {{source: {}, avg_ms: {}, p95_ms: {}, worst_max_ms: {}}}\n",
+        YamlString(name), YamlString(chain.source),
+        internal::FormatNumber(chain.avg_ms),
+        internal::FormatNumber(chain.p95_ms),
+        internal::FormatNumber(chain.worst_max_ms));
+  }
   return WriteFileAtomic(path, out, env);
+}
+
+const std::vector<std::string>& ChainNames() {
+  static const std::vector<std::string> kNames = {"sensing", "localization",
+                                                  "sensing_to_control"};
+  return kNames;
 }
 
 double MeanCostMs(const stack::CallbackCost& cost) {

@@ -380,5 +380,34 @@ TEST(CaretImportTest, ACallbackThatNeverRanCannotBeASource) {
        "never ran"});
 }
 
+TEST(CaretImportTest, TheMappedChainsComeFromThePathStatistics) {
+  Result<Profile> p = ImportCaret(kTrimmed, kMapping);
+  ASSERT_TRUE(p.ok()) << p.status().ToString();
+  ASSERT_EQ(p->chains.size(), 3u);
+  const ChainReference& sensing = p->chains.at("sensing");
+  EXPECT_EQ(sensing.source, "component_sensing_0");
+  EXPECT_NEAR(sensing.avg_ms, 85.125, 1e-12);
+  EXPECT_NEAR(sensing.p95_ms, 116.72, 1e-12);
+  EXPECT_NEAR(sensing.worst_max_ms, 250.757, 1e-12);
+  EXPECT_NEAR(p->chains.at("localization").avg_ms, 46.314, 1e-12);
+  EXPECT_NEAR(p->chains.at("sensing_to_control").avg_ms, 370.46, 1e-12);
+  EXPECT_NEAR(p->chains.at("sensing_to_control").worst_max_ms, 666.593, 1e-12);
+}
+
+TEST(CaretImportTest, AChainTheReportLacksOrAnUnknownChainIsRefused) {
+  const fs::path dir = TestDir();
+  const fs::path out = dir / "out.yaml";
+  std::string m = MappingWith(dir, "sensing: component_sensing_0",
+                              "sensing: component_sensing_9");
+  ExpectLocatedError(ImportTo(kTrimmed, m, out), m,
+                     {"chains.sensing: expected a target_path_name of",
+                      "found 'component_sensing_9', which it lacks",
+                      "did you mean 'component_sensing_0'"});
+  m = MappingWith(dir, "sensing: component_sensing_0",
+                  "perception: component_sensing_0");
+  ExpectLocatedError(ImportTo(kTrimmed, m, out), m, {"chains.perception"});
+  EXPECT_FALSE(fs::exists(out));
+}
+
 }  // namespace
 }  // namespace adse::profile

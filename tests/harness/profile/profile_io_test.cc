@@ -72,6 +72,7 @@ Profile Example() {
       21.173};
   p.provenance["trajectory_follower/control"] = {
       {"/control/a/callback_1", "/control/b/callback_0"}, 33.3, 2.169 + 0.1};
+  p.chains["sensing"] = {"component_sensing_0", 85.125, 116.72, 250.757};
   return p;
 }
 
@@ -103,6 +104,15 @@ void ExpectSameProfile(const Profile& a, const Profile& b) {
     EXPECT_EQ(pa.sources, pb.sources);
     EXPECT_EQ(pa.rate_hz, pb.rate_hz);
     EXPECT_EQ(pa.avg_ms, pb.avg_ms);
+  }
+  ASSERT_EQ(a.chains.size(), b.chains.size());
+  for (const auto& [name, chain] : a.chains) {
+    SCOPED_TRACE(name);
+    ASSERT_EQ(b.chains.count(name), 1u);
+    EXPECT_EQ(chain.source, b.chains.at(name).source);
+    EXPECT_EQ(chain.avg_ms, b.chains.at(name).avg_ms);
+    EXPECT_EQ(chain.p95_ms, b.chains.at(name).p95_ms);
+    EXPECT_EQ(chain.worst_max_ms, b.chains.at(name).worst_max_ms);
   }
 }
 
