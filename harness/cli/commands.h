@@ -157,6 +157,14 @@ struct ProfileShowArgs {
 };
 int RunProfileShow(const ProfileShowArgs& args);
 
+struct ProfileCheckArgs {
+  std::string scenario;  // names platform.profile
+  int cores = 16;        // the reference machine's cores (i9-12900KF: 16)
+  double lidar_hz = 10;  // the source's LiDAR rate (CARET: 9.6 Hz observed)
+  std::string out;       // run file to keep; empty: none
+};
+int RunProfileCheck(const ProfileCheckArgs& args);
+
 }  // namespace adse::cli
 
 #endif  // ADSE_HARNESS_CLI_COMMANDS_H_

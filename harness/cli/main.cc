@@ -389,6 +389,30 @@ int main(int argc, char** argv) {
       ->add_option("profile", profile_show.profile, "Profile file (YAML)")
       ->required();
 
+  adse::cli::ProfileCheckArgs profile_check;
+  CLI::App* profile_check_cmd = profile_cmd->add_subcommand(
+      "check",
+      "Simulate the scenario on its profile's reference machine (all cores "
+      "at the profile's clock) and compare the chain latencies (sensing, "
+      "localization, sensing to control) and per-callback latencies with "
+      "what the profile's source measured");
+  profile_check_cmd
+      ->add_option("scenario", profile_check.scenario,
+                   "Scenario YAML file naming platform.profile")
+      ->required();
+  profile_check_cmd
+      ->add_option("--cores", profile_check.cores,
+                   "Cores of the reference machine (default 16, the "
+                   "i9-12900KF's)")
+      ->check(CLI::Range(1, 1024));
+  profile_check_cmd
+      ->add_option("--lidar-hz", profile_check.lidar_hz,
+                   "LiDAR rate of the reference run (default 10, as the "
+                   "source's recording)")
+      ->check(CLI::PositiveNumber);
+  profile_check_cmd->add_option("-o,--out", profile_check.out,
+                                "Keep the reference run's file here");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -401,6 +425,7 @@ int main(int argc, char** argv) {
   if (worker_seed_opt->count() > 0) worker.seed = worker_seed;
   if (*profile_import_cmd) return adse::cli::RunProfileImport(profile_import);
   if (*profile_show_cmd) return adse::cli::RunProfileShow(profile_show);
+  if (*profile_check_cmd) return adse::cli::RunProfileCheck(profile_check);
   if (*run_cmd) return adse::cli::RunRun(run);
   if (*submit_cmd) return adse::cli::RunSubmit(submit);
   if (*status_cmd) return adse::cli::RunStatus(status);

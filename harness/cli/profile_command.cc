@@ -1,13 +1,19 @@
-// `adse profile import` and `adse profile show`: cost profiles from a CARET
-// report (harness/profile). Exit 0 ok, 2 bad input (a missing or malformed
-// report, mapping or profile), 1 anything else (e.g. the write failed); a
-// failed import writes nothing.
+// `adse profile import`, `show` and `check`: cost profiles from a CARET
+// report (harness/profile), and a simulation held against their source. Exit 0
+// ok, 2 bad input (a missing or malformed report, mapping or profile), 1
+// anything else (e.g. the write failed); a failed import writes nothing.
 #include <cstdio>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "analysis/runfile/run_file.h"
 #include "harness/cli/commands.h"
 #include "harness/profile/profile.h"
+#include "harness/profile/profile_check.h"
+#include "harness/sim/simulator.h"
+#include "harness/spec/spec_parser.h"
 
 namespace adse::cli {
 
@@ -47,6 +53,79 @@ int RunProfileShow(const ProfileShowArgs& args) {
     return ExitCodeFor(loaded.status());
   }
   std::printf("%s", profile::FormatProfileTable(*loaded).c_str());
+  return 0;
+}
+
+int RunProfileCheck(const ProfileCheckArgs& args) {
+  Result<spec::Spec> loaded = spec::LoadSpec(args.scenario);
+  if (!loaded.ok()) {
+    std::fprintf(stderr, "%s\n", loaded.status().message().c_str());
+    return ExitCodeFor(loaded.status());
+  }
+  spec::Spec spec = std::move(loaded).value();
+  if (spec.platform.profile.empty()) {
+    std::fprintf(stderr,
+                 "error: %s: platform.profile: expected a cost profile to "
+                 "check, found none (profile check compares a profile's "
+                 "source with adse)\n",
+                 args.scenario.c_str());
+    return 2;
+  }
+  Result<profile::Profile> costs = profile::ReadProfile(spec.platform.profile);
+  if (!costs.ok()) {
+    std::fprintf(stderr, "%s\n", costs.status().message().c_str());
+    return ExitCodeFor(costs.status());
+  }
+  // The reference machine replaces what the design space would choose;
+  // its other parameters take their exploration.start_from value, else
+  // their first.
+  spec.platform.cores = args.cores;
+  spec.platform.freq_ghz = costs->costs.reference_ghz;
+  const Status rate = spec.stack.Set("lidar.rate_hz", args.lidar_hz);
+  if (!rate.ok()) {
+    std::fprintf(stderr, "error: --lidar-hz: %s\n", rate.message().c_str());
+    return 2;
+  }
+  std::vector<spec::DesignParameter> kept;
+  spec::DesignPoint point;
+  for (const spec::DesignParameter& p : spec.design_space.parameters) {
+    if (p.bind == "platform.cores" || p.bind == "platform.freq_ghz" ||
+        p.bind == "stack.lidar.rate_hz") {
+      continue;
+    }
+    const auto from = spec.exploration.start_from.find(p.name);
+    point[p.name] = from != spec.exploration.start_from.end()
+                        ? from->second
+                        : p.values.front();
+    kept.push_back(p);
+  }
+  spec.design_space.parameters = std::move(kept);
+  spec.exploration.start_from.clear();
+  std::fprintf(stderr,
+               "simulating %s on the reference machine of profile '%s': %d "
+               "cores at %g GHz, LiDAR %g Hz ...\n",
+               spec.name.c_str(), costs->name.c_str(), args.cores,
+               costs->costs.reference_ghz, args.lidar_hz);
+  Result<runfile::RunData> run = sim::SimulatePoint(spec, point);
+  if (!run.ok()) {
+    std::fprintf(stderr, "%s\n", run.status().message().c_str());
+    return ExitCodeFor(run.status());
+  }
+  if (!args.out.empty()) {
+    const Status written = runfile::WriteRunFile(args.out, *run);
+    if (!written.ok()) {
+      std::fprintf(stderr, "error: %s\n", written.message().c_str());
+      return ExitCodeFor(written);
+    }
+  }
+  std::printf(
+      "profile check of '%s' (%s): %s after %.1f s simulated\n\n",
+      costs->name.c_str(), costs->source.cpu.c_str(),
+      run->termination_reason.c_str(),
+      run->metrics.count("nav_time_s") ? run->metrics.at("nav_time_s") : 0.0);
+  std::printf("%s", profile::FormatProfileCheck(
+                        profile::CompareWithProfile(*run, *costs))
+                        .c_str());
   return 0;
 }
 

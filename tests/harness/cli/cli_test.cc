@@ -467,4 +467,32 @@ TEST(CliProfileTest, ImportOfBadInputExitsWith2AndWritesNothing) {
   EXPECT_NE(show.out.find("/nonexistent/profile.yaml"), std::string::npos);
 }
 
+TEST(CliProfileTest, CheckComparesTheChainsOnTheReferenceMachine) {
+  const CommandRun check = Adse("profile check " + Small());
+  ASSERT_EQ(check.exit_code, 0) << check.out;
+  EXPECT_NE(check.out.find("16 cores at 4.9 GHz, LiDAR 10 Hz"),
+            std::string::npos)
+      << check.out;
+  // The sensing chain against Autoware's 85.1 ms, with its verdict.
+  EXPECT_TRUE(std::regex_search(
+      check.out, std::regex("\nsensing +[0-9]+ +[0-9.]+ +[0-9.]+ +85\\.12 "
+                            "+116\\.72 +[-+][0-9]+ %  within 15 %: ")))
+      << check.out;
+  EXPECT_NE(check.out.find("lidar_driver/points_raw"), std::string::npos);
+
+  // A scenario without a profile has nothing to check.
+  const std::string calibrated =
+      Variant("no_profile",
+              "platform: {kind: virtual, cost_model: counted, profile: "
+              "profiles/autoware-2022.12-i9-12900kf.yaml}",
+              "platform: {kind: virtual, cost_model: counted, calibration: "
+              "calibration/reference.json}");
+  const CommandRun none = Adse("profile check " + calibrated);
+  EXPECT_EQ(none.exit_code, 2) << none.out;
+  EXPECT_NE(none.out.find("platform.profile: expected a cost profile to "
+                          "check, found none"),
+            std::string::npos)
+      << none.out;
+}
+
 }  // namespace
