@@ -6,6 +6,7 @@
 #define ADSE_ANALYSIS_PICTURES_PICTURES_H_
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -117,6 +118,34 @@ Status RenderParetoPlot(const std::vector<ParetoPlotPoint>& points,
                         const ParetoPlotOptions& o = {});
 Result<std::string> ParetoPlotPng(const std::vector<ParetoPlotPoint>& points,
                                   const ParetoPlotOptions& o = {});
+
+// One row of a comparison chart: adse's value beside a reference's (e.g.
+// a latency measured on the real stack); a row without a reference shows
+// adse's bar alone.
+struct ComparisonRow {
+  std::string label;
+  double adse = 0.0;
+  std::optional<double> reference;
+};
+inline constexpr Rgb kAdseBarRgb{40, 90, 200};
+inline constexpr Rgb kReferenceBarRgb{230, 90, 0};
+
+struct ComparisonChartOptions {
+  std::string title;
+  std::string unit = "ms";
+  std::string adse_name = "adse";
+  std::string reference_name = "reference";
+  int width_px = 1000;
+  int row_height_px = 34;  // two bars and a gap
+};
+
+// Horizontal bars, one pair per row (adse above, reference below, each with
+// its value written after it), the labels left of the bars, a linear axis
+// from 0 with ticks, a legend and the title. InvalidArgument for bad
+// options, no rows, or a negative or non-finite value. Written atomically.
+Status RenderComparisonChart(const std::vector<ComparisonRow>& rows,
+                             const ComparisonChartOptions& options,
+                             const std::string& path);
 
 // A decoded picture, 8-bit RGB rows top to bottom (for checks and tests
 // that should not need OpenCV themselves).

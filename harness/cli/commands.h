@@ -161,7 +161,7 @@ struct ProfileCheckArgs {
   std::string scenario;  // names platform.profile
   int cores = 16;        // the reference machine's cores (i9-12900KF: 16)
   double lidar_hz = 10;  // the source's LiDAR rate (CARET: 9.6 Hz observed)
-  std::string out;       // run file to keep; empty: none
+  std::string out;       // folder; default <output>/profile-check
 };
 int RunProfileCheck(const ProfileCheckArgs& args);
 

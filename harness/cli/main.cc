@@ -410,8 +410,10 @@ int main(int argc, char** argv) {
                    "LiDAR rate of the reference run (default 10, as the "
                    "source's recording)")
       ->check(CLI::PositiveNumber);
-  profile_check_cmd->add_option("-o,--out", profile_check.out,
-                                "Keep the reference run's file here");
+  profile_check_cmd->add_option(
+      "-o,--out", profile_check.out,
+      "Folder for run.h5, check.txt and check.png (default: "
+      "<output>/profile-check)");
 
   try {
     app.parse(argc, argv);

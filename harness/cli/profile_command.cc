@@ -8,12 +8,16 @@
 #include <utility>
 #include <vector>
 
+#include <fmt/format.h>
+
+#include "analysis/pictures/pictures.h"
 #include "analysis/runfile/run_file.h"
 #include "harness/cli/commands.h"
 #include "harness/profile/profile.h"
 #include "harness/profile/profile_check.h"
 #include "harness/sim/simulator.h"
 #include "harness/spec/spec_parser.h"
+#include "stack/base/files.h"
 
 namespace adse::cli {
 
@@ -111,21 +115,43 @@ int RunProfileCheck(const ProfileCheckArgs& args) {
     std::fprintf(stderr, "%s\n", run.status().message().c_str());
     return ExitCodeFor(run.status());
   }
-  if (!args.out.empty()) {
-    const Status written = runfile::WriteRunFile(args.out, *run);
-    if (!written.ok()) {
-      std::fprintf(stderr, "error: %s\n", written.message().c_str());
-      return ExitCodeFor(written);
+  const profile::ProfileCheck check = profile::CompareWithProfile(*run, *costs);
+  const std::string text =
+      fmt::format("profile check of '{}' ({}): {} after {:.1f} s simulated\n\n",
+                  costs->name, costs->source.cpu, run->termination_reason,
+                  run->metrics.count("nav_time_s")
+                      ? run->metrics.at("nav_time_s")
+                      : 0.0) +
+      profile::FormatProfileCheck(check);
+  std::printf("%s", text.c_str());
+
+  const std::string dir =
+      args.out.empty() ? spec.ResolvedOutput() + "/profile-check" : args.out;
+  Status saved = MakeDirs(dir);
+  if (saved.ok()) saved = runfile::WriteRunFile(dir + "/run.h5", *run);
+  if (saved.ok()) saved = WriteFileAtomic(dir + "/check.txt", text);
+  if (saved.ok()) {
+    // The chains, then the callbacks that cost at least 1 ms at the source.
+    std::vector<analysis::ComparisonRow> rows;
+    for (const profile::CheckRow& r : check.chains) {
+      rows.push_back({r.name, r.adse_avg_ms, r.source_avg_ms});
     }
+    for (const profile::CheckRow& r : check.callbacks) {
+      if (r.source_avg_ms.value_or(0.0) < 1.0) continue;
+      rows.push_back({r.name, r.adse_avg_ms, r.source_avg_ms});
+    }
+    analysis::ComparisonChartOptions o;
+    o.title = fmt::format(
+        "profile check: mean latency, adse on {} cores at {} GHz vs {}",
+        args.cores, costs->costs.reference_ghz, costs->name);
+    o.reference_name = "measured by CARET";
+    saved = analysis::RenderComparisonChart(rows, o, dir + "/check.png");
   }
-  std::printf(
-      "profile check of '%s' (%s): %s after %.1f s simulated\n\n",
-      costs->name.c_str(), costs->source.cpu.c_str(),
-      run->termination_reason.c_str(),
-      run->metrics.count("nav_time_s") ? run->metrics.at("nav_time_s") : 0.0);
-  std::printf("%s", profile::FormatProfileCheck(
-                        profile::CompareWithProfile(*run, *costs))
-                        .c_str());
+  if (!saved.ok()) {
+    std::fprintf(stderr, "error: %s\n", saved.message().c_str());
+    return ExitCodeFor(saved);
+  }
+  std::printf("\nwrote %s/run.h5, check.txt, check.png\n", dir.c_str());
   return 0;
 }
 

@@ -373,5 +373,43 @@ TEST_F(PictureTest, ParetoPlotErrorsLeaveNoFile) {
   EXPECT_EQ(Listing(), std::vector<std::string>{"taken.png"});
 }
 
+TEST_F(PictureTest, AComparisonChartDrawsLongerBarsForLargerValues) {
+  const std::vector<ComparisonRow> rows = {{"sensing", 84.7, 85.1},
+                                           {"sensing_to_control", 182.5, 370.5},
+                                           {"no source", 12.0, std::nullopt}};
+  ComparisonChartOptions o;
+  o.title = "check";
+  ASSERT_TRUE(RenderComparisonChart(rows, o, Path("c.png")).ok());
+  Result<RgbImage> img = ReadImage(Path("c.png"));
+  ASSERT_TRUE(img.ok()) << img.status().ToString();
+  EXPECT_EQ(img->width_px, 1000);
+  // Each bar's length in one pixel row through it.
+  auto bar_px = [&](int row, Rgb colour) {
+    int n = 0;
+    for (int c = 0; c < img->width_px; ++c) n += img->At(c, row) == colour;
+    return n;
+  };
+  std::vector<int> adse, measured;
+  for (int r = 0; r < img->height_px; ++r) {
+    const int a = bar_px(r, kAdseBarRgb), m = bar_px(r, kReferenceBarRgb);
+    if (a > 0 && (adse.empty() || a != adse.back())) adse.push_back(a);
+    if (m > 0 && (measured.empty() || m != measured.back()))
+      measured.push_back(m);
+  }
+  // Legend swatch, then the three adse bars; swatch, then two references.
+  ASSERT_EQ(adse.size(), 4u) << ::testing::PrintToString(adse);
+  ASSERT_EQ(measured.size(), 3u) << ::testing::PrintToString(measured);
+  EXPECT_NEAR(static_cast<double>(adse[2]) / adse[1], 182.5 / 84.7, 0.05);
+  EXPECT_NEAR(static_cast<double>(measured[2]) / measured[1], 370.5 / 85.1,
+              0.05);
+  EXPECT_LT(adse[3], adse[1]);
+
+  EXPECT_FALSE(RenderComparisonChart({}, o, Path("none.png")).ok());
+  EXPECT_FALSE(
+      RenderComparisonChart({{"bad", -1.0, 2.0}}, o, Path("bad.png")).ok());
+  EXPECT_FALSE(fs::exists(Path("none.png")));
+  EXPECT_FALSE(fs::exists(Path("bad.png")));
+}
+
 }  // namespace
 }  // namespace adse::analysis

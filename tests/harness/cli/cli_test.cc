@@ -468,8 +468,14 @@ TEST(CliProfileTest, ImportOfBadInputExitsWith2AndWritesNothing) {
 }
 
 TEST(CliProfileTest, CheckComparesTheChainsOnTheReferenceMachine) {
-  const CommandRun check = Adse("profile check " + Small());
+  const fs::path out = fs::temp_directory_path() / "adse_cli_profile_check";
+  fs::remove_all(out);
+  const CommandRun check =
+      Adse("profile check " + Small() + " -o " + out.string());
   ASSERT_EQ(check.exit_code, 0) << check.out;
+  for (const char* file : {"run.h5", "check.txt", "check.png"}) {
+    EXPECT_TRUE(fs::is_regular_file(out / file)) << file;
+  }
   EXPECT_NE(check.out.find("16 cores at 4.9 GHz, LiDAR 10 Hz"),
             std::string::npos)
       << check.out;

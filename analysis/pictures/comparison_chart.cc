@@ -1,0 +1,139 @@
+// The side-by-side bar chart of `adse profile check`: adse's latencies
+// beside what the real stack measured.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "analysis/pictures/internal/drawing.h"
+#include "analysis/pictures/pictures.h"
+
+namespace adse::analysis {
+namespace {
+
+using internal::Align;
+using internal::Bgr;
+using internal::DrawText;
+using internal::Style;
+
+Status Check(const std::vector<ComparisonRow>& rows,
+             const ComparisonChartOptions& o) {
+  if (rows.empty()) return Status::InvalidArgument("comparison chart: no rows");
+  if (o.width_px < 400 || o.width_px > internal::kMaxSidePx) {
+    return Status::InvalidArgument(
+        fmt::format("comparison chart: width_px must be in [400, {}], got {}",
+                    internal::kMaxSidePx, o.width_px));
+  }
+  if (o.row_height_px < 12 || o.row_height_px > 200) {
+    return Status::InvalidArgument(fmt::format(
+        "comparison chart: row_height_px must be in [12, 200], got {}",
+        o.row_height_px));
+  }
+  if (static_cast<long long>(rows.size()) * o.row_height_px >
+      internal::kMaxSidePx) {
+    return Status::InvalidArgument(
+        fmt::format("comparison chart: {} rows do not fit in {} px",
+                    rows.size(), internal::kMaxSidePx));
+  }
+  for (const ComparisonRow& r : rows) {
+    auto bad = [](double v) { return !std::isfinite(v) || v < 0.0; };
+    if (bad(r.adse) || (r.reference && bad(*r.reference))) {
+      return Status::InvalidArgument("comparison chart: row '" + r.label +
+                                     "': values must be finite and >= 0");
+    }
+  }
+  return Status::Ok();
+}
+
+Result<std::string> ComparisonChartPng(const std::vector<ComparisonRow>& rows,
+                                       const ComparisonChartOptions& o) {
+  ADSE_RETURN_IF_ERROR(Check(rows, o));
+  return internal::Guarded("comparison chart", [&]() -> Result<std::string> {
+    const Style s{
+        std::clamp(o.row_height_px / 34.0, internal::kMinUi, internal::kMaxUi)};
+    const int header = s.Px(64), footer = s.Px(40), margin = s.Px(12);
+    const int height =
+        header + static_cast<int>(rows.size()) * o.row_height_px + footer;
+    cv::Mat img(height, o.width_px, CV_8UC3, internal::kWhite);
+
+    // Labels take the left third at most; the bars the rest.
+    int label_px = 0;
+    for (const ComparisonRow& r : rows) {
+      int baseline = 0;
+      label_px =
+          std::max(label_px, internal::TextSize(r.label, s, &baseline).width);
+    }
+    label_px = std::min(label_px, o.width_px / 3);
+    const int x0 = margin + label_px + s.Px(8);
+    const int value_px = s.Px(90);  // room for the value after a bar
+    const int x1 = o.width_px - margin - value_px;
+    double top = 0.0;
+    for (const ComparisonRow& r : rows) {
+      top = std::max({top, r.adse, r.reference.value_or(0.0)});
+    }
+    top = internal::NiceAbove(top > 0 ? top : 1.0);
+    auto x_of = [&](double v) {
+      return x0 + static_cast<int>(std::lround((x1 - x0) * v / top));
+    };
+
+    DrawText(&img, o.title, margin, s.Px(22), Align::kLeft, s, internal::kBlack,
+             false);
+    // Legend.
+    int lx = margin;
+    for (const auto& [name, colour] :
+         {std::pair{o.adse_name, kAdseBarRgb},
+          std::pair{o.reference_name, kReferenceBarRgb}}) {
+      cv::rectangle(img, cv::Rect(lx, s.Px(34), s.Px(18), s.Px(10)),
+                    Bgr(colour), cv::FILLED);
+      lx += s.Px(24) +
+            DrawText(&img, name, lx + s.Px(24), s.Px(44), Align::kLeft, s,
+                     internal::kBlack, false) +
+            s.Px(16);
+    }
+    // Grid and axis ticks.
+    const int y_bottom =
+        header + static_cast<int>(rows.size()) * o.row_height_px;
+    for (int i = 0; i <= 5; ++i) {
+      const double v = top * i / 5.0;
+      const int x = x_of(v);
+      cv::line(img, {x, header - s.Px(4)}, {x, y_bottom},
+               cv::Scalar(225, 225, 225), 1);
+      DrawText(&img, internal::FormatNumber(v), x, y_bottom + s.Px(16),
+               Align::kCentre, s, internal::kDarkGrey, false);
+    }
+    DrawText(&img, o.unit, x1, y_bottom + s.Px(32), Align::kRight, s,
+             internal::kDarkGrey, false);
+    // Rows.
+    const int bar = std::max(2, (o.row_height_px - s.Px(8)) / 2);
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const ComparisonRow& r = rows[i];
+      const int y = header + static_cast<int>(i) * o.row_height_px;
+      DrawText(&img, internal::FitText(internal::Ascii(r.label), s, label_px),
+               x0 - s.Px(8), y + bar + s.Px(4), Align::kRight, s,
+               internal::kBlack, false);
+      auto draw_bar = [&](double v, int top_y, Rgb colour) {
+        cv::rectangle(img, cv::Rect(x0, top_y, std::max(1, x_of(v) - x0), bar),
+                      Bgr(colour), cv::FILLED);
+        DrawText(&img, fmt::format("{:.1f}", v), x_of(v) + s.Px(4),
+                 top_y + bar - 1, Align::kLeft, s, internal::kBlack, false);
+      };
+      draw_bar(r.adse, y, kAdseBarRgb);
+      if (r.reference) draw_bar(*r.reference, y + bar, kReferenceBarRgb);
+    }
+    std::string png;
+    ADSE_RETURN_IF_ERROR(internal::EncodeOk(img, &png));
+    return png;
+  });
+}
+
+}  // namespace
+
+Status RenderComparisonChart(const std::vector<ComparisonRow>& rows,
+                             const ComparisonChartOptions& options,
+                             const std::string& path) {
+  return internal::WritePng(ComparisonChartPng(rows, options), path);
+}
+
+}  // namespace adse::analysis
