@@ -534,23 +534,28 @@ Status CheckGlobalHeaps(const std::string& path) {
     for (size_t p = at + kHeader; p + kHeader <= end;) {
       const unsigned index = bytes[p] | (bytes[p + 1] << 8);
       const uint64_t object = u64(p + 8);
-      const uint64_t need =
-          index > 0 ? kHeader + ((object + 7) / 8) * 8 : object;
-      if (need == 0) {
-        status = Status::Corruption(
-            path + ": damaged HDF5 global heap at byte " + std::to_string(at) +
-            " (an empty free-space object, which HDF5 cannot read past)");
-        break;
+      const uint64_t room = end - p;  // bytes left in the collection
+      if (index == 0) {               // free space; HDF5 parses on after it
+        if (object == 0) {
+          status = Status::Corruption(
+              path + ": damaged HDF5 global heap at byte " +
+              std::to_string(at) +
+              " (an empty free-space object, which HDF5 cannot read past)");
+          break;
+        }
+        if (object > room) break;  // trailing free space
+        p += static_cast<size_t>(object);
+        continue;
       }
-      if (need > end - p) {
-        if (p + kHeader > end || index == 0) break;  // trailing free space
+      // Compared before any arithmetic: a size near 2^64 must not wrap.
+      if (object > room - kHeader || kHeader + ((object + 7) / 8) * 8 > room) {
         status = Status::Corruption(
             path + ": damaged HDF5 global heap at byte " + std::to_string(at) +
             " (object " + std::to_string(index) + " claims " +
             std::to_string(object) + " bytes, more than its collection)");
         break;
       }
-      p += static_cast<size_t>(need);
+      p += static_cast<size_t>(kHeader + ((object + 7) / 8) * 8);
     }
   }
   ::munmap(map, n);

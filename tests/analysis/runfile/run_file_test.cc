@@ -679,8 +679,9 @@ TEST_F(RunFileTest, FileWithoutLanesReadsAsNoLanes) {
 }
 
 // Found by fuzz_run_file: libhdf5 1.10 loops forever on a global heap whose
-// free-space object is empty, and copies overlapping memory for an object
-// that claims more than its collection. Every reader refuses both first.
+// free-space object is empty, and copies overlapping (or negative-size)
+// memory for an object that claims more than its collection, up to 2^64 - 1
+// bytes. Every reader refuses them first.
 TEST(RunFileDamageTest, ADamagedGlobalHeapIsRefusedBeforeHdf5ReadsIt) {
   const std::string dir =
       std::string(ADSE_SOURCE_DIR) + "/tests/fuzz/regressions/run_file/";
@@ -688,6 +689,8 @@ TEST(RunFileDamageTest, ADamagedGlobalHeapIsRefusedBeforeHdf5ReadsIt) {
       {"hdf5_global_heap_loop.h5", "an empty free-space object"},
       {"hdf5_global_heap_object_past_collection.h5",
        "more than its collection"},
+      {"hdf5_global_heap_object_size_wraps.h5",
+       "claims 18446744073709551615 bytes, more than its collection"},
   };
   for (const auto& [file, why] : kCases) {
     SCOPED_TRACE(file);
