@@ -186,21 +186,10 @@ Result<Mapping> ReadMapping(const std::string& path) {
   if (!name.ok()) return name.status();
   mapping.name = *name;
 
-  Result<MapReader> source = root.Map("source");
+  Result<ProfileSource> source = internal::ReadSource(root);
   if (!source.ok()) return source.status();
-  ADSE_RETURN_IF_ERROR(
-      source->CheckKeys({"description", "license", "cpu", "note"}));
-  Result<std::string> description =
-      source->String("description", std::nullopt, true);
-  Result<std::string> license = source->String("license", "");
-  Result<std::string> cpu = source->String("cpu", "");
-  Result<std::string> note = source->String("note", "");
-  for (const auto* r : {&description, &license, &cpu, &note}) {
-    if (!r->ok()) return r->status();
-  }
-  mapping.source.description = *description;
-  mapping.source.license = *license;
-  mapping.source.cpu = *cpu;
+  mapping.source = *source;
+  const std::string note = source->note;
 
   Result<MapReader> reference = root.Map("reference");
   if (!reference.ok()) return reference.status();
@@ -214,7 +203,7 @@ Result<Mapping> ReadMapping(const std::string& path) {
   mapping.reference_ghz = *ghz;
   mapping.source.reference_ghz_assumed = *assumed;
   // One note in the profile: how to read the numbers, then the clock.
-  mapping.source.note = *note;
+  mapping.source.note = note;
   if (!reference_note->empty()) {
     mapping.source.note +=
         (mapping.source.note.empty() ? "" : " ") + *reference_note;

@@ -208,22 +208,9 @@ Result<Profile> ReadProfileDoc(const YamlDoc& doc) {
   if (!name.ok()) return name.status();
   profile.name = *name;
 
-  Result<MapReader> source = root.Map("source");
+  Result<ProfileSource> source = internal::ReadSource(root);
   if (!source.ok()) return source.status();
-  ADSE_RETURN_IF_ERROR(
-      source->CheckKeys({"description", "license", "cpu", "note"}));
-  Result<std::string> description =
-      source->String("description", std::nullopt, true);
-  Result<std::string> license = source->String("license", "");
-  Result<std::string> cpu = source->String("cpu", "");
-  Result<std::string> note = source->String("note", "");
-  for (const auto* r : {&description, &license, &cpu, &note}) {
-    if (!r->ok()) return r->status();
-  }
-  profile.source.description = *description;
-  profile.source.license = *license;
-  profile.source.cpu = *cpu;
-  profile.source.note = *note;
+  profile.source = *source;
 
   Result<MapReader> reference = root.Map("reference");
   if (!reference.ok()) return reference.status();

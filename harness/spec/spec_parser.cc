@@ -1,4 +1,5 @@
 #include "harness/spec/spec_parser.h"
+#include "harness/spec/yaml_limits.h"
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -15,8 +16,6 @@ namespace adse::spec {
 namespace fs = std::filesystem;
 
 using internal::Diagnostic;
-using internal::LimitExceeded;
-using internal::LimitScanner;
 using internal::SpecReader;
 
 Result<Spec> ParseSpec(std::string_view text, const std::string& file_name,
@@ -46,7 +45,8 @@ Result<Spec> ParseSpec(std::string_view text, const std::string& file_name,
   try {
     std::istringstream in(spec.source_text);
     YAML::Parser parser(in);
-    LimitScanner scanner;
+    YamlLimitScanner scanner(
+        YamlLimits{kMaxYamlDepth, kMaxYamlAliases, kMaxYamlNodes});
     parser.HandleNextDocument(scanner);
     if (parser.HandleNextDocument(scanner) && scanner.documents() > 1) {
       return Status::InvalidArgument(fmt::format(
@@ -54,7 +54,7 @@ Result<Spec> ParseSpec(std::string_view text, const std::string& file_name,
           "('---' separators)",
           file_name));
     }
-  } catch (const LimitExceeded& e) {
+  } catch (const YamlLimitExceeded& e) {
     reader.FileError(e.mark, "(file)", e.expected, e.found);
   } catch (const YAML::Exception& e) {
     const YAML::Mark mark = e.mark;

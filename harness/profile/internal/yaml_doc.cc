@@ -1,7 +1,6 @@
 #include "harness/profile/internal/yaml_doc.h"
 
 #include <fmt/format.h>
-#include <yaml-cpp/eventhandler.h>
 
 #include <algorithm>
 #include <charconv>
@@ -9,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "harness/spec/yaml_limits.h"
 #include "stack/base/files.h"
 
 namespace adse::profile::internal {
@@ -21,57 +21,6 @@ constexpr size_t kMaxYamlBytes = 16u << 20;
 constexpr int kMaxNodes = 2'000'000;
 constexpr int kMaxDepth = 64;
 constexpr int kMaxAliases = 1000;
-
-struct LimitExceeded {
-  YAML::Mark mark;
-  std::string what;
-};
-
-class LimitScanner : public YAML::EventHandler {
- public:
-  void OnDocumentStart(const YAML::Mark&) override { ++documents_; }
-  void OnDocumentEnd() override {}
-  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { Count(mark); }
-  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
-    Count(mark);
-    if (++aliases_ > kMaxAliases) {
-      throw LimitExceeded{mark, fmt::format("at most {} aliases", kMaxAliases)};
-    }
-  }
-  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
-                const std::string&) override {
-    Count(mark);
-  }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&,
-                       YAML::anchor_t, YAML::EmitterStyle::value) override {
-    Open(mark);
-  }
-  void OnSequenceEnd() override { --depth_; }
-  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
-                  YAML::EmitterStyle::value) override {
-    Open(mark);
-  }
-  void OnMapEnd() override { --depth_; }
-  int documents() const { return documents_; }
-
- private:
-  void Count(const YAML::Mark& mark) {
-    if (++nodes_ > kMaxNodes) {
-      throw LimitExceeded{mark, fmt::format("at most {} nodes", kMaxNodes)};
-    }
-  }
-  void Open(const YAML::Mark& mark) {
-    Count(mark);
-    if (++depth_ > kMaxDepth) {
-      throw LimitExceeded{
-          mark, fmt::format("nesting at most {} levels deep", kMaxDepth)};
-    }
-  }
-  int documents_ = 0;
-  int depth_ = 0;
-  int nodes_ = 0;
-  int aliases_ = 0;
-};
 
 int LineOf(const YAML::Mark& mark) {
   return mark.is_null() ? 1 : mark.line + 1;
@@ -127,15 +76,16 @@ Result<YamlDoc> YamlDoc::Load(const std::string& path,
   try {
     std::istringstream in(*text);
     YAML::Parser parser(in);
-    LimitScanner scanner;
+    spec::YamlLimitScanner scanner(
+        spec::YamlLimits{kMaxDepth, kMaxAliases, kMaxNodes});
     parser.HandleNextDocument(scanner);
     if (parser.HandleNextDocument(scanner) && scanner.documents() > 1) {
       return doc.Error(YAML::Mark(), "(file)", "one YAML document with " + what,
                        "several ('---' separators)");
     }
     doc.root_ = YAML::Load(*text);
-  } catch (const LimitExceeded& e) {
-    return doc.Error(e.mark, "(file)", e.what, "more");
+  } catch (const spec::YamlLimitExceeded& e) {
+    return doc.Error(e.mark, "(file)", e.expected, e.found);
   } catch (const YAML::Exception& e) {
     return doc.Error(e.mark, "(file)", "valid YAML with " + what,
                      "a syntax error: " + e.msg);
@@ -385,6 +335,27 @@ std::string DidYouMean(const std::string& word,
     out += "'" + close[i].second + "'";
   }
   return out + "?)";
+}
+
+Result<ProfileSource> ReadSource(const MapReader& parent) {
+  Result<MapReader> source = parent.Map("source");
+  if (!source.ok()) return source.status();
+  ADSE_RETURN_IF_ERROR(
+      source->CheckKeys({"description", "license", "cpu", "note"}));
+  Result<std::string> description =
+      source->String("description", std::nullopt, true);
+  Result<std::string> license = source->String("license", "");
+  Result<std::string> cpu = source->String("cpu", "");
+  Result<std::string> note = source->String("note", "");
+  for (const auto* r : {&description, &license, &cpu, &note}) {
+    if (!r->ok()) return r->status();
+  }
+  ProfileSource out;
+  out.description = *description;
+  out.license = *license;
+  out.cpu = *cpu;
+  out.note = *note;
+  return out;
 }
 
 }  // namespace adse::profile::internal

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/profile/profile.h"
 #include "stack/base/status.h"
 
 namespace adse::profile::internal {
@@ -138,6 +139,10 @@ std::string FormatNumber(double value);
 std::string DidYouMean(const std::string& word,
                        const std::vector<std::string>& candidates,
                        size_t n = 1);
+
+// The `source:` map that profiles and mappings share: description
+// (required), license, cpu and note.
+Result<ProfileSource> ReadSource(const MapReader& parent);
 
 }  // namespace adse::profile::internal
 

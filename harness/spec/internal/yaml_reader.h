@@ -23,69 +23,6 @@
 
 namespace adse::spec::internal {
 
-// Pre-scan: bounds the document before yaml-cpp builds any node, so deep
-// nesting, alias bombs and huge node counts cost little.
-
-struct LimitExceeded {
-  YAML::Mark mark;
-  std::string expected;
-  std::string found;
-};
-
-class LimitScanner : public YAML::EventHandler {
- public:
-  void OnDocumentStart(const YAML::Mark&) override { ++documents_; }
-  void OnDocumentEnd() override {}
-  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { Count(mark); }
-  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
-    Count(mark);
-    if (++aliases_ > kMaxYamlAliases) {
-      throw LimitExceeded{
-          mark, fmt::format("at most {} aliases (*name)", kMaxYamlAliases),
-          "more (an alias bomb?)"};
-    }
-  }
-  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
-                const std::string&) override {
-    Count(mark);
-  }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&,
-                       YAML::anchor_t, YAML::EmitterStyle::value) override {
-    Open(mark);
-  }
-  void OnSequenceEnd() override { --depth_; }
-  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
-                  YAML::EmitterStyle::value) override {
-    Open(mark);
-  }
-  void OnMapEnd() override { --depth_; }
-
-  int documents() const { return documents_; }
-
- private:
-  void Count(const YAML::Mark& mark) {
-    if (++nodes_ > kMaxYamlNodes) {
-      throw LimitExceeded{mark, fmt::format("at most {} nodes", kMaxYamlNodes),
-                          "more"};
-    }
-  }
-  // Throwing here stops yaml-cpp's recursive descent at our depth, long
-  // before its own (much larger) guard or the stack.
-  void Open(const YAML::Mark& mark) {
-    Count(mark);
-    if (++depth_ > kMaxYamlDepth) {
-      throw LimitExceeded{
-          mark, fmt::format("nesting at most {} levels deep", kMaxYamlDepth),
-          "deeper nesting"};
-    }
-  }
-
-  int documents_ = 0;
-  int depth_ = 0;
-  int nodes_ = 0;
-  int aliases_ = 0;
-};
-
 // A value in the file: its node, where it is, and its field path.
 struct Val {
   YAML::Node node;

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "harness/profile/profile.h"
+#include "tests/harness/testing/temp_files.h"
 
 namespace adse::profile {
 namespace {
@@ -28,21 +29,11 @@ const std::string kBundled =
 const std::string kNdt =
     "/localization/pose_estimator/ndt_scan_matcher/callback_1";
 
-fs::path TestDir() {
-  const ::testing::TestInfo* info =
-      ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::temp_directory_path() /
-                       (std::string("adse_caret_import_") + info->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+// A fresh folder for one test.
+fs::path TestDir() { return adse::testing::TestTempDir("adse-caret-import"); }
 
 std::string ReadText(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
+  return adse::testing::Slurp(path.string());
 }
 
 // Replaces the one occurrence of `from` in `text`.

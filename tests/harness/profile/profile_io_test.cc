@@ -11,6 +11,7 @@
 
 #include "harness/profile/profile.h"
 #include "stack/base/files.h"
+#include "tests/harness/testing/temp_files.h"
 #include "tests/stack/base/testing/fault_injection_env.h"
 
 namespace adse::profile {
@@ -19,21 +20,10 @@ namespace {
 namespace fs = std::filesystem;
 
 // A fresh folder for one test.
-fs::path TestDir() {
-  const ::testing::TestInfo* info =
-      ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::temp_directory_path() /
-                       (std::string("adse_profile_io_") + info->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path TestDir() { return adse::testing::TestTempDir("adse-profile-io"); }
 
 std::string ReadText(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
+  return adse::testing::Slurp(path.string());
 }
 
 stack::CallbackCost Cost(std::vector<double> ms) {

@@ -2,6 +2,7 @@
 #ifndef ADSE_TESTS_HARNESS_TESTING_TEMP_FILES_H_
 #define ADSE_TESTS_HARNESS_TESTING_TEMP_FILES_H_
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -20,6 +21,12 @@ inline std::string FreshTempDir(const std::string& prefix,
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
+}
+
+// FreshTempDir named after the running test.
+inline std::string TestTempDir(const std::string& prefix) {
+  return FreshTempDir(
+      prefix, ::testing::UnitTest::GetInstance()->current_test_info()->name());
 }
 
 // Writes `text` exactly (no atomic rename: tests use it to plant damage).
