@@ -271,6 +271,16 @@ Result<Profile> ReadProfileDoc(const YamlDoc& doc) {
       if (!sources.ok()) return sources.status();
       provenance.sources = *sources;
     }
+    // The executor's own rules, checked on this entry alone so that the
+    // error is located at it.
+    stack::CostProfile alone;
+    alone.reference_ghz = profile.costs.reference_ghz;
+    alone.callbacks.emplace(key, *cost);
+    if (const Status valid = stack::ValidateCostProfile(alone); !valid.ok()) {
+      return Status::InvalidArgument(
+          fmt::format("{}:{}:{}: error: {}", doc.path(), marks[i].line + 1,
+                      marks[i].column + 1, valid.message()));
+    }
     if (!profile.costs.callbacks.emplace(key, std::move(cost).value()).second) {
       return doc.Error(marks[i], callbacks->PathOf(key), "each callback once",
                        "'" + key + "' again");
@@ -301,21 +311,6 @@ Result<Profile> ReadProfileDoc(const YamlDoc& doc) {
     }
   }
 
-  // The executor's own rules, as a last net; its message names the
-  // callback, which locates it in the file.
-  const Status valid = stack::ValidateCostProfile(profile.costs);
-  if (!valid.ok()) {
-    YAML::Mark mark;
-    for (size_t i = 0; i < entries.size(); ++i) {
-      if (valid.message().find("callbacks." + entries[i].first + ":") !=
-          std::string::npos) {
-        mark = marks[i];
-      }
-    }
-    return Status::InvalidArgument(fmt::format(
-        "{}:{}:{}: error: {}", doc.path(), mark.is_null() ? 1 : mark.line + 1,
-        mark.is_null() ? 1 : mark.column + 1, valid.message()));
-  }
   return profile;
 }
 
