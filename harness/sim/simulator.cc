@@ -176,8 +176,13 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
       std::vector<geometry::OrientedBox> boxes;
       boxes.reserve(w.others().size());
       for (const world::OtherVehicle& v : w.others()) boxes.push_back(v.box);
-      world::PointCloud scan =
-          lidar.Scan({ego.x_m, ego.y_m, ego.yaw_rad}, next_lidar, boxes);
+      // The car moves during the sweep, so the scan comes distorted; the
+      // stack's distortion corrector undoes it from odometry.
+      const geometry::Twist2 motion{
+          ego.v_mps,
+          ego.v_mps * std::tan(ego.steer_rad) / w.ego_limits().wheelbase_m};
+      world::PointCloud scan = lidar.Scan({ego.x_m, ego.y_m, ego.yaw_rad},
+                                          next_lidar, boxes, motion);
       stack::PointCloudMsg msg;
       msg.header.stamp_s = next_lidar;
       msg.points = std::move(scan.points);

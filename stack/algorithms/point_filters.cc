@@ -28,6 +28,95 @@ Points CropPoints(const Points& points, const CropParams& params) {
   return out;
 }
 
+Points RemoveInsideBoxes(const Points& points,
+                         const std::vector<CropBox>& boxes) {
+  Points out;
+  out.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) {
+    const bool inside =
+        std::any_of(boxes.begin(), boxes.end(), [&p](const CropBox& b) {
+          return p.x() >= b.x_min_m && p.x() <= b.x_max_m &&
+                 p.y() >= b.y_min_m && p.y() <= b.y_max_m &&
+                 p.z() >= b.z_min_m && p.z() <= b.z_max_m;
+        });
+    if (!inside) out.push_back(p);
+  }
+  return out;
+}
+
+Points CorrectDistortion(const Points& points, const geometry::Twist2& twist,
+                         const DistortionParams& params) {
+  if (twist.v_mps == 0.0 && twist.yaw_rate_rps == 0.0) return points;
+  constexpr double kTwoPi = 2.0 * M_PI;
+  Points out;
+  out.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) {
+    double azimuth = std::atan2(double(p.y()), double(p.x()));
+    if (azimuth < 0.0) azimuth += kTwoPi;
+    const geometry::Pose2 moved =
+        geometry::MotionAfter(twist, params.sweep_s * azimuth / kTwoPi);
+    const double c = std::cos(moved.yaw_rad), s = std::sin(moved.yaw_rad);
+    out.emplace_back(static_cast<float>(c * p.x() - s * p.y() + moved.x_m),
+                     static_cast<float>(s * p.x() + c * p.y() + moved.y_m),
+                     p.z());
+  }
+  return out;
+}
+
+Points RemoveRingOutliers(const Points& points,
+                          const RingOutlierParams& params) {
+  constexpr double kRadToDeg = 180.0 / M_PI;
+  const int beams = std::max(1, params.beams);
+  const double span_deg = params.fov_up_deg - params.fov_down_deg;
+  // Points by ring; each ring stays in the driver's (azimuth) order.
+  std::vector<std::vector<int>> rings(beams);
+  std::vector<double> range(points.size()), azimuth(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    const double horizontal = std::hypot(double(p.x()), double(p.y()));
+    const double elevation_deg =
+        std::atan2(p.z() - params.sensor_height_m, horizontal) * kRadToDeg;
+    const int ring = beams == 1 ? 0
+                                : static_cast<int>(std::lround(
+                                      (elevation_deg - params.fov_down_deg) /
+                                      span_deg * (beams - 1)));
+    range[i] = std::hypot(horizontal, p.z() - params.sensor_height_m);
+    azimuth[i] = std::atan2(double(p.y()), double(p.x())) * kRadToDeg;
+    rings[std::clamp(ring, 0, beams - 1)].push_back(static_cast<int>(i));
+  }
+  std::vector<char> keep(points.size(), 0);
+  for (const std::vector<int>& ring : rings) {
+    size_t begin = 0;
+    while (begin < ring.size()) {
+      size_t end = begin + 1;  // the run is [begin, end)
+      while (end < ring.size()) {
+        const int a = ring[end - 1], b = ring[end];
+        const double lo = std::min(range[a], range[b]);
+        const double hi = std::max(range[a], range[b]);
+        const double gap = std::abs(azimuth[b] - azimuth[a]);
+        if (lo <= 0.0 || hi / lo > params.distance_ratio ||
+            std::min(gap, 360.0 - gap) > params.max_azimuth_gap_deg) {
+          break;
+        }
+        ++end;
+      }
+      const double length =
+          (points[ring[end - 1]] - points[ring[begin]]).norm();
+      if (static_cast<int>(end - begin) >= params.min_points ||
+          length >= params.min_length_m) {
+        for (size_t k = begin; k < end; ++k) keep[ring[k]] = 1;
+      }
+      begin = end;
+    }
+  }
+  Points out;
+  out.reserve(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (keep[i]) out.push_back(points[i]);
+  }
+  return out;
+}
+
 namespace {
 
 // RANSAC over the low points. Returns false when no plausible plane wins,

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "stack/geometry/geometry.h"
+
 namespace adse::algorithms {
 
 using Points = std::vector<Eigen::Vector3f>;
@@ -27,6 +29,55 @@ struct CropParams {
 // Keeps points inside the range annulus and the z band, outside the ego box.
 // Non-finite points are dropped. Work units: points in.
 Points CropPoints(const Points& points, const CropParams& params);
+
+// An axis-aligned box in the vehicle frame.
+struct CropBox {
+  double x_min_m = 0.0, x_max_m = 0.0;
+  double y_min_m = 0.0, y_max_m = 0.0;
+  double z_min_m = 0.0, z_max_m = 0.0;
+};
+
+// Removes the points inside any of `boxes` (Autoware's crop_box_filter with
+// `negative: true`, as its self and mirror crops run). Work units: points
+// in.
+Points RemoveInsideBoxes(const Points& points,
+                         const std::vector<CropBox>& boxes);
+
+struct DistortionParams {
+  double sweep_s = 0.1;  // one revolution, 1 / LiDAR rate
+};
+
+// Undoes a spinning LiDAR's motion distortion: each point is moved from the
+// sensor frame at the moment its column was sensed to the frame at the
+// sweep's start (the scan's stamp), by the twist the car had. The sensor
+// turns counter-clockwise from azimuth 0 at the start, so a point's moment
+// comes from its azimuth (the simulated sensor gives no per-point time).
+// In a right turn the last few columns' points can appear past azimuth 360
+// and are then taken for the first ones (at 0.5 rad/s and 10 Hz, 3 deg of
+// 360). The sensor sits above the origin of the vehicle frame. Work units:
+// points in.
+Points CorrectDistortion(const Points& points, const geometry::Twist2& twist,
+                         const DistortionParams& params);
+
+// Autoware's ring_outlier_filter: along each beam's ring, in azimuth order,
+// neighbours whose ranges differ by at most `distance_ratio` and whose
+// azimuths by at most `max_azimuth_gap_deg` form a run; a run with fewer
+// than `min_points` points that is also shorter than `min_length_m` is
+// noise (rain, dust, a stray return) and goes.
+struct RingOutlierParams {
+  int beams = 16;                    // the sensor's rings
+  double fov_down_deg = -15.0;       // elevation of the bottom ring
+  double fov_up_deg = 15.0;          // elevation of the top ring
+  double sensor_height_m = 1.9;      // above the vehicle frame's origin
+  double distance_ratio = 1.03;      // max/min range of neighbours in a run
+  double max_azimuth_gap_deg = 1.0;  // neighbours farther apart break a run
+  int min_points = 4;                // a run this long stays ...
+  double min_length_m = 0.1;         // ... and so does one this wide
+};
+
+// Removes isolated returns; keeps the input's order. Work units: points in.
+Points RemoveRingOutliers(const Points& points,
+                          const RingOutlierParams& params);
 
 struct GroundParams {
   // A point higher than this above the ground plane is an obstacle. The

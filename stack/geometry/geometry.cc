@@ -100,4 +100,20 @@ bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b) {
   return true;
 }
 
+Pose2 MotionAfter(const Twist2& twist, double dt_s) {
+  const double yaw = twist.yaw_rate_rps * dt_s;
+  const double d = twist.v_mps * dt_s;
+  Pose2 out;
+  out.yaw_rad = yaw;
+  if (std::abs(yaw) < 1e-9) {
+    out.x_m = d;
+    return out;
+  }
+  // Chord of the arc of radius v / w.
+  const double r = twist.v_mps / twist.yaw_rate_rps;
+  out.x_m = r * std::sin(yaw);
+  out.y_m = r * (1.0 - std::cos(yaw));
+  return out;
+}
+
 }  // namespace adse::geometry

@@ -39,6 +39,17 @@ struct Path2 {
   double MaxGap() const;
 };
 
+// Planar motion at constant speed and yaw rate (a sweeping LiDAR's carrier
+// during one revolution, Autoware's distortion-corrector model).
+struct Twist2 {
+  double v_mps = 0.0;         // forward speed
+  double yaw_rate_rps = 0.0;  // counter-clockwise
+};
+
+// Where a frame that starts at the origin with `twist` is after `dt_s`:
+// the exact constant-twist arc, a straight line when the yaw rate is ~0.
+Pose2 MotionAfter(const Twist2& twist, double dt_s);
+
 // The four corners of a box, counter-clockwise.
 std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box);
 

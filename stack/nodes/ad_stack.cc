@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <optional>
 
 #include "stack/algorithms/clustering.h"
@@ -67,7 +68,7 @@ class Stack final : public AdStack {
 
   // Node state. Callbacks of one node never overlap (the executor's
   // mutual exclusion), so none of this needs locking.
-  algo::CropParams crop_;
+  geometry::Twist2 corrector_twist_;  // newest odometry, for the sweep
   std::unique_ptr<algo::NdtMatcher> ndt_;
   std::optional<PoseMsg> ndt_latest_ekf_;
   double ndt_latest_ekf_t_ = 0.0;  // when that EKF pose was received
@@ -112,23 +113,91 @@ Status Stack::Build(Graph* g) {
 }
 
 void Stack::BuildSensing(Graph* g) {
-  // LiDAR driver: range and ego-body crop of the raw scan.
-  crop_.max_range_m = config_.Get("lidar.range_m");
-  crop_.ego_x_max_m =
-      inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2 + 0.2;
-  crop_.ego_x_min_m =
+  // Autoware's top-LiDAR chain, one node per stage so the stages pipeline
+  // across scans: driver (range crop) -> self crop -> mirror crop ->
+  // distortion corrector -> ring outlier filter -> /sensing/lidar/points.
+  const int raw = g->AddTopic<PointCloudMsg>("/sensing/lidar/pointcloud_raw");
+  const int self_cropped =
+      g->AddTopic<PointCloudMsg>("/sensing/lidar/self_cropped");
+  const int mirror_cropped =
+      g->AddTopic<PointCloudMsg>("/sensing/lidar/mirror_cropped");
+  const int rectified = g->AddTopic<PointCloudMsg>("/sensing/lidar/rectified");
+
+  // A stage that maps one cloud to another, reporting points in as work.
+  auto add_stage = [g](const std::string& node_name,
+                       const std::string& callback_name, int in_topic,
+                       int out_topic,
+                       std::function<algo::Points(const algo::Points&)> run) {
+    const int node = g->AddNode(node_name);
+    g->Subscribe<PointCloudMsg>(
+        node, in_topic, callback_name, 1,
+        [run = std::move(run), out_topic](const PointCloudMsg& in,
+                                          CallbackContext& ctx) {
+          PointCloudMsg out;
+          out.header = in.header;
+          out.points = run(in.points);
+          ctx.ReportWork({static_cast<double>(in.points.size()), 0.0, 1});
+          ctx.Publish(out_topic, std::move(out));
+        });
+    return node;
+  };
+
+  // The driver: the sensor's range window and the z band; the ego body is
+  // the self crop's job.
+  const world::LidarParams lidar = config_.Lidar();
+  algo::CropParams window;
+  window.max_range_m = lidar.range_m;
+  window.remove_ego = false;
+  add_stage(
+      "lidar_driver", "points_raw", topics_.lidar_raw, raw,
+      [window](const algo::Points& p) { return algo::CropPoints(p, window); });
+
+  // Returns off our own body, from rear to front bumper with a margin.
+  const double rear_m =
       inputs_.wheelbase_m / 2 - inputs_.vehicle_length_m / 2 - 0.2;
-  crop_.ego_half_width_m = inputs_.vehicle_width_m / 2 + 0.2;
-  const int node = g->AddNode("lidar_driver");
-  g->Subscribe<PointCloudMsg>(
-      node, topics_.lidar_raw, "points_raw", 1,
-      [this](const PointCloudMsg& in, CallbackContext& ctx) {
-        PointCloudMsg out;
-        out.header = in.header;
-        out.points = algo::CropPoints(in.points, crop_);
-        ctx.ReportWork({static_cast<double>(in.points.size()), 0.0, 1});
-        ctx.Publish(points_, std::move(out));
+  const double front_m =
+      inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2 + 0.2;
+  const double half_width_m = inputs_.vehicle_width_m / 2 + 0.2;
+  const std::vector<algo::CropBox> self_box = {
+      {rear_m, front_m, -half_width_m, half_width_m, -0.5, 2.5}};
+  add_stage("crop_box_filter_self", "points", raw, self_cropped,
+            [self_box](const algo::Points& p) {
+              return algo::RemoveInsideBoxes(p, self_box);
+            });
+  // The side mirrors, beside the A-pillars, just outside the body.
+  const double mirror_x_m = inputs_.wheelbase_m * 0.55;
+  const std::vector<algo::CropBox> mirror_boxes = {
+      {mirror_x_m - 0.3, mirror_x_m + 0.3, half_width_m, half_width_m + 0.3,
+       0.8, 1.4},
+      {mirror_x_m - 0.3, mirror_x_m + 0.3, -half_width_m - 0.3, -half_width_m,
+       0.8, 1.4}};
+  add_stage("crop_box_filter_mirror", "points", self_cropped, mirror_cropped,
+            [mirror_boxes](const algo::Points& p) {
+              return algo::RemoveInsideBoxes(p, mirror_boxes);
+            });
+
+  // Distortion corrector: the sweep's motion from the newest odometry.
+  algo::DistortionParams distortion;
+  distortion.sweep_s = 1.0 / lidar.rate_hz;
+  const int corrector = add_stage(
+      "distortion_corrector", "points", mirror_cropped, rectified,
+      [this, distortion](const algo::Points& p) {
+        return algo::CorrectDistortion(p, corrector_twist_, distortion);
       });
+  g->Subscribe<OdometryMsg>(corrector, topics_.odometry, "twist", 1,
+                            [this](const OdometryMsg& in, CallbackContext&) {
+                              corrector_twist_ = {in.v_mps, in.yaw_rate_rps};
+                            });
+
+  algo::RingOutlierParams ring;
+  ring.beams = lidar.beams;
+  ring.fov_down_deg = lidar.vertical_fov_down_deg;
+  ring.fov_up_deg = lidar.vertical_fov_up_deg;
+  ring.sensor_height_m = lidar.mount_height_m;
+  add_stage("ring_outlier_filter", "points", rectified, points_,
+            [ring](const algo::Points& p) {
+              return algo::RemoveRingOutliers(p, ring);
+            });
 }
 
 Status Stack::BuildLocalization(Graph* g) {

@@ -104,7 +104,8 @@ int LidarSimulator::rays_per_scan() const {
 
 PointCloud LidarSimulator::Scan(
     const geometry::Pose2& sensor_pose, double stamp_s,
-    const std::vector<geometry::OrientedBox>& vehicles) {
+    const std::vector<geometry::OrientedBox>& vehicles,
+    const geometry::Twist2& motion) {
   PointCloud cloud;
   cloud.stamp_s = stamp_s;
   cloud.points.reserve(rays_per_scan());
@@ -172,8 +173,15 @@ PointCloud LidarSimulator::Scan(
     in_view_.push_back(v);
   }
 
+  const bool moving = motion.v_mps != 0.0 || motion.yaw_rate_rps != 0.0;
+  const double sweep_s = params_.rate_hz > 0.0 ? 1.0 / params_.rate_hz : 0.0;
   for (int j = 0; j < columns; ++j) {
     const double ca = azimuth_cos_[j], sa = azimuth_sin_[j];
+    // The sensor's pose when it senses this column, in the start frame.
+    const geometry::Pose2 moved =
+        moving ? geometry::MotionAfter(motion, sweep_s * j / columns)
+               : geometry::Pose2{};
+    const double mc = std::cos(moved.yaw_rad), ms = std::sin(moved.yaw_rad);
     // World-frame horizontal direction of this column.
     const double wx = cy * ca - sy * sa;
     const double wy = sy * ca + cy * sa;
@@ -246,8 +254,10 @@ PointCloud LidarSimulator::Scan(
       // A real sensor reports nothing beyond its range (or behind itself).
       if (r <= 0.0 || r > limit) continue;
       const double ce = elevation_cos_[i], se = elevation_sin_[i];
-      cloud.points.emplace_back(static_cast<float>(r * ce * ca),
-                                static_cast<float>(r * ce * sa),
+      // Start frame to the frame of this column's moment.
+      const double px = r * ce * ca - moved.x_m, py = r * ce * sa - moved.y_m;
+      cloud.points.emplace_back(static_cast<float>(mc * px + ms * py),
+                                static_cast<float>(-ms * px + mc * py),
                                 static_cast<float>(r * se));
     }
   }

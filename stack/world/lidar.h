@@ -48,12 +48,21 @@ class LidarSimulator {
   LidarSimulator(const Scene* scene, const LidarParams& params, Weather weather,
                  uint64_t seed);
 
-  // One full revolution from `sensor_pose` (at mount height) at time
+  // One full revolution from `sensor_pose` (at mount height) starting at
   // `stamp_s`, seeing the static scene, the ground and `vehicles`.
   // `vehicles` should not hold the ego: a box containing the sensor is
   // ignored, but one below it would show its roof.
+  //
+  // `motion` is the carrier's twist during the sweep. Column j is sensed
+  // j / azimuths() of a revolution (1 / rate_hz) after the start, and its
+  // points are given in the sensor frame of that moment, as a real
+  // spinning sensor reports them: the scan is distorted by the motion.
+  // The rays are cast from the start pose; at 30 km/h and 10 Hz the
+  // sensor moves 0.8 m in a revolution, and the surface points this
+  // shifts are a second-order effect the frame change does not model.
   PointCloud Scan(const geometry::Pose2& sensor_pose, double stamp_s,
-                  const std::vector<geometry::OrientedBox>& vehicles);
+                  const std::vector<geometry::OrientedBox>& vehicles,
+                  const geometry::Twist2& motion = {});
 
   const LidarParams& params() const { return params_; }
   int rays_per_scan() const;

@@ -115,5 +115,21 @@ TEST(Path2Test, RepeatedPointsAndDegenerateInputs) {
   EXPECT_EQ(one.MaxGap(), 0.0);
 }
 
+TEST(MotionAfter, StraightLineAndQuarterCircle) {
+  const Pose2 straight = MotionAfter({10.0, 0.0}, 0.1);
+  EXPECT_NEAR(straight.x_m, 1.0, 1e-12);
+  EXPECT_EQ(straight.y_m, 0.0);
+  EXPECT_EQ(straight.yaw_rad, 0.0);
+  // Radius 5 m, a quarter turn: from (0, 0) heading +x to (5, 5) heading +y.
+  const double w = 0.5 * M_PI;
+  const Pose2 quarter = MotionAfter({5.0 * w, w}, 1.0);
+  EXPECT_NEAR(quarter.x_m, 5.0, 1e-9);
+  EXPECT_NEAR(quarter.y_m, 5.0, 1e-9);
+  EXPECT_NEAR(quarter.yaw_rad, w, 1e-12);
+  // Turning right mirrors it.
+  const Pose2 right = MotionAfter({5.0 * w, -w}, 1.0);
+  EXPECT_NEAR(right.y_m, -5.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace adse::geometry

@@ -472,5 +472,37 @@ TEST(LidarTest, PointsAreInTheSensorFrameOfARotatedPose) {
   EXPECT_GT(left, 20);
 }
 
+TEST(LidarTest, MotionDuringTheSweepDistortsLaterColumns) {
+  // A ring wall of radius 20 m around the sensor. Driving at 10 m/s, the
+  // sensor has moved 1 m by the last column of a 10 Hz sweep, so the wall
+  // behind-right of the start (sensed last) appears 1 m farther back, while
+  // the first column (straight ahead) is unchanged.
+  Scene scene;
+  for (int k = 0; k < 72; ++k) {
+    const double a0 = k * 5 * kDeg, a1 = (k + 1) * 5 * kDeg;
+    scene.AddObstacle(Wall({20 * std::cos(a0), 20 * std::sin(a0)},
+                           {20 * std::cos(a1), 20 * std::sin(a1)}, 6.0));
+  }
+  scene.Finalize();
+  LidarSimulator still(&scene, NoiselessParams(), Weather::kClear, 1);
+  LidarSimulator moving(&scene, NoiselessParams(), Weather::kClear, 1);
+  const PointCloud a = still.Scan({0, 0, 0}, 0.0, {});
+  const PointCloud b = moving.Scan({0, 0, 0}, 0.0, {}, {10.0, 0.0});
+  ASSERT_EQ(a.points.size(), b.points.size());
+  // Column j of 900 is sensed j/900 of 0.1 s in: the sensor is 1.0 * j/900
+  // m ahead, so every point shifts by that much backwards along x.
+  const size_t per_column = a.points.size() / 900;
+  ASSERT_EQ(per_column * 900, a.points.size());  // the wall closes the ring
+  for (size_t i = 0; i < a.points.size(); i += 97) {
+    const double moved = 1.0 * static_cast<double>(i / per_column) / 900.0;
+    EXPECT_NEAR(b.points[i].x(), a.points[i].x() - moved, 1e-4) << i;
+    EXPECT_NEAR(b.points[i].y(), a.points[i].y(), 1e-4) << i;
+    EXPECT_EQ(b.points[i].z(), a.points[i].z()) << i;
+  }
+  // No motion: bit for bit the still scan.
+  LidarSimulator zero(&scene, NoiselessParams(), Weather::kClear, 1);
+  EXPECT_EQ(zero.Scan({0, 0, 0}, 0.0, {}, {}).points, a.points);
+}
+
 }  // namespace
 }  // namespace adse::world
