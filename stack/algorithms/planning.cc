@@ -20,28 +20,13 @@ size_t SegmentIndex(const geometry::Path2& path, double s) {
 
 }  // namespace
 
-void BehaviorVelocityPlanner::SetPath(const geometry::Path2& path,
-                                      std::optional<Eigen::Vector2d> goal) {
-  path_ = path;
-  if (path_.s_m.size() != path_.points.size()) path_.UpdateArcLength();
-  has_progress_ = false;
-  last_s_m_ = 0.0;
-  goal_s_m_ = path_.length_m();
-  if (goal && has_path()) {
-    double lateral = 0.0, distance = 0.0;
-    goal_s_m_ = Project(*goal, 0.0, path_.length_m(), path_.length_m(),
-                        &lateral, &distance);
-  }
-}
-
-double BehaviorVelocityPlanner::Project(const Eigen::Vector2d& p, double s_lo,
-                                        double s_hi, double s_ref,
-                                        double* lateral_m,
-                                        double* distance_m) const {
-  s_lo = std::clamp(s_lo, 0.0, path_.length_m());
-  s_hi = std::clamp(s_hi, s_lo, path_.length_m());
-  const size_t i_lo = SegmentIndex(path_, s_lo);
-  const size_t i_hi = SegmentIndex(path_, s_hi);
+double ProjectOnPath(const geometry::Path2& path, const Eigen::Vector2d& p,
+                     double s_lo, double s_hi, double s_ref, double* lateral_m,
+                     double* distance_m) {
+  s_lo = std::clamp(s_lo, 0.0, path.length_m());
+  s_hi = std::clamp(s_hi, s_lo, path.length_m());
+  const size_t i_lo = SegmentIndex(path, s_lo);
+  const size_t i_hi = SegmentIndex(path, s_hi);
   struct Candidate {
     double distance, s, lateral;
   };
@@ -49,24 +34,24 @@ double BehaviorVelocityPlanner::Project(const Eigen::Vector2d& p, double s_lo,
   per_segment.reserve(i_hi - i_lo + 1);
   double best = std::numeric_limits<double>::infinity();
   for (size_t i = i_lo; i <= i_hi; ++i) {
-    const Eigen::Vector2d a = path_.points[i];
-    const Eigen::Vector2d ab = path_.points[i + 1] - a;
-    const double len = path_.s_m[i + 1] - path_.s_m[i];
+    const Eigen::Vector2d a = path.points[i];
+    const Eigen::Vector2d ab = path.points[i + 1] - a;
+    const double len = path.s_m[i + 1] - path.s_m[i];
     // Only the part of the segment inside [s_lo, s_hi].
     double t_lo = 0.0, t_hi = 1.0;
     if (len > 0.0) {
-      t_lo = std::clamp((s_lo - path_.s_m[i]) / len, 0.0, 1.0);
-      t_hi = std::clamp((s_hi - path_.s_m[i]) / len, 0.0, 1.0);
+      t_lo = std::clamp((s_lo - path.s_m[i]) / len, 0.0, 1.0);
+      t_hi = std::clamp((s_hi - path.s_m[i]) / len, 0.0, 1.0);
     }
     const double ab2 = ab.squaredNorm();
     double t = ab2 > 0.0 ? (p - a).dot(ab) / ab2 : 0.0;
     t = std::clamp(t, t_lo, t_hi);
     const Eigen::Vector2d r = p - (a + t * ab);
-    Candidate c{r.norm(), path_.s_m[i] + t * len, 0.0};
+    Candidate c{r.norm(), path.s_m[i] + t * len, 0.0};
     const Eigen::Vector2d dir =
         ab2 > 0.0 ? Eigen::Vector2d(ab / std::sqrt(ab2))
-                  : Eigen::Vector2d(std::cos(path_.HeadingAt(c.s)),
-                                    std::sin(path_.HeadingAt(c.s)));
+                  : Eigen::Vector2d(std::cos(path.HeadingAt(c.s)),
+                                    std::sin(path.HeadingAt(c.s)));
     c.lateral =
         dir.x() * r.y() - dir.y() * r.x() >= 0 ? c.distance : -c.distance;
     best = std::min(best, c.distance);
@@ -100,126 +85,185 @@ double BehaviorVelocityPlanner::Project(const Eigen::Vector2d& p, double s_lo,
   return chosen.s;
 }
 
-double BehaviorVelocityPlanner::CurvatureAt(double s) const {
+void PathPlanner::SetRoute(const geometry::Path2& route,
+                           std::optional<Eigen::Vector2d> goal) {
+  route_ = route;
+  if (route_.s_m.size() != route_.points.size()) route_.UpdateArcLength();
+  has_progress_ = false;
+  last_s_m_ = 0.0;
+  goal_s_m_ = route_.length_m();
+  if (goal && has_route()) {
+    double lateral = 0.0, distance = 0.0;
+    goal_s_m_ = ProjectOnPath(route_, *goal, 0.0, route_.length_m(),
+                              route_.length_m(), &lateral, &distance);
+  }
+}
+
+double PathPlanner::CurvatureAt(double s) const {
   // Curvature of the circle through three path points spaced over the
   // window (Menger curvature): smooth across polyline vertices, where the
   // tangent heading jumps, and right for a circle sampled by chords.
   const double half = 0.5 * std::max(params_.curvature_window_m, 1e-3);
   const double lo = std::max(0.0, s - half);
-  const double hi = std::min(path_.length_m(), s + half);
+  const double hi = std::min(route_.length_m(), s + half);
   if (hi - lo < 1e-6) return 0.0;
-  const Eigen::Vector2d a = path_.PointAt(lo);
-  const Eigen::Vector2d b = path_.PointAt(0.5 * (lo + hi));
-  const Eigen::Vector2d c = path_.PointAt(hi);
+  const Eigen::Vector2d a = route_.PointAt(lo);
+  const Eigen::Vector2d b = route_.PointAt(0.5 * (lo + hi));
+  const Eigen::Vector2d c = route_.PointAt(hi);
   const Eigen::Vector2d ab = b - a, ac = c - a;
   const double denom = ab.norm() * (c - b).norm() * ac.norm();
   if (denom < 1e-12) return 0.0;
   return 2.0 * (ab.x() * ac.y() - ab.y() * ac.x()) / denom;
 }
 
-PlannedTrajectory BehaviorVelocityPlanner::Plan(
-    const geometry::Pose2& pose,
-    const std::vector<PlannerObstacle>& obstacles) {
-  PlannedTrajectory out;
-  if (!has_path()) return out;
+PlannedPath PathPlanner::Plan(const geometry::Pose2& pose) {
+  PlannedPath out;
+  if (!has_route()) return out;
   const Eigen::Vector2d ego(pose.x_m, pose.y_m);
-  const double length = path_.length_m();
+  const double length = route_.length_m();
 
-  // Ego projection: near the last one while it fits, else the whole path.
+  // Ego projection: near the last one while it fits, else the whole route.
   double lateral = 0.0, distance = 0.0;
   double s = 0.0;
   bool searched_globally = !has_progress_;
   if (has_progress_) {
-    s = Project(ego, last_s_m_ - params_.projection_back_m,
-                last_s_m_ + params_.projection_ahead_m, last_s_m_, &lateral,
-                &distance);
+    s = ProjectOnPath(route_, ego, last_s_m_ - params_.projection_back_m,
+                      last_s_m_ + params_.projection_ahead_m, last_s_m_,
+                      &lateral, &distance);
     if (distance > params_.reacquire_distance_m) searched_globally = true;
   }
   if (searched_globally) {
-    s = Project(ego, 0.0, length, has_progress_ ? last_s_m_ : 0.0, &lateral,
-                &distance);
+    s = ProjectOnPath(route_, ego, 0.0, length, has_progress_ ? last_s_m_ : 0.0,
+                      &lateral, &distance);
   }
   // Monotone progress: small backward jitter of the pose does not move the
-  // trajectory start back (a re-acquisition may).
+  // path start back (a re-acquisition may).
   if (has_progress_ && !searched_globally) s = std::max(s, last_s_m_);
   last_s_m_ = s;
   has_progress_ = true;
   out.ego_s_m = s;
   out.lateral_offset_m = lateral;
-  int64_t work = 0;
+  out.ends_at_goal = goal_s_m_ <= s + params_.horizon_m;
 
-  const double end_s = std::min({s + params_.horizon_m, goal_s_m_, length});
-  if (goal_s_m_ <= s + params_.horizon_m) {
-    out.stop_for_goal = true;
-    out.stop_s_m = goal_s_m_;
-  }
-
-  // The nearest obstacle blocking the corridor between the ego and the
-  // trajectory end sets a stop point before it.
-  double obstacle_stop_s = std::numeric_limits<double>::infinity();
-  for (const PlannerObstacle& ob : obstacles) {
-    if (!ob.position.allFinite()) continue;
-    double ob_lateral = 0.0, ob_distance = 0.0;
-    const double ob_s = Project(ob.position, s - params_.ego_front_m,
-                                end_s + 10.0, s, &ob_lateral, &ob_distance);
-    work += 1 + static_cast<int64_t>((end_s - s) /
-                                     std::max(0.1, params_.spacing_m));
-    // The box's half extents across and along the path at that point.
-    const double rel = ob.yaw_rad - path_.HeadingAt(ob_s);
-    const double cr = std::abs(std::cos(rel)), sr = std::abs(std::sin(rel));
-    const double half_across = 0.5 * (ob.length_m * sr + ob.width_m * cr);
-    const double half_along = 0.5 * (ob.length_m * cr + ob.width_m * sr);
-    if (ob_distance - half_across > params_.corridor_half_width_m) continue;
-    if (ob_s + half_along < s) continue;  // behind the rear axle
-    const double stop =
-        ob_s - half_along - params_.stop_margin_m - params_.ego_front_m;
-    if (stop < obstacle_stop_s) {
-      obstacle_stop_s = stop;
-      out.obstacle_id = ob.id;
-    }
-  }
-  if (obstacle_stop_s <= end_s) {
-    out.stop_for_obstacle = true;
-    out.stop_s_m = out.stop_for_goal ? std::min(out.stop_s_m, obstacle_stop_s)
-                                     : obstacle_stop_s;
-  } else {
-    out.obstacle_id = -1;
-  }
-
-  // Sample arc lengths: regular spacing, the end, and the obstacle stop
-  // point exactly (so v reaches 0 there, not up to one spacing later).
-  std::vector<double> samples;
+  const double end_s =
+      std::max(s, std::min({s + params_.horizon_m, goal_s_m_, length}));
   const double step = std::max(params_.spacing_m, 0.05);
+  std::vector<double> samples;
   for (double si = s; si < end_s - 1e-6; si += step) samples.push_back(si);
-  samples.push_back(std::max(end_s, s));
-  if (out.stop_for_obstacle && obstacle_stop_s > s && obstacle_stop_s < end_s) {
-    samples.push_back(obstacle_stop_s);
-    std::sort(samples.begin(), samples.end());
-    samples.erase(std::unique(samples.begin(), samples.end(),
-                              [](double a, double b) { return b - a < 1e-3; }),
-                  samples.end());
-  }
+  samples.push_back(end_s);
   out.points.reserve(samples.size());
   for (double si : samples) {
     PlannedPoint pt;
-    const Eigen::Vector2d p = path_.PointAt(si);
+    const Eigen::Vector2d p = route_.PointAt(si);
     pt.x_m = p.x();
     pt.y_m = p.y();
-    pt.yaw_rad = path_.HeadingAt(si);
+    pt.yaw_rad = route_.HeadingAt(si);
     pt.s_m = si;
     pt.curvature_1pm = CurvatureAt(si);
-    double v = params_.speed_limit_mps;
-    const double k = std::abs(pt.curvature_1pm);
-    if (k > 1e-9) {
-      const double v_curve = std::sqrt(params_.max_lateral_accel_mps2 / k);
-      v = std::min(v, std::max(v_curve, params_.min_curve_speed_mps));
-    }
-    if (out.stop_for_goal && si >= goal_s_m_ - 1e-6) v = 0.0;
-    if (out.stop_for_obstacle && si >= obstacle_stop_s - 1e-6) v = 0.0;
-    pt.v_mps = std::max(0.0, v);
+    pt.v_mps = params_.speed_limit_mps;
     out.points.push_back(pt);
   }
-  out.work_units = work + static_cast<int64_t>(out.points.size());
+  out.work_units = static_cast<int64_t>(out.points.size());
+  return out;
+}
+
+int64_t LimitVelocity(std::vector<PlannedPoint>* points, bool ends_at_goal,
+                      const VelocityLimitParams& params) {
+  if (points == nullptr || points->empty()) return 0;
+  for (PlannedPoint& pt : *points) {
+    const double k = std::abs(pt.curvature_1pm);
+    if (k > 1e-9) {
+      const double v_curve = std::sqrt(params.max_lateral_accel_mps2 / k);
+      pt.v_mps =
+          std::min(pt.v_mps, std::max(v_curve, params.min_curve_speed_mps));
+    }
+    pt.v_mps = std::max(0.0, pt.v_mps);
+  }
+  if (ends_at_goal) points->back().v_mps = 0.0;
+  return static_cast<int64_t>(points->size());
+}
+
+ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
+                                const std::vector<PlannerObstacle>& obstacles,
+                                const ObstacleStopParams& params) {
+  ObstacleStop out;
+  if (points == nullptr || points->empty()) return out;
+  std::vector<PlannedPoint>& pts = *points;
+  const double s0 = pts.front().s_m;
+  const double end_s = pts.back().s_m;
+  // The path as a polyline, extended straight back to the rear of the
+  // search window and on past its end, with arc lengths offset to the
+  // route's.
+  geometry::Path2 path;
+  const auto heading = [](double yaw) {
+    return Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
+  };
+  const double back_m = params.ego_front_m;
+  path.points.push_back(Eigen::Vector2d(pts.front().x_m, pts.front().y_m) -
+                        back_m * heading(pts.front().yaw_rad));
+  for (const PlannedPoint& p : pts) path.points.emplace_back(p.x_m, p.y_m);
+  path.points.push_back(Eigen::Vector2d(pts.back().x_m, pts.back().y_m) +
+                        params.beyond_end_m * heading(pts.back().yaw_rad));
+  path.UpdateArcLength();
+  const double offset = s0 - back_m;  // route s of the polyline's start
+
+  double stop_s = std::numeric_limits<double>::infinity();
+  double near_edge_s = 0.0;
+  for (const PlannerObstacle& ob : obstacles) {
+    if (!ob.position.allFinite()) continue;
+    out.work_units += 1 + static_cast<int64_t>(pts.size());
+    double ob_lateral = 0.0, ob_distance = 0.0;
+    const double local_s =
+        ProjectOnPath(path, ob.position, 0.0, path.length_m(), back_m,
+                      &ob_lateral, &ob_distance);
+    const double ob_s = local_s + offset;
+    // The box's half extents across and along the path at that point.
+    const double rel = ob.yaw_rad - path.HeadingAt(local_s);
+    const double cr = std::abs(std::cos(rel)), sr = std::abs(std::sin(rel));
+    const double half_across = 0.5 * (ob.length_m * sr + ob.width_m * cr);
+    const double half_along = 0.5 * (ob.length_m * cr + ob.width_m * sr);
+    if (ob_distance - half_across > params.corridor_half_width_m) continue;
+    if (ob_s + half_along < s0) continue;  // behind the rear axle
+    const double stop =
+        ob_s - half_along - params.stop_margin_m - params.ego_front_m;
+    if (stop < stop_s) {
+      stop_s = stop;
+      near_edge_s = ob_s - half_along;
+      out.obstacle_id = ob.id;
+    }
+  }
+  if (stop_s > end_s) {
+    out.obstacle_id = -1;
+    return out;
+  }
+  out.stop = true;
+  out.stop_s_m = stop_s;
+  out.gap_m = near_edge_s - (s0 + params.ego_front_m);
+  // A point exactly at the stop line, so v reaches 0 there and not up to
+  // one spacing later.
+  if (stop_s > s0) {
+    auto it = std::lower_bound(
+        pts.begin(), pts.end(), stop_s,
+        [](const PlannedPoint& p, double s) { return p.s_m < s; });
+    if (it != pts.end() && it->s_m - stop_s > 1e-3 &&
+        stop_s - std::prev(it)->s_m > 1e-3) {
+      const PlannedPoint& a = *std::prev(it);
+      const PlannedPoint& b = *it;
+      const double t = (stop_s - a.s_m) / (b.s_m - a.s_m);
+      PlannedPoint q = a;
+      q.x_m = a.x_m + t * (b.x_m - a.x_m);
+      q.y_m = a.y_m + t * (b.y_m - a.y_m);
+      q.yaw_rad = t < 0.5 ? a.yaw_rad : b.yaw_rad;
+      q.curvature_1pm =
+          a.curvature_1pm + t * (b.curvature_1pm - a.curvature_1pm);
+      q.s_m = stop_s;
+      q.v_mps = std::min(a.v_mps, b.v_mps);
+      pts.insert(it, q);
+    }
+  }
+  for (PlannedPoint& p : pts) {
+    if (p.s_m >= stop_s - 1e-6) p.v_mps = 0.0;
+  }
   return out;
 }
 

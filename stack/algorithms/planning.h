@@ -1,5 +1,7 @@
-// Behaviour/velocity planning along the reference path, and the velocity
-// smoother. Eigen and std types only.
+// Planning along the route as Autoware splits it: the path ahead
+// (behavior_path_planner), speed limits on it (behavior_velocity_planner), a
+// stop before obstacles (obstacle_stop_planner) and the velocity smoother.
+// Eigen and std types only.
 #ifndef ADSE_STACK_ALGORITHMS_PLANNING_H_
 #define ADSE_STACK_ALGORITHMS_PLANNING_H_
 
@@ -32,20 +34,23 @@ struct PlannerObstacle {
   double yaw_rad = 0.0;
 };
 
-struct PlannerParams {
-  double horizon_m = 50.0;              // trajectory length ahead of the ego
-  double spacing_m = 1.0;               // distance between trajectory points
-  double speed_limit_mps = 8.33;        // 30 km/h
-  double max_lateral_accel_mps2 = 1.5;  // v <= sqrt(a_lat / |curvature|)
-  double min_curve_speed_mps = 1.0;     // curvature never asks for less
+// Nearest point of `path` to p over arc lengths [s_lo, s_hi]: returns its
+// s and sets the signed lateral offset (left positive) and the distance.
+// Passes of the path about as near as the nearest (laps, a U-turn's two
+// legs) are resolved towards s_ref, so near-ties do not flip between them.
+double ProjectOnPath(const geometry::Path2& path, const Eigen::Vector2d& p,
+                     double s_lo, double s_hi, double s_ref, double* lateral_m,
+                     double* distance_m);
+
+// --- behavior_path_planner: the reference path ahead of the ego ---------
+
+struct PathPlannerParams {
+  double horizon_m = 50.0;        // path length ahead of the ego
+  double spacing_m = 1.0;         // distance between path points
+  double speed_limit_mps = 8.33;  // the lane's limit (30 km/h)
   // Curvature of the circle through the path points at s - w/2, s and
   // s + w/2: smooths polylines whose vertices carry all the turning.
   double curvature_window_m = 4.0;
-  // Half width of the swept corridor: an obstacle whose box comes closer
-  // than this to the path blocks it.
-  double corridor_half_width_m = 1.4;
-  double stop_margin_m = 3.0;  // gap left between ego front and obstacle
-  double ego_front_m = 3.8;    // rear axle to front bumper
   // Projection of the ego on the path searches this window around the
   // last projection (paths may loop or pass close to themselves).
   double projection_back_m = 2.0;
@@ -54,53 +59,86 @@ struct PlannerParams {
   double reacquire_distance_m = 5.0;
 };
 
-struct PlannedTrajectory {
-  std::vector<PlannedPoint> points;  // from the ego's projection onwards
-  bool stop_for_goal = false;        // the goal is within the horizon
-  bool stop_for_obstacle = false;    // an obstacle blocks within it
-  int obstacle_id = -1;              // the blocking obstacle, if any
-  double stop_s_m = -1.0;            // where v becomes 0 (-1: nowhere)
-  double ego_s_m = 0.0;              // ego projection on the path
-  double lateral_offset_m = 0.0;     // ego from path, left positive
-  int64_t work_units = 0;            // points + obstacle projections
+struct PlannedPath {
+  std::vector<PlannedPoint> points;  // from the ego's projection onwards,
+                                     // at the lane's speed limit
+  bool ends_at_goal = false;         // the goal is within the horizon
+  double ego_s_m = 0.0;              // ego projection on the route
+  double lateral_offset_m = 0.0;     // ego from the route, left positive
+  int64_t work_units = 0;            // points
 };
 
-class BehaviorVelocityPlanner {
+class PathPlanner {
  public:
-  explicit BehaviorVelocityPlanner(const PlannerParams& params = {})
+  explicit PathPlanner(const PathPlannerParams& params = {})
       : params_(params) {}
 
-  // A new reference path; progress restarts. The goal is projected on the
-  // path (default: its end) and the ego stops there.
-  void SetPath(const geometry::Path2& path,
-               std::optional<Eigen::Vector2d> goal = std::nullopt);
-  bool has_path() const { return path_.points.size() >= 2; }
+  // A new route; progress restarts. The goal is projected on the route
+  // (default: its end) and the path ends there.
+  void SetRoute(const geometry::Path2& route,
+                std::optional<Eigen::Vector2d> goal = std::nullopt);
+  bool has_route() const { return route_.points.size() >= 2; }
   double goal_s_m() const { return goal_s_m_; }
 
-  // Trajectory ahead of `pose` (rear axle, map frame) with raw target
-  // speeds (steps to 0 at stops; SmoothVelocity makes them drivable).
-  // Empty without a path.
-  PlannedTrajectory Plan(const geometry::Pose2& pose,
-                         const std::vector<PlannerObstacle>& obstacles);
+  // The path ahead of `pose` (rear axle, map frame), sampled every
+  // spacing_m with the curvature at each point. Empty without a route.
+  PlannedPath Plan(const geometry::Pose2& pose);
 
-  // Progress along the path (never decreases until SetPath).
+  // Progress along the route (never decreases until SetRoute).
   double progress_s_m() const { return last_s_m_; }
-  const PlannerParams& params() const { return params_; }
+  const PathPlannerParams& params() const { return params_; }
 
  private:
-  // Nearest path point to p over arc lengths [s_lo, s_hi]; returns its s
-  // and the signed lateral offset (left positive) and distance. Passes of
-  // the path about as near as the nearest are resolved towards s_ref.
-  double Project(const Eigen::Vector2d& p, double s_lo, double s_hi,
-                 double s_ref, double* lateral_m, double* distance_m) const;
   double CurvatureAt(double s) const;
 
-  PlannerParams params_;
-  geometry::Path2 path_;
+  PathPlannerParams params_;
+  geometry::Path2 route_;
   double goal_s_m_ = 0.0;
   double last_s_m_ = 0.0;
   bool has_progress_ = false;
 };
+
+// --- behavior_velocity_planner: speed limits along the path -------------
+
+struct VelocityLimitParams {
+  double max_lateral_accel_mps2 = 1.5;  // v <= sqrt(a_lat / |curvature|)
+  double min_curve_speed_mps = 1.0;     // curvature never asks for less
+};
+
+// Lowers each point's speed to what its curvature allows and, when the
+// path ends at the goal, sets 0 at its last point. Returns work units
+// (points).
+int64_t LimitVelocity(std::vector<PlannedPoint>* points, bool ends_at_goal,
+                      const VelocityLimitParams& params);
+
+// --- obstacle_stop_planner: a stop before what blocks the path ----------
+
+struct ObstacleStopParams {
+  // Half width of the swept corridor: an obstacle whose box comes closer
+  // than this to the path blocks it.
+  double corridor_half_width_m = 1.4;
+  double stop_margin_m = 3.0;  // gap left between ego front and obstacle
+  double ego_front_m = 3.8;    // rear axle to front bumper
+  // Obstacles are looked for from the ego's front bumper back to the rear
+  // axle (ego_front_m behind the path's start) up to this far past its end.
+  double beyond_end_m = 10.0;
+};
+
+struct ObstacleStop {
+  bool stop = false;     // an obstacle blocks the path
+  int obstacle_id = -1;  // the nearest blocking obstacle
+  double stop_s_m = -1;  // where v becomes 0 (rear axle), -1: nowhere
+  // From the ego's front bumper to the obstacle's near edge, along the path.
+  double gap_m = -1;
+  int64_t work_units = 0;  // obstacles x points
+};
+
+// Finds the nearest obstacle whose box enters the corridor along `points`
+// (a path from the ego onwards), inserts a point exactly at the stop line
+// stop_margin_m before it, and sets 0 from there on.
+ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
+                                const std::vector<PlannerObstacle>& obstacles,
+                                const ObstacleStopParams& params);
 
 struct SmootherParams {
   double max_accel_mps2 = 1.0;  // forward pass: speed-up limit

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <functional>
 #include <optional>
 
@@ -25,6 +26,8 @@ namespace algo = adse::algorithms;
 // speed-up on the virtual platform is this model, not a measurement.
 constexpr double kNdtParallelFraction = 0.85;
 constexpr double kClusteringParallelFraction = 0.6;
+// Odometry samples the distortion corrector keeps (2 s at 50 Hz).
+constexpr size_t kTwistHistory = 100;
 // Braking asked for while there is no valid pose to steer by.
 constexpr double kNoPoseDecelMps2 = 3.0;
 
@@ -41,7 +44,18 @@ std::vector<algo::PlannedPoint> ToPlanned(
     q.yaw_rad = p.yaw_rad;
     q.s_m = p.s_m;
     q.v_mps = std::min(p.v_mps, max_v_mps);
+    q.curvature_1pm = p.curvature_1pm;
     out.push_back(q);
+  }
+  return out;
+}
+
+std::vector<TrajectoryPoint> ToMessage(
+    const std::vector<algo::PlannedPoint>& points) {
+  std::vector<TrajectoryPoint> out;
+  out.reserve(points.size());
+  for (const algo::PlannedPoint& p : points) {
+    out.push_back({p.x_m, p.y_m, p.yaw_rad, p.s_m, p.v_mps, p.curvature_1pm});
   }
   return out;
 }
@@ -64,11 +78,12 @@ class Stack final : public AdStack {
   StackInputs inputs_;
   StackTopics topics_;
   int points_ = -1, downsampled_ = -1, ndt_pose_ = -1, obstacle_points_ = -1,
-      detections_ = -1, route_ = -1, trajectory_raw_ = -1;
+      detections_ = -1, route_ = -1, path_ = -1, path_limited_ = -1,
+      trajectory_raw_ = -1;
 
   // Node state. Callbacks of one node never overlap (the executor's
   // mutual exclusion), so none of this needs locking.
-  geometry::Twist2 corrector_twist_;  // newest odometry, for the sweep
+  std::deque<OdometryMsg> corrector_twists_;  // newest odometry samples
   std::unique_ptr<algo::NdtMatcher> ndt_;
   std::optional<PoseMsg> ndt_latest_ekf_;
   double ndt_latest_ekf_t_ = 0.0;  // when that EKF pose was received
@@ -79,10 +94,9 @@ class Stack final : public AdStack {
   std::optional<PoseMsg> ground_pose_;
   std::optional<PoseMsg> cluster_pose_;
   std::unique_ptr<algo::Tracker> tracker_;
-  std::unique_ptr<algo::BehaviorVelocityPlanner> planner_;
-  std::optional<PoseMsg> planner_pose_;
-  std::optional<ObjectsMsg> planner_objects_;
-  bool planner_has_route_ = false;
+  std::unique_ptr<algo::PathPlanner> path_planner_;
+  std::optional<PoseMsg> path_pose_;
+  std::optional<ObjectsMsg> stop_objects_;
   std::optional<PoseMsg> smoother_pose_;
   std::unique_ptr<algo::TrajectoryFollower> follower_;
   std::optional<PoseMsg> follower_pose_;
@@ -101,6 +115,8 @@ Status Stack::Build(Graph* g) {
   detections_ = g->AddTopic<ObjectsMsg>("/perception/detections");
   topics_.objects = g->AddTopic<ObjectsMsg>("/perception/objects");
   route_ = g->AddTopic<PathMsg>("/planning/route");
+  path_ = g->AddTopic<TrajectoryMsg>("/planning/path");
+  path_limited_ = g->AddTopic<TrajectoryMsg>("/planning/path_with_velocity");
   trajectory_raw_ = g->AddTopic<TrajectoryMsg>("/planning/trajectory_raw");
   topics_.trajectory = g->AddTopic<TrajectoryMsg>("/planning/trajectory");
   topics_.control = g->AddTopic<ControlMsg>("/control/command");
@@ -127,7 +143,7 @@ void Stack::BuildSensing(Graph* g) {
   auto add_stage = [g](const std::string& node_name,
                        const std::string& callback_name, int in_topic,
                        int out_topic,
-                       std::function<algo::Points(const algo::Points&)> run) {
+                       std::function<algo::Points(const PointCloudMsg&)> run) {
     const int node = g->AddNode(node_name);
     g->Subscribe<PointCloudMsg>(
         node, in_topic, callback_name, 1,
@@ -135,7 +151,7 @@ void Stack::BuildSensing(Graph* g) {
                                           CallbackContext& ctx) {
           PointCloudMsg out;
           out.header = in.header;
-          out.points = run(in.points);
+          out.points = run(in);
           ctx.ReportWork({static_cast<double>(in.points.size()), 0.0, 1});
           ctx.Publish(out_topic, std::move(out));
         });
@@ -148,9 +164,10 @@ void Stack::BuildSensing(Graph* g) {
   algo::CropParams window;
   window.max_range_m = lidar.range_m;
   window.remove_ego = false;
-  add_stage(
-      "lidar_driver", "points_raw", topics_.lidar_raw, raw,
-      [window](const algo::Points& p) { return algo::CropPoints(p, window); });
+  add_stage("lidar_driver", "points_raw", topics_.lidar_raw, raw,
+            [window](const PointCloudMsg& in) {
+              return algo::CropPoints(in.points, window);
+            });
 
   // Returns off our own body, from rear to front bumper with a margin.
   const double rear_m =
@@ -161,8 +178,8 @@ void Stack::BuildSensing(Graph* g) {
   const std::vector<algo::CropBox> self_box = {
       {rear_m, front_m, -half_width_m, half_width_m, -0.5, 2.5}};
   add_stage("crop_box_filter_self", "points", raw, self_cropped,
-            [self_box](const algo::Points& p) {
-              return algo::RemoveInsideBoxes(p, self_box);
+            [self_box](const PointCloudMsg& in) {
+              return algo::RemoveInsideBoxes(in.points, self_box);
             });
   // The side mirrors, beside the A-pillars, just outside the body.
   const double mirror_x_m = inputs_.wheelbase_m * 0.55;
@@ -172,21 +189,35 @@ void Stack::BuildSensing(Graph* g) {
       {mirror_x_m - 0.3, mirror_x_m + 0.3, -half_width_m - 0.3, -half_width_m,
        0.8, 1.4}};
   add_stage("crop_box_filter_mirror", "points", self_cropped, mirror_cropped,
-            [mirror_boxes](const algo::Points& p) {
-              return algo::RemoveInsideBoxes(p, mirror_boxes);
+            [mirror_boxes](const PointCloudMsg& in) {
+              return algo::RemoveInsideBoxes(in.points, mirror_boxes);
             });
 
-  // Distortion corrector: the sweep's motion from the newest odometry.
+  // Distortion corrector: the sweep's motion from the odometry sample
+  // nearest the sweep's middle. Like Autoware's, it queues the twists (a
+  // deeper queue, so a busy node still takes every sample in turn).
   algo::DistortionParams distortion;
   distortion.sweep_s = 1.0 / lidar.rate_hz;
   const int corrector = add_stage(
       "distortion_corrector", "points", mirror_cropped, rectified,
-      [this, distortion](const algo::Points& p) {
-        return algo::CorrectDistortion(p, corrector_twist_, distortion);
+      [this, distortion](const PointCloudMsg& in) {
+        const double middle_s = in.header.stamp_s + distortion.sweep_s / 2;
+        geometry::Twist2 twist;
+        double best_s = INFINITY;
+        for (const OdometryMsg& o : corrector_twists_) {
+          const double gap_s = std::abs(o.header.stamp_s - middle_s);
+          if (gap_s < best_s) {
+            best_s = gap_s;
+            twist = {o.v_mps, o.yaw_rate_rps};
+          }
+        }
+        return algo::CorrectDistortion(in.points, twist, distortion);
       });
-  g->Subscribe<OdometryMsg>(corrector, topics_.odometry, "twist", 1,
+  g->Subscribe<OdometryMsg>(corrector, topics_.odometry, "twist", 10,
                             [this](const OdometryMsg& in, CallbackContext&) {
-                              corrector_twist_ = {in.v_mps, in.yaw_rate_rps};
+                              corrector_twists_.push_back(in);
+                              if (corrector_twists_.size() > kTwistHistory)
+                                corrector_twists_.pop_front();
                             });
 
   algo::RingOutlierParams ring;
@@ -195,8 +226,8 @@ void Stack::BuildSensing(Graph* g) {
   ring.fov_up_deg = lidar.vertical_fov_up_deg;
   ring.sensor_height_m = lidar.mount_height_m;
   add_stage("ring_outlier_filter", "points", rectified, points_,
-            [ring](const algo::Points& p) {
-              return algo::RemoveRingOutliers(p, ring);
+            [ring](const PointCloudMsg& in) {
+              return algo::RemoveRingOutliers(in.points, ring);
             });
 }
 
@@ -405,35 +436,68 @@ void Stack::BuildPlanning(Graph* g) {
     ctx.Publish(route_, std::move(out));
   });
 
-  algo::PlannerParams params;
-  params.horizon_m = config_.Get("planning.horizon_m");
-  params.speed_limit_mps = inputs_.speed_limit_mps;
-  params.max_lateral_accel_mps2 =
-      config_.Get("planning.max_lateral_accel_mps2");
-  params.corridor_half_width_m = config_.Get("planning.corridor_half_width_m");
-  params.stop_margin_m = config_.Get("planning.stop_margin_m");
-  params.ego_front_m = inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2;
-  planner_ = std::make_unique<algo::BehaviorVelocityPlanner>(params);
-  const int node = g->AddNode("behavior_velocity_planner");
-  g->Subscribe<PathMsg>(node, route_, "route", 1,
+  // behavior_path_planner: the route ahead of the ego at the lane's limit.
+  algo::PathPlannerParams path_params;
+  path_params.horizon_m = config_.Get("planning.horizon_m");
+  path_params.speed_limit_mps = inputs_.speed_limit_mps;
+  path_planner_ = std::make_unique<algo::PathPlanner>(path_params);
+  const int path_node = g->AddNode("behavior_path_planner");
+  g->Subscribe<PathMsg>(path_node, route_, "route", 1,
                         [this](const PathMsg& in, CallbackContext&) {
-                          planner_->SetPath(in.path, in.path.points.back());
-                          planner_has_route_ = true;
+                          path_planner_->SetRoute(in.path,
+                                                  in.path.points.back());
                         });
   g->Subscribe<PoseMsg>(
-      node, topics_.pose, "pose", 1,
-      [this](const PoseMsg& in, CallbackContext&) { planner_pose_ = in; });
-  g->Subscribe<ObjectsMsg>(node, topics_.objects, "objects", 1,
-                           [this](const ObjectsMsg& in, CallbackContext&) {
-                             planner_objects_ = in;
-                           });
-  g->AddTimer(
-      node, "plan", 1.0 / config_.Get("planning.rate_hz"),
-      [this](CallbackContext& ctx) {
-        if (!planner_has_route_ || !planner_pose_) return;
+      path_node, topics_.pose, "pose", 1,
+      [this](const PoseMsg& in, CallbackContext&) { path_pose_ = in; });
+  g->AddTimer(path_node, "plan", 1.0 / config_.Get("planning.rate_hz"),
+              [this](CallbackContext& ctx) {
+                if (!path_planner_->has_route() || !path_pose_) return;
+                const algo::PlannedPath path =
+                    path_planner_->Plan(path_pose_->pose);
+                TrajectoryMsg out;
+                out.header.stamp_s = path_pose_->header.stamp_s;
+                out.ends_at_goal = path.ends_at_goal;
+                out.points = ToMessage(path.points);
+                ctx.ReportWork({static_cast<double>(path.work_units), 0.0, 1});
+                ctx.Publish(path_, std::move(out));
+              });
+
+  // behavior_velocity_planner: speed limits along the path, 0 at the goal.
+  algo::VelocityLimitParams limits;
+  limits.max_lateral_accel_mps2 =
+      config_.Get("planning.max_lateral_accel_mps2");
+  const int velocity_node = g->AddNode("behavior_velocity_planner");
+  g->Subscribe<TrajectoryMsg>(
+      velocity_node, path_, "path", 1,
+      [this, limits](const TrajectoryMsg& in, CallbackContext& ctx) {
+        std::vector<algo::PlannedPoint> points = ToPlanned(in.points);
+        const int64_t work =
+            algo::LimitVelocity(&points, in.ends_at_goal, limits);
+        TrajectoryMsg out = in;
+        out.points = ToMessage(points);
+        ctx.ReportWork({static_cast<double>(work), 0.0, 1});
+        ctx.Publish(path_limited_, std::move(out));
+      });
+
+  // obstacle_stop_planner: a stop before the nearest object in the path's
+  // corridor.
+  algo::ObstacleStopParams stop_params;
+  stop_params.corridor_half_width_m =
+      config_.Get("planning.corridor_half_width_m");
+  stop_params.stop_margin_m = config_.Get("planning.stop_margin_m");
+  stop_params.ego_front_m =
+      inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2;
+  const int stop_node = g->AddNode("obstacle_stop_planner");
+  g->Subscribe<ObjectsMsg>(
+      stop_node, topics_.objects, "objects", 1,
+      [this](const ObjectsMsg& in, CallbackContext&) { stop_objects_ = in; });
+  g->Subscribe<TrajectoryMsg>(
+      stop_node, path_limited_, "trajectory", 1,
+      [this, stop_params](const TrajectoryMsg& in, CallbackContext& ctx) {
         std::vector<algo::PlannerObstacle> obstacles;
-        if (planner_objects_) {
-          for (const TrackedObject& o : planner_objects_->objects) {
+        if (stop_objects_) {
+          for (const TrackedObject& o : stop_objects_->objects) {
             algo::PlannerObstacle ob;
             ob.id = o.id;
             ob.position = o.position;
@@ -443,16 +507,13 @@ void Stack::BuildPlanning(Graph* g) {
             obstacles.push_back(ob);
           }
         }
-        const algo::PlannedTrajectory plan =
-            planner_->Plan(planner_pose_->pose, obstacles);
-        TrajectoryMsg out;
-        out.header.stamp_s = planner_pose_->header.stamp_s;
-        out.stop_for_goal = plan.stop_for_goal;
-        out.stop_for_obstacle = plan.stop_for_obstacle;
-        for (const algo::PlannedPoint& p : plan.points) {
-          out.points.push_back({p.x_m, p.y_m, p.yaw_rad, p.s_m, p.v_mps});
-        }
-        ctx.ReportWork({static_cast<double>(plan.work_units), 0.0, 1});
+        std::vector<algo::PlannedPoint> points = ToPlanned(in.points);
+        const algo::ObstacleStop stop =
+            algo::InsertObstacleStop(&points, obstacles, stop_params);
+        TrajectoryMsg out = in;
+        out.points = ToMessage(points);
+        out.stop_for_obstacle = stop.stop;
+        ctx.ReportWork({static_cast<double>(stop.work_units), 0.0, 1});
         ctx.Publish(trajectory_raw_, std::move(out));
       });
 

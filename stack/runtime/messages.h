@@ -65,15 +65,16 @@ struct PathMsg {
 
 struct TrajectoryPoint {
   double x_m = 0.0, y_m = 0.0, yaw_rad = 0.0;
-  double s_m = 0.0;    // arc length along the reference path
-  double v_mps = 0.0;  // target speed at this point
+  double s_m = 0.0;            // arc length along the reference path
+  double v_mps = 0.0;          // target speed at this point
+  double curvature_1pm = 0.0;  // signed path curvature (left positive)
 };
 
 struct TrajectoryMsg {
   Header header;
   std::vector<TrajectoryPoint> points;
-  bool stop_for_goal = false;
-  bool stop_for_obstacle = false;
+  bool ends_at_goal = false;       // the path's last point is the goal
+  bool stop_for_obstacle = false;  // an obstacle stop was inserted
 };
 
 struct ControlMsg {

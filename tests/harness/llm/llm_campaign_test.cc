@@ -217,9 +217,11 @@ TEST(LlmCampaignTest,
       HasSubstr("Last point evaluated: cores=16,freq_ghz=2.1,lidar_hz=14"));
   EXPECT_THAT(second_step, HasSubstr("cheapest feasible"));
   // The deciphering agents' readings are compared with the analysis.
-  EXPECT_THAT(second_step, HasSubstr("diagnosis: cpu_bound lidar_driver"));
+  // (At 16 cores, 2.1 GHz and 14 Hz the single-threaded ground filter
+  // cannot keep up with the scans.)
+  EXPECT_THAT(second_step, HasSubstr("diagnosis: cpu_bound ground_filter"));
   EXPECT_THAT(second_step, HasSubstr("text agent (disagrees, not used): "));
-  EXPECT_THAT(second_step, HasSubstr("missed cpu_bound lidar_driver"));
+  EXPECT_THAT(second_step, HasSubstr("missed cpu_bound ground_filter"));
   EXPECT_THAT(second_step, HasSubstr("vision agent (agrees): a clean drive"));
 
   Result<runfile::CampaignIndex> index =

@@ -8,6 +8,7 @@
 
 #include "stack/algorithms/planning.h"
 #include "stack/world/vehicle_model.h"
+#include "tests/stack/algorithms/testing/planning_chain.h"
 
 namespace adse::algorithms {
 namespace {
@@ -107,12 +108,13 @@ TEST(Pid, ReachesTargetOnAFirstOrderPlant) {
 // Closed loop: planner + smoother + follower driving a kinematic bicycle.
 struct Sim {
   world::BicycleModel car{world::VehicleLimits()};
-  BehaviorVelocityPlanner planner;
+  PathPlanner planner;
+  ObstacleStopParams stop;
   TrajectoryFollower follower;
   SmootherParams smoother;
   double max_lat_error_after_settle = 0.0;
 
-  explicit Sim(const PlannerParams& planner_params = {},
+  explicit Sim(const PathPlannerParams& planner_params = {},
                const FollowerParams& follower_params = {})
       : planner(planner_params), follower(follower_params) {}
 
@@ -123,10 +125,10 @@ struct Sim {
   void Run(double duration_s, const std::vector<PlannerObstacle>& obstacles,
            const std::function<void(double, const FollowerCommand&)>& check) {
     const double dt = 0.02;
-    PlannedTrajectory traj;
+    testing::ChainedPlan traj;
     for (int k = 0; k * dt < duration_s; ++k) {
       if (k % 5 == 0) {
-        traj = planner.Plan(Pose(), obstacles);
+        traj = testing::PlanChain(&planner, Pose(), obstacles, {}, stop);
         SmoothVelocity(&traj.points, car.state().v_mps, smoother);
       }
       const FollowerCommand cmd =
@@ -146,10 +148,10 @@ TEST(TrajectoryFollower, TracksACircleOfRadius20) {
     path.points.emplace_back(r * std::cos(a), r + r * std::sin(a));
   }
   path.UpdateArcLength();
-  PlannerParams pp;
+  PathPlannerParams pp;
   pp.speed_limit_mps = 5.0;
   Sim sim(pp);
-  sim.planner.SetPath(path);
+  sim.planner.SetRoute(path);
   world::VehicleState start;
   start.x_m = 0.0;
   start.y_m = 0.5;  // starts half a metre inside the circle
@@ -172,7 +174,7 @@ TEST(TrajectoryFollower, StopsAtGoalAndHolds) {
   for (double x = 0; x <= 40; x += 2) path.points.emplace_back(x, 0);
   path.UpdateArcLength();
   Sim sim;
-  sim.planner.SetPath(path);
+  sim.planner.SetRoute(path);
   sim.car.Reset(world::VehicleState{});
   bool stopping_at_end = false;
   sim.Run(40.0, {}, [&](double, const FollowerCommand& cmd) {
@@ -189,7 +191,7 @@ TEST(TrajectoryFollower, StopsBeforeObstacleWithMargin) {
   for (double x = 0; x <= 200; x += 5) path.points.emplace_back(x, 0);
   path.UpdateArcLength();
   Sim sim;
-  sim.planner.SetPath(path);
+  sim.planner.SetRoute(path);
   sim.car.Reset(world::VehicleState{});
   PlannerObstacle car;
   car.position = {60.0, 0.0};
@@ -199,7 +201,7 @@ TEST(TrajectoryFollower, StopsBeforeObstacleWithMargin) {
   sim.Run(40.0, {car}, [&](double, const FollowerCommand&) {
     max_x = std::max(max_x, sim.car.state().x_m);
   });
-  const PlannerParams& p = sim.planner.params();
+  const ObstacleStopParams& p = sim.stop;
   const double front_limit = 60.0 - 2.25 - p.stop_margin_m;
   EXPECT_LE(max_x + p.ego_front_m, front_limit + 0.3);  // small overshoot
   EXPECT_GT(max_x + p.ego_front_m, front_limit - 1.5);  // but got close

@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "tests/stack/algorithms/testing/planning_chain.h"
+
 namespace adse::algorithms {
 namespace {
 
@@ -32,67 +34,76 @@ PlannerObstacle Car(int id, double x, double y) {
   return ob;
 }
 
-TEST(BehaviorVelocityPlanner, FreeRoadAtSpeedLimit) {
-  BehaviorVelocityPlanner planner;
-  planner.SetPath(Straight(200, 5));
-  const PlannedTrajectory traj =
-      planner.Plan(geometry::Pose2{10.2, 0.3, 0}, {});
-  ASSERT_EQ(traj.points.size(), 51u);
-  EXPECT_NEAR(traj.ego_s_m, 10.2, 1e-9);
-  EXPECT_NEAR(traj.lateral_offset_m, 0.3, 1e-9);
-  EXPECT_NEAR(traj.points.front().s_m, 10.2, 1e-9);
-  EXPECT_NEAR(traj.points.back().s_m, 60.2, 1e-9);
-  EXPECT_NEAR(traj.points[5].x_m, 15.2, 1e-9);
-  EXPECT_FALSE(traj.stop_for_goal);
-  EXPECT_FALSE(traj.stop_for_obstacle);
-  for (const PlannedPoint& p : traj.points) {
+TEST(PathPlanner, FreeRoadAtSpeedLimit) {
+  PathPlanner planner;
+  planner.SetRoute(Straight(200, 5));
+  const PlannedPath path = planner.Plan(geometry::Pose2{10.2, 0.3, 0});
+  ASSERT_EQ(path.points.size(), 51u);
+  EXPECT_NEAR(path.ego_s_m, 10.2, 1e-9);
+  EXPECT_NEAR(path.lateral_offset_m, 0.3, 1e-9);
+  EXPECT_NEAR(path.points.front().s_m, 10.2, 1e-9);
+  EXPECT_NEAR(path.points.back().s_m, 60.2, 1e-9);
+  EXPECT_NEAR(path.points[5].x_m, 15.2, 1e-9);
+  EXPECT_FALSE(path.ends_at_goal);
+  for (const PlannedPoint& p : path.points) {
     EXPECT_DOUBLE_EQ(p.v_mps, planner.params().speed_limit_mps);
   }
-  EXPECT_GE(traj.work_units, 51);
+  EXPECT_EQ(path.work_units, 51);
+  // The later stages leave a straight, free road at the limit.
+  const testing::ChainedPlan chained =
+      testing::PlanChain(&planner, geometry::Pose2{10.2, 0.3, 0}, {});
+  EXPECT_FALSE(chained.obstacle.stop);
+  for (const PlannedPoint& p : chained.points) {
+    EXPECT_DOUBLE_EQ(p.v_mps, planner.params().speed_limit_mps);
+  }
 }
 
-TEST(BehaviorVelocityPlanner, StopsAtGoal) {
-  BehaviorVelocityPlanner planner;
-  planner.SetPath(Straight(100, 5));
-  const PlannedTrajectory traj = planner.Plan(geometry::Pose2{70, 0, 0}, {});
-  EXPECT_TRUE(traj.stop_for_goal);
-  ASSERT_FALSE(traj.points.empty());
-  EXPECT_NEAR(traj.points.back().s_m, 100.0, 1e-9);
-  EXPECT_EQ(traj.points.back().v_mps, 0.0);
-  EXPECT_GT(traj.points[traj.points.size() - 2].v_mps, 0.0);
-  EXPECT_NEAR(traj.stop_s_m, 100.0, 1e-9);
+TEST(PathPlanner, EndsAtGoalAndVelocityPlannerStopsThere) {
+  PathPlanner planner;
+  planner.SetRoute(Straight(100, 5));
+  const testing::ChainedPlan plan =
+      testing::PlanChain(&planner, geometry::Pose2{70, 0, 0}, {});
+  EXPECT_TRUE(plan.path.ends_at_goal);
+  ASSERT_FALSE(plan.points.empty());
+  EXPECT_NEAR(plan.points.back().s_m, 100.0, 1e-9);
+  EXPECT_EQ(plan.points.back().v_mps, 0.0);
+  EXPECT_GT(plan.points[plan.points.size() - 2].v_mps, 0.0);
   // Past the goal: one point, speed 0.
-  const PlannedTrajectory after = planner.Plan(geometry::Pose2{103, 0, 0}, {});
-  EXPECT_TRUE(after.stop_for_goal);
+  const testing::ChainedPlan after =
+      testing::PlanChain(&planner, geometry::Pose2{103, 0, 0}, {});
+  EXPECT_TRUE(after.path.ends_at_goal);
   ASSERT_EQ(after.points.size(), 1u);
   EXPECT_EQ(after.points[0].v_mps, 0.0);
 }
 
-TEST(BehaviorVelocityPlanner, GoalPointProjectedOnPath) {
-  BehaviorVelocityPlanner planner;
-  planner.SetPath(Straight(100, 5), Eigen::Vector2d(60.0, 0.4));
+TEST(PathPlanner, GoalPointProjectedOnRoute) {
+  PathPlanner planner;
+  planner.SetRoute(Straight(100, 5), Eigen::Vector2d(60.0, 0.4));
   EXPECT_NEAR(planner.goal_s_m(), 60.0, 1e-9);
-  const PlannedTrajectory traj = planner.Plan(geometry::Pose2{30, 0, 0}, {});
-  EXPECT_TRUE(traj.stop_for_goal);
-  EXPECT_NEAR(traj.points.back().s_m, 60.0, 1e-9);
-  EXPECT_EQ(traj.points.back().v_mps, 0.0);
+  const testing::ChainedPlan plan =
+      testing::PlanChain(&planner, geometry::Pose2{30, 0, 0}, {});
+  EXPECT_TRUE(plan.path.ends_at_goal);
+  EXPECT_NEAR(plan.points.back().s_m, 60.0, 1e-9);
+  EXPECT_EQ(plan.points.back().v_mps, 0.0);
 }
 
-TEST(BehaviorVelocityPlanner, StopsBeforeObstacleInCorridor) {
-  BehaviorVelocityPlanner planner;
-  planner.SetPath(Straight(200, 5));
-  const PlannerParams& params = planner.params();
-  const PlannedTrajectory traj =
-      planner.Plan(geometry::Pose2{0, 0, 0}, {Car(7, 40.0, 0.5)});
-  EXPECT_TRUE(traj.stop_for_obstacle);
-  EXPECT_FALSE(traj.stop_for_goal);
-  EXPECT_EQ(traj.obstacle_id, 7);
+TEST(ObstacleStopPlanner, StopsBeforeObstacleInCorridor) {
+  PathPlanner planner;
+  planner.SetRoute(Straight(200, 5));
+  const ObstacleStopParams params;
+  const testing::ChainedPlan plan = testing::PlanChain(
+      &planner, geometry::Pose2{0, 0, 0}, {Car(7, 40.0, 0.5)});
+  EXPECT_TRUE(plan.obstacle.stop);
+  EXPECT_FALSE(plan.path.ends_at_goal);
+  EXPECT_EQ(plan.obstacle.obstacle_id, 7);
   // Rear-axle stop point: the car's rear (37.75) - margin - ego front.
   const double expected_stop =
       40.0 - 2.25 - params.stop_margin_m - params.ego_front_m;
-  EXPECT_NEAR(traj.stop_s_m, expected_stop, 1e-9);
+  EXPECT_NEAR(plan.obstacle.stop_s_m, expected_stop, 1e-9);
+  // From the ego's front bumper (3.8 m ahead of the axle) to the car's rear.
+  EXPECT_NEAR(plan.obstacle.gap_m, 37.75 - params.ego_front_m, 1e-9);
   bool saw_zero_at_stop = false;
-  for (const PlannedPoint& p : traj.points) {
+  for (const PlannedPoint& p : plan.points) {
     // The ego front at this point is p.s + ego_front: standing still there
     // leaves at least the margin to the obstacle's rear.
     if (p.s_m + params.ego_front_m >=
@@ -104,25 +115,39 @@ TEST(BehaviorVelocityPlanner, StopsBeforeObstacleInCorridor) {
     if (std::abs(p.s_m - expected_stop) < 1e-9) saw_zero_at_stop = true;
   }
   EXPECT_TRUE(saw_zero_at_stop);  // an exact point at the stop line
+  EXPECT_GT(plan.obstacle.work_units, 0);
 }
 
-TEST(BehaviorVelocityPlanner, IgnoresObstaclesOutsideCorridorOrBehind) {
-  BehaviorVelocityPlanner planner;
-  planner.SetPath(Straight(200, 5));
+TEST(ObstacleStopPlanner, IgnoresObstaclesOutsideCorridorOrBehind) {
+  PathPlanner planner;
+  planner.SetRoute(Straight(200, 5));
   // Next lane (3.5 m over: 3.5 - 0.9 > 1.4) and behind the ego.
-  const PlannedTrajectory traj = planner.Plan(
-      geometry::Pose2{20, 0, 0}, {Car(1, 40.0, 3.5), Car(2, 5.0, 0.0)});
-  EXPECT_FALSE(traj.stop_for_obstacle);
-  EXPECT_EQ(traj.obstacle_id, -1);
-  for (const PlannedPoint& p : traj.points) EXPECT_GT(p.v_mps, 0.0);
+  const testing::ChainedPlan plan =
+      testing::PlanChain(&planner, geometry::Pose2{20, 0, 0},
+                         {Car(1, 40.0, 3.5), Car(2, 5.0, 0.0)});
+  EXPECT_FALSE(plan.obstacle.stop);
+  EXPECT_EQ(plan.obstacle.obstacle_id, -1);
+  for (const PlannedPoint& p : plan.points) EXPECT_GT(p.v_mps, 0.0);
   // A crossing car (across the path) reaches further sideways.
   PlannerObstacle crossing = Car(3, 40.0, 3.0);
   crossing.yaw_rad = kPi / 2;  // 2.25 m half extent across the path
   EXPECT_TRUE(
-      planner.Plan(geometry::Pose2{20, 0, 0}, {crossing}).stop_for_obstacle);
+      testing::PlanChain(&planner, geometry::Pose2{20, 0, 0}, {crossing})
+          .obstacle.stop);
 }
 
-TEST(BehaviorVelocityPlanner, CurvatureLimitsSpeedInCurve) {
+TEST(ObstacleStopPlanner, SeesAnObstacleJustPastThePathsEnd) {
+  // The path ends at the horizon (50 m); a car 4 m past it still sets a
+  // stop inside it, as it would on the full route.
+  PathPlanner planner;
+  planner.SetRoute(Straight(200, 5));
+  const testing::ChainedPlan plan = testing::PlanChain(
+      &planner, geometry::Pose2{0, 0, 0}, {Car(4, 54.0 + 2.25, 0.0)});
+  ASSERT_TRUE(plan.obstacle.stop);
+  EXPECT_NEAR(plan.obstacle.stop_s_m, 54.0 - 3.0 - 3.8, 1e-9);
+}
+
+TEST(VelocityPlanner, CurvatureLimitsSpeedInCurve) {
   // 50 m straight, a quarter circle of radius 10 m (1 m chords), straight.
   std::vector<Eigen::Vector2d> pts;
   for (double x = 0; x <= 50; x += 5) pts.emplace_back(x, 0);
@@ -131,13 +156,14 @@ TEST(BehaviorVelocityPlanner, CurvatureLimitsSpeedInCurve) {
     pts.emplace_back(50 + 10 * std::cos(a), 10 + 10 * std::sin(a));
   }
   for (double y = 15; y <= 60; y += 5) pts.emplace_back(60, y);
-  BehaviorVelocityPlanner planner;
-  planner.SetPath(Polyline(pts));
-  const PlannedTrajectory traj = planner.Plan(geometry::Pose2{30, 0, 0}, {});
-  const double v_curve =
-      std::sqrt(planner.params().max_lateral_accel_mps2 / 0.1);
+  PathPlanner planner;
+  planner.SetRoute(Polyline(pts));
+  const VelocityLimitParams limits;
+  const testing::ChainedPlan plan =
+      testing::PlanChain(&planner, geometry::Pose2{30, 0, 0}, {}, limits);
+  const double v_curve = std::sqrt(limits.max_lateral_accel_mps2 / 0.1);
   bool checked_curve = false;
-  for (const PlannedPoint& p : traj.points) {
+  for (const PlannedPoint& p : plan.points) {
     if (p.s_m < 45) {
       EXPECT_DOUBLE_EQ(p.v_mps, planner.params().speed_limit_mps);
     }
@@ -148,36 +174,47 @@ TEST(BehaviorVelocityPlanner, CurvatureLimitsSpeedInCurve) {
     }
   }
   EXPECT_TRUE(checked_curve);
+  // The limit never asks for less than min_curve_speed_mps.
+  std::vector<PlannedPoint> tight(3);
+  for (PlannedPoint& p : tight) {
+    p.v_mps = 8.0;
+    p.curvature_1pm = 100.0;
+  }
+  EXPECT_EQ(LimitVelocity(&tight, false, limits), 3);
+  for (const PlannedPoint& p : tight) {
+    EXPECT_DOUBLE_EQ(p.v_mps, limits.min_curve_speed_mps);
+  }
 }
 
-TEST(BehaviorVelocityPlanner, ProjectionStaysOnItsLegOfAUTurn) {
+TEST(PathPlanner, ProjectionStaysOnItsLegOfAUTurn) {
   // Out along y = 0 and back along y = 3: the return leg is closer to a
   // pose at y = 1.6 but the ego is on the way out.
-  BehaviorVelocityPlanner planner;
-  planner.SetPath(Polyline({{0, 0}, {50, 0}, {50, 3}, {0, 3}}));
-  planner.Plan(geometry::Pose2{0, 0, 0}, {});
+  PathPlanner planner;
+  planner.SetRoute(Polyline({{0, 0}, {50, 0}, {50, 3}, {0, 3}}));
+  planner.Plan(geometry::Pose2{0, 0, 0});
   for (double x = 2; x <= 30; x += 2) {
-    const PlannedTrajectory traj = planner.Plan(geometry::Pose2{x, 1.6, 0}, {});
-    EXPECT_NEAR(traj.ego_s_m, x, 1e-9);
+    const PlannedPath path = planner.Plan(geometry::Pose2{x, 1.6, 0});
+    EXPECT_NEAR(path.ego_s_m, x, 1e-9);
   }
   // Backward jitter does not move progress back.
-  EXPECT_NEAR(planner.Plan(geometry::Pose2{29.5, 0, 0}, {}).ego_s_m, 30.0,
-              1e-9);
+  EXPECT_NEAR(planner.Plan(geometry::Pose2{29.5, 0, 0}).ego_s_m, 30.0, 1e-9);
   // Far from the window (e.g. after a relocalization): global search.
-  EXPECT_NEAR(planner.Plan(geometry::Pose2{10, 3.2, kPi}, {}).ego_s_m, 93.0,
-              1e-9);
+  EXPECT_NEAR(planner.Plan(geometry::Pose2{10, 3.2, kPi}).ego_s_m, 93.0, 1e-9);
 }
 
-TEST(BehaviorVelocityPlanner, EmptyWithoutPath) {
-  BehaviorVelocityPlanner planner;
-  EXPECT_TRUE(planner.Plan(geometry::Pose2{}, {}).points.empty());
+TEST(PathPlanner, EmptyWithoutRoute) {
+  PathPlanner planner;
+  EXPECT_TRUE(planner.Plan(geometry::Pose2{}).points.empty());
+  std::vector<PlannedPoint> none;
+  EXPECT_EQ(LimitVelocity(&none, true, {}), 0);
+  EXPECT_FALSE(InsertObstacleStop(&none, {Car(1, 0, 0)}, {}).stop);
 }
 
 TEST(SmoothVelocity, RespectsAccelAndDecelLimits) {
-  BehaviorVelocityPlanner planner;
-  planner.SetPath(Straight(200, 5));
-  PlannedTrajectory traj =
-      planner.Plan(geometry::Pose2{0, 0, 0}, {Car(1, 45.0, 0.0)});
+  PathPlanner planner;
+  planner.SetRoute(Straight(200, 5));
+  testing::ChainedPlan traj = testing::PlanChain(
+      &planner, geometry::Pose2{0, 0, 0}, {Car(1, 45.0, 0.0)});
   const std::vector<PlannedPoint> raw = traj.points;
   SmootherParams params;
   SmoothVelocity(&traj.points, 0.0, params);
@@ -200,13 +237,14 @@ TEST(SmoothVelocity, RespectsAccelAndDecelLimits) {
   }
   EXPECT_GT(peak, 4.0);  // it does speed up in between
   // Moving fast towards a near stop: the profile brakes from the start.
-  BehaviorVelocityPlanner near_planner;
-  near_planner.SetPath(Straight(200, 5));
-  PlannedTrajectory near =
-      near_planner.Plan(geometry::Pose2{0, 0, 0}, {Car(1, 20.0, 0.0)});
+  PathPlanner near_planner;
+  near_planner.SetRoute(Straight(200, 5));
+  testing::ChainedPlan near = testing::PlanChain(
+      &near_planner, geometry::Pose2{0, 0, 0}, {Car(1, 20.0, 0.0)});
   SmoothVelocity(&near.points, 10.0, params);
   EXPECT_NEAR(near.points[0].v_mps,
-              std::sqrt(2 * params.max_decel_mps2 * near.stop_s_m), 1e-6);
+              std::sqrt(2 * params.max_decel_mps2 * near.obstacle.stop_s_m),
+              1e-6);
   EXPECT_LT(near.points[0].v_mps, 10.0);
   SmoothVelocity(nullptr, 1.0, params);  // no crash
 }
