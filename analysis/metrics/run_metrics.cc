@@ -21,10 +21,11 @@ double Percentile(std::vector<double> values, double q) {
 std::map<std::string, double> ComputeRunMetrics(
     const runfile::RunData& run, const RunMetricsOptions& options) {
   std::map<std::string, double> m;
-  const bool completed =
-      run.status == "complete" && run.termination_reason == "goal_reached";
+  const bool completed = run.status == runfile::kRunComplete &&
+                         run.termination_reason == "goal_reached";
   const double end_s = run.ego.empty() ? 0.0 : run.ego.back().t_s;
   m["completed"] = completed ? 1.0 : 0.0;
+  m[kCensoredMetric] = run.status == runfile::kRunInfeasible ? 1.0 : 0.0;
   m["nav_time_s"] = end_s;
 
   auto topic_index = [&](const std::string& name) {

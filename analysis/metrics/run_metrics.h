@@ -18,11 +18,16 @@ struct RunMetricsOptions {
   std::string lidar_topic = "/sensing/lidar/points_raw";
 };
 
-// Metrics by name: completed (0/1), nav_time_s (time to the goal; when not
-// completed, the time the run ended), ctrl_rate_hz (control commands per
-// second over the navigation), e2e_latency_p50_s / e2e_latency_p99_s
-// (control command publish time minus the stamp of the LiDAR scan it
-// derives from), dropped_messages (all topics), lidar_frames_dropped,
+// 1 when early stop ended the run (status infeasible): every other run
+// metric is then measured up to the stop, so censored, and nav_time_s is
+// only a lower bound.
+inline constexpr char kCensoredMetric[] = "censored";
+
+// Metrics by name: completed (0/1), censored (0/1), nav_time_s (time to the
+// goal; when not completed, the time the run ended), ctrl_rate_hz (control
+// commands per second over the navigation), e2e_latency_p50_s /
+// e2e_latency_p99_s (control command publish time minus the stamp of the LiDAR
+// scan it derives from), dropped_messages (all topics), lidar_frames_dropped,
 // collisions, callbacks (executions), cpu_utilization (busy core-seconds /
 // cores x nav time).
 std::map<std::string, double> ComputeRunMetrics(

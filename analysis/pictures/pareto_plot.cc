@@ -104,6 +104,11 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
     }
   }
   if (clip_y) ys.push_back(y_matters * 1.15);  // room for the arrows
+  for (const auto* p : shown) {
+    // Room above a censored point for its arrow.
+    if (p->censored && !(clip_y && p->nav_time_s > y_matters))
+      ys.push_back(p->nav_time_s * 1.08);
+  }
   for (double v : o.vertical_lines) {
     if (std::isfinite(v)) xs.push_back(v);
   }
@@ -187,9 +192,22 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
     cv::circle(img, Fixed(c), r * static_cast<int>(kShiftScale), colour,
                cv::FILLED, cv::LINE_AA, kShift);
   };
+  // An arrow pointing up from `base`: a time beyond it.
+  auto draw_arrow_up = [&](cv::Point2d base, const cv::Scalar& colour) {
+    const cv::Point2d tip = base - cv::Point2d(0, 3 * cross);
+    DrawPolyline(&img,
+                 {tip + cv::Point2d(-cross, cross), tip,
+                  tip + cv::Point2d(cross, cross)},
+                 colour, s.Px(1.5));
+    DrawSegment(&img, base, tip, colour, s.Px(1.5));
+  };
+  bool any_censored = false;
   for (const auto* p : shown) {
     if (p->feasible || p->on_front) continue;
-    if (clipped(p)) {
+    if (p->censored && !clipped(p)) {
+      any_censored = true;
+      draw_arrow_up(px(p->cost, p->nav_time_s), Bgr(kInfeasibleRgb));
+    } else if (clipped(p)) {
       // An arrow pointing up out of the plot.
       const cv::Point2d tip = px(p->cost, ay.max);
       DrawPolyline(&img,
@@ -265,6 +283,12 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
                              img, Fixed(c),
                              (radius + s.Px(5)) * static_cast<int>(kShiftScale),
                              kBlack, s.Px(1.5), cv::LINE_AA, kShift);
+                       }});
+  }
+  if (any_censored) {
+    entries.push_back({"stopped early (time at least)", [&](cv::Point2d c) {
+                         draw_arrow_up(c + cv::Point2d(0, 1.5 * cross),
+                                       Bgr(kInfeasibleRgb));
                        }});
   }
   if (!o.vertical_lines.empty() || !o.horizontal_lines.empty()) {

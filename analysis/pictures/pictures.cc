@@ -95,9 +95,14 @@ std::string Title(const runfile::RunData& run) {
   }
   std::string reason = run.termination_reason;
   reason = reason.substr(0, reason.find('\n'));
-  std::string outcome = run.status == "complete" ? reason : "FAILED: " + reason;
+  std::string outcome =
+      run.status == runfile::kRunFailed ? "FAILED: " + reason : reason;
   if (auto it = run.metrics.find("nav_time_s"); it != run.metrics.end()) {
-    outcome += fmt::format(", nav {:.1f} s", it->second);
+    // A censored run stopped early: its nav time is only a lower bound.
+    outcome +=
+        run.status == runfile::kRunInfeasible
+            ? fmt::format(", nav >= {:.1f} s (stopped early)", it->second)
+            : fmt::format(", nav {:.1f} s", it->second);
   }
   return fmt::format(
       "{} | {} | {}",

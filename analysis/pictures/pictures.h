@@ -91,6 +91,9 @@ struct ParetoPlotPoint {
   bool on_front = false;
   std::string label;       // written next to front points, e.g. "6c 1.5GHz 7Hz"
   bool highlight = false;  // ringed, e.g. the cheapest feasible design
+  // nav_time_s is only a lower bound (early stop ended the run): drawn as
+  // an arrow pointing up from it.
+  bool censored = false;
 };
 
 struct ParetoPlotOptions {

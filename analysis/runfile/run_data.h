@@ -54,10 +54,19 @@ struct NamedCallback {
   double period_s = 0.0;
 };
 
+// A run's status. complete: the simulation ended at the goal or the
+// timeout; infeasible: it was ended early because a constraint was
+// certainly violated (early stop), so its metrics are censored; failed: it
+// could not finish.
+inline constexpr char kRunComplete[] = "complete";
+inline constexpr char kRunInfeasible[] = "infeasible";
+inline constexpr char kRunFailed[] = "failed";
+
 struct RunData {
   // Identity and provenance (root attributes).
-  std::string status = "complete";  // complete | failed
-  std::string termination_reason;   // goal_reached | timeout | ... | error text
+  std::string status = kRunComplete;  // kRunComplete|kRunInfeasible|kRunFailed
+  // goal_reached | timeout | constraint_violated: <constraint> | error text
+  std::string termination_reason;
   std::string scenario_name;
   std::string scenario_text;  // the scenario file, verbatim
   std::string scenario_hash;  // sha256 of scenario_text

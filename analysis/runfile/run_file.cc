@@ -396,9 +396,11 @@ Status WriteContents(hid_t file, const RunData& run) {
 }
 
 Status Validate(const RunData& run) {
-  if (run.status != "complete" && run.status != "failed") {
+  if (run.status != kRunComplete && run.status != kRunInfeasible &&
+      run.status != kRunFailed) {
     return Status::InvalidArgument(
-        "run status must be complete or failed, got '" + run.status + "'");
+        "run status must be complete, infeasible or failed, got '" +
+        run.status + "'");
   }
   // The hash doubles as the checksum of /scenario/yaml (stored without one).
   if (!run.scenario_hash.empty() &&

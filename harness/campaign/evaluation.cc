@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/metrics/run_metrics.h"
+
 namespace adse::campaign {
 
 namespace {
@@ -16,13 +18,27 @@ Result<EvaluationRow> RowFromJson(const nlohmann::json& j,
   EvaluationRow row;
   try {
     row.content_key = j.at("content_key").get<std::string>();
+    // The row's status says whether a run file exists: an early-stopped
+    // (infeasible) run has one.
+    const std::string status = j.at("status").get<std::string>();
     row.status =
-        j.at("status").get<std::string>() == "complete" ? "complete" : "failed";
+        status == runfile::kRunComplete || status == runfile::kRunInfeasible
+            ? runfile::kRunComplete
+            : runfile::kRunFailed;
+    const bool censored = j.value("censored", false);
     row.reason = j.at("termination_reason").get<std::string>();
     row.seed = j.at("seed").get<uint64_t>();
     row.point = j.at("point").get<std::map<std::string, double>>();
     if (j.contains("metrics")) {
       for (const auto& [name, value] : j.at("metrics").items()) {
+        // A censored run's metrics were measured up to its early stop: the
+        // campaign never takes them for measurements, and leaves them out
+        // as the index leaves out what a run lacks (only the point's cost
+        // and the censoring itself are known).
+        if (censored && name != "hardware_cost" &&
+            name != analysis::kCensoredMetric) {
+          continue;
+        }
         row.metrics[name] = value.is_number()
                                 ? value.get<double>()
                                 : std::numeric_limits<double>::quiet_NaN();

@@ -8,6 +8,7 @@
 #include <regex>
 #include <sstream>
 
+#include "analysis/metrics/run_metrics.h"
 #include "analysis/pictures/pictures.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/files.h"
@@ -219,8 +220,30 @@ Status RenderFrontPicture(const spec::Spec& spec,
                           const std::string& png_path, Env* env) {
   std::vector<bool> on_front(rows.size(), false);
   for (int i : h.cost_time_front) on_front[i] = true;
+  // A censored run's time is unknown beyond its stop; it is drawn as an
+  // arrow up from the time bound that stopped it (the largest, when there
+  // are several), or left out when no time bound did.
+  double time_bound = std::nan("");
+  for (const std::string& c : spec.constraints) {
+    double bound = 0.0;
+    if (SimpleBound(c, kTimeMetric, &bound) &&
+        (std::isnan(time_bound) || bound > time_bound)) {
+      time_bound = bound;
+    }
+  }
   std::vector<analysis::ParetoPlotPoint> plot;
   for (size_t i = 0; i < rows.size(); ++i) {
+    if (RowMetric(rows[i], analysis::kCensoredMetric) == 1.0 &&
+        std::isfinite(RowMetric(rows[i], kCostMetric)) &&
+        std::isfinite(time_bound)) {
+      analysis::ParetoPlotPoint p;
+      p.cost = RowMetric(rows[i], kCostMetric);
+      p.nav_time_s = time_bound;
+      p.feasible = false;
+      p.censored = true;
+      plot.push_back(p);
+      continue;
+    }
     if (!Placed(rows[i])) continue;
     analysis::ParetoPlotPoint p;
     p.cost = RowMetric(rows[i], kCostMetric);

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "analysis/metrics/run_metrics.h"
 #include "harness/campaign/campaign.h"
 #include "harness/campaign/headline.h"
 #include "harness/cli/cli_support.h"
@@ -82,12 +83,18 @@ class Progress : public campaign::ExplorerListener {
           "[{}/{}] FAILED {}: {} ({} attempt(s); see runs/{}.failed.json)",
           done_, budget_, point, row.reason, row.attempts, row.content_key);
     } else if (!quiet_ && !tty_) {
+      // An early-stopped run has no measured nav time or rate: its reason
+      // says which bound stopped it.
+      const bool censored =
+          campaign::RowMetric(row, analysis::kCensoredMetric) == 1.0;
       line = fmt::format(
-          "[{}/{}] {}: {}, nav {:.1f} s, ctrl {:.1f} Hz, cost {:.3g}, {} "
+          "[{}/{}] {}: {}{}, cost {:.3g}, {} "
           "({}{})",
           done_, budget_, point, row.reason,
-          campaign::RowMetric(row, "nav_time_s"),
-          campaign::RowMetric(row, "ctrl_rate_hz"),
+          censored ? std::string(" (stopped early, metrics censored)")
+                   : fmt::format(", nav {:.1f} s, ctrl {:.1f} Hz",
+                                 campaign::RowMetric(row, "nav_time_s"),
+                                 campaign::RowMetric(row, "ctrl_rate_hz")),
           campaign::RowMetric(row, "hardware_cost"),
           row.feasible ? "feasible" : "infeasible", row.source,
           row.source == "simulated" ? fmt::format(" {:.1f} s", row.wall_s)

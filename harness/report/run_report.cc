@@ -31,6 +31,7 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
   r.point = run.design_point;
   r.seed = run.seed;
   r.status = run.status;
+  r.censored = run.status == runfile::kRunInfeasible;
   r.termination_reason = run.termination_reason;
   r.content_key = run.content_key;
   // Metrics are recomputed from the trace, never copied, so a changed
@@ -104,12 +105,13 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
       run.scenario_text, run.scenario_name + ".yaml (stored in the run)", ".",
       parse_options);
   if (spec.ok()) {
-    r.feasible = run.status == "complete";
+    // A censored run is infeasible whatever its metrics so far say.
+    r.feasible = run.status == runfile::kRunComplete;
     for (const std::string& c : spec->constraints) {
       Result<bool> ok =
           spec::EvaluateConstraint(*spec, c, r.metrics, run.design_point);
       const bool satisfied = ok.ok() && *ok;
-      r.constraints.push_back({c, satisfied});
+      r.constraints.push_back({c, satisfied, r.censored});
       r.feasible = r.feasible && satisfied;
     }
   } else {
@@ -134,14 +136,16 @@ nlohmann::json ToJson(const RunReport& r) {
   j["point"] = r.point;
   j["seed"] = r.seed;
   j["status"] = r.status;
+  j["censored"] = r.censored;
   j["termination_reason"] = r.termination_reason;
   j["content_key"] = r.content_key;
   for (const auto& [name, value] : r.metrics)
     j["metrics"][name] = Number(value);
   j["constraints"] = nlohmann::json::array();
   for (const ConstraintStatus& c : r.constraints) {
-    j["constraints"].push_back(
-        {{"expression", c.expression}, {"satisfied", c.satisfied}});
+    j["constraints"].push_back({{"expression", c.expression},
+                                {"satisfied", c.satisfied},
+                                {"censored", c.censored}});
   }
   if (!r.constraints_error.empty())
     j["constraints_error"] = r.constraints_error;
@@ -188,6 +192,12 @@ std::string FormatSummary(const RunReport& r) {
                : fmt::format("{:.4g}", it->second);
   };
   out += fmt::format("ended       {} ({})\n", r.termination_reason, r.status);
+  if (r.censored) {
+    out += fmt::format(
+        "censored    early stop at {} s: the metrics below are measured up "
+        "to it; nav_time_s is a lower bound\n",
+        metric("nav_time_s"));
+  }
   for (const char* name :
        {"completed", "nav_time_s", "ctrl_rate_hz", "hardware_cost",
         "deviation_score", "max_deviation_m", "offset_m", "zigzag_index",
@@ -201,8 +211,9 @@ std::string FormatSummary(const RunReport& r) {
         100 * r.driven_fraction);
   }
   for (const ConstraintStatus& c : r.constraints) {
-    out += fmt::format("constraint  {:<24} {}\n", c.expression,
-                       c.satisfied ? "ok" : "VIOLATED");
+    out += fmt::format("constraint  {:<24} {}{}\n", c.expression,
+                       c.satisfied ? "ok" : "VIOLATED",
+                       c.censored ? " (so far: censored)" : "");
   }
   if (!r.constraints_error.empty())
     out += "constraints n/a: " + r.constraints_error + "\n";

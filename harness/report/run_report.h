@@ -32,7 +32,10 @@ struct AnalyzeOptions {
 
 struct ConstraintStatus {
   std::string expression;
-  bool satisfied = false;
+  bool satisfied = false;  // by the run's metrics (censored: so far)
+  // The run was ended early (censored), so `satisfied` holds up to the stop
+  // only; the run's termination_reason names the constraint that stopped it.
+  bool censored = false;
 };
 
 struct FindingSummary {
@@ -64,7 +67,10 @@ struct RunReport {
   std::string scenario_name;
   std::map<std::string, double> point;
   uint64_t seed = 0;
-  std::string status;  // complete | failed
+  std::string status;  // runfile::kRunComplete | kRunInfeasible | kRunFailed
+  // Early stop ended the run: its metrics are measured up to the stop
+  // (metric `censored` = 1), nav_time_s only a lower bound.
+  bool censored = false;
   std::string termination_reason;
   std::string content_key;
   std::map<std::string, double> metrics;  // run metrics + deviation metrics

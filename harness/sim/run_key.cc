@@ -1,5 +1,6 @@
 #include "harness/sim/run_key.h"
 
+#include "harness/sim/early_stop.h"
 #include "stack/base/files.h"
 #include "stack/base/hash.h"
 
@@ -68,6 +69,13 @@ Result<std::string> RunKey(const spec::Spec& spec,
     } else {
       ADSE_RETURN_IF_ERROR(AddFile(&h, "platform.profile", p.profile));
     }
+  }
+  // Constraints end a run early (harness.early_stop) and so change what it
+  // records; keys of runs no constraint can stop stay as they were.
+  const std::vector<std::string> stoppable = EarlyStoppableConstraints(spec);
+  if (!stoppable.empty()) {
+    h.Add("early_stop");
+    for (const std::string& c : stoppable) h.Add(c);
   }
   // The point (with its bindings: the same name may bind another knob) and
   // the seed.

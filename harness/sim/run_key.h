@@ -1,7 +1,8 @@
 // The content key of a run: a hash of everything that can change what a
 // run does — the scenario's world, task, stack and platform, the design
-// point, the seed and the adse version — and of nothing else (not the
-// exploration, harness or output settings). Run files are named by it, so
+// point, the seed and the adse version, and the constraints that can end
+// the run early — and of nothing else (not the exploration, other harness
+// or output settings). Run files are named by it, so
 // any campaign can reuse any run with the same key.
 #ifndef ADSE_HARNESS_SIM_RUN_KEY_H_
 #define ADSE_HARNESS_SIM_RUN_KEY_H_

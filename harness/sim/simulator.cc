@@ -13,6 +13,7 @@
 #include "analysis/metrics/run_metrics.h"
 #include "harness/profile/profile.h"
 #include "harness/sim/calibration.h"
+#include "harness/sim/early_stop.h"
 #include "harness/sim/run_key.h"
 #include "harness/spec/spec_parser.h"
 #include "harness/spec/types.h"
@@ -158,8 +159,13 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
          next_progress = 0.0;
   stats.setup_s = Seconds(Clock::now() - t_begin);
 
+  Result<EarlyStop> early_stop =
+      EarlyStop::Create(spec, point, stack_config.Get("control.rate_hz"));
+  if (!early_stop.ok()) return early_stop.status();
+
   const double dt = w.step_s();
   const double timeout = spec.task.timeout_s;
+  std::string status = runfile::kRunComplete;
   std::string reason = "timeout";
   auto record_ego = [&] {
     const world::VehicleState& s = w.ego();
@@ -238,10 +244,21 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
       reason = "goal_reached";
       break;
     }
+    if (!early_stop->empty()) {
+      const RunProgress progress{w.time_s(),
+                                 static_cast<int64_t>(run.controls.size()),
+                                 static_cast<int64_t>(run.collisions.size())};
+      if (std::optional<std::string> violated =
+              early_stop->Violated(progress)) {
+        status = runfile::kRunInfeasible;
+        reason = "constraint_violated: " + *violated;
+        break;
+      }
+    }
   }
 
   // Provenance and the stack's description.
-  run.status = "complete";
+  run.status = status;
   run.termination_reason = reason;
   run.scenario_name = spec.name;
   run.scenario_text = spec.source_text;

@@ -121,6 +121,10 @@ const std::vector<MetricInfo>& KnownMetrics() {
       {"e2e_latency_p99_s", "99th percentile LiDAR-to-control latency, s"},
       {"dropped_messages", "messages dropped by keep-last queues, count"},
       {"collisions", "collisions of the ego with vehicles or obstacles, count"},
+      {"censored",
+       "early stop ended the run (status infeasible): its other metrics are "
+       "measured up to the stop (0 or 1)",
+       true},
   };
   return kMetrics;
 }

@@ -129,6 +129,10 @@ struct HarnessOptions {
   double run_timeout_s = 900.0;
   int retries = 1;
   int replicas = 1;
+  // End a run as soon as a constraint is certainly violated (see
+  // harness/sim/early_stop.h); false runs every point to the goal or the
+  // timeout.
+  bool early_stop = true;
   std::string isolation = "auto";  // auto|cgroup|affinity
   std::string executor = "local";  // local|slurm
   std::string cache_dir;           // empty: the user's cache dir

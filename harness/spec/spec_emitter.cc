@@ -55,6 +55,12 @@ Field<T> Integer(const char* key, I T::*member) {
           }};
 }
 template <typename T>
+Field<T> Boolean(const char* key, bool T::*member) {
+  return {key, [member](YAML::Emitter& out, const T& v, const Spec&) {
+            out << (v.*member ? "true" : "false");
+          }};
+}
+template <typename T>
 Field<T> Plain(const char* key, std::string T::*member) {
   return {key, [member](YAML::Emitter& out, const T& v, const Spec&) {
             out << v.*member;
@@ -306,6 +312,7 @@ const std::vector<Field<HarnessOptions>>& HarnessFields() {
       Number("run_timeout_s", &H::run_timeout_s),
       Integer("retries", &H::retries),
       Integer("replicas", &H::replicas),
+      Boolean("early_stop", &H::early_stop),
       Plain("isolation", &H::isolation),
       Plain("executor", &H::executor),
       QuotedIfSet("cache_dir", &H::cache_dir),

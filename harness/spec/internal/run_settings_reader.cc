@@ -24,8 +24,9 @@ const std::vector<std::string> kLlmKeys = {
     "backend",     "endpoint",  "models",  "prompts",
     "replay_from", "timeout_s", "retries", "api_key_env"};
 const std::vector<std::string> kHarnessKeys = {
-    "workers",  "cores_per_worker", "memory_mb", "run_timeout_s", "retries",
-    "replicas", "isolation",        "executor",  "cache_dir",     "slurm"};
+    "workers",  "cores_per_worker", "memory_mb",  "run_timeout_s",
+    "retries",  "replicas",         "early_stop", "isolation",
+    "executor", "cache_dir",        "slurm"};
 const std::vector<std::string> kSlurmKeys = {
     "partition",     "account",       "nodes",      "cpus",
     "time_limit",    "max_parallel",  "shard_size", "extra_args",
@@ -197,6 +198,7 @@ void SpecReader::ReadHarness(const Val& v) {
   if (const Val* e = f.Get("replicas")) {
     ReadInt(*e, &h.replicas, Bounds::Closed(1, 1000));
   }
+  if (const Val* e = f.Get("early_stop")) ReadBool(*e, &h.early_stop);
   if (const Val* e = f.Get("isolation")) {
     ReadEnum(*e, &h.isolation, pool::IsolationNames());
   }

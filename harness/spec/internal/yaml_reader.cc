@@ -174,6 +174,17 @@ bool YamlReader::ReadInt(const Val& v, int* out, const Bounds& bounds) {
   *out = static_cast<int>(value);
   return true;
 }
+bool YamlReader::ReadBool(const Val& v, bool* out) {
+  // Only YAML 1.2's spelling: `yes`, `on` or `1` for a flag is more often a
+  // slip than a choice.
+  const std::string text = v.node.IsScalar() ? v.node.Scalar() : "";
+  if (text != "true" && text != "false") {
+    Error(v, "true or false");
+    return false;
+  }
+  *out = text == "true";
+  return true;
+}
 bool YamlReader::ReadSeed(const Val& v, uint64_t* out) {
   const std::string text = v.node.IsScalar() ? v.node.Scalar() : "";
   uint64_t value = 0;

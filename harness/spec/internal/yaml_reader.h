@@ -134,6 +134,7 @@ class YamlReader {
   bool ReadNumber(const Val& v, double* out, const Bounds& bounds,
                   const char* noun = "a number");
   bool ReadInt(const Val& v, int* out, const Bounds& bounds);
+  bool ReadBool(const Val& v, bool* out);
   bool ReadSeed(const Val& v, uint64_t* out);
   bool ReadString(const Val& v, std::string* out,
                   const std::string& expected = "a non-empty string");

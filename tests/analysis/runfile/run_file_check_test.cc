@@ -255,7 +255,7 @@ TEST_F(RunFileCheckTest, ReportsBadRootAttributes) {
       << Join(problems);
   EXPECT_TRUE(Contains(problems,
                        "/: attribute 'status' is 'done', expected one of "
-                       "[\"complete\",\"failed\"]"))
+                       "[\"complete\",\"infeasible\",\"failed\"]"))
       << Join(problems);
   EXPECT_TRUE(Contains(problems, "/: attribute 'seed' is string, expected int"))
       << Join(problems);

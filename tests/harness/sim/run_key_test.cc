@@ -59,6 +59,22 @@ TEST(RunKeyTest, ChangesWithWhatChangesARun) {
   EXPECT_NE(key, Key(platform));
 }
 
+TEST(RunKeyTest, ConstraintsEnterOnlyWhenTheyCanStopTheRunEarly) {
+  const spec::Spec base = Small();  // nav_time_s <= 60, ctrl_rate_hz >= 1, ...
+  spec::Spec off = base;
+  off.harness.early_stop = false;
+  spec::Spec tighter = base;
+  tighter.constraints[0] = "nav_time_s <= 50";
+  spec::Spec undecidable = base;  // only constraints decided at the end
+  undecidable.constraints = {"completed", "max_deviation_m < 1"};
+  spec::Spec undecidable_off = undecidable;
+  undecidable_off.harness.early_stop = false;
+  EXPECT_NE(Key(base), Key(off));
+  EXPECT_NE(Key(base), Key(tighter));
+  EXPECT_EQ(Key(undecidable), Key(undecidable_off));
+  EXPECT_EQ(Key(undecidable), Key(off));
+}
+
 TEST(RunKeyTest, MissingCalibrationFileIsAnError) {
   spec::Spec s = Small();
   s.platform.cost_model = spec::CostModel::kCounted;

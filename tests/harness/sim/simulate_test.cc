@@ -149,6 +149,53 @@ TEST(SimulateTest, RunFileIsWrittenAndPassesTheSchemaCheck) {
   EXPECT_EQ(back->metrics.at("ctrl_rate_hz"), run->metrics.at("ctrl_rate_hz"));
 }
 
+TEST(SimulateTest,
+     AStarvedRunEndsAtItsNavTimeBoundInfeasibleAndCensoredUnlessTurnedOff) {
+  // robotaxi_small bounds nav_time_s <= 60 and times out at 300 s; one
+  // 1 GHz core does not reach the goal in 60 s.
+  spec::Spec spec = SmallScenario();
+  Result<runfile::RunData> stopped =
+      SimulatePoint(spec, SmallPoint(1, 1.0, 14));
+  spec.harness.early_stop = false;
+  spec.task.timeout_s = 90;  // enough to show the run goes on
+  Result<runfile::RunData> full = SimulatePoint(spec, SmallPoint(1, 1.0, 14));
+  ASSERT_TRUE(stopped.ok()) << stopped.status().ToString();
+  ASSERT_TRUE(full.ok()) << full.status().ToString();
+
+  EXPECT_EQ(stopped->status, runfile::kRunInfeasible);
+  EXPECT_EQ(stopped->termination_reason,
+            "constraint_violated: nav_time_s <= 60");
+  EXPECT_EQ(stopped->metrics.at("censored"), 1.0);
+  EXPECT_EQ(stopped->metrics.at("completed"), 0.0);
+  // It stops within a step of the bound.
+  EXPECT_GT(stopped->metrics.at("nav_time_s"), 60.0);
+  EXPECT_LT(stopped->metrics.at("nav_time_s"), 60.0 + 2 * spec.world.step_s);
+
+  EXPECT_EQ(full->status, runfile::kRunComplete);
+  EXPECT_EQ(full->metrics.at("censored"), 0.0);
+  EXPECT_GT(full->metrics.at("nav_time_s"), 89.0);
+  // Up to the stop, both runs are the same run.
+  ASSERT_LT(stopped->ego.size(), full->ego.size());
+  const runfile::EgoSample& last = stopped->ego.back();
+  const runfile::EgoSample& same = full->ego[stopped->ego.size() - 1];
+  EXPECT_EQ(last.t_s, same.t_s);
+  EXPECT_EQ(last.x_m, same.x_m);
+  EXPECT_EQ(last.y_m, same.y_m);
+
+  // The early-stopped run is stored as such and passes the schema check.
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "adse_sim_test_censored.h5")
+          .string();
+  ASSERT_TRUE(runfile::WriteRunFile(path, *stopped).ok());
+  std::vector<std::string> problems;
+  EXPECT_TRUE(runfile::CheckRunFile(path, &problems).ok());
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  Result<runfile::RunData> back = runfile::ReadRunFile(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->status, runfile::kRunInfeasible);
+  EXPECT_EQ(back->metrics.at("censored"), 1.0);
+}
+
 TEST(SimulateTest, PointOutsideTheSpaceIsRejected) {
   Result<runfile::RunData> run =
       SimulatePoint(SmallScenario(), SmallPoint(3, 2.1, 7));
