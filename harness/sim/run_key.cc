@@ -52,6 +52,11 @@ Result<std::string> RunKey(const spec::Spec& spec,
   h.Add("task").Add(static_cast<long long>(t.kind));
   AddLocation(&h, t.start);
   AddLocation(&h, t.goal);
+  // Keys of runs without waypoints stay as they were.
+  if (!t.via.empty()) {
+    h.Add("via");
+    for (const world::Location& l : t.via) AddLocation(&h, l);
+  }
   h.Add(t.goal_tolerance_m).Add(t.speed_limit_kmh).Add(t.timeout_s);
   // Stack: every knob's effective value, so a changed default changes keys.
   h.Add("stack");

@@ -217,6 +217,13 @@ const std::vector<Field<TaskOptions>>& TaskFields() {
                   const Spec&) { out << world::TaskKindToString(t.kind); }},
       {"start", [](YAML::Emitter& out, const TaskOptions& t,
                    const Spec&) { EmitLocation(out, t.start, nullptr); }},
+      {"via",
+       [](YAML::Emitter& out, const TaskOptions& t, const Spec&) {
+         out << YAML::Flow << YAML::BeginSeq;
+         for (const world::Location& l : t.via) EmitLocation(out, l, nullptr);
+         out << YAML::EndSeq;
+       },
+       [](const TaskOptions& t) { return !t.via.empty(); }},
       {"goal",
        [](YAML::Emitter& out, const TaskOptions& t, const Spec&) {
          EmitLocation(out, t.goal, &t.goal_tolerance_m);

@@ -129,7 +129,8 @@ struct World::Impl {
   WorldSetup setup;
   MapArtifacts map;
   RoadLocation start, goal;
-  Vec2 goal_xy = Vec2::Zero();  // final target (inside a slot when valet)
+  std::vector<RoadLocation> via;  // task.via, resolved
+  Vec2 goal_xy = Vec2::Zero();    // final target (inside a slot when valet)
   std::vector<std::string> route;
   geometry::Path2 ideal;
   double lane_width_m = 3.2;
@@ -164,6 +165,11 @@ struct World::Impl {
   Status StartSumo();
   Result<RoadLocation> Resolve(const Location& location,
                                const std::string& field, double slack_m);
+  // The edges from `from` to `to`, both included; errors name the fields.
+  Result<std::vector<std::string>> RouteLeg(const RoadLocation& from,
+                                            const RoadLocation& to,
+                                            const std::string& to_field,
+                                            const std::string& from_field);
   Status PlanRoute();
   Status BuildIdealPath();
   Status BuildScene();
@@ -318,48 +324,68 @@ Result<RoadLocation> World::Impl::Resolve(const Location& location,
   return out;
 }
 
-Status World::Impl::PlanRoute() {
+Result<std::vector<std::string>> World::Impl::RouteLeg(
+    const RoadLocation& from, const RoadLocation& to,
+    const std::string& to_field, const std::string& from_field) {
   try {
-    if (start.edge == goal.edge && goal.pos_m >= start.pos_m) {
-      route = {start.edge};
-      return Status::Ok();
+    if (from.edge == to.edge && to.pos_m >= from.pos_m) {
+      return std::vector<std::string>{from.edge};
     }
-    // The goal may lie behind the start on the same edge: leave the edge
+    // The target may lie behind the start on the same edge: leave the edge
     // first. Otherwise a plain shortest route.
     std::vector<std::string> best;
     double best_length = std::numeric_limits<double>::infinity();
-    if (start.edge == goal.edge) {
+    if (from.edge == to.edge) {
       std::set<std::string> next_edges;
-      for (int l = 0; l < libsumo::Edge::getLaneNumber(start.edge); ++l) {
+      for (int l = 0; l < libsumo::Edge::getLaneNumber(from.edge); ++l) {
         for (const auto& link :
-             libsumo::Lane::getLinks(start.edge + "_" + std::to_string(l))) {
+             libsumo::Lane::getLinks(from.edge + "_" + std::to_string(l))) {
           next_edges.insert(EdgeOfLane(link.approachedLane));
         }
       }
       for (const std::string& next : next_edges) {
         const libsumo::TraCIStage stage =
-            libsumo::Simulation::findRoute(next, goal.edge);
+            libsumo::Simulation::findRoute(next, to.edge);
         if (!stage.edges.empty() && stage.length < best_length) {
           best_length = stage.length;
-          best = {start.edge};
+          best = {from.edge};
           best.insert(best.end(), stage.edges.begin(), stage.edges.end());
         }
       }
     } else {
       const libsumo::TraCIStage stage =
-          libsumo::Simulation::findRoute(start.edge, goal.edge);
+          libsumo::Simulation::findRoute(from.edge, to.edge);
       best = stage.edges;
     }
     if (best.empty()) {
       return Status::InvalidArgument(fmt::format(
-          "task.goal: unreachable from task.start (no route from edge '{}' to "
-          "edge '{}')",
-          start.edge, goal.edge));
+          "{}: unreachable from {} (no route from edge '{}' to edge '{}')",
+          to_field, from_field, from.edge, to.edge));
     }
-    route = best;
+    return best;
   } catch (const std::exception& e) {
-    return Status::InvalidArgument(std::string("task.goal: routing failed: ") +
-                                   e.what());
+    return Status::InvalidArgument(to_field + ": routing failed: " + e.what());
+  }
+}
+
+Status World::Impl::PlanRoute() {
+  // Start, each waypoint, goal: the shortest leg between each and the next,
+  // joined where one leg's last edge is the next one's first.
+  std::vector<const RoadLocation*> stops = {&start};
+  std::vector<std::string> fields = {"task.start"};
+  for (size_t i = 0; i < via.size(); ++i) {
+    stops.push_back(&via[i]);
+    fields.push_back(fmt::format("task.via[{}]", i));
+  }
+  stops.push_back(&goal);
+  fields.push_back("task.goal");
+  route.clear();
+  for (size_t i = 0; i + 1 < stops.size(); ++i) {
+    Result<std::vector<std::string>> leg =
+        RouteLeg(*stops[i], *stops[i + 1], fields[i + 1], fields[i]);
+    if (!leg.ok()) return leg.status();
+    route.insert(route.end(), leg->begin() + (route.empty() ? 0 : 1),
+                 leg->end());
   }
   return Status::Ok();
 }
@@ -786,6 +812,12 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
   if (!goal.ok()) return goal.status();
   impl->start = *start;
   impl->goal = *goal;
+  for (size_t i = 0; i < setup.task.via.size(); ++i) {
+    Result<RoadLocation> via = impl->Resolve(
+        setup.task.via[i], fmt::format("task.via[{}]", i), kOffRoadSlackM);
+    if (!via.ok()) return via.status();
+    impl->via.push_back(*via);
+  }
   if (setup.task.kind == TaskKind::kValetParking) {
     // The road part of a valet route ends on the aisle beside the slot.
     const Location& g = setup.task.goal;

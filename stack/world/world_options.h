@@ -77,6 +77,9 @@ enum class TaskKind { kLaneDriving, kValetParking };
 struct TaskOptions {
   TaskKind kind = TaskKind::kLaneDriving;
   Location start;
+  // Places the route passes through, in order, between start and goal: the
+  // route is the shortest one from each to the next.
+  std::vector<Location> via;
   Location goal;
   // The goal counts as reached within this distance.
   double goal_tolerance_m = 2.0;

@@ -7,10 +7,13 @@
 #   tests/bench/early_stop_bench.sh [scenario] [workers]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
-adse="${ADSE_BIN:-${root}/build/bin/adse}"
 scenario="$(realpath "${1:-${root}/scenarios/robotaxi_small.yaml}")"
 workers="${2:-2}"
 out="$(mktemp -d)"
+# A copy of the binary: the campaigns run for long, and a rebuild meanwhile
+# must not swap the workers' program under them.
+cp "${ADSE_BIN:-${root}/build/bin/adse}" "${out}/adse"
+adse="${out}/adse"
 # The variants sit beside the scenario so that its relative paths resolve.
 dir="$(dirname "${scenario}")"
 on="${dir}/.early_stop_on.$$.yaml"

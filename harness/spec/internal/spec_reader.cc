@@ -30,8 +30,8 @@ const std::vector<std::string> kMapKeys = {"generate", "params", "net",
 const std::vector<std::string> kTrafficKeys = {"seed", "flows",
                                                "parked_occupancy"};
 const std::vector<std::string> kFlowKeys = {"from", "to", "vehicles_per_hour"};
-const std::vector<std::string> kTaskKeys = {"kind", "start", "goal",
-                                            "speed_limit_kmh", "timeout_s"};
+const std::vector<std::string> kTaskKeys = {
+    "kind", "start", "via", "goal", "speed_limit_kmh", "timeout_s"};
 const std::vector<std::string> kStartKeys = {"x", "y", "edge", "pos_m", "lane"};
 const std::vector<std::string> kGoalKeys = {"x",     "y",    "edge",
                                             "pos_m", "lane", "tolerance_m"};
@@ -379,6 +379,18 @@ void SpecReader::ReadTask(const Val& v) {
     ReadLocation(*e, false, &task.start);
   } else {
     Missing(v, "start", "a place {x, y} or {edge, pos_m, lane}");
+  }
+  if (const Val* e = f.Get("via")) {
+    std::vector<Val> items;
+    const std::string expected =
+        "a list of at most 100 places {x, y} or {edge, pos_m, lane}";
+    if (ReadList(*e, &items, expected) && items.size() > 100) {
+      Error(*e, expected, fmt::format(" with {} places", items.size()));
+    } else if (!items.empty()) {
+      task.via.assign(items.size(), world::Location());
+      for (size_t i = 0; i < items.size(); ++i)
+        ReadLocation(items[i], false, &task.via[i]);
+    }
   }
   if (const Val* e = f.Get("goal")) {
     ReadLocation(*e, true, &task.goal);

@@ -84,12 +84,22 @@ TEST(SpecErrorsTest, MapWhereAListIsExpected) {
               "expected a list");
 }
 
+TEST(SpecErrorsTest, WaypointsAreAListOfPlacesEachLocated) {
+  std::string text = kHead;
+  text.replace(text.find("  goal:"), 7, "  via: {x: 5, y: 0}\n  goal:");
+  ExpectError(text, "task.via", 6, "a list of at most 100 places");
+  text = kHead;
+  text.replace(text.find("  goal:"), 7,
+               "  via: [{x: 5, y: 0}, {x: 5, edge: E1}]\n  goal:");
+  ExpectError(text, "task.via[1]", 6, "either {x, y} or {edge, pos_m, lane}");
+}
+
 TEST(SpecErrorsTest, UnknownKeyWithSuggestion) {
   std::string text = kHead;
   text.replace(text.find("goal:"), 5, "gaol:");
   const std::string message = ErrorOf(text);
   EXPECT_THAT(message, HasSubstr("bad.yaml:6:3: error: task.gaol: expected a "
-                                 "key among {kind, start, goal, "
+                                 "key among {kind, start, via, goal, "
                                  "speed_limit_kmh, timeout_s}, found 'gaol' "
                                  "(did you mean 'goal'?)"));
   // ... and the now missing goal is reported too.

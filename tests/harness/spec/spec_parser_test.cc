@@ -293,14 +293,14 @@ TEST(SpecParserTest, NormalizedYamlRoundTripsNetMapsAndEdges) {
   const std::string text = R"(adse: 1
 name: weird.name_1
 world: {map: {net: a.net.xml}, weather: fog, step_s: 0.1}
-task: {kind: valet_parking, start: {edge: "E:0", pos_m: 1.5, lane: 2}, goal: {edge: "-E9", tolerance_m: 0.5}}
+task: {kind: valet_parking, start: {edge: "E:0", pos_m: 1.5, lane: 2}, via: [{x: 3, y: -4.5}, {edge: "E7", pos_m: 2}], goal: {edge: "-E9", tolerance_m: 0.5}}
 platform: {kind: cgroup, cost_model: counted, cores: 8, freq_ghz: 3.2}
 design_space: {hz: {bind: stack.lidar.rate_hz, values: [0.5, 7.25]}}
 cost: "2 * cores + hz / 10"
 constraints: ["collisions == 0", "nav_time_s <= 400 && completed"]
 exploration: {strategy: ga, seed: 18446744073709551615, population: 12}
 llm: {backend: openai, endpoint: "https://api.example.com/v1", models: {dse: "gpt: 4o"}}
-harness: {workers: 3, executor: slurm, slurm: {partition: gpu, time_limit: "1-00:30", extra_args: ["--qos=long", "--comment=#x #y"]}}
+harness: {workers: 3, early_stop: true, executor: slurm, slurm: {partition: gpu, time_limit: "1-00:30", extra_args: ["--qos=long", "--comment=#x #y"]}}
 output: /tmp/adse out/x
 )";
   Result<Spec> first = ParseSpec(text, "edge.yaml", dir);
@@ -315,6 +315,11 @@ output: /tmp/adse out/x
   EXPECT_EQ(again->task.start.edge, "E:0");
   EXPECT_EQ(again->task.goal.edge, "-E9");
   EXPECT_EQ(again->task.start.lane, 2);
+  ASSERT_EQ(again->task.via.size(), 2u);
+  EXPECT_NEAR(again->task.via[0].y_m, -4.5, kTol);
+  EXPECT_EQ(again->task.via[1].edge, "E7");
+  EXPECT_NEAR(again->task.via[1].pos_m, 2.0, kTol);
+  EXPECT_EQ(again->harness.early_stop, true);
   EXPECT_EQ(again->platform.kind, PlatformKind::kCgroup);
   EXPECT_EQ(again->platform.cost_model, CostModel::kCounted);
   EXPECT_NEAR(again->platform.freq_ghz, 3.2, kTol);

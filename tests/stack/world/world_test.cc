@@ -274,6 +274,53 @@ TEST(WorldTest, UnreachableGoalIsRejected) {
       << world.status().message();
 }
 
+// Two aisles between four rows: rows of W<i>/E<i> nodes at i = 0 (south
+// ring), 1, 2 (aisles) and 3 (north ring), every road two-way.
+WorldSetup TwoAisleLot() {
+  WorldSetup setup = SmallLot();
+  setup.world.map.generator_params = {{"rows", 4}, {"slots_per_row", 8}};
+  setup.task.goal = Location::OnEdge("E3_W3", 20.0);
+  return setup;
+}
+
+TEST(WorldTest, WaypointsLeadTheRouteThroughTheAislesInOrder) {
+  WorldSetup direct = TwoAisleLot();
+  WorldSetup serpentine = TwoAisleLot();
+  // West along the first aisle, then east along the second.
+  serpentine.task.via = {Location::OnEdge("E1_W1", 5.0),
+                         Location::OnEdge("W2_E2", 5.0)};
+  double direct_length = 0.0;
+  {
+    Result<std::unique_ptr<World>> world = World::Open(direct);
+    ASSERT_TRUE(world.ok()) << world.status().ToString();
+    direct_length = (*world)->ideal_path().length_m();
+  }
+  // libsumo holds one simulation per process: the second world opens after
+  // the first is gone.
+  Result<std::unique_ptr<World>> world = World::Open(serpentine);
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  const World& w = **world;
+  EXPECT_EQ(w.route_edges(),
+            (std::vector<std::string>{"W0_E0", "E0_E1", "E1_W1", "W1_W2",
+                                      "W2_E2", "E2_E3", "E3_W3"}));
+  // Two more aisle lengths than the direct route (about 20 m each).
+  EXPECT_GT(w.ideal_path().length_m(), direct_length + 30.0);
+  EXPECT_LT(w.ideal_path().MaxGap(), 0.51);
+  EXPECT_LT(w.ideal_path_max_join_gap_m(), 0.5);
+}
+
+TEST(WorldTest, AWaypointOffTheRoadIsRejectedByItsIndex) {
+  WorldSetup setup = TwoAisleLot();
+  setup.task.via = {Location::OnEdge("E1_W1", 5.0),
+                    Location::Xy(15.0, 8.0)};  // in the parking rows
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_FALSE(world.ok());
+  EXPECT_NE(world.status().message().find("task.via[1]"), std::string::npos)
+      << world.status().message();
+  EXPECT_NE(world.status().message().find("off the road"), std::string::npos)
+      << world.status().message();
+}
+
 TEST(WorldTest, SecondOpenWorldInOneProcessIsRefused) {
   Result<std::unique_ptr<World>> first = World::Open(SmallLot());
   ASSERT_TRUE(first.ok()) << first.status().ToString();
