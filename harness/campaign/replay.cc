@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "harness/campaign/headline.h"
 #include "harness/campaign/strategy_factory.h"
 #include "harness/spec/spec_parser.h"
 
@@ -105,8 +106,14 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
       }
     }
   }
+  const Headline answer = ComputeHeadline(spec, recording.rows);
   for (const EvaluationRow& row : result.evaluations) {
     run.proposals.push_back(row.point);
+    run.found_cheapest_feasible =
+        run.found_cheapest_feasible ||
+        (answer.cheapest >= 0 &&
+         analysis::SameDesignPoint(row.point,
+                                   recording.rows[answer.cheapest].point));
   }
   return run;
 }

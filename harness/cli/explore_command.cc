@@ -72,11 +72,12 @@ int RunExplore(const ExploreArgs& args) {
         "of front | "
         "hypervolume ratio (min / median / mean / max) | first true Pareto "
         "point at "
-        "(median eval) | not recorded |\n|---|---|---|---|---|---|\n");
+        "(median eval) | cheapest feasible found | not recorded "
+        "|\n|---|---|---|---|---|---|---|\n");
   }
   for (const std::string& name : strategies) {
     std::vector<double> found, ratio, first;
-    int front = 0, missing = 0;
+    int front = 0, missing = 0, cheapest = 0;
     nlohmann::json runs = nlohmann::json::array();
     for (int i = 0; i < args.seeds; ++i) {
       const uint64_t seed = args.first_seed + static_cast<uint64_t>(i);
@@ -93,6 +94,7 @@ int RunExplore(const ExploreArgs& args) {
         first.push_back(run->first_true_pareto_at);
       front = run->front_size;
       missing += run->missing;
+      cheapest += run->found_cheapest_feasible;
       nlohmann::json proposals = nlohmann::json::array();
       for (const spec::DesignPoint& point : run->proposals) {
         proposals.push_back(
@@ -104,6 +106,7 @@ int RunExplore(const ExploreArgs& args) {
                       {"true_pareto_found", run->true_pareto_found},
                       {"hypervolume_ratio", run->hypervolume_ratio},
                       {"first_true_pareto_at", run->first_true_pareto_at},
+                      {"found_cheapest_feasible", run->found_cheapest_feasible},
                       {"not_recorded", run->missing}});
     }
     const Distribution f = Describe(found), r = Describe(ratio),
@@ -119,18 +122,19 @@ int RunExplore(const ExploreArgs& args) {
                                  {"mean", r.mean},
                                  {"max", r.max}}},
                                {"true_front_size", front},
+                               {"seeds_that_found_cheapest_feasible", cheapest},
                                {"runs", runs}};
     if (!args.json) {
       std::printf(
           "| %s | %g / %g / %.2f / %g | %d | %.3f / %.3f / %.3f / %.3f | %s | "
-          "%d |\n",
+          "%d of %d seeds | %d |\n",
           name.c_str(), f.min, f.median, f.mean, f.max, front, r.min, r.median,
           r.mean, r.max,
           first.empty() ? "never"
                         : fmt::format("{:g} ({} of {} seeds)", a.median,
                                       first.size(), args.seeds)
                               .c_str(),
-          missing);
+          cheapest, args.seeds, missing);
     }
   }
   if (args.json) std::printf("%s\n", out.dump(2).c_str());

@@ -60,6 +60,15 @@ TEST(ReplayTest, AgentBeatsTheGaBaselineOnAverageOverSeeds) {
       << "agent " << agent / kSeeds << ", ga " << ga / kSeeds;
 }
 
+TEST(ReplayTest, AReplaySaysWhetherItEvaluatedTheCheapestFeasibleDesign) {
+  Result<ReplayRun> all = Replay(Recorded(), "exhaustive", 1, 280);
+  Result<ReplayRun> two = Replay(Recorded(), "exhaustive", 1, 2);
+  ASSERT_TRUE(all.ok() && two.ok());
+  EXPECT_TRUE(all->found_cheapest_feasible);
+  // Lexicographic order starts at the 1-core corner, which is infeasible.
+  EXPECT_FALSE(two->found_cheapest_feasible);
+}
+
 TEST(ReplayTest, ReplayIsDeterministicAndAnUnknownStrategyIsAnError) {
   Result<ReplayRun> a = Replay(Recorded(), "nsga2", 3, 15);
   Result<ReplayRun> b = Replay(Recorded(), "nsga2", 3, 15);

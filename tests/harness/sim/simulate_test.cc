@@ -48,6 +48,21 @@ spec::Spec ProfiledSmallScenario() {
   return spec;
 }
 
+// `run` written to a temporary run file, checked against the schema (no
+// problem expected) and read back.
+Result<runfile::RunData> WrittenAndReadBack(const runfile::RunData& run,
+                                            const std::string& name) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("adse_sim_test_" + name + ".h5"))
+                               .string();
+  Status written = runfile::WriteRunFile(path, run);
+  if (!written.ok()) return written;
+  std::vector<std::string> problems;
+  EXPECT_TRUE(runfile::CheckRunFile(path, &problems).ok());
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  return runfile::ReadRunFile(path);
+}
+
 TEST(SimulateTest, GenerousComputerDrivesToTheGoalAtTheNominalControlRate) {
   Result<runfile::RunData> run =
       SimulatePoint(SmallScenario(), SmallPoint(16, 2.1, 14));
@@ -136,14 +151,7 @@ TEST(SimulateTest, RunFileIsWrittenAndPassesTheSchemaCheck) {
   Result<runfile::RunData> run =
       SimulatePoint(SmallScenario(), SmallPoint(4, 2.1, 7));
   ASSERT_TRUE(run.ok()) << run.status().ToString();
-  const std::string path =
-      (std::filesystem::temp_directory_path() / "adse_sim_test_run.h5")
-          .string();
-  ASSERT_TRUE(runfile::WriteRunFile(path, *run).ok());
-  std::vector<std::string> problems;
-  EXPECT_TRUE(runfile::CheckRunFile(path, &problems).ok());
-  EXPECT_TRUE(problems.empty()) << problems.front();
-  Result<runfile::RunData> back = runfile::ReadRunFile(path);
+  Result<runfile::RunData> back = WrittenAndReadBack(*run, "run");
   ASSERT_TRUE(back.ok()) << back.status().ToString();
   EXPECT_EQ(back->trace.callbacks.size(), run->trace.callbacks.size());
   EXPECT_EQ(back->metrics.at("ctrl_rate_hz"), run->metrics.at("ctrl_rate_hz"));
@@ -183,14 +191,7 @@ TEST(SimulateTest,
   EXPECT_EQ(last.y_m, same.y_m);
 
   // The early-stopped run is stored as such and passes the schema check.
-  const std::string path =
-      (std::filesystem::temp_directory_path() / "adse_sim_test_censored.h5")
-          .string();
-  ASSERT_TRUE(runfile::WriteRunFile(path, *stopped).ok());
-  std::vector<std::string> problems;
-  EXPECT_TRUE(runfile::CheckRunFile(path, &problems).ok());
-  EXPECT_TRUE(problems.empty()) << problems.front();
-  Result<runfile::RunData> back = runfile::ReadRunFile(path);
+  Result<runfile::RunData> back = WrittenAndReadBack(*stopped, "censored");
   ASSERT_TRUE(back.ok()) << back.status().ToString();
   EXPECT_EQ(back->status, runfile::kRunInfeasible);
   EXPECT_EQ(back->metrics.at("censored"), 1.0);
