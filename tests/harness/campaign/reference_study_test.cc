@@ -1,0 +1,82 @@
+// The recorded exhaustive campaign of scenarios/reference_study.yaml
+// (tests/data/reference_study) has the reference study's shape: its
+// constraints cut the space, the starved corner fails them, and the time a
+// computer needs falls with its capacity.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "harness/campaign/evaluation.h"
+#include "harness/campaign/replay.h"
+
+namespace adse::campaign {
+namespace {
+
+const Recording& Recorded() {
+  static const Recording* recording = [] {
+    Result<Recording> r = LoadRecording(std::string(ADSE_SOURCE_DIR) +
+                                        "/tests/data/reference_study");
+    EXPECT_TRUE(r.ok()) << r.status().message();
+    return new Recording(r.ok() ? std::move(r).value() : Recording{});
+  }();
+  return *recording;
+}
+
+const EvaluationRow* At(double cores, double freq_ghz, double lidar_hz) {
+  for (const EvaluationRow& row : Recorded().rows) {
+    if (row.point.at("cores") == cores &&
+        std::abs(row.point.at("freq_ghz") - freq_ghz) < 1e-9 &&
+        row.point.at("lidar_hz") == lidar_hz) {
+      return &row;
+    }
+  }
+  return nullptr;
+}
+
+TEST(ReferenceStudyTest, TheRecordingHoldsTheWholeSpaceAndItsConstraintsCutIt) {
+  ASSERT_EQ(Recorded().rows.size(), 280u);
+  std::set<spec::DesignPoint> points;
+  int feasible = 0;
+  for (const EvaluationRow& row : Recorded().rows) {
+    points.insert(row.point);
+    feasible += row.feasible;
+    EXPECT_EQ(row.status, "complete") << row.reason;
+  }
+  EXPECT_EQ(points.size(), 280u);
+  // The band for the share of feasible points: 30 % to 80 %.
+  EXPECT_GE(feasible, 0.30 * 280);
+  EXPECT_LE(feasible, 0.80 * 280);
+}
+
+TEST(ReferenceStudyTest, TheStarvedCornerIsStoppedEarlyAtTheNavTimeBound) {
+  for (double lidar_hz : {7.0, 14.0}) {
+    const EvaluationRow* starved = At(1, 1.0, lidar_hz);
+    ASSERT_NE(starved, nullptr);
+    EXPECT_FALSE(starved->feasible);
+    EXPECT_EQ(starved->reason, "constraint_violated: nav_time_s <= 400");
+    EXPECT_EQ(RowMetric(*starved, "censored"), 1.0);
+    EXPECT_TRUE(std::isnan(RowMetric(*starved, "nav_time_s")));
+  }
+}
+
+TEST(ReferenceStudyTest, TheStudysFourPointsOrderAsInTheStudy) {
+  const EvaluationRow* slow = At(4, 1.2, 14);
+  const EvaluationRow* mid = At(6, 1.5, 7);
+  const EvaluationRow* fast = At(18, 1.8, 7);
+  const EvaluationRow* wide = At(23, 1.5, 7);
+  ASSERT_TRUE(slow && mid && fast && wide);
+  // As in the study: (4, 1.2, 14) fails the 400 s bound, the other three
+  // drive within it, and more capacity is faster.
+  EXPECT_FALSE(slow->feasible);
+  EXPECT_TRUE(mid->feasible && fast->feasible && wide->feasible);
+  EXPECT_GT(RowMetric(*mid, "nav_time_s"), RowMetric(*fast, "nav_time_s"));
+  EXPECT_GT(RowMetric(*mid, "nav_time_s"), RowMetric(*wide, "nav_time_s"));
+  // The censored (4, 1.2, 14) ran past 400 s: at least 2.9x the fast point.
+  EXPECT_LT(RowMetric(*fast, "nav_time_s"), 400.0 / 2.9);
+  EXPECT_LT(RowMetric(*mid, "ctrl_rate_hz"),
+            RowMetric(*fast, "ctrl_rate_hz") + 1e-9);
+}
+
+}  // namespace
+}  // namespace adse::campaign
