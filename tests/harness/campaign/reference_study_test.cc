@@ -5,22 +5,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <set>
 
 #include "harness/campaign/evaluation.h"
 #include "harness/campaign/replay.h"
+#include "tests/harness/testing/recording.h"
 
 namespace adse::campaign {
 namespace {
 
 const Recording& Recorded() {
-  static const Recording* recording = [] {
-    Result<Recording> r = LoadRecording(std::string(ADSE_SOURCE_DIR) +
-                                        "/tests/data/reference_study");
-    EXPECT_TRUE(r.ok()) << r.status().message();
-    return new Recording(r.ok() ? std::move(r).value() : Recording{});
-  }();
-  return *recording;
+  return adse::testing::RecordingUnderTestData("reference_study");
 }
 
 const EvaluationRow* At(double cores, double freq_ghz, double lidar_hz) {
@@ -36,17 +30,13 @@ const EvaluationRow* At(double cores, double freq_ghz, double lidar_hz) {
 
 TEST(ReferenceStudyTest, TheRecordingHoldsTheWholeSpaceAndItsConstraintsCutIt) {
   ASSERT_EQ(Recorded().rows.size(), 280u);
-  std::set<spec::DesignPoint> points;
-  int feasible = 0;
-  for (const EvaluationRow& row : Recorded().rows) {
-    points.insert(row.point);
-    feasible += row.feasible;
+  for (const EvaluationRow& row : Recorded().rows)
     EXPECT_EQ(row.status, "complete") << row.reason;
-  }
-  EXPECT_EQ(points.size(), 280u);
+  const adse::testing::Census census = adse::testing::CensusOf(Recorded());
+  EXPECT_EQ(census.distinct_points, 280u);
   // The band for the share of feasible points: 30 % to 80 %.
-  EXPECT_GE(feasible, 0.30 * 280);
-  EXPECT_LE(feasible, 0.80 * 280);
+  EXPECT_GE(census.feasible, 0.30 * 280);
+  EXPECT_LE(census.feasible, 0.80 * 280);
 }
 
 TEST(ReferenceStudyTest, TheStarvedCornerIsStoppedEarlyAtTheNavTimeBound) {

@@ -6,34 +6,21 @@
 
 #include <gtest/gtest.h>
 
-#include <set>
+#include "tests/harness/testing/recording.h"
 
 namespace adse::campaign {
 namespace {
 
-const std::string kRecording =
-    std::string(ADSE_SOURCE_DIR) + "/tests/data/robotaxi_exhaustive";
-
 const Recording& Recorded() {
-  static const Recording* recording = [] {
-    Result<Recording> r = LoadRecording(kRecording);
-    EXPECT_TRUE(r.ok()) << r.status().message();
-    return new Recording(r.ok() ? std::move(r).value() : Recording{});
-  }();
-  return *recording;
+  return adse::testing::RecordingUnderTestData("robotaxi_exhaustive");
 }
 
 TEST(ReplayTest, TheRecordingHoldsTheWholeSpaceWithAFeasibleFront) {
   ASSERT_EQ(Recorded().rows.size(), 280u);
-  std::set<spec::DesignPoint> points;
-  int feasible = 0;
-  for (const EvaluationRow& row : Recorded().rows) {
-    points.insert(row.point);
-    feasible += row.feasible;
-  }
-  EXPECT_EQ(points.size(), 280u);
-  EXPECT_GT(feasible, 100);
-  EXPECT_LT(feasible, 280) << "starved computers fail the constraints";
+  const adse::testing::Census census = adse::testing::CensusOf(Recorded());
+  EXPECT_EQ(census.distinct_points, 280u);
+  EXPECT_GT(census.feasible, 100);
+  EXPECT_LT(census.feasible, 280) << "starved computers fail the constraints";
 }
 
 TEST(ReplayTest, AgentFindsAtLeastSixTrueParetoPointsWithABudgetOf15) {
