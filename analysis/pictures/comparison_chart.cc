@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/pictures/internal/drawing.h"
+#include "analysis/pictures/internal/drawing_impl.h"
 #include "analysis/pictures/pictures.h"
 
 namespace adse::analysis {

@@ -16,7 +16,7 @@
 #include <opencv2/imgproc.hpp>
 #include <utility>
 
-#include "analysis/pictures/internal/drawing.h"
+#include "analysis/pictures/internal/drawing_impl.h"
 
 namespace adse::analysis::internal {
 

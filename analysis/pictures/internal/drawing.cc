@@ -1,4 +1,4 @@
-#include "analysis/pictures/internal/drawing.h"
+#include "analysis/pictures/internal/drawing_impl.h"
 
 #include <fmt/format.h>
 

@@ -1,7 +1,7 @@
 // Drawing primitives shared by the pictures (OpenCV); included only by
 // analysis/pictures .cc files, never by users of pictures.h.
-#ifndef ADSE_ANALYSIS_PICTURES_INTERNAL_DRAWING_H_
-#define ADSE_ANALYSIS_PICTURES_INTERNAL_DRAWING_H_
+#ifndef ADSE_ANALYSIS_PICTURES_INTERNAL_DRAWING_IMPL_H_
+#define ADSE_ANALYSIS_PICTURES_INTERNAL_DRAWING_IMPL_H_
 
 #include <exception>
 #include <new>
@@ -104,4 +104,4 @@ auto Guarded(const char* what, F&& f) -> decltype(f()) {
 
 }  // namespace adse::analysis::internal
 
-#endif  // ADSE_ANALYSIS_PICTURES_INTERNAL_DRAWING_H_
+#endif  // ADSE_ANALYSIS_PICTURES_INTERNAL_DRAWING_IMPL_H_
