@@ -79,6 +79,8 @@ std::optional<std::string> EarlyStop::Violated(
     const RunProgress& progress) const {
   const double t = progress.t_s;
   const double end = std::max(timeout_s_, t);
+  // One copy per step: each check overwrites only its own metric.
+  std::map<std::string, double> values = fixed_;
   for (const Check& check : checks_) {
     double lo = 0.0, hi = 0.0;
     const char* name = kNavTime;
@@ -110,7 +112,6 @@ std::optional<std::string> EarlyStop::Violated(
         hi = lo + kInteriorSamples + 1;
         break;
     }
-    std::map<std::string, double> values = fixed_;
     bool satisfiable = false;
     for (int i = 0; i <= kInteriorSamples + 1 && !satisfiable; ++i) {
       const double f = static_cast<double>(i) / (kInteriorSamples + 1);
