@@ -171,6 +171,30 @@ std::vector<int> RanksImpl(const std::vector<Evaluation>& evals) {
   return ranks;
 }
 
+double PointsHypervolumeImpl(const std::vector<std::vector<double>>& points,
+                             const std::vector<double>& reference) {
+  if (reference.empty() ||
+      std::any_of(reference.begin(), reference.end(),
+                  [](double r) { return !std::isfinite(r); })) {
+    return 0.0;
+  }
+  std::vector<pagmo::vector_double> inside;
+  for (const std::vector<double>& f : points) {
+    bool ok = f.size() == reference.size();
+    for (size_t k = 0; ok && k < f.size(); ++k) {
+      ok = std::isfinite(f[k]) && f[k] < reference[k];
+    }
+    if (ok) inside.push_back(f);
+  }
+  if (inside.empty()) return 0.0;
+  // Duplicates add no volume; dropping them keeps pagmo's input minimal.
+  std::sort(inside.begin(), inside.end());
+  inside.erase(std::unique(inside.begin(), inside.end()), inside.end());
+  if (reference.size() == 1) return reference[0] - inside.front()[0];
+  pagmo::hypervolume hv(inside, /*verify=*/false);
+  return hv.compute(reference);
+}
+
 double HypervolumeImpl(const std::vector<Evaluation>& evals,
                        const std::vector<double>& reference) {
   const Split split = SplitEvaluations(evals);
@@ -180,22 +204,11 @@ double HypervolumeImpl(const std::vector<Evaluation>& evals,
                   [](double r) { return !std::isfinite(r); })) {
     return kNaN;
   }
-  std::vector<pagmo::vector_double> points;
+  std::vector<std::vector<double>> points;
   for (int i : NonDominatedWithin(evals, split.feasible, split.m)) {
-    const auto& f = evals[i].objectives;
-    bool inside = true;
-    for (size_t k = 0; k < f.size(); ++k) {
-      inside = inside && std::isfinite(f[k]) && f[k] < reference[k];
-    }
-    if (inside) points.push_back(f);
+    points.push_back(evals[i].objectives);
   }
-  if (points.empty()) return 0.0;
-  // Duplicates add no volume; dropping them keeps pagmo's input minimal.
-  std::sort(points.begin(), points.end());
-  points.erase(std::unique(points.begin(), points.end()), points.end());
-  if (split.m == 1) return reference[0] - points.front()[0];
-  pagmo::hypervolume hv(points, /*verify=*/true);
-  return hv.compute(reference);
+  return PointsHypervolumeImpl(points, reference);
 }
 
 std::vector<double> ReferenceImpl(const std::vector<Evaluation>& evals,
@@ -265,6 +278,32 @@ bool SameDesignPoint(const std::map<std::string, double>& a,
 
 // pagmo reports bad input by throwing; the checks above make that a bug,
 // so these edges only keep exceptions from escaping.
+double PointsHypervolume(const std::vector<std::vector<double>>& points,
+                         const std::vector<double>& reference) {
+  try {
+    return PointsHypervolumeImpl(points, reference);
+  } catch (const std::exception&) {
+    return 0.0;
+  }
+}
+
+bool Dominates(const std::vector<double>& a, const std::vector<double>& b) {
+  bool better = false;
+  for (size_t i = 0; i < a.size() && i < b.size(); ++i) {
+    if (a[i] > b[i]) return false;
+    if (a[i] < b[i]) better = true;
+  }
+  return better;
+}
+
+bool WeaklyDominates(const std::vector<double>& a,
+                     const std::vector<double>& b) {
+  for (size_t i = 0; i < a.size() && i < b.size(); ++i) {
+    if (a[i] > b[i]) return false;
+  }
+  return true;
+}
+
 std::vector<int> ParetoFront(const std::vector<Evaluation>& evals) {
   try {
     return FrontImpl(evals);

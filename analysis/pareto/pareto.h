@@ -52,6 +52,22 @@ std::vector<int> ParetoRanks(const std::vector<Evaluation>& evals);
 double Hypervolume(const std::vector<Evaluation>& evals,
                    const std::vector<double>& reference);
 
+// The same volume for bare objective vectors of equal size (minimisation),
+// all taken as feasible: the volume they dominate within `reference`.
+// Points not strictly better than the reference everywhere, or with a
+// non-finite objective, add nothing; 0 when none is left or the reference
+// size differs from the points'. Cheap for the small sets a strategy scores
+// many times per round (pagmo's exact algorithms, no copies of maps).
+double PointsHypervolume(const std::vector<std::vector<double>>& points,
+                         const std::vector<double>& reference);
+
+// Pareto dominance (minimisation) of two objective vectors of equal size:
+// `a` is no worse anywhere and better somewhere.
+bool Dominates(const std::vector<double>& a, const std::vector<double>& b);
+// `a` is no worse anywhere (equal vectors weakly dominate each other).
+bool WeaklyDominates(const std::vector<double>& a,
+                     const std::vector<double>& b);
+
 // A reference point for Hypervolume: per objective, the worst (largest)
 // finite value among feasible usable evaluations, moved outwards by
 // margin × |worst| (by `margin` itself when the worst is 0), so the

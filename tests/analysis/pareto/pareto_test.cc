@@ -227,6 +227,27 @@ TEST(ParetoHypervolumeTest, NothingFeasibleOrNothingInsideIsZero) {
   EXPECT_EQ(Hypervolume({Eval({kInf, 0})}, {1, 1}), 0.0);
 }
 
+TEST(ParetoHypervolumeTest, BareVectorsGiveTheSameVolume) {
+  const std::vector<std::vector<double>> points = {
+      {1, 3}, {2, 2}, {3, 1}, {2.5, 2.5}, {2, 2}, {0.5, 10}, {4, 0.5}};
+  EXPECT_DOUBLE_EQ(PointsHypervolume(points, {4, 4}), 6.0);
+  EXPECT_DOUBLE_EQ(PointsHypervolume({{1, 2, 2}, {2, 1, 1}}, {3, 3, 3}), 5.0);
+  EXPECT_DOUBLE_EQ(PointsHypervolume({{3}, {1.5}}, {4}), 2.5);
+  EXPECT_EQ(PointsHypervolume({}, {1, 1}), 0.0);
+  EXPECT_EQ(PointsHypervolume({{kNaN, 0}}, {1, 1}), 0.0);
+  EXPECT_EQ(PointsHypervolume({{0, 0}}, {1}), 0.0);  // size mismatch
+  EXPECT_EQ(PointsHypervolume({{0, 0}}, {1, kInf}), 0.0);
+}
+
+TEST(ParetoDominanceTest, StrictAndWeak) {
+  EXPECT_TRUE(analysis::Dominates({1, 2}, {1, 3}));
+  EXPECT_FALSE(analysis::Dominates({1, 2}, {1, 2}));
+  EXPECT_FALSE(analysis::Dominates({1, 4}, {2, 3}));
+  EXPECT_TRUE(WeaklyDominates({1, 2}, {1, 2}));
+  EXPECT_TRUE(WeaklyDominates({0, 2}, {1, 2}));
+  EXPECT_FALSE(WeaklyDominates({1, 3}, {1, 2}));
+}
+
 TEST(ParetoHypervolumeTest, BadReferenceIsNaN) {
   const std::vector<Evaluation> evals = {Eval({1, 1})};
   EXPECT_TRUE(std::isnan(Hypervolume(evals, {2})));

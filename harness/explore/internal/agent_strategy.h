@@ -1,0 +1,190 @@
+// The built-in `agent` strategy's state, with its steps split by role:
+// agent.cc keeps the memory of told runs and fits the surrogates,
+// acquisition.cc scores candidates and chooses, rationale.cc says why.
+// Internal to harness/explore; only those files include it.
+#ifndef ADSE_HARNESS_EXPLORE_INTERNAL_AGENT_STRATEGY_H_
+#define ADSE_HARNESS_EXPLORE_INTERNAL_AGENT_STRATEGY_H_
+
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "harness/explore/internal/surrogate.h"
+#include "harness/explore/strategy.h"
+#include "harness/spec/expression.h"
+#include "stack/base/random.h"
+
+namespace adse::explore::internal {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Joint samples of the predicted metrics per candidate.
+constexpr int kSamples = 64;
+// Spaces up to this size are scored exhaustively.
+constexpr uint64_t kEnumerateLimit = 4096;
+// Random candidates drawn in larger spaces (plus neighbours of seen points).
+constexpr int kSampledCandidates = 2000;
+// In larger spaces, the neighbours of this many latest runs are scored too.
+constexpr size_t kNeighbourhoods = 48;
+// The surrogates learn from at most this many (most recent) runs.
+constexpr size_t kMaxModelPoints = 160;
+// The prior slope a sensor rate gets when the diagnosis of an infeasible
+// run names it (sign from the remedy).
+constexpr double kRateVote = 0.3;
+// Default GP length scales over normalised knobs: most knobs, and those
+// with at most 3 values.
+constexpr double kLength = 0.25;
+constexpr double kFewValuesLength = 1.0;
+// Failed runs: how likely a run works is a kernel vote of the runs within
+// about kRunsSteps grid steps, next to a prior of kRunsPrior worth
+// kRunsPriorWeight runs.
+constexpr double kRunsSteps = 1.5;
+constexpr double kRunsPrior = 0.9;
+constexpr double kRunsPriorWeight = 0.3;
+// Weight of the (normalised) expected hypervolume gain next to the
+// probability of landing on the predicted front.
+constexpr double kHypervolumeWeight = 0.3;
+// The metric computed from the cost expression rather than modelled.
+constexpr char kCostMetric[] = "hardware_cost";
+// The flag of a run that reached its goal.
+constexpr char kCompletedMetric[] = "completed";
+
+enum class KnobRole { kCores, kFrequency, kRate, kOther };
+
+struct Knob {
+  const spec::DesignParameter* parameter = nullptr;
+  KnobRole role = KnobRole::kOther;
+  std::vector<double> u;  // normalised coordinate of each allowed value
+  std::string sensor;     // for a rate: the bind's middle part ("lidar")
+};
+
+struct Record {
+  Genes genes;
+  Observation observation;
+  std::vector<double> objectives;  // minimisation form, NaN when failed
+  bool feasible = false;
+  bool failed = false;
+};
+
+struct Candidate {
+  Genes genes;
+  std::vector<double> u;
+  double cost = kNaN;        // exact, from the cost expression
+  std::vector<double> mean;  // per model, model units
+  std::vector<double> sd;
+  double p_feasible = 0.0;
+  double gain = 0.0;     // expected hypervolume gain (normalised)
+  double p_front = 0.0;  // probability of joining the predicted front
+  double factor = 1.0;   // diagnosis multiplier
+  double runs = 1.0;     // probability that a run there does not fail
+  double score = 0.0;
+  std::string hint;  // the remedy it follows, if any
+};
+
+class AgentStrategy : public Strategy {
+ public:
+  explicit AgentStrategy(const spec::Spec& spec);
+  std::vector<spec::DesignPoint> Ask(int k) override;
+  void Tell(const Observation& observation) override;
+  std::string name() const override { return "agent"; }
+  std::string rationale() const override { return rationale_; }
+
+ private:
+  void Remember(const Observation& observation);
+
+  std::string Fallback(int n, std::vector<Genes>* chosen);
+
+  void SetUpKnobs();
+
+  void SetUpMetrics();
+
+  std::vector<double> Objectives(const Observation& observation) const;
+
+  std::vector<double> Coordinates(const Genes& genes) const;
+
+  // Which way constraint-only metrics should move: probe each constraint
+  // with the metric halved and doubled around the latest usable run.
+  void ProbeDirections();
+
+  // Remedy directions (per knob, -1/0/+1) from one run's diagnosis.
+  std::vector<int> RemedyDirections(const Record& record,
+                                    std::string* text) const;
+
+  void FitModels();
+
+  std::vector<Genes> Candidates(const std::vector<Genes>& chosen);
+
+  double Cost(const Genes& genes) const;
+
+  // Objectives (minimisation form) and feasibility of sample s.
+  bool SampleOutcome(const Candidate& c, int s, std::vector<double>* objectives,
+                     std::map<std::string, double>* scratch) const;
+
+  // The expected objectives at a candidate (sample means, minimisation).
+  std::vector<double> MeanObjectives(const Candidate& c) const;
+
+  // Chooses up to n points (after those already in `chosen`); returns the
+  // sentence that explains the first model-based choice.
+  std::string Choose(int n, std::vector<Genes>* chosen);
+
+  Candidate Predicted(const Genes& genes) const;
+
+  static double Distance2(const std::vector<double>& a,
+                          const std::vector<double>& b);
+
+  // Grid steps between two points (Euclidean over value indices).
+  static double Steps(const Genes& a, const Genes& b);
+
+  // How likely a run at the candidate is to work at all: a kernel-weighted
+  // vote of the runs around it (in grid steps), next to a prior that runs
+  // work.
+  double RunsProbability(const Candidate& c) const;
+
+  // Diagnosis: candidates that move from the latest runs only the way
+  // their remedies say get a bonus.
+  void ApplyFactors(std::vector<Candidate>* candidates);
+
+  std::string SpaceFilling(std::vector<Candidate>* candidates, int wanted,
+                           std::vector<Genes>* chosen);
+
+  std::string Describe(const spec::DesignPoint& point) const;
+
+  // What the latest run showed.
+  std::string LastText() const;
+
+  std::string ExplainChoice(const Candidate& pick,
+                            const std::vector<double>& mean, double base,
+                            int usable_runs) const;
+
+  const spec::Spec* spec_;
+  SpaceGrid grid_;
+  int budget_;
+  Random random_;
+  std::vector<Knob> knobs_;
+  std::vector<double> lengths_;  // GP length scale per knob
+  std::vector<MetricModel> models_;
+  bool any_failed_ = false;
+  std::vector<spec::Expression> constraints_;
+  std::vector<std::vector<double>> z_;  // [sample][model]
+  std::vector<int> objective_model_;    // per objective, index or -1
+  std::optional<Genes> start_;
+  int proposed_ = 0;
+  int fresh_ = 0;  // runs told since the last Ask
+  std::set<Genes> seen_;
+  std::set<Genes> told_;
+  std::set<Genes> pending_;
+  std::vector<Record> records_;
+  std::string rationale_;
+};
+
+// A number for the rationale: 3 significant digits, "n/a" for NaN.
+std::string Num(double value);
+
+}  // namespace adse::explore::internal
+
+#endif  // ADSE_HARNESS_EXPLORE_INTERNAL_AGENT_STRATEGY_H_

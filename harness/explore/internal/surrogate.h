@@ -1,0 +1,119 @@
+// The built-in agent's surrogate of one metric: a parametric trend over
+// the normalised knobs (fitted with Ceres under a robust loss) plus a small
+// Gaussian process on its residuals, which interpolates the runs and gives
+// an uncertainty that grows with the distance from them. Internal to the
+// agent (harness/explore/agent*.cc).
+#ifndef ADSE_HARNESS_EXPLORE_INTERNAL_SURROGATE_H_
+#define ADSE_HARNESS_EXPLORE_INTERNAL_SURROGATE_H_
+
+#include <Eigen/Dense>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace adse::explore::internal {
+
+// Inverse of the standard normal CDF (Acklam's rational approximation,
+// relative error < 1.2e-9), for stratified samples.
+double NormalQuantile(double p);
+
+// The parametric trend over normalised knobs u (fitted with Ceres).
+enum class TrendShape { kLinear, kFloor, kCeiling };
+
+struct Trend {
+  TrendShape shape = TrendShape::kLinear;
+  double a = 0.0;
+  std::vector<double> b;
+  double f = 0.0;
+  double cost = std::numeric_limits<double>::infinity();  // final Ceres cost
+                                                          // (data + priors)
+
+  double Value(const std::vector<double>& u) const;
+};
+
+// Gaussian process on the trend's residuals: a constant, a linear and a
+// squared-exponential kernel plus noise.
+class ResidualGp {
+ public:
+  struct Hyper {
+    double constant2 = 0.01;
+    double linear2 = 0.25;
+    double signal2 = 0.01;
+    std::vector<double> lengths;  // per knob
+    double noise2 = 4e-4;
+  };
+
+  // Returns the log marginal likelihood (or -inf when singular).
+  double Fit(const std::vector<std::vector<double>>& x,
+             const std::vector<double>& r, const Hyper& hyper);
+
+  // Mean and variance of an observation at u (noise included).
+  void Predict(const std::vector<double>& u, double* mean,
+               double* variance) const;
+
+ private:
+  double Kernel(const std::vector<double>& a,
+                const std::vector<double>& b) const;
+
+  Hyper hyper_;
+  std::vector<std::vector<double>> x_;
+  Eigen::LLT<Eigen::MatrixXd> llt_;
+  Eigen::VectorXd alpha_;
+};
+
+// How a metric is modelled: log of a positive metric, a standardised
+// value, or a 0/1 flag.
+enum class MetricSpace { kLog, kLinear, kBoolean };
+
+class MetricModel {
+ public:
+  std::string name;
+  // +1: higher is better (maximised, or a constraint wants it high), -1:
+  // lower is better, 0: unknown. Used for the prior slopes.
+  int good_direction = 0;
+  bool in_constraint = false;
+  bool boolean_hint = false;  // documented as 0/1
+
+  bool fitted() const { return fitted_; }
+  int points() const { return points_; }
+  MetricSpace space() const { return space_; }
+
+  // Fits the trend and the residual GP to (u, value) pairs. `prior_slope`
+  // holds one prior mean per knob in model units (before the direction),
+  // `lengths` the GP's default length scale per knob.
+  void Fit(const std::vector<std::vector<double>>& u,
+           const std::vector<double>& values,
+           const std::vector<double>& prior_slope,
+           const std::vector<double>& lengths);
+
+  // Mean and standard deviation in model units.
+  void Predict(const std::vector<double>& u, double* mean, double* sd) const;
+
+  // A sampled value as an objective may use it: no better than the best
+  // run seen by more than kOptimismRoom (model units), since a surrogate
+  // extrapolates too eagerly.
+  double Bounded(double value) const;
+
+  // A model value back in metric units.
+  double ToMetric(double t) const;
+
+ private:
+  static Trend FitTrend(TrendShape shape,
+                        const std::vector<std::vector<double>>& u,
+                        const std::vector<double>& t,
+                        const std::vector<double>& mu, double slope_sd,
+                        double sigma);
+
+  bool fitted_ = false;
+  int points_ = 0;
+  double best_ = std::numeric_limits<double>::quiet_NaN();
+  MetricSpace space_ = MetricSpace::kLog;
+  double shift_ = 0.0;
+  double scale_ = 1.0;
+  Trend trend_;
+  ResidualGp gp_;
+};
+
+}  // namespace adse::explore::internal
+
+#endif  // ADSE_HARNESS_EXPLORE_INTERNAL_SURROGATE_H_
