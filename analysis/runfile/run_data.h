@@ -62,6 +62,19 @@ inline constexpr char kRunComplete[] = "complete";
 inline constexpr char kRunInfeasible[] = "infeasible";
 inline constexpr char kRunFailed[] = "failed";
 
+// The termination reason of an early-stopped run is this prefix followed
+// by the constraint, exactly as the scenario writes it.
+inline constexpr char kConstraintViolatedPrefix[] = "constraint_violated: ";
+
+// The constraint an early-stopped run's reason names; empty for any other
+// reason.
+inline std::string ViolatedConstraint(const std::string& reason) {
+  const std::string prefix = kConstraintViolatedPrefix;
+  return reason.compare(0, prefix.size(), prefix) == 0
+             ? reason.substr(prefix.size())
+             : std::string();
+}
+
 struct RunData {
   // Identity and provenance (root attributes).
   std::string status = kRunComplete;  // kRunComplete|kRunInfeasible|kRunFailed

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/metrics/run_metrics.h"
+#include "analysis/runfile/run_data.h"
 
 namespace adse::campaign {
 
@@ -96,6 +97,9 @@ explore::Observation ObservationFromRow(const EvaluationRow& row) {
     if (!std::isnan(value)) o.metrics[name] = value;
   }
   o.feasible = row.feasible;
+  o.censored = RowMetric(row, analysis::kCensoredMetric) == 1.0;
+  if (o.censored)
+    o.violated_constraint = runfile::ViolatedConstraint(row.reason);
   // The diagnosis is advisory: a row whose JSON does not parse (written by
   // hand, or damaged) is simply told without it.
   const nlohmann::json j =

@@ -52,8 +52,9 @@ struct ReplayRun {
   double hypervolume_ratio = 0.0;
   // Evaluation index (1-based) of the first true Pareto point, 0 if none.
   int first_true_pareto_at = 0;
-  // Whether it evaluated the recording's cheapest feasible design (what
-  // the user asked for); false when the recording has none.
+  // Whether it evaluated a feasible design at the recording's cheapest
+  // feasible cost (what the user asked for; designs tying in cost are
+  // equally cheap); false when the recording has none.
   bool found_cheapest_feasible = false;
   std::vector<spec::DesignPoint> proposals;  // in order
 };

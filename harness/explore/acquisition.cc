@@ -86,6 +86,13 @@ bool AgentStrategy::SampleOutcome(
     values[knobs_[d].parameter->name] = knobs_[d].parameter->values[c.genes[d]];
   }
   for (const spec::Expression& constraint : constraints_) {
+    // A constraint on a metric no run has shown yet cannot be predicted:
+    // it is taken to hold until a run says otherwise.
+    bool known = true;
+    for (const std::string& variable : constraint.variables()) {
+      known = known && values.count(variable) > 0;
+    }
+    if (!known) continue;
     const double v = constraint.Evaluate(values);
     if (!std::isfinite(v) || v == 0.0) return false;
   }
@@ -273,6 +280,22 @@ std::string AgentStrategy::Choose(int n, std::vector<Genes>* chosen) {
       c.p_front = static_cast<double>(on_front[i]) / kSamples * c.runs;
       max_gain = std::max(max_gain, c.gain);
     }
+    // What the user asked for is the cheapest feasible design: while no run
+    // is feasible, and on every kCheapestEvery-th pick after, the pick goes
+    // to the cheapest design instead of the front's volume.
+    const int best_cheap = CheapestPick(candidates, *chosen);
+    if (best_cheap >= 0) {
+      const Candidate& pick = candidates[best_cheap];
+      chosen->push_back(pick.genes);
+      const std::vector<double> mean = mean_objectives[best_cheap];
+      if (pick.p_feasible >= 0.5) front.push_back(normalise(mean));
+      if (text.empty()) {
+        text = ExplainCheapest(pick, mean, usable_runs);
+      } else {
+        extra.push_back(Describe(grid_.ToPoint(pick.genes)));
+      }
+      continue;
+    }
     int best = -1;
     for (size_t i = 0; i < candidates.size(); ++i) {
       Candidate& c = candidates[i];
@@ -316,6 +339,47 @@ std::string AgentStrategy::Choose(int n, std::vector<Genes>* chosen) {
         fmt::join(extra, "), ("));
   }
   return text;
+}
+
+int AgentStrategy::CheapestPick(const std::vector<Candidate>& candidates,
+                                const std::vector<Genes>& chosen) const {
+  double cheapest = kInf;  // the cheapest feasible run's cost
+  for (const Record& record : records_) {
+    if (!record.feasible) continue;
+    const double cost = Cost(record.genes);
+    if (std::isfinite(cost)) cheapest = std::min(cheapest, cost);
+  }
+  const int pick = proposed_ + static_cast<int>(chosen.size());
+  const bool none_feasible = !std::isfinite(cheapest);
+  if (!none_feasible && pick % kCheapestEvery != kCheapestEvery - 1) return -1;
+  int best = -1;
+  double best_score = 0.0;
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    const Candidate& c = candidates[i];
+    if (!std::isfinite(c.cost) ||
+        std::find(chosen.begin(), chosen.end(), c.genes) != chosen.end()) {
+      continue;
+    }
+    double score;
+    if (none_feasible) {
+      // The cheapest candidate that is probably feasible; failing that,
+      // the one most likely feasible.
+      score = c.p_feasible >= 0.5 ? 2.0 - c.cost / (1.0 + std::abs(c.cost))
+                                  : c.p_feasible;
+    } else {
+      // Expected saving over the cheapest feasible run, relative; among
+      // equal savings, the one likelier on the front.
+      score = c.p_feasible * std::max(0.0, cheapest - c.cost) / cheapest +
+              1e-3 * c.p_front;
+    }
+    if (score > best_score + 1e-12) {
+      best_score = score;
+      best = static_cast<int>(i);
+    }
+  }
+  // A saving this unlikely is not worth a run the front could use.
+  if (!none_feasible && best_score < kMinCheapestSaving + 1e-3) return -1;
+  return best;
 }
 
 Candidate AgentStrategy::Predicted(const Genes& genes) const {

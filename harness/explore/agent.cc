@@ -134,6 +134,7 @@ void AgentStrategy::Remember(const Observation& observation) {
   record.failed = observation.failed;
   record.feasible = observation.feasible && !observation.failed;
   record.objectives = Objectives(observation);
+  if (observation.censored) record.censored = CensoredAt(observation);
   records_.push_back(std::move(record));
   ++fresh_;
 }
@@ -161,15 +162,12 @@ void AgentStrategy::SetUpKnobs() {
        spec_->design_space.parameters) {
     Knob knob;
     knob.parameter = &parameter;
-    if (parameter.bind == "platform.cores") {
-      knob.role = KnobRole::kCores;
-    } else if (parameter.bind == "platform.freq_ghz") {
-      knob.role = KnobRole::kFrequency;
-    } else if (parameter.bind.rfind("stack.", 0) == 0 &&
-               (parameter.bind.find("rate") != std::string::npos ||
-                parameter.bind.find("_hz") != std::string::npos)) {
-      knob.role = KnobRole::kRate;
-      const std::string rest = parameter.bind.substr(6);
+    knob.role = parameter.role;
+    const std::string prefix = "stack.";
+    if (knob.role == KnobRole::kSensorRate &&
+        parameter.bind.compare(0, prefix.size(), prefix) == 0) {
+      // stack.lidar.rate_hz: the sensor is the knob's first path part.
+      const std::string rest = parameter.bind.substr(prefix.size());
       knob.sensor = rest.substr(0, rest.find('.'));
     }
     const std::vector<double>& values = parameter.values;
@@ -179,6 +177,7 @@ void AgentStrategy::SetUpKnobs() {
     };
     const double lo = values.empty() ? 0.0 : transform(values.front());
     const double hi = values.empty() ? 0.0 : transform(values.back());
+    knob.log_range = positive ? hi - lo : 1.0;
     for (double v : values) {
       knob.u.push_back(hi > lo ? (transform(v) - lo) / (hi - lo) : 0.0);
     }
@@ -222,6 +221,7 @@ void AgentStrategy::SetUpMetrics() {
       add(variable)->in_constraint = true;
     }
     constraints_.push_back(std::move(*expression));
+    constraint_texts_.push_back(text);
   }
   for (const spec::Objective& objective : spec_->objectives) {
     int index = -1;
@@ -310,7 +310,7 @@ std::vector<int> AgentStrategy::RemedyDirections(const Record& record,
       } else if (knob.role == KnobRole::kFrequency &&
                  remedy.find("higher frequency") != std::string::npos) {
         want = +1;
-      } else if (knob.role == KnobRole::kRate) {
+      } else if (knob.role == KnobRole::kSensorRate) {
         const bool names_sensor =
             !knob.sensor.empty() &&
             (hint.node.find(knob.sensor) != std::string::npos ||
@@ -334,8 +334,68 @@ std::vector<int> AgentStrategy::RemedyDirections(const Record& record,
   return direction;
 }
 
+std::optional<CensoredBound> AgentStrategy::CensoredAt(
+    const Observation& observation) const {
+  const auto found =
+      std::find(constraint_texts_.begin(), constraint_texts_.end(),
+                observation.violated_constraint);
+  if (found == constraint_texts_.end()) return std::nullopt;
+  const spec::Expression& constraint =
+      constraints_[found - constraint_texts_.begin()];
+  const MetricModel* model = nullptr;
+  for (const std::string& variable : constraint.variables()) {
+    for (const MetricModel& m : models_) {
+      if (m.name != variable) continue;
+      if (model != nullptr) return std::nullopt;  // two metrics: no bound
+      model = &m;
+    }
+  }
+  if (model == nullptr) return std::nullopt;
+  // Where the constraint flips, with the run's point fixed: scan a wide
+  // log grid of the metric for the first change of truth, then bisect.
+  // Early stop decides only constraints monotone in their metric's final
+  // value, so one change is expected; none means no usable bound.
+  std::map<std::string, double> values = observation.point;
+  Result<double> cost = spec::EvaluateCost(*spec_, observation.point);
+  if (cost.ok()) values[kCostMetric] = *cost;
+  auto holds = [&](double metric) {
+    values[model->name] = metric;
+    const double v = constraint.Evaluate(values);
+    return std::isfinite(v) && v != 0.0;
+  };
+  std::vector<double> grid = {0.0};
+  for (int k = -48; k <= 72; ++k) grid.push_back(std::pow(10.0, k / 8.0));
+  for (size_t i = 1; i < grid.size(); ++i) {
+    const bool low = holds(grid[i - 1]);
+    if (low == holds(grid[i])) continue;
+    double a = grid[i - 1];
+    double b = grid[i];
+    for (int iteration = 0; iteration < 60; ++iteration) {
+      const double mid = 0.5 * (a + b);
+      (holds(mid) == low ? a : b) = mid;
+    }
+    CensoredBound bound;
+    bound.metric = model->name;
+    bound.bound = 0.5 * (a + b);
+    // The run's value lies where the constraint fails.
+    bound.side = low ? +1 : -1;
+    return bound;
+  }
+  return std::nullopt;
+}
+
 void AgentStrategy::FitModels() {
   ProbeDirections();
+  // A metric only a constraint reads, seen only past its bound, improves
+  // away from where the stopped runs lie.
+  for (MetricModel& model : models_) {
+    for (const Record& record : records_) {
+      if (model.good_direction == 0 && record.censored &&
+          record.censored->metric == model.name) {
+        model.good_direction = -record.censored->side;
+      }
+    }
+  }
   // Prior slope sizes per knob: resources help; the diagnosis of any
   // infeasible run strengthens the knob it names.
   std::vector<double> prior(knobs_.size(), 0.0);
@@ -348,9 +408,17 @@ void AgentStrategy::FitModels() {
   for (size_t d = 0; d < knobs_.size(); ++d) {
     const KnobRole role = knobs_[d].role;
     if (role == KnobRole::kCores || role == KnobRole::kFrequency) {
-      prior[d] = votes[d] > 0 ? 1.0 : 0.6;
-    } else if (role == KnobRole::kRate && votes[d] != 0) {
-      prior[d] = votes[d] > 0 ? kRateVote : -kRateVote;
+      // Per unit of log capacity, cores and clock help alike: the prior is
+      // an elasticity, so over the normalised knob it scales with the
+      // knob's log range (1..28 cores spans 4.5 times 1.0..2.1 GHz).
+      prior[d] =
+          (votes[d] > 0 ? kVotedElasticity : kElasticity) * knobs_[d].log_range;
+    } else if (role == KnobRole::kSensorRate) {
+      // A faster sensor loads the whole chain behind it: it hurts, by
+      // default a little; the diagnosis may say which way it goes here.
+      prior[d] = votes[d] > 0   ? kRateVote
+                 : votes[d] < 0 ? -kRateVote
+                                : -kSensorElasticity * knobs_[d].log_range;
     }
   }
   const size_t first =
@@ -366,6 +434,7 @@ void AgentStrategy::FitModels() {
   for (MetricModel& model : models_) {
     std::vector<std::vector<double>> u;
     std::vector<double> values;
+    std::vector<int> sides;
     for (size_t i = first; i < records_.size(); ++i) {
       const Record& record = records_[i];
       if (record.failed) continue;
@@ -375,6 +444,12 @@ void AgentStrategy::FitModels() {
           continue;
         }
       }
+      if (record.censored && record.censored->metric == model.name) {
+        u.push_back(Coordinates(record.genes));
+        values.push_back(record.censored->bound);
+        sides.push_back(record.censored->side);
+        continue;
+      }
       auto it = record.observation.metrics.find(model.name);
       if (it == record.observation.metrics.end() ||
           !std::isfinite(it->second)) {
@@ -382,12 +457,13 @@ void AgentStrategy::FitModels() {
       }
       u.push_back(Coordinates(record.genes));
       values.push_back(it->second);
+      sides.push_back(0);
     }
     std::vector<double> slope = prior;
     if (!model.in_constraint) {
       for (double& s : slope) s *= 0.4;
     }
-    model.Fit(u, values, slope, lengths_);
+    model.Fit(u, values, sides, slope, lengths_);
   }
   any_failed_ = false;
   for (const Record& record : records_) {

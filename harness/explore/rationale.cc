@@ -83,15 +83,30 @@ std::string AgentStrategy::LastText() const {
                      diagnosis.empty() ? "" : "; " + diagnosis);
 }
 
-std::string AgentStrategy::ExplainChoice(const Candidate& pick,
-                                         const std::vector<double>& mean,
-                                         double base, int usable_runs) const {
+std::string AgentStrategy::Predictions(const std::vector<double>& mean) const {
   std::vector<std::string> predicted;
   for (size_t j = 0; j < spec_->objectives.size(); ++j) {
     const spec::Objective& objective = spec_->objectives[j];
     const double v = objective.minimize ? mean[j] : -mean[j];
     predicted.push_back(fmt::format("{} {}", objective.metric, Num(v)));
   }
+  return fmt::format("{}", fmt::join(predicted, ", "));
+}
+
+std::string AgentStrategy::ExplainCheapest(const Candidate& pick,
+                                           const std::vector<double>& mean,
+                                           int usable_runs) const {
+  return fmt::format(
+      "Looking for the cheapest feasible design: model ({} run{}) predicts "
+      "({}), cost {}, feasible with p={:.2f} at {}.",
+      usable_runs, usable_runs == 1 ? "" : "s",
+      Describe(grid_.ToPoint(pick.genes)), Num(pick.cost), pick.p_feasible,
+      Predictions(mean));
+}
+
+std::string AgentStrategy::ExplainChoice(const Candidate& pick,
+                                         const std::vector<double>& mean,
+                                         double base, int usable_runs) const {
   std::string reason;
   if (!pick.hint.empty()) {
     reason = fmt::format(", following {}", pick.hint);
@@ -101,7 +116,7 @@ std::string AgentStrategy::ExplainChoice(const Candidate& pick,
       "p={:.2f} it joins the predicted Pareto front, expected hypervolume "
       "gain {:.3g} over {:.3g}{}.",
       usable_runs, usable_runs == 1 ? "" : "s",
-      Describe(grid_.ToPoint(pick.genes)), pick.p_feasible,
-      fmt::join(predicted, ", "), pick.p_front, pick.gain, base, reason);
+      Describe(grid_.ToPoint(pick.genes)), pick.p_feasible, Predictions(mean),
+      pick.p_front, pick.gain, base, reason);
 }
 }  // namespace adse::explore::internal

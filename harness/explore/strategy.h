@@ -46,6 +46,12 @@ struct Observation {
   std::map<std::string, double> metrics;
   bool feasible = false;  // all constraints hold
   bool failed = false;    // the run failed (no metrics)
+  // The run was stopped early because `violated_constraint` (as the
+  // scenario writes it) could no longer hold: infeasible, its metrics other
+  // than hardware_cost withheld, and the constraint's metric known to lie
+  // on the violating side of its bound.
+  bool censored = false;
+  std::string violated_constraint;
   // The run's diagnosis, most severe first (empty when healthy or failed).
   std::vector<BottleneckHint> bottlenecks;
   // The run's content key, when it has a run (agents read its report).

@@ -251,7 +251,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
       if (std::optional<std::string> violated =
               early_stop->Violated(progress)) {
         status = runfile::kRunInfeasible;
-        reason = "constraint_violated: " + *violated;
+        reason = runfile::kConstraintViolatedPrefix + *violated;
         break;
       }
     }

@@ -17,9 +17,17 @@ namespace adse::spec {
 // A design point: parameter name -> value, ordered by name.
 using DesignPoint = std::map<std::string, double>;
 
+// What a design parameter stands for, for strategies that reason about
+// capacity (the built-in agent's priors and the diagnosis' remedies):
+// none, cores, frequency, sensor_rate.
+enum class KnobRole { kNone, kCores, kFrequency, kSensorRate };
+
 struct DesignParameter {
   std::string name;  // key under design_space:
   std::string bind;  // "platform.cores", "stack.lidar.rate_hz", ...
+  // `role:`; by default cores for platform.cores, frequency for
+  // platform.freq_ghz, sensor_rate for a sensor's rate knob, else none.
+  KnobRole role = KnobRole::kNone;
   // The allowed values, ascending and distinct. A `range: [lo, hi]` with an
   // optional `step` (default 1) is expanded here.
   std::vector<double> values;

@@ -353,6 +353,10 @@ const std::vector<Field<Spec>>& SpecFields() {
            out << YAML::Key << d.name << YAML::Value << YAML::Flow
                << YAML::BeginMap;
            out << YAML::Key << "bind" << YAML::Value << d.bind;
+           if (d.role != DefaultKnobRole(d.bind)) {
+             out << YAML::Key << "role" << YAML::Value
+                 << KnobRoleToString(d.role);
+           }
            // A long regular list is written back as the range it came
            // from, so the normalised text stays within kMaxSpecBytes.
            std::string lo, hi, step;

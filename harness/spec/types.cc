@@ -2,7 +2,9 @@
 
 #include <algorithm>
 
+#include "harness/spec/internal/spec_reader.h"
 #include "stack/base/vocabulary.h"
+#include "stack/config/stack_config.h"
 
 namespace adse::spec {
 namespace {
@@ -19,7 +21,35 @@ const std::vector<Term<CostModel>>& CostModelTerms() {
   return kTerms;
 }
 
+const std::vector<Term<KnobRole>>& KnobRoleTerms() {
+  static const std::vector<Term<KnobRole>> kTerms = {
+      {KnobRole::kNone, "none"},
+      {KnobRole::kCores, "cores"},
+      {KnobRole::kFrequency, "frequency"},
+      {KnobRole::kSensorRate, "sensor_rate"}};
+  return kTerms;
+}
+
 }  // namespace
+
+const char* KnobRoleToString(KnobRole role) {
+  return NameOf(KnobRoleTerms(), role);
+}
+bool StringToKnobRole(std::string_view name, KnobRole* role) {
+  return ValueOf(KnobRoleTerms(), name, role);
+}
+std::vector<std::string> KnobRoleNames() { return NamesOf(KnobRoleTerms()); }
+
+KnobRole DefaultKnobRole(const std::string& bind) {
+  if (bind == internal::kPlatformCores) return KnobRole::kCores;
+  if (bind == internal::kPlatformFreq) return KnobRole::kFrequency;
+  const std::string prefix = "stack.";
+  if (bind.compare(0, prefix.size(), prefix) == 0) {
+    const KnobInfo* knob = FindStackKnob(bind.substr(prefix.size()));
+    if (knob != nullptr && knob->sensor_rate) return KnobRole::kSensorRate;
+  }
+  return KnobRole::kNone;
+}
 
 const char* PlatformKindToString(PlatformKind kind) {
   return NameOf(PlatformKindTerms(), kind);

@@ -18,6 +18,13 @@ const char* PlatformKindToString(PlatformKind kind);
 bool StringToPlatformKind(std::string_view name, PlatformKind* kind);
 std::vector<std::string> PlatformKindNames();
 
+// design_space.<name>.role: none, cores, frequency, sensor_rate.
+const char* KnobRoleToString(KnobRole role);
+bool StringToKnobRole(std::string_view name, KnobRole* role);
+std::vector<std::string> KnobRoleNames();
+// The role a parameter bound to `bind` has unless it says otherwise.
+KnobRole DefaultKnobRole(const std::string& bind);
+
 const char* CostModelToString(CostModel model);
 bool StringToCostModel(std::string_view name, CostModel* model);
 std::vector<std::string> CostModelNames();

@@ -11,7 +11,7 @@ const std::vector<KnobInfo>& StackKnobs() {
     const world::LidarParams d;
     return std::vector<KnobInfo>{
         {"lidar.rate_hz", false, 0.5, 100.0, d.rate_hz,
-         "LiDAR scans per second, Hz"},
+         "LiDAR scans per second, Hz", /*sensor_rate=*/true},
         {"lidar.beams", true, 1, 128, static_cast<double>(d.beams),
          "vertical channels"},
         {"lidar.horizontal_resolution_deg", false, 0.05, 10.0,
@@ -28,7 +28,7 @@ const std::vector<KnobInfo>& StackKnobs() {
          "range noise in clear weather, m"},
         // Wheel odometry from the vehicle.
         {"odometry.rate_hz", false, 1.0, 200.0, 50.0,
-         "wheel odometry messages per second, Hz"},
+         "wheel odometry messages per second, Hz", /*sensor_rate=*/true},
         // Localization.
         {"localization.voxel_leaf_m", false, 0.1, 5.0, 1.0,
          "voxel size of the scan given to NDT, m"},

@@ -21,6 +21,9 @@ struct KnobInfo {
   double max_value = 0.0;
   double default_value = 0.0;
   std::string doc;  // one line, with the unit
+  // A sensor's publishing rate: lowering it sheds load from the whole
+  // chain behind the sensor (a design space's default `role`).
+  bool sensor_rate = false;
 };
 
 // Every knob the stack has, in a stable order.

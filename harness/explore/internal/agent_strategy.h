@@ -33,6 +33,20 @@ constexpr int kSampledCandidates = 2000;
 constexpr size_t kNeighbourhoods = 48;
 // The surrogates learn from at most this many (most recent) runs.
 constexpr size_t kMaxModelPoints = 160;
+// Prior elasticity of a metric to a cores- or clock-like knob (how much
+// log metric per log knob), and after the diagnosis of an infeasible run
+// has asked for that knob.
+  const char* e = std::getenv("ADSE_TUNE");
+  if (!e) return d;
+  double v[8];
+  int n = std::sscanf(e, "%lf,%lf,%lf,%lf,%lf,%lf", v, v + 1, v + 2, v + 3,
+                      v + 4, v + 5);
+  return i < n ? v[i] : d;
+}
+constexpr double kElasticity = 0.5;
+constexpr double kVotedElasticity = 0.8;
+// ... and to a sensor-rate knob, which adds load rather than capacity.
+constexpr double kSensorElasticity = 0.5;
 // The prior slope a sensor rate gets when the diagnosis of an infeasible
 // run names it (sign from the remedy).
 constexpr double kRateVote = 0.3;
@@ -49,18 +63,36 @@ constexpr double kRunsPriorWeight = 0.3;
 // Weight of the (normalised) expected hypervolume gain next to the
 // probability of landing on the predicted front.
 constexpr double kHypervolumeWeight = 0.3;
+// Every this many picks, one goes to the cheapest design likely feasible
+// (what the user asked for) rather than the front's volume, unless its
+// expected relative saving over the cheapest feasible run is below
+// kMinCheapestSaving.
+constexpr int kCheapestEvery = 4;
+constexpr double kMinCheapestSaving = 0.02;
 // The metric computed from the cost expression rather than modelled.
 constexpr char kCostMetric[] = "hardware_cost";
 // The flag of a run that reached its goal.
 constexpr char kCompletedMetric[] = "completed";
 
-enum class KnobRole { kCores, kFrequency, kRate, kOther };
+using spec::KnobRole;
 
 struct Knob {
   const spec::DesignParameter* parameter = nullptr;
-  KnobRole role = KnobRole::kOther;
+  KnobRole role = KnobRole::kNone;  // from the design space
   std::vector<double> u;  // normalised coordinate of each allowed value
   std::string sensor;     // for a rate: the bind's middle part ("lidar")
+  // log(largest / smallest value) for a positive knob (normalised over
+  // log scale), else 1.
+  double log_range = 1.0;
+};
+
+// What a run stopped early says of its violated constraint's metric: its
+// final value lies beyond `bound` (metric units), above it when side is +1
+// (a time past its limit), below when -1 (a rate under its floor).
+struct CensoredBound {
+  std::string metric;
+  double bound = 0.0;
+  int side = 0;
 };
 
 struct Record {
@@ -69,6 +101,7 @@ struct Record {
   std::vector<double> objectives;  // minimisation form, NaN when failed
   bool feasible = false;
   bool failed = false;
+  std::optional<CensoredBound> censored;  // stopped early, bound known
 };
 
 struct Candidate {
@@ -115,6 +148,10 @@ class AgentStrategy : public Strategy {
   std::vector<int> RemedyDirections(const Record& record,
                                     std::string* text) const;
 
+  // The bound a censored run puts on its violated constraint's metric;
+  // nothing when the constraint is unknown or not a bound on one metric.
+  std::optional<CensoredBound> CensoredAt(const Observation& observation) const;
+
   void FitModels();
 
   std::vector<Genes> Candidates(const std::vector<Genes>& chosen);
@@ -131,6 +168,11 @@ class AgentStrategy : public Strategy {
   // Chooses up to n points (after those already in `chosen`); returns the
   // sentence that explains the first model-based choice.
   std::string Choose(int n, std::vector<Genes>* chosen);
+
+  // The index of the candidate to pick for the cheapest feasible design,
+  // or -1 when this pick belongs to the front (see kCheapestEvery).
+  int CheapestPick(const std::vector<Candidate>& candidates,
+                   const std::vector<Genes>& chosen) const;
 
   Candidate Predicted(const Genes& genes) const;
 
@@ -157,6 +199,13 @@ class AgentStrategy : public Strategy {
   // What the latest run showed.
   std::string LastText() const;
 
+  // "metric value, ..." of the objectives' predicted means.
+  std::string Predictions(const std::vector<double>& mean) const;
+
+  std::string ExplainCheapest(const Candidate& pick,
+                              const std::vector<double>& mean,
+                              int usable_runs) const;
+
   std::string ExplainChoice(const Candidate& pick,
                             const std::vector<double>& mean, double base,
                             int usable_runs) const;
@@ -170,8 +219,9 @@ class AgentStrategy : public Strategy {
   std::vector<MetricModel> models_;
   bool any_failed_ = false;
   std::vector<spec::Expression> constraints_;
-  std::vector<std::vector<double>> z_;  // [sample][model]
-  std::vector<int> objective_model_;    // per objective, index or -1
+  std::vector<std::string> constraint_texts_;  // as the scenario writes them
+  std::vector<std::vector<double>> z_;         // [sample][model]
+  std::vector<int> objective_model_;           // per objective, index or -1
   std::optional<Genes> start_;
   int proposed_ = 0;
   int fresh_ = 0;  // runs told since the last Ask

@@ -24,6 +24,9 @@ constexpr double kSaturationRoom = 0.3;
 constexpr double kSaturationSd = 0.4;
 // How far beyond the best run seen an objective's prediction may go.
 constexpr double kOptimismRoom = 0.025;
+// How far past its bound a censored value is taken, in model units (log
+// for positive metrics: about 10 %; standard deviations otherwise).
+constexpr double kCensoredMargin = 0.1;
 
 template <typename T>
 T Softplus(const T& x) {
@@ -53,14 +56,19 @@ struct TrendResidual {
   TrendShape shape;
   std::vector<double> u;
   double t;
+  // 0: t was measured; +1 / -1: the value is known only to be at least /
+  // at most t (a censored run), so only a trend on the wrong side of t
+  // costs anything (a one-sided, Tobit-like residual).
+  int side;
   double inv_sigma;
 
   template <typename T>
   bool operator()(T const* const* parameters, T* residual) const {
     const T* f = shape == TrendShape::kLinear ? nullptr : parameters[2];
-    residual[0] =
-        (T(t) - TrendValue(shape, parameters[0], parameters[1], f, u)) *
-        T(inv_sigma);
+    const T value = TrendValue(shape, parameters[0], parameters[1], f, u);
+    const bool wrong_side =
+        side == 0 || (side > 0 ? value < T(t) : value > T(t));
+    residual[0] = wrong_side ? (T(t) - value) * T(inv_sigma) : T(0.0);
     return true;
   }
 };
@@ -159,24 +167,43 @@ double ResidualGp::Kernel(const std::vector<double>& a,
 
 void MetricModel::Fit(const std::vector<std::vector<double>>& u,
                       const std::vector<double>& values,
+                      const std::vector<int>& sides,
                       const std::vector<double>& prior_slope,
                       const std::vector<double>& lengths) {
   fitted_ = false;
   points_ = static_cast<int>(values.size());
   if (values.empty()) return;
   const size_t dims = u.front().size();
+  auto side = [&sides](size_t i) { return i < sides.size() ? sides[i] : 0; };
   bool all_positive = true;
   bool all_flags = true;
-  for (double v : values) {
+  bool any_measured = false;
+  for (size_t i = 0; i < values.size(); ++i) {
+    const double v = values[i];
     all_positive = all_positive && v > 0.0;
     all_flags = all_flags && (v == 0.0 || v == 1.0);
+    any_measured = any_measured || side(i) == 0;
   }
-  if (boolean_hint || (all_flags && !all_positive)) {
+  if (boolean_hint || (all_flags && !all_positive && any_measured)) {
     space_ = MetricSpace::kBoolean;
   } else if (all_positive) {
     space_ = MetricSpace::kLog;
   } else {
     space_ = MetricSpace::kLinear;
+  }
+  if (space_ == MetricSpace::kBoolean &&
+      std::any_of(sides.begin(), sides.end(), [](int v) { return v != 0; })) {
+    // A 0/1 flag's bound says nothing beyond the flag: fit the measured
+    // values alone.
+    std::vector<std::vector<double>> measured_u;
+    std::vector<double> measured;
+    for (size_t i = 0; i < values.size(); ++i) {
+      if (side(i) != 0) continue;
+      measured_u.push_back(u[i]);
+      measured.push_back(values[i]);
+    }
+    Fit(measured_u, measured, {}, prior_slope, lengths);
+    return;
   }
   std::vector<double> t(values.size());
   shift_ = 0.0;
@@ -190,9 +217,14 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
     shift_ = mean;
     scale_ = var > 1e-18 ? std::sqrt(var) : std::max(1.0, std::abs(mean));
   }
+  // A censored bound is taken a margin beyond itself (in model units): the
+  // run was stopped because its value was certainly past the bound.
+  std::vector<int> sided(values.size());
   for (size_t i = 0; i < values.size(); ++i) {
     t[i] = space_ == MetricSpace::kLog ? std::log(values[i])
                                        : (values[i] - shift_) / scale_;
+    sided[i] = side(i);
+    t[i] += sided[i] * kCensoredMargin;
   }
   // Residual scale of the trend and the prior slope size, in model units.
   const double sigma = space_ == MetricSpace::kLog       ? 0.1
@@ -213,13 +245,13 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
   if (space_ != MetricSpace::kBoolean && good_direction != 0) {
     preferred = good_direction < 0 ? TrendShape::kFloor : TrendShape::kCeiling;
   }
-  trend_ = FitTrend(preferred, u, t, mu, slope_sd, sigma);
+  trend_ = FitTrend(preferred, u, t, sided, mu, slope_sd, sigma);
   if (space_ != MetricSpace::kBoolean && values.size() >= dims + 3) {
     const double penalty = 0.5 * std::log(static_cast<double>(values.size()));
     for (TrendShape shape :
          {TrendShape::kLinear, TrendShape::kFloor, TrendShape::kCeiling}) {
       if (shape == preferred) continue;
-      Trend other = FitTrend(shape, u, t, mu, slope_sd, sigma);
+      Trend other = FitTrend(shape, u, t, sided, mu, slope_sd, sigma);
       const double extra = shape == TrendShape::kLinear ? 0.0 : penalty;
       const double mine = trend_.shape == TrendShape::kLinear ? 0.0 : penalty;
       if (other.cost + extra < trend_.cost + mine) trend_ = other;
@@ -228,7 +260,13 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
   std::vector<double> residuals(t.size());
   double rms = 0.0;
   for (size_t i = 0; i < t.size(); ++i) {
-    residuals[i] = t[i] - trend_.Value(u[i]);
+    // A censored value is imputed as the trend, or its bound when the
+    // trend does not reach past it.
+    const double trend = trend_.Value(u[i]);
+    double value = t[i];
+    if (sided[i] > 0) value = std::max(t[i], trend);
+    if (sided[i] < 0) value = std::min(t[i], trend);
+    residuals[i] = value - trend;
     rms += residuals[i] * residuals[i];
   }
   rms = std::sqrt(rms / t.size());
@@ -269,8 +307,10 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
   // surrogate extrapolates too eagerly, which would send the search
   // after improvements that saturated long ago.
   best_ = kNaN;
-  for (double v : values) {
+  for (size_t i = 0; i < values.size(); ++i) {
+    const double v = values[i];
     if (good_direction == 0) break;
+    if (side(i) != 0) continue;
     if (std::isnan(best_) || (good_direction < 0 ? v < best_ : v > best_)) {
       best_ = v;
     }
@@ -313,6 +353,7 @@ double MetricModel::ToMetric(double t) const {
 Trend MetricModel::FitTrend(TrendShape shape,
                             const std::vector<std::vector<double>>& u,
                             const std::vector<double>& t,
+                            const std::vector<int>& sides,
                             const std::vector<double>& mu, double slope_sd,
                             double sigma) {
   const size_t dims = mu.size();
@@ -340,7 +381,7 @@ Trend MetricModel::FitTrend(TrendShape shape,
   ceres::Problem problem(problem_options);
   for (size_t j = 0; j < t.size(); ++j) {
     auto* cost = new ceres::DynamicAutoDiffCostFunction<TrendResidual>(
-        new TrendResidual{shape, u[j], t[j], 1.0 / sigma});
+        new TrendResidual{shape, u[j], t[j], sides[j], 1.0 / sigma});
     cost->AddParameterBlock(1);
     cost->AddParameterBlock(static_cast<int>(dims));
     std::vector<double*> blocks = {&trend.a, trend.b.data()};

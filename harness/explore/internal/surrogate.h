@@ -78,11 +78,14 @@ class MetricModel {
   int points() const { return points_; }
   MetricSpace space() const { return space_; }
 
-  // Fits the trend and the residual GP to (u, value) pairs. `prior_slope`
-  // holds one prior mean per knob in model units (before the direction),
-  // `lengths` the GP's default length scale per knob.
+  // Fits the trend and the residual GP to (u, value) pairs. `sides` (may be
+  // empty: all measured) marks censored values: +1 when the true value is
+  // known only to be above `value` (a run stopped early past a time bound),
+  // -1 below it, 0 measured. `prior_slope` holds one prior mean per knob in
+  // model units (before the direction), `lengths` the GP's default length
+  // scale per knob.
   void Fit(const std::vector<std::vector<double>>& u,
-           const std::vector<double>& values,
+           const std::vector<double>& values, const std::vector<int>& sides,
            const std::vector<double>& prior_slope,
            const std::vector<double>& lengths);
 
@@ -101,6 +104,7 @@ class MetricModel {
   static Trend FitTrend(TrendShape shape,
                         const std::vector<std::vector<double>>& u,
                         const std::vector<double>& t,
+                        const std::vector<int>& sides,
                         const std::vector<double>& mu, double slope_sd,
                         double sigma);
 

@@ -8,6 +8,7 @@
 #include "harness/spec/expression.h"
 #include "harness/spec/internal/spec_reader.h"
 #include "harness/spec/text_util.h"
+#include "harness/spec/types.h"
 #include "stack/base/platform_limits.h"
 #include "stack/config/stack_config.h"
 
@@ -15,7 +16,7 @@ namespace adse::spec::internal {
 namespace {
 
 const std::vector<std::string> kParameterKeys = {"bind", "range", "values",
-                                                 "step"};
+                                                 "step", "role"};
 const std::vector<std::string> kObjectiveKeys = {"minimize", "maximize"};
 
 }  // namespace
@@ -103,6 +104,17 @@ void SpecReader::ReadParameter(const std::string& name, const Val& v,
             "a target: platform.cores, platform.freq_ghz or "
             "stack.<knob>");
     ok = false;
+  }
+
+  p.role = DefaultKnobRole(p.bind);
+  if (const Val* e = f.Get("role")) {
+    std::string role;
+    const std::string expected =
+        "a role: " + JoinList(KnobRoleNames()) + " (what the knob stands for)";
+    if (ReadString(*e, &role, expected) && !StringToKnobRole(role, &p.role)) {
+      Error(*e, expected, DidYouMean(role, KnobRoleNames()));
+      ok = false;
+    }
   }
 
   const Val* range = f.Get("range");

@@ -55,6 +55,13 @@ TEST(EvaluationTest, ACensoredRunIsARowWithoutMeasuredMetrics) {
   EXPECT_FALSE(o.failed);
   EXPECT_FALSE(o.feasible);
   EXPECT_EQ(o.metrics.count("nav_time_s"), 0u);
+  // Strategies learn which constraint stopped it.
+  EXPECT_TRUE(o.censored);
+  EXPECT_EQ(o.violated_constraint, "nav_time_s <= 60");
+  const explore::Observation measured =
+      ObservationFromRow(RowFromReport(Report(4, 45.0, false)));
+  EXPECT_FALSE(measured.censored);
+  EXPECT_EQ(measured.violated_constraint, "");
 }
 
 TEST(EvaluationTest, ACensoredRunIsNeverOnTheFront) {

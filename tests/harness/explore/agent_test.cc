@@ -258,6 +258,41 @@ TEST(AgentTest, FailedRunsAreSurvivedAndTheirNeighboursAvoided) {
   ExpectDistinctAndAllowed(spec, all_failed);
 }
 
+TEST(AgentTest, RunsStoppedEarlyTeachTheBoundAndSendItToMoreCapacity) {
+  // Starting from a starved point whose runs are stopped at the time bound
+  // (infeasible, metrics withheld but hardware_cost), the agent must read
+  // each stop as "slower than 60 s here" and find feasible designs, not
+  // walk the cheapest corner.
+  const spec::Spec spec = MakeSpec(
+      "{budget: 12, seed: 4, start_from: {cores: 2, freq_ghz: 1.0, "
+      "lidar_hz: 14}}");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  int stopped = 0;
+  auto evaluate = [&stopped](const spec::DesignPoint& point) {
+    Observation o = Evaluate(point);
+    if (o.metrics.at("completed") == 1 && o.metrics.at("nav_time_s") > 60) {
+      ++stopped;
+      const double cost = o.metrics.at("hardware_cost");
+      o.metrics = {{"hardware_cost", cost}, {"censored", 1}};
+      o.censored = true;
+      o.violated_constraint = "nav_time_s <= 60";
+    }
+    return o;
+  };
+  const std::vector<spec::DesignPoint> points = Drive(*strategy, 1, evaluate);
+  ASSERT_EQ(points.size(), 12u);
+  ExpectDistinctAndAllowed(spec, points);
+  int feasible = 0;
+  for (const spec::DesignPoint& point : points) {
+    feasible += Evaluate(point).feasible ? 1 : 0;
+  }
+  EXPECT_GE(stopped, 1);
+  EXPECT_GE(feasible, 6) << "stopped runs: " << stopped;
+  // The second proposal already moves to more capacity than the start.
+  EXPECT_GT(points[1].at("cores") * points[1].at("freq_ghz"), 2.0);
+}
+
 TEST(AgentTest, BatchesAreDistinctAndSpread) {
   const spec::Spec spec = MakeSpec("{budget: 24, seed: 7, batch: 4}");
   std::unique_ptr<Strategy> strategy = Create(spec);

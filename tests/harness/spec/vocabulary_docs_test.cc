@@ -65,6 +65,7 @@ TEST(VocabularyDocsTest, EveryChoiceIsDocumentedAsTheParserKnowsIt) {
       {"backend", LlmBackendNames()},
       {"isolation", pool::IsolationNames()},
       {"executor", ExecutorNames()},
+      {"role", KnobRoleNames()},
   };
   for (const auto& choice : kChoices) {
     ASSERT_GE(choice.names.size(), 2u) << choice.field;
