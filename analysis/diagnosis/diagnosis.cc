@@ -19,9 +19,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr char kExternal[] = "external";
 constexpr char kCpuBound[] = "cpu_bound";
 constexpr char kFrequencyBound[] = "frequency_bound";
-constexpr char kMoreCores[] = "more cores";
-constexpr char kHigherFrequency[] = "higher frequency";
-constexpr char kLowerSensorRate[] = "lower sensor rate";
 
 // ---- Options ---------------------------------------------------------------
 
@@ -485,19 +482,23 @@ Diagnosis Diagnose(const runfile::RunData& run,
     const bool exec_limited = ev.exec_load >= options.remedy_exec_load;
     const bool core_limited =
         !ev.has_wait_ratio || ev.core_wait_ratio >= options.remedy_wait_ratio;
-    std::vector<std::string> remedies;
-    if (exec_limited) remedies.push_back(kHigherFrequency);
-    if (core_limited) remedies.push_back(kMoreCores);
-    if (remedies.empty()) {  // neither alone: the one nearer its threshold
-      remedies.push_back(ev.exec_load / options.remedy_exec_load >=
-                                 ev.core_wait_ratio / options.remedy_wait_ratio
-                             ? kHigherFrequency
-                             : kMoreCores);
+    if (exec_limited)
+      f.remedies.push_back({RemedyKind::kHigherFrequency, f.node});
+    if (core_limited) f.remedies.push_back({RemedyKind::kMoreCores, f.node});
+    if (f.remedies.empty()) {  // neither alone: the one nearer its threshold
+      f.remedies.push_back(
+          {ev.exec_load / options.remedy_exec_load >=
+                   ev.core_wait_ratio / options.remedy_wait_ratio
+               ? RemedyKind::kHigherFrequency
+               : RemedyKind::kMoreCores,
+           f.node});
     }
     const bool from_sensor = publishers[topic].size() == 1 &&
                              *publishers[topic].begin() == kExternal;
-    if (from_sensor) remedies.push_back(kLowerSensorRate);
-    f.remedy = Join(remedies, "; ");
+    if (from_sensor) {
+      f.remedies.push_back({RemedyKind::kLowerSensorRate, f.topics[0]});
+    }
+    f.remedy = RemediesText(f.remedies);
 
     const std::string wait_text =
         ev.has_wait_ratio
@@ -609,25 +610,26 @@ Diagnosis Diagnose(const runfile::RunData& run,
     if (origin.rate_hz > 0.0) f.rates_hz["origin_hz"] = origin.rate_hz;
     const std::string upstream =
         f.upstream.empty() ? std::string("unknown") : f.upstream;
-    f.remedy = fmt::format("raise the rate of {}'s publisher ({})", f.topics[0],
-                           upstream);
+    f.remedies.push_back(
+        {RemedyKind::kRaisePublisherRate, f.topics[0], upstream});
     std::string cause;
     if (origin.kind == "cpu_bound") {
       cause = fmt::format("upstream limit: {} is cpu_bound", origin.where);
-      f.remedy += fmt::format("; relieve {} (cpu_bound)", origin.where);
+      f.remedies.push_back({RemedyKind::kRelieveNode, origin.where});
     } else if (origin.kind == "sensor") {
       cause = fmt::format("its rate is set by the sensor topic {} ({:.2f} Hz)",
                           origin.where, origin.rate_hz);
-      f.remedy += fmt::format("; raise the rate of sensor {}", origin.where);
+      f.remedies.push_back({RemedyKind::kRaiseSensorRate, origin.where});
     } else if (origin.kind == "timer") {
       cause = fmt::format(
           "its rate is set by the timer {} ({:.2f} Hz): a configuration "
           "choice",
           origin.where, origin.rate_hz);
-      f.remedy += fmt::format("; shorten the period of {}", origin.where);
+      f.remedies.push_back({RemedyKind::kShortenTimerPeriod, origin.where});
     } else {
       cause = "its origin is unknown";
     }
+    f.remedy = RemediesText(f.remedies);
     f.message = fmt::format(
         "{} is limited by its input {} at {:.2f} Hz, {:.1f}% below the "
         "{:.2f} Hz median of its other inputs (> {:.1f}%); {} -> {}",

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/diagnosis/remedy.h"
 #include "analysis/runfile/run_data.h"
 #include "stack/base/status.h"
 
@@ -42,8 +43,8 @@ struct DiagnosisOptions {
   // [0, run end].
   double start_s = 0.0;
   double end_s = -1.0;
-  // Remedy of a cpu_bound finding ("higher frequency" vs "more cores"), see
-  // Finding::remedy: the node's execution load at which faster cores are
+  // Remedy of a cpu_bound finding (higher frequency vs more cores), see
+  // Finding::remedies: the node's execution load at which faster cores are
   // needed, and the core-wait / execution ratio at which more cores are.
   double remedy_exec_load = 1.0;
   double remedy_wait_ratio = 1.0;
@@ -110,13 +111,16 @@ struct Finding {
   // "input_hz:<topic>" for every input considered, and origin_hz (the
   // sensor's or timer's rate) when the origin has one.
   std::map<std::string, double> rates_hz;
-  // "; "-joined, most important first. cpu_bound: "higher frequency" when
-  // exec_load >= remedy_exec_load, "more cores" when core_wait_ratio >=
-  // remedy_wait_ratio (if neither, the one nearer its threshold), plus
-  // "lower sensor rate" when the topic comes from outside the graph.
-  // frequency_bound: "raise the rate of <topic>'s publisher (<node>)", then
-  // by origin "; raise the rate of sensor <topic>" | "; shorten the period
-  // of <timer>" | "; relieve <node> (cpu_bound)".
+  // What would relieve it, most important first. cpu_bound: higher_frequency
+  // when exec_load >= remedy_exec_load, more_cores when core_wait_ratio >=
+  // remedy_wait_ratio (if neither, the one nearer its threshold), both about
+  // `node`; plus lower_sensor_rate of topics[0] when it comes from outside
+  // the graph. frequency_bound: raise_publisher_rate of topics[0] (publisher
+  // `upstream`, "unknown" if none), then by origin raise_sensor_rate of the
+  // sensor topic | shorten_timer_period of the timer | relieve_node of the
+  // cpu_bound node.
+  std::vector<Remedy> remedies;
+  // RemediesText(remedies), e.g. "higher frequency; lower sensor rate".
   std::string remedy;
   std::string message;    // one readable sentence with the numbers
   double severity = 0.0;  // the relative deficit; findings sort by it

@@ -36,7 +36,8 @@ struct EvaluationRow {
   uint64_t seed = 0;
   std::map<std::string, double> point;    // design parameter -> value
   std::map<std::string, double> metrics;  // NaN where a run lacks one
-  // The diagnosis as JSON text ([{kind,node,remedy,severity}, ...]).
+  // The diagnosis as JSON text ([{kind,node,remedy,remedies,severity}, ...];
+  // remedies: [{kind,target}, ...], see harness/campaign/evaluation.h).
   std::string bottlenecks_json;
 };
 

@@ -4,6 +4,7 @@
 #include <limits>
 #include <map>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "analysis/metrics/run_metrics.h"
@@ -47,15 +48,33 @@ Result<EvaluationRow> RowFromJson(const nlohmann::json& j,
     }
     row.feasible = j.at("feasible").get<bool>();
     nlohmann::json bottlenecks = nlohmann::json::array();
-    for (const nlohmann::json& f : j.at("findings")) {
+    const nlohmann::json& findings = j.at("findings");
+    for (size_t i = 0; i < findings.size(); ++i) {
+      const nlohmann::json& f = findings[i];
       double severity = 0.0;
       if (f.contains("rates_hz") && f["rates_hz"].contains("deficit") &&
           f["rates_hz"]["deficit"].is_number()) {
         severity = f["rates_hz"]["deficit"].get<double>();
       }
+      // Strategies are told the typed remedies: a report without them
+      // (before report_version 2) is stale, and its run is analysed again.
+      if (!f.contains("remedies")) {
+        return Status::Corruption(fmt::format(
+            "{}: finding {} has no typed remedies (a report older than "
+            "report_version 2)",
+            path, i));
+      }
+      Result<std::vector<analysis::Remedy>> remedies =
+          report::RemediesFromJson(f.at("remedies"));
+      if (!remedies.ok()) {
+        return Status::Corruption(fmt::format(
+            "{}: finding {} ({} {}): {}", path, i, f.value("kind", "?"),
+            f.value("node", "?"), remedies.status().message()));
+      }
       bottlenecks.push_back({{"kind", f.value("kind", "")},
                              {"node", f.value("node", "")},
                              {"remedy", f.value("remedy", "")},
+                             {"remedies", report::RemediesToJson(*remedies)},
                              {"severity", severity}});
     }
     row.bottlenecks_json = bottlenecks.dump();
@@ -112,6 +131,13 @@ explore::Observation ObservationFromRow(const EvaluationRow& row) {
       hint.node = b.value("node", "");
       hint.remedy = b.value("remedy", "");
       hint.severity = b.value("severity", 0.0);
+      if (b.contains("remedies")) {
+        // Unreadable typed remedies leave only the text, like a row that
+        // predates them.
+        Result<std::vector<analysis::Remedy>> remedies =
+            report::RemediesFromJson(b["remedies"]);
+        if (remedies.ok()) hint.remedies = std::move(remedies).value();
+      }
       o.bottlenecks.push_back(hint);
     }
   }

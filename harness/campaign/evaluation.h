@@ -19,21 +19,26 @@ namespace adse::campaign {
 using runfile::EvaluationRow;
 
 // The row for a complete run: metrics, feasibility, termination reason and
-// the diagnosis (bottlenecks_json) from its report. Index, iteration,
-// source, attempts and wall time are the caller's.
+// the diagnosis from its report. Index, iteration, source, attempts and
+// wall time are the caller's. bottlenecks_json holds one object per
+// finding: {"kind", "node", "remedy" (text), "remedies" (typed, as
+// report::RemediesToJson), "severity"}.
 EvaluationRow RowFromReport(const report::RunReport& report);
 
 // The same row from a report's JSON (report::ToJson), as a worker writes it
 // next to its run file (runs/<key>.report.json): the coordinator then need
 // not analyse the run again. Corruption naming `path` when the text is not
-// such a report.
+// such a report, when a finding has no typed remedies (a report older than
+// report_version 2) or names an unknown remedy kind (the message names it).
 Result<EvaluationRow> RowFromReportJson(const std::string& text,
                                         const std::string& path);
 
 // A row's metric, NaN when the run has none (failed runs have none).
 double RowMetric(const EvaluationRow& row, const std::string& name);
 
-// What a strategy is told about a row (failed rows: failed = true).
+// What a strategy is told about a row (failed rows: failed = true). The
+// diagnosis is advisory: a bottleneck whose typed remedies are missing (an
+// index written before them) or unreadable keeps only its text.
 explore::Observation ObservationFromRow(const EvaluationRow& row);
 
 // The row in the form analysis/pareto ranks: the spec's objectives in

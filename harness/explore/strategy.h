@@ -25,6 +25,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "analysis/diagnosis/remedy.h"
 #include "harness/spec/spec.h"
 #include "stack/base/random.h"
 #include "stack/base/status.h"
@@ -35,8 +36,12 @@ namespace adse::explore {
 struct BottleneckHint {
   std::string kind;       // "cpu_bound" | "frequency_bound"
   std::string node;       // the node that cannot keep up / is input-limited
-  std::string remedy;     // e.g. "higher frequency; more cores"
+  std::string remedy;     // readable text of `remedies`, for prompts
   double severity = 0.0;  // relative deficit
+  // What would relieve it, most important first: act on these, not on the
+  // text. Empty when the row predates typed remedies. (The initialiser lets
+  // the four fields above be brace-initialised without a -Wextra warning.)
+  std::vector<analysis::Remedy> remedies = {};
 };
 
 // What a strategy is told about an evaluated point.

@@ -78,8 +78,8 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
   const analysis::Diagnosis diagnosis =
       analysis::Diagnose(run, diagnosis_options);
   for (const analysis::Finding& f : diagnosis.findings) {
-    r.findings.push_back(
-        {f.kind, f.node, f.remedy, f.message, f.topics, f.rates_hz});
+    r.findings.push_back({f.kind, f.node, f.remedy, f.message, f.topics,
+                          f.rates_hz, f.remedies});
   }
   for (const analysis::TopicStats& t : diagnosis.topics) {
     TopicSummary summary{t.name, t.publisher, t.publish_rate_hz, 0.0, 0};
@@ -160,6 +160,7 @@ nlohmann::json ToJson(const RunReport& r) {
                              {"topics", f.topics},
                              {"rates_hz", f.rates_hz},
                              {"remedy", f.remedy},
+                             {"remedies", RemediesToJson(f.remedies)},
                              {"message", f.message}});
   }
   j["trace"]["topics"] = nlohmann::json::array();
@@ -181,6 +182,56 @@ nlohmann::json ToJson(const RunReport& r) {
   }
   j["images"] = r.images;
   return j;
+}
+
+nlohmann::json RemediesToJson(const std::vector<analysis::Remedy>& remedies) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const analysis::Remedy& remedy : remedies) {
+    nlohmann::json entry = {{"kind", analysis::RemedyKindToString(remedy.kind)},
+                            {"target", remedy.target}};
+    if (!remedy.publisher.empty()) entry["publisher"] = remedy.publisher;
+    j.push_back(std::move(entry));
+  }
+  return j;
+}
+
+Result<std::vector<analysis::Remedy>> RemediesFromJson(
+    const nlohmann::json& j) {
+  if (!j.is_array()) {
+    return Status::Corruption("remedies are not a JSON array");
+  }
+  std::vector<analysis::Remedy> remedies;
+  for (size_t i = 0; i < j.size(); ++i) {
+    const nlohmann::json& entry = j[i];
+    auto text = [&](const char* key) -> const nlohmann::json* {
+      if (!entry.is_object() || !entry.contains(key)) return nullptr;
+      const nlohmann::json& v = entry.at(key);
+      return v.is_string() ? &v : nullptr;
+    };
+    const nlohmann::json* kind = text("kind");
+    const nlohmann::json* target = text("target");
+    if (kind == nullptr || target == nullptr) {
+      return Status::Corruption(
+          fmt::format("remedy {} has no string \"kind\" and \"target\": {}", i,
+                      entry.dump()));
+    }
+    Result<analysis::RemedyKind> parsed =
+        analysis::StringToRemedyKind(kind->get<std::string>());
+    if (!parsed.ok()) {
+      return parsed.status().WithContext(fmt::format("remedy {}", i));
+    }
+    analysis::Remedy remedy{*parsed, target->get<std::string>()};
+    if (entry.contains("publisher")) {
+      const nlohmann::json* publisher = text("publisher");
+      if (publisher == nullptr) {
+        return Status::Corruption(
+            fmt::format("remedy {}: \"publisher\" is not a string", i));
+      }
+      remedy.publisher = publisher->get<std::string>();
+    }
+    remedies.push_back(std::move(remedy));
+  }
+  return remedies;
 }
 
 std::string FormatSummary(const RunReport& r) {

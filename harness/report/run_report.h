@@ -12,6 +12,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "analysis/diagnosis/remedy.h"
 #include "analysis/runfile/run_data.h"
 #include "stack/base/env.h"
 #include "stack/base/status.h"
@@ -39,9 +40,13 @@ struct ConstraintStatus {
 };
 
 struct FindingSummary {
-  std::string kind, node, remedy, message;
+  std::string kind, node;
+  std::string remedy;  // the readable text of `remedies`
+  std::string message;
   std::vector<std::string> topics;
   std::map<std::string, double> rates_hz;
+  // What would relieve it, most important first (analysis::Finding).
+  std::vector<analysis::Remedy> remedies;
 };
 
 // The trace in numbers, for readers that cannot open the run file (the
@@ -62,7 +67,8 @@ struct CallbackSummary {
 };
 
 struct RunReport {
-  int report_version = 1;
+  // 2: findings carry typed `remedies` beside the readable `remedy`.
+  int report_version = 2;
   std::string run_file;
   std::string scenario_name;
   std::map<std::string, double> point;
@@ -95,7 +101,19 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
                              const std::string& run_file,
                              const AnalyzeOptions& options);
 
+// JSON of the whole report. Each finding is {"kind", "node", "topics",
+// "rates_hz", "remedy" (text), "remedies" (RemediesToJson), "message"}.
 nlohmann::json ToJson(const RunReport& report);
+
+// Typed remedies as JSON: [{"kind": "more_cores", "target":
+// "ndt_scan_matcher"}, ...], kinds as analysis::RemedyKindToString, plus
+// "publisher" where a remedy has one (raise_publisher_rate). The run report
+// and the campaign's bottleneck column both use this shape.
+nlohmann::json RemediesToJson(const std::vector<analysis::Remedy>& remedies);
+// The inverse. An unknown kind is InvalidArgument naming it and the valid
+// ones; anything else malformed (not an array, an entry without a string
+// "kind" or "target") is Corruption saying which entry.
+Result<std::vector<analysis::Remedy>> RemediesFromJson(const nlohmann::json& j);
 
 // A short human summary: outcome, key metrics, constraints, findings.
 std::string FormatSummary(const RunReport& report);

@@ -154,6 +154,9 @@ TEST(DiagnosisCpuBoundTest, SlowSubscriberIsCpuBoundWithEvidence) {
   EXPECT_NEAR(f.rates_hz.at("core_wait_ratio"), 0.0, 1e-12);
   EXPECT_NEAR(f.severity, 0.6, 1e-9);
   // First stage after a sensor: a lower sensor rate also helps.
+  EXPECT_EQ(f.remedies,
+            (std::vector<Remedy>{{RemedyKind::kHigherFrequency, "filter"},
+                                 {RemedyKind::kLowerSensorRate, "/in"}}));
   EXPECT_EQ(f.remedy, "higher frequency; lower sensor rate");
   EXPECT_NE(f.message.find("4.00 Hz of 10.00 Hz"), std::string::npos)
       << f.message;
@@ -179,7 +182,9 @@ TEST(DiagnosisCpuBoundTest, WaitingForACoreSuggestsMoreCores) {
   EXPECT_EQ(f.upstream, "driver");
   EXPECT_NEAR(f.rates_hz.at("exec_load"), 0.2, 1e-9);
   EXPECT_NEAR(f.rates_hz.at("core_wait_ratio"), 7.5, 1e-9);
-  EXPECT_EQ(f.remedy, "more cores");  // not fed by a sensor
+  EXPECT_EQ(f.remedies,  // not fed by a sensor
+            (std::vector<Remedy>{{RemedyKind::kMoreCores, "filter"}}));
+  EXPECT_EQ(f.remedy, "more cores");
 }
 
 TEST(DiagnosisCpuBoundTest, WaitingForItsOwnNodeIsNotCoreWait) {
@@ -202,6 +207,9 @@ TEST(DiagnosisCpuBoundTest, WaitingForItsOwnNodeIsNotCoreWait) {
   EXPECT_NEAR(f->rates_hz.at("core_wait_ratio"), 0.0, 1e-9);
   // 0.01 s x 10 Hz + the timer's 0.95 share of the node.
   EXPECT_NEAR(f->rates_hz.at("exec_load"), 1.05, 1e-9);
+  EXPECT_EQ(f->remedies,
+            (std::vector<Remedy>{{RemedyKind::kHigherFrequency, "planner"},
+                                 {RemedyKind::kLowerSensorRate, "/in"}}));
   EXPECT_EQ(f->remedy, "higher frequency; lower sensor rate");
 }
 
@@ -277,6 +285,10 @@ TEST(DiagnosisFrequencyBoundTest, SlowInputIsNamedWithItsPublisher) {
   EXPECT_NEAR(f.severity, 0.5, 1e-9);
   EXPECT_EQ(f.origin, "timer:pub1/on_timer");
   EXPECT_NEAR(f.rates_hz.at("origin_hz"), 10.0, 1e-9);
+  EXPECT_EQ(f.remedies,
+            (std::vector<Remedy>{
+                {RemedyKind::kRaisePublisherRate, "/in1", "pub1"},
+                {RemedyKind::kShortenTimerPeriod, "pub1/on_timer"}}));
   EXPECT_EQ(f.remedy,
             "raise the rate of /in1's publisher (pub1); shorten the period of "
             "pub1/on_timer");
@@ -328,8 +340,16 @@ TEST(DiagnosisFrequencyBoundTest, UpstreamCpuBoundIsNamedAsTheCause) {
   EXPECT_NE(d.findings[1].message.find("upstream limit: slow is cpu_bound"),
             std::string::npos)
       << d.findings[1].message;
-  EXPECT_NE(d.findings[1].remedy.find("relieve slow (cpu_bound)"),
-            std::string::npos);
+  EXPECT_EQ(d.findings[0].remedies,
+            (std::vector<Remedy>{{RemedyKind::kHigherFrequency, "slow"},
+                                 {RemedyKind::kLowerSensorRate, "/raw"}}));
+  EXPECT_EQ(
+      d.findings[1].remedies,
+      (std::vector<Remedy>{{RemedyKind::kRaisePublisherRate, "/mid", "slow"},
+                           {RemedyKind::kRelieveNode, "slow"}}));
+  EXPECT_EQ(d.findings[1].remedy,
+            "raise the rate of /mid's publisher (slow); relieve slow "
+            "(cpu_bound)");
 }
 
 // sensor /raw (7 Hz) -> driver -> /points -> cluster -> /objects -> planner,
@@ -368,6 +388,10 @@ TEST(DiagnosisFrequencyBoundTest, OriginIsTracedUpstreamToTheSensor) {
   EXPECT_EQ(f.upstream, "cluster");
   EXPECT_EQ(f.origin, "sensor:/raw");
   EXPECT_NEAR(f.rates_hz.at("origin_hz"), 7.0, 1e-9);
+  EXPECT_EQ(f.remedies,
+            (std::vector<Remedy>{
+                {RemedyKind::kRaisePublisherRate, "/objects", "cluster"},
+                {RemedyKind::kRaiseSensorRate, "/raw"}}));
   EXPECT_EQ(f.remedy,
             "raise the rate of /objects's publisher (cluster); raise the rate "
             "of sensor /raw");
@@ -554,6 +578,8 @@ TEST(DiagnosisRobustnessTest, MalformedAndEmptyRunsDoNotThrow) {
   EXPECT_EQ(d.callbacks[1].node, "orphan");
   EXPECT_EQ(d.topics[0].publisher, "");
   ASSERT_EQ(d.findings.size(), 1u);  // never taken
+  EXPECT_EQ(d.findings[0].remedies,
+            (std::vector<Remedy>{{RemedyKind::kMoreCores, "n"}}));
   EXPECT_EQ(d.findings[0].remedy, "more cores");
   EXPECT_EQ(d.findings[0].rates_hz.count("core_wait_ratio"), 0u);
 }

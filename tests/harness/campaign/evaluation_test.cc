@@ -6,8 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "harness/spec/spec_parser.h"
+#include "tests/harness/testing/recording.h"
 
 namespace adse::campaign {
 namespace {
@@ -75,6 +81,154 @@ TEST(EvaluationTest, ACensoredRunIsNeverOnTheFront) {
   const EvaluationRow measured = RowFromReport(Report(4, 45.0, false));
   EXPECT_EQ(RowMetric(measured, "nav_time_s"), 45.0);
   EXPECT_EQ(RowMetric(measured, "censored"), 0.0);
+}
+
+using analysis::Remedy;
+using analysis::RemedyKind;
+
+// A starved run's report with one finding of each kind.
+report::RunReport ReportWithFindings() {
+  report::RunReport r = Report(2, 50.0, false);
+  report::FindingSummary cpu;
+  cpu.kind = "cpu_bound";
+  cpu.node = "lidar_driver";
+  cpu.topics = {"/sensing/lidar/points_raw"};
+  cpu.rates_hz = {{"deficit", 0.4}};
+  cpu.remedies = {{RemedyKind::kMoreCores, "lidar_driver"},
+                  {RemedyKind::kLowerSensorRate, "/sensing/lidar/points_raw"}};
+  cpu.remedy = analysis::RemediesText(cpu.remedies);
+  report::FindingSummary frequency;
+  frequency.kind = "frequency_bound";
+  frequency.node = "planner";
+  frequency.topics = {"/objects"};
+  frequency.rates_hz = {{"deficit", 0.3}};
+  frequency.remedies = {
+      {RemedyKind::kRaisePublisherRate, "/objects", "euclidean_cluster"},
+      {RemedyKind::kRelieveNode, "euclidean_cluster"}};
+  frequency.remedy = analysis::RemediesText(frequency.remedies);
+  r.findings = {cpu, frequency};
+  return r;
+}
+
+TEST(EvaluationTest, TypedRemediesGoFromTheReportToTheStrategy) {
+  const report::RunReport r = ReportWithFindings();
+  const nlohmann::json j = report::ToJson(r);
+  EXPECT_EQ(j["findings"][0]["remedies"],
+            nlohmann::json::parse(
+                R"([{"kind":"more_cores","target":"lidar_driver"},
+                    {"kind":"lower_sensor_rate",
+                     "target":"/sensing/lidar/points_raw"}])"));
+  EXPECT_EQ(j["findings"][0]["remedy"], "more cores; lower sensor rate");
+  EXPECT_EQ(j["findings"][1]["remedies"][0],
+            nlohmann::json::parse(
+                R"({"kind":"raise_publisher_rate","target":"/objects",
+                    "publisher":"euclidean_cluster"})"));
+
+  // As a worker leaves it next to its run, and as the index stores it.
+  Result<EvaluationRow> row = RowFromReportJson(j.dump(1), "x.report.json");
+  ASSERT_TRUE(row.ok()) << row.status().ToString();
+  const nlohmann::json bottlenecks =
+      nlohmann::json::parse(row->bottlenecks_json);
+  ASSERT_EQ(bottlenecks.size(), 2u);
+  EXPECT_EQ(bottlenecks[0]["remedies"], j["findings"][0]["remedies"]);
+  EXPECT_EQ(bottlenecks[1]["remedies"], j["findings"][1]["remedies"]);
+  EXPECT_EQ(bottlenecks[0]["remedy"], "more cores; lower sensor rate");
+  EXPECT_EQ(RowFromReport(r).bottlenecks_json, row->bottlenecks_json);
+
+  const explore::Observation o = ObservationFromRow(*row);
+  ASSERT_EQ(o.bottlenecks.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(o.bottlenecks[i].kind, r.findings[i].kind);
+    EXPECT_EQ(o.bottlenecks[i].node, r.findings[i].node);
+    EXPECT_EQ(o.bottlenecks[i].remedies, r.findings[i].remedies);
+    EXPECT_EQ(o.bottlenecks[i].remedy, r.findings[i].remedy);
+  }
+  EXPECT_EQ(o.bottlenecks[1].remedy,
+            "raise the rate of /objects's publisher (euclidean_cluster); "
+            "relieve euclidean_cluster (cpu_bound)");
+}
+
+TEST(EvaluationTest, AReportWithAnUnknownRemedyKindIsRefusedNamingIt) {
+  nlohmann::json j = report::ToJson(ReportWithFindings());
+  j["findings"][1]["remedies"][1]["kind"] = "buy_a_faster_car";
+  Result<EvaluationRow> row = RowFromReportJson(j.dump(), "x.report.json");
+  ASSERT_FALSE(row.ok());
+  EXPECT_EQ(row.status().code(), Status::Code::kCorruption);
+  const std::string& message = row.status().message();
+  EXPECT_NE(message.find("x.report.json"), std::string::npos) << message;
+  EXPECT_NE(message.find("finding 1 (frequency_bound planner)"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("unknown remedy kind 'buy_a_faster_car'"),
+            std::string::npos)
+      << message;
+
+  j = report::ToJson(ReportWithFindings());
+  j["findings"][0]["remedies"][0].erase("target");
+  row = RowFromReportJson(j.dump(), "x.report.json");
+  ASSERT_FALSE(row.ok());
+  EXPECT_NE(row.status().message().find("remedy 0 has no string"),
+            std::string::npos)
+      << row.status().message();
+}
+
+TEST(EvaluationTest, AReportWithoutTypedRemediesIsStale) {
+  nlohmann::json j = report::ToJson(ReportWithFindings());
+  j["findings"][0].erase("remedies");
+  Result<EvaluationRow> row = RowFromReportJson(j.dump(), "old.report.json");
+  ASSERT_FALSE(row.ok());
+  EXPECT_NE(row.status().message().find("report_version 2"), std::string::npos)
+      << row.status().message();
+  // A healthy run's old report has no finding to miss them.
+  j["findings"] = nlohmann::json::array();
+  EXPECT_TRUE(RowFromReportJson(j.dump(), "old.report.json").ok());
+}
+
+TEST(EvaluationTest, AnIndexRowWithoutTypedRemediesKeepsItsText) {
+  EvaluationRow row = RowFromReport(Report(2, 50.0, false));
+  row.bottlenecks_json =
+      R"([{"kind":"cpu_bound","node":"ekf_localizer","remedy":"more cores",)"
+      R"("severity":0.3},)"
+      R"({"kind":"cpu_bound","node":"x","remedy":"more cores",)"
+      R"("remedies":[{"kind":"warp_drive","target":"x"}],"severity":0.2}])";
+  const explore::Observation o = ObservationFromRow(row);
+  ASSERT_EQ(o.bottlenecks.size(), 2u);
+  for (const explore::BottleneckHint& hint : o.bottlenecks) {
+    EXPECT_EQ(hint.remedy, "more cores");
+    EXPECT_TRUE(hint.remedies.empty()) << hint.node;
+  }
+}
+
+// tests/data/migrate_remedies.py gave the recordings their typed remedies:
+// they must say what the recorded text says.
+TEST(EvaluationTest, TheRecordedCampaignsCarryTypedRemediesThatReadAsText) {
+  for (const char* name : {"robotaxi_exhaustive", "reference_study"}) {
+    const Recording& recording = adse::testing::RecordingUnderTestData(name);
+    ASSERT_EQ(recording.rows.size(), 280u) << name;
+    std::set<std::string> kinds;
+    int hints = 0;
+    for (const EvaluationRow& row : recording.rows) {
+      for (const explore::BottleneckHint& hint :
+           ObservationFromRow(row).bottlenecks) {
+        ++hints;
+        ASSERT_FALSE(hint.remedies.empty()) << name << " " << hint.node;
+        EXPECT_EQ(analysis::RemediesText(hint.remedies), hint.remedy)
+            << name << " " << hint.node;
+        for (const Remedy& remedy : hint.remedies) {
+          kinds.insert(analysis::RemedyKindToString(remedy.kind));
+          if (remedy.kind == RemedyKind::kLowerSensorRate) {
+            EXPECT_EQ(remedy.target.rfind("/sensing/", 0), 0u) << remedy;
+          } else {
+            EXPECT_EQ(remedy.target, hint.node) << remedy;
+          }
+        }
+      }
+    }
+    EXPECT_GT(hints, 0) << name;
+    EXPECT_EQ(kinds, (std::set<std::string>{"higher_frequency", "more_cores",
+                                            "lower_sensor_rate"}))
+        << name;
+  }
 }
 
 }  // namespace

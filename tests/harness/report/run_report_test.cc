@@ -49,6 +49,23 @@ TEST(RunReportTest,
     EXPECT_FALSE(f.message.empty());
     EXPECT_FALSE(f.remedy.empty());
     EXPECT_FALSE(f.rates_hz.empty()) << "a finding carries its evidence";
+    // The typed remedies are what the text says, about this finding.
+    ASSERT_FALSE(f.remedies.empty()) << f.node;
+    EXPECT_EQ(analysis::RemediesText(f.remedies), f.remedy);
+    if (f.kind == "cpu_bound") {
+      EXPECT_EQ(f.remedies[0].target, f.node);
+    }
+  }
+  // The JSON carries them beside the text.
+  const nlohmann::json j = ToJson(r);
+  ASSERT_FALSE(j["findings"].empty());
+  for (const nlohmann::json& f : j["findings"]) {
+    ASSERT_TRUE(f.contains("remedies")) << f.dump();
+    Result<std::vector<analysis::Remedy>> remedies =
+        RemediesFromJson(f["remedies"]);
+    ASSERT_TRUE(remedies.ok()) << remedies.status().ToString();
+    EXPECT_EQ(analysis::RemediesText(*remedies),
+              f["remedy"].get<std::string>());
   }
   EXPECT_FALSE(r.feasible);
 }
