@@ -473,7 +473,12 @@ Status WriteFileAtomically(
   {
     Hdf5Session session;
     Handle fapl = MakeFileAccessProps();
-    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()));
+    // No modification time on the root group either, so the same contents
+    // give the same bytes (datasets and groups already track none).
+    Handle fcpl(H5Pcreate(H5P_FILE_CREATE));
+    if (fcpl.valid()) H5Pset_obj_track_times(fcpl.get(), false);
+    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC,
+                          fcpl.valid() ? fcpl.get() : H5P_DEFAULT, fapl.get()));
     if (!file.valid()) {
       status = Status::IoError(tmp +
                                ": cannot create HDF5 file: " + TakeHdf5Error());

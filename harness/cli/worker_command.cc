@@ -78,6 +78,18 @@ int Work(const WorkerArgs& args) {
                  s.message().c_str());
     return 1;
   }
+  // The coordinator takes the worker's analysis instead of redoing it;
+  // written after the run file, which stays the truth (a missing or stale
+  // report only costs the coordinator that analysis again).
+  if (!args.report.empty()) {
+    analysed->content_key = run->content_key;
+    if (Status s = WriteFileAtomic(args.report,
+                                   report::ToJson(*analysed).dump(1) + "\n");
+        !s.ok()) {
+      std::fprintf(stderr, "warning: writing %s: %s\n", args.report.c_str(),
+                   s.message().c_str());
+    }
+  }
   std::fprintf(stderr, "wrote %s (%s)\n", args.out.c_str(),
                run->termination_reason.c_str());
   return 0;

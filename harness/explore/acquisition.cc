@@ -351,7 +351,8 @@ int AgentStrategy::CheapestPick(const std::vector<Candidate>& candidates,
   }
   const int pick = proposed_ + static_cast<int>(chosen.size());
   const bool none_feasible = !std::isfinite(cheapest);
-  if (!none_feasible && pick % kCheapestEvery != kCheapestEvery - 1) return -1;
+  const bool cheapest_turn = pick % kCheapestEvery == kCheapestEvery - 1;
+  if (!none_feasible && !cheapest_turn) return -1;
   int best = -1;
   double best_score = 0.0;
   for (size_t i = 0; i < candidates.size(); ++i) {

@@ -294,40 +294,58 @@ void AgentStrategy::ProbeDirections() {
   }
 }
 
+namespace {
+
+// Whether `topic` ("/sensing/lidar/points_raw") has `sensor` ("lidar") as
+// one of its path parts.
+bool TopicOfSensor(const std::string& topic, const std::string& sensor) {
+  if (sensor.empty()) return false;
+  const std::string part = "/" + sensor;
+  for (size_t at = topic.find(part); at != std::string::npos;
+       at = topic.find(part, at + 1)) {
+    const size_t end = at + part.size();
+    if (end == topic.size() || topic[end] == '/') return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 std::vector<int> AgentStrategy::RemedyDirections(const Record& record,
                                                  std::string* text) const {
   std::vector<int> direction(knobs_.size(), 0);
   std::vector<std::string> parts;
   for (const BottleneckHint& hint : record.observation.bottlenecks) {
-    std::vector<std::string> applied;
-    const std::string& remedy = hint.remedy;
-    for (size_t d = 0; d < knobs_.size(); ++d) {
-      const Knob& knob = knobs_[d];
-      int want = 0;
-      if (knob.role == KnobRole::kCores &&
-          remedy.find("more cores") != std::string::npos) {
-        want = +1;
-      } else if (knob.role == KnobRole::kFrequency &&
-                 remedy.find("higher frequency") != std::string::npos) {
-        want = +1;
-      } else if (knob.role == KnobRole::kSensorRate) {
-        const bool names_sensor =
-            !knob.sensor.empty() &&
-            (hint.node.find(knob.sensor) != std::string::npos ||
-             remedy.find(knob.sensor) != std::string::npos);
-        if (remedy.find("lower sensor rate") != std::string::npos) {
-          want = -1;
-        } else if (remedy.find("raise the rate") != std::string::npos &&
-                   (names_sensor ||
-                    remedy.find("sensor") != std::string::npos)) {
-          want = +1;
+    for (const analysis::Remedy& remedy : hint.remedies) {
+      for (size_t d = 0; d < knobs_.size(); ++d) {
+        const Knob& knob = knobs_[d];
+        int want = 0;
+        switch (remedy.kind) {
+          case analysis::RemedyKind::kMoreCores:
+            want = knob.role == KnobRole::kCores ? +1 : 0;
+            break;
+          case analysis::RemedyKind::kHigherFrequency:
+            want = knob.role == KnobRole::kFrequency ? +1 : 0;
+            break;
+          case analysis::RemedyKind::kLowerSensorRate:
+          case analysis::RemedyKind::kRaiseSensorRate:
+            if (knob.role == KnobRole::kSensorRate &&
+                TopicOfSensor(remedy.target, knob.sensor)) {
+              want = remedy.kind == analysis::RemedyKind::kLowerSensorRate ? -1
+                                                                           : +1;
+            }
+            break;
+          case analysis::RemedyKind::kRaisePublisherRate:
+          case analysis::RemedyKind::kShortenTimerPeriod:
+          case analysis::RemedyKind::kRelieveNode:
+            break;  // no design knob stands for these
         }
+        if (want != 0 && direction[d] == 0) direction[d] = want;
       }
-      if (want != 0 && direction[d] == 0) direction[d] = want;
     }
     if (parts.size() < 2 && !hint.node.empty()) {
       parts.push_back(fmt::format("{} {} -> {}", hint.node, hint.kind,
-                                  remedy.empty() ? "?" : remedy));
+                                  hint.remedy.empty() ? "?" : hint.remedy));
     }
   }
   if (text != nullptr) *text = fmt::format("{}", fmt::join(parts, ", "));

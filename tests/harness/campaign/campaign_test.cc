@@ -17,8 +17,11 @@
 #include <thread>
 
 #include "analysis/runfile/campaign_file.h"
+#include "analysis/runfile/run_file.h"
+#include "harness/campaign/evaluation.h"
 #include "harness/campaign/replay.h"
 #include "harness/campaign/run_store.h"
+#include "harness/report/run_report.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/files.h"
 #include "tests/harness/testing/small_scenario.h"
@@ -108,6 +111,28 @@ TEST(CampaignTest,
   }
   EXPECT_GT(feasible, 0);
   EXPECT_EQ(IndexKeys(out).size(), 12u);
+  // Each run's analysis (the worker's, which the campaign takes instead of
+  // analysing again) agrees with a fresh analysis of its run file.
+  for (const std::string& key : RunFiles(out)) {
+    const std::string path = out + "/runs/" + key;
+    Result<std::string> text = ReadFile(path + ".report.json");
+    ASSERT_TRUE(text.ok()) << key;
+    Result<EvaluationRow> stored = RowFromReportJson(*text, path);
+    Result<runfile::RunData> run = runfile::ReadRunFile(path + ".h5");
+    ASSERT_TRUE(stored.ok() && run.ok()) << key;
+    Result<report::RunReport> fresh =
+        report::AnalyzeRun(*run, path + ".h5", {});
+    ASSERT_TRUE(fresh.ok()) << fresh.status().message();
+    const EvaluationRow again = RowFromReport(*fresh);
+    EXPECT_EQ(stored->content_key, key);
+    EXPECT_EQ(stored->feasible, again.feasible) << key;
+    ASSERT_EQ(stored->metrics.size(), again.metrics.size()) << key;
+    for (const auto& [name, value] : again.metrics) {
+      EXPECT_NEAR(stored->metrics.at(name), value,
+                  1e-9 * std::max(1.0, std::abs(value)))
+          << key << " " << name;
+    }
+  }
 
   Result<CampaignSummary> second =
       RunCampaign(spec, Options(out, "exhaustive", 12));

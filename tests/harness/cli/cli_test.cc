@@ -387,6 +387,28 @@ TEST(CliRunTest, WorkerRefusesAScenarioThatChangedUnderItsCampaign) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+TEST(CliRunTest, WorkerLeavesItsAnalysisBesideTheRunFileWhenAsked) {
+  const fs::path dir = fs::temp_directory_path() / "adse_cli_worker_report";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string out = (dir / "run.h5").string();
+  const std::string report = (dir / "run.report.json").string();
+  const CommandRun run = Adse("worker " + Small() +
+                              " --point cores=4,freq_ghz=2.1,lidar_hz=14 -o " +
+                              out + " --report " + report);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  ASSERT_TRUE(fs::exists(out));
+  std::ifstream in(report);
+  ASSERT_TRUE(in) << "no " << report;
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  ASSERT_TRUE(j.is_object());
+  EXPECT_EQ(j.value("content_key", "").size(), 64u);
+  ASSERT_TRUE(j.contains("metrics"));
+  EXPECT_TRUE(j["metrics"].contains("nav_time_s"));
+  EXPECT_TRUE(j["metrics"].contains("deviation_score"));
+  EXPECT_TRUE(j.contains("findings"));
+}
+
 // `adse profile`: the bundled profile is what importing the trimmed CARET
 // report with the bundled mapping writes; bad input is exit 2 with the file
 // and field named, and nothing written.

@@ -114,6 +114,14 @@ TEST(SpecErrorsTest, MisspelledEnumValueWithSuggestion) {
               "exploration.strategy", 9, "(did you mean 'nsga2'?)");
 }
 
+TEST(SpecErrorsTest, AnUnknownKnobRoleNamesTheRoles) {
+  std::string text = kHead;
+  text.replace(text.find("range: [1, 4]"), 13, "range: [1, 4], role: core");
+  ExpectError(text, "design_space.cores.role", 8,
+              "none, cores, frequency, sensor_rate (what the knob stands "
+              "for), found 'core' (did you mean 'cores'?)");
+}
+
 TEST(SpecErrorsTest, DuplicateKey) {
   ExpectError(std::string(kHead) + "task:\n  kind: valet_parking\n", "task", 9,
               "found 'task' again (first at line 4)");

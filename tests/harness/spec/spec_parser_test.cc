@@ -227,6 +227,37 @@ design_space: {hz: {bind: stack.lidar.rate_hz, values: [14, 7, 10]}}
   EXPECT_NEAR(hz->values[2], 14, kTol);
 }
 
+TEST(SpecParserTest, KnobRolesDefaultFromTheBindAndMayBeDeclared) {
+  const Spec spec = ParseOk(R"(adse: 1
+world: {map: {generate: grid}}
+task: {start: {x: 0, y: 0}, goal: {x: 1, y: 1}}
+design_space:
+  cores: {bind: platform.cores, range: [1, 4]}
+  freq_ghz: {bind: platform.freq_ghz, values: [1, 2]}
+  hz: {bind: stack.lidar.rate_hz, values: [7, 14]}
+  odo: {bind: stack.odometry.rate_hz, values: [25, 50]}
+  leaf: {bind: stack.localization.voxel_leaf_m, values: [1, 2]}
+  ctrl: {bind: stack.control.rate_hz, values: [10, 30], role: frequency}
+)");
+  auto role = [&spec](const char* name) {
+    return spec.design_space.Find(name)->role;
+  };
+  EXPECT_EQ(role("cores"), KnobRole::kCores);
+  EXPECT_EQ(role("freq_ghz"), KnobRole::kFrequency);
+  EXPECT_EQ(role("hz"), KnobRole::kSensorRate);
+  EXPECT_EQ(role("odo"), KnobRole::kSensorRate);
+  // A node's timer rate is no sensor: no role unless declared.
+  EXPECT_EQ(role("leaf"), KnobRole::kNone);
+  EXPECT_EQ(role("ctrl"), KnobRole::kFrequency);
+  // Only a declared role that differs from the default is written back.
+  const std::string yaml = NormalizedYaml(spec);
+  EXPECT_NE(yaml.find("role: frequency"), std::string::npos) << yaml;
+  EXPECT_EQ(yaml.find("role: cores"), std::string::npos) << yaml;
+  Result<Spec> again = ParseSpec(yaml, "normalized.yaml", "");
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  EXPECT_EQ(again->design_space.Find("ctrl")->role, KnobRole::kFrequency);
+}
+
 TEST(SpecParserTest, NetAndPolygonPathsResolveFromTheFileFolder) {
   const std::string dir = MakeTempDir();
   WriteText(fs::path(dir) / "maps/town.net.xml",

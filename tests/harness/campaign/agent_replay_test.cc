@@ -1,0 +1,103 @@
+// The built-in agent replayed over every recording and landscape in
+// tests/data at a budget of 15 over 20 seeds (issue 16's measure): what it
+// finds of the true front, its hypervolume next to random search's, and in
+// how many seeds it evaluates the cheapest feasible design. Thresholds sit
+// a little below the values measured when this test was written (README,
+// "Strategies"); where they fall short of the issue's targets, the README
+// says so.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "harness/campaign/replay.h"
+#include "tests/harness/testing/recording.h"
+
+namespace adse::campaign {
+namespace {
+
+constexpr int kSeeds = 20;
+constexpr int kBudget = 15;
+
+struct Outcome {
+  double median_true_pareto = 0.0;
+  double median_hypervolume = 0.0;
+  int cheapest_found = 0;  // seeds
+};
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+Outcome ReplayOver(const std::string& data, const std::string& strategy) {
+  const Recording& recording = adse::testing::RecordingUnderTestData(data);
+  std::vector<double> found, volume;
+  Outcome outcome;
+  for (uint64_t seed = 1; seed <= kSeeds; ++seed) {
+    Result<ReplayRun> run = Replay(recording, strategy, seed, kBudget);
+    EXPECT_TRUE(run.ok()) << data << ": " << run.status().message();
+    if (!run.ok()) return outcome;
+    EXPECT_EQ(run->missing, 0) << data;
+    found.push_back(run->true_pareto_found);
+    volume.push_back(run->hypervolume_ratio);
+    outcome.cheapest_found += run->found_cheapest_feasible ? 1 : 0;
+  }
+  outcome.median_true_pareto = Median(found);
+  outcome.median_hypervolume = Median(volume);
+  return outcome;
+}
+
+struct Expected {
+  double true_pareto;  // median at least
+  double hypervolume;  // median at least
+  int cheapest_found;  // seeds at least
+};
+
+void ExpectAgentOn(const std::string& data, const Expected& expected) {
+  const Outcome agent = ReplayOver(data, "agent");
+  const Outcome random = ReplayOver(data, "random");
+  EXPECT_GE(agent.median_true_pareto, expected.true_pareto) << data;
+  EXPECT_GE(agent.median_hypervolume, expected.hypervolume) << data;
+  EXPECT_GE(agent.cheapest_found, expected.cheapest_found) << data;
+  // Never below random search's median hypervolume (to rounding).
+  EXPECT_GE(agent.median_hypervolume, random.median_hypervolume - 0.005)
+      << data << ": random search's median " << random.median_hypervolume;
+}
+
+TEST(AgentReplayTest, OnTheRecordedRobotaxiCampaign) {
+  ExpectAgentOn("robotaxi_exhaustive", {10, 0.74, 13});
+}
+
+TEST(AgentReplayTest, OnTheReferenceStudyWhereStarvedRunsAreStoppedEarly) {
+  ExpectAgentOn("reference_study", {6, 0.96, 0});
+}
+
+TEST(AgentReplayTest, OnALandscapeThatSaturates) {
+  ExpectAgentOn("landscapes/saturating", {4, 0.99, 17});
+}
+
+TEST(AgentReplayTest, OnALandscapeCutByATimeBoundWithCensoredRuns) {
+  ExpectAgentOn("landscapes/constraint_cut", {6, 0.98, 17});
+}
+
+TEST(AgentReplayTest, OnANoisyLandscape) {
+  ExpectAgentOn("landscapes/noisy", {2, 0.9, 10});
+}
+
+TEST(AgentReplayTest, OnALandscapePricedByAnotherCostExpression) {
+  ExpectAgentOn("landscapes/other_cost", {4, 0.92, 14});
+}
+
+TEST(AgentReplayTest, OnALandscapeWithAKnobThatDoesNothing) {
+  ExpectAgentOn("landscapes/dead_knob", {5, 0.98, 12});
+}
+
+TEST(AgentReplayTest, OnAFourDimensionalLandscape) {
+  ExpectAgentOn("landscapes/four_d", {0, 0.9, 0});
+}
+
+}  // namespace
+}  // namespace adse::campaign

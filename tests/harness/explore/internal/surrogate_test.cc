@@ -1,0 +1,68 @@
+// The agent's surrogate of one metric: measured values are interpolated,
+// and a value known only to lie past a bound (a run stopped early) pulls
+// the prediction past that bound without fixing it there.
+#include "harness/explore/internal/surrogate.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace adse::explore::internal {
+namespace {
+
+// Navigation time over one normalised knob (more cores to the right).
+MetricModel NavTimeModel() {
+  MetricModel model;
+  model.name = "nav_time_s";
+  model.good_direction = -1;  // lower is better
+  model.in_constraint = true;
+  return model;
+}
+
+double Predicted(const MetricModel& model, double u) {
+  double mean = 0.0, sd = 0.0;
+  model.Predict({u}, &mean, &sd);
+  return model.ToMetric(mean);
+}
+
+TEST(SurrogateTest, MeasuredValuesAreInterpolated) {
+  MetricModel model = NavTimeModel();
+  model.Fit({{0.2}, {0.5}, {0.8}}, {300, 200, 150}, {}, {1.0}, {0.25});
+  ASSERT_TRUE(model.fitted());
+  EXPECT_NEAR(Predicted(model, 0.5), 200, 20);
+  EXPECT_GT(Predicted(model, 0.2), Predicted(model, 0.8));
+}
+
+TEST(SurrogateTest, RunsStoppedPastABoundArePredictedPastIt) {
+  MetricModel model = NavTimeModel();
+  // Two starved runs stopped at the 400 s bound (true value above it), one
+  // measured run with more capacity.
+  model.Fit({{0.0}, {0.2}, {0.8}}, {400, 400, 150}, {+1, +1, 0}, {1.0},
+            {0.25});
+  ASSERT_TRUE(model.fitted());
+  EXPECT_GT(Predicted(model, 0.0), 400);
+  EXPECT_GT(Predicted(model, 0.2), 400);
+  EXPECT_NEAR(Predicted(model, 0.8), 150, 20);
+  // Only censored runs: still a model, all of it past the bound there.
+  MetricModel only = NavTimeModel();
+  only.Fit({{0.1}, {0.3}}, {400, 400}, {+1, +1}, {1.0}, {0.25});
+  ASSERT_TRUE(only.fitted());
+  EXPECT_GT(Predicted(only, 0.1), 400);
+  // ... and more capacity is predicted faster (the prior's direction).
+  EXPECT_LT(Predicted(only, 1.0), Predicted(only, 0.1));
+}
+
+TEST(SurrogateTest, ABoundOnAFlagIsIgnoredRatherThanTakenForAValue) {
+  MetricModel model;
+  model.name = "completed";
+  model.boolean_hint = true;
+  model.good_direction = +1;
+  model.Fit({{0.2}, {0.8}, {0.9}}, {0, 1, 1}, {+1, 0, 0}, {1.0}, {0.25});
+  ASSERT_TRUE(model.fitted());
+  EXPECT_EQ(model.points(), 2);  // the bound left out
+  EXPECT_EQ(model.space(), MetricSpace::kBoolean);
+}
+
+}  // namespace
+}  // namespace adse::explore::internal
