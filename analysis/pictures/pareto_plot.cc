@@ -28,12 +28,6 @@ constexpr double kClipRatio = 2.0;
 // ---------------------------------------------------------------------------
 // Pareto plot.
 
-struct Axis {
-  double min = 0.0, max = 1.0, step = 1.0;
-  int decimals = 0;
-};
-
-// Range of `values` padded by 5 %, with 1-2-5 ticks about every 1/6.
 Axis MakeAxis(const std::vector<double>& values) {
   double lo = values[0], hi = values[0];
   for (double v : values) {

@@ -32,6 +32,10 @@ inline constexpr Rgb kFeasibleRgb{40, 90, 200};
 inline constexpr Rgb kInfeasibleRgb{150, 150, 150};
 inline constexpr Rgb kFrontRgb{230, 90, 0};  // front points + line
 inline constexpr Rgb kConstraintRgb{190, 30, 60};
+// The study's form: the campaign's points, the reference's, its front.
+inline constexpr Rgb kStudyPointRgb{215, 30, 30};  // red triangles
+inline constexpr Rgb kReferenceRgb{175, 175, 175};
+inline constexpr Rgb kReferenceFrontRgb{90, 105, 140};  // slate
 
 struct TrajectoryImageOptions {
   int width_px = 1200;     // 200..4000
@@ -121,6 +125,25 @@ Status RenderParetoPlot(const std::vector<ParetoPlotPoint>& points,
                         const ParetoPlotOptions& o = {});
 Result<std::string> ParetoPlotPng(const std::vector<ParetoPlotPoint>& points,
                                   const ParetoPlotOptions& o = {});
+
+// The reference study's form of the same picture: navigation time on x,
+// hardware cost on y; a reference campaign's points (an exhaustive
+// recording) as small grey dots with its front (`on_front`) as a grey
+// staircase; the campaign's own points as red triangles, filled when
+// feasible, hollow when not (a run stopped early sits at the bound that
+// stopped it, `censored`); each bound dashed. InvalidArgument for bad
+// options or when neither set has a finite point.
+struct StudyPlotOptions {
+  int width_px = 1000, height_px = 700;  // 300..4000 each
+  std::string title;
+  std::vector<double> time_bounds_s;  // vertical dashed lines
+  std::vector<double> cost_bounds;    // horizontal dashed lines
+  std::string points_name = "this campaign";
+  std::string reference_name = "reference (every point)";
+};
+Result<std::string> StudyPlotPng(const std::vector<ParetoPlotPoint>& points,
+                                 const std::vector<ParetoPlotPoint>& reference,
+                                 const StudyPlotOptions& o = {});
 
 // One row of a comparison chart: adse's value beside a reference's (e.g.
 // a latency measured on the real stack); a row without a reference shows

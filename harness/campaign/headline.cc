@@ -218,23 +218,31 @@ std::string HeadlineMarkdown(const spec::Spec& spec,
   return md.str();
 }
 
-Status RenderFrontPicture(const spec::Spec& spec,
-                          const std::vector<EvaluationRow>& rows,
-                          const Headline& h, const std::string& title,
-                          const std::string& png_path, Env* env) {
-  std::vector<bool> on_front(rows.size(), false);
-  for (int i : h.cost_time_front) on_front[i] = true;
-  // A censored run's time is unknown beyond its stop; it is drawn as an
-  // arrow up from the time bound that stopped it (the largest, when there
-  // are several), or left out when no time bound did.
-  double time_bound = std::nan("");
+namespace {
+
+// The simple bounds the constraints put on `metric`, in file order.
+std::vector<double> BoundsOn(const spec::Spec& spec, const char* metric) {
+  std::vector<double> bounds;
   for (const std::string& c : spec.constraints) {
     double bound = 0.0;
-    if (SimpleBound(c, kTimeMetric, &bound) &&
-        (std::isnan(time_bound) || bound > time_bound)) {
-      time_bound = bound;
-    }
+    if (SimpleBound(c, metric, &bound)) bounds.push_back(bound);
   }
+  return bounds;
+}
+
+// Every placeable row as a plot point. A censored run's time is unknown
+// beyond its stop; it sits at the time bound that stopped it (the largest,
+// when there are several), or is left out when no time bound did.
+std::vector<analysis::ParetoPlotPoint> PlotPoints(
+    const spec::Spec& spec, const std::vector<EvaluationRow>& rows,
+    const Headline& h) {
+  std::vector<bool> on_front(rows.size(), false);
+  for (int i : h.cost_time_front) on_front[i] = true;
+  const std::vector<double> time_bounds = BoundsOn(spec, kTimeMetric);
+  const double time_bound =
+      time_bounds.empty()
+          ? std::nan("")
+          : *std::max_element(time_bounds.begin(), time_bounds.end());
   std::vector<analysis::ParetoPlotPoint> plot;
   for (size_t i = 0; i < rows.size(); ++i) {
     if (RowMetric(rows[i], analysis::kCensoredMetric) == 1.0 &&
@@ -258,20 +266,43 @@ Status RenderFrontPicture(const spec::Spec& spec,
     p.highlight = static_cast<int>(i) == h.cheapest;
     plot.push_back(p);
   }
+  return plot;
+}
+
+}  // namespace
+
+Status RenderFrontPicture(const spec::Spec& spec,
+                          const std::vector<EvaluationRow>& rows,
+                          const Headline& h, const std::string& title,
+                          const std::string& png_path, Env* env) {
+  const std::vector<analysis::ParetoPlotPoint> plot = PlotPoints(spec, rows, h);
   analysis::ParetoPlotOptions options;
   options.title = title;
   options.front_name = fmt::format("cost-time front ({})",
                                    fmt::join(spec.design_space.Names(), "/"));
-  for (const std::string& c : spec.constraints) {
-    double bound = 0.0;
-    if (SimpleBound(c, kTimeMetric, &bound)) {
-      options.horizontal_lines.push_back(bound);
-    }
-    if (SimpleBound(c, kCostMetric, &bound)) {
-      options.vertical_lines.push_back(bound);
-    }
-  }
+  options.horizontal_lines = BoundsOn(spec, kTimeMetric);
+  options.vertical_lines = BoundsOn(spec, kCostMetric);
   Result<std::string> png = analysis::ParetoPlotPng(plot, options);
+  if (!png.ok()) return png.status();
+  return WriteFileAtomic(png_path, *png, env);
+}
+
+Status RenderStudyPicture(const spec::Spec& spec,
+                          const std::vector<EvaluationRow>& rows,
+                          const spec::Spec& reference_spec,
+                          const std::vector<EvaluationRow>& reference_rows,
+                          const std::string& title, const std::string& png_path,
+                          Env* env) {
+  analysis::StudyPlotOptions options;
+  options.title = title;
+  options.time_bounds_s = BoundsOn(spec, kTimeMetric);
+  options.cost_bounds = BoundsOn(spec, kCostMetric);
+  options.points_name = spec.exploration.strategy;
+  Result<std::string> png = analysis::StudyPlotPng(
+      PlotPoints(spec, rows, ComputeHeadline(spec, rows)),
+      PlotPoints(reference_spec, reference_rows,
+                 ComputeHeadline(reference_spec, reference_rows)),
+      options);
   if (!png.ok()) return png.status();
   return WriteFileAtomic(png_path, *png, env);
 }

@@ -73,6 +73,18 @@ Status RenderFrontPicture(const spec::Spec& spec,
                           const std::string& png_path,
                           Env* env = Env::Default());
 
+// The same in the reference study's form (navigation time across, cost
+// up): this campaign's rows as red triangles over a reference campaign's
+// (an exhaustive recording's) points in grey and its cost-time front as a
+// grey line, each simple bound dashed. `points_name` in the legend is the
+// campaign's strategy.
+Status RenderStudyPicture(const spec::Spec& spec,
+                          const std::vector<EvaluationRow>& rows,
+                          const spec::Spec& reference_spec,
+                          const std::vector<EvaluationRow>& reference_rows,
+                          const std::string& title, const std::string& png_path,
+                          Env* env = Env::Default());
+
 // A constraint of the form `metric OP number` or `number OP metric`
 // (OP one of < <= > >=) on `metric`: its bound. False for anything else.
 bool SimpleBound(const std::string& constraint, const std::string& metric,

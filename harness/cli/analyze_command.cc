@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 
 #include "analysis/runfile/campaign_file.h"
@@ -17,6 +18,7 @@
 #include "harness/campaign/campaign.h"
 #include "harness/campaign/evaluation.h"
 #include "harness/campaign/headline.h"
+#include "harness/campaign/replay.h"
 #include "harness/campaign/run_store.h"
 #include "harness/cli/commands.h"
 #include "harness/report/run_report.h"
@@ -173,7 +175,8 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
 // again and the answer views are written by the code adse run uses, into
 // <folder>/analysis/vN; the run files are never touched.
 int AnalyzeFolder(const std::string& target,
-                  const report::AnalyzeOptions& base_options, bool json) {
+                  const report::AnalyzeOptions& base_options,
+                  const campaign::Recording* reference, bool json) {
   const campaign::CampaignFolder folder(target);
   std::optional<runfile::CampaignIndex> index;
   std::error_code ec;
@@ -323,6 +326,19 @@ int AnalyzeFolder(const std::string& target,
     std::fprintf(stderr, "error: %s\n", s.message().c_str());
     return 1;
   }
+  if (reference != nullptr) {
+    const std::string png = version + "/pareto.png";
+    if (Status s = campaign::RenderStudyPicture(
+            *spec, rows, reference->spec, reference->rows,
+            fmt::format("{}: {} evaluations ({}) over {} ({} points)",
+                        spec->name, rows.size(), summary.strategy,
+                        reference->spec.name, reference->rows.size()),
+            png);
+        !s.ok()) {
+      std::fprintf(stderr, "error: %s: %s\n", png.c_str(), s.message().c_str());
+      return 1;
+    }
+  }
   if (json) {
     Result<std::string> text = ReadFile(version + "/summary.json");
     std::printf("%s", text.ok() ? text->c_str() : "{}\n");
@@ -337,8 +353,11 @@ int AnalyzeFolder(const std::string& target,
     std::printf("%s", campaign::HeadlineText(
                           *spec, rows, campaign::ComputeHeadline(*spec, rows))
                           .c_str());
-    std::printf("wrote %s (report.md, summary.json, pareto.png)\n",
-                version.c_str());
+    std::printf("wrote %s (report.md, summary.json, pareto.png%s)\n",
+                version.c_str(),
+                reference != nullptr
+                    ? (" in the study's form over " + reference->folder).c_str()
+                    : "");
   }
   return exit_code;
 }
@@ -369,12 +388,36 @@ int RunAnalyze(const AnalyzeArgs& args) {
     }
     options.thresholds[t.substr(0, eq)] = value;
   }
+  // The reference is read before anything is written.
+  std::optional<campaign::Recording> reference;
+  if (!args.reference.empty()) {
+    Result<campaign::Recording> loaded =
+        campaign::LoadRecording(args.reference);
+    if (!loaded.ok()) {
+      std::fprintf(stderr, "error: --reference: %s\n",
+                   loaded.status().message().c_str());
+      return 2;
+    }
+    reference = std::move(*loaded);
+    for (const std::string& target : args.targets) {
+      std::error_code ec;
+      if (!fs::is_directory(target, ec)) {
+        std::fprintf(stderr,
+                     "error: --reference: %s is not a campaign folder (the "
+                     "study's picture is a campaign's)\n",
+                     target.c_str());
+        return 2;
+      }
+    }
+  }
   int exit_code = 0;
   for (const std::string& target : args.targets) {
     std::error_code ec;
     if (fs::is_directory(target, ec)) {
       exit_code =
-          std::max(exit_code, AnalyzeFolder(target, options, args.json));
+          std::max(exit_code,
+                   AnalyzeFolder(target, options,
+                                 reference ? &*reference : nullptr, args.json));
       continue;
     }
     if (!fs::exists(target, ec)) {

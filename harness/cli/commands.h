@@ -55,6 +55,10 @@ struct AnalyzeArgs {
   std::vector<std::string> targets;     // run files or folders of them
   std::vector<std::string> thresholds;  // NAME=VALUE (diagnosis options)
   std::vector<std::string> diff;        // two analysis version folders
+  // A reference campaign (folder or campaign.h5, e.g. an exhaustive
+  // recording): each campaign's pareto.png is drawn in the study's form
+  // over it.
+  std::string reference;
   bool json = false;
 };
 int RunAnalyze(const AnalyzeArgs& args);

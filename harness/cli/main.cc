@@ -113,6 +113,12 @@ int main(int argc, char** argv) {
       ->add_option("--diff", analyze.diff,
                    "Compare two analysis version folders: --diff A B")
       ->expected(2);
+  analyze_cmd->add_option(
+      "--reference", analyze.reference,
+      "A reference campaign (e.g. an exhaustive recording): draw each "
+      "campaign's pareto.png in the reference study's form over it "
+      "(navigation time across, cost up, its points in grey, its front as a "
+      "line, this campaign's as red triangles)");
   analyze_cmd->add_flag("--json", analyze.json, "Print the report(s) as JSON");
 
   adse::cli::RunArgs run;

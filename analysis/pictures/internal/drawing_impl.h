@@ -79,6 +79,16 @@ void DrawDashed(cv::Mat* img, cv::Point2d a, cv::Point2d b,
 // 1, 2 or 5 times a power of ten, at most `limit` (> 0).
 double NiceBelow(double limit);
 
+// A linear plot axis: its range and tick step, ticks written with
+// `decimals` decimals.
+struct Axis {
+  double min = 0.0, max = 1.0, step = 1.0;
+  int decimals = 0;
+};
+// Range of `values` (not empty) padded by 5 %, with 1-2-5 ticks about
+// every 1/6.
+Axis MakeAxis(const std::vector<double>& values);
+
 // 1, 2 or 5 times a power of ten, nearest above `rough` (> 0).
 double NiceAbove(double rough);
 

@@ -283,6 +283,44 @@ std::vector<ParetoPlotPoint> StudyPoints() {
   };
 }
 
+TEST_F(PictureTest, StudyPlotDrawsTheCampaignOverTheReferenceWithItsBound) {
+  // The reference: every point in grey, its front as a darker line; the
+  // campaign's four points as red triangles.
+  std::vector<ParetoPlotPoint> reference = StudyPoints();
+  const std::vector<ParetoPlotPoint> points = {
+      {9.0, 505, false}, {12.0, 380, true}, {20.0, 240, true}, {40, 200, true}};
+  StudyPlotOptions options;
+  options.time_bounds_s = {400};
+  options.title = "agent over the exhaustive study";
+  Result<std::string> png = StudyPlotPng(points, reference, options);
+  ASSERT_TRUE(png.ok()) << png.status().ToString();
+  {
+    std::ofstream out(Path("study.png"), std::ios::binary);
+    out << *png;
+  }
+  Result<RgbImage> img = ReadImage(Path("study.png"));
+  ASSERT_TRUE(img.ok()) << img.status().ToString();
+  EXPECT_EQ(img->width_px, 1000);
+  EXPECT_GT(CountColour(*img, kStudyPointRgb), 4 * 15);
+  EXPECT_GT(CountColour(*img, kReferenceRgb), 4 * 10);
+  EXPECT_GT(CountColour(*img, kReferenceFrontRgb), 200);  // the front line
+  // Without a reference only the campaign's own points are drawn.
+  Result<std::string> alone = StudyPlotPng(points, {}, options);
+  ASSERT_TRUE(alone.ok());
+  {
+    std::ofstream out(Path("alone.png"), std::ios::binary);
+    out << *alone;
+  }
+  Result<RgbImage> bare = ReadImage(Path("alone.png"));
+  ASSERT_TRUE(bare.ok());
+  EXPECT_EQ(CountColour(*bare, kReferenceFrontRgb), 0);
+  EXPECT_GT(CountColour(*bare, kStudyPointRgb), 4 * 15);
+  // Nothing finite to draw, or a bad size, is refused.
+  EXPECT_FALSE(StudyPlotPng({}, {}, options).ok());
+  options.width_px = 10;
+  EXPECT_FALSE(StudyPlotPng(points, reference, options).ok());
+}
+
 TEST_F(PictureTest, ParetoPlotRendersPointsFrontAndConstraints) {
   ParetoPlotOptions options;
   options.horizontal_lines = {400};

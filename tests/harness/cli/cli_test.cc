@@ -374,6 +374,36 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
       << diff.out;
 }
 
+TEST(CliRunTest, AnalyzeWithAReferenceDrawsTheStudysFigureOrRefusesClearly) {
+  const fs::path out = fs::temp_directory_path() / "adse_cli_study_figure";
+  fs::remove_all(out);
+  ASSERT_EQ(Adse("run " + Small() + " --budget 3 -q -o " + out.string())
+                .exit_code,
+            0);
+  const std::string recording =
+      std::string(ADSE_SOURCE_DIR) + "/tests/data/reference_study";
+  const CommandRun ok =
+      Adse("analyze " + out.string() + " --reference " + recording);
+  ASSERT_EQ(ok.exit_code, 0) << ok.out;
+  EXPECT_NE(ok.out.find("in the study's form over"), std::string::npos)
+      << ok.out;
+  EXPECT_TRUE(fs::exists(out / "analysis" / "v1" / "pareto.png"));
+  // A reference that is no campaign: exit 2, named, nothing written.
+  const CommandRun missing =
+      Adse("analyze " + out.string() + " --reference /nonexistent/ref");
+  EXPECT_EQ(missing.exit_code, 2) << missing.out;
+  EXPECT_NE(missing.out.find("--reference"), std::string::npos) << missing.out;
+  EXPECT_NE(missing.out.find("/nonexistent/ref"), std::string::npos)
+      << missing.out;
+  EXPECT_FALSE(fs::exists(out / "analysis" / "v2"));
+  // The figure is a campaign's: a run file with --reference is refused.
+  const CommandRun file = Adse("analyze " + (out / "campaign.h5").string() +
+                               " --reference " + recording);
+  EXPECT_EQ(file.exit_code, 2) << file.out;
+  EXPECT_NE(file.out.find("not a campaign folder"), std::string::npos)
+      << file.out;
+}
+
 TEST(CliRunTest, WorkerRefusesAScenarioThatChangedUnderItsCampaign) {
   const std::string out =
       (fs::temp_directory_path() / "adse_cli_worker.h5").string();

@@ -1,0 +1,236 @@
+// The reference study's figure: a campaign's points over an exhaustive
+// reference campaign, navigation time across, cost up.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "analysis/pictures/internal/drawing_impl.h"
+#include "analysis/pictures/pictures.h"
+
+namespace adse::analysis::internal {
+namespace {
+
+constexpr int kMinSidePx = 300;
+const cv::Scalar kReferenceDot = Bgr(kReferenceRgb);
+const cv::Scalar kReferenceLine = Bgr(kReferenceFrontRgb);
+const cv::Scalar kTriangle = Bgr(kStudyPointRgb);
+
+bool Placed(const ParetoPlotPoint& p) {
+  return std::isfinite(p.cost) && std::isfinite(p.nav_time_s);
+}
+
+Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
+                                 const std::vector<ParetoPlotPoint>& reference,
+                                 const StudyPlotOptions& o) {
+  for (int side : {o.width_px, o.height_px}) {
+    if (side < kMinSidePx || side > kMaxSidePx) {
+      return Status::InvalidArgument(
+          fmt::format("study plot size {}x{} px is outside {}..{}", o.width_px,
+                      o.height_px, kMinSidePx, kMaxSidePx));
+    }
+  }
+  std::vector<double> xs, ys;
+  for (const auto* set : {&points, &reference}) {
+    for (const ParetoPlotPoint& p : *set) {
+      if (!Placed(p)) continue;
+      xs.push_back(p.nav_time_s);
+      ys.push_back(p.cost);
+    }
+  }
+  if (xs.empty()) return Status::InvalidArgument("no point to plot");
+  for (double v : o.time_bounds_s) {
+    if (std::isfinite(v)) xs.push_back(v);
+  }
+  for (double v : o.cost_bounds) {
+    if (std::isfinite(v)) ys.push_back(v);
+  }
+  const Axis ax = MakeAxis(xs), ay = MakeAxis(ys);
+
+  const Style s{std::clamp(std::min(o.width_px / 1000.0, o.height_px / 700.0),
+                           kMinUi, kMaxUi)};
+  int baseline = 0;
+  const int text_h = TextSize("Ag", s, &baseline).height;
+  const int line_px = text_h + baseline + s.Px(8);
+  const int left = s.Px(58) + line_px;
+  const int top = line_px + s.Px(10);
+  const int right = o.width_px - s.Px(24);
+  const int bottom = o.height_px - 2 * line_px - s.Px(8);
+  const cv::Rect area(left, top, right - left, bottom - top);
+  auto px = [&](double time, double cost) {
+    return cv::Point2d(
+        area.x + (time - ax.min) / (ax.max - ax.min) * area.width,
+        area.y + area.height -
+            (cost - ay.min) / (ay.max - ay.min) * area.height);
+  };
+
+  cv::Mat img(o.height_px, o.width_px, CV_8UC3, Bgr(kBackgroundRgb));
+  const cv::Scalar grid(235, 235, 235);
+  const int tick = s.Px(5);
+  auto tick_text = [](double v, const Axis& a) {
+    if (std::abs(v) < 1e-9 * a.step) v = 0.0;
+    return fmt::format("{:.{}f}", v, a.decimals);
+  };
+  for (double k = std::ceil(ax.min / ax.step); k * ax.step <= ax.max; ++k) {
+    const double x = px(k * ax.step, ay.min).x;
+    DrawSegment(&img, {x, double(area.y)}, {x, double(bottom)}, grid, 1);
+    DrawSegment(&img, {x, double(bottom)}, {x, double(bottom + tick)}, kBlack,
+                1);
+    DrawText(&img, tick_text(k * ax.step, ax), static_cast<int>(x),
+             bottom + tick + text_h + s.Px(4), Align::kCentre, s, kBlack,
+             false);
+  }
+  for (double k = std::ceil(ay.min / ay.step); k * ay.step <= ay.max; ++k) {
+    const double y = px(ax.min, k * ay.step).y;
+    DrawSegment(&img, {double(area.x), y}, {double(right), y}, grid, 1);
+    DrawSegment(&img, {double(area.x - tick), y}, {double(area.x), y}, kBlack,
+                1);
+    DrawText(&img, tick_text(k * ay.step, ay), area.x - tick - s.Px(4),
+             static_cast<int>(y) + text_h / 2, Align::kRight, s, kBlack, false);
+  }
+  for (double v : o.time_bounds_s) {
+    if (std::isfinite(v)) {
+      DrawDashed(&img, px(v, ay.min), px(v, ay.max), kBlack, s.Px(1.5),
+                 s.Px(8));
+    }
+  }
+  for (double v : o.cost_bounds) {
+    if (std::isfinite(v)) {
+      DrawDashed(&img, px(ax.min, v), px(ax.max, v), kBlack, s.Px(1.5),
+                 s.Px(8));
+    }
+  }
+
+  // The reference: every point, then its front as a staircase in cost
+  // order (a min-min front promises nothing between its points).
+  const int dot = s.Px(2.5);
+  auto draw_dot = [&](cv::Point2d c, const cv::Scalar& colour, int r) {
+    cv::circle(img, Fixed(c), r * static_cast<int>(kShiftScale), colour,
+               cv::FILLED, cv::LINE_AA, kShift);
+  };
+  std::vector<const ParetoPlotPoint*> front;
+  for (const ParetoPlotPoint& p : reference) {
+    if (!Placed(p)) continue;
+    draw_dot(px(p.nav_time_s, p.cost), kReferenceDot, dot);
+    if (p.on_front && p.feasible) front.push_back(&p);
+  }
+  std::sort(front.begin(), front.end(), [](const auto* a, const auto* b) {
+    return a->cost < b->cost ||
+           (a->cost == b->cost && a->nav_time_s < b->nav_time_s);
+  });
+  std::vector<cv::Point2d> line;
+  for (const auto* p : front) {
+    const cv::Point2d c = px(p->nav_time_s, p->cost);
+    // Cost rises as time falls: step across in cost first, then in time.
+    if (!line.empty()) line.push_back({line.back().x, c.y});
+    line.push_back(c);
+  }
+  DrawPolyline(&img, line, kReferenceLine, s.Px(2));
+  for (const auto* p : front) {
+    draw_dot(px(p->nav_time_s, p->cost), kReferenceLine, dot + s.Px(1));
+  }
+
+  // The campaign's points on top.
+  const double side = s.Px(7);
+  auto draw_triangle = [&](cv::Point2d c, bool filled) {
+    const std::vector<cv::Point> corners = {
+        Fixed(c + cv::Point2d(0, -side * 0.6)),
+        Fixed(c + cv::Point2d(-side * 0.55, side * 0.4)),
+        Fixed(c + cv::Point2d(side * 0.55, side * 0.4))};
+    if (filled) {
+      cv::fillConvexPoly(img, corners, kTriangle, cv::LINE_AA, kShift);
+    } else {
+      cv::polylines(img, corners, true, kTriangle, s.Px(1.5), cv::LINE_AA,
+                    kShift);
+    }
+  };
+  for (const ParetoPlotPoint& p : points) {
+    if (Placed(p)) draw_triangle(px(p.nav_time_s, p.cost), p.feasible);
+  }
+  cv::rectangle(img, area, kBlack, 1);
+
+  // Legend, top right (slow and expensive: the emptiest corner).
+  struct Entry {
+    std::string name;
+    std::function<void(cv::Point2d)> sample;
+  };
+  std::vector<Entry> entries = {
+      {o.points_name + ", feasible",
+       [&](cv::Point2d c) { draw_triangle(c, true); }},
+      {o.points_name + ", infeasible",
+       [&](cv::Point2d c) { draw_triangle(c, false); }}};
+  if (!reference.empty()) {
+    entries.push_back({o.reference_name, [&](cv::Point2d c) {
+                         draw_dot(c, kReferenceDot, dot);
+                       }});
+    entries.push_back({"its true front", [&](cv::Point2d c) {
+                         DrawSegment(&img, c - cv::Point2d(s.Px(12), 0),
+                                     c + cv::Point2d(s.Px(12), 0),
+                                     kReferenceLine, s.Px(2));
+                       }});
+  }
+  if (!o.time_bounds_s.empty() || !o.cost_bounds.empty()) {
+    entries.push_back({"constraint bound", [&](cv::Point2d c) {
+                         DrawDashed(&img, c - cv::Point2d(s.Px(12), 0),
+                                    c + cv::Point2d(s.Px(12), 0), kBlack,
+                                    s.Px(1.5), s.Px(5));
+                       }});
+  }
+  int text_w = 0;
+  for (const Entry& e : entries) {
+    text_w = std::max(text_w, TextSize(Ascii(e.name), s, &baseline).width);
+  }
+  const int row = line_px;
+  const cv::Rect box(right - s.Px(10) - (s.Px(50) + text_w), area.y + s.Px(10),
+                     s.Px(50) + text_w,
+                     row * static_cast<int>(entries.size()) + s.Px(6));
+  cv::rectangle(img, box, kWhite, cv::FILLED);
+  cv::rectangle(img, box, kDarkGrey, 1);
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const int y = box.y + s.Px(3) + row * static_cast<int>(i) + row / 2;
+    entries[i].sample(cv::Point2d(box.x + s.Px(20), y));
+    DrawText(&img, entries[i].name, box.x + s.Px(40), y + text_h / 2,
+             Align::kLeft, s, kBlack, false);
+  }
+
+  DrawText(&img, o.title, o.width_px / 2, line_px - baseline, Align::kCentre, s,
+           kBlack, false);
+  DrawText(&img, "navigation time (s)", area.x + area.width / 2,
+           o.height_px - s.Px(8) - baseline, Align::kCentre, s, kBlack, false);
+  // The y label, turned: OpenCV draws text horizontally only.
+  const std::string label = "hardware cost";
+  const cv::Size size = TextSize(label, s, &baseline);
+  cv::Mat strip(size.height + baseline + 2, size.width + 2, CV_8UC3,
+                Bgr(kBackgroundRgb));
+  cv::putText(strip, label, cv::Point(1, size.height + 1), kFont,
+              s.font_scale(), kBlack, s.text_thickness(), cv::LINE_AA);
+  cv::Mat turned;
+  cv::rotate(strip, turned, cv::ROTATE_90_COUNTERCLOCKWISE);
+  const int y = std::clamp(area.y + area.height / 2 - turned.rows / 2, 0,
+                           std::max(0, o.height_px - turned.rows));
+  if (s.Px(6) + turned.cols <= o.width_px && y + turned.rows <= o.height_px) {
+    turned.copyTo(img(cv::Rect(s.Px(6), y, turned.cols, turned.rows)));
+  }
+
+  std::string png;
+  ADSE_RETURN_IF_ERROR(EncodeOk(img, &png));
+  return png;
+}
+
+}  // namespace
+}  // namespace adse::analysis::internal
+
+namespace adse::analysis {
+
+Result<std::string> StudyPlotPng(const std::vector<ParetoPlotPoint>& points,
+                                 const std::vector<ParetoPlotPoint>& reference,
+                                 const StudyPlotOptions& o) {
+  return internal::Guarded("study plot", [&] {
+    return internal::StudyPngImpl(points, reference, o);
+  });
+}
+
+}  // namespace adse::analysis
