@@ -28,27 +28,6 @@ constexpr double kClipRatio = 2.0;
 // ---------------------------------------------------------------------------
 // Pareto plot.
 
-Axis MakeAxis(const std::vector<double>& values) {
-  double lo = values[0], hi = values[0];
-  for (double v : values) {
-    lo = std::min(lo, v);
-    hi = std::max(hi, v);
-  }
-  if (!(hi > lo)) {
-    const double half = std::max(std::abs(lo) * 0.1, 1.0);
-    lo -= half;
-    hi += half;
-  }
-  const double pad = 0.05 * (hi - lo);
-  Axis axis;
-  axis.min = lo - pad;
-  axis.max = hi + pad;
-  axis.step = NiceAbove((axis.max - axis.min) / 6.0);
-  axis.decimals =
-      std::max(0, -static_cast<int>(std::floor(std::log10(axis.step) + 1e-9)));
-  return axis;
-}
-
 Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
                                   const ParetoPlotOptions& o) {
   for (int side : {o.width_px, o.height_px}) {
@@ -133,33 +112,7 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
   };
 
   cv::Mat img(o.height_px, o.width_px, CV_8UC3, Bgr(kBackgroundRgb));
-  const cv::Scalar grid(235, 235, 235);
-
-  // Grid, ticks and tick labels.
-  const int tick = s.Px(5);
-  auto tick_text = [](double v, const Axis& a) {
-    if (std::abs(v) < 1e-9 * a.step) v = 0.0;  // no "-0"
-    return fmt::format("{:.{}f}", v, a.decimals);
-  };
-  for (double k = std::ceil(ax.min / ax.step); k * ax.step <= ax.max; ++k) {
-    const double v = k * ax.step;
-    const double x = px(v, ay.min).x;
-    DrawSegment(&img, {x, double(area.y)}, {x, double(bottom)}, grid, 1);
-    DrawSegment(&img, {x, double(bottom)}, {x, double(bottom + tick)}, kBlack,
-                1);
-    DrawText(&img, tick_text(v, ax), static_cast<int>(x),
-             bottom + tick + text_h + s.Px(4), Align::kCentre, s, kBlack,
-             false);
-  }
-  for (double k = std::ceil(ay.min / ay.step); k * ay.step <= ay.max; ++k) {
-    const double v = k * ay.step;
-    const double y = px(ax.min, v).y;
-    DrawSegment(&img, {double(area.x), y}, {double(right), y}, grid, 1);
-    DrawSegment(&img, {double(area.x - tick), y}, {double(area.x), y}, kBlack,
-                1);
-    DrawText(&img, tick_text(v, ay), area.x - tick - s.Px(4),
-             static_cast<int>(y) + text_h / 2, Align::kRight, s, kBlack, false);
-  }
+  DrawAxes(&img, area, ax, ay, s);
 
   // Constraint lines.
   for (double v : o.vertical_lines) {
@@ -423,24 +376,7 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
   }
   DrawText(&img, o.x_label, area.x + area.width / 2,
            o.height_px - s.Px(8) - baseline, Align::kCentre, s, kBlack, false);
-  if (!o.y_label.empty()) {
-    // OpenCV draws text horizontally only: draw it on its own strip and
-    // turn the strip.
-    const std::string label = FitText(Ascii(o.y_label), s, area.height);
-    const cv::Size size = TextSize(label, s, &baseline);
-    cv::Mat strip(size.height + baseline + 2, size.width + 2, CV_8UC3,
-                  Bgr(kBackgroundRgb));
-    cv::putText(strip, label, cv::Point(1, size.height + 1), kFont,
-                s.font_scale(), kBlack, s.text_thickness(), cv::LINE_AA);
-    cv::Mat turned;
-    cv::rotate(strip, turned, cv::ROTATE_90_COUNTERCLOCKWISE);
-    const int x = s.Px(6);
-    const int y = std::clamp(area.y + area.height / 2 - turned.rows / 2, 0,
-                             std::max(0, o.height_px - turned.rows));
-    if (x + turned.cols <= o.width_px && y + turned.rows <= o.height_px) {
-      turned.copyTo(img(cv::Rect(x, y, turned.cols, turned.rows)));
-    }
-  }
+  if (!o.y_label.empty()) DrawTurnedLabel(&img, o.y_label, area, s);
 
   std::string png;
   ADSE_RETURN_IF_ERROR(EncodeOk(img, &png));

@@ -68,29 +68,7 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
   };
 
   cv::Mat img(o.height_px, o.width_px, CV_8UC3, Bgr(kBackgroundRgb));
-  const cv::Scalar grid(235, 235, 235);
-  const int tick = s.Px(5);
-  auto tick_text = [](double v, const Axis& a) {
-    if (std::abs(v) < 1e-9 * a.step) v = 0.0;
-    return fmt::format("{:.{}f}", v, a.decimals);
-  };
-  for (double k = std::ceil(ax.min / ax.step); k * ax.step <= ax.max; ++k) {
-    const double x = px(k * ax.step, ay.min).x;
-    DrawSegment(&img, {x, double(area.y)}, {x, double(bottom)}, grid, 1);
-    DrawSegment(&img, {x, double(bottom)}, {x, double(bottom + tick)}, kBlack,
-                1);
-    DrawText(&img, tick_text(k * ax.step, ax), static_cast<int>(x),
-             bottom + tick + text_h + s.Px(4), Align::kCentre, s, kBlack,
-             false);
-  }
-  for (double k = std::ceil(ay.min / ay.step); k * ay.step <= ay.max; ++k) {
-    const double y = px(ax.min, k * ay.step).y;
-    DrawSegment(&img, {double(area.x), y}, {double(right), y}, grid, 1);
-    DrawSegment(&img, {double(area.x - tick), y}, {double(area.x), y}, kBlack,
-                1);
-    DrawText(&img, tick_text(k * ay.step, ay), area.x - tick - s.Px(4),
-             static_cast<int>(y) + text_h / 2, Align::kRight, s, kBlack, false);
-  }
+  DrawAxes(&img, area, ax, ay, s);
   for (double v : o.time_bounds_s) {
     if (std::isfinite(v)) {
       DrawDashed(&img, px(v, ay.min), px(v, ay.max), kBlack, s.Px(1.5),
@@ -200,20 +178,7 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
            kBlack, false);
   DrawText(&img, "navigation time (s)", area.x + area.width / 2,
            o.height_px - s.Px(8) - baseline, Align::kCentre, s, kBlack, false);
-  // The y label, turned: OpenCV draws text horizontally only.
-  const std::string label = "hardware cost";
-  const cv::Size size = TextSize(label, s, &baseline);
-  cv::Mat strip(size.height + baseline + 2, size.width + 2, CV_8UC3,
-                Bgr(kBackgroundRgb));
-  cv::putText(strip, label, cv::Point(1, size.height + 1), kFont,
-              s.font_scale(), kBlack, s.text_thickness(), cv::LINE_AA);
-  cv::Mat turned;
-  cv::rotate(strip, turned, cv::ROTATE_90_COUNTERCLOCKWISE);
-  const int y = std::clamp(area.y + area.height / 2 - turned.rows / 2, 0,
-                           std::max(0, o.height_px - turned.rows));
-  if (s.Px(6) + turned.cols <= o.width_px && y + turned.rows <= o.height_px) {
-    turned.copyTo(img(cv::Rect(s.Px(6), y, turned.cols, turned.rows)));
-  }
+  DrawTurnedLabel(&img, "hardware cost", area, s);
 
   std::string png;
   ADSE_RETURN_IF_ERROR(EncodeOk(img, &png));

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "stack/base/files.h"
@@ -166,6 +167,81 @@ Status WritePng(Result<std::string> png, const std::string& path) {
   if (path.empty()) return Status::InvalidArgument("empty PNG path");
   if (!png.ok()) return png.status().WithContext(path);
   return WriteFileAtomic(path, *png);
+}
+
+Axis MakeAxis(const std::vector<double>& values) {
+  double lo = values[0], hi = values[0];
+  for (double v : values) {
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  if (!(hi > lo)) {
+    const double half = std::max(std::abs(lo) * 0.1, 1.0);
+    lo -= half;
+    hi += half;
+  }
+  const double pad = 0.05 * (hi - lo);
+  Axis axis;
+  axis.min = lo - pad;
+  axis.max = hi + pad;
+  axis.step = NiceAbove((axis.max - axis.min) / 6.0);
+  axis.decimals =
+      std::max(0, -static_cast<int>(std::floor(std::log10(axis.step) + 1e-9)));
+  return axis;
+}
+
+void DrawAxes(cv::Mat* img, const cv::Rect& area, const Axis& ax,
+              const Axis& ay, const Style& s) {
+  const cv::Scalar grid(235, 235, 235);
+  int baseline = 0;
+  const int text_h = TextSize("Ag", s, &baseline).height;
+  const int tick = s.Px(5);
+  const int bottom = area.y + area.height;
+  const int right = area.x + area.width;
+  auto text = [](double v, const Axis& a) {
+    if (std::abs(v) < 1e-9 * a.step) v = 0.0;  // no "-0"
+    return fmt::format("{:.{}f}", v, a.decimals);
+  };
+  for (double k = std::ceil(ax.min / ax.step); k * ax.step <= ax.max; ++k) {
+    const double v = k * ax.step;
+    const double x = area.x + (v - ax.min) / (ax.max - ax.min) * area.width;
+    DrawSegment(img, {x, double(area.y)}, {x, double(bottom)}, grid, 1);
+    DrawSegment(img, {x, double(bottom)}, {x, double(bottom + tick)}, kBlack,
+                1);
+    DrawText(img, text(v, ax), static_cast<int>(x),
+             bottom + tick + text_h + s.Px(4), Align::kCentre, s, kBlack,
+             false);
+  }
+  for (double k = std::ceil(ay.min / ay.step); k * ay.step <= ay.max; ++k) {
+    const double v = k * ay.step;
+    const double y = bottom - (v - ay.min) / (ay.max - ay.min) * area.height;
+    DrawSegment(img, {double(area.x), y}, {double(right), y}, grid, 1);
+    DrawSegment(img, {double(area.x - tick), y}, {double(area.x), y}, kBlack,
+                1);
+    DrawText(img, text(v, ay), area.x - tick - s.Px(4),
+             static_cast<int>(y) + text_h / 2, Align::kRight, s, kBlack, false);
+  }
+}
+
+void DrawTurnedLabel(cv::Mat* img, const std::string& label,
+                     const cv::Rect& area, const Style& s) {
+  // OpenCV draws text horizontally only: draw it on its own strip and
+  // turn the strip.
+  const std::string text = FitText(Ascii(label), s, area.height);
+  int baseline = 0;
+  const cv::Size size = TextSize(text, s, &baseline);
+  cv::Mat strip(size.height + baseline + 2, size.width + 2, CV_8UC3,
+                Bgr(kBackgroundRgb));
+  cv::putText(strip, text, cv::Point(1, size.height + 1), kFont, s.font_scale(),
+              kBlack, s.text_thickness(), cv::LINE_AA);
+  cv::Mat turned;
+  cv::rotate(strip, turned, cv::ROTATE_90_COUNTERCLOCKWISE);
+  const int x = s.Px(6);
+  const int y = std::clamp(area.y + area.height / 2 - turned.rows / 2, 0,
+                           std::max(0, img->rows - turned.rows));
+  if (x + turned.cols <= img->cols && y + turned.rows <= img->rows) {
+    turned.copyTo((*img)(cv::Rect(x, y, turned.cols, turned.rows)));
+  }
 }
 
 }  // namespace adse::analysis::internal

@@ -88,6 +88,12 @@ struct Axis {
 // Range of `values` (not empty) padded by 5 %, with 1-2-5 ticks about
 // every 1/6.
 Axis MakeAxis(const std::vector<double>& values);
+// Grid lines, ticks and tick labels of a plot `area` over the axes.
+void DrawAxes(cv::Mat* img, const cv::Rect& area, const Axis& ax,
+              const Axis& ay, const Style& s);
+// A y-axis label, turned upright, left of `area` and centred on it.
+void DrawTurnedLabel(cv::Mat* img, const std::string& label,
+                     const cv::Rect& area, const Style& s);
 
 // 1, 2 or 5 times a power of ten, nearest above `rough` (> 0).
 double NiceAbove(double rough);

@@ -20,9 +20,6 @@
 
 namespace adse::explore::internal {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 // Joint samples of the predicted metrics per candidate.
 constexpr int kSamples = 64;
 // Spaces up to this size are scored exhaustively.

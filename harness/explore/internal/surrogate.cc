@@ -11,9 +11,6 @@
 namespace adse::explore::internal {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 // Prior slopes of a 0/1 metric (run completed) per unit of a knob that
 // helps, and their sd.
 constexpr double kFlagSlope = 0.3;

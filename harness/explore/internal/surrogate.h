@@ -13,6 +13,9 @@
 
 namespace adse::explore::internal {
 
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+
 // Inverse of the standard normal CDF (Acklam's rational approximation,
 // relative error < 1.2e-9), for stratified samples.
 double NormalQuantile(double p);
@@ -25,8 +28,8 @@ struct Trend {
   double a = 0.0;
   std::vector<double> b;
   double f = 0.0;
-  double cost = std::numeric_limits<double>::infinity();  // final Ceres cost
-                                                          // (data + priors)
+  double cost = kInf;  // final Ceres cost
+                       // (data + priors)
 
   double Value(const std::vector<double>& u) const;
 };
@@ -110,7 +113,7 @@ class MetricModel {
 
   bool fitted_ = false;
   int points_ = 0;
-  double best_ = std::numeric_limits<double>::quiet_NaN();
+  double best_ = kNaN;
   MetricSpace space_ = MetricSpace::kLog;
   double shift_ = 0.0;
   double scale_ = 1.0;
