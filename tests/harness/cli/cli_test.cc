@@ -377,9 +377,9 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
 TEST(CliRunTest, AnalyzeWithAReferenceDrawsTheStudysFigureOrRefusesClearly) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_study_figure";
   fs::remove_all(out);
-  ASSERT_EQ(Adse("run " + Small() + " --budget 3 -q -o " + out.string())
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      Adse("run " + Small() + " --budget 3 -q -o " + out.string()).exit_code,
+      0);
   const std::string recording =
       std::string(ADSE_SOURCE_DIR) + "/tests/data/reference_study";
   const CommandRun ok =

@@ -38,8 +38,7 @@ TEST(SurrogateTest, RunsStoppedPastABoundArePredictedPastIt) {
   MetricModel model = NavTimeModel();
   // Two starved runs stopped at the 400 s bound (true value above it), one
   // measured run with more capacity.
-  model.Fit({{0.0}, {0.2}, {0.8}}, {400, 400, 150}, {+1, +1, 0}, {1.0},
-            {0.25});
+  model.Fit({{0.0}, {0.2}, {0.8}}, {400, 400, 150}, {+1, +1, 0}, {1.0}, {0.25});
   ASSERT_TRUE(model.fitted());
   EXPECT_GT(Predicted(model, 0.0), 400);
   EXPECT_GT(Predicted(model, 0.2), 400);
