@@ -341,6 +341,11 @@ std::string AgentStrategy::Choose(int n, std::vector<Genes>* chosen) {
   return text;
 }
 
+namespace {
+// Weight of the chance of joining the front among equal expected savings.
+constexpr double kFrontTieBreak = 1e-3;
+}  // namespace
+
 int AgentStrategy::CheapestPick(const std::vector<Candidate>& candidates,
                                 const std::vector<Genes>& chosen) const {
   double cheapest = kInf;  // the cheapest feasible run's cost
@@ -370,16 +375,20 @@ int AgentStrategy::CheapestPick(const std::vector<Candidate>& candidates,
     } else {
       // Expected saving over the cheapest feasible run, relative; among
       // equal savings, the one likelier on the front.
-      score = c.p_feasible * std::max(0.0, cheapest - c.cost) / cheapest +
-              1e-3 * c.p_front;
+      score = c.p_feasible * std::max(0.0, cheapest - c.cost) /
+                  std::max(std::abs(cheapest), 1e-12) +
+              kFrontTieBreak * c.p_front;
     }
     if (score > best_score + 1e-12) {
       best_score = score;
       best = static_cast<int>(i);
     }
   }
-  // A saving this unlikely is not worth a run the front could use.
-  if (!none_feasible && best_score < kMinCheapestSaving + 1e-3) return -1;
+  // A saving this unlikely is not worth a run the front could use (the
+  // tie-break alone never is).
+  if (!none_feasible && best_score < kMinCheapestSaving + kFrontTieBreak) {
+    return -1;
+  }
   return best;
 }
 
