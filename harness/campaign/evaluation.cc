@@ -146,31 +146,17 @@ explore::Observation ObservationFromRow(const EvaluationRow& row) {
 
 analysis::Evaluation ParetoEvaluation(const spec::Spec& spec,
                                       const EvaluationRow& row) {
-  const explore::Observation o = ObservationFromRow(row);
-  analysis::Evaluation input;
-  input.point = row.point;
-  input.objectives = explore::MinimizationObjectives(spec, o);
-  input.violation = explore::ConstraintViolation(spec, o);
-  input.feasible = o.feasible && !o.failed;
-  for (double& v : input.objectives) {
-    // Unplaceable rows still take part, ranked behind every placed one.
-    if (!std::isfinite(v)) {
-      input.feasible = false;
-      v = std::numeric_limits<double>::max();
-    }
-  }
-  if (!std::isfinite(input.violation)) input.violation = 1e9;
-  if (!input.feasible && input.violation == 0.0) input.violation = 1.0;
-  return input;
+  return explore::ParetoEvaluationOf(spec, ObservationFromRow(row));
 }
 
 std::vector<int> ParetoFrontOf(const spec::Spec& spec,
                                const std::vector<EvaluationRow>& rows) {
-  std::vector<analysis::Evaluation> evals;
+  std::vector<explore::Observation> observations;
+  observations.reserve(rows.size());
   for (const EvaluationRow& row : rows) {
-    evals.push_back(ParetoEvaluation(spec, row));
+    observations.push_back(ObservationFromRow(row));
   }
-  return analysis::ParetoFront(evals);
+  return explore::ParetoFrontOf(spec, observations);
 }
 
 }  // namespace adse::campaign

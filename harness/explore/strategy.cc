@@ -114,6 +114,35 @@ std::optional<Genes> UnseenSampler::Next(const std::set<Genes>& seen) {
   return std::nullopt;
 }
 
+analysis::Evaluation ParetoEvaluationOf(const spec::Spec& spec,
+                                        const Observation& observation) {
+  analysis::Evaluation input;
+  input.point = observation.point;
+  input.objectives = MinimizationObjectives(spec, observation);
+  input.violation = ConstraintViolation(spec, observation);
+  input.feasible = observation.feasible && !observation.failed;
+  for (double& v : input.objectives) {
+    // Unplaceable runs still take part, ranked behind every placed one.
+    if (!std::isfinite(v)) {
+      input.feasible = false;
+      v = std::numeric_limits<double>::max();
+    }
+  }
+  if (!std::isfinite(input.violation)) input.violation = 1e9;
+  if (!input.feasible && input.violation == 0.0) input.violation = 1.0;
+  return input;
+}
+
+std::vector<int> ParetoFrontOf(const spec::Spec& spec,
+                               const std::vector<Observation>& observations) {
+  std::vector<analysis::Evaluation> evals;
+  evals.reserve(observations.size());
+  for (const Observation& o : observations) {
+    evals.push_back(ParetoEvaluationOf(spec, o));
+  }
+  return analysis::ParetoFront(evals);
+}
+
 std::vector<double> MinimizationObjectives(const spec::Spec& spec,
                                            const Observation& observation) {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();

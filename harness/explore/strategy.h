@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "analysis/diagnosis/remedy.h"
+#include "analysis/pareto/pareto.h"
 #include "harness/spec/spec.h"
 #include "stack/base/random.h"
 #include "stack/base/status.h"
@@ -173,6 +174,18 @@ std::vector<double> MinimizationObjectives(const spec::Spec& spec,
 // since `feasible` is authoritative); +inf for a failed run.
 double ConstraintViolation(const spec::Spec& spec,
                            const Observation& observation);
+
+// The observation as analysis/pareto takes it: objectives in minimisation
+// form, feasibility and violation. A run without a usable value of an
+// objective still takes part, infeasible and ranked behind every placed one.
+analysis::Evaluation ParetoEvaluationOf(const spec::Spec& spec,
+                                        const Observation& observation);
+
+// The constraint-aware Pareto front of `observations` (indices, ascending):
+// the one computation behind every front adse shows — campaigns, replay,
+// analysis, status — and the LLM agents' memory.
+std::vector<int> ParetoFrontOf(const spec::Spec& spec,
+                               const std::vector<Observation>& observations);
 
 // The individual strategies (CreateStrategy is the checked entry point).
 std::unique_ptr<Strategy> NewExhaustiveStrategy(const spec::Spec& spec);

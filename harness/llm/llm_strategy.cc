@@ -227,7 +227,8 @@ class LlmStrategy : public explore::Strategy {
           first ? "(none yet: this is the first proposal)" : last_point_},
          {"last_result", first ? "(none)" : last_result_},
          {"last_report", first ? "(none)" : last_report_},
-         {"memory", FormatMemory(Curate(memory_, spec_.design_space))},
+         {"memory", FormatMemory(Curate(memory_, spec_.design_space, {},
+                                        ParetoFrontOfMemory(spec_, memory_)))},
          {"evaluated", listed.empty() ? "(none)" : Lines(listed)}});
     return {{"system", system_prompt_, {}},
             {"user", step.ok() ? *step : "", {}}};

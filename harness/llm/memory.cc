@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "harness/explore/strategy.h"
 #include "harness/llm/jsonl_log.h"
 #include "harness/spec/spec_parser.h"
 
@@ -38,7 +39,7 @@ double GridDistance(const spec::DesignSpace& space, const spec::DesignPoint& a,
 
 std::vector<std::pair<const MemoryRecord*, std::string>> Curate(
     const std::vector<MemoryRecord>& records, const spec::DesignSpace& space,
-    const CurationOptions& o) {
+    const CurationOptions& o, const std::vector<int>& front) {
   std::map<size_t, std::string> reasons;  // record position -> reasons
   auto add = [&](size_t i, const std::string& why) {
     std::string& r = reasons[i];
@@ -69,6 +70,15 @@ std::vector<std::pair<const MemoryRecord*, std::string>> Curate(
       feasible,
       [&](size_t i) { return MetricOr(records[i], o.cost_metric, 1e300); },
       o.cheapest_feasible, "cheapest feasible");
+  std::vector<size_t> on_front;
+  for (int i : front) {
+    if (i >= 0 && static_cast<size_t>(i) < records.size())
+      on_front.push_back(i);
+  }
+  take(
+      on_front,
+      [&](size_t i) { return MetricOr(records[i], o.cost_metric, 1e300); },
+      o.front, "on the Pareto front");
   take(
       completed,
       [&](size_t i) { return MetricOr(records[i], o.time_metric, 1e300); },
@@ -101,6 +111,21 @@ std::vector<std::pair<const MemoryRecord*, std::string>> Curate(
   std::vector<std::pair<const MemoryRecord*, std::string>> out;
   for (size_t i : kept) out.push_back({&records[i], reasons[i]});
   return out;
+}
+
+std::vector<int> ParetoFrontOfMemory(const spec::Spec& spec,
+                                     const std::vector<MemoryRecord>& records) {
+  std::vector<explore::Observation> observations;
+  observations.reserve(records.size());
+  for (const MemoryRecord& r : records) {
+    explore::Observation o;
+    o.point = r.point;
+    o.metrics = r.metrics;
+    o.feasible = r.feasible;
+    o.failed = r.failed;
+    observations.push_back(std::move(o));
+  }
+  return explore::ParetoFrontOf(spec, observations);
 }
 
 std::string FormatMemory(

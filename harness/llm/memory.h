@@ -28,6 +28,7 @@ struct MemoryRecord {
 
 struct CurationOptions {
   int cheapest_feasible = 3;
+  int front = 3;  // on the Pareto front (as every command computes it)
   int fastest = 2;
   int most_recent = 3;
   int nearest = 3;   // neighbours of the last point, in grid steps
@@ -41,10 +42,17 @@ struct CurationOptions {
 // Picks the subset, each with the reasons it was picked ("cheapest
 // feasible", ...), in evaluation order. Deterministic. When the categories
 // pick more than max_records, each category's first pick is kept, then
-// each one's second, and so on (categories in the order above).
+// each one's second, and so on (categories in the order above). `front`:
+// the positions in `records` of the Pareto front (ParetoFrontOfMemory),
+// of which the cheapest are picked.
 std::vector<std::pair<const MemoryRecord*, std::string>> Curate(
     const std::vector<MemoryRecord>& records, const spec::DesignSpace& space,
-    const CurationOptions& options = {});
+    const CurationOptions& options = {}, const std::vector<int>& front = {});
+
+// The Pareto front of the records, by explore::ParetoFrontOf: the same
+// front the campaign's headline and every command show.
+std::vector<int> ParetoFrontOfMemory(const spec::Spec& spec,
+                                     const std::vector<MemoryRecord>& records);
 
 // One line per record: "#7 cores=4 freq_ghz=1.2 | feasible | nav_time_s=48.4
 // ... | cpu_bound ndt_scan_matcher | why: ... [cheapest feasible]".

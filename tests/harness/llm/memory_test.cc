@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "harness/explore/strategy.h"
 #include "harness/llm/jsonl_log.h"
 #include "tests/harness/testing/small_scenario.h"
 
@@ -69,6 +70,7 @@ MemoryRecord Rec(int64_t index, spec::DesignPoint point, Outcome o) {
 CurationOptions Nothing() {
   CurationOptions o;
   o.cheapest_feasible = 0;
+  o.front = 0;
   o.fastest = 0;
   o.most_recent = 0;
   o.nearest = 0;
@@ -105,6 +107,38 @@ TEST(CurateTest, NoHistoryPicksNothing) {
   const spec::Spec spec = SmallScenario();
   EXPECT_THAT(Curate({}, spec.design_space), IsEmpty());
   EXPECT_EQ(FormatMemory({}), "(none yet)");
+}
+
+TEST(CurateTest, TheFrontIsTheOneEveryCommandComputesAndItsCheapestArePicked) {
+  const spec::Spec spec = SmallScenario();  // cost and nav time, nav <= 60
+  const std::vector<MemoryRecord> records = {
+      Rec(0, SmallPoint(4, 1.0, 7), {.cost = 4, .nav_s = 50}),
+      Rec(1, SmallPoint(8, 1.0, 7), {.cost = 8, .nav_s = 30}),
+      Rec(2, SmallPoint(4, 2.1, 7), {.cost = 8, .nav_s = 40}),  // dominated
+      Rec(3, SmallPoint(1, 2.1, 7),
+          {.cost = 2, .nav_s = 70, .feasible = false}),
+      Rec(4, SmallPoint(16, 2.1, 14), {.failed = true}),
+      Rec(5, SmallPoint(12, 1.0, 7), {.cost = 12, .nav_s = 25}),
+  };
+  const std::vector<int> front = ParetoFrontOfMemory(spec, records);
+  EXPECT_THAT(front, ElementsAre(0, 1, 5));
+  // The same as explore::ParetoFrontOf over the same observations, which
+  // campaigns, replay and analysis use.
+  std::vector<explore::Observation> observations;
+  for (const MemoryRecord& r : records) {
+    explore::Observation o;
+    o.point = r.point;
+    o.metrics = r.metrics;
+    o.feasible = r.feasible;
+    o.failed = r.failed;
+    observations.push_back(o);
+  }
+  EXPECT_EQ(explore::ParetoFrontOf(spec, observations), front);
+  CurationOptions o = Nothing();
+  o.front = 2;
+  EXPECT_THAT(Indices(Curate(records, spec.design_space, o, front), records),
+              ElementsAre(Pair(0, "on the Pareto front"),
+                          Pair(1, "on the Pareto front")));
 }
 
 TEST(CurateTest, PicksTheCheapestFeasibleByHardwareCost) {
