@@ -90,8 +90,7 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
   }
   const Axis ax = MakeAxis(xs), ay = MakeAxis(ys);
 
-  const Style s{std::clamp(std::min(o.width_px / 1000.0, o.height_px / 700.0),
-                           kMinUi, kMaxUi)};
+  const Style s = PlotStyle(o.width_px, o.height_px);
   int baseline = 0;
   const int text_h = TextSize("Ag", s, &baseline).height;
   const int line_px = text_h + baseline + s.Px(8);

@@ -190,6 +190,11 @@ Axis MakeAxis(const std::vector<double>& values) {
   return axis;
 }
 
+Style PlotStyle(int width_px, int height_px) {
+  return Style{std::clamp(std::min(width_px / 1000.0, height_px / 700.0),
+                          kMinUi, kMaxUi)};
+}
+
 void DrawAxes(cv::Mat* img, const cv::Rect& area, const Axis& ax,
               const Axis& ay, const Style& s) {
   const cv::Scalar grid(235, 235, 235);

@@ -88,6 +88,8 @@ struct Axis {
 // Range of `values` (not empty) padded by 5 %, with 1-2-5 ticks about
 // every 1/6.
 Axis MakeAxis(const std::vector<double>& values);
+// The style of a plot drawn at width x height px (1000 x 700 is scale 1).
+Style PlotStyle(int width_px, int height_px);
 // Grid lines, ticks and tick labels of a plot `area` over the axes.
 void DrawAxes(cv::Mat* img, const cv::Rect& area, const Axis& ax,
               const Axis& ay, const Style& s);
