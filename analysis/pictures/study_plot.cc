@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -15,6 +16,7 @@ namespace adse::analysis::internal {
 namespace {
 
 constexpr int kMinSidePx = 300;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 const cv::Scalar kReferenceDot = Bgr(kReferenceRgb);
 const cv::Scalar kReferenceLine = Bgr(kReferenceFrontRgb);
 const cv::Scalar kTriangle = Bgr(kStudyPointRgb);
@@ -129,7 +131,9 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
   }
   cv::rectangle(img, area, kBlack, 1);
 
-  // Legend, top right (slow and expensive: the emptiest corner).
+  // Legend: at the top (right, middle or left) where it covers the fewest
+  // points and no bound (slow and expensive, top right, is usually empty,
+  // but a time bound near the right edge runs through it).
   struct Entry {
     std::string name;
     std::function<void(cv::Point2d)> sample;
@@ -161,9 +165,33 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
     text_w = std::max(text_w, TextSize(Ascii(e.name), s, &baseline).width);
   }
   const int row = line_px;
-  const cv::Rect box(right - s.Px(10) - (s.Px(50) + text_w), area.y + s.Px(10),
-                     s.Px(50) + text_w,
-                     row * static_cast<int>(entries.size()) + s.Px(6));
+  const int box_w = s.Px(50) + text_w;
+  const int box_h = row * static_cast<int>(entries.size()) + s.Px(6);
+  cv::Rect box;
+  double least = kInf;
+  for (const int x : {right - s.Px(10) - box_w,
+                      area.x + (area.width - box_w) / 2, area.x + s.Px(10)}) {
+    const cv::Rect candidate(x, area.y + s.Px(10), box_w, box_h);
+    double covered = 0.0;
+    for (const auto* set : {&points, &reference}) {
+      for (const ParetoPlotPoint& p : *set) {
+        if (!Placed(p)) continue;
+        const cv::Point2d c = px(p.nav_time_s, p.cost);
+        covered += candidate.contains(
+            cv::Point(static_cast<int>(c.x), static_cast<int>(c.y)));
+      }
+    }
+    for (double v : o.time_bounds_s) {
+      const double x_px = px(v, ay.min).x;
+      if (x_px >= candidate.x && x_px <= candidate.x + candidate.width) {
+        covered += 10.0;  // worse than a few hidden points
+      }
+    }
+    if (covered < least) {
+      least = covered;
+      box = candidate;
+    }
+  }
   cv::rectangle(img, box, kWhite, cv::FILLED);
   cv::rectangle(img, box, kDarkGrey, 1);
   for (size_t i = 0; i < entries.size(); ++i) {
