@@ -189,6 +189,45 @@ Status ReadColumn(hid_t parent, const std::string& name,
 Status ReadColumn(hid_t parent, const std::string& name,
                   std::vector<std::string>* out);
 
+// ---------------------------------------------------------------------------
+// Shared by the module's HDF5 files (hdf5_util.cc: errors; hdf5_strings.cc:
+// string types and values), not meant for its readers and writers.
+
+// Absolute HDF5 path of `name` below `loc`, for messages.
+std::string PathOf(hid_t loc, const std::string& name);
+// A read failure: Corruption; with the HDF5 error stack's innermost text.
+Status ReadError(const std::string& what);
+Status ReadHdf5Error(const std::string& object, const std::string& action);
+// A write failure with the HDF5 error stack's text: IoError.
+Status WriteHdf5Error(const std::string& object, const std::string& action);
+
+// A fixed-length, NUL-padded UTF-8 string type of `bytes` (at least one
+// byte), and one just long enough for `value`. Fixed rather than variable
+// length: variable-length strings live in HDF5's global heap, which has no
+// checksums, and a damaged heap crashes libhdf5 on read.
+Handle MakeFixedStringTypeOfSize(size_t bytes);
+Handle MakeFixedStringType(const std::string& value);
+// `value` padded to its type's size (the empty string becomes one NUL).
+std::vector<char> PaddedString(const std::string& value);
+// Strings packed into one buffer of fixed-width, NUL-padded cells as wide
+// as the longest value (at least 1 byte); a value holding a NUL is refused
+// (InvalidArgument naming `what`), since it would end early on reading.
+struct PackedStrings {
+  size_t width = 1;
+  std::vector<char> bytes;  // values.size() * width
+};
+Result<PackedStrings> PackStrings(const std::vector<std::string>& values,
+                                  const std::string& what);
+// The strings (variable or fixed length) of an attribute or dataset:
+// `is_attr` picks H5Aread/H5Dread; `array` wants a 1-D array, otherwise
+// exactly one string.
+Result<std::vector<std::string>> ReadStrings(hid_t obj, bool is_attr,
+                                             const std::string& what,
+                                             bool array);
+// The one string of an attribute or dataset.
+Result<std::string> ReadScalarString(hid_t obj, bool is_attr,
+                                     const std::string& what);
+
 // One field of a compound row dataset. Rows are packed (no padding) in the
 // order of the fields, in the file and in memory alike.
 enum class FieldType { kFloat64, kInt32, kInt64, kUInt64, kEnum8, kString };
