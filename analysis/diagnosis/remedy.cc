@@ -1,41 +1,25 @@
 #include "analysis/diagnosis/remedy.h"
 
-#include <cstddef>
 #include <ostream>
+
+#include "stack/base/vocabulary.h"
 
 namespace adse::analysis {
 namespace {
 
-struct KindToken {
-  RemedyKind kind;
-  const char* token;
-};
-
-// The single list of the vocabulary, in enum order (checked below), so a
-// kind's token is one array lookup and a token's kind one scan.
-constexpr KindToken kRemedyKindTokens[] = {
-    {RemedyKind::kMoreCores, "more_cores"},
-    {RemedyKind::kHigherFrequency, "higher_frequency"},
-    {RemedyKind::kLowerSensorRate, "lower_sensor_rate"},
-    {RemedyKind::kRaisePublisherRate, "raise_publisher_rate"},
-    {RemedyKind::kRaiseSensorRate, "raise_sensor_rate"},
-    {RemedyKind::kShortenTimerPeriod, "shorten_timer_period"},
-    {RemedyKind::kRelieveNode, "relieve_node"},
-};
-constexpr size_t kNumRemedyKinds =
-    sizeof(kRemedyKindTokens) / sizeof(kRemedyKindTokens[0]);
-
-constexpr bool TokensInEnumOrder() {
-  for (size_t i = 0; i < kNumRemedyKinds; ++i) {
-    if (static_cast<size_t>(kRemedyKindTokens[i].kind) != i) return false;
-  }
-  return true;
+// The single list of the vocabulary.
+const std::vector<Term<RemedyKind>>& RemedyKindTerms() {
+  static const std::vector<Term<RemedyKind>> kTerms = {
+      {RemedyKind::kMoreCores, "more_cores"},
+      {RemedyKind::kHigherFrequency, "higher_frequency"},
+      {RemedyKind::kLowerSensorRate, "lower_sensor_rate"},
+      {RemedyKind::kRaisePublisherRate, "raise_publisher_rate"},
+      {RemedyKind::kRaiseSensorRate, "raise_sensor_rate"},
+      {RemedyKind::kShortenTimerPeriod, "shorten_timer_period"},
+      {RemedyKind::kRelieveNode, "relieve_node"},
+  };
+  return kTerms;
 }
-static_assert(TokensInEnumOrder(),
-              "kRemedyKindTokens must list the kinds in enum order");
-static_assert(static_cast<size_t>(RemedyKind::kRelieveNode) + 1 ==
-                  kNumRemedyKinds,
-              "every RemedyKind needs a token in kRemedyKindTokens");
 
 }  // namespace
 
@@ -52,29 +36,22 @@ std::ostream& operator<<(std::ostream& os, const Remedy& remedy) {
 }
 
 const char* RemedyKindToString(RemedyKind kind) {
-  const size_t i = static_cast<size_t>(kind);
-  return i < kNumRemedyKinds ? kRemedyKindTokens[i].token : "unknown";
+  return NameOf(RemedyKindTerms(), kind);
 }
 
 Result<RemedyKind> StringToRemedyKind(const std::string& token) {
-  for (const KindToken& entry : kRemedyKindTokens) {
-    if (token == entry.token) return entry.kind;
-  }
+  RemedyKind kind = RemedyKind::kMoreCores;
+  if (ValueOf(RemedyKindTerms(), token, &kind)) return kind;
   std::string valid;
-  for (const KindToken& entry : kRemedyKindTokens) {
-    if (!valid.empty()) valid += ", ";
-    valid += entry.token;
+  for (const std::string& name : RemedyKindTokens()) {
+    valid += (valid.empty() ? "" : ", ") + name;
   }
   return Status::InvalidArgument("unknown remedy kind '" + token +
                                  "'; valid kinds: " + valid);
 }
 
 std::vector<std::string> RemedyKindTokens() {
-  std::vector<std::string> tokens;
-  for (const KindToken& entry : kRemedyKindTokens) {
-    tokens.emplace_back(entry.token);
-  }
-  return tokens;
+  return NamesOf(RemedyKindTerms());
 }
 
 std::string RemedyText(const Remedy& remedy) {

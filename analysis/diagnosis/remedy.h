@@ -17,9 +17,8 @@
 namespace adse::analysis {
 
 // One per thing the diagnosis proposes. A new kind needs its token in
-// remedy.cc's kRemedyKindTokens (the single list of the vocabulary) and its
-// text in RemedyText; keep kRelieveNode last or move that file's count
-// check along.
+// remedy.cc's RemedyKindTerms (the single list of the vocabulary) and its
+// text in RemedyText.
 enum class RemedyKind {
   // cpu_bound: the node's callbacks wait for a core longer than they run.
   kMoreCores,
