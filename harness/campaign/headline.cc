@@ -91,6 +91,8 @@ bool SimpleBound(const std::string& constraint, const std::string& metric,
   return false;
 }
 
+double CostKey(double cost) { return std::round(cost * 1e9) / 1e9; }
+
 Headline ComputeHeadline(const spec::Spec& spec,
                          const std::vector<EvaluationRow>& rows) {
   Headline h;
@@ -101,11 +103,9 @@ Headline ComputeHeadline(const spec::Spec& spec,
       feasible.push_back(static_cast<int>(i));
     }
   }
-  // Costs are compared to 1e-9: 3 x 1.2 (3.5999999999999996) and 2 x 1.8
-  // cost the same, and the faster of them is the cheapest design.
-  auto cost = [&](int i) {
-    return std::round(RowMetric(rows[i], kCostMetric) * 1e9) / 1e9;
-  };
+  // 3 x 1.2 (3.5999999999999996) and 2 x 1.8 cost the same, and the
+  // faster of them is the cheapest design.
+  auto cost = [&](int i) { return CostKey(RowMetric(rows[i], kCostMetric)); };
   auto time = [&](int i) { return RowMetric(rows[i], kTimeMetric); };
   auto by_cost = [&](int a, int b) {
     return cost(a) != cost(b)   ? cost(a) < cost(b)

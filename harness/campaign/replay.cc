@@ -1,7 +1,5 @@
 #include "harness/campaign/replay.h"
 
-#include <algorithm>
-#include <cmath>
 #include <filesystem>
 #include <limits>
 
@@ -115,15 +113,14 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
   const Headline answer = ComputeHeadline(spec, recording.rows);
   const double cheapest =
       answer.cheapest >= 0
-          ? RowMetric(recording.rows[answer.cheapest], "hardware_cost")
+          ? CostKey(RowMetric(recording.rows[answer.cheapest], "hardware_cost"))
           : std::numeric_limits<double>::quiet_NaN();
   for (const EvaluationRow& row : result.evaluations) {
     run.proposals.push_back(row.point);
-    const double cost = RowMetric(row, "hardware_cost");
     run.found_cheapest_feasible =
         run.found_cheapest_feasible ||
         (row.status == runfile::kRunComplete && row.feasible &&
-         std::abs(cost - cheapest) <= 1e-9 * std::max(1.0, std::abs(cheapest)));
+         CostKey(RowMetric(row, "hardware_cost")) == cheapest);
   }
   return run;
 }

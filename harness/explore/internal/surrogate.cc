@@ -171,7 +171,9 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
   points_ = static_cast<int>(values.size());
   if (values.empty()) return;
   const size_t dims = u.front().size();
-  auto side = [&sides](size_t i) { return i < sides.size() ? sides[i] : 0; };
+  // Empty `sides`: every value measured.
+  std::vector<int> sided = sides;
+  sided.resize(values.size(), 0);
   bool all_positive = true;
   bool all_flags = true;
   bool any_measured = false;
@@ -179,7 +181,7 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
     const double v = values[i];
     all_positive = all_positive && v > 0.0;
     all_flags = all_flags && (v == 0.0 || v == 1.0);
-    any_measured = any_measured || side(i) == 0;
+    any_measured = any_measured || sided[i] == 0;
   }
   if (boolean_hint || (all_flags && !all_positive && any_measured)) {
     space_ = MetricSpace::kBoolean;
@@ -195,7 +197,7 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
     std::vector<std::vector<double>> measured_u;
     std::vector<double> measured;
     for (size_t i = 0; i < values.size(); ++i) {
-      if (side(i) != 0) continue;
+      if (sided[i] != 0) continue;
       measured_u.push_back(u[i]);
       measured.push_back(values[i]);
     }
@@ -216,11 +218,9 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
   }
   // A censored bound is taken a margin beyond itself (in model units): the
   // run was stopped because its value was certainly past the bound.
-  std::vector<int> sided(values.size());
   for (size_t i = 0; i < values.size(); ++i) {
     t[i] = space_ == MetricSpace::kLog ? std::log(values[i])
                                        : (values[i] - shift_) / scale_;
-    sided[i] = side(i);
     t[i] += sided[i] * kCensoredMargin;
   }
   // Residual scale of the trend and the prior slope size, in model units.
@@ -307,7 +307,7 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
   for (size_t i = 0; i < values.size(); ++i) {
     const double v = values[i];
     if (good_direction == 0) break;
-    if (side(i) != 0) continue;
+    if (sided[i] != 0) continue;
     if (std::isnan(best_) || (good_direction < 0 ? v < best_ : v > best_)) {
       best_ = v;
     }
