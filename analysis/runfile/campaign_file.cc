@@ -3,6 +3,7 @@
 // results-schema/campaign.schema.json (human guide: results-schema/README.md).
 #include "analysis/runfile/campaign_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -84,6 +85,16 @@ Status Validate(const CampaignIndex& index) {
     const EvaluationRow& row = index.evaluations[i];
     ADSE_RETURN_IF_ERROR(CheckKeys("parameter", i, row.point, parameters));
     ADSE_RETURN_IF_ERROR(CheckKeys("metric", i, row.metrics, metrics));
+    for (const EvaluationRow& replica : row.replicas) {
+      ADSE_RETURN_IF_ERROR(
+          CheckKeys("parameter", i, replica.point, parameters));
+      ADSE_RETURN_IF_ERROR(CheckKeys("metric", i, replica.metrics, metrics));
+      if (replica.index != row.index || !replica.replicas.empty()) {
+        return Status::InvalidArgument(
+            "evaluation " + std::to_string(i) +
+            ": a replica has another index or replicas of its own");
+      }
+    }
   }
   for (size_t i = 0; i < index.iterations.size(); ++i) {
     for (const std::string& key : index.iterations[i].content_keys) {
@@ -142,6 +153,67 @@ std::string JoinKeys(const std::vector<std::string>& keys) {
   return out;
 }
 
+// /evaluations, or /replicas (the same columns, `replica` instead of
+// `replicas` and `unstable`).
+Status WriteEvaluationTable(hid_t file, const char* name,
+                            const CampaignIndex& index,
+                            const std::vector<EvaluationRow>& rows) {
+  const bool replica_table = std::string(name) == "replicas";
+  Result<Handle> group = internal::CreateGroup(file, name);
+  if (!group.ok()) return group.status();
+  const hid_t g = group->get();
+  using Row = EvaluationRow;
+  ADSE_RETURN_IF_ERROR(WriteColumn(
+      g, "index", Gather<int64_t>(rows, [](const Row& r) { return r.index; })));
+  ADSE_RETURN_IF_ERROR(WriteColumn(
+      g, "iteration",
+      Gather<int64_t>(rows, [](const Row& r) { return r.iteration; })));
+  ADSE_RETURN_IF_ERROR(WriteColumn(
+      g, "content_key",
+      Gather<std::string>(rows, [](const Row& r) { return r.content_key; })));
+  ADSE_RETURN_IF_ERROR(WriteColumn(
+      g, "status",
+      Gather<std::string>(rows, [](const Row& r) { return r.status; })));
+  ADSE_RETURN_IF_ERROR(WriteColumn(
+      g, "reason",
+      Gather<std::string>(rows, [](const Row& r) { return r.reason; })));
+  ADSE_RETURN_IF_ERROR(WriteColumn(
+      g, "source",
+      Gather<std::string>(rows, [](const Row& r) { return r.source; })));
+  ADSE_RETURN_IF_ERROR(WriteColumn(
+      g, "attempts",
+      Gather<int64_t>(rows, [](const Row& r) { return r.attempts; })));
+  ADSE_RETURN_IF_ERROR(
+      WriteColumn(g, "wall_s",
+                  Gather<double>(rows, [](const Row& r) { return r.wall_s; })));
+  ADSE_RETURN_IF_ERROR(WriteColumn(
+      g, "feasible",
+      Gather<uint8_t>(rows, [](const Row& r) { return r.feasible ? 1 : 0; })));
+  ADSE_RETURN_IF_ERROR(WriteColumn(
+      g, "seed", Gather<uint64_t>(rows, [](const Row& r) { return r.seed; })));
+  ADSE_RETURN_IF_ERROR(WriteColumn(g, "bottlenecks_json",
+                                   Gather<std::string>(rows, [](const Row& r) {
+                                     return r.bottlenecks_json;
+                                   })));
+  if (replica_table) {
+    ADSE_RETURN_IF_ERROR(WriteColumn(
+        g, "replica",
+        Gather<int64_t>(rows, [](const Row& r) { return r.replica; })));
+  } else {
+    ADSE_RETURN_IF_ERROR(
+        WriteColumn(g, "replicas", Gather<int64_t>(rows, [](const Row& r) {
+                      return std::max<size_t>(1, r.replicas.size());
+                    })));
+    ADSE_RETURN_IF_ERROR(
+        WriteColumn(g, "unstable", Gather<uint8_t>(rows, [](const Row& r) {
+                      return r.unstable ? 1 : 0;
+                    })));
+  }
+  ADSE_RETURN_IF_ERROR(
+      WriteNumberGroup(g, "point", index.parameters, rows, &Row::point));
+  return WriteNumberGroup(g, "metrics", index.metrics, rows, &Row::metrics);
+}
+
 Status WriteContents(hid_t file, const CampaignIndex& index) {
   using internal::WriteStringAttr;
   ADSE_RETURN_IF_ERROR(
@@ -159,52 +231,13 @@ Status WriteContents(hid_t file, const CampaignIndex& index) {
   ADSE_RETURN_IF_ERROR(
       WriteStringAttr(file, "adse_version", index.adse_version));
 
-  {
-    const auto& rows = index.evaluations;
-    Result<Handle> group = internal::CreateGroup(file, "evaluations");
-    if (!group.ok()) return group.status();
-    const hid_t g = group->get();
-    using Row = EvaluationRow;
-    ADSE_RETURN_IF_ERROR(WriteColumn(
-        g, "index",
-        Gather<int64_t>(rows, [](const Row& r) { return r.index; })));
-    ADSE_RETURN_IF_ERROR(WriteColumn(
-        g, "iteration",
-        Gather<int64_t>(rows, [](const Row& r) { return r.iteration; })));
-    ADSE_RETURN_IF_ERROR(WriteColumn(
-        g, "content_key",
-        Gather<std::string>(rows, [](const Row& r) { return r.content_key; })));
-    ADSE_RETURN_IF_ERROR(WriteColumn(
-        g, "status",
-        Gather<std::string>(rows, [](const Row& r) { return r.status; })));
-    ADSE_RETURN_IF_ERROR(WriteColumn(
-        g, "reason",
-        Gather<std::string>(rows, [](const Row& r) { return r.reason; })));
-    ADSE_RETURN_IF_ERROR(WriteColumn(
-        g, "source",
-        Gather<std::string>(rows, [](const Row& r) { return r.source; })));
-    ADSE_RETURN_IF_ERROR(WriteColumn(
-        g, "attempts",
-        Gather<int64_t>(rows, [](const Row& r) { return r.attempts; })));
-    ADSE_RETURN_IF_ERROR(WriteColumn(
-        g, "wall_s",
-        Gather<double>(rows, [](const Row& r) { return r.wall_s; })));
-    ADSE_RETURN_IF_ERROR(
-        WriteColumn(g, "feasible", Gather<uint8_t>(rows, [](const Row& r) {
-                      return r.feasible ? 1 : 0;
-                    })));
-    ADSE_RETURN_IF_ERROR(WriteColumn(
-        g, "seed",
-        Gather<uint64_t>(rows, [](const Row& r) { return r.seed; })));
-    ADSE_RETURN_IF_ERROR(WriteColumn(
-        g, "bottlenecks_json", Gather<std::string>(rows, [](const Row& r) {
-          return r.bottlenecks_json;
-        })));
-    ADSE_RETURN_IF_ERROR(
-        WriteNumberGroup(g, "point", index.parameters, rows, &Row::point));
-    ADSE_RETURN_IF_ERROR(
-        WriteNumberGroup(g, "metrics", index.metrics, rows, &Row::metrics));
+  ADSE_RETURN_IF_ERROR(
+      WriteEvaluationTable(file, "evaluations", index, index.evaluations));
+  std::vector<EvaluationRow> replicas;
+  for (const EvaluationRow& row : index.evaluations) {
+    replicas.insert(replicas.end(), row.replicas.begin(), row.replicas.end());
   }
+  ADSE_RETURN_IF_ERROR(WriteEvaluationTable(file, "replicas", index, replicas));
   {
     const auto& rows = index.iterations;
     Result<Handle> group = internal::CreateGroup(file, "iterations");
@@ -340,6 +373,63 @@ std::vector<std::string> SplitKeys(const std::string& joined) {
   return keys;
 }
 
+// The rows of /evaluations or /replicas (see WriteEvaluationTable); the
+// column names of point/ and metrics/ go to `index` (of /evaluations) or
+// are checked against it (of /replicas).
+Status ReadEvaluationTable(hid_t file, const std::string& path,
+                           CampaignIndex* index,
+                           std::vector<EvaluationRow>* rows) {
+  const bool replica_table = path == "/replicas";
+  Result<Handle> group = internal::OpenGroup(file, path);
+  if (!group.ok()) return group.status();
+  const hid_t g = group->get();
+  std::vector<int64_t> numbers;
+  ADSE_RETURN_IF_ERROR(ReadColumn(g, "index", &numbers));
+  const size_t n = numbers.size();
+  rows->assign(n, EvaluationRow{});
+  for (size_t i = 0; i < n; ++i) (*rows)[i].index = numbers[i];
+
+  using Row = EvaluationRow;
+  ADSE_RETURN_IF_ERROR(
+      ReadMember<int64_t>(g, path, "iteration", rows, &Row::iteration));
+  ADSE_RETURN_IF_ERROR(
+      ReadMember<std::string>(g, path, "content_key", rows, &Row::content_key));
+  ADSE_RETURN_IF_ERROR(
+      ReadMember<std::string>(g, path, "status", rows, &Row::status));
+  ADSE_RETURN_IF_ERROR(
+      ReadMember<std::string>(g, path, "reason", rows, &Row::reason));
+  ADSE_RETURN_IF_ERROR(
+      ReadMember<std::string>(g, path, "source", rows, &Row::source));
+  ADSE_RETURN_IF_ERROR(
+      ReadMember<int64_t>(g, path, "attempts", rows, &Row::attempts));
+  ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, "bottlenecks_json",
+                                               rows, &Row::bottlenecks_json));
+  ADSE_RETURN_IF_ERROR(
+      ReadMember<double>(g, path, "wall_s", rows, &Row::wall_s));
+  ADSE_RETURN_IF_ERROR(
+      ReadMember<uint8_t>(g, path, "feasible", rows, &Row::feasible));
+  ADSE_RETURN_IF_ERROR(ReadMember<uint64_t>(g, path, "seed", rows, &Row::seed));
+  if (replica_table) {
+    ADSE_RETURN_IF_ERROR(
+        ReadMember<int64_t>(g, path, "replica", rows, &Row::replica));
+  } else if (internal::GetObjectKind(file, path + "/unstable") !=
+             internal::ObjectKind::kMissing) {
+    // Indexes written before replicas existed lack the column.
+    ADSE_RETURN_IF_ERROR(
+        ReadMember<uint8_t>(g, path, "unstable", rows, &Row::unstable));
+  }
+  std::vector<std::string> parameters, metrics;
+  ADSE_RETURN_IF_ERROR(ReadNumberGroup(file, path + "/point", &parameters, rows,
+                                       &EvaluationRow::point));
+  ADSE_RETURN_IF_ERROR(ReadNumberGroup(file, path + "/metrics", &metrics, rows,
+                                       &EvaluationRow::metrics));
+  if (!replica_table) {
+    index->parameters = std::move(parameters);
+    index->metrics = std::move(metrics);
+  }
+  return Status::Ok();
+}
+
 Status ReadContents(hid_t file, CampaignIndex* index) {
   using internal::ReadStringAttr;
   // `kind` first: a run file (same schema_version) is told apart clearly.
@@ -374,45 +464,27 @@ Status ReadContents(hid_t file, CampaignIndex* index) {
   ADSE_RETURN_IF_ERROR(
       Assign(ReadStringAttr(file, "adse_version"), &index->adse_version));
 
-  {
-    const std::string path = "/evaluations";
-    Result<Handle> group = internal::OpenGroup(file, path);
-    if (!group.ok()) return group.status();
-    const hid_t g = group->get();
-    std::vector<int64_t> numbers;
-    ADSE_RETURN_IF_ERROR(ReadColumn(g, "index", &numbers));
-    const size_t n = numbers.size();
-    auto& rows = index->evaluations;
-    rows.assign(n, EvaluationRow{});
-    for (size_t i = 0; i < n; ++i) rows[i].index = numbers[i];
-
-    using Row = EvaluationRow;
+  ADSE_RETURN_IF_ERROR(
+      ReadEvaluationTable(file, "/evaluations", index, &index->evaluations));
+  // Indexes written before replicas existed have no replica table.
+  if (internal::GetObjectKind(file, "/replicas") !=
+      internal::ObjectKind::kMissing) {
+    std::vector<EvaluationRow> replicas;
     ADSE_RETURN_IF_ERROR(
-        ReadMember<int64_t>(g, path, "iteration", &rows, &Row::iteration));
-    ADSE_RETURN_IF_ERROR(ReadMember<std::string>(g, path, "content_key", &rows,
-                                                 &Row::content_key));
-    ADSE_RETURN_IF_ERROR(
-        ReadMember<std::string>(g, path, "status", &rows, &Row::status));
-    ADSE_RETURN_IF_ERROR(
-        ReadMember<std::string>(g, path, "reason", &rows, &Row::reason));
-    ADSE_RETURN_IF_ERROR(
-        ReadMember<std::string>(g, path, "source", &rows, &Row::source));
-    ADSE_RETURN_IF_ERROR(
-        ReadMember<int64_t>(g, path, "attempts", &rows, &Row::attempts));
-    ADSE_RETURN_IF_ERROR(ReadMember<std::string>(
-        g, path, "bottlenecks_json", &rows, &Row::bottlenecks_json));
-    ADSE_RETURN_IF_ERROR(
-        ReadMember<double>(g, path, "wall_s", &rows, &Row::wall_s));
-    ADSE_RETURN_IF_ERROR(
-        ReadMember<uint8_t>(g, path, "feasible", &rows, &Row::feasible));
-    ADSE_RETURN_IF_ERROR(
-        ReadMember<uint64_t>(g, path, "seed", &rows, &Row::seed));
-    ADSE_RETURN_IF_ERROR(ReadNumberGroup(file, path + "/point",
-                                         &index->parameters, &rows,
-                                         &EvaluationRow::point));
-    ADSE_RETURN_IF_ERROR(ReadNumberGroup(file, path + "/metrics",
-                                         &index->metrics, &rows,
-                                         &EvaluationRow::metrics));
+        ReadEvaluationTable(file, "/replicas", index, &replicas));
+    std::map<int64_t, size_t> position;
+    for (size_t i = 0; i < index->evaluations.size(); ++i) {
+      position[index->evaluations[i].index] = i;
+    }
+    for (EvaluationRow& replica : replicas) {
+      const auto found = position.find(replica.index);
+      if (found == position.end()) {
+        return Status::Corruption("/replicas/index: replica of evaluation " +
+                                  std::to_string(replica.index) +
+                                  ", which /evaluations lacks");
+      }
+      index->evaluations[found->second].replicas.push_back(std::move(replica));
+    }
   }
   {
     const std::string path = "/iterations";

@@ -39,6 +39,16 @@ struct EvaluationRow {
   // The diagnosis as JSON text ([{kind,node,remedy,remedies,severity}, ...];
   // remedies: [{kind,target}, ...], see harness/campaign/evaluation.h).
   std::string bottlenecks_json;
+  // Replica number (harness.replicas): 0 for an evaluation; in `replicas`,
+  // the run's number, which its seed is derived from.
+  int64_t replica = 0;
+  // Feasibility differs across the point's replicas.
+  bool unstable = false;
+  // A point run more than once (harness.replicas > 1): its runs, each a row
+  // of its own (index and iteration the evaluation's, `replica` its number),
+  // of which this row is the aggregate (harness/campaign/replicas.h). Empty
+  // for a point run once, whose row is its run.
+  std::vector<EvaluationRow> replicas;
 };
 
 struct IterationRow {
@@ -83,7 +93,9 @@ struct CampaignIndex {
 // Writes the index atomically (temporary name, fsync, rename), so a reader
 // sees the old or the new file. Columns: /evaluations/<field> and
 // /evaluations/point/<parameter>, /evaluations/metrics/<metric> as
-// equal-length 1-D datasets (pandas: one Series per dataset).
+// equal-length 1-D datasets (pandas: one Series per dataset). Every
+// evaluation's replicas go to /replicas, a table with the same columns plus
+// `replica`, whose `index` names the evaluation they belong to.
 // A row's point/metrics entry missing from its map is stored as NaN.
 // InvalidArgument (nothing written) if a parameter or metric name is empty,
 // ".", holds '/' or is listed twice; if a row's point or metrics has a name

@@ -74,14 +74,6 @@ Result<spec::Spec> Overridden(const spec::Spec& input,
   if (!options.isolation.empty()) spec.harness.isolation = options.isolation;
   if (options.workers >= 0) spec.harness.workers = options.workers;
 
-  if (spec.harness.replicas != 1) {
-    // Not silently ignored: one run per point is all adse run does yet.
-    return Status::InvalidArgument(
-        spec.Where("harness.replicas") +
-        "harness.replicas: adse run evaluates each point once; expected 1, "
-        "found " +
-        std::to_string(spec.harness.replicas));
-  }
   if (spec.harness.executor != "local" && !options.make_pool) {
     return Status::InvalidArgument(
         spec.Where("harness.executor") + "harness.executor: '" +

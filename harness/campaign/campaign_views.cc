@@ -14,6 +14,7 @@
 #include "analysis/runfile/campaign_file.h"
 #include "harness/campaign/campaign.h"
 #include "harness/campaign/headline.h"
+#include "harness/campaign/replicas.h"
 #include "harness/campaign/run_store.h"
 #include "harness/llm/exchange_log.h"
 #include "harness/llm/llm_strategy.h"
@@ -54,6 +55,47 @@ std::string Number(double v) {
   return fmt::format("{:.4g}", v);
 }
 
+// With replicas: each point's metrics as median [min–max] over its runs,
+// and the unstable points. Empty when every point ran once.
+std::string ReplicaSection(const spec::Spec& spec,
+                           const std::vector<EvaluationRow>& rows,
+                           const std::vector<std::string>& columns) {
+  std::ostringstream md;
+  bool any = false;
+  for (const EvaluationRow& row : rows) any = any || row.replicas.size() > 1;
+  if (!any) return "";
+  auto value = [](double v) {
+    return std::isinf(v) ? std::string(v > 0 ? "stopped↑" : "stopped↓")
+                         : Number(v);
+  };
+  md << "\n## Replicas\n\nEach point ran several times, each run with its "
+        "own seed (traffic, cost sampling, sensor noise). Metrics are the "
+        "median over the runs, [min – max] beside it; a run stopped early "
+        "ranks beyond the bound it broke (stopped↑ above it, stopped↓ "
+        "below). A point is feasible when more than half its runs are, and "
+        "**unstable** when they disagree.\n\n| # | point | runs | "
+     << fmt::format("{}", fmt::join(columns, " | ")) << " |\n|---|---|---|";
+  for (size_t i = 0; i < columns.size(); ++i) md << "---|";
+  md << "\n";
+  for (const EvaluationRow& row : rows) {
+    if (row.replicas.size() <= 1) continue;
+    md << "| " << row.index << " | "
+       << spec::FormatPoint(spec.design_space, row.point) << " | "
+       << (row.unstable ? "**" + ReplicaSummary(row) + "**"
+                        : ReplicaSummary(row))
+       << " | ";
+    for (const std::string& c : columns) {
+      std::optional<MetricSpread> m = SpreadOf(spec, row, c);
+      md << (m ? fmt::format("{} [{} – {}]", value(m->median), value(m->min),
+                             value(m->max))
+               : std::string("—"))
+         << " | ";
+    }
+    md << "\n";
+  }
+  return md.str();
+}
+
 nlohmann::json RowJson(const spec::Spec& spec, const EvaluationRow& row) {
   nlohmann::json metrics = nlohmann::json::object();
   for (const auto& [name, value] : row.metrics) {
@@ -77,6 +119,45 @@ nlohmann::json RowJson(const spec::Spec& spec, const EvaluationRow& row) {
       nlohmann::json::parse(row.bottlenecks_json, nullptr, false);
   if (j["bottlenecks"].is_discarded())
     j["bottlenecks"] = nlohmann::json::array();
+  j["replicas"] = std::max<size_t>(1, row.replicas.size());
+  j["unstable"] = row.unstable;
+  if (row.replicas.size() > 1) {
+    // Infinite quantiles (runs stopped beyond a bound) are null; `censored`
+    // counts those runs.
+    auto number = [](double v) {
+      return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+    };
+    nlohmann::json spread = nlohmann::json::object();
+    std::set<std::string> names;
+    for (const EvaluationRow& run : row.replicas) {
+      for (const auto& [name, value] : run.metrics) names.insert(name);
+    }
+    for (const std::string& name : names) {
+      if (std::optional<MetricSpread> m = SpreadOf(spec, row, name)) {
+        spread[name] = {
+            {"median", number(m->median)}, {"min", number(m->min)},
+            {"max", number(m->max)},       {"q1", number(m->q1)},
+            {"q3", number(m->q3)},         {"measured", m->measured},
+            {"censored", m->censored}};
+      }
+    }
+    j["spread"] = spread;
+    nlohmann::json runs = nlohmann::json::array();
+    for (const EvaluationRow& run : row.replicas) {
+      nlohmann::json run_metrics = nlohmann::json::object();
+      for (const auto& [name, value] : run.metrics)
+        run_metrics[name] = number(value);
+      runs.push_back({{"replica", run.replica},
+                      {"content_key", run.content_key},
+                      {"seed", run.seed},
+                      {"status", run.status},
+                      {"reason", run.reason},
+                      {"source", run.source},
+                      {"feasible", run.feasible},
+                      {"metrics", run_metrics}});
+    }
+    j["runs"] = runs;
+  }
   return j;
 }
 
@@ -220,6 +301,7 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
     md << (row.feasible ? "yes" : "no") << " | [png](" << image_dir << "/"
        << row.content_key << "/trajectory.png) |\n";
   }
+  md << ReplicaSection(spec, rows, columns);
 
   md << "\n## Iterations\n\nEach round's proposal and the strategy's "
         "reasoning.\n\n| iteration | proposed | rationale |\n|---|---|---|\n";
@@ -244,7 +326,11 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
         Cell(row.reason), row.source, Number(RowMetric(row, "hardware_cost")),
         Number(RowMetric(row, "nav_time_s")),
         Number(RowMetric(row, "ctrl_rate_hz")),
-        Number(RowMetric(row, "deviation_score")), row.feasible ? "yes" : "no");
+        Number(RowMetric(row, "deviation_score")),
+        row.replicas.size() > 1
+            ? fmt::format("{} ({})", row.feasible ? "yes" : "no",
+                          ReplicaSummary(row))
+            : std::string(row.feasible ? "yes" : "no"));
   }
 
   md << "\n## Failures\n\n";
@@ -283,6 +369,9 @@ Status WriteCampaignViews(const spec::Spec& spec,
   std::set<std::string> metric_names;
   for (const EvaluationRow& row : rows) {
     for (const auto& [name, value] : row.metrics) metric_names.insert(name);
+    for (const EvaluationRow& run : row.replicas) {
+      for (const auto& [name, value] : run.metrics) metric_names.insert(name);
+    }
   }
   index.metrics.assign(metric_names.begin(), metric_names.end());
   index.evaluations = rows;

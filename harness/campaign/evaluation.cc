@@ -9,6 +9,7 @@
 
 #include "analysis/metrics/run_metrics.h"
 #include "analysis/runfile/run_data.h"
+#include "harness/spec/design_point.h"
 
 namespace adse::campaign {
 
@@ -98,6 +99,19 @@ Result<EvaluationRow> RowFromReportJson(const std::string& text,
     return Status::Corruption(path + ": not a run report (invalid JSON)");
   }
   return RowFromJson(j, path);
+}
+
+bool RowFeasible(const spec::Spec& spec, const EvaluationRow& row) {
+  if (row.status != runfile::kRunComplete ||
+      RowMetric(row, analysis::kCensoredMetric) == 1.0) {
+    return false;
+  }
+  for (const std::string& constraint : spec.constraints) {
+    Result<bool> holds =
+        spec::EvaluateConstraint(spec, constraint, row.metrics, row.point);
+    if (!holds.ok() || !*holds) return false;
+  }
+  return true;
 }
 
 double RowMetric(const EvaluationRow& row, const std::string& name) {

@@ -33,6 +33,10 @@ EvaluationRow RowFromReport(const report::RunReport& report);
 Result<EvaluationRow> RowFromReportJson(const std::string& text,
                                         const std::string& path);
 
+// Whether the row's run satisfies every constraint of `spec` on its metrics
+// and point; a failed run, or one stopped early, never does.
+bool RowFeasible(const spec::Spec& spec, const EvaluationRow& row);
+
 // A row's metric, NaN when the run has none (failed runs have none).
 double RowMetric(const EvaluationRow& row, const std::string& name);
 

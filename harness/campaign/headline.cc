@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <regex>
 #include <sstream>
 
 #include "analysis/metrics/run_metrics.h"
 #include "analysis/pictures/pictures.h"
+#include "harness/campaign/replicas.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/files.h"
 
@@ -21,11 +23,13 @@ bool Placed(const EvaluationRow& row) {
          std::isfinite(RowMetric(row, kTimeMetric));
 }
 
+// Runs behind the rows at row i's design point: each row's replicas.
 int RunsAt(const std::vector<EvaluationRow>& rows, int i) {
   if (i < 0) return 0;
   int n = 0;
   for (const EvaluationRow& row : rows) {
-    n += row.status == "complete" && row.point == rows[i].point;
+    if (row.status != "complete" || row.point != rows[i].point) continue;
+    n += static_cast<int>(std::max<size_t>(1, row.replicas.size()));
   }
   return n;
 }
@@ -47,15 +51,28 @@ std::string Value(double v, const char* unit) {
   return fmt::format("{:.4g}{}", v, unit);
 }
 
-// "cost 2.4, nav 150.2 s, ctrl 9.8 Hz (1 run)"
-std::string Facts(const std::vector<EvaluationRow>& rows, int i, int runs) {
+// "cost 2.4, nav 150.2 s, ctrl 9.8 Hz (1 run, no replicas)"; with
+// replicas "(median of 3 runs, nav 148.1–152.0 s)", and how sure: an
+// unstable point says in how many runs it was feasible.
+std::string Facts(const spec::Spec& spec,
+                  const std::vector<EvaluationRow>& rows, int i, int runs) {
   const EvaluationRow& row = rows[i];
+  std::string sureness;
+  if (row.replicas.size() > 1) {
+    sureness = fmt::format("median of {} runs", row.replicas.size());
+    if (std::optional<MetricSpread> nav = SpreadOf(spec, row, kTimeMetric)) {
+      sureness += fmt::format(", nav {}–{}", Value(nav->min, ""),
+                              Value(nav->max, " s"));
+    }
+    if (row.unstable) sureness += ", " + ReplicaSummary(row);
+  } else {
+    sureness = runs <= 1 ? std::string("1 run, no replicas")
+                         : fmt::format("{} runs at this point", runs);
+  }
   return fmt::format("cost {}, nav {}, ctrl {} ({})",
                      Value(RowMetric(row, kCostMetric), ""),
                      Value(RowMetric(row, kTimeMetric), " s"),
-                     Value(RowMetric(row, "ctrl_rate_hz"), " Hz"),
-                     runs <= 1 ? std::string("1 run, no replicas")
-                               : fmt::format("{} runs at this point", runs));
+                     Value(RowMetric(row, "ctrl_rate_hz"), " Hz"), sureness);
 }
 
 struct Line {
@@ -164,7 +181,7 @@ std::string HeadlineText(const spec::Spec& spec,
     out << fmt::format(
         "{:<19} {}  {}\n", line.what,
         spec::FormatPoint(spec.design_space, rows[line.row].point),
-        Facts(rows, line.row, line.runs));
+        Facts(spec, rows, line.row, line.runs));
   }
   std::vector<std::string> objectives;
   for (const spec::Objective& o : spec.objectives)
@@ -202,7 +219,7 @@ std::string HeadlineMarkdown(const spec::Spec& spec,
     md << fmt::format(
         "- **{}:** `{}` — {}. [trajectory]({}/{}/trajectory.png)\n", what,
         spec::FormatPoint(spec.design_space, row.point),
-        Facts(rows, line.row, line.runs), image_dir, row.content_key);
+        Facts(spec, rows, line.row, line.runs), image_dir, row.content_key);
   }
   if (spec.objectives.size() > 2 ||
       (spec.objectives.size() == 2 &&

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/runfile/run_file.h"
+#include "harness/campaign/replicas.h"
 #include "harness/report/run_report.h"
 #include "harness/sim/run_key.h"
 #include "harness/spec/spec_parser.h"
@@ -60,10 +61,13 @@ PoolEvaluator::PoolEvaluator(const spec::Spec& spec,
                              PoolEvaluatorOptions options)
     : spec_(spec), folder_(folder), pool_(pool), options_(std::move(options)) {}
 
-int PoolEvaluator::capacity() const { return pool_->slots(); }
+int PoolEvaluator::capacity() const {
+  // In points: each takes harness.replicas runs.
+  return std::max(1, pool_->slots() / std::max(1, spec_.harness.replicas));
+}
 
 int PoolEvaluator::outstanding() const {
-  return static_cast<int>(queued_.size() + running_.size() + ready_.size());
+  return static_cast<int>(points_.size() + ready_.size());
 }
 
 bool PoolEvaluator::interrupted() const {
@@ -116,6 +120,11 @@ std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
   }
   row->index = p.request.index;
   row->iteration = p.request.iteration;
+  row->replica = p.replica;
+  // Feasibility under this campaign's constraints: a run reused from the
+  // cache was analysed under the scenario that ran it, whose constraints
+  // that do not stop runs early may differ.
+  row->feasible = RowFeasible(spec_, *row);
   row->content_key = p.key;
   row->source = source;
   row->attempts = p.attempt;
@@ -128,6 +137,7 @@ EvaluationRow PoolEvaluator::FailedRow(const Pending& p,
   EvaluationRow row;
   row.index = p.request.index;
   row.iteration = p.request.iteration;
+  row.replica = p.replica;
   row.content_key = p.key;
   row.status = "failed";
   row.reason = record.outcome + ": " + record.detail;
@@ -141,9 +151,10 @@ EvaluationRow PoolEvaluator::FailedRow(const Pending& p,
 }
 
 std::optional<EvaluationRow> PoolEvaluator::Prepare(const EvalRequest& request,
-                                                    Pending* p) {
+                                                    int replica, Pending* p) {
   p->request = request;
-  p->seed = spec_.world.traffic.seed;
+  p->replica = replica;
+  p->seed = sim::ReplicaSeed(spec_, replica);
   Result<std::string> key = sim::RunKey(spec_, request.point, p->seed);
   if (!key.ok()) {
     // Only an unreadable input file makes this fail; no run can help.
@@ -167,26 +178,51 @@ std::optional<EvaluationRow> PoolEvaluator::Prepare(const EvalRequest& request,
 
 std::optional<EvaluationRow> PoolEvaluator::Recorded(
     const EvalRequest& request) {
-  Pending p;
-  return Prepare(request, &p);
+  std::vector<EvaluationRow> runs;
+  for (int r = 0; r < std::max(1, spec_.harness.replicas); ++r) {
+    Pending p;
+    std::optional<EvaluationRow> row = Prepare(request, r, &p);
+    if (!row) return std::nullopt;
+    runs.push_back(*std::move(row));
+  }
+  return AggregateReplicas(spec_, std::move(runs));
 }
 
 void PoolEvaluator::Start(const EvalRequest& request) {
-  Pending p;
-  if (std::optional<EvaluationRow> known = Prepare(request, &p)) {
-    ready_.push_back(*known);
-    return;
-  }
-  if (options_.cache != nullptr && options_.cache->Find(p.key)) {
-    if (options_.cache->CopyOut(p.key, folder_.RunPath(p.key)).ok()) {
-      if (auto row = LoadRun(p, "cache")) {
-        ready_.push_back(*row);
-        return;
+  const int replicas = std::max(1, spec_.harness.replicas);
+  points_[request.index].assign(replicas, std::nullopt);
+  for (int r = 0; r < replicas; ++r) {
+    Pending p;
+    if (std::optional<EvaluationRow> known = Prepare(request, r, &p)) {
+      Deliver(p, *std::move(known));
+      continue;
+    }
+    if (options_.cache != nullptr && options_.cache->Find(p.key)) {
+      if (options_.cache->CopyOut(p.key, folder_.RunPath(p.key)).ok()) {
+        if (auto row = LoadRun(p, "cache")) {
+          Deliver(p, *std::move(row));
+          continue;
+        }
       }
     }
+    queued_.push_back(p);
   }
-  queued_.push_back(p);
   Dispatch();
+}
+
+void PoolEvaluator::Deliver(const Pending& p, EvaluationRow row) {
+  auto point = points_.find(p.request.index);
+  if (point == points_.end()) return;
+  point->second[p.replica] = std::move(row);
+  for (const std::optional<EvaluationRow>& run : point->second) {
+    if (!run) return;  // replicas still to come
+  }
+  std::vector<EvaluationRow> runs;
+  for (std::optional<EvaluationRow>& run : point->second) {
+    runs.push_back(*std::move(run));
+  }
+  points_.erase(point);
+  ready_.push_back(AggregateReplicas(spec_, std::move(runs)));
 }
 
 void PoolEvaluator::Dispatch() {
@@ -246,7 +282,7 @@ void PoolEvaluator::Finish(const pool::JobResult& result) {
           std::fprintf(stderr, "warning: cache: %s\n", s.message().c_str());
         }
       }
-      ready_.push_back(*row);
+      Deliver(p, *std::move(row));
       return;
     }
     detail = "the worker succeeded but its run file is unusable";
@@ -282,7 +318,7 @@ void PoolEvaluator::Finish(const pool::JobResult& result) {
       !s.ok()) {
     std::fprintf(stderr, "warning: %s\n", s.message().c_str());
   }
-  ready_.push_back(FailedRow(p, record, "simulated"));
+  Deliver(p, FailedRow(p, record, "simulated"));
 }
 
 std::vector<EvaluationRow> PoolEvaluator::Wait() {
@@ -318,10 +354,13 @@ std::vector<EvaluationRow> PoolEvaluator::Cancel() {
     if (fs::exists(folder_.RunPath(it->second.key), ec)) {
       if (auto row = LoadRun(it->second, "simulated")) {
         row->wall_s = r.wall_s;
-        ready_.push_back(*row);
+        Deliver(it->second, *std::move(row));
       }
     }
   }
+  // A point with replicas still to run stays unevaluated; the runs it has
+  // are in runs/, and a resumed campaign takes them from there.
+  points_.clear();
   running_.clear();
   queued_.clear();
   std::vector<EvaluationRow> rows;

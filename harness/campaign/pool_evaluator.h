@@ -54,21 +54,28 @@ class PoolEvaluator : public Evaluator {
   // before the stop.
   std::vector<EvaluationRow> Cancel();
 
-  // The row of a point whose run or failure record is already in the
-  // folder (nothing is started; the pool may be null), else nullopt.
+  // The row of a point whose runs (or failure records) are all already in
+  // the folder (nothing is started; the pool may be null), else nullopt.
   std::optional<EvaluationRow> Recorded(const EvalRequest& request);
 
  private:
+  // One run of a point: replica `replica` of harness.replicas.
   struct Pending {
     EvalRequest request;
+    int replica = 0;
     std::string key;
     uint64_t seed = 0;
     int attempt = 0;  // 1-based once started
   };
 
-  // Fills `p` for `request`; returns the row when the result is already
-  // known (in the folder, or the key cannot be computed).
-  std::optional<EvaluationRow> Prepare(const EvalRequest& request, Pending* p);
+  // Fills `p` for replica `replica` of `request`; returns the run's row
+  // when it is already known (in the folder, or the key cannot be
+  // computed).
+  std::optional<EvaluationRow> Prepare(const EvalRequest& request, int replica,
+                                       Pending* p);
+  // Takes a finished run's row; once all of its point's replicas are in,
+  // the point's row (AggregateReplicas) is ready.
+  void Deliver(const Pending& p, EvaluationRow row);
   // A row from an existing run file; nullopt when the file is unusable
   // (then it is moved aside and the point simulated again).
   std::optional<EvaluationRow> LoadRun(const Pending& p,
@@ -82,6 +89,8 @@ class PoolEvaluator : public Evaluator {
   const CampaignFolder& folder_;
   pool::WorkerPool* pool_;
   PoolEvaluatorOptions options_;
+  // Points started and not yet ready: their replicas' rows so far.
+  std::map<int64_t, std::vector<std::optional<EvaluationRow>>> points_;
   std::deque<Pending> queued_;
   std::map<uint64_t, Pending> running_;  // job id -> attempt
   uint64_t next_job_ = 1;

@@ -1,8 +1,11 @@
 #include "harness/sim/run_key.h"
 
+#include <algorithm>
+
 #include "harness/sim/early_stop.h"
 #include "stack/base/files.h"
 #include "stack/base/hash.h"
+#include "stack/base/random.h"
 
 namespace adse::sim {
 namespace {
@@ -91,6 +94,23 @@ Result<std::string> RunKey(const spec::Spec& spec,
   }
   h.Add("seed").Add(static_cast<long long>(seed));
   return h.Hex();
+}
+
+uint64_t ReplicaSeed(const spec::Spec& spec, int replica) {
+  const uint64_t seed = spec.world.traffic.seed;
+  if (replica == 0) return seed;
+  return Random::DeriveSeed(seed, "replica " + std::to_string(replica));
+}
+
+Result<std::vector<std::string>> ReplicaKeys(const spec::Spec& spec,
+                                             const spec::DesignPoint& point) {
+  std::vector<std::string> keys;
+  for (int r = 0; r < std::max(1, spec.harness.replicas); ++r) {
+    Result<std::string> key = RunKey(spec, point, ReplicaSeed(spec, r));
+    if (!key.ok()) return key.status();
+    keys.push_back(*std::move(key));
+  }
+  return keys;
 }
 
 }  // namespace adse::sim

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "harness/spec/spec.h"
 #include "stack/base/status.h"
@@ -20,6 +21,16 @@ namespace adse::sim {
 // only when such a file cannot be read.
 Result<std::string> RunKey(const spec::Spec& spec,
                            const spec::DesignPoint& point, uint64_t seed);
+
+// The seed of a point's replica `replica` (harness.replicas; 0-based). It
+// seeds everything random in the run: traffic, cost sampling, sensor noise.
+// Replica 0 runs with the scenario's traffic seed, so a point run once keeps
+// its key; replica r > 0 with a seed derived from it.
+uint64_t ReplicaSeed(const spec::Spec& spec, int replica);
+
+// The content keys of the point's harness.replicas runs, in replica order.
+Result<std::vector<std::string>> ReplicaKeys(const spec::Spec& spec,
+                                             const spec::DesignPoint& point);
 
 }  // namespace adse::sim
 

@@ -59,7 +59,9 @@ std::pair<size_t, size_t> SweepPlan::ShardRange(int shard) const {
 Status WriteSweepPlan(const std::string& campaign_dir, const SweepPlan& plan) {
   json points = json::array();
   for (const PlannedPoint& p : plan.points) {
-    points.push_back({{"index", p.index}, {"point", p.point}, {"key", p.key}});
+    json point = {{"index", p.index}, {"point", p.point}, {"key", p.key}};
+    if (p.replica_keys.size() > 1) point["replica_keys"] = p.replica_keys;
+    points.push_back(point);
   }
   return WriteJson(PlanPath(campaign_dir),
                    {{"kind", "adse-sweep-plan"},
@@ -97,9 +99,19 @@ Result<SweepPlan> ReadSweepPlan(const std::string& campaign_dir) {
     plan.use_cache = j->value("use_cache", true);
     plan.cache_dir = j->value("cache_dir", "");
     for (const json& p : j->at("points")) {
-      plan.points.push_back({p.at("index").get<int64_t>(),
-                             p.at("point").get<std::string>(),
-                             p.at("key").get<std::string>()});
+      PlannedPoint planned{p.at("index").get<int64_t>(),
+                           p.at("point").get<std::string>(),
+                           p.at("key").get<std::string>(),
+                           {}};
+      planned.replica_keys =
+          p.value("replica_keys", std::vector<std::string>{planned.key});
+      if (planned.replica_keys.empty() ||
+          planned.replica_keys.front() != planned.key) {
+        return Status::Corruption(
+            fmt::format("{}: point {}: replica_keys must start with its key",
+                        path, planned.index));
+      }
+      plan.points.push_back(std::move(planned));
     }
   } catch (const json::exception& e) {
     return Status::Corruption(path + ": " + e.what());

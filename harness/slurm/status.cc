@@ -145,7 +145,9 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
   }
   std::map<std::string, std::string> point_of;  // key -> point text
   if (plan.ok()) {
-    for (const PlannedPoint& p : plan->points) point_of[p.key] = p.point;
+    for (const PlannedPoint& p : plan->points) {
+      for (const std::string& key : p.replica_keys) point_of[key] = p.point;
+    }
   }
   std::set<std::string> running_keys;
   for (const StepState& step : steps) {
@@ -161,12 +163,24 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
   }
 
   if (plan.ok()) {
+    // A point is done when each of its runs (replicas) has a result, and
+    // failed when every one failed.
     for (const PlannedPoint& p : plan->points) {
-      if (runs.count(p.key)) {
-        ++st.done;
-      } else if (failures.count(p.key)) {
+      size_t ran = 0, failed = 0, running = 0;
+      for (const std::string& key : p.replica_keys) {
+        if (runs.count(key)) {
+          ++ran;
+        } else if (failures.count(key)) {
+          ++failed;
+        } else if (running_keys.count(key)) {
+          ++running;
+        }
+      }
+      if (failed == p.replica_keys.size()) {
         ++st.failed;
-      } else if (running_keys.count(p.key)) {
+      } else if (ran + failed == p.replica_keys.size()) {
+        ++st.done;
+      } else if (running > 0) {
         ++st.running;
       } else {
         ++st.pending;

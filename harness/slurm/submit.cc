@@ -263,26 +263,31 @@ BatchScript IndexScript(const Context& c, const std::string& after_job) {
 Result<std::vector<PlannedPoint>> PlanPoints(const spec::Spec& spec,
                                              explore::Strategy& strategy) {
   std::vector<PlannedPoint> points;
-  const uint64_t seed = spec.world.traffic.seed;
   for (;;) {
     const std::vector<spec::DesignPoint> batch =
         strategy.Ask(std::max(1, spec.exploration.budget));
     if (batch.empty()) break;
     for (const spec::DesignPoint& point : batch) {
-      Result<std::string> key = sim::RunKey(spec, point, seed);
-      if (!key.ok()) return key.status();
+      Result<std::vector<std::string>> keys = sim::ReplicaKeys(spec, point);
+      if (!keys.ok()) return keys.status();
       points.push_back({static_cast<int64_t>(points.size()),
-                        spec::FormatPoint(spec.design_space, point), *key});
+                        spec::FormatPoint(spec.design_space, point),
+                        keys->front(), *keys});
     }
   }
   return points;
 }
 
-// Whether the point has a result (a run or a failure record) in the folder.
-bool Finished(const std::string& folder, const std::string& key) {
+// Whether every run of the point has a result (a run or a failure record)
+// in the folder.
+bool Finished(const std::string& folder, const PlannedPoint& point) {
   const campaign::CampaignFolder f(folder);
-  std::error_code ec;
-  return fs::exists(f.RunPath(key), ec) || fs::exists(f.FailurePath(key), ec);
+  for (const std::string& key : point.replica_keys) {
+    std::error_code ec;
+    if (!fs::exists(f.RunPath(key), ec) && !fs::exists(f.FailurePath(key), ec))
+      return false;
+  }
+  return true;
 }
 
 Status WriteScript(SubmittedScript* script) {
@@ -358,12 +363,6 @@ Result<SubmitResult> Submit(const spec::Spec& input,
   spec::Spec spec = input;
   if (!options.strategy.empty()) spec.exploration.strategy = options.strategy;
   if (options.budget >= 0) spec.exploration.budget = options.budget;
-  if (spec.harness.replicas != 1) {
-    return Status::InvalidArgument(
-        spec.Where("harness.replicas") +
-        "harness.replicas: adse evaluates each point once; expected 1, found " +
-        std::to_string(spec.harness.replicas));
-  }
   if (spec.harness.isolation != "auto") {
     return Status::InvalidArgument(
         spec.Where("harness.isolation") + "harness.isolation: on Slurm, " +
@@ -563,7 +562,7 @@ Result<SubmitResult> Submit(const spec::Spec& input,
     const auto [begin, end] = plan.ShardRange(shard);
     bool open = false;
     for (size_t i = begin; i < end; ++i) {
-      if (Finished(c.folder, plan.points[i].key)) {
+      if (Finished(c.folder, plan.points[i])) {
         ++result.finished_points;
       } else {
         open = true;

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "harness/campaign/replicas.h"
 #include "harness/campaign/run_store.h"
 #include "harness/sim/run_key.h"
 #include "harness/slurm/allocation.h"
@@ -45,7 +46,6 @@ Result<LoadedPlan> LoadPlan(const std::string& campaign_dir, size_t begin,
   spec->exploration.strategy = plan->strategy;
   spec->exploration.budget = plan->budget;
   LoadedPlan loaded{*plan, *spec, {}};
-  const uint64_t seed = spec->world.traffic.seed;
   end = std::min(end, plan->points.size());
   for (size_t i = 0; i < plan->points.size(); ++i) {
     const PlannedPoint& p = plan->points[i];
@@ -58,14 +58,15 @@ Result<LoadedPlan> LoadPlan(const std::string& campaign_dir, size_t begin,
           plan->scenario, p.point, point.status().message()));
     }
     if (i >= begin && i < end) {
-      Result<std::string> key = sim::RunKey(*spec, *point, seed);
-      if (!key.ok()) return key.status();
-      if (*key != p.key) {
+      Result<std::vector<std::string>> keys = sim::ReplicaKeys(*spec, *point);
+      if (!keys.ok()) return keys.status();
+      if (*keys != p.replica_keys) {
         return Status::InvalidArgument(fmt::format(
             "{} changed since adse submit planned the sweep (point {}: "
-            "content key {} planned, {} now); restore it, or submit the "
-            "campaign again to another folder",
-            plan->scenario, p.point, p.key.substr(0, 12), key->substr(0, 12)));
+            "content key {} and {} replica(s) planned, {} and {} now); "
+            "restore it, or submit the campaign again to another folder",
+            plan->scenario, p.point, p.key.substr(0, 12), p.replica_keys.size(),
+            keys->front().substr(0, 12), keys->size()));
       }
     }
     loaded.requests.push_back(
@@ -142,8 +143,13 @@ Result<ShardSummary> RunShard(const ShardOptions& options) {
   summary.campaign = *done;
   std::map<std::string, ShardResult> results;
   for (const campaign::EvaluationRow& row : done->exploration.evaluations) {
-    results[row.content_key] = {row.source, static_cast<int>(row.attempts),
-                                row.wall_s};
+    // One entry per run: a point with replicas has several.
+    for (const campaign::EvaluationRow& run :
+         row.replicas.empty() ? std::vector<campaign::EvaluationRow>{row}
+                              : row.replicas) {
+      results[run.content_key] = {run.source, static_cast<int>(run.attempts),
+                                  run.wall_s};
+    }
   }
   if (Status s = WriteShardResults(options.campaign_dir, task, results);
       !s.ok()) {
@@ -191,12 +197,23 @@ Result<campaign::CampaignSummary> BuildSweepIndex(
         missing.push_back(plan.points[i].point);
         continue;
       }
-      row->source = "campaign";
-      auto known = shard_results[shard].find(row->content_key);
-      if (known != shard_results[shard].end()) {
-        row->source = known->second.source;
-        row->attempts = known->second.attempts;
-        row->wall_s = known->second.wall_s;
+      // Each run as its shard recorded it; a point with replicas is
+      // aggregated again from its runs so recorded.
+      auto as_recorded = [&](campaign::EvaluationRow* run) {
+        run->source = "campaign";
+        auto known = shard_results[shard].find(run->content_key);
+        if (known != shard_results[shard].end()) {
+          run->source = known->second.source;
+          run->attempts = known->second.attempts;
+          run->wall_s = known->second.wall_s;
+        }
+      };
+      if (row->replicas.empty()) {
+        as_recorded(&*row);
+      } else {
+        std::vector<campaign::EvaluationRow> runs = std::move(row->replicas);
+        for (campaign::EvaluationRow& run : runs) as_recorded(&run);
+        row = campaign::AggregateReplicas(spec, std::move(runs));
       }
       it.content_keys.push_back(row->content_key);
       summary.exploration.evaluations.push_back(*row);

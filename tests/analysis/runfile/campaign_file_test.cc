@@ -18,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -100,6 +101,22 @@ CampaignIndex MakeIndex(size_t rows) {
           std::string("≥ 4") + R"(","severity":0.)" + std::to_string(i % 10) +
           "}]";
     }
+    // Every fourth point ran three times: its replicas, one unstable.
+    if (i % 4 == 2) {
+      const EvaluationRow run = row;
+      for (int64_t r = 0; r < 3; ++r) {
+        EvaluationRow replica = run;
+        replica.replica = r;
+        replica.content_key = Sha256Hex("replica " + std::to_string(r) +
+                                        " of point " + std::to_string(i));
+        replica.seed = row.seed + 7 * static_cast<uint64_t>(r);
+        replica.feasible = row.feasible && (i % 8 != 2 || r != 1);
+        if (!failed) replica.metrics["nav_time_s"] += 0.5 * r;
+        if (r == 2) replica.metrics.erase("deviation_score");
+        row.replicas.push_back(std::move(replica));
+      }
+      row.unstable = i % 8 == 2 && row.feasible;
+    }
     index.evaluations.push_back(std::move(row));
   }
   const size_t rounds = (rows + 9) / 10;
@@ -163,23 +180,38 @@ std::string Diff(const CampaignIndex& a, const CampaignIndex& b) {
     out << "evaluations size: " << a.evaluations.size() << " vs "
         << b.evaluations.size() << "\n";
   } else {
+    std::function<void(const std::string&, const EvaluationRow&,
+                       const EvaluationRow&)>
+        rows = [&](const std::string& row, const EvaluationRow& x,
+                   const EvaluationRow& y) {
+          integer(row + "index", x.index, y.index);
+          integer(row + "iteration", x.iteration, y.iteration);
+          str(row + "content_key", x.content_key, y.content_key);
+          str(row + "status", x.status, y.status);
+          str(row + "reason", x.reason, y.reason);
+          str(row + "source", x.source, y.source);
+          integer(row + "attempts", x.attempts, y.attempts);
+          num(row + "wall_s", x.wall_s, y.wall_s);
+          if (x.feasible != y.feasible) out << row << "feasible\n";
+          if (x.seed != y.seed) out << row << "seed\n";
+          map(row + "point", x.point, y.point);
+          map(row + "metrics", x.metrics, y.metrics);
+          str(row + "bottlenecks_json", x.bottlenecks_json, y.bottlenecks_json);
+          integer(row + "replica", x.replica, y.replica);
+          if (x.unstable != y.unstable) out << row << "unstable\n";
+          if (x.replicas.size() != y.replicas.size()) {
+            out << row << "replicas size: " << x.replicas.size() << " vs "
+                << y.replicas.size() << "\n";
+            return;
+          }
+          for (size_t r = 0; r < x.replicas.size(); ++r) {
+            rows(row + "replica " + std::to_string(r) + " ", x.replicas[r],
+                 y.replicas[r]);
+          }
+        };
     for (size_t i = 0; i < a.evaluations.size(); ++i) {
-      const EvaluationRow& x = a.evaluations[i];
-      const EvaluationRow& y = b.evaluations[i];
-      const std::string row = "evaluation " + std::to_string(i) + " ";
-      integer(row + "index", x.index, y.index);
-      integer(row + "iteration", x.iteration, y.iteration);
-      str(row + "content_key", x.content_key, y.content_key);
-      str(row + "status", x.status, y.status);
-      str(row + "reason", x.reason, y.reason);
-      str(row + "source", x.source, y.source);
-      integer(row + "attempts", x.attempts, y.attempts);
-      num(row + "wall_s", x.wall_s, y.wall_s);
-      if (x.feasible != y.feasible) out << row << "feasible\n";
-      if (x.seed != y.seed) out << row << "seed\n";
-      map(row + "point", x.point, y.point);
-      map(row + "metrics", x.metrics, y.metrics);
-      str(row + "bottlenecks_json", x.bottlenecks_json, y.bottlenecks_json);
+      rows("evaluation " + std::to_string(i) + " ", a.evaluations[i],
+           b.evaluations[i]);
     }
   }
   if (a.iterations.size() != b.iterations.size()) {
@@ -350,6 +382,54 @@ TEST_F(CampaignFileTest, LlmExchangesRoundTripAndOlderIndexesHaveNone) {
   EXPECT_EQ(old->evaluations.size(), 280u);
 }
 
+TEST_F(CampaignFileTest, ReplicasRoundTripAndOlderIndexesHaveNone) {
+  const CampaignIndex index = MakeIndex(12);
+  size_t with_replicas = 0;
+  for (const EvaluationRow& row : index.evaluations) {
+    with_replicas += !row.replicas.empty();
+  }
+  ASSERT_EQ(with_replicas, 3u);
+  const std::string path = Path("campaign.h5");
+  ASSERT_TRUE(WriteCampaignIndex(path, index).ok());
+  Result<CampaignIndex> back = ReadCampaignIndex(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(Diff(index, *back), "");
+  EXPECT_TRUE(back->evaluations[2].unstable);
+  EXPECT_EQ(back->evaluations[2].replicas[1].replica, 1);
+
+  // An index written before replicas: no /replicas, no unstable column.
+  {
+    RawFile raw(path);
+    ASSERT_GE(raw.get(), 0);
+    ASSERT_GE(H5Ldelete(raw.get(), "/replicas", H5P_DEFAULT), 0);
+    ASSERT_GE(H5Ldelete(raw.get(), "/evaluations/unstable", H5P_DEFAULT), 0);
+  }
+  back = ReadCampaignIndex(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  for (const EvaluationRow& row : back->evaluations) {
+    EXPECT_TRUE(row.replicas.empty());
+    EXPECT_FALSE(row.unstable);
+  }
+}
+
+TEST_F(CampaignFileTest, AReplicaOfAnUnknownEvaluationIsCorruption) {
+  const std::string path = Path("campaign.h5");
+  ASSERT_TRUE(WriteCampaignIndex(path, MakeIndex(4)).ok());
+  {
+    RawFile raw(path);
+    ASSERT_GE(raw.get(), 0);
+    // The replicas of evaluation 2 claim one that does not exist.
+    const hid_t dataset = H5Dopen2(raw.get(), "/replicas/index", H5P_DEFAULT);
+    ASSERT_GE(dataset, 0);
+    const int64_t bad[3] = {99, 99, 99};
+    ASSERT_GE(
+        H5Dwrite(dataset, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, bad),
+        0);
+    H5Dclose(dataset);
+  }
+  ExpectCorruption(path, "replica of evaluation 99");
+}
+
 TEST_F(CampaignFileTest, DiffSeesADifference) {
   // The round-trip check is only as good as Diff.
   const CampaignIndex a = MakeIndex(30);
@@ -361,6 +441,9 @@ TEST_F(CampaignFileTest, DiffSeesADifference) {
   EXPECT_NE(Diff(a, b), "");
   b = a;
   b.evaluations[3].reason += " ";
+  EXPECT_NE(Diff(a, b), "");
+  b = a;
+  b.evaluations[6].replicas[2].metrics["nav_time_s"] += 1e-12;
   EXPECT_NE(Diff(a, b), "");
 }
 
@@ -758,7 +841,8 @@ TEST_F(CampaignFileTest, SchemaDocumentsEverythingTheWriterWrites) {
     documented.insert(group.at("path").get<std::string>());
   }
   written.clear();
-  for (const char* group : {"/evaluations", "/iterations", "/llm_exchanges"}) {
+  for (const char* group :
+       {"/evaluations", "/replicas", "/iterations", "/llm_exchanges"}) {
     H5G_info_t info;
     ASSERT_GE(H5Gget_info_by_name(raw.get(), group, &info, H5P_DEFAULT), 0);
     for (hsize_t i = 0; i < info.nlinks; ++i) {
@@ -771,7 +855,7 @@ TEST_F(CampaignFileTest, SchemaDocumentsEverythingTheWriterWrites) {
   for (const std::string& name : written) {
     EXPECT_EQ(documented.count(name), 1u) << name << " is not documented";
   }
-  EXPECT_EQ(written.size(), documented.size() - 3)  // minus the three groups
+  EXPECT_EQ(written.size(), documented.size() - 4)  // minus the four groups
       << "documented items missing from the file";
 }
 
@@ -859,7 +943,8 @@ with h5py.File(sys.argv[1], "r") as f:
     columns = [k for k in ev if isinstance(ev[k], h5py.Dataset)]
     assert sorted(columns) == sorted(
         ["index", "iteration", "content_key", "status", "reason", "source",
-         "attempts", "wall_s", "feasible", "seed", "bottlenecks_json"]), columns
+         "attempts", "wall_s", "feasible", "seed", "bottlenecks_json",
+         "replicas", "unstable"]), columns
     df = pd.DataFrame({k: ev[k][...] for k in columns})
     for k in ("content_key", "status", "reason", "source", "bottlenecks_json"):
         df[k] = df[k].str.decode("utf-8")
@@ -900,6 +985,18 @@ with h5py.File(sys.argv[1], "r") as f:
     assert done["nav_time_s"].notna().all()
     assert table[table["status"] == "failed"]["nav_time_s"].isna().all()
     assert int(table["feasible"].sum()) == sum(r["feasible"] for r in exp["rows"])
+
+    # Replicas: one row per run, joined to their evaluation by index.
+    rep = f["replicas"]
+    runs = pd.DataFrame({k: rep[k][...] for k in rep
+                         if isinstance(rep[k], h5py.Dataset)})
+    assert len(runs) == int(df["replicas"][df["replicas"] > 1].sum()), runs
+    per_point = runs.groupby("index")["replica"].count()
+    for i, count in per_point.items():
+        assert df.set_index("index").loc[i, "replicas"] == count, (i, count)
+    rep_metrics = pd.DataFrame(
+        {n: rep["metrics"][n][...] for n in metric_names})
+    assert len(rep_metrics) == len(runs)
 
     it = f["iterations"]
     rounds = pd.DataFrame({k: it[k][...] for k in it})

@@ -282,17 +282,29 @@ TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
   EXPECT_EQ(isolation.exit_code, 2) << isolation.out;
   EXPECT_NE(isolation.out.find("--isolation"), std::string::npos)
       << isolation.out;
+}
+
+TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
   std::ifstream in(Small());
   std::string text((std::istreambuf_iterator<char>(in)),
                    std::istreambuf_iterator<char>());
   const std::string file =
-      WriteScenario("replicas", text + "harness: {replicas: 3}\n");
-  const CommandRun replicas =
-      Adse("run " + file + " -o " +
-           (fs::temp_directory_path() / "adse_cli_replicas").string());
-  EXPECT_EQ(replicas.exit_code, 2) << replicas.out;
-  EXPECT_NE(replicas.out.find("harness.replicas"), std::string::npos)
-      << replicas.out;
+      WriteScenario("replicas", text + "harness: {replicas: 2}\n");
+  const fs::path out = fs::temp_directory_path() / "adse_cli_replicas";
+  fs::remove_all(out);
+  const CommandRun run =
+      Adse("run " + file + " --budget 1 --no-cache -o " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  size_t runs = 0;
+  for (const auto& e : fs::directory_iterator(out / "runs")) {
+    runs += e.path().extension() == ".h5";
+  }
+  EXPECT_EQ(runs, 2u) << "one run file per replica";
+  std::ifstream report(out / "report.md");
+  const std::string md((std::istreambuf_iterator<char>(report)),
+                       std::istreambuf_iterator<char>());
+  EXPECT_NE(md.find("## Replicas"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 2 runs |"), std::string::npos) << md;
 }
 
 TEST(CliRunTest,

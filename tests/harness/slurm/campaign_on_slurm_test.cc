@@ -220,6 +220,56 @@ TEST_F(CampaignOnSlurmTest, ArraySweepEndsWithTheSameRunsAsALocalCampaign) {
   EXPECT_EQ(ReadJson(out + "/summary.json")["counts"]["evaluations"], 4);
 }
 
+TEST_F(CampaignOnSlurmTest, ASweepWithReplicasRunsEveryReplicaAsItsOwnStep) {
+  const std::string scenario = SmallScenarioIn(
+      dir_, "{strategy: random, budget: 2}",
+      "{memory_mb: 1024, replicas: 2, slurm: {shard_size: 1, max_parallel: "
+      "2, signal_lead_s: 60}}");
+  const std::string out = dir_ + "/sweep";
+  const json submitted = Submit(scenario, out);
+  EXPECT_EQ(submitted["points"], 2);
+  EXPECT_EQ(submitted["shards"], 2);
+  WaitForJob(JobOf(submitted, "index"));
+  EXPECT_EQ(cluster_->JobState(JobOf(submitted, "array")),
+            "COMPLETED,COMPLETED");
+  EXPECT_EQ(RunFiles(out).size(), 4u) << "2 points x 2 replicas";
+  const json st = StatusOf(out);
+  EXPECT_EQ(st["counts"],
+            json({{"done", 2}, {"failed", 0}, {"running", 0}, {"pending", 0}}));
+
+  // The same points as a local campaign: the same replicas and medians.
+  const std::string local = dir_ + "/local";
+  const AdseRun run = Adse(
+      {"run", scenario, "-o", local, "--workers", "2", "--no-cache", "-q"});
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const runfile::CampaignIndex slurm_index = Index(out);
+  const runfile::CampaignIndex local_index = Index(local);
+  ASSERT_EQ(slurm_index.evaluations.size(), 2u);
+  ASSERT_EQ(local_index.evaluations.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    const runfile::EvaluationRow& a = slurm_index.evaluations[i];
+    const runfile::EvaluationRow& b = local_index.evaluations[i];
+    ASSERT_EQ(a.replicas.size(), 2u) << i;
+    ASSERT_EQ(b.replicas.size(), 2u) << i;
+    EXPECT_NE(a.replicas[0].seed, a.replicas[1].seed);
+    for (size_t r = 0; r < 2; ++r) {
+      EXPECT_EQ(a.replicas[r].content_key, b.replicas[r].content_key);
+      EXPECT_EQ(a.replicas[r].source, "simulated") << i << " " << r;
+    }
+    EXPECT_EQ(a.feasible, b.feasible) << i;
+    EXPECT_EQ(a.unstable, b.unstable) << i;
+    ASSERT_EQ(a.metrics.size(), b.metrics.size()) << i;
+    for (const auto& [name, value] : b.metrics) {
+      EXPECT_NEAR(a.metrics.at(name), value, 1e-9 * (1 + std::abs(value)))
+          << i << " " << name;
+    }
+  }
+  // Submitted again: every replica of every point is finished.
+  const json resubmitted = Submit(scenario, out);
+  EXPECT_EQ(resubmitted["finished_points"], 2);
+  EXPECT_TRUE(JobOf(resubmitted, "array").empty());
+}
+
 TEST_F(CampaignOnSlurmTest,
        AdaptiveCampaignInsideAnAllocationRunsTwoStepsAtOnceOnTwoCpus) {
   if (cluster_->cpus() < 2) {

@@ -1,0 +1,203 @@
+// A point's replicas folded into its row: medians with runs stopped early
+// ranked beyond their bound, majority feasibility, the unstable flag, the
+// representative run, and the spread the views show.
+#include "harness/campaign/replicas.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "analysis/runfile/run_data.h"
+#include "harness/spec/spec_parser.h"
+
+namespace adse::campaign {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+spec::Spec Scenario() {
+  spec::ParseOptions options;
+  options.check_files = false;
+  Result<spec::Spec> spec = spec::ParseSpec(
+      "adse: 1\nname: replicas\nworld: {map: {generate: parking_lot}}\n"
+      "task: {start: {x: 5, y: -1.75}, goal: {x: 60, y: 29.75}}\n"
+      "design_space:\n  cores: {bind: platform.cores, values: [1, 4]}\n"
+      "objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]\n"
+      "constraints: [nav_time_s <= 60, ctrl_rate_hz >= 1]\n"
+      "harness: {replicas: 3}\n",
+      "replicas.yaml", ".", options);
+  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
+  return std::move(spec).value();
+}
+
+// A run that reached the goal in `nav_time_s` at 4 cores.
+EvaluationRow Reached(int replica, double nav_time_s,
+                      double ctrl_rate_hz = 5.0) {
+  EvaluationRow row;
+  row.index = 7;
+  row.iteration = 2;
+  row.replica = replica;
+  row.content_key = std::string(64, static_cast<char>('a' + replica));
+  row.seed = 100 + static_cast<uint64_t>(replica);
+  row.status = "complete";
+  row.reason = "goal_reached";
+  row.source = "simulated";
+  row.attempts = 1;
+  row.wall_s = 2.0;
+  row.point = {{"cores", 4}};
+  row.metrics = {{"nav_time_s", nav_time_s},
+                 {"ctrl_rate_hz", ctrl_rate_hz},
+                 {"hardware_cost", 4},
+                 {"completed", 1},
+                 {"censored", 0}};
+  row.feasible = nav_time_s <= 60 && ctrl_rate_hz >= 1;
+  row.bottlenecks_json = "[]";
+  return row;
+}
+
+// A run stopped early on `constraint`: only cost and censoring are known.
+EvaluationRow Stopped(int replica, const std::string& constraint) {
+  EvaluationRow row = Reached(replica, 0);
+  row.reason = std::string(runfile::kConstraintViolatedPrefix) + constraint;
+  row.metrics = {{"hardware_cost", 4}, {"censored", 1}};
+  row.feasible = false;
+  return row;
+}
+
+EvaluationRow Failed(int replica) {
+  EvaluationRow row = Reached(replica, 0);
+  row.status = "failed";
+  row.reason = "crashed: killed by signal 11";
+  row.metrics.clear();
+  row.feasible = false;
+  return row;
+}
+
+TEST(ReplicasTest, OneRunIsItsOwnRow) {
+  const EvaluationRow run = Reached(0, 42.0);
+  const EvaluationRow row = AggregateReplicas(Scenario(), {run});
+  EXPECT_EQ(row.content_key, run.content_key);
+  EXPECT_EQ(row.metrics, run.metrics);
+  EXPECT_TRUE(row.replicas.empty());
+  EXPECT_FALSE(row.unstable);
+  EXPECT_EQ(ReplicaSummary(row), "1 run");
+  EXPECT_FALSE(SpreadOf(Scenario(), row, "nav_time_s"));
+}
+
+TEST(ReplicasTest, MetricsAreTheMedianAndTheRunsAreKept) {
+  const EvaluationRow row = AggregateReplicas(
+      Scenario(),
+      {Reached(0, 50.0, 4.0), Reached(1, 40.0, 6.0), Reached(2, 45.0, 5.0)});
+  EXPECT_EQ(row.status, "complete");
+  EXPECT_DOUBLE_EQ(row.metrics.at("nav_time_s"), 45.0);
+  EXPECT_DOUBLE_EQ(row.metrics.at("ctrl_rate_hz"), 5.0);
+  EXPECT_DOUBLE_EQ(row.metrics.at("censored"), 0.0);
+  EXPECT_TRUE(row.feasible);
+  EXPECT_FALSE(row.unstable);
+  ASSERT_EQ(row.replicas.size(), 3u);
+  EXPECT_EQ(row.replicas[1].replica, 1);
+  EXPECT_EQ(row.index, 7);
+  EXPECT_EQ(row.iteration, 2);
+  EXPECT_EQ(row.attempts, 3);
+  EXPECT_DOUBLE_EQ(row.wall_s, 6.0);
+  EXPECT_EQ(row.content_key, row.replicas[0].content_key);
+  EXPECT_EQ(ReplicaSummary(row), "3 runs");
+
+  const std::optional<MetricSpread> nav =
+      SpreadOf(Scenario(), row, "nav_time_s");
+  ASSERT_TRUE(nav);
+  EXPECT_DOUBLE_EQ(nav->min, 40.0);
+  EXPECT_DOUBLE_EQ(nav->max, 50.0);
+  EXPECT_DOUBLE_EQ(nav->q1, 42.5);
+  EXPECT_DOUBLE_EQ(nav->q3, 47.5);
+  EXPECT_EQ(nav->measured, 3);
+  EXPECT_EQ(nav->censored, 0);
+}
+
+TEST(ReplicasTest, AnEvenNumberOfRunsTakesTheMeanOfTheMiddleTwo) {
+  spec::Spec spec = Scenario();
+  spec.harness.replicas = 4;
+  const EvaluationRow row = AggregateReplicas(
+      spec,
+      {Reached(0, 50.0), Reached(1, 40.0), Reached(2, 44.0), Reached(3, 46.0)});
+  EXPECT_DOUBLE_EQ(row.metrics.at("nav_time_s"), 45.0);
+}
+
+TEST(ReplicasTest, ARunStoppedEarlyRanksBeyondTheBoundItBroke) {
+  // Two runs made it, one was stopped past 60 s: the median is the slower
+  // of the two, not their mean, and the point is unstable.
+  const EvaluationRow row = AggregateReplicas(
+      Scenario(),
+      {Reached(0, 50.0), Stopped(1, "nav_time_s <= 60"), Reached(2, 40.0)});
+  EXPECT_DOUBLE_EQ(row.metrics.at("nav_time_s"), 50.0);
+  EXPECT_TRUE(row.feasible);
+  EXPECT_TRUE(row.unstable);
+  EXPECT_DOUBLE_EQ(row.metrics.at("censored"), 0.0);
+  EXPECT_EQ(row.reason, "goal_reached");
+  EXPECT_EQ(ReplicaSummary(row), "unstable: feasible in 2 of 3 runs");
+  const std::optional<MetricSpread> nav =
+      SpreadOf(Scenario(), row, "nav_time_s");
+  ASSERT_TRUE(nav);
+  EXPECT_EQ(nav->max, kInf);
+  EXPECT_EQ(nav->measured, 2);
+  EXPECT_EQ(nav->censored, 1);
+  EXPECT_EQ(nav->q3, kInf);
+
+  // A rate floor: the stopped run ranks below every measured rate.
+  const EvaluationRow slow = AggregateReplicas(
+      Scenario(), {Reached(0, 50.0, 3.0), Stopped(1, "ctrl_rate_hz >= 1"),
+                   Reached(2, 40.0, 2.0)});
+  EXPECT_DOUBLE_EQ(slow.metrics.at("ctrl_rate_hz"), 2.0);
+  EXPECT_EQ(SpreadOf(Scenario(), slow, "ctrl_rate_hz")->min, -kInf);
+}
+
+TEST(ReplicasTest, AMajorityStoppedEarlyMakesTheRowCensored) {
+  const EvaluationRow row = AggregateReplicas(
+      Scenario(), {Reached(0, 55.0), Stopped(1, "nav_time_s <= 60"),
+                   Stopped(2, "nav_time_s <= 60")});
+  EXPECT_FALSE(row.feasible);
+  EXPECT_TRUE(row.unstable);
+  EXPECT_EQ(row.metrics.count("nav_time_s"), 0u);
+  EXPECT_DOUBLE_EQ(row.metrics.at("censored"), 1.0);
+  EXPECT_DOUBLE_EQ(row.metrics.at("hardware_cost"), 4.0);
+  // The representative is a stopped run: its reason names the constraint.
+  EXPECT_EQ(runfile::ViolatedConstraint(row.reason), "nav_time_s <= 60");
+  EXPECT_EQ(row.content_key, row.replicas[1].content_key);
+
+  // Every run stopped: no run measured the time at all.
+  const EvaluationRow all =
+      AggregateReplicas(Scenario(), {Stopped(0, "nav_time_s <= 60"),
+                                     Stopped(1, "nav_time_s <= 60"),
+                                     Stopped(2, "nav_time_s <= 60")});
+  EXPECT_FALSE(all.feasible);
+  EXPECT_FALSE(all.unstable);
+  EXPECT_DOUBLE_EQ(all.metrics.at("censored"), 1.0);
+}
+
+TEST(ReplicasTest, FailedRunsCountAgainstFeasibilityButNotStability) {
+  const EvaluationRow row = AggregateReplicas(
+      Scenario(), {Failed(0), Reached(1, 50.0), Reached(2, 40.0)});
+  EXPECT_EQ(row.status, "complete");
+  EXPECT_TRUE(row.feasible);  // 2 of 3
+  EXPECT_FALSE(row.unstable);
+  EXPECT_DOUBLE_EQ(row.metrics.at("nav_time_s"), 45.0);
+  EXPECT_EQ(row.content_key, row.replicas[1].content_key);
+  EXPECT_EQ(ReplicaSummary(row), "3 runs, 1 failed");
+
+  const EvaluationRow half =
+      AggregateReplicas(Scenario(), {Failed(0), Failed(1), Reached(2, 40.0)});
+  EXPECT_FALSE(half.feasible);  // 1 of 3 is no majority
+
+  const EvaluationRow none =
+      AggregateReplicas(Scenario(), {Failed(0), Failed(1), Failed(2)});
+  EXPECT_EQ(none.status, "failed");
+  EXPECT_FALSE(none.feasible);
+  EXPECT_TRUE(none.metrics.empty());
+  EXPECT_EQ(none.reason, "crashed: killed by signal 11");
+}
+
+}  // namespace
+}  // namespace adse::campaign
