@@ -440,6 +440,7 @@ Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
   j["strategy"] = spec.exploration.strategy;
   j["exploration_seed"] = spec.exploration.seed;
   j["budget"] = spec.exploration.budget;
+  j["replicas"] = spec.harness.replicas;
   j["workers"] = summary.workers;
   j["isolation"] = summary.isolation;
   j["isolation_note"] = summary.isolation_note;

@@ -305,6 +305,13 @@ TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
                        std::istreambuf_iterator<char>());
   EXPECT_NE(md.find("## Replicas"), std::string::npos) << md;
   EXPECT_NE(md.find("| 2 runs |"), std::string::npos) << md;
+  // adse status counts runs: both replicas are done, none pending.
+  const CommandRun status = Adse("status " + out.string() + " --json");
+  ASSERT_EQ(status.exit_code, 0) << status.out;
+  EXPECT_NE(status.out.find("\"done\": 2"), std::string::npos) << status.out;
+  EXPECT_NE(status.out.find("\"pending\": 0"), std::string::npos)
+      << status.out;
+  EXPECT_NE(status.out.find("\"total\": 2"), std::string::npos) << status.out;
 }
 
 TEST(CliRunTest,
