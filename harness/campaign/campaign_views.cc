@@ -82,16 +82,15 @@ std::string ReplicaSection(const spec::Spec& spec,
     md << "| " << row.index << " | "
        << spec::FormatPoint(spec.design_space, row.point) << " | "
        << (row.unstable ? "**" + ReplicaSummary(row) + "**"
-                        : ReplicaSummary(row))
-       << " | ";
+                        : ReplicaSummary(row));
     for (const std::string& c : columns) {
       std::optional<MetricSpread> m = SpreadOf(spec, row, c);
-      md << (m ? fmt::format("{} [{} – {}]", value(m->median), value(m->min),
+      md << " | "
+         << (m ? fmt::format("{} [{} – {}]", value(m->median), value(m->min),
                              value(m->max))
-               : std::string("—"))
-         << " | ";
+               : std::string("—"));
     }
-    md << "\n";
+    md << " |\n";
   }
   return md.str();
 }

@@ -3,7 +3,6 @@
 // median, a run stopped early in every replica, resume that runs only the
 // missing replica, and a point whose replicas disagree flagged unstable.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -23,21 +22,13 @@
 #include "harness/spec/spec_parser.h"
 #include "stack/base/files.h"
 #include "tests/harness/testing/small_scenario.h"
+#include "tests/harness/testing/temp_files.h"
 
 namespace adse::campaign {
 namespace {
 namespace fs = std::filesystem;
 
 const std::string kAdse = std::string(ADSE_BINARY_DIR) + "/bin/adse";
-
-std::string TempDir(const std::string& name) {
-  const std::string dir = fs::temp_directory_path().string() +
-                          "/adse-replicas-" + name + "-" +
-                          std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 // robotaxi_small.yaml with its design space, constraints and harness
 // replaced, written to `dir` (the profile by absolute path).
@@ -87,7 +78,7 @@ size_t RunFileCount(const std::string& folder) {
 
 TEST(ReplicasCampaignTest,
      EachReplicaRunsWithItsOwnSeedAndAResumedCampaignRunsOnlyTheMissingOne) {
-  const std::string dir = TempDir("resume");
+  const std::string dir = adse::testing::TestTempDir("adse-replicas");
   // A starved point that every replica stops early, a generous one that
   // reaches the goal in every replica.
   const spec::Spec spec = Scenario(
@@ -192,7 +183,7 @@ TEST(ReplicasCampaignTest,
 }
 
 TEST(ReplicasCampaignTest, APointWhoseReplicasDisagreeIsFlaggedUnstable) {
-  const std::string dir = TempDir("unstable");
+  const std::string dir = adse::testing::TestTempDir("adse-replicas");
   const std::string cache = dir + "/cache";
   // No early stop: the constraints do not enter the run keys, so a second
   // campaign with another bound reuses the first one's runs.

@@ -117,6 +117,47 @@ class CampaignOnSlurmTest : public ::testing::Test {
     return index.ok() ? *index : runfile::CampaignIndex{};
   }
 
+  // Runs `scenario` as a local campaign into `local` and returns its index
+  // after checking it has `rows` evaluations, like `slurm_index`, with the
+  // same points and, run by run, the same metrics (the counted cost model
+  // is deterministic).
+  static runfile::CampaignIndex ExpectSameAsLocal(
+      const std::string& scenario, const std::string& local,
+      const runfile::CampaignIndex& slurm_index, size_t rows) {
+    const AdseRun run = Adse(
+        {"run", scenario, "-o", local, "--workers", "2", "--no-cache", "-q"});
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    const runfile::CampaignIndex local_index = Index(local);
+    EXPECT_EQ(slurm_index.evaluations.size(), rows);
+    EXPECT_EQ(local_index.evaluations.size(), rows);
+    for (size_t i = 0;
+         i < std::min(rows, std::min(slurm_index.evaluations.size(),
+                                     local_index.evaluations.size()));
+         ++i) {
+      const runfile::EvaluationRow& a = slurm_index.evaluations[i];
+      const runfile::EvaluationRow& b = local_index.evaluations[i];
+      EXPECT_EQ(a.content_key, b.content_key) << i;
+      EXPECT_EQ(a.point, b.point) << i;
+      EXPECT_EQ(a.status, "complete");
+      EXPECT_EQ(a.reason, b.reason) << i;
+      EXPECT_EQ(a.feasible, b.feasible) << i;
+      EXPECT_EQ(a.unstable, b.unstable) << i;
+      EXPECT_EQ(a.metrics.size(), b.metrics.size()) << i;
+      for (const auto& [name, value] : b.metrics) {
+        if (!a.metrics.count(name)) continue;
+        EXPECT_NEAR(a.metrics.at(name), value, 1e-9 * (1 + std::abs(value)))
+            << i << " " << name;
+      }
+      EXPECT_EQ(a.replicas.size(), b.replicas.size()) << i;
+      for (size_t r = 0; r < std::min(a.replicas.size(), b.replicas.size());
+           ++r) {
+        EXPECT_EQ(a.replicas[r].content_key, b.replicas[r].content_key)
+            << i << " replica " << r;
+      }
+    }
+    return local_index;
+  }
+
   // Polls until `done` holds or the deadline passes.
   template <typename F>
   bool Eventually(F done, double timeout_s, double every_s = 0.1) {
@@ -186,29 +227,8 @@ TEST_F(CampaignOnSlurmTest, ArraySweepEndsWithTheSameRunsAsALocalCampaign) {
   EXPECT_EQ(st["jobs"][0]["tasks"].size(), 2u);
 
   // The same sweep as a local campaign: the same runs, in the same order,
-  // with the same metrics (the counted cost model is deterministic).
-  const std::string local = dir_ + "/local";
-  const AdseRun run = Adse(
-      {"run", scenario, "-o", local, "--workers", "2", "--no-cache", "-q"});
-  ASSERT_EQ(run.exit_code, 0) << run.output;
-  const runfile::CampaignIndex slurm_index = Index(out);
-  const runfile::CampaignIndex local_index = Index(local);
-  ASSERT_EQ(slurm_index.evaluations.size(), 4u);
-  ASSERT_EQ(local_index.evaluations.size(), 4u);
-  for (size_t i = 0; i < 4; ++i) {
-    const runfile::EvaluationRow& a = slurm_index.evaluations[i];
-    const runfile::EvaluationRow& b = local_index.evaluations[i];
-    EXPECT_EQ(a.content_key, b.content_key) << i;
-    EXPECT_EQ(a.point, b.point) << i;
-    EXPECT_EQ(a.status, "complete");
-    EXPECT_EQ(a.reason, b.reason) << i;
-    EXPECT_EQ(a.feasible, b.feasible) << i;
-    ASSERT_EQ(a.metrics.size(), b.metrics.size()) << i;
-    for (const auto& [name, value] : b.metrics) {
-      EXPECT_NEAR(a.metrics.at(name), value, 1e-9 * (1 + std::abs(value)))
-          << i << " " << name;
-    }
-  }
+  // with the same metrics.
+  ExpectSameAsLocal(scenario, dir_ + "/local", Index(out), 4);
 
   // Submitted again when finished: nothing to simulate, only the index.
   const json resubmitted = Submit(scenario, out);
@@ -238,30 +258,13 @@ TEST_F(CampaignOnSlurmTest, ASweepWithReplicasRunsEveryReplicaAsItsOwnStep) {
             json({{"done", 2}, {"failed", 0}, {"running", 0}, {"pending", 0}}));
 
   // The same points as a local campaign: the same replicas and medians.
-  const std::string local = dir_ + "/local";
-  const AdseRun run = Adse(
-      {"run", scenario, "-o", local, "--workers", "2", "--no-cache", "-q"});
-  ASSERT_EQ(run.exit_code, 0) << run.output;
   const runfile::CampaignIndex slurm_index = Index(out);
-  const runfile::CampaignIndex local_index = Index(local);
-  ASSERT_EQ(slurm_index.evaluations.size(), 2u);
-  ASSERT_EQ(local_index.evaluations.size(), 2u);
-  for (size_t i = 0; i < 2; ++i) {
-    const runfile::EvaluationRow& a = slurm_index.evaluations[i];
-    const runfile::EvaluationRow& b = local_index.evaluations[i];
-    ASSERT_EQ(a.replicas.size(), 2u) << i;
-    ASSERT_EQ(b.replicas.size(), 2u) << i;
-    EXPECT_NE(a.replicas[0].seed, a.replicas[1].seed);
-    for (size_t r = 0; r < 2; ++r) {
-      EXPECT_EQ(a.replicas[r].content_key, b.replicas[r].content_key);
-      EXPECT_EQ(a.replicas[r].source, "simulated") << i << " " << r;
-    }
-    EXPECT_EQ(a.feasible, b.feasible) << i;
-    EXPECT_EQ(a.unstable, b.unstable) << i;
-    ASSERT_EQ(a.metrics.size(), b.metrics.size()) << i;
-    for (const auto& [name, value] : b.metrics) {
-      EXPECT_NEAR(a.metrics.at(name), value, 1e-9 * (1 + std::abs(value)))
-          << i << " " << name;
+  ExpectSameAsLocal(scenario, dir_ + "/local", slurm_index, 2);
+  for (const runfile::EvaluationRow& row : slurm_index.evaluations) {
+    ASSERT_EQ(row.replicas.size(), 2u);
+    EXPECT_NE(row.replicas[0].seed, row.replicas[1].seed);
+    for (const runfile::EvaluationRow& run : row.replicas) {
+      EXPECT_EQ(run.source, "simulated");
     }
   }
   // Submitted again: every replica of every point is finished.
