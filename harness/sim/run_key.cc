@@ -70,6 +70,10 @@ Result<std::string> RunKey(const spec::Spec& spec,
   h.Add("platform").Add(static_cast<long long>(p.kind)).Add(p.reference_ghz);
   h.Add(static_cast<long long>(p.cost_model)).Add(p.cost_scale);
   h.Add(static_cast<long long>(p.cores)).Add(p.freq_ghz);
+  // Keys of virtual runs stay as they were before the real-time platform.
+  if (p.kind == spec::PlatformKind::kCgroup) {
+    h.Add("time_dilation").Add(p.time_dilation);
+  }
   if (p.cost_model == spec::CostModel::kCounted) {
     // Keys of calibrated runs stay as they were before profiles existed.
     if (p.profile.empty()) {

@@ -7,13 +7,16 @@
 #include <cmath>
 #include <ctime>
 #include <fstream>
+#include <map>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include "analysis/metrics/run_metrics.h"
 #include "harness/profile/profile.h"
 #include "harness/sim/calibration.h"
 #include "harness/sim/early_stop.h"
+#include "harness/sim/host_placement.h"
 #include "harness/sim/run_key.h"
 #include "harness/spec/spec_parser.h"
 #include "harness/spec/types.h"
@@ -23,6 +26,7 @@
 #include "stack/base/random.h"
 #include "stack/nodes/ad_stack.h"
 #include "stack/runtime/executor.h"
+#include "stack/runtime/realtime_executor.h"
 #include "stack/world/lidar.h"
 #include "stack/world/map_cloud.h"
 
@@ -144,10 +148,43 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
       return calibration.status().WithContext("platform.calibration");
     vp.counted = std::move(calibration).value();
   }
+  std::map<std::string, std::string> platform_notes;
+  std::optional<AffinityGuard> world_affinity;
   Result<std::unique_ptr<stack::Executor>> made =
-      stack::CreateVirtualExecutor(&graph, vp);
+      Status::Internal("no executor made");
+  if (platform.kind == spec::PlatformKind::kCgroup) {
+    if (vp.profile == nullptr) {
+      return Status::InvalidArgument(
+          "platform.kind: cgroup pads every callback to its cost profile: "
+          "set platform.cost_model: counted and platform.profile");
+    }
+    Result<HostPlacement> placement = PlaceOnHost(platform.cores);
+    if (!placement.ok()) return placement.status();
+    stack::RealTimeOptions rt;
+    rt.cores = platform.cores;
+    rt.freq_ghz = platform.freq_ghz;
+    rt.profile = vp.profile;
+    rt.profile_seed = vp.profile_seed;
+    rt.cost_scale = platform.cost_scale;
+    rt.time_dilation = platform.time_dilation;
+    rt.host_cpus = placement->stack_cpus;
+    // The world keeps off the stack's cores where the host has others.
+    if (!placement->world_cpus.empty()) {
+      Result<AffinityGuard> guard = AffinityGuard::Pin(placement->world_cpus);
+      if (!guard.ok()) return guard.status();
+      world_affinity.emplace(std::move(guard).value());
+    }
+    platform_notes["confinement"] = placement->description;
+    platform_notes["time_dilation"] = fmt::format("{}", rt.time_dilation);
+    made = stack::CreateRealTimeExecutor(&graph, rt);
+  } else {
+    made = stack::CreateVirtualExecutor(&graph, vp);
+  }
   if (!made.ok()) return made.status().WithContext("platform");
   stack::Executor& executor = **made;
+  // Real time: how far the world fell behind the stack's clock.
+  const auto wall_start = Clock::now();
+  double world_lag_max_s = 0.0;
 
   const world::LidarParams lidar_params = stack_config.Lidar();
   world::LidarSimulator lidar(&w.scene(), lidar_params, setup.world.weather,
@@ -215,6 +252,11 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
       next_odometry += odometry_period;
     }
     const auto t_exec = Clock::now();
+    if (platform.kind == spec::PlatformKind::kCgroup) {
+      world_lag_max_s =
+          std::max(world_lag_max_s,
+                   Seconds(t_exec - wall_start) / platform.time_dilation - t);
+    }
     Status advanced = executor.AdvanceTo(t + dt);
     stats.executor_s += Seconds(Clock::now() - t_exec);
     if (!advanced.ok())
@@ -277,6 +319,10 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
                   {"cost_model", spec::CostModelToString(platform.cost_model)},
                   {"cost_scale", fmt::format("{}", platform.cost_scale)}};
   if (!profile_name.empty()) run.platform["profile"] = profile_name;
+  for (const auto& [key, value] : platform_notes) run.platform[key] = value;
+  if (platform.kind == spec::PlatformKind::kCgroup) {
+    run.platform["world_lag_max_s"] = fmt::format("{:.4f}", world_lag_max_s);
+  }
   for (size_t i = 0; i < w.ideal_path().points.size(); ++i) {
     run.ideal_path.push_back({w.ideal_path().s_m[i],
                               w.ideal_path().points[i].x(),
@@ -299,6 +345,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
          c.kind == stack::CallbackSpec::Kind::kTimer ? "timer" : "subscription",
          c.topic, c.period_s});
   }
+  executor.Stop();
   run.trace = executor.trace();
   // executor_s so far is the wall time inside AdvanceTo: the callbacks plus
   // the executor's own bookkeeping. Only the measured model records the

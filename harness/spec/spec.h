@@ -74,6 +74,10 @@ struct PlatformOptions {
   // Multiplies every callback cost: a sensitivity knob (1 = as measured or
   // as profiled).
   double cost_scale = 1.0;
+  // kind cgroup: wall seconds per simulated second (>= 1); slows the sim
+  // clock and stretches every callback cost alike, so a small host can
+  // hold a heavy stack.
+  double time_dilation = 1.0;
 };
 
 struct Objective {

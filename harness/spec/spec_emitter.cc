@@ -246,7 +246,16 @@ const std::vector<Field<PlatformOptions>>& PlatformFields() {
       QuotedIfSet("profile", &PlatformOptions::profile),
       Integer("cores", &PlatformOptions::cores),
       Number("freq_ghz", &PlatformOptions::freq_ghz),
-      Number("cost_scale", &PlatformOptions::cost_scale)};
+      Number("cost_scale", &PlatformOptions::cost_scale),
+      [] {
+        // Only the real-time platform has a clock to slow.
+        Field<PlatformOptions> f =
+            Number("time_dilation", &PlatformOptions::time_dilation);
+        f.present = [](const PlatformOptions& p) {
+          return p.kind == PlatformKind::kCgroup;
+        };
+        return f;
+      }()};
   return kFields;
 }
 

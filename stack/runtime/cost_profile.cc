@@ -22,6 +22,28 @@ double SampleCost(const CallbackCost& cost, double u) {
   return lo->cost_s + t * (hi->cost_s - lo->cost_s);
 }
 
+double InvocationUniform(uint64_t seed, uint64_t i) {
+  uint64_t z = seed + (i + 1) * 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return static_cast<double>(z >> 11) * 0x1.0p-53;
+}
+
+double DrawnCostS(const CallbackCost& cost, double u, double units) {
+  double s = SampleCost(cost, u);
+  if (cost.reference_units > 0.0) {
+    s *= (std::isfinite(units) && units > 0.0 ? units : 0.0) /
+         cost.reference_units;
+  }
+  return s;
+}
+
+double FrequencyFactor(const CallbackCost& cost, double reference_ghz,
+                       double freq_ghz, double cost_scale) {
+  return std::pow(reference_ghz / freq_ghz, cost.freq_exponent) * cost_scale;
+}
+
 namespace {
 
 Status Invalid(const std::string& callback, const std::string& message) {

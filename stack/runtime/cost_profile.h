@@ -5,6 +5,7 @@
 #ifndef ADSE_STACK_RUNTIME_COST_PROFILE_H_
 #define ADSE_STACK_RUNTIME_COST_PROFILE_H_
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -50,6 +51,28 @@ struct CostProfile {
 // The cost at quantile u in [0, 1] (clamped): linear between the two
 // neighbouring quantile points.
 double SampleCost(const CallbackCost& cost, double u);
+
+// Uniform in [0, 1) for draw `i` of a callback's stream seeded `seed`
+// (SplitMix64 of seed and i): a draw depends only on its own callback's
+// seed and count, never on how often other callbacks ran.
+double InvocationUniform(uint64_t seed, uint64_t i);
+
+// One invocation's profiled cost at the reference clock on one core: the
+// draw at `u`, times units / reference_units when the entry has reference
+// units (a negative or non-finite `units` counts as 0).
+double DrawnCostS(const CallbackCost& cost, double u, double units);
+
+// The factor every profiled cost of `cost` takes at `freq_ghz`:
+// (reference_ghz / freq_ghz)^freq_exponent * cost_scale.
+double FrequencyFactor(const CallbackCost& cost, double reference_ghz,
+                       double freq_ghz, double cost_scale);
+
+// Amdahl: the time of `serial_s` whose fraction p (clamped to [0, 1]) runs
+// on k >= 1 threads.
+inline double AmdahlS(double serial_s, double p, int k) {
+  p = p < 0.0 ? 0.0 : (p > 1.0 ? 1.0 : p);
+  return serial_s * (1.0 - p + p / (k < 1 ? 1 : k));
+}
 
 // InvalidArgument naming the callback and the field when the profile breaks
 // the rules above (also: reference_units finite >= 0, freq_exponent finite

@@ -1,6 +1,6 @@
 // Executors decide when a graph's callbacks run and what they cost. The
 // `virtual` platform simulates N cores at f GHz as discrete events; the
-// real-time `cgroup` platform will implement the same interface.
+// real-time platform (realtime_executor.h) runs them on host threads.
 #ifndef ADSE_STACK_RUNTIME_EXECUTOR_H_
 #define ADSE_STACK_RUNTIME_EXECUTOR_H_
 
@@ -64,7 +64,11 @@ class Executor {
   // leaves the clock at t_s.
   virtual Status AdvanceTo(double t_s) = 0;
   virtual double now_s() const = 0;
+  // The trace so far; on a real-time platform only after Stop().
   virtual const Trace& trace() const = 0;
+  // Ends execution: no callback runs once it returns. The virtual platform
+  // runs nothing between AdvanceTo calls and has nothing to stop.
+  virtual void Stop() {}
 };
 
 // Validates `options` (cores >= 1, frequencies > 0, ...), naming the field.

@@ -10,6 +10,8 @@
 #include <typeindex>
 #include <vector>
 
+#include "stack/base/status.h"
+#include "stack/runtime/cost_profile.h"
 #include "stack/runtime/messages.h"
 
 namespace adse::stack {
@@ -140,6 +142,15 @@ class CallbackContext {
  protected:
   virtual void PublishErased(int topic, MessagePtr message, double stamp_s) = 0;
 };
+
+// InvalidArgument naming the callback or sink: a node or topic index out
+// of range, a queue_depth < 1, a timer period <= 0 or phase < 0, or a
+// missing function. Every executor checks its graph with it.
+Status ValidateGraph(const Graph& graph);
+
+// InvalidArgument listing the graph's callbacks that `profile` has no
+// entry for (they would cost nothing).
+Status CheckProfileCovers(const CostProfile& profile, const Graph& graph);
 
 }  // namespace adse::stack
 

@@ -75,16 +75,6 @@ double ThreadCpuSeconds() {
 
 bool IsFinitePositive(double v) { return std::isfinite(v) && v > 0.0; }
 
-// Uniform in [0, 1) for draw `i` of a stream: SplitMix64 of (seed, i), so
-// a draw depends only on its own callback's seed and count.
-double DrawUniform(uint64_t seed, uint64_t i) {
-  uint64_t z = seed + (i + 1) * 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  z ^= z >> 31;
-  return static_cast<double>(z >> 11) * 0x1.0p-53;
-}
-
 Status ValidateCountedCost(const CountedCost& cost, const std::string& field) {
   if (!std::isfinite(cost.fixed_s) || cost.fixed_s < 0.0) {
     return Status::InvalidArgument(fmt::format(
@@ -307,9 +297,8 @@ VirtualExecutor::VirtualExecutor(const Graph* graph,
     if (profile_ != nullptr && !measured_) {
       // CreateVirtualExecutor checked that every callback has an entry.
       st.profiled = &profile_->callbacks.at(spec.name);
-      st.profile_factor = std::pow(profile_->reference_ghz / options.freq_ghz,
-                                   st.profiled->freq_exponent) *
-                          options.cost_scale;
+      st.profile_factor = FrequencyFactor(*st.profiled, profile_->reference_ghz,
+                                          options.freq_ghz, options.cost_scale);
       st.draw_seed = Random::DeriveSeed(options.profile_seed, spec.name);
     }
     if (st.is_timer) {
@@ -580,8 +569,8 @@ void VirtualExecutor::Start(int c) {
     base_s = host_cpu_s;
   } else if (st.profiled != nullptr) {
     const CallbackCost& cost = *st.profiled;
-    base_s = SampleCost(cost, DrawUniform(st.draw_seed, st.draws++));
-    if (cost.reference_units > 0.0) base_s *= units / cost.reference_units;
+    base_s =
+        DrawnCostS(cost, InvocationUniform(st.draw_seed, st.draws++), units);
     // The source's parallel part, on at most the threads both it scales to
     // and the callback runs with (e.g. the localization.ndt_threads knob).
     p = cost.parallel_fraction;
@@ -590,9 +579,8 @@ void VirtualExecutor::Start(int c) {
   } else {
     base_s = st.counted.fixed_s + st.counted.per_unit_s * units;
   }
-  p = std::clamp(p, 0.0, 1.0);
   const int k = std::max(1, std::min(max_threads, free_cores_));
-  double cost_s = base_s * (1.0 - p + p / k) * factor;
+  double cost_s = AmdahlS(base_s, p, k) * factor;
   if (!(cost_s >= kMinCostS)) cost_s = kMinCostS;  // also catches NaN
 
   int first_core = -1;
@@ -611,59 +599,6 @@ void VirtualExecutor::Start(int c) {
   rec.cores = k;
   rec.first_core = first_core;
   PushEvent(rec.end_s, kCompletion, c);
-}
-
-Status ValidateGraph(const Graph& graph) {
-  const int num_topics = static_cast<int>(graph.topics().size());
-  const int num_nodes = static_cast<int>(graph.nodes().size());
-  for (const CallbackSpec& spec : graph.callbacks()) {
-    if (spec.node < 0 || spec.node >= num_nodes) {
-      return Status::InvalidArgument(fmt::format(
-          "callback '{}': node index {} out of range", spec.name, spec.node));
-    }
-    if (spec.kind == CallbackSpec::Kind::kSubscription) {
-      if (spec.topic < 0 || spec.topic >= num_topics) {
-        return Status::InvalidArgument(
-            fmt::format("callback '{}': topic index {} out of range", spec.name,
-                        spec.topic));
-      }
-      if (spec.queue_depth < 1) {
-        return Status::InvalidArgument(
-            fmt::format("callback '{}': queue_depth must be >= 1, got {}",
-                        spec.name, spec.queue_depth));
-      }
-      if (!spec.on_message) {
-        return Status::InvalidArgument(
-            fmt::format("callback '{}': no function", spec.name));
-      }
-    } else {
-      if (!IsFinitePositive(spec.period_s)) {
-        return Status::InvalidArgument(
-            fmt::format("timer '{}': period_s must be finite and > 0, got {}",
-                        spec.name, spec.period_s));
-      }
-      if (!std::isfinite(spec.phase_s) || spec.phase_s < 0.0) {
-        return Status::InvalidArgument(
-            fmt::format("timer '{}': phase_s must be finite and >= 0, got {}",
-                        spec.name, spec.phase_s));
-      }
-      if (!spec.on_timer) {
-        return Status::InvalidArgument(
-            fmt::format("timer '{}': no function", spec.name));
-      }
-    }
-  }
-  for (size_t s = 0; s < graph.sinks().size(); ++s) {
-    const SinkSpec& sink = graph.sinks()[s];
-    if (sink.topic < 0 || sink.topic >= num_topics) {
-      return Status::InvalidArgument(
-          fmt::format("sink #{}: topic index {} out of range", s, sink.topic));
-    }
-    if (!sink.fn) {
-      return Status::InvalidArgument(fmt::format("sink #{}: no function", s));
-    }
-  }
-  return Status::Ok();
 }
 
 }  // namespace
@@ -707,17 +642,7 @@ Result<std::unique_ptr<Executor>> CreateVirtualExecutor(
   if (options.profile != nullptr &&
       options.cost_model == CostModelKind::kCounted) {
     // A callback the profile does not cost would be charged nothing: refuse.
-    std::vector<std::string> missing;
-    for (const CallbackSpec& spec : graph->callbacks()) {
-      if (options.profile->callbacks.count(spec.name) == 0) {
-        missing.push_back(spec.name);
-      }
-    }
-    if (!missing.empty()) {
-      return Status::InvalidArgument(
-          fmt::format("cost profile has no entry for callback(s): {}",
-                      fmt::join(missing, ", ")));
-    }
+    ADSE_RETURN_IF_ERROR(CheckProfileCovers(*options.profile, *graph));
   }
   return std::unique_ptr<Executor>(new VirtualExecutor(graph, options));
 }

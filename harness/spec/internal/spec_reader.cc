@@ -37,7 +37,7 @@ const std::vector<std::string> kGoalKeys = {"x",     "y",    "edge",
                                             "pos_m", "lane", "tolerance_m"};
 const std::vector<std::string> kPlatformKeys = {
     "kind",    "reference_ghz", "cost_model", "calibration",
-    "profile", "cores",         "freq_ghz",   "cost_scale"};
+    "profile", "cores",         "freq_ghz",   "cost_scale", "time_dilation"};
 
 }  // namespace
 
@@ -541,6 +541,9 @@ void SpecReader::ReadPlatform(const Val& v) {
   }
   if (const Val* e = f.Get("cost_scale")) {
     ReadNumber(*e, &p.cost_scale, {0, 1000, true, false});
+  }
+  if (const Val* e = f.Get("time_dilation")) {
+    ReadNumber(*e, &p.time_dilation, {1, 1000, false, false});
   }
 }
 
