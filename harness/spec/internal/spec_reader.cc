@@ -36,8 +36,8 @@ const std::vector<std::string> kStartKeys = {"x", "y", "edge", "pos_m", "lane"};
 const std::vector<std::string> kGoalKeys = {"x",     "y",    "edge",
                                             "pos_m", "lane", "tolerance_m"};
 const std::vector<std::string> kPlatformKeys = {
-    "kind",    "reference_ghz", "cost_model", "calibration",
-    "profile", "cores",         "freq_ghz",   "cost_scale", "time_dilation"};
+    "kind",  "reference_ghz", "cost_model", "calibration",  "profile",
+    "cores", "freq_ghz",      "cost_scale", "time_dilation"};
 
 }  // namespace
 
