@@ -169,6 +169,14 @@ struct ProfileCheckArgs {
 };
 int RunProfileCheck(const ProfileCheckArgs& args);
 
+struct FidelityArgs {
+  std::string scenario;             // names platform.profile
+  std::vector<std::string> points;  // "cores=1,freq_ghz=2.1,..."
+  int runs = 3;                     // real-time runs per point
+  std::string out;                  // folder; default <output>/fidelity
+};
+int RunFidelity(const FidelityArgs& args);
+
 }  // namespace adse::cli
 
 #endif  // ADSE_HARNESS_CLI_COMMANDS_H_

@@ -421,6 +421,34 @@ int main(int argc, char** argv) {
       "Folder for run.h5, check.txt and check.png (default: "
       "<output>/profile-check)");
 
+  adse::cli::FidelityArgs fidelity;
+  CLI::App* fidelity_cmd = app.add_subcommand(
+      "fidelity",
+      "Hold the virtual platform against real execution: run each point on "
+      "the virtual platform and --runs times on the real-time one (the "
+      "stack's threads on as many host CPUs as the point has cores), and "
+      "compare nav time, control rate, drops, the sensing-to-control chain "
+      "and each callback's p50/p99 latency; writes fidelity.txt, "
+      "fidelity.json and a picture per point");
+  fidelity_cmd
+      ->add_option("scenario", fidelity.scenario,
+                   "Scenario YAML file (cost_model: counted with a profile)")
+      ->required();
+  fidelity_cmd
+      ->add_option("--points", fidelity.points,
+                   "Design points, e.g. cores=1,freq_ghz=2.1,lidar_hz=7; at "
+                   "most as many cores as this host gives the process")
+      ->required();
+  fidelity_cmd
+      ->add_option("--runs", fidelity.runs,
+                   "Real-time runs per point (default 3; their median is "
+                   "compared)")
+      ->check(CLI::Range(1, 100));
+  fidelity_cmd->add_option(
+      "-o,--out", fidelity.out,
+      "Folder for fidelity.txt, fidelity.json and fidelity-N.png (default: "
+      "<output>/fidelity)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -434,6 +462,7 @@ int main(int argc, char** argv) {
   if (*profile_import_cmd) return adse::cli::RunProfileImport(profile_import);
   if (*profile_show_cmd) return adse::cli::RunProfileShow(profile_show);
   if (*profile_check_cmd) return adse::cli::RunProfileCheck(profile_check);
+  if (*fidelity_cmd) return adse::cli::RunFidelity(fidelity);
   if (*run_cmd) return adse::cli::RunRun(run);
   if (*submit_cmd) return adse::cli::RunSubmit(submit);
   if (*status_cmd) return adse::cli::RunStatus(status);

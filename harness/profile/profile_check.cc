@@ -36,7 +36,38 @@ int TopicIndex(const runfile::RunData& run, const std::string& name) {
   return -1;
 }
 
-// Chain instances, in seconds, from the trace's topic events.
+
+std::string Ms(const std::optional<double>& v) {
+  return v ? fmt::format("{:9.2f}", *v) : fmt::format("{:>9}", "-");
+}
+
+std::string Rows(const std::vector<CheckRow>& rows, const char* source_p95) {
+  std::string out = fmt::format(
+      "{:<40} {:>6} {:>9} {:>9} {:>9} {:>9} {:>8}  {}\n", "", "n", "adse avg",
+      "adse p95", "src avg", source_p95, "avg diff", "target");
+  for (const CheckRow& r : rows) {
+    std::string diff = "-", target;
+    if (r.source_avg_ms && *r.source_avg_ms > 0 && r.samples > 0) {
+      const double d = r.adse_avg_ms / *r.source_avg_ms - 1.0;
+      diff = fmt::format("{:+.0f} %", 100.0 * d);
+      if (r.tolerance) {
+        target = fmt::format("within {:.0f} %: {}", 100.0 * *r.tolerance,
+                             std::abs(d) <= *r.tolerance ? "met" : "MISSED");
+      }
+    }
+    out +=
+        fmt::format("{:<40} {:>6} {} {} {} {} {:>8}  {}\n", r.name, r.samples,
+                    r.samples > 0 ? fmt::format("{:9.2f}", r.adse_avg_ms)
+                                  : fmt::format("{:>9}", "-"),
+                    r.samples > 0 ? fmt::format("{:9.2f}", r.adse_p95_ms)
+                                  : fmt::format("{:>9}", "-"),
+                    Ms(r.source_avg_ms), Ms(r.source_p95_ms), diff, target);
+  }
+  return out;
+}
+
+}  // namespace
+
 std::map<std::string, std::vector<double>> ChainLatencies(
     const runfile::RunData& run, const ChainTopics& topics) {
   const int raw = TopicIndex(run, topics.raw_scan);
@@ -74,37 +105,6 @@ std::map<std::string, std::vector<double>> ChainLatencies(
   }
   return out;
 }
-
-std::string Ms(const std::optional<double>& v) {
-  return v ? fmt::format("{:9.2f}", *v) : fmt::format("{:>9}", "-");
-}
-
-std::string Rows(const std::vector<CheckRow>& rows, const char* source_p95) {
-  std::string out = fmt::format(
-      "{:<40} {:>6} {:>9} {:>9} {:>9} {:>9} {:>8}  {}\n", "", "n", "adse avg",
-      "adse p95", "src avg", source_p95, "avg diff", "target");
-  for (const CheckRow& r : rows) {
-    std::string diff = "-", target;
-    if (r.source_avg_ms && *r.source_avg_ms > 0 && r.samples > 0) {
-      const double d = r.adse_avg_ms / *r.source_avg_ms - 1.0;
-      diff = fmt::format("{:+.0f} %", 100.0 * d);
-      if (r.tolerance) {
-        target = fmt::format("within {:.0f} %: {}", 100.0 * *r.tolerance,
-                             std::abs(d) <= *r.tolerance ? "met" : "MISSED");
-      }
-    }
-    out +=
-        fmt::format("{:<40} {:>6} {} {} {} {} {:>8}  {}\n", r.name, r.samples,
-                    r.samples > 0 ? fmt::format("{:9.2f}", r.adse_avg_ms)
-                                  : fmt::format("{:>9}", "-"),
-                    r.samples > 0 ? fmt::format("{:9.2f}", r.adse_p95_ms)
-                                  : fmt::format("{:>9}", "-"),
-                    Ms(r.source_avg_ms), Ms(r.source_p95_ms), diff, target);
-  }
-  return out;
-}
-
-}  // namespace
 
 ProfileCheck CompareWithProfile(const runfile::RunData& run,
                                 const Profile& profile,

@@ -4,6 +4,7 @@
 #ifndef ADSE_HARNESS_PROFILE_PROFILE_CHECK_H_
 #define ADSE_HARNESS_PROFILE_PROFILE_CHECK_H_
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,6 +40,11 @@ struct ChainTopics {
   std::string ndt_pose = "/localization/ndt_pose";
   std::string pose = "/localization/pose";  // the EKF's fused pose
 };
+
+// Every instance of each chain of ChainNames() in `run`, in seconds, as
+// CompareWithProfile measures them (below).
+std::map<std::string, std::vector<double>> ChainLatencies(
+    const runfile::RunData& run, const ChainTopics& topics = {});
 
 // Compares `run` (simulated with `profile`) with the profile's source.
 // Chains: sensing = a raw scan's arrival to the publication of its

@@ -284,6 +284,42 @@ TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
       << isolation.out;
 }
 
+TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
+  std::ifstream in(std::string(ADSE_SOURCE_DIR) +
+                   "/scenarios/fidelity_small.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)),
+                   std::istreambuf_iterator<char>());
+  const std::string from = "timeout_s: 30";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), "timeout_s: 4");
+  const std::string file = WriteScenario("fidelity", text);
+  const fs::path out = fs::temp_directory_path() / "adse_cli_fidelity";
+  fs::remove_all(out);
+  const CommandRun run = Adse(
+      "fidelity " + file +
+      " --points cores=1,freq_ghz=2.1,lidar_hz=7 --runs 1 -o " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("virtual vs real-time (median of 1 run; affinity"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("ctrl_rate_hz"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("callback p50 latency"), std::string::npos);
+  for (const char* name : {"fidelity.txt", "fidelity.json", "fidelity-1.png"}) {
+    EXPECT_TRUE(fs::is_regular_file(out / name)) << name;
+  }
+  // A point outside the space, and no runs, are bad input.
+  const CommandRun outside =
+      Adse("fidelity " + file +
+           " --points cores=3,freq_ghz=2.1,lidar_hz=7 -o " + out.string());
+  EXPECT_EQ(outside.exit_code, 2) << outside.out;
+  EXPECT_NE(outside.out.find("cores"), std::string::npos) << outside.out;
+  const CommandRun none =
+      Adse("fidelity " + file +
+           " --points cores=1,freq_ghz=2.1,lidar_hz=7 --runs 0");
+  EXPECT_EQ(none.exit_code, 2) << none.out;
+  EXPECT_NE(none.out.find("--runs"), std::string::npos) << none.out;
+}
+
 TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
   std::ifstream in(Small());
   std::string text((std::istreambuf_iterator<char>(in)),
@@ -309,8 +345,7 @@ TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
   const CommandRun status = Adse("status " + out.string() + " --json");
   ASSERT_EQ(status.exit_code, 0) << status.out;
   EXPECT_NE(status.out.find("\"done\": 2"), std::string::npos) << status.out;
-  EXPECT_NE(status.out.find("\"pending\": 0"), std::string::npos)
-      << status.out;
+  EXPECT_NE(status.out.find("\"pending\": 0"), std::string::npos) << status.out;
   EXPECT_NE(status.out.find("\"total\": 2"), std::string::npos) << status.out;
 }
 

@@ -1,0 +1,130 @@
+// `adse fidelity <scenario> --points P1 P2 ... [--runs K]`: each point on
+// the virtual platform and K times on the real-time one, compared (harness/
+// fidelity). Exit 0 ok, 2 bad input (a point outside the space, a scenario
+// without a cost profile, more cores than the host gives), 1 otherwise.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "analysis/pictures/pictures.h"
+#include "harness/cli/cli_support.h"
+#include "harness/cli/commands.h"
+#include "harness/fidelity/fidelity.h"
+#include "harness/spec/design_point.h"
+#include "stack/base/files.h"
+
+namespace adse::cli {
+namespace {
+
+nlohmann::json ComparisonsJson(
+    const std::vector<fidelity::Comparison>& comparisons) {
+  auto number = [](double v) {
+    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+  };
+  nlohmann::json out = nlohmann::json::array();
+  for (const fidelity::Comparison& c : comparisons) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (double v : c.realtime) runs.push_back(number(v));
+    out.push_back(
+        {{"name", c.name},
+         {"virtual", number(c.virtual_value)},
+         {"realtime_median", number(c.realtime_median)},
+         {"realtime_runs", runs},
+         {"difference", number(c.difference)},
+         {"tolerance",
+          c.tolerance ? nlohmann::json(*c.tolerance) : nlohmann::json()},
+         {"met", c.tolerance ? nlohmann::json(c.met()) : nlohmann::json()}});
+  }
+  return out;
+}
+
+}  // namespace
+
+int RunFidelity(const FidelityArgs& args) {
+  std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
+  if (!spec) return 2;
+  std::vector<spec::DesignPoint> points;
+  for (const std::string& text : args.points) {
+    Result<spec::DesignPoint> point =
+        spec::ParsePoint(spec->design_space, text);
+    if (!point.ok()) {
+      std::fprintf(stderr, "error: --points %s: %s\n", text.c_str(),
+                   point.status().message().c_str());
+      return 2;
+    }
+    points.push_back(*point);
+  }
+  const std::string dir =
+      args.out.empty() ? spec->ResolvedOutput() + "/fidelity" : args.out;
+  if (Status made = MakeDirs(dir); !made.ok()) {
+    std::fprintf(stderr, "error: %s\n", made.message().c_str());
+    return 1;
+  }
+  fidelity::FidelityOptions options;
+  options.runs = args.runs;
+  options.on_run = [](const std::string& point, const std::string& what) {
+    std::fprintf(stderr, "%s: %s run ...\n", point.c_str(), what.c_str());
+  };
+  std::string text;
+  nlohmann::json j = {{"scenario", spec->name},
+                      {"runs", args.runs},
+                      {"points", nlohmann::json::array()}};
+  for (size_t i = 0; i < points.size(); ++i) {
+    Result<fidelity::PointFidelity> f =
+        fidelity::ComparePoint(*spec, points[i], options);
+    if (!f.ok()) {
+      ReportError(*spec, f.status());
+      // What was compared so far stays on disk.
+      if (!text.empty()) (void)WriteFileAtomic(dir + "/fidelity.txt", text);
+      return ExitCodeFor(f.status());
+    }
+    const std::string table = fidelity::FormatPointFidelity(*f);
+    std::printf("%s\n", table.c_str());
+    text += table + "\n";
+    j["points"].push_back(
+        {{"point", f->point},
+         {"confinement", f->confinement},
+         {"metrics", ComparisonsJson(f->metrics)},
+         {"callback_p50_ms", ComparisonsJson(f->callback_p50_ms)},
+         {"callback_p99_ms", ComparisonsJson(f->callback_p99_ms)}});
+    // Per point: the callbacks' p50, virtual above real-time.
+    std::vector<analysis::ComparisonRow> rows;
+    for (const fidelity::Comparison& c : f->callback_p50_ms) {
+      std::optional<double> real;
+      if (std::isfinite(c.realtime_median)) real = c.realtime_median;
+      rows.push_back({c.name, c.virtual_value, real});
+    }
+    if (!rows.empty()) {
+      analysis::ComparisonChartOptions o;
+      o.title = fmt::format("p50 callback latency at {}: virtual vs real time",
+                            f->point);
+      o.adse_name = "virtual platform";
+      o.reference_name =
+          args.runs == 1
+              ? std::string("real time (1 run)")
+              : fmt::format("real time (median of {} runs)", args.runs);
+      const std::string png = fmt::format("{}/fidelity-{}.png", dir, i + 1);
+      if (Status drawn = analysis::RenderComparisonChart(rows, o, png);
+          !drawn.ok()) {
+        std::fprintf(stderr, "error: %s\n", drawn.message().c_str());
+        return 1;
+      }
+    }
+  }
+  Status saved = WriteFileAtomic(dir + "/fidelity.txt", text);
+  if (saved.ok()) {
+    saved = WriteFileAtomic(dir + "/fidelity.json", j.dump(1) + "\n");
+  }
+  if (!saved.ok()) {
+    std::fprintf(stderr, "error: %s\n", saved.message().c_str());
+    return 1;
+  }
+  std::printf("wrote %s/fidelity.txt, fidelity.json and fidelity-N.png\n",
+              dir.c_str());
+  return 0;
+}
+
+}  // namespace adse::cli

@@ -1,0 +1,231 @@
+#include "harness/fidelity/fidelity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "harness/profile/profile_check.h"
+#include "harness/sim/simulator.h"
+#include "harness/spec/design_point.h"
+
+namespace adse::fidelity {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Issue 15's targets.
+constexpr double kRunTolerance = 0.10;       // nav time, control rate
+constexpr double kCallbackTolerance = 0.20;  // per-callback p50
+// Callbacks cheaper than this on the virtual platform are left out: their
+// latency is the executor's bookkeeping, not the model.
+constexpr double kMinCallbackMs = 1.0;
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Nearest-rank quantile of `v` (sorted in place).
+double Quantile(std::vector<double>& v, double q) {
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const size_t rank =
+      static_cast<size_t>(std::ceil(q * static_cast<double>(v.size())));
+  return v[std::max<size_t>(rank, 1) - 1];
+}
+
+Comparison Compare(const std::string& name, double virtual_value,
+                   const std::vector<double>& realtime,
+                   std::optional<double> tolerance) {
+  Comparison c;
+  c.name = name;
+  c.virtual_value = virtual_value;
+  for (double v : realtime) {
+    if (!std::isnan(v)) c.realtime.push_back(v);
+  }
+  c.realtime_median = Median(c.realtime);
+  c.difference =
+      std::isfinite(virtual_value) && virtual_value != 0.0 &&
+              std::isfinite(c.realtime_median)
+          ? (c.realtime_median - virtual_value) / std::abs(virtual_value)
+          : kNaN;
+  c.tolerance = tolerance;
+  return c;
+}
+
+double Metric(const runfile::RunData& run, const std::string& name) {
+  const auto it = run.metrics.find(name);
+  return it == run.metrics.end() ? kNaN : it->second;
+}
+
+double SensingToControlMs(const runfile::RunData& run) {
+  std::map<std::string, std::vector<double>> chains =
+      profile::ChainLatencies(run);
+  const std::vector<double>& v = chains["sensing_to_control"];
+  if (v.empty()) return kNaN;
+  return 1000.0 * std::accumulate(v.begin(), v.end(), 0.0) /
+         static_cast<double>(v.size());
+}
+
+// Per callback name: its execution latencies (start to end), ms.
+std::map<std::string, std::vector<double>> CallbackLatenciesMs(
+    const runfile::RunData& run) {
+  std::map<std::string, std::vector<double>> out;
+  for (const stack::CallbackRecord& r : run.trace.callbacks) {
+    if (r.callback < 0 ||
+        r.callback >= static_cast<int>(run.callback_info.size())) {
+      continue;
+    }
+    out[run.callback_info[r.callback].name].push_back(1000.0 *
+                                                      (r.end_s - r.start_s));
+  }
+  return out;
+}
+
+std::string Number(double v) {
+  return std::isfinite(v) ? fmt::format("{:.4g}", v) : "—";
+}
+
+}  // namespace
+
+bool Comparison::met() const {
+  return tolerance && std::isfinite(difference) &&
+         std::abs(difference) <= *tolerance;
+}
+
+PointFidelity CompareRuns(const runfile::RunData& virtual_run,
+                          const std::vector<runfile::RunData>& realtime_runs) {
+  PointFidelity f;
+  struct Quantity {
+    const char* name;
+    std::optional<double> tolerance;
+  };
+  // A nav time is compared only between runs that reached the goal: a
+  // timeout's is the timeout on both platforms.
+  auto reached = [](const runfile::RunData& r) {
+    return r.termination_reason == "goal_reached";
+  };
+  for (const Quantity& q : {Quantity{"nav_time_s", kRunTolerance},
+                            Quantity{"ctrl_rate_hz", kRunTolerance},
+                            Quantity{"e2e_latency_p50_s", std::nullopt},
+                            Quantity{"dropped_messages", std::nullopt},
+                            Quantity{"lidar_frames_dropped", std::nullopt}}) {
+    const bool time = std::string(q.name) == "nav_time_s";
+    std::vector<double> rt;
+    for (const runfile::RunData& r : realtime_runs) {
+      rt.push_back(time && !reached(r) ? kNaN : Metric(r, q.name));
+    }
+    f.metrics.push_back(Compare(
+        q.name,
+        time && !reached(virtual_run) ? kNaN : Metric(virtual_run, q.name), rt,
+        q.tolerance));
+  }
+  std::vector<double> chain;
+  for (const runfile::RunData& r : realtime_runs) {
+    chain.push_back(SensingToControlMs(r));
+  }
+  f.metrics.push_back(Compare("sensing_to_control_ms",
+                              SensingToControlMs(virtual_run), chain,
+                              std::nullopt));
+
+  std::map<std::string, std::vector<double>> v =
+      CallbackLatenciesMs(virtual_run);
+  std::vector<std::map<std::string, std::vector<double>>> rts;
+  for (const runfile::RunData& r : realtime_runs) {
+    rts.push_back(CallbackLatenciesMs(r));
+  }
+  for (auto& [name, latencies] : v) {
+    const double p50 = Quantile(latencies, 0.5);
+    if (!(p50 >= kMinCallbackMs)) continue;
+    const double p99 = Quantile(latencies, 0.99);
+    std::vector<double> rt50, rt99;
+    for (auto& run : rts) {
+      auto it = run.find(name);
+      if (it == run.end()) continue;
+      rt50.push_back(Quantile(it->second, 0.5));
+      rt99.push_back(Quantile(it->second, 0.99));
+    }
+    f.callback_p50_ms.push_back(Compare(name, p50, rt50, kCallbackTolerance));
+    f.callback_p99_ms.push_back(Compare(name, p99, rt99, std::nullopt));
+  }
+  return f;
+}
+
+Result<PointFidelity> ComparePoint(const spec::Spec& input,
+                                   const spec::DesignPoint& point,
+                                   const FidelityOptions& options) {
+  if (options.runs < 1) {
+    return Status::InvalidArgument(
+        fmt::format("runs: expected at least 1, found {}", options.runs));
+  }
+  ADSE_RETURN_IF_ERROR(input.design_space.Check(point));
+  spec::Spec spec = input;
+  spec.harness.early_stop = false;
+  const std::string text = spec::FormatPoint(spec.design_space, point);
+
+  spec.platform.kind = spec::PlatformKind::kVirtual;
+  if (options.on_run) options.on_run(text, "virtual");
+  Result<runfile::RunData> virtual_run = sim::SimulatePoint(spec, point);
+  if (!virtual_run.ok()) return virtual_run.status();
+
+  spec.platform.kind = spec::PlatformKind::kCgroup;
+  std::vector<runfile::RunData> realtime;
+  for (int k = 0; k < options.runs; ++k) {
+    if (options.on_run) {
+      options.on_run(text, fmt::format("real-time {}/{}", k + 1, options.runs));
+    }
+    Result<runfile::RunData> run = sim::SimulatePoint(spec, point);
+    if (!run.ok()) return run.status();
+    realtime.push_back(std::move(run).value());
+  }
+  PointFidelity f = CompareRuns(*virtual_run, realtime);
+  f.point = text;
+  const auto where = realtime.front().platform.find("confinement");
+  if (where != realtime.front().platform.end()) f.confinement = where->second;
+  f.runs.push_back(std::move(virtual_run).value());
+  for (runfile::RunData& r : realtime) f.runs.push_back(std::move(r));
+  return f;
+}
+
+std::string FormatPointFidelity(const PointFidelity& f) {
+  std::ostringstream out;
+  const size_t k = f.runs.empty() ? 0 : f.runs.size() - 1;
+  out << fmt::format("{}: virtual vs real-time (median of {} run{}; {})\n",
+                     f.point, k, k == 1 ? "" : "s", f.confinement);
+  auto table = [&](const char* what, const std::vector<Comparison>& rows) {
+    out << fmt::format("  {:<44} {:>10} {:>10} {:>22} {:>8}  {}\n", what,
+                       "virtual", "real-time", "real-time runs", "diff",
+                       "target");
+    for (const Comparison& c : rows) {
+      std::string runs;
+      if (!c.realtime.empty()) {
+        runs = Number(*std::min_element(c.realtime.begin(), c.realtime.end()));
+        runs += "–" +
+                Number(*std::max_element(c.realtime.begin(), c.realtime.end()));
+      }
+      const std::string diff =
+          std::isfinite(c.difference)
+              ? fmt::format("{:+.1f}%", 100.0 * c.difference)
+              : std::string("—");
+      const std::string target =
+          c.tolerance ? fmt::format("±{:.0f}% {}", 100.0 * *c.tolerance,
+                                    c.met() ? "met" : "missed")
+                      : std::string();
+      out << fmt::format("  {:<44} {:>10} {:>10} {:>22} {:>8}  {}\n", c.name,
+                         Number(c.virtual_value), Number(c.realtime_median),
+                         runs, diff, target);
+    }
+  };
+  table("run", f.metrics);
+  table("callback p50 latency, start to end (ms)", f.callback_p50_ms);
+  table("callback p99 latency (ms)", f.callback_p99_ms);
+  return out.str();
+}
+
+}  // namespace adse::fidelity

@@ -1,0 +1,75 @@
+// `adse fidelity`: the virtual platform held against real execution. Each
+// point runs once on the virtual platform (deterministic) and K times on
+// the real-time platform (noisy), with the same scenario and seed; the
+// comparison says, metric by metric and callback by callback, how far the
+// model is from what the host's scheduler did.
+#ifndef ADSE_HARNESS_FIDELITY_FIDELITY_H_
+#define ADSE_HARNESS_FIDELITY_FIDELITY_H_
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/runfile/run_data.h"
+#include "harness/spec/spec.h"
+#include "stack/base/status.h"
+
+namespace adse::fidelity {
+
+struct FidelityOptions {
+  // Real-time runs per point (their median is compared), >= 1.
+  int runs = 3;
+  // Told before each run: (point text, "virtual" | "real-time k/K").
+  std::function<void(const std::string&, const std::string&)> on_run;
+};
+
+// One compared quantity: the virtual platform's value, the real-time
+// runs' values, and the relative difference of their median from it.
+struct Comparison {
+  std::string name;
+  double virtual_value = 0.0;
+  std::vector<double> realtime;  // one per real-time run that had it
+  double realtime_median = 0.0;
+  // (median - virtual) / |virtual|; NaN when either is missing or virtual
+  // is 0.
+  double difference = 0.0;
+  // Issue 15's target for it (|difference| <= tolerance), if any.
+  std::optional<double> tolerance;
+  bool met() const;
+};
+
+struct PointFidelity {
+  std::string point;        // FormatPoint text
+  std::string confinement;  // where the real-time runs ran
+  // nav_time_s (only of runs that reached the goal) and ctrl_rate_hz
+  // (targets 10 %), e2e_latency_p50_s,
+  // dropped_messages, lidar_frames_dropped, and the sensing-to-control
+  // chain's mean.
+  std::vector<Comparison> metrics;
+  // Per callback of at least 1 ms on the virtual platform: the p50 of its
+  // execution latency, start to end (target 20 %), then its p99.
+  std::vector<Comparison> callback_p50_ms;
+  std::vector<Comparison> callback_p99_ms;
+  // The runs themselves (the virtual one, then the real-time ones).
+  std::vector<runfile::RunData> runs;
+};
+
+// Runs `point` both ways. Early stop is off for these runs: a censored
+// time would compare nothing. Errors: the point's or the platform's
+// (InvalidArgument for a point outside the space or a scenario without a
+// cost profile, Unavailable when the host has too few CPUs).
+Result<PointFidelity> ComparePoint(const spec::Spec& spec,
+                                   const spec::DesignPoint& point,
+                                   const FidelityOptions& options);
+
+// The quantities of `virtual_run` and `realtime_runs` (exposed for tests).
+PointFidelity CompareRuns(const runfile::RunData& virtual_run,
+                          const std::vector<runfile::RunData>& realtime_runs);
+
+// The table `adse fidelity` prints for one point.
+std::string FormatPointFidelity(const PointFidelity& fidelity);
+
+}  // namespace adse::fidelity
+
+#endif  // ADSE_HARNESS_FIDELITY_FIDELITY_H_

@@ -1,0 +1,95 @@
+// The comparison `adse fidelity` prints, on runs built by hand: medians of
+// the real-time runs against the virtual run, the targets, nav times only
+// between runs that reached the goal, and callbacks under 1 ms left out.
+#include "harness/fidelity/fidelity.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace adse::fidelity {
+namespace {
+
+// A run that reached the goal (or timed out) with one 10 ms callback
+// ("a/work", `work_ms` each) and one 0.1 ms callback ("a/tick").
+runfile::RunData MadeRun(double nav_time_s, double ctrl_rate_hz, double work_ms,
+                         bool reached = true) {
+  runfile::RunData run;
+  run.termination_reason = reached ? "goal_reached" : "timeout";
+  run.metrics = {{"nav_time_s", nav_time_s},
+                 {"ctrl_rate_hz", ctrl_rate_hz},
+                 {"e2e_latency_p50_s", 0.3},
+                 {"dropped_messages", 10},
+                 {"lidar_frames_dropped", 2}};
+  run.callback_info = {{"a/work", 0, "subscription", 0, 0.0},
+                       {"a/tick", 0, "timer", -1, 0.01}};
+  for (int i = 0; i < 100; ++i) {
+    stack::CallbackRecord work;
+    work.callback = 0;
+    work.start_s = i;
+    work.end_s = i + work_ms / 1000.0 * (i == 99 ? 3.0 : 1.0);
+    run.trace.callbacks.push_back(work);
+    stack::CallbackRecord tick;
+    tick.callback = 1;
+    tick.start_s = i;
+    tick.end_s = i + 0.0001;
+    run.trace.callbacks.push_back(tick);
+  }
+  return run;
+}
+
+const Comparison& Find(const std::vector<Comparison>& rows,
+                       const std::string& name) {
+  for (const Comparison& c : rows) {
+    if (c.name == name) return c;
+  }
+  ADD_FAILURE() << name << " missing";
+  return rows.front();
+}
+
+TEST(FidelityTest, TheMedianRealTimeRunIsHeldAgainstTheVirtualOne) {
+  const PointFidelity f =
+      CompareRuns(MadeRun(100.0, 30.0, 10.0),
+                  {MadeRun(104.0, 27.0, 11.0), MadeRun(130.0, 20.0, 13.0),
+                   MadeRun(101.0, 28.0, 12.5)});
+  const Comparison& nav = Find(f.metrics, "nav_time_s");
+  EXPECT_DOUBLE_EQ(nav.realtime_median, 104.0);
+  EXPECT_NEAR(nav.difference, 0.04, 1e-12);
+  EXPECT_TRUE(nav.met());
+  const Comparison& ctrl = Find(f.metrics, "ctrl_rate_hz");
+  EXPECT_DOUBLE_EQ(ctrl.realtime_median, 27.0);
+  EXPECT_NEAR(ctrl.difference, -0.1, 1e-12);
+  EXPECT_TRUE(ctrl.met());  // exactly at the 10 % bound
+  EXPECT_EQ(ctrl.realtime.size(), 3u);
+  EXPECT_FALSE(Find(f.metrics, "dropped_messages").tolerance);
+
+  // One callback of at least 1 ms: its p50 and p99; the 0.1 ms timer is
+  // left out.
+  ASSERT_EQ(f.callback_p50_ms.size(), 1u);
+  EXPECT_EQ(f.callback_p50_ms[0].name, "a/work");
+  EXPECT_NEAR(f.callback_p50_ms[0].virtual_value, 10.0, 1e-9);
+  EXPECT_NEAR(f.callback_p50_ms[0].realtime_median, 12.5, 1e-9);
+  EXPECT_NEAR(f.callback_p50_ms[0].difference, 0.25, 1e-9);
+  EXPECT_FALSE(f.callback_p50_ms[0].met()) << "25 % is past the 20 % target";
+  EXPECT_NEAR(f.callback_p99_ms[0].virtual_value, 10.0, 1e-9);
+
+  const std::string table = FormatPointFidelity(f);
+  EXPECT_NE(table.find("±20% missed"), std::string::npos) << table;
+  EXPECT_NE(table.find("±10% met"), std::string::npos) << table;
+}
+
+TEST(FidelityTest, NavTimesOfRunsThatTimedOutAreNotCompared) {
+  const PointFidelity f = CompareRuns(MadeRun(30.0, 4.0, 10.0, false),
+                                      {MadeRun(30.0, 3.0, 10.0, false)});
+  const Comparison& nav = Find(f.metrics, "nav_time_s");
+  EXPECT_TRUE(std::isnan(nav.virtual_value));
+  EXPECT_TRUE(nav.realtime.empty());
+  EXPECT_TRUE(std::isnan(nav.difference));
+  EXPECT_FALSE(nav.met());
+  EXPECT_NEAR(Find(f.metrics, "ctrl_rate_hz").difference, -0.25, 1e-12);
+}
+
+}  // namespace
+}  // namespace adse::fidelity
