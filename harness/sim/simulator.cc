@@ -112,7 +112,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   graph.AddSink<stack::ControlMsg>(topics.control, [&](const stack::ControlMsg&
                                                            m,
                                                        double t_s) {
-    gate.OnCommand(t_s, m.accel_mps2, m.steer_rad);
+    gate.OnCommand(t_s, m.accel_mps2, m.steer_rad, m.reverse);
     run.controls.push_back({t_s, m.header.stamp_s, m.accel_mps2, m.steer_rad});
   });
   graph.AddSink<stack::PoseMsg>(topics.pose,
@@ -222,7 +222,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
 
     const algorithms::GateOutput command = gate.Output(t + dt);
     const auto t_world = Clock::now();
-    Status stepped = w.Step({command.accel_mps2, command.steer_rad});
+    Status stepped =
+        w.Step({command.accel_mps2, command.steer_rad, command.reverse});
     stats.world_s += Seconds(Clock::now() - t_world);
     if (!stepped.ok()) return stepped;
     record_ego();

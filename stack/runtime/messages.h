@@ -79,8 +79,9 @@ struct TrajectoryMsg {
 
 struct ControlMsg {
   Header header;
-  double accel_mps2 = 0.0;
+  double accel_mps2 = 0.0;  // along the gear; negative brakes
   double steer_rad = 0.0;
+  bool reverse = false;  // gear
 };
 
 }  // namespace adse::stack
