@@ -25,6 +25,7 @@
 #include "stack/runtime/executor.h"
 #include "stack/world/lidar.h"
 #include "stack/world/map_cloud.h"
+#include "stack/world/parking_goal.h"
 
 namespace adse::sim {
 namespace {
@@ -47,6 +48,33 @@ std::string HostDescription() {
   }
   return fmt::format("{}; {}; {} cores", name, cpu,
                      std::thread::hardware_concurrency());
+}
+
+// The valet task's goal and lot, for the parking metrics and picture.
+void RecordParking(const world::World& w, const world::TaskOptions& task,
+                   runfile::ParkingRecord* out) {
+  out->present = true;
+  out->slot = w.goal_slot().name;
+  out->goal_x_m = w.parking_goal().x_m;
+  out->goal_y_m = w.parking_goal().y_m;
+  out->goal_yaw_rad = w.parking_goal().yaw_rad;
+  out->tolerance_m = task.goal_tolerance_m;
+  out->yaw_tolerance_rad = task.goal_yaw_tolerance_deg * M_PI / 180.0;
+  out->wheelbase_m = w.ego_limits().wheelbase_m;
+  out->length_m = w.ego_limits().length_m;
+  out->width_m = w.ego_limits().width_m;
+  for (const world::ParkingSlot& s : w.scene().parking_slots()) {
+    out->slots.push_back({s.box.center.x(), s.box.center.y(), s.box.yaw_rad,
+                          s.box.length_m, s.box.width_m, s.occupied ? 1 : 0,
+                          s.name == w.goal_slot().name ? 1 : 0});
+  }
+  const std::vector<std::vector<Eigen::Vector2d>> outlines =
+      world::ObstacleOutlines(w.scene());
+  for (size_t i = 0; i < outlines.size(); ++i) {
+    for (const Eigen::Vector2d& p : outlines[i]) {
+      out->obstacles.push_back({static_cast<int32_t>(i), p.x(), p.y()});
+    }
+  }
 }
 
 }  // namespace
@@ -85,7 +113,9 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     return map_cloud.status().WithContext("localization map");
 
   stack::StackInputs inputs;
-  inputs.route = w.ideal_path();
+  // The road part: the whole ideal path for lane driving; for valet parking
+  // it ends on the aisle, where the stack's freespace planner takes over.
+  inputs.route = w.road_path();
   inputs.lane_width_m = w.lane_width_m();
   inputs.map_cloud = std::move(map_cloud).value();
   inputs.initial_pose = {w.ego().x_m, w.ego().y_m, w.ego().yaw_rad};
@@ -94,6 +124,13 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   inputs.wheelbase_m = w.ego_limits().wheelbase_m;
   inputs.vehicle_length_m = w.ego_limits().length_m;
   inputs.vehicle_width_m = w.ego_limits().width_m;
+  if (w.parking_task()) {
+    inputs.parking = true;
+    inputs.parking_goal = w.parking_goal();
+    // The lot's map as the car carries it: walls, poles and the parked
+    // cars of the map's occupancy.
+    inputs.parking_obstacles = world::ObstacleOutlines(w.scene());
+  }
 
   stack::Graph graph;
   Result<std::unique_ptr<stack::AdStack>> ad_stack =
@@ -115,6 +152,22 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     gate.OnCommand(t_s, m.accel_mps2, m.steer_rad, m.reverse);
     run.controls.push_back({t_s, m.header.stamp_s, m.accel_mps2, m.steer_rad});
   });
+  // valet_parking: the stack's manoeuvre, or its word that there is none
+  // (which ends the run: waiting longer changes nothing).
+  bool no_path = false;
+  if (topics.parking_path >= 0) {
+    graph.AddSink<stack::ParkingPathMsg>(
+        topics.parking_path, [&](const stack::ParkingPathMsg& m, double t_s) {
+          run.parking.planned_at_s = t_s;
+          run.parking.path_found = m.found ? 1 : 0;
+          run.parking.planned_path.clear();
+          for (const stack::ParkingPathPoint& p : m.poses) {
+            run.parking.planned_path.push_back(
+                {p.x_m, p.y_m, p.yaw_rad, p.reverse ? 1 : 0});
+          }
+          no_path = !m.found;
+        });
+  }
   graph.AddSink<stack::PoseMsg>(topics.pose,
                                 [&](const stack::PoseMsg& m, double t_s) {
                                   gate.OnLocalization(t_s, m.valid);
@@ -245,6 +298,10 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
       reason = "goal_reached";
       break;
     }
+    if (no_path) {
+      reason = "no_path";
+      break;
+    }
     if (!early_stop->empty()) {
       const RunProgress progress{w.time_s(),
                                  static_cast<int64_t>(run.controls.size()),
@@ -284,6 +341,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
                               w.ideal_path().points[i].y()});
   }
   run.lane_width_m = w.lane_width_m();
+  if (w.parking_task()) RecordParking(w, spec.task, &run.parking);
   const std::vector<std::vector<Eigen::Vector2d>> lanes = w.LaneShapes();
   for (size_t i = 0; i < lanes.size(); ++i) {
     for (const Eigen::Vector2d& p : lanes[i]) {

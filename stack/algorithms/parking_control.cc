@@ -88,7 +88,8 @@ Eigen::Vector2d ParkingFollower::PointAt(const Segment& seg, double s) const {
 }
 
 ParkingCommand ParkingFollower::Update(const geometry::Pose2& pose,
-                                       double v_mps, double dt_s) {
+                                       double v_mps, double dt_s,
+                                       double speed_cap_mps) {
   const ParkingFollowerParams& p = params_;
   ParkingCommand out;
   if (segments_.empty()) {
@@ -126,7 +127,9 @@ ParkingCommand ParkingFollower::Update(const geometry::Pose2& pose,
   // Speed: cruise, then brake to stop at the segment's end with the
   // deceleration that stopping there takes (the car's lag would overshoot
   // a speed profile tracked by the PID alone).
-  const double cruise = seg.reverse ? p.reverse_speed_mps : p.forward_speed_mps;
+  const double cruise =
+      std::min(seg.reverse ? p.reverse_speed_mps : p.forward_speed_mps,
+               std::max(speed_cap_mps, 0.0));
   const double speed_along = seg.reverse ? -v_mps : v_mps;
   const double to_stop = std::max(0.0, remaining - 0.5 * p.arrive_tolerance_m);
   const double needed = speed_along > 0 ? speed_along * speed_along /

@@ -5,6 +5,7 @@
 #ifndef ADSE_STACK_ALGORITHMS_PARKING_CONTROL_H_
 #define ADSE_STACK_ALGORITHMS_PARKING_CONTROL_H_
 
+#include <cmath>
 #include <vector>
 
 #include "stack/algorithms/control.h"
@@ -53,8 +54,10 @@ class ParkingFollower {
   int segments() const { return static_cast<int>(segments_.size()); }
 
   // One control step: the rear axle's pose, the signed speed (negative in
-  // reverse) and the time since the previous step.
-  ParkingCommand Update(const geometry::Pose2& pose, double v_mps, double dt_s);
+  // reverse) and the time since the previous step. `speed_cap_mps` lowers
+  // the cruise speeds (the stack's degraded mode when fixes are old).
+  ParkingCommand Update(const geometry::Pose2& pose, double v_mps, double dt_s,
+                        double speed_cap_mps = INFINITY);
   const ParkingFollowerParams& params() const { return params_; }
 
  private:

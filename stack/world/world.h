@@ -64,8 +64,20 @@ class World {
   int collisions() const;
   // Vehicles whose contact with the ego began in the last step.
   const std::vector<std::string>& new_contacts() const;
+  // Lane driving: within goal_tolerance_m of the goal. valet_parking:
+  // parked, i.e. standing with the body's centre within goal_tolerance_m of
+  // the slot's and the heading within goal_yaw_tolerance_deg.
   bool goal_reached() const;
   double distance_to_goal_m() const;
+
+  // valet_parking only: the goal's slot, the rear-axle pose parked in it,
+  // the heading error now and the road part of the route (the whole ideal
+  // path for lane driving), which ends on the aisle beside the slot.
+  bool parking_task() const;
+  const ParkingSlot& goal_slot() const;
+  const geometry::Pose2& parking_goal() const;
+  double goal_yaw_error_rad() const;
+  const geometry::Path2& road_path() const;
 
   const geometry::Path2& ideal_path() const;
   const std::vector<std::string>& route_edges() const;
