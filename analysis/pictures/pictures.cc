@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "analysis/pictures/internal/drawing_impl.h"
+#include "analysis/pictures/internal/parking_layer.h"
 
 namespace adse::analysis::internal {
 
@@ -181,6 +182,10 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
     DrawPolyline(&img, lane, Bgr(kLaneCentreRgb), 1, cv::LINE_8);
   }
 
+  // valet_parking: the lot under the drive.
+  const ToPixel to_px = px;
+  DrawParkingLot(&img, run.parking, to_px, s);
+
   // Other vehicles, faintly, one path per id in time order.
   bool any_vehicle = false;
   if (o.draw_vehicles) {
@@ -212,6 +217,7 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   for (const auto& p : run.ideal_path) ideal.push_back(px(p.x_m, p.y_m));
   DrawPolyline(&img, ego, Bgr(kTrajectoryRgb), s.Px(5));
   DrawPolyline(&img, ideal, Bgr(kIdealPathRgb), s.Px(2));
+  DrawParkingManoeuvre(&img, run, to_px, s);
 
   cv::Point2d start(NAN, NAN), goal(NAN, NAN);
   for (const auto& p : ego) {
@@ -302,9 +308,22 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
                   [&](cv::Point2d a, cv::Point2d b) {
                     DrawStartMarker(&img, 0.5 * (a + b), s);
                   });
-  LegendEntry(&img, x, legend_y, "goal", s, [&](cv::Point2d a, cv::Point2d b) {
-    DrawGoalMarker(&img, 0.5 * (a + b), s);
-  });
+  x = LegendEntry(&img, x, legend_y, "goal", s,
+                  [&](cv::Point2d a, cv::Point2d b) {
+                    DrawGoalMarker(&img, 0.5 * (a + b), s);
+                  });
+  if (run.parking.present) {
+    x = LegendEntry(&img, x, legend_y, "target slot", s,
+                    line_sample(kTargetSlotRgb, s.Px(3)));
+    x = LegendEntry(&img, x, legend_y, "parked car / wall", s,
+                    line_sample(kObstacleRgb, s.Px(5)));
+    x = LegendEntry(&img, x, legend_y, "plan fwd", s,
+                    line_sample(kPlannedForwardRgb, s.Px(2)));
+    x = LegendEntry(&img, x, legend_y, "plan rev", s,
+                    line_sample(kPlannedReverseRgb, s.Px(2)));
+    LegendEntry(&img, x, legend_y, "car at end", s,
+                line_sample(kEgoBodyRgb, s.Px(2)));
+  }
   cv::line(img, cv::Point(0, map.map_top_px - 1),
            cv::Point(map.width_px - 1, map.map_top_px - 1), Bgr(kLaneCentreRgb),
            1);

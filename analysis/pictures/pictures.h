@@ -36,6 +36,13 @@ inline constexpr Rgb kConstraintRgb{190, 30, 60};
 inline constexpr Rgb kStudyPointRgb{215, 30, 30};  // red triangles
 inline constexpr Rgb kReferenceRgb{175, 175, 175};
 inline constexpr Rgb kReferenceFrontRgb{90, 105, 140};  // slate
+// valet_parking: the lot and the manoeuvre.
+inline constexpr Rgb kSlotRgb{175, 185, 200};      // cool grey
+inline constexpr Rgb kObstacleRgb{112, 104, 96};   // warm grey: walls, cars
+inline constexpr Rgb kTargetSlotRgb{230, 140, 0};  // orange
+inline constexpr Rgb kPlannedForwardRgb{150, 60, 190};  // purple
+inline constexpr Rgb kPlannedReverseRgb{215, 40, 140};  // magenta
+inline constexpr Rgb kEgoBodyRgb{20, 60, 160};          // dark blue
 
 struct TrajectoryImageOptions {
   int width_px = 1200;     // 200..4000
@@ -78,7 +85,10 @@ Result<WorldToImage> TrajectoryImageMapping(
 // marker (green circle at the first ego sample, else the path start) and a
 // goal marker (red cross at the path end) with labels, a scale bar with its
 // length, the world coordinates of the map corners written in the corners,
-// a title line (scenario, design point, outcome) and a legend. White
+// a title line (scenario, design point, outcome) and a legend. A
+// valet_parking run also shows the lot's slots, walls, poles and parked
+// cars, the target slot, the stack's planned manoeuvre (forward and
+// reverse legs) and the car's body where it ended. White
 // background, y up. Encoded as PNG in memory, then written atomically
 // (adse::WriteFileAtomic): no partial file on any error.
 Status RenderTrajectoryImage(const runfile::RunData& run,

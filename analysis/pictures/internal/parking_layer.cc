@@ -1,0 +1,108 @@
+#include "analysis/pictures/internal/parking_layer.h"
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+namespace adse::analysis::internal {
+namespace {
+
+// Corners of a box (centre, heading along its length) in pixels.
+std::vector<cv::Point2d> BoxPx(double cx, double cy, double yaw, double length,
+                               double width, const ToPixel& px) {
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  std::vector<cv::Point2d> out;
+  for (const auto& [u, v] : {std::pair{0.5, 0.5}, std::pair{-0.5, 0.5},
+                             std::pair{-0.5, -0.5}, std::pair{0.5, -0.5}}) {
+    const double lx = u * length, ly = v * width;
+    out.push_back(px(cx + c * lx - s * ly, cy + s * lx + c * ly));
+  }
+  return out;
+}
+
+void Outline(cv::Mat* img, std::vector<cv::Point2d> corners,
+             const cv::Scalar& colour, int thickness,
+             cv::LineTypes type = cv::LINE_AA) {
+  corners.push_back(corners.front());
+  DrawPolyline(img, corners, colour, thickness, type);
+}
+
+void Fill(cv::Mat* img, const std::vector<cv::Point2d>& corners,
+          const cv::Scalar& colour) {
+  std::vector<cv::Point> pts;
+  for (const cv::Point2d& p : corners) {
+    if (!Finite(p) || std::abs(p.x) > 1e6 || std::abs(p.y) > 1e6) return;
+    pts.push_back(Fixed(p));
+  }
+  cv::fillPoly(*img, std::vector<std::vector<cv::Point>>{pts}, colour,
+               cv::LINE_AA, kShift);
+}
+
+}  // namespace
+
+void DrawParkingLot(cv::Mat* img, const runfile::ParkingRecord& parking,
+                    const ToPixel& px, const Style& s) {
+  if (!parking.present) return;
+  for (const runfile::ParkingSlotRow& slot : parking.slots) {
+    Outline(img,
+            BoxPx(slot.x_m, slot.y_m, slot.yaw_rad, slot.length_m, slot.width_m,
+                  px),
+            Bgr(kSlotRgb), s.Px(1), cv::LINE_8);  // crisp, as lane centres
+  }
+  // Obstacles: consecutive rows of one number are one outline.
+  std::vector<cv::Point2d> outline;
+  auto flush = [&] {
+    if (outline.size() >= 3) {
+      Fill(img, outline, Bgr(kObstacleRgb));
+    } else if (outline.size() == 2) {
+      DrawSegment(img, outline[0], outline[1], Bgr(kObstacleRgb), s.Px(3));
+    }
+    outline.clear();
+  };
+  for (size_t i = 0; i < parking.obstacles.size(); ++i) {
+    if (i > 0 &&
+        parking.obstacles[i].obstacle != parking.obstacles[i - 1].obstacle) {
+      flush();
+    }
+    outline.push_back(px(parking.obstacles[i].x_m, parking.obstacles[i].y_m));
+  }
+  flush();
+  for (const runfile::ParkingSlotRow& slot : parking.slots) {
+    if (!slot.target) continue;
+    Outline(img,
+            BoxPx(slot.x_m, slot.y_m, slot.yaw_rad, slot.length_m, slot.width_m,
+                  px),
+            Bgr(kTargetSlotRgb), s.Px(3));
+  }
+}
+
+void DrawParkingManoeuvre(cv::Mat* img, const runfile::RunData& run,
+                          const ToPixel& px, const Style& s) {
+  const runfile::ParkingRecord& parking = run.parking;
+  if (!parking.present) return;
+  // Each leg of the plan in its gear's colour (a pose's gear is the gear
+  // driving to it).
+  for (size_t i = 1; i < parking.planned_path.size(); ++i) {
+    const runfile::ParkingPathRow& a = parking.planned_path[i - 1];
+    const runfile::ParkingPathRow& b = parking.planned_path[i];
+    DrawSegment(img, px(a.x_m, a.y_m), px(b.x_m, b.y_m),
+                Bgr(b.reverse ? kPlannedReverseRgb : kPlannedForwardRgb),
+                s.Px(2));
+  }
+  if (run.ego.empty()) return;
+  // The car as it ended: its body, centre half a wheelbase ahead of the
+  // rear axle, with a tick on its nose.
+  const runfile::EgoSample& e = run.ego.back();
+  const double ahead = 0.5 * parking.wheelbase_m;
+  const double cx = e.x_m + ahead * std::cos(e.yaw_rad);
+  const double cy = e.y_m + ahead * std::sin(e.yaw_rad);
+  Outline(img, BoxPx(cx, cy, e.yaw_rad, parking.length_m, parking.width_m, px),
+          Bgr(kEgoBodyRgb), s.Px(2));
+  const double nose = 0.5 * parking.length_m;
+  DrawSegment(
+      img, px(cx, cy),
+      px(cx + nose * std::cos(e.yaw_rad), cy + nose * std::sin(e.yaw_rad)),
+      Bgr(kEgoBodyRgb), s.Px(2));
+}
+
+}  // namespace adse::analysis::internal
