@@ -134,9 +134,10 @@ struct World::Impl {
   std::vector<RoadLocation> via;  // task.via, resolved
   Vec2 goal_xy = Vec2::Zero();    // final target (rear axle when valet)
   bool valet = false;
-  ParkingSlot goal_slot;         // valet: the slot parked in
-  geometry::Pose2 parking_goal;  // valet: rear axle parked
-  geometry::Path2 road;          // the route's road part
+  ParkingSlot goal_slot;                 // valet: the slot parked in
+  geometry::Pose2 parking_goal;          // valet: rear axle parked
+  geometry::Path2 road;                  // the route's road part
+  std::vector<ManoeuvrePose> reference;  // valet: the reference manoeuvre
   std::vector<std::string> route;
   geometry::Path2 ideal;
   double lane_width_m = 3.2;
@@ -521,6 +522,7 @@ Status World::Impl::BuildIdealPath() {
       if (manoeuvre.ok()) {
         for (const algorithms::GearedPose& p : manoeuvre->poses) {
           manoeuvre_points.emplace_back(p.pose.x_m, p.pose.y_m);
+          reference.push_back({p.pose, p.reverse});
         }
       }
       goal_xy = Vec2(parking_goal.x_m, parking_goal.y_m);
@@ -918,6 +920,9 @@ double World::goal_yaw_error_rad() const {
       impl_->ego->state().yaw_rad - impl_->parking_goal.yaw_rad, 2 * M_PI));
 }
 const geometry::Path2& World::road_path() const { return impl_->road; }
+const std::vector<ManoeuvrePose>& World::reference_manoeuvre() const {
+  return impl_->reference;
+}
 const geometry::Path2& World::ideal_path() const { return impl_->ideal; }
 const std::vector<std::string>& World::route_edges() const {
   return impl_->route;

@@ -34,6 +34,12 @@ struct RoadLocation {
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // on the lane centre
 };
 
+// A pose of the reference parking manoeuvre and the gear it is driven in.
+struct ManoeuvrePose {
+  geometry::Pose2 pose;  // rear axle
+  bool reverse = false;
+};
+
 struct OtherVehicle {
   std::string id;
   geometry::OrientedBox box;
@@ -78,6 +84,10 @@ class World {
   const geometry::Pose2& parking_goal() const;
   double goal_yaw_error_rad() const;
   const geometry::Path2& road_path() const;
+  // The reference manoeuvre from the road part's end into the slot (the
+  // ideal path's last part), planned on the ground truth; empty when the
+  // planner found none or for lane driving.
+  const std::vector<ManoeuvrePose>& reference_manoeuvre() const;
 
   const geometry::Path2& ideal_path() const;
   const std::vector<std::string>& route_edges() const;

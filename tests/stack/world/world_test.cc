@@ -368,6 +368,29 @@ TEST(WorldTest, ValetGoalIsTheParkedPoseInTheNamedSlot) {
   EXPECT_FALSE(w.goal_reached());  // not parked at the start
 }
 
+TEST(WorldTest, PerfectDriverParksAlongTheReferenceManoeuvre) {
+  Result<std::unique_ptr<World>> world = World::Open(ValetLot());
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  World& w = **world;
+  ASSERT_FALSE(w.reference_manoeuvre().empty());
+  IdealDriverOptions options;
+  options.scan = false;
+  options.timeout_s = 120;
+  Result<IdealDriveReport> report = DriveIdealPath(w, nullptr, options);
+  ASSERT_TRUE(report.ok()) << report.status().ToString();
+  EXPECT_TRUE(report->reached_goal);
+  EXPECT_TRUE(w.goal_reached());
+  EXPECT_EQ(report->collisions, 0);
+  EXPECT_LT(report->max_lateral_error_m, 0.5);
+  // It drove in reverse at some point only if the manoeuvre asks for it.
+  bool plan_reverses = false, drove_back = false;
+  for (const ManoeuvrePose& p : w.reference_manoeuvre())
+    plan_reverses = plan_reverses || p.reverse;
+  for (const TrajectorySample& t : report->trajectory)
+    drove_back = drove_back || t.v_mps < -0.1;
+  EXPECT_EQ(drove_back, plan_reverses);
+}
+
 TEST(WorldTest, ValetGoalNeedsTheParkedHeadingAlongTheSlot) {
   WorldSetup setup = ValetLot();
   setup.task.goal.has_yaw = false;
