@@ -168,6 +168,15 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
           no_path = !m.found;
         });
   }
+  // ... and its word that the car stands at the manoeuvre's end: parked
+  // as far as it can tell. Outside the tolerances nothing more will happen.
+  double parking_done_at_s = -1.0;
+  if (topics.parking_done >= 0) {
+    graph.AddSink<stack::ParkingDoneMsg>(
+        topics.parking_done, [&](const stack::ParkingDoneMsg&, double t_s) {
+          if (parking_done_at_s < 0) parking_done_at_s = t_s;
+        });
+  }
   graph.AddSink<stack::PoseMsg>(topics.pose,
                                 [&](const stack::PoseMsg& m, double t_s) {
                                   gate.OnLocalization(t_s, m.valid);
@@ -300,6 +309,13 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     }
     if (no_path) {
       reason = "no_path";
+      break;
+    }
+    // Once the car truly stands (the stack's speed estimate lags), and a
+    // second after the stack's word at the earliest.
+    if (parking_done_at_s >= 0 && w.time_s() > parking_done_at_s + 1.0 &&
+        std::abs(w.ego().v_mps) < 0.01) {
+      reason = "parked_out_of_tolerance";
       break;
     }
     if (!early_stop->empty()) {

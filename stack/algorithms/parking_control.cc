@@ -12,6 +12,7 @@ ParkingFollower::ParkingFollower(const ParkingFollowerParams& params)
 void ParkingFollower::SetPath(const std::vector<GearedPose>& poses) {
   segments_.clear();
   current_ = 0;
+  finished_ = false;
   last_index_ = 0;
   pid_.Reset();
   for (size_t i = 0; i < poses.size(); ++i) {
@@ -92,9 +93,13 @@ ParkingCommand ParkingFollower::Update(const geometry::Pose2& pose,
                                        double speed_cap_mps) {
   const ParkingFollowerParams& p = params_;
   ParkingCommand out;
-  if (segments_.empty()) {
+  if (segments_.empty() || finished_) {
     out.accel_mps2 = -p.stop_decel_mps2;
     out.finished = true;
+    if (!segments_.empty()) {
+      out.segment = current_;
+      out.reverse = segments_[current_].reverse;
+    }
     return out;
   }
   const Eigen::Vector2d pos(pose.x_m, pose.y_m);
@@ -116,6 +121,7 @@ ParkingCommand ParkingFollower::Update(const geometry::Pose2& pose,
       continue;
     }
     out.finished = at_end && standing && current_ + 1 == segments();
+    finished_ = out.finished;
     break;
   }
   const Segment& seg = segments_[current_];

@@ -35,9 +35,11 @@ struct ParkingFollowerParams {
 struct ParkingCommand {
   double accel_mps2 = 0.0;  // along the gear; negative brakes
   double steer_rad = 0.0;
-  bool reverse = false;   // gear of the segment being driven
-  bool finished = false;  // at the end of the last segment, holding
-  int segment = 0;        // index of the segment being driven
+  bool reverse = false;  // gear of the segment being driven
+  // At the end of the last segment, standing: from then on it holds (a
+  // parked car does not creep when its pose estimate moves).
+  bool finished = false;
+  int segment = 0;  // index of the segment being driven
   double target_speed_mps = 0.0;
   double lateral_error_m = 0.0;  // from the segment, left positive
   double remaining_m = 0.0;      // to the segment's end (negative: past it)
@@ -78,6 +80,7 @@ class ParkingFollower {
   Pid pid_;
   std::vector<Segment> segments_;
   int current_ = 0;
+  bool finished_ = false;
   size_t last_index_ = 0;  // projection's segment start, never decreasing
 };
 

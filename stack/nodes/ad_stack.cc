@@ -114,6 +114,7 @@ class Stack final : public AdStack {
   bool parking_planned_ = false;  // the planner has answered (path or not)
   std::unique_ptr<algo::ParkingFollower> parking_follower_;
   bool parking_mode_ = false;  // the follower drives the parking path
+  bool parking_done_ = false;  // ... and has reached its end
 };
 
 Status Stack::Build(Graph* g) {
@@ -557,6 +558,7 @@ void Stack::BuildParking(Graph* g) {
   // the manoeuvre into the slot from the localization pose, once.
   topics_.parking_path =
       g->AddTopic<ParkingPathMsg>("/planning/scenario_planning/parking/path");
+  topics_.parking_done = g->AddTopic<ParkingDoneMsg>("/control/parking_done");
   algo::FreespacePlannerParams params;
   params.turning_radius_m = config_.Get("parking.turning_radius_m");
   params.max_expansions =
@@ -613,6 +615,14 @@ void Stack::Park(CallbackContext& ctx, double dt_s, double speed_cap_mps,
   out->steer_rad = c.steer_rad;
   out->reverse = c.reverse;
   ctx.ReportWork({1.0, 0.0, 1});
+  if (c.finished && !parking_done_) {
+    // Once: the car stands at the manoeuvre's end (parked, as far as the
+    // stack can tell).
+    parking_done_ = true;
+    ParkingDoneMsg done;
+    done.header.stamp_s = out->header.stamp_s;
+    ctx.Publish(topics_.parking_done, std::move(done));
+  }
   ctx.Publish(topics_.control, std::move(*out));
 }
 

@@ -46,6 +46,7 @@ struct StackTopics {
   int trajectory = -1;    // out: TrajectoryMsg
   int objects = -1;       // out: ObjectsMsg
   int parking_path = -1;  // out: ParkingPathMsg (valet_parking only)
+  int parking_done = -1;  // out: ParkingDoneMsg (valet_parking only)
 };
 
 class AdStack {

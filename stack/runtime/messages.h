@@ -93,6 +93,11 @@ struct ParkingPathMsg {
   int64_t expansions = 0;               // search effort
 };
 
+// The controller's parking mode reached the manoeuvre's end and holds.
+struct ParkingDoneMsg {
+  Header header;
+};
+
 struct ControlMsg {
   Header header;
   double accel_mps2 = 0.0;  // along the gear; negative brakes

@@ -83,5 +83,20 @@ TEST(ValetParkingTest, UnreachableSlotEndsTheRunWithNoPathNotATimeout) {
   EXPECT_GE(run->parking.planned_at_s, 0.0);
 }
 
+TEST(ValetParkingTest, ParkedOutsideTheToleranceEndsTheRunAtOnce) {
+  spec::Spec spec = Bundled("valet_parking.yaml");
+  // Tighter than the manoeuvre ends (about 1.4 degrees off at this point).
+  spec.task.goal_yaw_tolerance_deg = 0.2;
+  Result<runfile::RunData> run = SimulatePoint(spec, kGenerous);
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->termination_reason, "parked_out_of_tolerance");
+  EXPECT_EQ(run->metrics.at("completed"), 0.0);
+  EXPECT_EQ(run->metrics.at("parked"), 0.0);
+  EXPECT_GT(run->metrics.at("parking_yaw_error_deg"), 0.2);
+  EXPECT_LT(run->metrics.at("parking_position_error_m"), 0.5);
+  // Standing in the slot, not waiting for the 300 s timeout.
+  EXPECT_LT(run->metrics.at("nav_time_s"), 60.0);
+}
+
 }  // namespace
 }  // namespace adse::sim

@@ -113,6 +113,14 @@ TEST(ParkingFollower, SplitsThePathAtGearChanges) {
   c = follower.Update({0.0, 0, 0}, 0.0, 0.05);
   EXPECT_TRUE(c.finished);
   EXPECT_LT(c.accel_mps2, 0);
+  // Finished stays finished, wherever the pose estimate moves next.
+  c = follower.Update({0.5, 0.1, 0}, 0.0, 0.05);
+  EXPECT_TRUE(c.finished);
+  EXPECT_LT(c.accel_mps2, 0);
+  EXPECT_TRUE(c.reverse);
+  // A new path starts over.
+  follower.SetPath(poses);
+  EXPECT_FALSE(follower.Update({0, 0, 0}, 0.0, 0.05).finished);
 }
 
 TEST(ParkingFollower, ReverseSteeringTurnsTowardsThePath) {
