@@ -118,7 +118,9 @@ inline std::string ViolatedConstraint(const std::string& reason) {
 struct RunData {
   // Identity and provenance (root attributes).
   std::string status = kRunComplete;  // kRunComplete|kRunInfeasible|kRunFailed
-  // goal_reached | timeout | constraint_violated: <constraint> | error text
+  // goal_reached | timeout | constraint_violated: <constraint> | error text;
+  // valet_parking also: no_path (the planner found no manoeuvre),
+  // parked_out_of_tolerance (the manoeuvre ended outside the tolerances)
   std::string termination_reason;
   std::string scenario_name;
   std::string scenario_text;  // the scenario file, verbatim
