@@ -59,7 +59,10 @@ struct WorldToImage {
   double px_per_m = 1.0;
   int map_top_px = 0;
   int width_px = 0;
-  int height_px = 0;  // whole image, header included
+  int height_px = 0;  // whole image, header and detail panel included
+  // valet_parking: rows of the detail panel below the map, which shows the
+  // manoeuvre enlarged (0: no panel).
+  int detail_px = 0;
 
   // Pixel coordinates (column, row; fractional) of a world point.
   double Column(double x_m) const { return (x_m - min_x_m) * px_per_m; }
@@ -67,7 +70,10 @@ struct WorldToImage {
     return map_top_px + (max_y_m - y_m) * px_per_m;
   }
   double MaxXM() const { return min_x_m + width_px / px_per_m; }
-  double MinYM() const { return max_y_m - (height_px - map_top_px) / px_per_m; }
+  int MapBottomPx() const { return height_px - detail_px; }
+  double MinYM() const {
+    return max_y_m - (MapBottomPx() - map_top_px) / px_per_m;
+  }
 };
 
 // The mapping RenderTrajectoryImage uses for `run`. The map covers the
@@ -88,7 +94,8 @@ Result<WorldToImage> TrajectoryImageMapping(
 // a title line (scenario, design point, outcome) and a legend. A
 // valet_parking run also shows the lot's slots, walls, poles and parked
 // cars, the target slot, the stack's planned manoeuvre (forward and
-// reverse legs) and the car's body where it ended. White
+// reverse legs) and the car's body where it ended, and below the map a
+// detail panel with the manoeuvre enlarged. White
 // background, y up. Encoded as PNG in memory, then written atomically
 // (adse::WriteFileAtomic): no partial file on any error.
 Status RenderTrajectoryImage(const runfile::RunData& run,

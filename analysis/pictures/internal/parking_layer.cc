@@ -1,5 +1,6 @@
 #include "analysis/pictures/internal/parking_layer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <vector>
@@ -103,6 +104,70 @@ void DrawParkingManoeuvre(cv::Mat* img, const runfile::RunData& run,
       img, px(cx, cy),
       px(cx + nose * std::cos(e.yaw_rad), cy + nose * std::sin(e.yaw_rad)),
       Bgr(kEgoBodyRgb), s.Px(2));
+}
+
+void DrawParkingDetail(cv::Mat* panel, const runfile::RunData& run,
+                       const std::vector<std::vector<cv::Point2d>>& lanes,
+                       const Style& s) {
+  const runfile::ParkingRecord& parking = run.parking;
+  // What to show: the target slot and the plan (or, without one, the
+  // slot's surroundings), with a margin.
+  std::vector<cv::Point2d> focus;
+  for (const runfile::ParkingSlotRow& slot : parking.slots) {
+    if (slot.target) focus.emplace_back(slot.x_m, slot.y_m);
+  }
+  for (const runfile::ParkingPathRow& p : parking.planned_path) {
+    focus.emplace_back(p.x_m, p.y_m);
+  }
+  if (focus.empty()) focus.emplace_back(parking.goal_x_m, parking.goal_y_m);
+  cv::Point2d lo = focus[0], hi = focus[0];
+  for (const cv::Point2d& p : focus) {
+    lo.x = std::min(lo.x, p.x);
+    lo.y = std::min(lo.y, p.y);
+    hi.x = std::max(hi.x, p.x);
+    hi.y = std::max(hi.y, p.y);
+  }
+  constexpr double kMarginM = 5.0;
+  const double width_m = hi.x - lo.x + 2 * kMarginM;
+  const double height_m = hi.y - lo.y + 2 * kMarginM;
+  const double px_per_m =
+      std::min(panel->cols / width_m, panel->rows / height_m);
+  const cv::Point2d centre = 0.5 * (lo + hi);
+  const ToPixel px = [&](double x, double y) {
+    return cv::Point2d(0.5 * panel->cols + (x - centre.x) * px_per_m,
+                       0.5 * panel->rows - (y - centre.y) * px_per_m);
+  };
+
+  const double lane_px = run.lane_width_m * px_per_m;
+  for (const auto& lane : lanes) {
+    std::vector<cv::Point2d> line;
+    for (const cv::Point2d& p : lane) line.push_back(px(p.x, p.y));
+    if (std::isfinite(lane_px) && lane_px >= 2.0) {
+      DrawPolyline(panel, line, Bgr(kLaneRgb),
+                   static_cast<int>(std::min(lane_px, 500.0)));
+    }
+  }
+  DrawParkingLot(panel, parking, px, s);
+  std::vector<cv::Point2d> ego, ideal;
+  for (const auto& e : run.ego) ego.push_back(px(e.x_m, e.y_m));
+  for (const auto& p : run.ideal_path) ideal.push_back(px(p.x_m, p.y_m));
+  DrawPolyline(panel, ego, Bgr(kTrajectoryRgb), s.Px(5));
+  DrawPolyline(panel, ideal, Bgr(kIdealPathRgb), s.Px(2));
+  DrawParkingManoeuvre(panel, run, px, s);
+
+  // Scale bar and caption, bottom left.
+  const double bar_m = NiceBelow(0.2 * panel->cols / px_per_m);
+  const int y = panel->rows - s.Px(12);
+  const cv::Point2d a(s.Px(10), y), b(s.Px(10) + bar_m * px_per_m, y);
+  DrawSegment(panel, a, b, kBlack, s.Px(2));
+  int baseline = 0;
+  const int text_h = TextSize("Ag", s, &baseline).height;
+  DrawText(panel, FormatNumber(bar_m) + " m", s.Px(10), y - s.Px(6),
+           Align::kLeft, s, kBlack, true);
+  DrawText(panel,
+           "detail: slot " + (parking.slot.empty() ? "?" : parking.slot) +
+               " and the manoeuvre",
+           s.Px(10), s.Px(6) + text_h, Align::kLeft, s, kDarkGrey, true);
 }
 
 }  // namespace adse::analysis::internal

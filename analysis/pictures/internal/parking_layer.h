@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "analysis/pictures/internal/drawing_impl.h"
 #include "analysis/pictures/pictures.h"
@@ -23,6 +24,14 @@ void DrawParkingLot(cv::Mat* img, const runfile::ParkingRecord& parking,
 // their own colours, and the car's body at the run's last sample.
 void DrawParkingManoeuvre(cv::Mat* img, const runfile::RunData& run,
                           const ToPixel& px, const Style& s);
+
+// The detail panel (drawn into `panel`, which clips): the manoeuvre's
+// surroundings enlarged — lanes (world coordinates), the lot, the
+// trajectory, the plan and the car at the end, with a scale bar and a
+// caption.
+void DrawParkingDetail(cv::Mat* panel, const runfile::RunData& run,
+                       const std::vector<std::vector<cv::Point2d>>& lanes,
+                       const Style& s);
 
 }  // namespace adse::analysis::internal
 

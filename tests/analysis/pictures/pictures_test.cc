@@ -215,6 +215,19 @@ TEST_F(PictureTest, ValetRunShowsTheLotTheTargetAndTheManoeuvre) {
       ColourNear(*img, map->Column(40.0), map->Row(10.0), kObstacleRgb));
   EXPECT_TRUE(
       ColourNear(*img, map->Column(41.25), map->Row(10.0), kTargetSlotRgb, 2));
+  // The detail panel below the map shows the target slot enlarged.
+  ASSERT_GT(map->detail_px, 0);
+  EXPECT_EQ(img->height_px, map->height_px);
+  int target_in_panel = 0;
+  for (int r = map->MapBottomPx(); r < img->height_px; ++r) {
+    for (int c = 0; c < img->width_px; ++c) {
+      target_in_panel += img->At(c, r) == kTargetSlotRgb;
+    }
+  }
+  EXPECT_GT(target_in_panel, 200);
+  Result<WorldToImage> plain_map = TrajectoryImageMapping(plain, options);
+  ASSERT_TRUE(plain_map.ok());
+  EXPECT_EQ(plain_map->detail_px, 0);
   for (Rgb c : {kObstacleRgb, kTargetSlotRgb, kPlannedForwardRgb,
                 kPlannedReverseRgb, kEgoBodyRgb, kSlotRgb}) {
     EXPECT_GT(CountColour(*img, c), 20) << Name(c);
