@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <limits>
 
+#include "analysis/metrics/parking_metrics.h"
+
 namespace adse::analysis {
 
 double Percentile(std::vector<double> values, double q) {
@@ -72,6 +74,7 @@ std::map<std::string, double> ComputeRunMetrics(
   }
   m["cpu_utilization"] =
       (cores > 0 && end_s > 0) ? busy_core_s / (cores * end_s) : 0.0;
+  AddParkingMetrics(run, &m);
   return m;
 }
 

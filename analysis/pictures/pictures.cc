@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "analysis/pictures/internal/drawing_impl.h"
+#include "analysis/pictures/internal/parking_layer.h"
 
 namespace adse::analysis::internal {
 
@@ -21,6 +22,8 @@ constexpr int kMinTrajectoryWidthPx = 200;
 constexpr double kMaxMapAspect = 2.0;  // height / width
 constexpr double kMinMapAspect = 0.25;
 constexpr double kMinExtentM = 1.0;
+// valet_parking's detail panel: height / width.
+constexpr double kDetailAspect = 0.45;
 // A vehicle that moves further than this between two samples was removed
 // and re-inserted (or teleported): its path is not drawn across the gap.
 constexpr double kVehicleJumpM = 50.0;
@@ -83,6 +86,10 @@ Result<WorldToImage> MappingImpl(const runfile::RunData& run,
   const int map_height_px =
       std::max(1, static_cast<int>(std::lround(extent_y * map.px_per_m)));
   map.height_px = map.map_top_px + map_height_px;
+  if (run.parking.present && !run.parking.slots.empty()) {
+    map.detail_px = static_cast<int>(std::lround(kDetailAspect * o.width_px));
+    map.height_px += map.detail_px;
+  }
   map.min_x_m = centre_x - 0.5 * extent_x;
   map.max_y_m = centre_y + 0.5 * map_height_px / map.px_per_m;
   return map;
@@ -162,12 +169,14 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   };
 
   // Lanes: surfaces first, so that no band hides another lane's centre.
-  std::vector<std::vector<cv::Point2d>> lanes;
+  std::vector<std::vector<cv::Point2d>> lanes, lanes_world;
   for (size_t i = 0; i < run.lanes.size(); ++i) {
     if (i == 0 || run.lanes[i].lane != run.lanes[i - 1].lane) {
       lanes.emplace_back();
+      lanes_world.emplace_back();
     }
     lanes.back().push_back(px(run.lanes[i].x_m, run.lanes[i].y_m));
+    lanes_world.back().emplace_back(run.lanes[i].x_m, run.lanes[i].y_m);
   }
   const double lane_px = run.lane_width_m * map.px_per_m;
   if (std::isfinite(lane_px) && lane_px >= 2.0) {
@@ -180,6 +189,10 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
     // Crisp: an anti-aliased 1-px line would fade into the band.
     DrawPolyline(&img, lane, Bgr(kLaneCentreRgb), 1, cv::LINE_8);
   }
+
+  // valet_parking: the lot under the drive.
+  const ToPixel to_px = px;
+  DrawParkingLot(&img, run.parking, to_px, s);
 
   // Other vehicles, faintly, one path per id in time order.
   bool any_vehicle = false;
@@ -212,6 +225,7 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   for (const auto& p : run.ideal_path) ideal.push_back(px(p.x_m, p.y_m));
   DrawPolyline(&img, ego, Bgr(kTrajectoryRgb), s.Px(5));
   DrawPolyline(&img, ideal, Bgr(kIdealPathRgb), s.Px(2));
+  DrawParkingManoeuvre(&img, run, to_px, s);
 
   cv::Point2d start(NAN, NAN), goal(NAN, NAN);
   for (const auto& p : ego) {
@@ -243,7 +257,7 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   const double map_width_m = map.width_px / map.px_per_m;
   const double bar_m = NiceBelow(map_width_m / 5.0);
   const double bar_px = bar_m * map.px_per_m;
-  const int bar_y = map.height_px - s.Px(14);
+  const int bar_y = map.MapBottomPx() - s.Px(14);
   const cv::Point2d bar_a(0.5 * (map.width_px - bar_px), bar_y);
   const cv::Point2d bar_b = bar_a + cv::Point2d(bar_px, 0);
   const double tick = s.Px(5);
@@ -264,7 +278,7 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   const int text_h = TextSize("Ag", s, &baseline).height;
   const int inset = s.Px(6);
   const int top_y = map.map_top_px + inset + text_h;
-  const int bottom_y = map.height_px - inset - baseline;
+  const int bottom_y = map.MapBottomPx() - inset - baseline;
   DrawText(&img, corner(map.min_x_m, map.max_y_m), inset, top_y, Align::kLeft,
            s, kDarkGrey, true);
   DrawText(&img, corner(map.MaxXM(), map.max_y_m), map.width_px - inset, top_y,
@@ -273,6 +287,15 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
            Align::kLeft, s, kDarkGrey, true);
   DrawText(&img, corner(map.MaxXM(), map.MinYM()), map.width_px - inset,
            bottom_y, Align::kRight, s, kDarkGrey, true);
+
+  if (map.detail_px > 0) {
+    cv::Mat panel =
+        img(cv::Rect(0, map.MapBottomPx(), map.width_px, map.detail_px));
+    DrawParkingDetail(&panel, run, lanes_world, s);
+    cv::line(img, cv::Point(0, map.MapBottomPx()),
+             cv::Point(map.width_px - 1, map.MapBottomPx()),
+             Bgr(kLaneCentreRgb), 1);
+  }
 
   // Header: title, then the legend; a rule above the map.
   cv::rectangle(img, cv::Rect(0, 0, map.width_px, map.map_top_px),
@@ -302,9 +325,22 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
                   [&](cv::Point2d a, cv::Point2d b) {
                     DrawStartMarker(&img, 0.5 * (a + b), s);
                   });
-  LegendEntry(&img, x, legend_y, "goal", s, [&](cv::Point2d a, cv::Point2d b) {
-    DrawGoalMarker(&img, 0.5 * (a + b), s);
-  });
+  x = LegendEntry(&img, x, legend_y, "goal", s,
+                  [&](cv::Point2d a, cv::Point2d b) {
+                    DrawGoalMarker(&img, 0.5 * (a + b), s);
+                  });
+  if (run.parking.present) {
+    x = LegendEntry(&img, x, legend_y, "target slot", s,
+                    line_sample(kTargetSlotRgb, s.Px(3)));
+    x = LegendEntry(&img, x, legend_y, "parked car / wall", s,
+                    line_sample(kObstacleRgb, s.Px(5)));
+    x = LegendEntry(&img, x, legend_y, "plan fwd", s,
+                    line_sample(kPlannedForwardRgb, s.Px(2)));
+    x = LegendEntry(&img, x, legend_y, "plan rev", s,
+                    line_sample(kPlannedReverseRgb, s.Px(2)));
+    LegendEntry(&img, x, legend_y, "car at end", s,
+                line_sample(kEgoBodyRgb, s.Px(2)));
+  }
   cv::line(img, cv::Point(0, map.map_top_px - 1),
            cv::Point(map.width_px - 1, map.map_top_px - 1), Bgr(kLaneCentreRgb),
            1);

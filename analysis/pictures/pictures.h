@@ -36,6 +36,13 @@ inline constexpr Rgb kConstraintRgb{190, 30, 60};
 inline constexpr Rgb kStudyPointRgb{215, 30, 30};  // red triangles
 inline constexpr Rgb kReferenceRgb{175, 175, 175};
 inline constexpr Rgb kReferenceFrontRgb{90, 105, 140};  // slate
+// valet_parking: the lot and the manoeuvre.
+inline constexpr Rgb kSlotRgb{175, 185, 200};      // cool grey
+inline constexpr Rgb kObstacleRgb{112, 104, 96};   // warm grey: walls, cars
+inline constexpr Rgb kTargetSlotRgb{230, 140, 0};  // orange
+inline constexpr Rgb kPlannedForwardRgb{150, 60, 190};  // purple
+inline constexpr Rgb kPlannedReverseRgb{215, 40, 140};  // magenta
+inline constexpr Rgb kEgoBodyRgb{20, 60, 160};          // dark blue
 
 struct TrajectoryImageOptions {
   int width_px = 1200;     // 200..4000
@@ -52,7 +59,10 @@ struct WorldToImage {
   double px_per_m = 1.0;
   int map_top_px = 0;
   int width_px = 0;
-  int height_px = 0;  // whole image, header included
+  int height_px = 0;  // whole image, header and detail panel included
+  // valet_parking: rows of the detail panel below the map, which shows the
+  // manoeuvre enlarged (0: no panel).
+  int detail_px = 0;
 
   // Pixel coordinates (column, row; fractional) of a world point.
   double Column(double x_m) const { return (x_m - min_x_m) * px_per_m; }
@@ -60,7 +70,10 @@ struct WorldToImage {
     return map_top_px + (max_y_m - y_m) * px_per_m;
   }
   double MaxXM() const { return min_x_m + width_px / px_per_m; }
-  double MinYM() const { return max_y_m - (height_px - map_top_px) / px_per_m; }
+  int MapBottomPx() const { return height_px - detail_px; }
+  double MinYM() const {
+    return max_y_m - (MapBottomPx() - map_top_px) / px_per_m;
+  }
 };
 
 // The mapping RenderTrajectoryImage uses for `run`. The map covers the
@@ -78,7 +91,11 @@ Result<WorldToImage> TrajectoryImageMapping(
 // marker (green circle at the first ego sample, else the path start) and a
 // goal marker (red cross at the path end) with labels, a scale bar with its
 // length, the world coordinates of the map corners written in the corners,
-// a title line (scenario, design point, outcome) and a legend. White
+// a title line (scenario, design point, outcome) and a legend. A
+// valet_parking run also shows the lot's slots, walls, poles and parked
+// cars, the target slot, the stack's planned manoeuvre (forward and
+// reverse legs) and the car's body where it ended, and below the map a
+// detail panel with the manoeuvre enlarged. White
 // background, y up. Encoded as PNG in memory, then written atomically
 // (adse::WriteFileAtomic): no partial file on any error.
 Status RenderTrajectoryImage(const runfile::RunData& run,

@@ -46,6 +46,46 @@ struct CollisionEvent {
   std::string other_id;
 };
 
+// valet_parking: a parking slot of the lot.
+struct ParkingSlotRow {
+  double x_m, y_m, yaw_rad;  // centre; yaw along the slot's depth
+  double length_m, width_m;
+  int32_t occupied;  // 1: a parked car stands in it
+  int32_t target;    // 1: the goal's slot
+};
+
+// valet_parking: one vertex of an obstacle's footprint (wall, pole, parked
+// car, building); the vertices of one obstacle are consecutive rows.
+struct OutlinePoint {
+  int32_t obstacle;  // 0-based obstacle number within the file
+  double x_m, y_m;
+};
+
+// valet_parking: a pose of the stack's planned manoeuvre (rear axle).
+struct ParkingPathRow {
+  double x_m, y_m, yaw_rad;
+  int32_t reverse;  // 1: driven in reverse
+};
+
+// valet_parking's record (the /parking group): the goal and the lot the
+// manoeuvre was planned in, and the plan itself.
+struct ParkingRecord {
+  bool present = false;  // false: not a valet_parking run (no /parking)
+  std::string slot;      // the goal slot's name
+  // The parked pose (rear axle) and its tolerances.
+  double goal_x_m = 0.0, goal_y_m = 0.0, goal_yaw_rad = 0.0;
+  double tolerance_m = 0.0, yaw_tolerance_rad = 0.0;
+  // The ego's body (the rear axle is half a wheelbase behind its centre).
+  double wheelbase_m = 2.7, length_m = 4.6, width_m = 1.9;
+  // When the stack planned the manoeuvre (-1: it never did) and whether
+  // it found one.
+  double planned_at_s = -1.0;
+  int32_t path_found = 0;
+  std::vector<ParkingSlotRow> slots;
+  std::vector<OutlinePoint> obstacles;
+  std::vector<ParkingPathRow> planned_path;  // empty when none was found
+};
+
 struct NamedCallback {
   std::string name;  // "<node>/<callback>"
   int32_t node = -1;
@@ -78,7 +118,9 @@ inline std::string ViolatedConstraint(const std::string& reason) {
 struct RunData {
   // Identity and provenance (root attributes).
   std::string status = kRunComplete;  // kRunComplete|kRunInfeasible|kRunFailed
-  // goal_reached | timeout | constraint_violated: <constraint> | error text
+  // goal_reached | timeout | constraint_violated: <constraint> | error text;
+  // valet_parking also: no_path (the planner found no manoeuvre),
+  // parked_out_of_tolerance (the manoeuvre ended outside the tolerances)
   std::string termination_reason;
   std::string scenario_name;
   std::string scenario_text;  // the scenario file, verbatim
@@ -99,6 +141,7 @@ struct RunData {
   std::vector<LanePoint> lanes;  // may be empty (not recorded)
   std::vector<VehicleSample> vehicles;
   std::vector<CollisionEvent> collisions;
+  ParkingRecord parking;
 
   // Stack and trace.
   std::vector<std::string> node_names;

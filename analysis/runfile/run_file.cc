@@ -162,6 +162,33 @@ const std::vector<Column<CollisionEvent>>& CollisionColumns() {
   return *columns;
 }
 
+const std::vector<Column<ParkingSlotRow>>& ParkingSlotColumns() {
+  static const auto* columns = new std::vector<Column<ParkingSlotRow>>{
+      F64("x_m", &ParkingSlotRow::x_m),
+      F64("y_m", &ParkingSlotRow::y_m),
+      F64("yaw_rad", &ParkingSlotRow::yaw_rad),
+      F64("length_m", &ParkingSlotRow::length_m),
+      F64("width_m", &ParkingSlotRow::width_m),
+      I32("occupied", &ParkingSlotRow::occupied),
+      I32("target", &ParkingSlotRow::target)};
+  return *columns;
+}
+
+const std::vector<Column<OutlinePoint>>& OutlineColumns() {
+  static const auto* columns = new std::vector<Column<OutlinePoint>>{
+      I32("obstacle", &OutlinePoint::obstacle), F64("x_m", &OutlinePoint::x_m),
+      F64("y_m", &OutlinePoint::y_m)};
+  return *columns;
+}
+
+const std::vector<Column<ParkingPathRow>>& ParkingPathColumns() {
+  static const auto* columns = new std::vector<Column<ParkingPathRow>>{
+      F64("x_m", &ParkingPathRow::x_m), F64("y_m", &ParkingPathRow::y_m),
+      F64("yaw_rad", &ParkingPathRow::yaw_rad),
+      I32("reverse", &ParkingPathRow::reverse)};
+  return *columns;
+}
+
 const std::vector<Column<IndexedName>>& IndexedNameColumns() {
   static const auto* columns = new std::vector<Column<IndexedName>>{
       I32("index", &IndexedName::index),
@@ -385,6 +412,31 @@ Status WriteContents(hid_t file, const RunData& run) {
     ADSE_RETURN_IF_ERROR(
         WriteTable(group->get(), "commands", run.controls, ControlColumns()));
   }
+  if (run.parking.present) {
+    const ParkingRecord& p = run.parking;
+    Result<Handle> group = CreateGroup(file, "parking");
+    if (!group.ok()) return group.status();
+    const hid_t g = group->get();
+    ADSE_RETURN_IF_ERROR(WriteStringAttr(g, "slot", p.slot));
+    for (const auto& [name, value] :
+         {std::pair<const char*, double>{"goal_x_m", p.goal_x_m},
+          {"goal_y_m", p.goal_y_m},
+          {"goal_yaw_rad", p.goal_yaw_rad},
+          {"tolerance_m", p.tolerance_m},
+          {"yaw_tolerance_rad", p.yaw_tolerance_rad},
+          {"wheelbase_m", p.wheelbase_m},
+          {"length_m", p.length_m},
+          {"width_m", p.width_m},
+          {"planned_at_s", p.planned_at_s}}) {
+      ADSE_RETURN_IF_ERROR(WriteF64Attr(g, name, value));
+    }
+    ADSE_RETURN_IF_ERROR(internal::WriteI32Attr(g, "path_found", p.path_found));
+    ADSE_RETURN_IF_ERROR(WriteTable(g, "slots", p.slots, ParkingSlotColumns()));
+    ADSE_RETURN_IF_ERROR(
+        WriteTable(g, "obstacles", p.obstacles, OutlineColumns()));
+    ADSE_RETURN_IF_ERROR(
+        WriteTable(g, "planned_path", p.planned_path, ParkingPathColumns()));
+  }
   {
     Result<Handle> group = CreateGroup(file, "metrics");
     if (!group.ok()) return group.status();
@@ -541,6 +593,37 @@ Status ReadContents(hid_t file, RunData* run) {
     ADSE_RETURN_IF_ERROR(
         Assign(ReadTable(group->get(), "collisions", CollisionColumns()),
                &run->collisions));
+  }
+  // Only valet_parking runs have /parking.
+  if (internal::GetObjectKind(file, "/parking") !=
+      internal::ObjectKind::kMissing) {
+    Result<Handle> group = OpenGroup(file, "/parking");
+    if (!group.ok()) return group.status();
+    const hid_t g = group->get();
+    ParkingRecord& p = run->parking;
+    p.present = true;
+    ADSE_RETURN_IF_ERROR(Assign(ReadStringAttr(g, "slot"), &p.slot));
+    for (const auto& [name, out] :
+         {std::pair<const char*, double*>{"goal_x_m", &p.goal_x_m},
+          {"goal_y_m", &p.goal_y_m},
+          {"goal_yaw_rad", &p.goal_yaw_rad},
+          {"tolerance_m", &p.tolerance_m},
+          {"yaw_tolerance_rad", &p.yaw_tolerance_rad},
+          {"wheelbase_m", &p.wheelbase_m},
+          {"length_m", &p.length_m},
+          {"width_m", &p.width_m},
+          {"planned_at_s", &p.planned_at_s}}) {
+      ADSE_RETURN_IF_ERROR(Assign(internal::ReadF64Attr(g, name), out));
+    }
+    Result<int64_t> found = internal::ReadI64Attr(g, "path_found");
+    if (!found.ok()) return found.status();
+    p.path_found = static_cast<int32_t>(*found);
+    ADSE_RETURN_IF_ERROR(
+        Assign(ReadTable(g, "slots", ParkingSlotColumns()), &p.slots));
+    ADSE_RETURN_IF_ERROR(
+        Assign(ReadTable(g, "obstacles", OutlineColumns()), &p.obstacles));
+    ADSE_RETURN_IF_ERROR(Assign(
+        ReadTable(g, "planned_path", ParkingPathColumns()), &p.planned_path));
   }
   {
     Result<Handle> group = OpenGroup(file, "/trace");

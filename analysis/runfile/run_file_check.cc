@@ -107,7 +107,8 @@ class Checker {
     const std::string path = spec.at("path").get<std::string>();
     const ObjectKind kind = internal::GetObjectKind(file_, path);
     if (kind == ObjectKind::kMissing) {
-      Problem(path, "missing group");
+      // Optional groups exist only in some runs (e.g. /parking).
+      if (!spec.value("optional", false)) Problem(path, "missing group");
       return;
     }
     if (kind != ObjectKind::kGroup) {
@@ -196,7 +197,7 @@ class Checker {
     const std::string path = spec.at("path").get<std::string>();
     const ObjectKind kind = internal::GetObjectKind(file_, path);
     if (kind == ObjectKind::kMissing) {
-      Problem(path, "missing dataset");
+      if (!spec.value("optional", false)) Problem(path, "missing dataset");
       return;
     }
     if (kind != ObjectKind::kDataset) {

@@ -256,6 +256,16 @@ std::string FormatSummary(const RunReport& r) {
         "lidar_frames_dropped", "collisions", "cpu_utilization"}) {
     out += fmt::format("{:<20} {}\n", name, metric(name));
   }
+  // valet_parking runs: the manoeuvre's own metrics.
+  if (r.metrics.count("parked")) {
+    for (const char* name :
+         {"parked", "parking_position_error_m", "parking_yaw_error_deg",
+          "parking_time_s", "parking_path_deviation_m",
+          "parking_path_deviation_max_m", "min_clearance_m",
+          "obstacle_collisions", "gear_changes"}) {
+      out += fmt::format("{:<28} {}\n", name, metric(name));
+    }
+  }
   if (!r.deviation_complete && r.deviation_error.empty()) {
     out += fmt::format(
         "deviation   scored on the driven part ({:.0f} % of the path)\n",

@@ -30,6 +30,9 @@ void AddLocation(ContentHasher* h, const world::Location& l) {
   } else {
     h->Add(l.x_m).Add(l.y_m);
   }
+  // Places without a slot or heading key as they did before either existed.
+  if (!l.slot.empty()) h->Add("slot").Add(l.slot);
+  if (l.has_yaw) h->Add("yaw_deg").Add(l.yaw_deg);
 }
 
 }  // namespace
@@ -49,6 +52,10 @@ Result<std::string> RunKey(const spec::Spec& spec,
   for (const world::Flow& f : w.traffic.flows) {
     h.Add(f.from_edge).Add(f.to_edge).Add(f.vehicles_per_hour);
   }
+  if (!w.traffic.parked_slots.empty()) {
+    h.Add("parked_slots");
+    for (const std::string& name : w.traffic.parked_slots) h.Add(name);
+  }
   h.Add(static_cast<long long>(w.weather)).Add(w.step_s);
   // Task.
   const world::TaskOptions& t = spec.task;
@@ -61,10 +68,16 @@ Result<std::string> RunKey(const spec::Spec& spec,
     for (const world::Location& l : t.via) AddLocation(&h, l);
   }
   h.Add(t.goal_tolerance_m).Add(t.speed_limit_kmh).Add(t.timeout_s);
+  const bool valet = t.kind == world::TaskKind::kValetParking;
+  if (valet) h.Add("goal_yaw_tolerance_deg").Add(t.goal_yaw_tolerance_deg);
   // Stack: every knob's effective value, so a changed default changes keys.
+  // The parking knobs act only on valet_parking, whose keys alone hold them
+  // (lane-driving keys stay as they were before they existed).
   h.Add("stack");
-  for (const KnobInfo& knob : StackKnobs())
+  for (const KnobInfo& knob : StackKnobs()) {
+    if (!valet && knob.path.rfind("parking.", 0) == 0) continue;
     h.Add(knob.path).Add(spec.stack.Get(knob.path));
+  }
   // Platform.
   const spec::PlatformOptions& p = spec.platform;
   h.Add("platform").Add(static_cast<long long>(p.kind)).Add(p.reference_ghz);

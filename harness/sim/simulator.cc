@@ -29,6 +29,7 @@
 #include "stack/runtime/realtime_executor.h"
 #include "stack/world/lidar.h"
 #include "stack/world/map_cloud.h"
+#include "stack/world/parking_goal.h"
 
 namespace adse::sim {
 namespace {
@@ -51,6 +52,33 @@ std::string HostDescription() {
   }
   return fmt::format("{}; {}; {} cores", name, cpu,
                      std::thread::hardware_concurrency());
+}
+
+// The valet task's goal and lot, for the parking metrics and picture.
+void RecordParking(const world::World& w, const world::TaskOptions& task,
+                   runfile::ParkingRecord* out) {
+  out->present = true;
+  out->slot = w.goal_slot().name;
+  out->goal_x_m = w.parking_goal().x_m;
+  out->goal_y_m = w.parking_goal().y_m;
+  out->goal_yaw_rad = w.parking_goal().yaw_rad;
+  out->tolerance_m = task.goal_tolerance_m;
+  out->yaw_tolerance_rad = task.goal_yaw_tolerance_deg * M_PI / 180.0;
+  out->wheelbase_m = w.ego_limits().wheelbase_m;
+  out->length_m = w.ego_limits().length_m;
+  out->width_m = w.ego_limits().width_m;
+  for (const world::ParkingSlot& s : w.scene().parking_slots()) {
+    out->slots.push_back({s.box.center.x(), s.box.center.y(), s.box.yaw_rad,
+                          s.box.length_m, s.box.width_m, s.occupied ? 1 : 0,
+                          s.name == w.goal_slot().name ? 1 : 0});
+  }
+  const std::vector<std::vector<Eigen::Vector2d>> outlines =
+      world::ObstacleOutlines(w.scene());
+  for (size_t i = 0; i < outlines.size(); ++i) {
+    for (const Eigen::Vector2d& p : outlines[i]) {
+      out->obstacles.push_back({static_cast<int32_t>(i), p.x(), p.y()});
+    }
+  }
 }
 
 }  // namespace
@@ -89,7 +117,9 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     return map_cloud.status().WithContext("localization map");
 
   stack::StackInputs inputs;
-  inputs.route = w.ideal_path();
+  // The road part: the whole ideal path for lane driving; for valet parking
+  // it ends on the aisle, where the stack's freespace planner takes over.
+  inputs.route = w.road_path();
   inputs.lane_width_m = w.lane_width_m();
   inputs.map_cloud = std::move(map_cloud).value();
   inputs.initial_pose = {w.ego().x_m, w.ego().y_m, w.ego().yaw_rad};
@@ -98,6 +128,13 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   inputs.wheelbase_m = w.ego_limits().wheelbase_m;
   inputs.vehicle_length_m = w.ego_limits().length_m;
   inputs.vehicle_width_m = w.ego_limits().width_m;
+  if (w.parking_task()) {
+    inputs.parking = true;
+    inputs.parking_goal = w.parking_goal();
+    // The lot's map as the car carries it: walls, poles and the parked
+    // cars of the map's occupancy.
+    inputs.parking_obstacles = world::ObstacleOutlines(w.scene());
+  }
 
   stack::Graph graph;
   Result<std::unique_ptr<stack::AdStack>> ad_stack =
@@ -116,9 +153,34 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   graph.AddSink<stack::ControlMsg>(topics.control, [&](const stack::ControlMsg&
                                                            m,
                                                        double t_s) {
-    gate.OnCommand(t_s, m.accel_mps2, m.steer_rad);
+    gate.OnCommand(t_s, m.accel_mps2, m.steer_rad, m.reverse);
     run.controls.push_back({t_s, m.header.stamp_s, m.accel_mps2, m.steer_rad});
   });
+  // valet_parking: the stack's manoeuvre, or its word that there is none
+  // (which ends the run: waiting longer changes nothing).
+  bool no_path = false;
+  if (topics.parking_path >= 0) {
+    graph.AddSink<stack::ParkingPathMsg>(
+        topics.parking_path, [&](const stack::ParkingPathMsg& m, double t_s) {
+          run.parking.planned_at_s = t_s;
+          run.parking.path_found = m.found ? 1 : 0;
+          run.parking.planned_path.clear();
+          for (const stack::ParkingPathPoint& p : m.poses) {
+            run.parking.planned_path.push_back(
+                {p.x_m, p.y_m, p.yaw_rad, p.reverse ? 1 : 0});
+          }
+          no_path = !m.found;
+        });
+  }
+  // ... and its word that the car stands at the manoeuvre's end: parked
+  // as far as it can tell. Outside the tolerances nothing more will happen.
+  double parking_done_at_s = -1.0;
+  if (topics.parking_done >= 0) {
+    graph.AddSink<stack::ParkingDoneMsg>(
+        topics.parking_done, [&](const stack::ParkingDoneMsg&, double t_s) {
+          if (parking_done_at_s < 0) parking_done_at_s = t_s;
+        });
+  }
   graph.AddSink<stack::PoseMsg>(topics.pose,
                                 [&](const stack::PoseMsg& m, double t_s) {
                                   gate.OnLocalization(t_s, m.valid);
@@ -264,7 +326,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
 
     const algorithms::GateOutput command = gate.Output(t + dt);
     const auto t_world = Clock::now();
-    Status stepped = w.Step({command.accel_mps2, command.steer_rad});
+    Status stepped =
+        w.Step({command.accel_mps2, command.steer_rad, command.reverse});
     stats.world_s += Seconds(Clock::now() - t_world);
     if (!stepped.ok()) return stepped;
     record_ego();
@@ -284,6 +347,17 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     }
     if (w.goal_reached()) {
       reason = "goal_reached";
+      break;
+    }
+    if (no_path) {
+      reason = "no_path";
+      break;
+    }
+    // Once the car truly stands (the stack's speed estimate lags), and a
+    // second after the stack's word at the earliest.
+    if (parking_done_at_s >= 0 && w.time_s() > parking_done_at_s + 1.0 &&
+        std::abs(w.ego().v_mps) < 0.01) {
+      reason = "parked_out_of_tolerance";
       break;
     }
     if (!early_stop->empty()) {
@@ -329,6 +403,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
                               w.ideal_path().points[i].y()});
   }
   run.lane_width_m = w.lane_width_m();
+  if (w.parking_task()) RecordParking(w, spec.task, &run.parking);
   const std::vector<std::vector<Eigen::Vector2d>> lanes = w.LaneShapes();
   for (size_t i = 0; i < lanes.size(); ++i) {
     for (const Eigen::Vector2d& p : lanes[i]) {

@@ -121,6 +121,30 @@ const std::vector<MetricInfo>& KnownMetrics() {
       {"e2e_latency_p99_s", "99th percentile LiDAR-to-control latency, s"},
       {"dropped_messages", "messages dropped by keep-last queues, count"},
       {"collisions", "collisions of the ego with vehicles or obstacles, count"},
+      // valet_parking runs only (analysis/metrics/parking_metrics.h).
+      {"parked",
+       "valet_parking: the run ended standing in the slot within the goal's "
+       "position and heading tolerances (0 or 1)",
+       true},
+      {"parking_position_error_m",
+       "valet_parking: parked body centre's distance from the slot's "
+       "target at the end, m"},
+      {"parking_yaw_error_deg",
+       "valet_parking: heading error from the parked heading at the end, "
+       "degrees"},
+      {"parking_time_s",
+       "valet_parking: from the manoeuvre's plan to the end of the run, s"},
+      {"parking_path_deviation_m",
+       "valet_parking: mean distance of the rear axle from the planned "
+       "manoeuvre while driving it, m"},
+      {"min_clearance_m",
+       "valet_parking: smallest gap between the ego's body and a wall, pole "
+       "or parked car, m"},
+      {"obstacle_collisions",
+       "valet_parking: contacts of the ego's body with walls, poles or "
+       "parked cars, count"},
+      {"gear_changes",
+       "valet_parking: reversals of the direction of motion, count"},
       {"censored",
        "early stop ended the run (status infeasible): its other metrics are "
        "measured up to the stop (0 or 1)",

@@ -102,9 +102,11 @@ void EmitPoint(YAML::Emitter& out, const DesignPoint& point,
 }
 
 void EmitLocation(YAML::Emitter& out, const world::Location& l,
-                  const double* tolerance) {
+                  const world::TaskOptions* goal_of) {
   out << YAML::Flow << YAML::BeginMap;
-  if (l.by_edge) {
+  if (!l.slot.empty()) {
+    out << YAML::Key << "slot" << YAML::Value << YAML::DoubleQuoted << l.slot;
+  } else if (l.by_edge) {
     out << YAML::Key << "edge" << YAML::Value << YAML::DoubleQuoted << l.edge;
     out << YAML::Key << "pos_m" << YAML::Value << FormatNumber(l.pos_m);
     out << YAML::Key << "lane" << YAML::Value << l.lane;
@@ -112,9 +114,18 @@ void EmitLocation(YAML::Emitter& out, const world::Location& l,
     out << YAML::Key << "x" << YAML::Value << FormatNumber(l.x_m);
     out << YAML::Key << "y" << YAML::Value << FormatNumber(l.y_m);
   }
-  if (tolerance != nullptr) {
+  if (l.has_yaw) {
+    out << YAML::Key << "yaw_deg" << YAML::Value << FormatNumber(l.yaw_deg);
+  }
+  if (goal_of != nullptr) {
     out << YAML::Key << "tolerance_m" << YAML::Value
-        << FormatNumber(*tolerance);
+        << FormatNumber(goal_of->goal_tolerance_m);
+    // Only a parked pose has a heading to hold: lane-driving scenarios
+    // normalise (and key their runs) as before.
+    if (goal_of->kind == world::TaskKind::kValetParking) {
+      out << YAML::Key << "yaw_tolerance_deg" << YAML::Value
+          << FormatNumber(goal_of->goal_yaw_tolerance_deg);
+    }
   }
   out << YAML::EndMap;
 }
@@ -191,7 +202,14 @@ const std::vector<Field<TrafficOptions>>& TrafficFields() {
          }
          out << YAML::EndSeq;
        }},
-      Number("parked_occupancy", &TrafficOptions::parked_occupancy)};
+      Number("parked_occupancy", &TrafficOptions::parked_occupancy),
+      {"parked_slots",
+       [](YAML::Emitter& out, const TrafficOptions& t, const Spec&) {
+         out << YAML::Flow << YAML::BeginSeq;
+         for (const std::string& name : t.parked_slots) out << name;
+         out << YAML::EndSeq;
+       },
+       [](const TrafficOptions& t) { return !t.parked_slots.empty(); }}};
   return kFields;
 }
 
@@ -224,10 +242,8 @@ const std::vector<Field<TaskOptions>>& TaskFields() {
          out << YAML::EndSeq;
        },
        [](const TaskOptions& t) { return !t.via.empty(); }},
-      {"goal",
-       [](YAML::Emitter& out, const TaskOptions& t, const Spec&) {
-         EmitLocation(out, t.goal, &t.goal_tolerance_m);
-       }},
+      {"goal", [](YAML::Emitter& out, const TaskOptions& t,
+                  const Spec&) { EmitLocation(out, t.goal, &t); }},
       Number("speed_limit_kmh", &TaskOptions::speed_limit_kmh),
       Number("timeout_s", &TaskOptions::timeout_s)};
   return kFields;

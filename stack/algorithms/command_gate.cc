@@ -18,13 +18,15 @@ const char* GateReasonName(GateReason reason) {
   return "unknown";
 }
 
-void CommandGate::OnCommand(double t_s, double accel_mps2, double steer_rad) {
+void CommandGate::OnCommand(double t_s, double accel_mps2, double steer_rad,
+                            bool reverse) {
   // A late-arriving older command must not replace a newer one.
   if (has_command_ && t_s < command_t_s_) return;
   has_command_ = true;
   command_t_s_ = t_s;
   accel_mps2_ = accel_mps2;
   steer_rad_ = steer_rad;
+  reverse_ = reverse;
 }
 
 void CommandGate::OnLocalization(double t_s, bool valid) {
@@ -37,6 +39,7 @@ GateOutput CommandGate::Output(double t_s) const {
   GateOutput out;
   out.command_age_s = has_command_ ? std::max(0.0, t_s - command_t_s_) : -1.0;
   out.steer_rad = has_command_ ? steer_rad_ : 0.0;
+  out.reverse = has_command_ && reverse_;
   if (!has_command_) {
     out.reason = GateReason::kNoCommand;
   } else if (out.command_age_s > params_.stale_after_s) {

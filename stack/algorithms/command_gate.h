@@ -23,6 +23,7 @@ const char* GateReasonName(GateReason reason);
 struct GateOutput {
   double accel_mps2 = 0.0;
   double steer_rad = 0.0;  // held at the last command while braking
+  bool reverse = false;    // gear of the last command, held while braking
   bool braking = false;    // true: emergency braking instead of the command
   GateReason reason = GateReason::kNone;
   double command_age_s = 0.0;  // now - time of the last command (-1: none)
@@ -33,8 +34,9 @@ class CommandGate {
   explicit CommandGate(const CommandGateParams& params = {})
       : params_(params) {}
 
-  // A command as it arrives at time t_s.
-  void OnCommand(double t_s, double accel_mps2, double steer_rad);
+  // A command as it arrives at time t_s; `reverse` is its gear.
+  void OnCommand(double t_s, double accel_mps2, double steer_rad,
+                 bool reverse = false);
   // The stack's localization status as it arrives (lost = !valid).
   void OnLocalization(double t_s, bool valid);
   // What to apply at time t_s.
@@ -48,6 +50,7 @@ class CommandGate {
   double command_t_s_ = 0.0;
   double accel_mps2_ = 0.0;
   double steer_rad_ = 0.0;
+  bool reverse_ = false;
   bool localization_lost_ = false;
   double localization_t_s_ = -1e300;
 };

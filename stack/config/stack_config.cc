@@ -83,6 +83,21 @@ const std::vector<KnobInfo>& StackKnobs() {
          "the command gate brakes when the newest command is older, s"},
         {"control.emergency_decel_mps2", false, 0.5, 10.0, 3.0,
          "the command gate's braking, m/s^2"},
+        // Parking (valet_parking only): the freespace planner and the
+        // controller's parking mode.
+        {"parking.rate_hz", false, 0.2, 50.0, 2.0,
+         "freespace planner's timer (plans once the car stands at the end "
+         "of its road route), Hz"},
+        {"parking.turning_radius_m", false, 4.0, 20.0, 5.0,
+         "tightest turn the parking path asks for, m"},
+        {"parking.max_expansions", true, 100, 1000000, 50000,
+         "freespace search budget (node expansions) before no_path"},
+        {"parking.collision_margin_m", false, 0.0, 2.0, 0.25,
+         "clearance the parking path keeps around the car's body, m"},
+        {"parking.forward_speed_mps", false, 0.2, 5.0, 1.5,
+         "parking speed forwards, m/s"},
+        {"parking.reverse_speed_mps", false, 0.2, 3.0, 1.0,
+         "parking speed in reverse, m/s"},
     };
   }();
   return kKnobs;

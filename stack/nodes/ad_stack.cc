@@ -9,8 +9,10 @@
 #include "stack/algorithms/clustering.h"
 #include "stack/algorithms/control.h"
 #include "stack/algorithms/ekf.h"
+#include "stack/algorithms/freespace_planner.h"
 #include "stack/algorithms/map_filter.h"
 #include "stack/algorithms/ndt_matcher.h"
+#include "stack/algorithms/parking_control.h"
 #include "stack/algorithms/planning.h"
 #include "stack/algorithms/point_filters.h"
 #include "stack/algorithms/tracker.h"
@@ -72,7 +74,12 @@ class Stack final : public AdStack {
   Status BuildLocalization(Graph* g);
   void BuildPerception(Graph* g);
   void BuildPlanning(Graph* g);
+  void BuildParking(Graph* g);
   void BuildControl(Graph* g);
+  // The controller's parking mode: one command along the manoeuvre, gear
+  // and all, published.
+  void Park(CallbackContext& ctx, double dt_s, double speed_cap_mps,
+            ControlMsg* out);
 
   StackConfig config_;
   StackInputs inputs_;
@@ -102,6 +109,12 @@ class Stack final : public AdStack {
   std::optional<PoseMsg> follower_pose_;
   std::optional<TrajectoryMsg> follower_trajectory_;
   double follower_last_t_ = -1.0;
+  std::unique_ptr<algo::FreespacePlanner> freespace_;
+  std::optional<PoseMsg> freespace_pose_;
+  bool parking_planned_ = false;  // the planner has answered (path or not)
+  std::unique_ptr<algo::ParkingFollower> parking_follower_;
+  bool parking_mode_ = false;  // the follower drives the parking path
+  bool parking_done_ = false;  // ... and has reached its end
 };
 
 Status Stack::Build(Graph* g) {
@@ -124,6 +137,7 @@ Status Stack::Build(Graph* g) {
   ADSE_RETURN_IF_ERROR(BuildLocalization(g));
   BuildPerception(g);
   BuildPlanning(g);
+  if (inputs_.parking) BuildParking(g);
   BuildControl(g);
   return Status::Ok();
 }
@@ -538,6 +552,80 @@ void Stack::BuildPlanning(Graph* g) {
       });
 }
 
+void Stack::BuildParking(Graph* g) {
+  // Autoware's parking scenario: once the car stands at the end of its
+  // road route (on the aisle beside the slot), the freespace planner plans
+  // the manoeuvre into the slot from the localization pose, once.
+  topics_.parking_path =
+      g->AddTopic<ParkingPathMsg>("/planning/scenario_planning/parking/path");
+  topics_.parking_done = g->AddTopic<ParkingDoneMsg>("/control/parking_done");
+  algo::FreespacePlannerParams params;
+  params.turning_radius_m = config_.Get("parking.turning_radius_m");
+  params.max_expansions =
+      static_cast<int>(config_.Get("parking.max_expansions"));
+  params.collision_margin_m = config_.Get("parking.collision_margin_m");
+  algo::VehicleFootprint footprint;
+  footprint.front_m = 0.5 * (inputs_.wheelbase_m + inputs_.vehicle_length_m);
+  footprint.rear_m = 0.5 * (inputs_.vehicle_length_m - inputs_.wheelbase_m);
+  footprint.width_m = inputs_.vehicle_width_m;
+  freespace_ = std::make_unique<algo::FreespacePlanner>(params, footprint);
+  const int node = g->AddNode("freespace_planner");
+  g->Subscribe<PoseMsg>(
+      node, topics_.pose, "pose", 1,
+      [this](const PoseMsg& in, CallbackContext&) { freespace_pose_ = in; });
+  g->AddTimer(
+      node, "plan", 1.0 / config_.Get("parking.rate_hz"),
+      [this](CallbackContext& ctx) {
+        if (parking_planned_ || !freespace_pose_ || !freespace_pose_->valid)
+          return;
+        const geometry::Pose2& pose = freespace_pose_->pose;
+        const Eigen::Vector2d end = inputs_.route.points.back();
+        // Handed over when standing within reach of the route's end.
+        const bool arrived =
+            (Eigen::Vector2d(pose.x_m, pose.y_m) - end).norm() <=
+                std::max(3.0, inputs_.goal_tolerance_m) &&
+            std::abs(freespace_pose_->v_mps) < 0.1;
+        if (!arrived) return;
+        parking_planned_ = true;
+        ParkingPathMsg out;
+        out.header.stamp_s = freespace_pose_->header.stamp_s;
+        const Result<algo::FreespacePath> path = freespace_->Plan(
+            pose, inputs_.parking_goal, inputs_.parking_obstacles);
+        out.found = path.ok();
+        out.expansions = freespace_->last_stats().expansions;
+        if (path.ok()) {
+          for (const algo::GearedPose& p : path->poses) {
+            out.poses.push_back(
+                {p.pose.x_m, p.pose.y_m, p.pose.yaw_rad, p.reverse});
+          }
+        } else {
+          out.failure = path.status().message();
+        }
+        ctx.ReportWork(
+            {static_cast<double>(freespace_->last_stats().work_units), 0.0, 1});
+        ctx.Publish(topics_.parking_path, std::move(out));
+      });
+}
+
+void Stack::Park(CallbackContext& ctx, double dt_s, double speed_cap_mps,
+                 ControlMsg* out) {
+  const algo::ParkingCommand c = parking_follower_->Update(
+      follower_pose_->pose, follower_pose_->v_mps, dt_s, speed_cap_mps);
+  out->accel_mps2 = c.accel_mps2;
+  out->steer_rad = c.steer_rad;
+  out->reverse = c.reverse;
+  ctx.ReportWork({1.0, 0.0, 1});
+  if (c.finished && !parking_done_) {
+    // Once: the car stands at the manoeuvre's end (parked, as far as the
+    // stack can tell).
+    parking_done_ = true;
+    ParkingDoneMsg done;
+    done.header.stamp_s = out->header.stamp_s;
+    ctx.Publish(topics_.parking_done, std::move(done));
+  }
+  ctx.Publish(topics_.control, std::move(*out));
+}
+
 void Stack::BuildControl(Graph* g) {
   algo::FollowerParams params;
   params.pure_pursuit.wheelbase_m = inputs_.wheelbase_m;
@@ -551,6 +639,23 @@ void Stack::BuildControl(Graph* g) {
       [this](const TrajectoryMsg& in, CallbackContext&) {
         follower_trajectory_ = in;
       });
+  if (inputs_.parking) {
+    algo::ParkingFollowerParams parking;
+    parking.wheelbase_m = inputs_.wheelbase_m;
+    parking.forward_speed_mps = config_.Get("parking.forward_speed_mps");
+    parking.reverse_speed_mps = config_.Get("parking.reverse_speed_mps");
+    parking_follower_ = std::make_unique<algo::ParkingFollower>(parking);
+    g->Subscribe<ParkingPathMsg>(
+        node, topics_.parking_path, "parking_path", 1,
+        [this](const ParkingPathMsg& in, CallbackContext&) {
+          if (!in.found) return;
+          std::vector<algo::GearedPose> poses;
+          for (const ParkingPathPoint& p : in.poses)
+            poses.push_back({{p.x_m, p.y_m, p.yaw_rad}, p.reverse});
+          parking_follower_->SetPath(poses);
+          parking_mode_ = true;
+        });
+  }
   const double max_travel_per_fix_m =
       config_.Get("control.max_travel_per_fix_m");
   g->AddTimer(node, "control", 1.0 / config_.Get("control.rate_hz"),
@@ -575,6 +680,7 @@ void Stack::BuildControl(Graph* g) {
                       follower_pose_->header.stamp_s < 0
                           ? 0.0
                           : max_travel_per_fix_m / std::max(fix_age, 1e-3);
+                  if (parking_mode_) return Park(ctx, dt, speed_cap, &out);
                   const std::vector<algo::PlannedPoint> points =
                       follower_trajectory_
                           ? ToPlanned(follower_trajectory_->points, speed_cap)

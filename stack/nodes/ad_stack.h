@@ -29,16 +29,24 @@ struct StackInputs {
   double wheelbase_m = 2.7;
   double vehicle_length_m = 4.6;
   double vehicle_width_m = 1.9;
+  // valet_parking: the route ends on the aisle beside the slot; from there
+  // the freespace planner takes the car to `parking_goal` (rear axle) among
+  // the lot's walls, poles and parked cars as its map holds them.
+  bool parking = false;
+  geometry::Pose2 parking_goal;
+  std::vector<std::vector<Eigen::Vector2d>> parking_obstacles;
 };
 
 // Topic indices the harness talks to.
 struct StackTopics {
-  int lidar_raw = -1;   // in: PointCloudMsg, vehicle frame
-  int odometry = -1;    // in: OdometryMsg
-  int pose = -1;        // out: PoseMsg (EKF)
-  int control = -1;     // out: ControlMsg
-  int trajectory = -1;  // out: TrajectoryMsg
-  int objects = -1;     // out: ObjectsMsg
+  int lidar_raw = -1;     // in: PointCloudMsg, vehicle frame
+  int odometry = -1;      // in: OdometryMsg
+  int pose = -1;          // out: PoseMsg (EKF)
+  int control = -1;       // out: ControlMsg
+  int trajectory = -1;    // out: TrajectoryMsg
+  int objects = -1;       // out: ObjectsMsg
+  int parking_path = -1;  // out: ParkingPathMsg (valet_parking only)
+  int parking_done = -1;  // out: ParkingDoneMsg (valet_parking only)
 };
 
 class AdStack {

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "stack/geometry/geometry.h"
@@ -77,10 +78,31 @@ struct TrajectoryMsg {
   bool stop_for_obstacle = false;  // an obstacle stop was inserted
 };
 
+// The freespace planner's parking manoeuvre (or why there is none).
+struct ParkingPathPoint {
+  double x_m = 0.0;  // rear axle, map frame
+  double y_m = 0.0;
+  double yaw_rad = 0.0;
+  bool reverse = false;  // gear this pose is driven in
+};
+struct ParkingPathMsg {
+  Header header;
+  bool found = false;
+  std::vector<ParkingPathPoint> poses;  // start to goal, when found
+  std::string failure;                  // why not, when not found
+  int64_t expansions = 0;               // search effort
+};
+
+// The controller's parking mode reached the manoeuvre's end and holds.
+struct ParkingDoneMsg {
+  Header header;
+};
+
 struct ControlMsg {
   Header header;
-  double accel_mps2 = 0.0;
+  double accel_mps2 = 0.0;  // along the gear; negative brakes
   double steer_rad = 0.0;
+  bool reverse = false;  // gear
 };
 
 }  // namespace adse::stack

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "stack/algorithms/parking_control.h"
+
 namespace adse::world {
 namespace {
 
@@ -51,7 +53,14 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
                                         const IdealDriverOptions& options,
                                         const ScanCallback& on_scan) {
   IdealDriveReport report;
-  const geometry::Path2& path = world.ideal_path();
+  // The road part (all of the ideal path but a valet task's manoeuvre) by
+  // pure pursuit; then the manoeuvre, gears and all, with the stack's
+  // parking controller on the true pose.
+  const geometry::Path2& path = world.road_path();
+  algorithms::ParkingFollowerParams parking_params;
+  parking_params.wheelbase_m = world.ego_limits().wheelbase_m;
+  algorithms::ParkingFollower parking(parking_params);
+  bool parking_mode = false;
   const double dt = world.step_s();
   const VehicleLimits& limits = world.ego_limits();
   const double scan_period = lidar ? 1.0 / lidar->params().rate_hz : 0.0;
@@ -64,10 +73,11 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
     report.trajectory.push_back({world.time_s(), ego.x_m, ego.y_m, ego.yaw_rad,
                                  ego.v_mps, ego.steer_rad, ego.accel_mps2});
     double s_here = 0.0;
-    const double lateral = DistanceToPath(path, pos, &s_here);
+    DistanceToPath(path, pos, &s_here);
     s_progress = std::max(s_progress, s_here);
-    report.max_lateral_error_m = std::max(report.max_lateral_error_m, lateral);
-    if (world.goal_reached() && ego.v_mps < 0.5) {
+    report.max_lateral_error_m = std::max(
+        report.max_lateral_error_m, DistanceToPath(world.ideal_path(), pos));
+    if (world.goal_reached() && std::abs(ego.v_mps) < 0.5) {
       report.reached_goal = true;
       break;
     }
@@ -82,6 +92,22 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
       ++report.scans;
       if (on_scan) on_scan(cloud, pose);
       next_scan_t += scan_period;
+    }
+    if (!parking_mode && !world.reference_manoeuvre().empty() &&
+        s_progress >= path.length_m() - 0.05 && std::abs(ego.v_mps) < 0.05) {
+      std::vector<algorithms::GearedPose> poses;
+      for (const ManoeuvrePose& p : world.reference_manoeuvre())
+        poses.push_back({p.pose, p.reverse});
+      parking.SetPath(poses);
+      parking_mode = true;
+    }
+    if (parking_mode) {
+      const algorithms::ParkingCommand c =
+          parking.Update({ego.x_m, ego.y_m, ego.yaw_rad}, ego.v_mps, dt);
+      const auto t0 = Clock::now();
+      ADSE_RETURN_IF_ERROR(world.Step({c.accel_mps2, c.steer_rad, c.reverse}));
+      report.world_wall_s += Seconds(Clock::now() - t0);
+      continue;
     }
     // Pure pursuit on the true pose.
     // Shorter lookahead when slow (in curves) keeps corners from being cut.
@@ -125,7 +151,6 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
     const auto t0 = Clock::now();
     ADSE_RETURN_IF_ERROR(world.Step(command));
     report.world_wall_s += Seconds(Clock::now() - t0);
-    (void)dt;
   }
   report.time_s = world.time_s();
   report.collisions = world.collisions();

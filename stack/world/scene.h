@@ -40,6 +40,7 @@ struct FaceCrossing {
 
 // A parking slot (for parked cars and valet goals).
 struct ParkingSlot {
+  std::string name;           // the map's polygon id
   geometry::OrientedBox box;  // slot rectangle; length along the slot's depth
   bool occupied = false;
 };

@@ -18,11 +18,24 @@ void BicycleModel::Step(const ControlCommand& command, double dt_s) {
       s0.steer_rad + std::clamp(target - s0.steer_rad, -max_delta, max_delta);
   steer1 = std::clamp(steer1, -lim.max_steer_rad, lim.max_steer_rad);
 
-  // Longitudinal: braking stops the car, it never reverses.
+  // Longitudinal, signed speed. Driving pushes along the gear (so drive in
+  // the gear opposite to the motion first slows the car, as a real one
+  // does); braking only ever takes speed off, down to a standstill.
   const double accel =
       std::clamp(command.accel_mps2, -lim.max_decel_mps2, lim.max_accel_mps2);
-  const double v0 = std::clamp(s0.v_mps, 0.0, lim.max_speed_mps);
-  const double v1 = std::clamp(v0 + accel * dt_s, 0.0, lim.max_speed_mps);
+  const double v0 =
+      std::clamp(s0.v_mps, -lim.max_reverse_speed_mps, lim.max_speed_mps);
+  double a_eff = 0.0;  // signed acceleration along x of the body
+  double v1 = v0;
+  if (accel >= 0.0) {
+    a_eff = command.reverse ? -accel : accel;
+    v1 = std::clamp(v0 + a_eff * dt_s, -lim.max_reverse_speed_mps,
+                    lim.max_speed_mps);
+  } else if (v0 != 0.0) {
+    a_eff = v0 > 0 ? accel : -accel;
+    v1 = v0 + a_eff * dt_s;
+    if ((v1 > 0) != (v0 > 0)) v1 = 0.0;
+  }
 
   // Midpoint (RK2) step with inputs taken as linear over the step:
   // heading at mid-step from the start yaw rate, then the whole step with
@@ -31,11 +44,11 @@ void BicycleModel::Step(const ControlCommand& command, double dt_s) {
   const double L = lim.wheelbase_m;
   const double yaw_rate0 = v0 * std::tan(s0.steer_rad) / L;
   const double yaw_mid = s0.yaw_rad + 0.5 * dt_s * yaw_rate0;
-  // Mean speed over the step, exact when the speed reaches 0 or the cap
+  // Mean speed over the step, exact when the speed reaches 0 or a cap
   // mid-step (then it stays there for the rest of the step).
   double v_mid = 0.5 * (v0 + v1);
-  if (accel != 0.0 && std::abs(v1 - v0) < std::abs(accel) * dt_s) {
-    const double t_reach = (v1 - v0) / accel;
+  if (a_eff != 0.0 && std::abs(v1 - v0) < std::abs(a_eff) * dt_s) {
+    const double t_reach = (v1 - v0) / a_eff;
     v_mid = (0.5 * (v0 + v1) * t_reach + v1 * (dt_s - t_reach)) / dt_s;
   }
   const double steer_mid = 0.5 * (s0.steer_rad + steer1);

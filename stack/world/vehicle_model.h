@@ -1,5 +1,5 @@
 // The ego vehicle: a kinematic bicycle model integrating acceleration and
-// steering commands with actuator limits.
+// steering commands with actuator limits, in forward or reverse gear.
 #ifndef ADSE_STACK_WORLD_VEHICLE_MODEL_H_
 #define ADSE_STACK_WORLD_VEHICLE_MODEL_H_
 
@@ -17,19 +17,23 @@ struct VehicleLimits {
   double max_accel_mps2 = 2.5;
   double max_decel_mps2 = 6.0;  // positive number
   double max_speed_mps = 20.0;
+  double max_reverse_speed_mps = 3.0;  // positive number
 };
 
 // What the stack's controller asks for.
 struct ControlCommand {
-  double accel_mps2 = 0.0;  // signed; negative brakes
-  double steer_rad = 0.0;   // front wheel angle target
+  // Positive drives in the gear's direction, negative brakes (towards a
+  // standstill, never through it).
+  double accel_mps2 = 0.0;
+  double steer_rad = 0.0;  // front wheel angle target
+  bool reverse = false;    // gear: driving backwards
 };
 
 struct VehicleState {
   double x_m = 0.0;  // rear axle centre
   double y_m = 0.0;
   double yaw_rad = 0.0;
-  double v_mps = 0.0;  // never negative: no reversing
+  double v_mps = 0.0;  // signed: negative while reversing
   double steer_rad = 0.0;
   double accel_mps2 = 0.0;
 };

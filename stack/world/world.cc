@@ -21,10 +21,12 @@
 #include <map>
 #include <set>
 
+#include "stack/algorithms/freespace_planner.h"
 #include "stack/base/files.h"
 #include "stack/base/hash.h"
 #include "stack/base/random.h"
 #include "stack/world/map_cloud.h"
+#include "stack/world/parking_goal.h"
 
 namespace adse::world {
 namespace {
@@ -130,7 +132,12 @@ struct World::Impl {
   MapArtifacts map;
   RoadLocation start, goal;
   std::vector<RoadLocation> via;  // task.via, resolved
-  Vec2 goal_xy = Vec2::Zero();    // final target (inside a slot when valet)
+  Vec2 goal_xy = Vec2::Zero();    // final target (rear axle when valet)
+  bool valet = false;
+  ParkingSlot goal_slot;                 // valet: the slot parked in
+  geometry::Pose2 parking_goal;          // valet: rear axle parked
+  geometry::Path2 road;                  // the route's road part
+  std::vector<ManoeuvrePose> reference;  // valet: the reference manoeuvre
   std::vector<std::string> route;
   geometry::Path2 ideal;
   double lane_width_m = 3.2;
@@ -496,47 +503,41 @@ Status World::Impl::BuildIdealPath() {
     lane_width_m = width_sum / static_cast<double>(n);
     goal_xy = goal.xy;
 
-    if (setup.task.kind == TaskKind::kValetParking) {
-      // Final leg into the slot that holds the goal: a cubic Bezier from
-      // the aisle, tangent to the lane, ending at the slot centre pointing in.
-      const ParkingSlot* slot = nullptr;
-      const Vec2 target(setup.task.goal.x_m, setup.task.goal.y_m);
-      for (const ParkingSlot& s : scene.parking_slots()) {
-        const Eigen::Vector2d local =
-            Eigen::Rotation2Dd(-s.box.yaw_rad) * (target - s.box.center);
-        if (std::abs(local.x()) <= s.box.length_m / 2 &&
-            std::abs(local.y()) <= s.box.width_m / 2) {
-          slot = &s;
+    road = Resample(points, kResampleStepM);
+    std::vector<Vec2> manoeuvre_points;
+    if (valet) {
+      // The reference manoeuvre: the freespace planner's path from where the
+      // road part ends into the slot, on the ground-truth lot. When it finds
+      // none the ideal path is the road part (the stack will find none
+      // either and say so).
+      const geometry::Pose2 from{road.points.back().x(), road.points.back().y(),
+                                 road.HeadingAt(road.length_m())};
+      algorithms::VehicleFootprint footprint;
+      footprint.front_m = 0.5 * (setup.ego.wheelbase_m + setup.ego.length_m);
+      footprint.rear_m = 0.5 * (setup.ego.length_m - setup.ego.wheelbase_m);
+      footprint.width_m = setup.ego.width_m;
+      algorithms::FreespacePlanner planner({}, footprint);
+      Result<algorithms::FreespacePath> manoeuvre =
+          planner.Plan(from, parking_goal, ObstacleOutlines(scene));
+      if (manoeuvre.ok()) {
+        for (const algorithms::GearedPose& p : manoeuvre->poses) {
+          manoeuvre_points.emplace_back(p.pose.x_m, p.pose.y_m);
+          reference.push_back({p.pose, p.reverse});
         }
       }
-      if (slot == nullptr) {
-        return Status::InvalidArgument(
-            "task.goal: valet_parking needs the goal inside a parking slot of "
-            "the map");
-      }
-      geometry::Path2 road = Resample(points, kResampleStepM);
-      const Vec2 p0 = road.points.back();
-      const double h0 = road.HeadingAt(road.length_m());
-      const Vec2 t0(std::cos(h0), std::sin(h0));
-      const Vec2 p3 = slot->box.center;
-      Vec2 in = (p3 - p0);
-      // The slot's depth axis, pointing away from the aisle.
-      Vec2 axis(std::cos(slot->box.yaw_rad), std::sin(slot->box.yaw_rad));
-      if (axis.dot(in) < 0) axis = -axis;
-      const double reach = (p3 - p0).norm();
-      const Vec2 p1 = p0 + t0 * reach * 0.5;
-      const Vec2 p2 = p3 - axis * reach * 0.5;
-      std::vector<Vec2> leg;
-      for (int k = 1; k <= 40; ++k) {
-        const double u = k / 40.0;
-        leg.push_back(std::pow(1 - u, 3) * p0 +
-                      3 * std::pow(1 - u, 2) * u * p1 +
-                      3 * (1 - u) * u * u * p2 + std::pow(u, 3) * p3);
-      }
-      append(leg);
-      goal_xy = p3;
+      goal_xy = Vec2(parking_goal.x_m, parking_goal.y_m);
     }
-    ideal = Resample(points, kResampleStepM);
+    // A manoeuvre with gear changes passes its cusps twice: no resampling.
+    if (valet) {
+      ideal.points = road.points;
+      for (const Vec2& p : manoeuvre_points) {
+        if (ideal.points.empty() || (p - ideal.points.back()).norm() > 1e-6)
+          ideal.points.push_back(p);
+      }
+      ideal.UpdateArcLength();
+    } else {
+      ideal = road;
+    }
   } catch (const std::exception& e) {
     return Status::Internal(std::string("building the ideal path: ") +
                             e.what());
@@ -557,6 +558,7 @@ Status World::Impl::BuildScene() {
           libsumo::Polygon::getParameter(id, "height_m");
       if (type == "adse.parking_slot" && shape.size() >= 4) {
         ParkingSlot slot;
+        slot.name = id;
         const Vec2 e1 = shape[1] - shape[0];
         const Vec2 e2 = shape[2] - shape[1];
         // Length along the slot's depth (the longer side).
@@ -802,13 +804,29 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
   }
   impl->map = *map;
   ADSE_RETURN_IF_ERROR(impl->StartSumo());
+  ADSE_RETURN_IF_ERROR(impl->BuildScene());
+  // A valet goal names a slot (or a point in one) and the parked heading;
+  // its place for the route is the slot's centre.
+  impl->valet = setup.task.kind == TaskKind::kValetParking;
+  if (impl->valet) {
+    Result<ParkingSlot> slot =
+        FindGoalSlot(impl->scene.parking_slots(), setup.task.goal);
+    if (!slot.ok()) return slot.status();
+    Result<geometry::Pose2> parked =
+        ParkedPose(*slot, setup.task.goal, setup.ego);
+    if (!parked.ok()) return parked.status();
+    impl->goal_slot = *slot;
+    impl->parking_goal = *parked;
+    impl->setup.task.goal.x_m = slot->box.center.x();
+    impl->setup.task.goal.y_m = slot->box.center.y();
+  }
   Result<RoadLocation> start =
       impl->Resolve(setup.task.start, "task.start", kOffRoadSlackM);
   if (!start.ok()) return start.status();
   // A valet goal lies in a slot beside the aisle, so it may be further off.
-  const bool valet = setup.task.kind == TaskKind::kValetParking;
-  Result<RoadLocation> goal = impl->Resolve(
-      setup.task.goal, "task.goal", valet ? kValetSlackM : kOffRoadSlackM);
+  Result<RoadLocation> goal =
+      impl->Resolve(impl->setup.task.goal, "task.goal",
+                    impl->valet ? kValetSlackM : kOffRoadSlackM);
   if (!goal.ok()) return goal.status();
   impl->start = *start;
   impl->goal = *goal;
@@ -818,52 +836,14 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
     if (!via.ok()) return via.status();
     impl->via.push_back(*via);
   }
-  if (setup.task.kind == TaskKind::kValetParking) {
-    // The road part of a valet route ends on the aisle beside the slot.
-    const Location& g = setup.task.goal;
-    if (g.by_edge) {
-      return Status::InvalidArgument(
-          "task.goal: valet_parking needs the goal as {x, y} inside a slot");
-    }
-  }
   ADSE_RETURN_IF_ERROR(impl->PlanRoute());
-  ADSE_RETURN_IF_ERROR(impl->BuildScene());
-  // Parked cars: a seeded share of the slots, never the valet goal's slot.
-  {
-    Random random(
-        Random::DeriveSeed(setup.world.traffic.seed, "traffic.parked"));
-    Scene with_cars;
-    const Vec2 goal_point(setup.task.goal.x_m, setup.task.goal.y_m);
-    for (const Obstacle& o : impl->scene.obstacles()) with_cars.AddObstacle(o);
-    for (ParkingSlot slot : impl->scene.parking_slots()) {
-      const bool draw = random.Bernoulli(setup.world.traffic.parked_occupancy);
-      const double jitter_x = random.Uniform(-0.15, 0.15);
-      const double jitter_y = random.Uniform(-0.15, 0.15);
-      const double jitter_yaw = random.Uniform(-0.05, 0.05);
-      const Eigen::Vector2d local = Eigen::Rotation2Dd(-slot.box.yaw_rad) *
-                                    (goal_point - slot.box.center);
-      const bool is_goal = setup.task.kind == TaskKind::kValetParking &&
-                           std::abs(local.x()) <= slot.box.length_m / 2 &&
-                           std::abs(local.y()) <= slot.box.width_m / 2;
-      if (draw && !is_goal) {
-        slot.occupied = true;
-        geometry::OrientedBox car;
-        car.center = slot.box.center + Vec2(jitter_x, jitter_y);
-        car.yaw_rad = slot.box.yaw_rad + jitter_yaw;
-        car.length_m = std::min(4.5, slot.box.length_m - 0.4);
-        car.width_m = std::min(1.8, slot.box.width_m - 0.4);
-        car.height_m = 1.5;
-        Obstacle obstacle;
-        obstacle.kind = ObstacleKind::kParkedCar;
-        obstacle.footprint = geometry::BoxCorners(car);
-        obstacle.z_max_m = car.height_m;
-        with_cars.AddObstacle(std::move(obstacle));
-      }
-      with_cars.AddParkingSlot(slot);
-    }
-    with_cars.Finalize();
-    impl->scene = std::move(with_cars);
-  }
+  // Parked cars: a seeded share of the slots (never the valet goal's), or
+  // exactly the slots the scenario lists.
+  Result<Scene> parked =
+      WithParkedCars(impl->scene, setup.world.traffic,
+                     impl->valet ? impl->goal_slot.name : "");
+  if (!parked.ok()) return parked.status();
+  impl->scene = std::move(parked).value();
   ADSE_RETURN_IF_ERROR(impl->BuildIdealPath());
   ADSE_RETURN_IF_ERROR(impl->SetUpTraffic());
   ADSE_RETURN_IF_ERROR(impl->AddEgo());
@@ -920,7 +900,28 @@ double World::distance_to_goal_m() const {
   return (Vec2(s.x_m, s.y_m) - impl_->goal_xy).norm();
 }
 bool World::goal_reached() const {
-  return distance_to_goal_m() <= impl_->setup.task.goal_tolerance_m;
+  const Impl& w = *impl_;
+  if (!w.valet) return distance_to_goal_m() <= w.setup.task.goal_tolerance_m;
+  // Parked: standing in the slot, as the tolerances allow. The rear axles'
+  // distance equals the bodies' (same heading up to the tolerance).
+  return std::abs(w.ego->state().v_mps) < 0.05 &&
+         distance_to_goal_m() <= w.setup.task.goal_tolerance_m &&
+         goal_yaw_error_rad() <=
+             w.setup.task.goal_yaw_tolerance_deg * M_PI / 180.0;
+}
+bool World::parking_task() const { return impl_->valet; }
+const ParkingSlot& World::goal_slot() const { return impl_->goal_slot; }
+const geometry::Pose2& World::parking_goal() const {
+  return impl_->parking_goal;
+}
+double World::goal_yaw_error_rad() const {
+  if (!impl_->valet) return 0.0;
+  return std::abs(std::remainder(
+      impl_->ego->state().yaw_rad - impl_->parking_goal.yaw_rad, 2 * M_PI));
+}
+const geometry::Path2& World::road_path() const { return impl_->road; }
+const std::vector<ManoeuvrePose>& World::reference_manoeuvre() const {
+  return impl_->reference;
 }
 const geometry::Path2& World::ideal_path() const { return impl_->ideal; }
 const std::vector<std::string>& World::route_edges() const {

@@ -34,6 +34,12 @@ struct RoadLocation {
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // on the lane centre
 };
 
+// A pose of the reference parking manoeuvre and the gear it is driven in.
+struct ManoeuvrePose {
+  geometry::Pose2 pose;  // rear axle
+  bool reverse = false;
+};
+
 struct OtherVehicle {
   std::string id;
   geometry::OrientedBox box;
@@ -64,8 +70,24 @@ class World {
   int collisions() const;
   // Vehicles whose contact with the ego began in the last step.
   const std::vector<std::string>& new_contacts() const;
+  // Lane driving: within goal_tolerance_m of the goal. valet_parking:
+  // parked, i.e. standing with the body's centre within goal_tolerance_m of
+  // the slot's and the heading within goal_yaw_tolerance_deg.
   bool goal_reached() const;
   double distance_to_goal_m() const;
+
+  // valet_parking only: the goal's slot, the rear-axle pose parked in it,
+  // the heading error now and the road part of the route (the whole ideal
+  // path for lane driving), which ends on the aisle beside the slot.
+  bool parking_task() const;
+  const ParkingSlot& goal_slot() const;
+  const geometry::Pose2& parking_goal() const;
+  double goal_yaw_error_rad() const;
+  const geometry::Path2& road_path() const;
+  // The reference manoeuvre from the road part's end into the slot (the
+  // ideal path's last part), planned on the ground truth; empty when the
+  // planner found none or for lane driving.
+  const std::vector<ManoeuvrePose>& reference_manoeuvre() const;
 
   const geometry::Path2& ideal_path() const;
   const std::vector<std::string>& route_edges() const;

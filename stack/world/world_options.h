@@ -37,6 +37,9 @@ struct TrafficOptions {
   std::vector<Flow> flows;
   // Fraction of parking slots holding a parked car, in [0, 1].
   double parked_occupancy = 0.0;
+  // Slots (by name) holding a parked car; when given, exactly these do and
+  // parked_occupancy is not drawn.
+  std::vector<std::string> parked_slots;
 };
 
 struct WorldOptions {
@@ -70,6 +73,12 @@ struct Location {
   std::string edge;
   double pos_m = 0.0;
   int lane = 0;
+  // A parking slot by name (a valet goal): its centre is the place.
+  std::string slot;
+  // Heading at the place (a valet goal's parked heading), degrees
+  // counter-clockwise from +x.
+  bool has_yaw = false;
+  double yaw_deg = 0.0;
 };
 
 enum class TaskKind { kLaneDriving, kValetParking };
@@ -81,8 +90,11 @@ struct TaskOptions {
   // route is the shortest one from each to the next.
   std::vector<Location> via;
   Location goal;
-  // The goal counts as reached within this distance.
+  // The goal counts as reached within this distance (valet_parking: of the
+  // parked body's centre from the slot's target, standing still).
   double goal_tolerance_m = 2.0;
+  // valet_parking: the parked heading's tolerance.
+  double goal_yaw_tolerance_deg = 10.0;
   double speed_limit_kmh = 30.0;
   // Simulated time after the start event at which a run is abandoned.
   double timeout_s = 1500.0;

@@ -27,14 +27,16 @@ const std::vector<std::string> kWorldKeys = {"map", "traffic", "weather",
                                              "step_s"};
 const std::vector<std::string> kMapKeys = {"generate", "params", "net",
                                            "polygons"};
-const std::vector<std::string> kTrafficKeys = {"seed", "flows",
-                                               "parked_occupancy"};
+const std::vector<std::string> kTrafficKeys = {
+    "seed", "flows", "parked_occupancy", "parked_slots"};
 const std::vector<std::string> kFlowKeys = {"from", "to", "vehicles_per_hour"};
 const std::vector<std::string> kTaskKeys = {
     "kind", "start", "via", "goal", "speed_limit_kmh", "timeout_s"};
 const std::vector<std::string> kStartKeys = {"x", "y", "edge", "pos_m", "lane"};
-const std::vector<std::string> kGoalKeys = {"x",     "y",    "edge",
-                                            "pos_m", "lane", "tolerance_m"};
+const std::vector<std::string> kGoalKeys = {
+    "x",           "y",       "edge",
+    "pos_m",       "lane",    "slot",
+    "tolerance_m", "yaw_deg", "yaw_tolerance_deg"};
 const std::vector<std::string> kPlatformKeys = {
     "kind",  "reference_ghz", "cost_model", "calibration",  "profile",
     "cores", "freq_ghz",      "cost_scale", "time_dilation"};
@@ -334,6 +336,14 @@ void SpecReader::ReadTraffic(const Val& v) {
   if (const Val* e = f.Get("parked_occupancy")) {
     ReadNumber(*e, &traffic.parked_occupancy, Bounds::Closed(0, 1));
   }
+  if (const Val* e = f.Get("parked_slots")) {
+    std::vector<Val> items;
+    if (ReadList(*e, &items, "a list of parking slot names")) {
+      traffic.parked_slots.assign(items.size(), std::string());
+      for (size_t i = 0; i < items.size(); ++i)
+        ReadString(items[i], &traffic.parked_slots[i], "a parking slot name");
+    }
+  }
   if (const Val* e = f.Get("flows")) {
     std::vector<Val> items;
     if (!ReadList(*e, &items,
@@ -407,19 +417,24 @@ void SpecReader::ReadTask(const Val& v) {
 
 void SpecReader::ReadLocation(const Val& v, bool goal,
                               world::Location* location) {
-  const std::string expected = goal ? "a place {x, y, tolerance_m} or {edge, "
-                                      "pos_m, lane, tolerance_m}"
-                                    : "a place {x, y} or {edge, pos_m, lane}";
+  const std::string expected =
+      goal ? "a place {x, y, tolerance_m}, {edge, pos_m, lane, tolerance_m} "
+             "or {slot, yaw_deg, tolerance_m, yaw_tolerance_deg}"
+           : "a place {x, y} or {edge, pos_m, lane}";
   Fields f;
   if (!ReadFields(v, goal ? &kGoalKeys : &kStartKeys, &f, expected)) return;
   const bool by_xy = f.Get("x") || f.Get("y");
   const bool by_edge = f.Get("edge") || f.Get("pos_m") || f.Get("lane");
-  if (by_xy && by_edge) {
-    Error(v.key_mark, v.path, "either {x, y} or {edge, pos_m, lane}",
-          "both x/y and edge fields");
-  } else if (!by_xy && !by_edge) {
-    Error(v.key_mark, v.path, "either {x, y} or {edge, pos_m, lane}",
-          "neither");
+  const bool by_slot = f.Get("slot") != nullptr;
+  const char* forms = goal ? "one of {x, y}, {edge, pos_m, lane} or {slot}"
+                           : "either {x, y} or {edge, pos_m, lane}";
+  if (int(by_xy) + int(by_edge) + int(by_slot) > 1) {
+    Error(v.key_mark, v.path, forms, "fields of more than one");
+  } else if (!by_xy && !by_edge && !by_slot) {
+    Error(v.key_mark, v.path, forms, "none");
+  } else if (by_slot) {
+    location->by_edge = false;
+    ReadString(*f.Get("slot"), &location->slot, "a parking slot name");
   } else if (by_xy) {
     location->by_edge = false;
     for (const char* key : {"x", "y"}) {
@@ -446,6 +461,14 @@ void SpecReader::ReadLocation(const Val& v, bool goal,
   }
   if (const Val* e = f.Get("tolerance_m")) {
     ReadNumber(*e, &spec_.task.goal_tolerance_m, Bounds::Positive());
+  }
+  if (const Val* e = f.Get("yaw_deg")) {
+    location->has_yaw = true;
+    ReadNumber(*e, &location->yaw_deg, Bounds::Closed(-360, 360));
+  }
+  if (const Val* e = f.Get("yaw_tolerance_deg")) {
+    ReadNumber(*e, &spec_.task.goal_yaw_tolerance_deg,
+               Bounds{0, 180, true, false});
   }
 }
 

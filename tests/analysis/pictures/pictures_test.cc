@@ -186,6 +186,55 @@ TEST_F(PictureTest, VehiclesCanBeLeftOut) {
   EXPECT_GT(CountColour(*img, kTrajectoryRgb), 100);
 }
 
+TEST_F(PictureTest, ValetRunShowsTheLotTheTargetAndTheManoeuvre) {
+  RunData run = SquareRun();
+  runfile::ParkingRecord& p = run.parking;
+  p.present = true;
+  // Three slots north of the path's first leg; the middle one the target,
+  // a parked car in the west one.
+  for (int i = 0; i < 3; ++i) {
+    p.slots.push_back(
+        {40.0 + 2.5 * i, 10.0, M_PI / 2, 5.0, 2.5, i == 0, i == 1});
+  }
+  p.obstacles = {
+      {0, 39.1, 7.8}, {0, 40.9, 7.8}, {0, 40.9, 12.2}, {0, 39.1, 12.2}};
+  p.planned_path = {{40, 3, 0, 0}, {46, 3, 0, 0}, {42.5, 8.65, -M_PI / 2, 1}};
+  RunData plain = SquareRun();
+  TrajectoryImageOptions options;
+  Result<WorldToImage> map = TrajectoryImageMapping(run, options);
+  ASSERT_TRUE(map.ok());
+  ASSERT_TRUE(RenderTrajectoryImage(run, Path("valet.png"), options).ok());
+  ASSERT_TRUE(RenderTrajectoryImage(plain, Path("plain.png"), options).ok());
+  Result<RgbImage> img = ReadImage(Path("valet.png"));
+  Result<RgbImage> none = ReadImage(Path("plain.png"));
+  ASSERT_TRUE(img.ok() && none.ok());
+  // The parked car is filled where it stands, the target slot outlined
+  // (its west edge at x = 41.25), both legs of the plan drawn; none of it
+  // in a lane-driving picture.
+  EXPECT_TRUE(
+      ColourNear(*img, map->Column(40.0), map->Row(10.0), kObstacleRgb));
+  EXPECT_TRUE(
+      ColourNear(*img, map->Column(41.25), map->Row(10.0), kTargetSlotRgb, 2));
+  // The detail panel below the map shows the target slot enlarged.
+  ASSERT_GT(map->detail_px, 0);
+  EXPECT_EQ(img->height_px, map->height_px);
+  int target_in_panel = 0;
+  for (int r = map->MapBottomPx(); r < img->height_px; ++r) {
+    for (int c = 0; c < img->width_px; ++c) {
+      target_in_panel += img->At(c, r) == kTargetSlotRgb;
+    }
+  }
+  EXPECT_GT(target_in_panel, 200);
+  Result<WorldToImage> plain_map = TrajectoryImageMapping(plain, options);
+  ASSERT_TRUE(plain_map.ok());
+  EXPECT_EQ(plain_map->detail_px, 0);
+  for (Rgb c : {kObstacleRgb, kTargetSlotRgb, kPlannedForwardRgb,
+                kPlannedReverseRgb, kEgoBodyRgb, kSlotRgb}) {
+    EXPECT_GT(CountColour(*img, c), 20) << Name(c);
+    EXPECT_EQ(CountColour(*none, c), 0) << Name(c);
+  }
+}
+
 TEST_F(PictureTest, PngBytesAreAPng) {
   Result<std::string> png = TrajectoryImagePng(SquareRun());
   ASSERT_TRUE(png.ok()) << png.status().ToString();

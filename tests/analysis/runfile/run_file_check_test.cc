@@ -10,6 +10,7 @@
 #endif
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -45,6 +46,12 @@ RunData MakeRun() {
   run.trace.topic_events.resize(5);
   run.trace.timer_overruns = {0};
   run.controls = {{0.1, 0.05, 0.3, 0.0}};
+  // A valet run's /parking, so every dataset the writer can write is here.
+  run.parking.present = true;
+  run.parking.slot = "slot_r0_s3";
+  run.parking.slots = {{18.25, 8.0, M_PI / 2, 5.0, 2.5, 0, 1}};
+  run.parking.obstacles = {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}};
+  run.parking.planned_path = {{1, 2, 0, 0}, {0, 2, 0, 1}};
   return run;
 }
 

@@ -313,6 +313,52 @@ TEST_F(RunFileTest, FullRunRoundTripsExactly) {
   EXPECT_EQ(Diff(run, *back), "");
 }
 
+TEST_F(RunFileTest, ParkingRecordRoundTripsAndIsAbsentOtherwise) {
+  RunData run = MakeFullRun();
+  ParkingRecord& p = run.parking;
+  p.present = true;
+  p.slot = "slot_r1_s4";
+  p.goal_x_m = 20.75;
+  p.goal_y_m = 21.35;
+  p.goal_yaw_rad = -M_PI / 2;
+  p.tolerance_m = 0.5;
+  p.yaw_tolerance_rad = 0.17;
+  p.planned_at_s = 20.0;
+  p.path_found = 1;
+  p.slots = {{20.75, 20.0, M_PI / 2, 5.0, 2.5, 0, 1},
+             {18.25, 20.0, M_PI / 2, 5.0, 2.5, 1, 0}};
+  p.obstacles = {{0, 0, 0}, {0, 10, 0}, {1, 5, 5}, {1, 6, 5}, {1, 6, 6}};
+  p.planned_path = {{20.0, 15.75, M_PI, 0}, {24.0, 15.75, M_PI, 1}};
+  const std::string path = Path("valet.h5");
+  ASSERT_TRUE(WriteRunFile(path, run).ok());
+  Result<RunData> back = ReadRunFile(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(Diff(run, *back), "");
+  const ParkingRecord& q = back->parking;
+  ASSERT_TRUE(q.present);
+  EXPECT_EQ(q.slot, p.slot);
+  EXPECT_EQ(q.goal_y_m, p.goal_y_m);
+  EXPECT_EQ(q.goal_yaw_rad, p.goal_yaw_rad);
+  EXPECT_EQ(q.yaw_tolerance_rad, p.yaw_tolerance_rad);
+  EXPECT_EQ(q.planned_at_s, 20.0);
+  EXPECT_EQ(q.path_found, 1);
+  ASSERT_EQ(q.slots.size(), 2u);
+  EXPECT_EQ(q.slots[1].occupied, 1);
+  EXPECT_EQ(q.slots[0].target, 1);
+  ASSERT_EQ(q.obstacles.size(), 5u);
+  EXPECT_EQ(q.obstacles[4].obstacle, 1);
+  EXPECT_EQ(q.obstacles[4].y_m, 6.0);
+  ASSERT_EQ(q.planned_path.size(), 2u);
+  EXPECT_EQ(q.planned_path[1].reverse, 1);
+  std::vector<std::string> problems;
+  EXPECT_TRUE(CheckRunFile(path, &problems).ok()) << problems.size();
+  // A lane-driving run has no /parking and reads back without one.
+  ASSERT_TRUE(WriteRunFile(Path("plain.h5"), MakeFullRun()).ok());
+  Result<RunData> plain = ReadRunFile(Path("plain.h5"));
+  ASSERT_TRUE(plain.ok());
+  EXPECT_FALSE(plain->parking.present);
+}
+
 TEST_F(RunFileTest, EmptyRunRoundTripsAndKeepsEmptyDatasets) {
   RunData run;  // defaults: no rows anywhere, empty strings
   const std::string path = Path("empty.h5");

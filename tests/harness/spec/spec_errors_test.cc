@@ -122,6 +122,29 @@ TEST(SpecErrorsTest, AnUnknownKnobRoleNamesTheRoles) {
               "for), found 'core' (did you mean 'cores'?)");
 }
 
+TEST(SpecErrorsTest, ValetGoalForms) {
+  const std::string head = R"(adse: 1
+world:
+  map: {generate: grid}
+task:
+  kind: valet_parking
+  start: {x: 0, y: 0}
+)";
+  const std::string space =
+      "design_space:\n  cores: {bind: platform.cores, range: [1, 4]}\n";
+  ExpectError(head + "  goal: {slot: s1, x: 3, y: 4}\n" + space, "task.goal", 7,
+              "fields of more than one");
+  ExpectError(head + "  goal: {slot: s1, yaw_deg: 400}\n" + space,
+              "task.goal.yaw_deg", 7);
+  ExpectError(
+      head + "  goal: {slot: s1, yaw_deg: 90, yaw_tolerance_deg: 0}\n" + space,
+      "task.goal.yaw_tolerance_deg", 7);
+  // Only a goal may name a slot.
+  ExpectError(std::string("adse: 1\nworld:\n  map: {generate: grid}\ntask:\n") +
+                  "  start: {slot: s1}\n  goal: {x: 1, y: 1}\n" + space,
+              "task.start.slot", 5, "found 'slot'");
+}
+
 TEST(SpecErrorsTest, DuplicateKey) {
   ExpectError(std::string(kHead) + "task:\n  kind: valet_parking\n", "task", 9,
               "found 'task' again (first at line 4)");

@@ -318,6 +318,42 @@ TEST(SpecParserTest, NormalizedYamlRoundTrips) {
   EXPECT_EQ(again->harness.slurm.time_limit, "02:00:00");
 }
 
+TEST(SpecParserTest, ValetGoalBySlotWithHeadingRoundTrips) {
+  const std::string text = R"(adse: 1
+world:
+  map: {generate: parking_lot, params: {rows: 2}}
+  traffic: {seed: 3, parked_slots: [slot_r1_s3, slot_r1_s5]}
+task:
+  kind: valet_parking
+  start: {x: 12, y: -1.75}
+  goal: {slot: slot_r1_s4, yaw_deg: -90, tolerance_m: 0.4, yaw_tolerance_deg: 8}
+design_space:
+  cores: {bind: platform.cores, range: [1, 4]}
+)";
+  Result<Spec> first = ParseSpec(text, "valet.yaml", "/");
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  const std::string yaml = NormalizedYaml(*first);
+  Result<Spec> again = ParseSpec(yaml, "normalized.yaml", "/");
+  ASSERT_TRUE(again.ok()) << again.status().message() << "\n" << yaml;
+  EXPECT_EQ(NormalizedYaml(*again), yaml);
+  EXPECT_EQ(again->task.goal.slot, "slot_r1_s4");
+  EXPECT_TRUE(again->task.goal.has_yaw);
+  EXPECT_NEAR(again->task.goal.yaw_deg, -90, kTol);
+  EXPECT_NEAR(again->task.goal_tolerance_m, 0.4, kTol);
+  EXPECT_NEAR(again->task.goal_yaw_tolerance_deg, 8, kTol);
+  EXPECT_EQ(again->world.traffic.parked_slots,
+            (std::vector<std::string>{"slot_r1_s3", "slot_r1_s5"}));
+  // Lane driving's normal form carries no heading tolerance.
+  EXPECT_EQ(NormalizedYaml(*ParseSpec(R"(adse: 1
+world: {map: {generate: grid}}
+task: {start: {x: 0, y: 0}, goal: {x: 100, y: 0}}
+design_space: {cores: {bind: platform.cores, range: [1, 4]}}
+)",
+                                      "lane.yaml", "/"))
+                .find("yaw_tolerance_deg"),
+            std::string::npos);
+}
+
 TEST(SpecParserTest, NormalizedYamlRoundTripsNetMapsAndEdges) {
   const std::string dir = MakeTempDir();
   WriteText(fs::path(dir) / "a.net.xml", "<net version=\"1.16\"></net>\n");

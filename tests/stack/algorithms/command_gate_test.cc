@@ -34,6 +34,19 @@ TEST(CommandGate, StaleCommandBrakesWithSteerHeld) {
   EXPECT_DOUBLE_EQ(gate.Output(1.7).accel_mps2, 0.5);
 }
 
+TEST(CommandGate, GearPassesAndIsHeldWhileBraking) {
+  CommandGate gate;
+  EXPECT_FALSE(gate.Output(0.0).reverse);
+  gate.OnCommand(1.0, 0.4, 0.2, true);
+  EXPECT_TRUE(gate.Output(1.1).reverse);
+  // Stale: brakes in the same gear (braking takes speed off either way).
+  const GateOutput out = gate.Output(2.0);
+  EXPECT_TRUE(out.braking);
+  EXPECT_TRUE(out.reverse);
+  gate.OnCommand(2.1, 0.4, 0.2, false);
+  EXPECT_FALSE(gate.Output(2.2).reverse);
+}
+
 TEST(CommandGate, LostLocalizationBrakes) {
   CommandGateParams params;
   params.emergency_decel_mps2 = 4.0;

@@ -79,16 +79,50 @@ TEST(BicycleModelTest, BrakingStopsWithoutReversing) {
   EXPECT_NEAR(model.state().x_m, 1.0 / 12.0, 1e-12);
   EXPECT_EQ(model.state().accel_mps2, 0.0);
   EXPECT_EQ(model.state().yaw_rad, 0.0);  // steering at rest turns nothing
-  // A negative speed handed in is treated as standing still.
-  s.v_mps = -3.0;
+  // Braking in reverse stops the car too, never driving it forwards.
+  s.v_mps = -1.0;
   model.Reset(s);
-  model.Step({0.0, 0.0}, 0.1);
+  model.Step({-6.0, 0.0, true}, 0.2);
   EXPECT_EQ(model.state().v_mps, 0.0);
-  EXPECT_EQ(model.state().x_m, 0.0);
+  EXPECT_NEAR(model.state().x_m, -1.0 / 12.0, 1e-12);
+  s.v_mps = 0.0;
+  model.Reset(s);
   // Non-positive steps change nothing.
   model.Step({2.0, 0.0}, 0.0);
   model.Step({2.0, 0.0}, -1.0);
   EXPECT_EQ(model.state().v_mps, 0.0);
+}
+
+TEST(BicycleModelTest, ReverseGearDrivesBackwardsUpToItsSpeedLimit) {
+  VehicleLimits lim;
+  lim.max_reverse_speed_mps = 2.0;
+  BicycleModel model(lim);
+  model.Reset(VehicleState{});
+  for (int i = 0; i < 100; ++i) model.Step({1.0, 0.0, true}, 0.1);
+  EXPECT_DOUBLE_EQ(model.state().v_mps, -2.0);
+  // 2 s to reach 2 m/s (2 m), then 8 s at 2 m/s: 18 m behind the start.
+  EXPECT_NEAR(model.state().x_m, -18.0, 1e-9);
+  EXPECT_DOUBLE_EQ(model.state().yaw_rad, 0.0);
+  // Steering left while backing turns the nose right (clockwise).
+  model.Step({0.0, 0.3, true}, 0.5);
+  model.Step({0.0, 0.3, true}, 0.5);
+  EXPECT_LT(model.state().yaw_rad, -0.05);
+}
+
+TEST(BicycleModelTest, DrivingAgainstTheMotionSlowsThenReverses) {
+  VehicleLimits lim;
+  BicycleModel model(lim);
+  VehicleState s;
+  s.v_mps = 1.0;
+  model.Reset(s);
+  // Reverse gear with 1 m/s^2 while rolling forwards at 1 m/s: through a
+  // standstill at t = 1 s and backwards after, as a real car would.
+  for (int i = 0; i < 10; ++i) model.Step({1.0, 0.0, true}, 0.1);
+  EXPECT_NEAR(model.state().v_mps, 0.0, 1e-12);
+  EXPECT_NEAR(model.state().x_m, 0.5, 1e-12);
+  for (int i = 0; i < 10; ++i) model.Step({1.0, 0.0, true}, 0.1);
+  EXPECT_NEAR(model.state().v_mps, -1.0, 1e-12);
+  EXPECT_NEAR(model.state().x_m, 0.0, 1e-12);
 }
 
 TEST(BicycleModelTest, BodyIsCentredHalfAWheelbaseAheadOfTheRearAxle) {

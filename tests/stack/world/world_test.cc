@@ -329,22 +329,128 @@ TEST(WorldTest, SecondOpenWorldInOneProcessIsRefused) {
   EXPECT_EQ(second.status().code(), Status::Code::kUnavailable);
 }
 
-TEST(WorldTest, ValetParkingPathEndsInsideTheGoalSlot) {
+// A valet task into slot 3 of row 0 (below the aisle: x in [17, 19.5],
+// y in [5.5, 10.5]), nose in (heading south).
+WorldSetup ValetLot() {
   WorldSetup setup = SmallLot();
   setup.task.kind = TaskKind::kValetParking;
-  // Slot 3 of row 0 (below the aisle): x in [17, 19.5], y in [5.5, 10.5].
-  setup.task.goal = Location::Xy(18.25, 8.0);
+  setup.task.goal = Location();
+  setup.task.goal.slot = "slot_r0_s3";
+  setup.task.goal.has_yaw = true;
+  setup.task.goal.yaw_deg = -90;
+  setup.task.goal_tolerance_m = 0.5;
+  return setup;
+}
+
+TEST(WorldTest, ValetGoalIsTheParkedPoseInTheNamedSlot) {
+  const WorldSetup setup = ValetLot();
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_TRUE(world.ok()) << world.status().ToString();
-  const geometry::Path2& path = (*world)->ideal_path();
-  EXPECT_NEAR(path.points.back().x(), 18.25, 0.1);
-  EXPECT_NEAR(path.points.back().y(), 8.0, 0.1);
-  EXPECT_LT(path.MaxGap(), 0.51);
-  for (const auto& slot : (*world)->scene().parking_slots()) {
-    if ((slot.box.center - Eigen::Vector2d(18.25, 8.0)).norm() < 0.5) {
-      EXPECT_FALSE(slot.occupied) << "the goal slot must stay free";
-    }
+  const World& w = **world;
+  ASSERT_TRUE(w.parking_task());
+  EXPECT_EQ(w.goal_slot().name, "slot_r0_s3");
+  EXPECT_FALSE(w.goal_slot().occupied);
+  // The body's centre (half a wheelbase ahead of the rear axle) is the
+  // slot's centre, heading into the slot.
+  const geometry::Pose2& goal = w.parking_goal();
+  EXPECT_NEAR(goal.x_m, 18.25, 1e-9);
+  EXPECT_NEAR(goal.y_m, 8.0 + 0.5 * setup.ego.wheelbase_m, 1e-9);
+  EXPECT_NEAR(goal.yaw_rad, -M_PI / 2, 1e-9);
+  // The road part ends on the aisle beside the slot; the ideal path goes
+  // on with the reference manoeuvre to the parked pose.
+  const geometry::Path2& road = w.road_path();
+  EXPECT_NEAR(road.points.back().x(), 18.25, 0.3);
+  EXPECT_GT(road.points.back().y(), 10.5);
+  const Eigen::Vector2d end = w.ideal_path().points.back();
+  EXPECT_NEAR(end.x(), goal.x_m, 1e-6);
+  EXPECT_NEAR(end.y(), goal.y_m, 1e-6);
+  EXPECT_GT(w.ideal_path().length_m(), road.length_m() + 4.0);
+  EXPECT_FALSE(w.goal_reached());  // not parked at the start
+}
+
+TEST(WorldTest, PerfectDriverParksAlongTheReferenceManoeuvre) {
+  Result<std::unique_ptr<World>> world = World::Open(ValetLot());
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  World& w = **world;
+  ASSERT_FALSE(w.reference_manoeuvre().empty());
+  IdealDriverOptions options;
+  options.scan = false;
+  options.timeout_s = 120;
+  Result<IdealDriveReport> report = DriveIdealPath(w, nullptr, options);
+  ASSERT_TRUE(report.ok()) << report.status().ToString();
+  EXPECT_TRUE(report->reached_goal);
+  EXPECT_TRUE(w.goal_reached());
+  EXPECT_EQ(report->collisions, 0);
+  EXPECT_LT(report->max_lateral_error_m, 0.5);
+  // It drove in reverse at some point only if the manoeuvre asks for it.
+  bool plan_reverses = false, drove_back = false;
+  for (const ManoeuvrePose& p : w.reference_manoeuvre())
+    plan_reverses = plan_reverses || p.reverse;
+  for (const TrajectorySample& t : report->trajectory)
+    drove_back = drove_back || t.v_mps < -0.1;
+  EXPECT_EQ(drove_back, plan_reverses);
+}
+
+TEST(WorldTest, ValetGoalNeedsTheParkedHeadingAlongTheSlot) {
+  WorldSetup setup = ValetLot();
+  setup.task.goal.has_yaw = false;
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_FALSE(world.ok());
+  EXPECT_EQ(world.status().message().rfind("task.goal.yaw_deg:", 0), 0u)
+      << world.status().message();
+}
+
+TEST(WorldTest, ValetGoalAcrossTheSlotIsRefused) {
+  WorldSetup setup = ValetLot();
+  setup.task.goal.yaw_deg = 0;
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_FALSE(world.ok());
+  EXPECT_EQ(world.status().message().rfind("task.goal.yaw_deg: 0 is across", 0),
+            0u)
+      << world.status().message();
+}
+
+TEST(WorldTest, ValetGoalInAnUnknownSlotIsRefused) {
+  WorldSetup setup = ValetLot();
+  setup.task.goal.slot = "slot_r9_s3";
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_FALSE(world.ok());
+  EXPECT_EQ(world.status().message().rfind("task.goal.slot:", 0), 0u)
+      << world.status().message();
+}
+
+TEST(WorldTest, OccupiedTargetSlotIsRefused) {
+  WorldSetup setup = ValetLot();
+  setup.world.traffic.parked_slots = {"slot_r0_s2", "slot_r0_s3"};
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_FALSE(world.ok());
+  EXPECT_EQ(world.status().code(), Status::Code::kInvalidArgument);
+  EXPECT_EQ(world.status().message().rfind(
+                "task.goal.slot: slot 'slot_r0_s3' is occupied", 0),
+            0u)
+      << world.status().message();
+}
+
+TEST(WorldTest, ParkedSlotsListedAreExactlyTheOccupiedOnes) {
+  WorldSetup setup = ValetLot();
+  setup.world.traffic.parked_slots = {"slot_r0_s2", "slot_r0_s4", "slot_r1_s0"};
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  int occupied = 0;
+  for (const ParkingSlot& slot : (*world)->scene().parking_slots()) {
+    const bool listed = slot.name == "slot_r0_s2" ||
+                        slot.name == "slot_r0_s4" || slot.name == "slot_r1_s0";
+    EXPECT_EQ(slot.occupied, listed) << slot.name;
+    occupied += slot.occupied;
   }
+  EXPECT_EQ(occupied, 3);
+  setup.world.traffic.parked_slots = {"slot_r0_s2", "nowhere"};
+  world.value().reset();
+  Result<std::unique_ptr<World>> again = World::Open(setup);
+  ASSERT_FALSE(again.ok());
+  EXPECT_EQ(again.status().message().rfind("world.traffic.parked_slots[1]:", 0),
+            0u)
+      << again.status().message();
 }
 
 }  // namespace

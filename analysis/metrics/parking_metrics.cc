@@ -1,0 +1,177 @@
+#include "analysis/metrics/parking_metrics.h"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace adse::analysis {
+namespace {
+
+using Vec2 = Eigen::Vector2d;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double Cross(const Vec2& a, const Vec2& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+
+double PointSegment(const Vec2& p, const Vec2& a, const Vec2& b) {
+  const Vec2 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0;
+  return (a + t * ab - p).norm();
+}
+
+bool SegmentsCross(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+  const double d1 = Cross(b - a, c - a), d2 = Cross(b - a, d - a);
+  const double d3 = Cross(d - c, a - c), d4 = Cross(d - c, b - c);
+  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0));
+}
+
+double SegmentSegment(const Vec2& a, const Vec2& b, const Vec2& c,
+                      const Vec2& d) {
+  if (SegmentsCross(a, b, c, d)) return 0.0;
+  return std::min({PointSegment(a, c, d), PointSegment(b, c, d),
+                   PointSegment(c, a, b), PointSegment(d, a, b)});
+}
+
+bool InsidePolygon(const std::vector<Vec2>& poly, const Vec2& p) {
+  if (poly.size() < 3) return false;
+  bool inside = false;
+  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const Vec2& a = poly[i];
+    const Vec2& b = poly[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) &&
+        p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
+      inside = !inside;
+    }
+  }
+  return inside;
+}
+
+// Distance between two closed outlines (a 2-point outline is a segment);
+// 0 when they touch or one holds the other.
+double OutlineDistance(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
+  auto edges = [](const std::vector<Vec2>& o) {
+    return o.size() == 2 ? 1 : o.size();
+  };
+  double best = kInf;
+  for (size_t i = 0; i < edges(a); ++i) {
+    for (size_t j = 0; j < edges(b); ++j) {
+      best = std::min(best, SegmentSegment(a[i], a[(i + 1) % a.size()], b[j],
+                                           b[(j + 1) % b.size()]));
+    }
+  }
+  if (best > 0 && (InsidePolygon(a, b.front()) || InsidePolygon(b, a.front())))
+    best = 0.0;
+  return best;
+}
+
+// The body's corners for a rear-axle sample.
+std::vector<Vec2> Body(const runfile::EgoSample& e,
+                       const runfile::ParkingRecord& p) {
+  const Vec2 dir(std::cos(e.yaw_rad), std::sin(e.yaw_rad));
+  const Vec2 left(-dir.y(), dir.x());
+  const Vec2 centre = Vec2(e.x_m, e.y_m) + 0.5 * p.wheelbase_m * dir;
+  const Vec2 hl = 0.5 * p.length_m * dir, hw = 0.5 * p.width_m * left;
+  return {centre + hl + hw, centre - hl + hw, centre - hl - hw,
+          centre + hl - hw};
+}
+
+}  // namespace
+
+void AddParkingMetrics(const runfile::RunData& run,
+                       std::map<std::string, double>* m) {
+  const runfile::ParkingRecord& p = run.parking;
+  if (!p.present) return;
+  const double nan = std::nan("");
+
+  // Where it ended up.
+  if (run.ego.empty()) {
+    (*m)["parked"] = 0.0;
+    (*m)["parking_position_error_m"] = nan;
+    (*m)["parking_yaw_error_deg"] = nan;
+  } else {
+    const runfile::EgoSample& end = run.ego.back();
+    const double pos = std::hypot(end.x_m - p.goal_x_m, end.y_m - p.goal_y_m);
+    const double yaw =
+        std::abs(std::remainder(end.yaw_rad - p.goal_yaw_rad, 2 * M_PI));
+    (*m)["parking_position_error_m"] = pos;
+    (*m)["parking_yaw_error_deg"] = yaw * 180.0 / M_PI;
+    (*m)["parked"] = std::abs(end.v_mps) < 0.05 && pos <= p.tolerance_m &&
+                             yaw <= p.yaw_tolerance_rad
+                         ? 1.0
+                         : 0.0;
+  }
+  const double end_s = run.ego.empty() ? 0.0 : run.ego.back().t_s;
+  (*m)["parking_time_s"] = p.planned_at_s >= 0 ? end_s - p.planned_at_s : nan;
+
+  // Deviation from the plan while driving it.
+  if (p.planned_path.size() >= 2) {
+    double sum = 0.0, worst = 0.0;
+    int n = 0;
+    for (const runfile::EgoSample& e : run.ego) {
+      if (e.t_s < p.planned_at_s) continue;
+      double d = kInf;
+      for (size_t i = 0; i + 1 < p.planned_path.size(); ++i) {
+        const auto& a = p.planned_path[i];
+        const auto& b = p.planned_path[i + 1];
+        d = std::min(d, PointSegment(Vec2(e.x_m, e.y_m), Vec2(a.x_m, a.y_m),
+                                     Vec2(b.x_m, b.y_m)));
+      }
+      sum += d;
+      worst = std::max(worst, d);
+      ++n;
+    }
+    (*m)["parking_path_deviation_m"] = n > 0 ? sum / n : nan;
+    (*m)["parking_path_deviation_max_m"] = n > 0 ? worst : nan;
+  } else {
+    (*m)["parking_path_deviation_m"] = nan;
+    (*m)["parking_path_deviation_max_m"] = nan;
+  }
+
+  // Clearance and contacts with the lot's obstacles.
+  std::vector<std::vector<Vec2>> outlines;
+  for (const runfile::OutlinePoint& v : p.obstacles) {
+    if (static_cast<size_t>(v.obstacle) >= outlines.size())
+      outlines.resize(v.obstacle + 1);
+    outlines[v.obstacle].emplace_back(v.x_m, v.y_m);
+  }
+  double clearance = kInf;
+  int contacts = 0;
+  bool touching = false;
+  for (const runfile::EgoSample& e : run.ego) {
+    const std::vector<Vec2> body = Body(e, p);
+    const Vec2 centre = 0.25 * (body[0] + body[1] + body[2] + body[3]);
+    double nearest = kInf;
+    for (const std::vector<Vec2>& o : outlines) {
+      if (o.size() < 2) continue;
+      // Skip what is far away (the body's half-diagonal is under 3 m).
+      double far = kInf;
+      for (const Vec2& v : o) far = std::min(far, (v - centre).norm());
+      if (o.size() > 2 && far > 30.0) continue;
+      nearest = std::min(nearest, OutlineDistance(body, o));
+    }
+    clearance = std::min(clearance, nearest);
+    const bool now = nearest <= 0.0;
+    if (now && !touching) ++contacts;
+    touching = now;
+  }
+  (*m)["min_clearance_m"] = std::isfinite(clearance) ? clearance : nan;
+  (*m)["obstacle_collisions"] = contacts;
+
+  // Gear changes: the direction of motion reversing.
+  int changes = 0, last = 0;
+  for (const runfile::EgoSample& e : run.ego) {
+    const int sign = e.v_mps > kStandstillMps    ? 1
+                     : e.v_mps < -kStandstillMps ? -1
+                                                 : 0;
+    if (sign != 0 && last != 0 && sign != last) ++changes;
+    if (sign != 0) last = sign;
+  }
+  (*m)["gear_changes"] = changes;
+}
+
+}  // namespace adse::analysis

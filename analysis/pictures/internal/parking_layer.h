@@ -1,0 +1,38 @@
+// The valet task's layer of the trajectory image: the lot's slots, its
+// walls, poles and parked cars, the target slot, the stack's planned
+// manoeuvre (forward and reverse legs) and the car as it ended.
+#ifndef ADSE_ANALYSIS_PICTURES_INTERNAL_PARKING_LAYER_H_
+#define ADSE_ANALYSIS_PICTURES_INTERNAL_PARKING_LAYER_H_
+
+#include <functional>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "analysis/pictures/internal/drawing_impl.h"
+#include "analysis/pictures/pictures.h"
+
+namespace adse::analysis::internal {
+
+using ToPixel = std::function<cv::Point2d(double x_m, double y_m)>;
+
+// Under everything else: slots (outlines), obstacles (filled), the target
+// slot (a thick outline).
+void DrawParkingLot(cv::Mat* img, const runfile::ParkingRecord& parking,
+                    const ToPixel& px, const Style& s);
+
+// Over the trajectory: the planned manoeuvre, forward and reverse legs in
+// their own colours, and the car's body at the run's last sample.
+void DrawParkingManoeuvre(cv::Mat* img, const runfile::RunData& run,
+                          const ToPixel& px, const Style& s);
+
+// The detail panel (drawn into `panel`, which clips): the manoeuvre's
+// surroundings enlarged — lanes (world coordinates), the lot, the
+// trajectory, the plan and the car at the end, with a scale bar and a
+// caption.
+void DrawParkingDetail(cv::Mat* panel, const runfile::RunData& run,
+                       const std::vector<std::vector<cv::Point2d>>& lanes,
+                       const Style& s);
+
+}  // namespace adse::analysis::internal
+
+#endif  // ADSE_ANALYSIS_PICTURES_INTERNAL_PARKING_LAYER_H_

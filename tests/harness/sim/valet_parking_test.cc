@@ -1,0 +1,102 @@
+// The bundled valet scenarios end to end: SUMO, the stack on the virtual
+// platform costed by the valet profile, the freespace planner and the
+// controller's parking mode. Each case is its own process (one SUMO each).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "analysis/runfile/run_file.h"
+#include "harness/sim/simulator.h"
+#include "harness/spec/spec_parser.h"
+
+namespace adse::sim {
+namespace {
+
+spec::Spec Bundled(const std::string& name) {
+  Result<spec::Spec> spec =
+      spec::LoadSpec(std::string(ADSE_SOURCE_DIR) + "/scenarios/" + name);
+  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
+  return *spec;
+}
+
+const spec::DesignPoint kGenerous = {{"cores", 8}, {"freq_ghz", 3.0}};
+
+// Parked in the slot within the tolerances, without touching anything,
+// having driven the planned manoeuvre closely.
+void ExpectParked(const runfile::RunData& run, int min_gear_changes) {
+  const auto& m = run.metrics;
+  EXPECT_EQ(run.termination_reason, "goal_reached");
+  EXPECT_EQ(m.at("completed"), 1.0);
+  EXPECT_EQ(m.at("parked"), 1.0);
+  EXPECT_LE(m.at("parking_position_error_m"), 0.5);
+  EXPECT_LE(m.at("parking_yaw_error_deg"), 10.0);
+  EXPECT_EQ(m.at("obstacle_collisions"), 0.0);
+  EXPECT_EQ(m.at("collisions"), 0.0);
+  EXPECT_GT(m.at("min_clearance_m"), 0.1);
+  EXPECT_LT(m.at("parking_path_deviation_max_m"), 0.5);
+  EXPECT_GE(m.at("gear_changes"), min_gear_changes);
+  EXPECT_LT(m.at("nav_time_s"), 90.0);
+  ASSERT_TRUE(run.parking.present);
+  EXPECT_EQ(run.parking.path_found, 1);
+  EXPECT_GT(run.parking.planned_path.size(), 10u);
+  // The record survives the run file and passes the schema check.
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "adse_valet_test.h5").string();
+  ASSERT_TRUE(runfile::WriteRunFile(path, run).ok());
+  std::vector<std::string> problems;
+  EXPECT_TRUE(runfile::CheckRunFile(path, &problems).ok());
+  EXPECT_TRUE(problems.empty()) << problems.front();
+}
+
+TEST(ValetParkingTest, BacksIntoTheSlot) {
+  Result<runfile::RunData> run =
+      SimulatePoint(Bundled("valet_parking.yaml"), kGenerous);
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  // The road ends beside the slot facing west; backing in needs at least
+  // one change from forward to reverse.
+  ExpectParked(*run, 1);
+  EXPECT_EQ(run->parking.planned_path.back().reverse, 1);
+}
+
+TEST(ValetParkingTest, DrivesNoseFirstIntoTheSlot) {
+  Result<runfile::RunData> run =
+      SimulatePoint(Bundled("valet_parking_nose_in.yaml"), kGenerous);
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  ExpectParked(*run, 1);
+  EXPECT_EQ(run->parking.planned_path.back().reverse, 0);
+}
+
+TEST(ValetParkingTest, UnreachableSlotEndsTheRunWithNoPathNotATimeout) {
+  spec::Spec spec = Bundled("valet_parking.yaml");
+  // A planner that keeps 0.8 m around the body cannot fit the car between
+  // the parked neighbours (3.2 m apart, the car 1.9 m wide).
+  ASSERT_TRUE(spec.stack.Set("parking.collision_margin_m", 0.8).ok());
+  Result<runfile::RunData> run = SimulatePoint(spec, kGenerous);
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->termination_reason, "no_path");
+  EXPECT_EQ(run->metrics.at("completed"), 0.0);
+  EXPECT_EQ(run->metrics.at("parked"), 0.0);
+  EXPECT_EQ(run->parking.path_found, 0);
+  EXPECT_TRUE(run->parking.planned_path.empty());
+  // It ends once the car stands at the aisle, far from the 300 s timeout.
+  EXPECT_LT(run->metrics.at("nav_time_s"), 40.0);
+  EXPECT_GE(run->parking.planned_at_s, 0.0);
+}
+
+TEST(ValetParkingTest, ParkedOutsideTheToleranceEndsTheRunAtOnce) {
+  spec::Spec spec = Bundled("valet_parking.yaml");
+  // Tighter than the manoeuvre ends (about 1.4 degrees off at this point).
+  spec.task.goal_yaw_tolerance_deg = 0.2;
+  Result<runfile::RunData> run = SimulatePoint(spec, kGenerous);
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->termination_reason, "parked_out_of_tolerance");
+  EXPECT_EQ(run->metrics.at("completed"), 0.0);
+  EXPECT_EQ(run->metrics.at("parked"), 0.0);
+  EXPECT_GT(run->metrics.at("parking_yaw_error_deg"), 0.2);
+  EXPECT_LT(run->metrics.at("parking_position_error_m"), 0.5);
+  // Standing in the slot, not waiting for the 300 s timeout.
+  EXPECT_LT(run->metrics.at("nav_time_s"), 60.0);
+}
+
+}  // namespace
+}  // namespace adse::sim

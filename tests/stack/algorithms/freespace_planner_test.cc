@@ -1,0 +1,182 @@
+#include "stack/algorithms/freespace_planner.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "tests/stack/algorithms/testing/parking_row.h"
+
+namespace adse::algorithms {
+namespace {
+
+using geometry::OrientedBox;
+using geometry::Pose2;
+using testing::BodyAt;
+using testing::Box;
+using testing::Footprint;
+using testing::kAisle;
+using testing::kSlotDepth;
+using testing::kStart;
+using testing::kTargetSlot;
+using testing::Lot;
+using testing::MakeLot;
+using testing::SlotCentreX;
+using testing::SlotGoal;
+
+// Exact check: the body at every returned pose overlaps no obstacle box.
+void ExpectNoCollision(const FreespacePath& path, const Lot& lot) {
+  for (size_t i = 0; i < path.poses.size(); ++i) {
+    const OrientedBox body = BodyAt(path.poses[i].pose, Footprint());
+    for (const OrientedBox& b : lot.boxes) {
+      ASSERT_FALSE(geometry::BoxesOverlap(body, b))
+          << "pose " << i << " at (" << path.poses[i].pose.x_m << ", "
+          << path.poses[i].pose.y_m << ") hits the box at " << b.center.x()
+          << ", " << b.center.y();
+    }
+  }
+}
+
+void ExpectEndsAt(const FreespacePath& path, const Pose2& goal) {
+  ASSERT_GE(path.poses.size(), 2u);
+  const Pose2& end = path.poses.back().pose;
+  EXPECT_NEAR(end.x_m, goal.x_m, 1e-6);
+  EXPECT_NEAR(end.y_m, goal.y_m, 1e-6);
+  EXPECT_NEAR(std::remainder(end.yaw_rad - goal.yaw_rad, 2 * M_PI), 0, 1e-6);
+  // Poses are close enough for a controller to follow.
+  for (size_t i = 1; i < path.poses.size(); ++i) {
+    const Pose2& a = path.poses[i - 1].pose;
+    const Pose2& b = path.poses[i].pose;
+    EXPECT_LE(std::hypot(b.x_m - a.x_m, b.y_m - a.y_m), 0.26);
+  }
+}
+
+TEST(FreespacePlanner, ForwardIntoTheSlot) {
+  const Lot lot = MakeLot();
+  FreespacePlanner planner({}, Footprint());
+  const Result<FreespacePath> path =
+      planner.Plan(kStart, SlotGoal(true), lot.Outlines());
+  ASSERT_TRUE(path.ok()) << path.status().ToString();
+  ExpectEndsAt(*path, SlotGoal(true));
+  ExpectNoCollision(*path, lot);
+  // It arrives driving forwards.
+  EXPECT_FALSE(path->poses.back().reverse);
+  EXPECT_GT(planner.last_stats().expansions, 0);
+  EXPECT_GT(planner.last_stats().work_units, 0);
+}
+
+TEST(FreespacePlanner, ReverseIntoTheSlot) {
+  const Lot lot = MakeLot();
+  FreespacePlanner planner({}, Footprint());
+  const Result<FreespacePath> path =
+      planner.Plan(kStart, SlotGoal(false), lot.Outlines());
+  ASSERT_TRUE(path.ok()) << path.status().ToString();
+  ExpectEndsAt(*path, SlotGoal(false));
+  ExpectNoCollision(*path, lot);
+  // The start faces along the aisle and the goal faces out of the slot:
+  // the car must back in, so the last leg is in reverse after a change.
+  EXPECT_TRUE(path->poses.back().reverse);
+  EXPECT_GE(path->gear_changes, 1);
+  int changes = 0;
+  for (size_t i = 1; i < path->poses.size(); ++i) {
+    if (path->poses[i].reverse != path->poses[i - 1].reverse) ++changes;
+  }
+  EXPECT_EQ(changes, path->gear_changes);
+}
+
+TEST(FreespacePlanner, SameInputsSamePath) {
+  const Lot lot = MakeLot();
+  FreespacePlanner a({}, Footprint()), b({}, Footprint());
+  const Result<FreespacePath> pa =
+      a.Plan(kStart, SlotGoal(false), lot.Outlines());
+  const Result<FreespacePath> pb =
+      b.Plan(kStart, SlotGoal(false), lot.Outlines());
+  ASSERT_TRUE(pa.ok() && pb.ok());
+  ASSERT_EQ(pa->poses.size(), pb->poses.size());
+  EXPECT_EQ(a.last_stats().expansions, b.last_stats().expansions);
+  for (size_t i = 0; i < pa->poses.size(); ++i) {
+    EXPECT_EQ(pa->poses[i].pose.x_m, pb->poses[i].pose.x_m);
+  }
+}
+
+TEST(FreespacePlanner, BlockedSlotHasNoPathAtOnce) {
+  Lot lot = MakeLot();
+  // A pole in the middle of the target slot.
+  lot.boxes.push_back(Box(SlotCentreX(kTargetSlot), kAisle + 2.0, 0.3, 0.3));
+  FreespacePlanner planner({}, Footprint());
+  const auto t0 = std::chrono::steady_clock::now();
+  const Result<FreespacePath> path =
+      planner.Plan(kStart, SlotGoal(true), lot.Outlines());
+  const double ms = std::chrono::duration<double, std::milli>(
+                        std::chrono::steady_clock::now() - t0)
+                        .count();
+  ASSERT_FALSE(path.ok());
+  EXPECT_EQ(path.status().code(), Status::Code::kNotFound);
+  EXPECT_NE(path.status().message().find("does not fit at the goal"),
+            std::string::npos)
+      << path.status().message();
+  EXPECT_EQ(planner.last_stats().expansions, 0);
+  EXPECT_LT(ms, 200.0);
+}
+
+TEST(FreespacePlanner, WalledOffSlotHasNoPathWithoutSearching) {
+  Lot lot = MakeLot();
+  // A wall across the aisle between the start and the slot.
+  lot.boxes.push_back(Box(8.0, kAisle / 2, 0.2, kAisle + 2 * kSlotDepth));
+  FreespacePlanner planner({}, Footprint());
+  const Result<FreespacePath> path =
+      planner.Plan(kStart, SlotGoal(true), lot.Outlines());
+  ASSERT_FALSE(path.ok());
+  EXPECT_EQ(path.status().code(), Status::Code::kNotFound);
+  EXPECT_NE(path.status().message().find("no passage"), std::string::npos)
+      << path.status().message();
+  EXPECT_EQ(planner.last_stats().expansions, 0);
+}
+
+TEST(FreespacePlanner, ExpansionBudgetEndsTheSearch) {
+  const Lot lot = MakeLot();
+  FreespacePlannerParams params;
+  params.max_expansions = 3;
+  params.analytic_range_m = 1.0;  // no shot from the start
+  FreespacePlanner planner(params, Footprint());
+  const Result<FreespacePath> path =
+      planner.Plan(kStart, SlotGoal(false), lot.Outlines());
+  ASSERT_FALSE(path.ok());
+  EXPECT_NE(path.status().message().find("after 3 expansions"),
+            std::string::npos)
+      << path.status().message();
+}
+
+TEST(FreespacePlanner, FootprintCheckSeesAPoleUnderTheCar) {
+  OccupancyGrid grid({-10, -10}, {10, 10}, 0.2);
+  grid.AddObstacle(geometry::BoxCorners(Box(1.5, 0.0, 0.3, 0.3)));
+  const VehicleFootprint fp = Footprint();
+  EXPECT_TRUE(grid.FootprintCollides({0, 0, 0}, fp, 0.0));
+  EXPECT_FALSE(grid.FootprintCollides({0, 3.0, 0}, fp, 0.0));
+  // Beside the car: only the margin reaches it.
+  EXPECT_FALSE(grid.FootprintCollides({0, 1.5, 0}, fp, 0.0));
+  EXPECT_TRUE(grid.FootprintCollides({0, 1.5, 0}, fp, 0.5));
+  // A thin wall (two points) is seen too; outside the grid is occupied.
+  grid.AddObstacle({{-10, 5}, {10, 5}});
+  EXPECT_TRUE(grid.FootprintCollides({0, 4.5, 0}, fp, 0.0));
+  EXPECT_TRUE(grid.FootprintCollides({9.0, -5, 0}, fp, 0.0));
+}
+
+TEST(FreespacePlanner, ParamsValidationNamesTheField) {
+  FreespacePlannerParams p;
+  p.yaw_bins = 3;
+  EXPECT_EQ(ValidateFreespacePlannerParams(p).message().rfind("yaw_bins", 0),
+            0u);
+  p = {};
+  p.step_m = 0.5;
+  EXPECT_EQ(ValidateFreespacePlannerParams(p).message().rfind("step_m", 0), 0u);
+  p = {};
+  p.reverse_penalty = 0.5;
+  EXPECT_EQ(
+      ValidateFreespacePlannerParams(p).message().rfind("reverse_penalty", 0),
+      0u);
+  EXPECT_TRUE(ValidateFreespacePlannerParams({}).ok());
+}
+
+}  // namespace
+}  // namespace adse::algorithms

@@ -1,0 +1,140 @@
+#include "stack/algorithms/parking_control.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "stack/algorithms/freespace_planner.h"
+#include "stack/world/vehicle_model.h"
+#include "tests/stack/algorithms/testing/parking_row.h"
+
+namespace adse::algorithms {
+namespace {
+
+using geometry::Pose2;
+
+struct Drive {
+  Pose2 end;
+  int motion_reversals = 0;  // sign changes of the car's speed
+  double max_lateral_error_m = 0.0;
+  double time_s = 0.0;
+  bool finished = false;
+  bool collided = false;
+};
+
+// Drives the ego's bicycle model along `path` with the parking follower at
+// 30 Hz, as the stack's control timer does, until it reports finished.
+Drive DrivePath(const FreespacePath& path, const testing::Lot& lot) {
+  world::BicycleModel car{world::VehicleLimits{}};
+  world::VehicleState s;
+  s.x_m = path.poses.front().pose.x_m;
+  s.y_m = path.poses.front().pose.y_m;
+  s.yaw_rad = path.poses.front().pose.yaw_rad;
+  car.Reset(s);
+  ParkingFollower follower;
+  follower.SetPath(path.poses);
+  Drive drive;
+  const double dt = 1.0 / 30.0;
+  int last_sign = 0;
+  world::ControlCommand command;
+  for (int i = 0; i < 30 * 120 && !drive.finished; ++i) {
+    const world::VehicleState& st = car.state();
+    const ParkingCommand c =
+        follower.Update({st.x_m, st.y_m, st.yaw_rad}, st.v_mps, dt);
+    drive.finished = c.finished;
+    drive.max_lateral_error_m =
+        std::max(drive.max_lateral_error_m, std::abs(c.lateral_error_m));
+    command = {c.accel_mps2, c.steer_rad, c.reverse};
+    car.Step(command, dt);
+    const int sign = car.state().v_mps > 1e-3    ? 1
+                     : car.state().v_mps < -1e-3 ? -1
+                                                 : 0;
+    if (sign != 0 && last_sign != 0 && sign != last_sign) {
+      ++drive.motion_reversals;
+    }
+    if (sign != 0) last_sign = sign;
+    for (const geometry::OrientedBox& b : lot.boxes) {
+      drive.collided = drive.collided || geometry::BoxesOverlap(car.Body(), b);
+    }
+    drive.time_s += dt;
+  }
+  drive.end = {car.state().x_m, car.state().y_m, car.state().yaw_rad};
+  return drive;
+}
+
+void ExpectParks(bool nose_in) {
+  const testing::Lot lot = testing::MakeLot();
+  FreespacePlanner planner({}, testing::Footprint());
+  const Pose2 goal = testing::SlotGoal(nose_in);
+  const Result<FreespacePath> path =
+      planner.Plan(testing::kStart, goal, lot.Outlines());
+  ASSERT_TRUE(path.ok()) << path.status().ToString();
+  const Drive drive = DrivePath(*path, lot);
+  EXPECT_TRUE(drive.finished);
+  EXPECT_FALSE(drive.collided);
+  EXPECT_LT(std::hypot(drive.end.x_m - goal.x_m, drive.end.y_m - goal.y_m),
+            0.3);
+  EXPECT_LT(
+      std::abs(std::remainder(drive.end.yaw_rad - goal.yaw_rad, 2 * M_PI)),
+      0.1);
+  // The car shifted where the path does, and no more.
+  EXPECT_EQ(drive.motion_reversals, path->gear_changes);
+  EXPECT_LT(drive.max_lateral_error_m, 0.35);
+  EXPECT_LT(drive.time_s, 90.0);
+}
+
+TEST(ParkingFollower, ParksNoseInOnThePlannedPath) { ExpectParks(true); }
+
+TEST(ParkingFollower, BacksIntoTheSlotOnThePlannedPath) { ExpectParks(false); }
+
+TEST(ParkingFollower, SplitsThePathAtGearChanges) {
+  std::vector<GearedPose> poses;
+  for (int i = 0; i <= 4; ++i) poses.push_back({{0.5 * i, 0, 0}, false});
+  for (int i = 1; i <= 4; ++i) poses.push_back({{2.0 - 0.5 * i, 0, 0}, true});
+  ParkingFollower follower;
+  follower.SetPath(poses);
+  EXPECT_EQ(follower.segments(), 2);
+  // At the start, standing: forwards, speeding up.
+  ParkingCommand c = follower.Update({0, 0, 0}, 0.0, 0.05);
+  EXPECT_FALSE(c.reverse);
+  EXPECT_GT(c.accel_mps2, 0);
+  EXPECT_NEAR(c.remaining_m, 2.0, 1e-9);
+  // At the cusp but still rolling: brake, no shift yet.
+  c = follower.Update({2.0, 0, 0}, 0.3, 0.05);
+  EXPECT_FALSE(c.reverse);
+  EXPECT_LT(c.accel_mps2, 0);
+  // Standing at the cusp: shift to reverse and drive the second segment.
+  c = follower.Update({2.0, 0, 0}, 0.0, 0.05);
+  EXPECT_TRUE(c.reverse);
+  EXPECT_EQ(c.segment, 1);
+  EXPECT_GT(c.accel_mps2, 0);
+  EXPECT_NEAR(c.steer_rad, 0.0, 1e-9);
+  // Standing at the end: finished, holding.
+  c = follower.Update({0.0, 0, 0}, 0.0, 0.05);
+  EXPECT_TRUE(c.finished);
+  EXPECT_LT(c.accel_mps2, 0);
+  // Finished stays finished, wherever the pose estimate moves next.
+  c = follower.Update({0.5, 0.1, 0}, 0.0, 0.05);
+  EXPECT_TRUE(c.finished);
+  EXPECT_LT(c.accel_mps2, 0);
+  EXPECT_TRUE(c.reverse);
+  // A new path starts over.
+  follower.SetPath(poses);
+  EXPECT_FALSE(follower.Update({0, 0, 0}, 0.0, 0.05).finished);
+}
+
+TEST(ParkingFollower, ReverseSteeringTurnsTowardsThePath) {
+  // Backing along -x with the path 0.5 m to the car's left (y > 0, the car
+  // facing +x): backing up with the wheels turned left swings the rear to
+  // the left, towards the path (and the nose right).
+  std::vector<GearedPose> poses;
+  for (int i = 0; i <= 20; ++i) poses.push_back({{-0.5 * i, 0.5, 0}, true});
+  ParkingFollower follower;
+  follower.SetPath(poses);
+  const ParkingCommand c = follower.Update({0, 0, 0}, -0.5, 0.05);
+  EXPECT_TRUE(c.reverse);
+  EXPECT_GT(c.steer_rad, 0.05);
+}
+
+}  // namespace
+}  // namespace adse::algorithms
