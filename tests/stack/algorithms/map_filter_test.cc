@@ -28,5 +28,37 @@ TEST(MapFilterTest, KeepsOnlyWhatTheMapDoesNotExplain) {
   EXPECT_FLOAT_EQ(kept[1].x(), 9.0f);
 }
 
+TEST(StructureGridTest, TellsMapStructureFromFreeRoad) {
+  // A wall along x = 10, y in [-5, 5], on a ground grid that covers
+  // everything (ground is not structure).
+  std::vector<Eigen::Vector3f> map;
+  for (float y = -5; y <= 5; y += 0.2f) {
+    for (float z = 0; z <= 2; z += 0.2f) map.emplace_back(10.0f, y, z);
+  }
+  for (float x = -20; x <= 20; x += 1.0f) {
+    for (float y = -20; y <= 20; y += 1.0f) map.emplace_back(x, y, 0.0f);
+  }
+  StructureGrid grid;
+  grid.SetMap(map);
+  EXPECT_GT(grid.cells(), 0u);
+  // A box fitted to a stretch of the wall (a cluster of its points).
+  EXPECT_DOUBLE_EQ(grid.StructureFraction({10.2, 0}, 3.0, 0.4, M_PI / 2), 1.0);
+  EXPECT_TRUE(grid.IsStructure({10.2, 0}, 3.0, 0.4, M_PI / 2));
+  // The same wall seen 0.8 m off (a localization error): still structure.
+  EXPECT_TRUE(grid.IsStructure({9.2, 0}, 3.0, 0.4, M_PI / 2));
+  // A car on the open road, over ground points only.
+  EXPECT_DOUBLE_EQ(grid.StructureFraction({0, 0}, 4.5, 1.8, 0.0), 0.0);
+  EXPECT_FALSE(grid.IsStructure({0, 0}, 4.5, 1.8, 0.0));
+  // A car parked 0.6 m from the wall: only its side next to it is near
+  // structure, less than half of its footprint.
+  const double along_wall =
+      grid.StructureFraction({8.5, 0}, 4.5, 1.8, M_PI / 2);
+  EXPECT_GT(along_wall, 0.0);
+  EXPECT_LT(along_wall, 0.5);
+  EXPECT_FALSE(grid.IsStructure({8.5, 0}, 4.5, 1.8, M_PI / 2));
+  // Past the wall's end.
+  EXPECT_FALSE(grid.IsStructure({10.2, 9}, 3.0, 0.4, M_PI / 2));
+}
+
 }  // namespace
 }  // namespace adse::algorithms
