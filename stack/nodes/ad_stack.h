@@ -33,12 +33,13 @@ struct StackInputs {
 
 // Topic indices the harness talks to.
 struct StackTopics {
-  int lidar_raw = -1;   // in: PointCloudMsg, vehicle frame
-  int odometry = -1;    // in: OdometryMsg
-  int pose = -1;        // out: PoseMsg (EKF)
-  int control = -1;     // out: ControlMsg
-  int trajectory = -1;  // out: TrajectoryMsg
-  int objects = -1;     // out: ObjectsMsg
+  int lidar_raw = -1;    // in: PointCloudMsg, vehicle frame
+  int odometry = -1;     // in: OdometryMsg
+  int pose = -1;         // out: PoseMsg (EKF)
+  int control = -1;      // out: ControlMsg
+  int trajectory = -1;   // out: TrajectoryMsg
+  int stop_reason = -1;  // out: StopReasonMsg, why the trajectory stops
+  int objects = -1;      // out: ObjectsMsg
 };
 
 class AdStack {
