@@ -34,6 +34,17 @@ struct NdtParams {
   // PCL's NDT score per point (transform likelihood); must be at least
   // this. Depends on resolution and outlier_ratio: retune with them.
   double min_transform_likelihood = 1.5;
+  // That likelihood counts every scan point, and scores 0 for points the
+  // map has no normal cell for (its 1 m ground grid gives a 2 m cell too
+  // few points), so where structure is sparse (a road lined only with
+  // poles) right poses score 0.2-0.3 and are refused. A match is therefore
+  // also accepted on the likelihood per point that has a cell
+  // (cell_likelihood, as Autoware's nearest-voxel likelihood): measured
+  // 3.9-5.0 at right poses, on poles and in the parking lot, and 0.7-2.0
+  // at poses 2.5-11 m off (where fitness alone, 0.33-0.40 at some, would
+  // not tell), given enough such points.
+  double min_cell_likelihood = 3.0;
+  int min_points_near_cells = 30;
   double outlier_ratio = 0.55;  // NDT's mixture weight for outliers
   int threads = 1;              // hint only; PCL 1.13's NDT is serial
   // Uncertainty (1 sigma) the pose fusion gives a match: NDT's Hessian is
@@ -54,9 +65,15 @@ struct NdtResult {
   // PCL's flag; PCL also sets it when the iteration limit is hit.
   bool converged = false;
   bool hit_iteration_limit = false;  // iterations == max_iterations
-  // converged, fitness below max and likelihood above min.
+  // converged, fitness below max, and either likelihood at least its min
+  // or cell likelihood at least its min over enough points near cells.
   bool accepted = false;
-  int points_used = 0;     // scan points given to NDT
+  int points_used = 0;  // scan points given to NDT
+  // Aligned points with a normal cell of the map within one resolution,
+  // and the likelihood per such point (transform_likelihood counts every
+  // point, those the map has no cell for, such as sparse ground, as 0).
+  int points_near_cells = 0;
+  double cell_likelihood = 0.0;
   int64_t work_units = 0;  // iterations x points (cost model)
 };
 

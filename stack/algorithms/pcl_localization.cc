@@ -43,12 +43,30 @@ Cloud::Ptr ToCloud(const std::vector<Eigen::Vector3f>& points) {
   return cloud;
 }
 
-}  // namespace
-
 // ---------------------------------------------------------------- NDT
 
+// PCL's NDT with its normal cells open to the acceptance test.
+class Ndt
+    : public pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ> {
+ public:
+  // Points of `cloud` with a normal cell of the map within one resolution:
+  // the neighbourhood PCL scores a point by (the others score 0).
+  int PointsNearCells(const Cloud& cloud) const {
+    std::vector<TargetGridLeafConstPtr> cells;
+    std::vector<float> distances;
+    int near = 0;
+    for (const pcl::PointXYZ& p : cloud.points) {
+      if (target_cells_.radiusSearch(p, resolution_, cells, distances, 1) > 0)
+        ++near;
+    }
+    return near;
+  }
+};
+
+}  // namespace
+
 struct NdtMatcher::Impl {
-  pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ> ndt;
+  Ndt ndt;
   Cloud::Ptr map;
   // Nearest map point for the fitness score; shared with NDT so PCL does
   // not build a second tree on the first Align().
@@ -169,10 +187,21 @@ Result<NdtResult> NdtMatcher::Align(const std::vector<Eigen::Vector3f>& scan,
   }
   result.fitness_score_m2 =
       impl_->aligned.empty() ? cap2 : sum / impl_->aligned.size();
-  result.accepted =
-      result.converged && result.fitness_score_m2 < params_.max_fitness_m2 &&
-      result.transform_likelihood >= params_.min_transform_likelihood;
-  // The fitness pass costs about one more iteration's worth of searches.
+  result.points_near_cells = impl_->ndt.PointsNearCells(impl_->aligned);
+  result.cell_likelihood = result.points_near_cells > 0
+                               ? result.transform_likelihood *
+                                     result.points_used /
+                                     result.points_near_cells
+                               : 0.0;
+  const bool likely =
+      result.transform_likelihood >= params_.min_transform_likelihood ||
+      (result.points_near_cells >= params_.min_points_near_cells &&
+       result.cell_likelihood >= params_.min_cell_likelihood);
+  result.accepted = result.converged &&
+                    result.fitness_score_m2 < params_.max_fitness_m2 && likely;
+  // The fitness pass costs about one more iteration's worth of searches
+  // (counting points near cells is part of scoring, as Autoware's NDT,
+  // whose costs the profile holds, computes its nearest-voxel likelihood).
   result.work_units = static_cast<int64_t>(result.iterations + 1) *
                       static_cast<int64_t>(result.points_used);
   return result;
