@@ -20,12 +20,15 @@ void MapFilter::SetMap(const std::vector<Eigen::Vector3f>& map_points) {
   voxels_.clear();
   std::unordered_set<int64_t> occupied;
   occupied.reserve(map_points.size());
-  for (const Eigen::Vector3f& p : map_points)
-    occupied.insert(Key(p.x(), p.y(), p.z()));
+  for (const Eigen::Vector3f& p : map_points) {
+    if (p.z() > params_.ground_height_m)
+      occupied.insert(Key(p.x(), p.y(), p.z()));
+  }
   voxels_.reserve(occupied.size() * 8);
   const double v = params_.voxel_m;
   for (const Eigen::Vector3f& p : map_points) {
-    if (occupied.erase(Key(p.x(), p.y(), p.z())) == 0) continue;  // voxel done
+    // Ground, or a voxel done.
+    if (occupied.erase(Key(p.x(), p.y(), p.z())) == 0) continue;
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dz = -1; dz <= 1; ++dz) {

@@ -16,6 +16,12 @@ namespace adse::algorithms {
 struct MapFilterParams {
   double voxel_m = 0.5;  // map voxel size; a point within about one voxel of
                          // a map point counts as explained by the map
+  // Map points this low are ground. The ground filter removes scan points
+  // this low before the map filter sees them, so ground needs no voxels,
+  // and with them its neighbours would explain every point below
+  // voxel_m * 2 anywhere on the map (a car's whole lower body), at the
+  // cost of a voxel set over the map's whole area (GBs for a city).
+  double ground_height_m = 0.25;
 };
 
 class MapFilter {

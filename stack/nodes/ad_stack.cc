@@ -334,6 +334,9 @@ void Stack::BuildPerception(Graph* g) {
   algo::GroundParams ground;
   ground.height_threshold_m = config_.Get("perception.ground_height_m");
   const double max_range = config_.Get("perception.max_range_m");
+  algo::MapFilterParams map_params;
+  map_params.ground_height_m = ground.height_threshold_m;
+  map_filter_ = algo::MapFilter(map_params);
   map_filter_.SetMap(inputs_.map_cloud);
   const int ground_node = g->AddNode("ground_filter");
   g->Subscribe<PoseMsg>(
