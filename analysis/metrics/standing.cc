@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 namespace adse::analysis {
@@ -10,7 +11,9 @@ namespace {
 // Per reason, and for obstacles per track: time stood and what was seen.
 struct TrackTime {
   double standing_s = 0.0;
-  double min_gap_m = -1;
+  // Gaps are negative for an object beside the car (its near edge behind
+  // the front bumper), so no sentinel value can stand for "none yet".
+  double min_gap_m = std::numeric_limits<double>::infinity();
   bool static_structure = false;
 };
 
@@ -44,8 +47,7 @@ StandingSummary SummarizeStanding(const runfile::RunData& run,
     if (reason == StopReason::kObstacle) {
       TrackTime& t = per_track[newest->track_id];
       t.standing_s += dt;
-      if (t.min_gap_m < 0 || newest->obstacle_gap_m < t.min_gap_m)
-        t.min_gap_m = newest->obstacle_gap_m;
+      t.min_gap_m = std::min(t.min_gap_m, newest->obstacle_gap_m);
       t.static_structure = t.static_structure || newest->static_structure != 0;
     }
   }

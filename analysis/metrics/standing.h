@@ -26,7 +26,8 @@ struct StandingTime {
   StopReason reason = StopReason::kNone;
   double standing_s = 0.0;
   // kObstacle: the track that held the car longest, its nearest gap (front
-  // bumper to its near edge) and whether the map has structure there.
+  // bumper to its near edge; negative when the object is beside the car)
+  // and whether the map has structure there.
   int track_id = -1;
   double obstacle_gap_m = -1;
   bool static_structure = false;

@@ -253,9 +253,15 @@ Result<std::vector<analysis::Remedy>> RemediesFromJson(
 std::string DescribeStanding(const analysis::StandingTime& t) {
   std::string what = StopReasonToString(t.reason);
   if (t.reason == StopReason::kObstacle) {
-    what += fmt::format(" (track {}{}, {:.1f} m ahead)", t.track_id,
-                        t.static_structure ? ", static structure" : "",
-                        t.obstacle_gap_m);
+    // A negative gap: the object's near edge is behind the front bumper
+    // (it cut in beside the car).
+    what += fmt::format(
+        " (track {}{}, {})", t.track_id,
+        t.static_structure ? ", static structure" : "",
+        t.obstacle_gap_m >= 0
+            ? fmt::format("{:.1f} m ahead", t.obstacle_gap_m)
+            : fmt::format("beside the car, {:.1f} m behind its front",
+                          -t.obstacle_gap_m));
   } else if (t.reason == StopReason::kNone) {
     what += " (the plan did not stop: held outside the planner)";
   }

@@ -79,6 +79,21 @@ TEST(StandingTest, EachStandingStretchGoesToTheReasonThatHeldTheCar) {
   EXPECT_NEAR(s.by_reason[4].standing_s, 2.0, 1e-6);
 }
 
+TEST(StandingTest, AnObjectBesideTheCarKeepsItsNearestNegativeGap) {
+  // A car cutting in beside the ego: its near edge 6.5 m, then 8.8 m,
+  // then 7.0 m behind the front bumper.
+  runfile::RunData run = RunStanding({{10, 40}});
+  Publish(&run, 0, 10, Reason(StopReason::kNone, -1));
+  Publish(&run, 10, 20, Obstacle(37, -6.5, false));
+  Publish(&run, 20, 30, Obstacle(37, -8.8, false));
+  Publish(&run, 30, 40, Obstacle(37, -7.0, false));
+  Publish(&run, 40, 100.05, Reason(StopReason::kNone, -1));
+  const StandingSummary s = SummarizeStanding(run);
+  ASSERT_EQ(s.by_reason.size(), 1u);
+  EXPECT_EQ(s.by_reason[0].track_id, 37);
+  EXPECT_DOUBLE_EQ(s.by_reason[0].obstacle_gap_m, -8.8);
+}
+
 TEST(StandingTest, BeforeThePlannerSpeaksThereIsNoTrajectory) {
   runfile::RunData run = RunStanding({{0, 2}});
   Publish(&run, 0.55, 100, Reason(StopReason::kNone, -1));

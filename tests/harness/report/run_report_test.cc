@@ -151,6 +151,17 @@ TEST(RunReportTest, NamesTheDominantStopReasonAndHowLongTheCarStood) {
   EXPECT_FALSE(j["standing"]["by_reason"][1].contains("track_id"));
 }
 
+TEST(RunReportTest, AnObjectBesideTheCarIsSaidToBeBesideIt) {
+  analysis::StandingTime t;
+  t.reason = StopReason::kObstacle;
+  t.standing_s = 33.6;
+  t.track_id = 37;
+  t.obstacle_gap_m = -8.8;
+  EXPECT_EQ(DescribeStanding(t),
+            "obstacle (track 37, beside the car, 8.8 m behind its front): "
+            "33.6 s");
+}
+
 TEST(RunReportTest, AnOldRunFileSaysItHasNoStopReasons) {
   runfile::RunData run = StoodRun();
   run.stop_reasons.clear();
