@@ -43,10 +43,11 @@ struct NdtParams {
   // Autoware's nearest-voxel likelihood: measured 4.9-7.2 at right poses
   // (parking lot, a pole-lined road, the DRT town), 0-1.2 at poses 2.5-11
   // m off (where fitness alone, 0.33-0.40 at some, would not tell), given
-  // enough such points (37-609 at right poses).
+  // enough such points (18-609 at right poses; a start on acosta, with two
+  // poles in 20 m, had 18 at 6.5).
   double ground_height_m = 0.3;
   double min_structure_likelihood = 3.0;
-  int min_structure_points = 20;
+  int min_structure_points = 10;
   double outlier_ratio = 0.55;  // NDT's mixture weight for outliers
   int threads = 1;              // hint only; PCL 1.13's NDT is serial
   // Uncertainty (1 sigma) the pose fusion gives a match: NDT's Hessian is
