@@ -375,6 +375,49 @@ TEST(NdtMatcher, HoldsItsPoseOnARoadLinedOnlyWithPoles) {
   EXPECT_GE(ended_wrong, 18);
 }
 
+// Fewer poles still: one side of the road, every 40 m (a start on acosta
+// saw two poles in 20 m): the few structure points that have a cell carry
+// the match, and a wrong pose leaves them none.
+TEST(NdtMatcher, HoldsItsPoseWithAFewPolesInView) {
+  world::Scene scene;
+  for (double x = -180; x <= 180; x += 40) {
+    world::Obstacle pole;
+    pole.kind = world::ObstacleKind::kPole;
+    pole.z_max_m = 5.0;
+    pole.footprint = {
+        {x - 0.15, -5.9}, {x + 0.15, -5.9}, {x + 0.15, -5.6}, {x - 0.15, -5.6}};
+    scene.AddObstacle(pole);
+  }
+  scene.Finalize();
+  world::MapCloudOptions options;
+  options.ground_margin_m = 150.0;
+  options.ground_spacing_m = 1.5;
+  NdtMatcher ndt;
+  ASSERT_TRUE(ndt.SetMap(world::SampleSceneSurface(scene, options)).ok());
+  world::LidarParams lidar_params;
+  world::LidarSimulator lidar(&scene, lidar_params, world::Weather::kClear, 9);
+  const geometry::Pose2 truth{12.0, -1.6, 0.0};
+  Points scan;
+  for (const Eigen::Vector3f& p : lidar.Scan(truth, 0.0, {}).points) {
+    scan.push_back(p + Eigen::Vector3f(0, 0, lidar_params.mount_height_m));
+  }
+  const Points filtered = VoxelDownsample(CropPoints(scan, CropParams()), 1.0);
+  auto r = ndt.Align(filtered, geometry::Pose2{12.2, -1.7, kDeg});
+  ASSERT_TRUE(r.ok());
+  EXPECT_TRUE(r->accepted) << "structure points " << r->structure_points
+                           << " likelihood " << r->structure_likelihood
+                           << " fitness " << r->fitness_score_m2;
+  EXPECT_LT(r->structure_points, 20);  // 17: fewer than the 20 once asked
+  EXPECT_NEAR(r->pose.x_m, truth.x_m, 0.2);
+  EXPECT_NEAR(r->pose.y_m, truth.y_m, 0.2);
+  auto wrong = ndt.Align(filtered, geometry::Pose2{22.0, -1.6, 0.0});
+  ASSERT_TRUE(wrong.ok());
+  ASSERT_GT(std::abs(wrong->pose.x_m - truth.x_m), 1.0);
+  EXPECT_FALSE(wrong->accepted)
+      << "structure points " << wrong->structure_points << " likelihood "
+      << wrong->structure_likelihood;
+}
+
 TEST(VoxelDownsample, KnownCountsOnAGrid) {
   // A 40 x 40 grid at 0.25 m, offset so no point lies on a voxel border:
   // 1 m voxels hold 4 x 4 points each, 10 x 10 voxels.
