@@ -418,6 +418,44 @@ TEST(NdtMatcher, HoldsItsPoseWithAFewPolesInView) {
       << wrong->structure_likelihood;
 }
 
+// A car starting at the fringe of a bare network (the first pole 10 m
+// ahead, nothing behind): with the map's default ground, the LiDAR's
+// ground behind the car is on the map too, and the start pose is held.
+TEST(NdtMatcher, HoldsItsStartPoseAtTheFringeOfTheMap) {
+  world::Scene scene;
+  for (double y = 20; y <= 300; y += 20) {
+    for (const double x : {-5.75, 5.75}) {
+      world::Obstacle pole;
+      pole.kind = world::ObstacleKind::kPole;
+      pole.z_max_m = 5.0;
+      pole.footprint = {{x - 0.15, y - 0.15},
+                        {x + 0.15, y - 0.15},
+                        {x + 0.15, y + 0.15},
+                        {x - 0.15, y + 0.15}};
+      scene.AddObstacle(pole);
+    }
+  }
+  scene.Finalize();
+  NdtMatcher ndt;
+  ASSERT_TRUE(
+      ndt.SetMap(world::SampleSceneSurface(scene, world::MapCloudOptions()))
+          .ok());
+  world::LidarParams lidar_params;
+  world::LidarSimulator lidar(&scene, lidar_params, world::Weather::kClear, 4);
+  const geometry::Pose2 truth{1.6, 10.0, M_PI / 2};
+  Points scan;
+  for (const Eigen::Vector3f& p : lidar.Scan(truth, 0.0, {}).points) {
+    scan.push_back(p + Eigen::Vector3f(0, 0, lidar_params.mount_height_m));
+  }
+  auto r =
+      ndt.Align(VoxelDownsample(CropPoints(scan, CropParams()), 1.0), truth);
+  ASSERT_TRUE(r.ok());
+  EXPECT_TRUE(r->accepted) << "fitness " << r->fitness_score_m2
+                           << " structure likelihood "
+                           << r->structure_likelihood;
+  EXPECT_LT(r->fitness_score_m2, 0.5);
+}
+
 TEST(VoxelDownsample, KnownCountsOnAGrid) {
   // A 40 x 40 grid at 0.25 m, offset so no point lies on a voxel border:
   // 1 m voxels hold 4 x 4 points each, 10 x 10 voxels.
