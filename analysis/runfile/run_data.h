@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "stack/algorithms/stop_reason.h"
 #include "stack/runtime/trace.h"
 
 namespace adse::runfile {
@@ -39,6 +40,17 @@ struct ControlSample {
   double t_s;      // publish time
   double stamp_s;  // originating sensor time
   double accel_mps2, steer_rad;
+};
+
+// Why the planner's trajectory stops, as published on /planning/stop_reason.
+struct StopSample {
+  double t_s;      // publish time
+  double stamp_s;  // the pose the trajectory was planned from
+  StopReason reason;
+  double stop_distance_m;    // ego rear axle to the stop; 0 there, -1 none
+  int32_t track_id;          // kObstacle: the track; else -1
+  double obstacle_gap_m;     // kObstacle: front bumper to its near edge
+  int32_t static_structure;  // kObstacle: 1 when the map has structure there
 };
 
 struct CollisionEvent {
@@ -149,6 +161,7 @@ struct RunData {
   std::vector<std::string> topic_names;
   stack::Trace trace;
   std::vector<ControlSample> controls;
+  std::vector<StopSample> stop_reasons;  // may be empty (older files)
 
   // Metrics by name (see scenarios/README.md); booleans as 0/1.
   std::map<std::string, double> metrics;

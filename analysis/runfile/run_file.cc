@@ -249,6 +249,39 @@ const std::vector<Column<ControlSample>>& ControlColumns() {
   return *columns;
 }
 
+// The planner's stop reason as an HDF5 enum whose codes are the
+// vocabulary's (stack/algorithms/stop_reason.h), so readers see names.
+Column<StopSample> StopReasonColumn() {
+  std::vector<std::pair<std::string, int8_t>> codes;
+  for (const std::string& name : StopReasonNames()) {
+    StopReason reason = StopReason::kNone;
+    StringToStopReason(name, &reason);
+    codes.emplace_back(name, static_cast<int8_t>(reason));
+  }
+  return {FieldDesc{"reason", FieldType::kEnum8, 0, std::move(codes)},
+          [](const StopSample& row, char* out) {
+            const int8_t code = static_cast<int8_t>(row.reason);
+            std::memcpy(out, &code, 1);
+          },
+          [](const char* in, StopSample* row) {
+            int8_t code = 0;
+            std::memcpy(&code, in, 1);
+            row->reason = static_cast<StopReason>(code);
+          }};
+}
+
+const std::vector<Column<StopSample>>& StopReasonColumns() {
+  static const auto* columns = new std::vector<Column<StopSample>>{
+      F64("t_s", &StopSample::t_s),
+      F64("stamp_s", &StopSample::stamp_s),
+      StopReasonColumn(),
+      F64("stop_distance_m", &StopSample::stop_distance_m),
+      I32("track_id", &StopSample::track_id),
+      F64("obstacle_gap_m", &StopSample::obstacle_gap_m),
+      I32("static_structure", &StopSample::static_structure)};
+  return *columns;
+}
+
 template <typename Row>
 std::vector<FieldDesc> Descs(const std::vector<Column<Row>>& columns) {
   std::vector<FieldDesc> descs;
@@ -438,6 +471,12 @@ Status WriteContents(hid_t file, const RunData& run) {
         WriteTable(g, "planned_path", p.planned_path, ParkingPathColumns()));
   }
   {
+    Result<Handle> group = CreateGroup(file, "planning");
+    if (!group.ok()) return group.status();
+    ADSE_RETURN_IF_ERROR(WriteTable(group->get(), "stop_reasons",
+                                    run.stop_reasons, StopReasonColumns()));
+  }
+  {
     Result<Handle> group = CreateGroup(file, "metrics");
     if (!group.ok()) return group.status();
     for (const auto& [name, value] : run.metrics) {
@@ -459,6 +498,16 @@ Status Validate(const RunData& run) {
       run.scenario_hash != Sha256Hex(run.scenario_text)) {
     return Status::InvalidArgument(
         "scenario_hash is not the sha256 of scenario_text");
+  }
+  for (size_t i = 0; i < run.stop_reasons.size(); ++i) {
+    StopReason named = StopReason::kNone;
+    const StopReason reason = run.stop_reasons[i].reason;
+    if (!StringToStopReason(StopReasonToString(reason), &named) ||
+        named != reason) {
+      return Status::InvalidArgument(
+          "stop reason " + std::to_string(i) + " has unknown code " +
+          std::to_string(static_cast<int>(run.stop_reasons[i].reason)));
+    }
   }
   const auto& events = run.trace.topic_events;
   for (size_t i = 0; i < events.size(); ++i) {
@@ -682,6 +731,16 @@ Status ReadContents(hid_t file, RunData* run) {
     if (!group.ok()) return group.status();
     ADSE_RETURN_IF_ERROR(Assign(
         ReadTable(group->get(), "commands", ControlColumns()), &run->controls));
+  }
+  // Files written before /planning/stop_reasons existed (same schema
+  // version) have no stop reasons.
+  if (internal::GetObjectKind(file, "/planning/stop_reasons") !=
+      internal::ObjectKind::kMissing) {
+    Result<Handle> group = OpenGroup(file, "/planning");
+    if (!group.ok()) return group.status();
+    ADSE_RETURN_IF_ERROR(
+        Assign(ReadTable(group->get(), "stop_reasons", StopReasonColumns()),
+               &run->stop_reasons));
   }
   return Status::Ok();
 }

@@ -97,6 +97,8 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
         {c.name, c.latency_p50_s, c.latency_p99_s, c.utilization});
   }
 
+  r.standing = analysis::SummarizeStanding(run);
+
   // Constraints, from the scenario stored in the run. The files it names
   // (a calibration, a net) need not exist where the run is re-analysed.
   spec::ParseOptions parse_options;
@@ -163,6 +165,20 @@ nlohmann::json ToJson(const RunReport& r) {
                              {"remedies", RemediesToJson(f.remedies)},
                              {"message", f.message}});
   }
+  nlohmann::json standing = {{"standing_s", Number(r.standing.standing_s)},
+                             {"has_reasons", r.standing.has_reasons},
+                             {"by_reason", nlohmann::json::array()}};
+  for (const analysis::StandingTime& t : r.standing.by_reason) {
+    nlohmann::json entry = {{"reason", StopReasonToString(t.reason)},
+                            {"standing_s", Number(t.standing_s)}};
+    if (t.reason == StopReason::kObstacle) {
+      entry["track_id"] = t.track_id;
+      entry["obstacle_gap_m"] = Number(t.obstacle_gap_m);
+      entry["static_structure"] = t.static_structure;
+    }
+    standing["by_reason"].push_back(std::move(entry));
+  }
+  j["standing"] = std::move(standing);
   j["trace"]["topics"] = nlohmann::json::array();
   for (const TopicSummary& t : r.topics) {
     j["trace"]["topics"].push_back(
@@ -234,6 +250,24 @@ Result<std::vector<analysis::Remedy>> RemediesFromJson(
   return remedies;
 }
 
+std::string DescribeStanding(const analysis::StandingTime& t) {
+  std::string what = StopReasonToString(t.reason);
+  if (t.reason == StopReason::kObstacle) {
+    // A negative gap: the object's near edge is behind the front bumper
+    // (it cut in beside the car).
+    what += fmt::format(
+        " (track {}{}, {})", t.track_id,
+        t.static_structure ? ", static structure" : "",
+        t.obstacle_gap_m >= 0
+            ? fmt::format("{:.1f} m ahead", t.obstacle_gap_m)
+            : fmt::format("beside the car, {:.1f} m behind its front",
+                          -t.obstacle_gap_m));
+  } else if (t.reason == StopReason::kNone) {
+    what += " (the plan did not stop: held outside the planner)";
+  }
+  return fmt::format("{}: {:.1f} s", what, t.standing_s);
+}
+
 std::string FormatSummary(const RunReport& r) {
   std::string out;
   auto metric = [&](const char* name) {
@@ -270,6 +304,20 @@ std::string FormatSummary(const RunReport& r) {
     out += fmt::format(
         "deviation   scored on the driven part ({:.0f} % of the path)\n",
         100 * r.driven_fraction);
+  }
+  if (r.standing.by_reason.empty()) {
+    out += fmt::format("stood       {:.1f} s{}\n", r.standing.standing_s,
+                       r.standing.has_reasons || r.standing.standing_s == 0
+                           ? ""
+                           : " (no stop reasons recorded in this run file)");
+  } else {
+    out += fmt::format("stood       {:.1f} s, mostly for {}\n",
+                       r.standing.standing_s,
+                       DescribeStanding(r.standing.by_reason.front()));
+    for (size_t i = 1; i < r.standing.by_reason.size(); ++i) {
+      out += fmt::format("            also {}\n",
+                         DescribeStanding(r.standing.by_reason[i]));
+    }
   }
   for (const ConstraintStatus& c : r.constraints) {
     out += fmt::format("constraint  {:<24} {}{}\n", c.expression,

@@ -13,6 +13,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "analysis/diagnosis/remedy.h"
+#include "analysis/metrics/standing.h"
 #include "analysis/runfile/run_data.h"
 #include "stack/base/env.h"
 #include "stack/base/status.h"
@@ -68,7 +69,8 @@ struct CallbackSummary {
 
 struct RunReport {
   // 2: findings carry typed `remedies` beside the readable `remedy`.
-  int report_version = 2;
+  // 3: `standing` says how long the car stood and for which stop reason.
+  int report_version = 3;
   std::string run_file;
   std::string scenario_name;
   std::map<std::string, double> point;
@@ -91,6 +93,8 @@ struct RunReport {
   double driven_fraction = 0.0;
   std::string deviation_error;
   std::vector<FindingSummary> findings;
+  // How long the ego stood and why, longest reason first (the dominant).
+  analysis::StandingSummary standing;
   std::vector<TopicSummary> topics;
   std::vector<CallbackSummary> callbacks;
   std::map<std::string, std::string> images;  // "trajectory" -> png path
@@ -115,8 +119,13 @@ nlohmann::json RemediesToJson(const std::vector<analysis::Remedy>& remedies);
 // "kind" or "target") is Corruption saying which entry.
 Result<std::vector<analysis::Remedy>> RemediesFromJson(const nlohmann::json& j);
 
-// A short human summary: outcome, key metrics, constraints, findings.
+// A short human summary: outcome, key metrics, why the car stood,
+// constraints, findings.
 std::string FormatSummary(const RunReport& report);
+
+// One stretch of standing in words, e.g. "obstacle (track 12, static
+// structure, 1.8 m ahead): 412.3 s".
+std::string DescribeStanding(const analysis::StandingTime& time);
 
 }  // namespace adse::report
 

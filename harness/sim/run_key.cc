@@ -10,8 +10,10 @@
 namespace adse::sim {
 namespace {
 
-// Bump when the meaning of a run changes without any input changing.
-constexpr char kKeyVersion[] = "adse-run-key-v1";
+// Bump when the meaning of a run changes without any input changing. v2:
+// NDT's acceptance and the map filter changed (issue 17), so runs cached
+// by earlier versions are not reused.
+constexpr char kKeyVersion[] = "adse-run-key-v2";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

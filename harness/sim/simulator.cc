@@ -181,6 +181,12 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
           if (parking_done_at_s < 0) parking_done_at_s = t_s;
         });
   }
+  graph.AddSink<stack::StopReasonMsg>(
+      topics.stop_reason, [&](const stack::StopReasonMsg& m, double t_s) {
+        run.stop_reasons.push_back(
+            {t_s, m.header.stamp_s, m.reason, m.stop_distance_m, m.track_id,
+             m.obstacle_gap_m, m.static_structure ? 1 : 0});
+      });
   graph.AddSink<stack::PoseMsg>(topics.pose,
                                 [&](const stack::PoseMsg& m, double t_s) {
                                   gate.OnLocalization(t_s, m.valid);

@@ -34,6 +34,20 @@ struct NdtParams {
   // PCL's NDT score per point (transform likelihood); must be at least
   // this. Depends on resolution and outlier_ratio: retune with them.
   double min_transform_likelihood = 1.5;
+  // That likelihood counts every scan point, and scores 0 for points the
+  // map has no normal cell for: its ground grid (1 m, 1.5 m on city maps)
+  // gives a 2 m cell too few points. Where structure is sparse (an OSM
+  // town: roadside poles only) right poses score 0.1-0.3 and all were
+  // refused. So a match is also accepted on the likelihood per structure
+  // point (higher than ground_height_m at the pose) that has a cell, as
+  // Autoware's nearest-voxel likelihood: measured 4.9-7.2 at right poses
+  // (parking lot, a pole-lined road, the DRT town), 0-1.2 at poses 2.5-11
+  // m off (where fitness alone, 0.33-0.40 at some, would not tell), given
+  // enough such points (18-609 at right poses; a start on acosta, with two
+  // poles in 20 m, had 18 at 6.5).
+  double ground_height_m = 0.3;
+  double min_structure_likelihood = 3.0;
+  int min_structure_points = 10;
   double outlier_ratio = 0.55;  // NDT's mixture weight for outliers
   int threads = 1;              // hint only; PCL 1.13's NDT is serial
   // Uncertainty (1 sigma) the pose fusion gives a match: NDT's Hessian is
@@ -48,15 +62,23 @@ struct NdtResult {
   double z_m = 0.0;  // height of the transform (ground should give ~0)
   // Full scan-to-map transform, z and roll/pitch free.
   Eigen::Matrix4f transform = Eigen::Matrix4f::Identity();
+  // The scores below are those of `pose` (z = 0, no roll or pitch), the
+  // pose that is used, not of `transform`.
   double fitness_score_m2 = 0.0;      // see NdtParams::max_fitness_m2
   double transform_likelihood = 0.0;  // see min_transform_likelihood
   int iterations = 0;                 // Newton iterations used
   // PCL's flag; PCL also sets it when the iteration limit is hit.
   bool converged = false;
   bool hit_iteration_limit = false;  // iterations == max_iterations
-  // converged, fitness below max and likelihood above min.
+  // converged, fitness below max, and either likelihood at least its min
+  // or structure likelihood at least its min over enough points.
   bool accepted = false;
-  int points_used = 0;     // scan points given to NDT
+  int points_used = 0;  // scan points given to NDT
+  // Structure points of the scan (higher than ground_height_m) with a
+  // normal cell of the map within one resolution, and their likelihood
+  // per point (see NdtParams::min_structure_likelihood).
+  int structure_points = 0;
+  double structure_likelihood = 0.0;
   int64_t work_units = 0;  // iterations x points (cost model)
 };
 

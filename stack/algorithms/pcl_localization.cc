@@ -7,6 +7,7 @@
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
+#include <pcl/common/transforms.h>
 #include <pcl/console/print.h>
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/kdtree/kdtree_flann.h>
@@ -43,17 +44,53 @@ Cloud::Ptr ToCloud(const std::vector<Eigen::Vector3f>& points) {
   return cloud;
 }
 
-}  // namespace
-
 // ---------------------------------------------------------------- NDT
 
+// PCL's NDT with its normal cells open to the acceptance test.
+class Ndt
+    : public pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ> {
+ public:
+  // PCL's NDT score of `cloud` (map frame) as it stands: per point, the sum
+  // over the normal cells within one resolution (Magnusson's eq. 6.9, as
+  // computeDerivatives adds it up). Also the score and count of the points
+  // higher than min_z_m (structure, not ground) that have a cell.
+  double Score(const Cloud& cloud, double min_z_m, double* structure_score,
+               int* structure_near) const {
+    std::vector<TargetGridLeafConstPtr> cells;
+    std::vector<float> distances;
+    double score = 0.0;
+    *structure_score = 0.0;
+    *structure_near = 0;
+    for (const pcl::PointXYZ& p : cloud.points) {
+      target_cells_.radiusSearch(p, resolution_, cells, distances);
+      double point_score = 0.0;
+      for (const TargetGridLeafConstPtr& cell : cells) {
+        const Eigen::Vector3d d =
+            p.getVector3fMap().cast<double>() - cell->getMean();
+        point_score +=
+            -gauss_d1_ *
+            std::exp(-gauss_d2_ * d.dot(cell->getInverseCov() * d) / 2);
+      }
+      score += point_score;
+      if (!cells.empty() && p.z > min_z_m) {
+        ++*structure_near;
+        *structure_score += point_score;
+      }
+    }
+    return score;
+  }
+};
+
+}  // namespace
+
 struct NdtMatcher::Impl {
-  pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ> ndt;
+  Ndt ndt;
   Cloud::Ptr map;
   // Nearest map point for the fitness score; shared with NDT so PCL does
   // not build a second tree on the first Align().
   pcl::search::KdTree<pcl::PointXYZ>::Ptr tree;
   Cloud aligned;  // scratch output of align(), reused
+  Cloud planar;   // the scan at the planar pose, reused
 };
 
 NdtMatcher::NdtMatcher(const NdtParams& params)
@@ -135,7 +172,6 @@ Result<NdtResult> NdtMatcher::Align(const std::vector<Eigen::Vector3f>& scan,
     result.transform = impl_->ndt.getFinalTransformation();
     result.iterations = impl_->ndt.getFinalNumIteration();
     result.converged = impl_->ndt.hasConverged();
-    result.transform_likelihood = impl_->ndt.getTransformationLikelihood();
   } catch (const std::exception& e) {
     return Status::Internal(std::string("NDT align: ") + e.what());
   }
@@ -152,27 +188,48 @@ Result<NdtResult> NdtMatcher::Align(const std::vector<Eigen::Vector3f>& scan,
   // with small roll/pitch left free.
   result.pose.yaw_rad = std::atan2(t(1, 0), t(0, 0));
 
-  // Fitness: mean capped squared distance of the aligned scan to the map.
-  // PCL's getFitnessScore ignores far points instead of capping them,
-  // which scores a scan matched to nothing as perfect.
+  // Scores of the planar pose that is published, not of NDT's 6-DoF
+  // result: where the map's ground has no cells (too sparse), nothing holds
+  // NDT's z, which drifts up to 0.4 m and lifts the scan's ground off the
+  // map's, failing right poses.
+  const Eigen::Affine3f planar =
+      Eigen::Translation3f(result.pose.x_m, result.pose.y_m, 0.0f) *
+      Eigen::AngleAxisf(static_cast<float>(result.pose.yaw_rad),
+                        Eigen::Vector3f::UnitZ());
+  pcl::transformPointCloud(*source, impl_->planar, planar);
+  // Fitness: mean capped squared distance of the scan to the map. PCL's
+  // getFitnessScore ignores far points instead of capping them, which
+  // scores a scan matched to nothing as perfect.
   const double cap2 =
       params_.fitness_max_distance_m * params_.fitness_max_distance_m;
   double sum = 0.0;
   std::vector<int> index(1);
   std::vector<float> dist2(1);
-  for (const pcl::PointXYZ& p : impl_->aligned.points) {
+  for (const pcl::PointXYZ& p : impl_->planar.points) {
     if (impl_->tree->nearestKSearch(p, 1, index, dist2) > 0) {
       sum += std::min<double>(dist2[0], cap2);
     } else {
       sum += cap2;
     }
   }
-  result.fitness_score_m2 =
-      impl_->aligned.empty() ? cap2 : sum / impl_->aligned.size();
-  result.accepted =
-      result.converged && result.fitness_score_m2 < params_.max_fitness_m2 &&
-      result.transform_likelihood >= params_.min_transform_likelihood;
-  // The fitness pass costs about one more iteration's worth of searches.
+  result.fitness_score_m2 = sum / result.points_used;
+  double structure_score = 0.0;
+  const double score =
+      impl_->ndt.Score(impl_->planar, params_.ground_height_m, &structure_score,
+                       &result.structure_points);
+  result.transform_likelihood = score / result.points_used;
+  result.structure_likelihood = result.structure_points > 0
+                                    ? structure_score / result.structure_points
+                                    : 0.0;
+  const bool likely =
+      result.transform_likelihood >= params_.min_transform_likelihood ||
+      (result.structure_points >= params_.min_structure_points &&
+       result.structure_likelihood >= params_.min_structure_likelihood);
+  result.accepted = result.converged &&
+                    result.fitness_score_m2 < params_.max_fitness_m2 && likely;
+  // The fitness pass costs about one more iteration's worth of searches
+  // (the scores at the planar pose are part of scoring, as Autoware's NDT,
+  // whose costs the profile holds, computes its nearest-voxel likelihood).
   result.work_units = static_cast<int64_t>(result.iterations + 1) *
                       static_cast<int64_t>(result.points_used);
   return result;

@@ -230,10 +230,12 @@ ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
       stop_s = stop;
       near_edge_s = ob_s - half_along;
       out.obstacle_id = ob.id;
+      out.static_structure = ob.static_structure;
     }
   }
   if (stop_s > end_s) {
     out.obstacle_id = -1;
+    out.static_structure = false;
     return out;
   }
   out.stop = true;
@@ -263,6 +265,37 @@ ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
   }
   for (PlannedPoint& p : pts) {
     if (p.s_m >= stop_s - 1e-6) p.v_mps = 0.0;
+  }
+  return out;
+}
+
+StopDecision DecideStop(std::vector<PlannedPoint>* points, bool ends_at_goal,
+                        bool localization_lost, const ObstacleStop& obstacle) {
+  StopDecision out;
+  if (points == nullptr || points->empty()) {
+    out.reason = StopReason::kNoTrajectory;
+    out.distance_m = 0.0;
+    return out;
+  }
+  if (localization_lost) {
+    for (PlannedPoint& p : *points) p.v_mps = 0.0;
+    out.reason = StopReason::kLocalizationLost;
+    out.distance_m = 0.0;
+    return out;
+  }
+  const double s0 = points->front().s_m;
+  if (ends_at_goal) {
+    out.reason = StopReason::kGoal;
+    out.distance_m = std::max(0.0, points->back().s_m - s0);
+  }
+  // The obstacle's stop lies on the path (never past its end), so at the
+  // goal or before it: it is the one that holds the car.
+  if (obstacle.stop) {
+    out.reason = StopReason::kObstacle;
+    out.distance_m = std::max(0.0, obstacle.stop_s_m - s0);
+    out.obstacle_id = obstacle.obstacle_id;
+    out.obstacle_gap_m = obstacle.gap_m;
+    out.static_structure = obstacle.static_structure;
   }
   return out;
 }

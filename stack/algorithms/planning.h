@@ -10,6 +10,7 @@
 #include <optional>
 #include <vector>
 
+#include "stack/algorithms/stop_reason.h"
 #include "stack/geometry/geometry.h"
 
 namespace adse::algorithms {
@@ -32,6 +33,9 @@ struct PlannerObstacle {
   double length_m = 0.0;
   double width_m = 0.0;
   double yaw_rad = 0.0;
+  // The map has structure where it stands (StructureGrid): static
+  // structure taken for an object, not traffic.
+  bool static_structure = false;
 };
 
 // Nearest point of `path` to p over arc lengths [s_lo, s_hi]: returns its
@@ -125,9 +129,10 @@ struct ObstacleStopParams {
 };
 
 struct ObstacleStop {
-  bool stop = false;     // an obstacle blocks the path
-  int obstacle_id = -1;  // the nearest blocking obstacle
-  double stop_s_m = -1;  // where v becomes 0 (rear axle), -1: nowhere
+  bool stop = false;              // an obstacle blocks the path
+  int obstacle_id = -1;           // the nearest blocking obstacle
+  bool static_structure = false;  // that obstacle is map structure
+  double stop_s_m = -1;           // where v becomes 0 (rear axle), -1: nowhere
   // From the ego's front bumper to the obstacle's near edge, along the path.
   double gap_m = -1;
   int64_t work_units = 0;  // obstacles x points
@@ -139,6 +144,28 @@ struct ObstacleStop {
 ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
                                 const std::vector<PlannerObstacle>& obstacles,
                                 const ObstacleStopParams& params);
+
+// --- Why the trajectory stops ---------------------------------------------
+
+struct StopDecision {
+  StopReason reason = StopReason::kNone;
+  // Along the path from the ego (rear axle) to where the speed becomes 0;
+  // 0 when the stop is there or behind; -1 without a stop.
+  double distance_m = -1;
+  // kObstacle only: the track, the gap from the ego's front bumper to its
+  // near edge, and whether the map has structure there.
+  int obstacle_id = -1;
+  double obstacle_gap_m = -1;
+  bool static_structure = false;
+};
+
+// The stop the trajectory `points` (from the ego onwards) makes, and why:
+// no points, no trajectory; localization lost holds the car where it is
+// (every speed set to 0: the planner does not drive by a pose it does not
+// trust); otherwise the nearer of the goal's stop (ends_at_goal: its last
+// point) and the obstacle's, or none.
+StopDecision DecideStop(std::vector<PlannedPoint>* points, bool ends_at_goal,
+                        bool localization_lost, const ObstacleStop& obstacle);
 
 struct SmootherParams {
   double max_accel_mps2 = 1.0;  // forward pass: speed-up limit

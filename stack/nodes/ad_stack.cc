@@ -98,6 +98,7 @@ class Stack final : public AdStack {
   double ekf_last_t_ = 0.0;
   double ekf_stamp_ = -1.0;  // stamp of the newest fused NDT pose
   algo::MapFilter map_filter_;
+  algo::StructureGrid structure_grid_;  // obstacle_stop_planner's map view
   std::optional<PoseMsg> ground_pose_;
   std::optional<PoseMsg> cluster_pose_;
   std::unique_ptr<algo::Tracker> tracker_;
@@ -132,6 +133,7 @@ Status Stack::Build(Graph* g) {
   path_limited_ = g->AddTopic<TrajectoryMsg>("/planning/path_with_velocity");
   trajectory_raw_ = g->AddTopic<TrajectoryMsg>("/planning/trajectory_raw");
   topics_.trajectory = g->AddTopic<TrajectoryMsg>("/planning/trajectory");
+  topics_.stop_reason = g->AddTopic<StopReasonMsg>("/planning/stop_reason");
   topics_.control = g->AddTopic<ControlMsg>("/control/command");
   BuildSensing(g);
   ADSE_RETURN_IF_ERROR(BuildLocalization(g));
@@ -346,6 +348,9 @@ void Stack::BuildPerception(Graph* g) {
   algo::GroundParams ground;
   ground.height_threshold_m = config_.Get("perception.ground_height_m");
   const double max_range = config_.Get("perception.max_range_m");
+  algo::MapFilterParams map_params;
+  map_params.ground_height_m = ground.height_threshold_m;
+  map_filter_ = algo::MapFilter(map_params);
   map_filter_.SetMap(inputs_.map_cloud);
   const int ground_node = g->AddNode("ground_filter");
   g->Subscribe<PoseMsg>(
@@ -464,18 +469,23 @@ void Stack::BuildPlanning(Graph* g) {
   g->Subscribe<PoseMsg>(
       path_node, topics_.pose, "pose", 1,
       [this](const PoseMsg& in, CallbackContext&) { path_pose_ = in; });
-  g->AddTimer(path_node, "plan", 1.0 / config_.Get("planning.rate_hz"),
-              [this](CallbackContext& ctx) {
-                if (!path_planner_->has_route() || !path_pose_) return;
-                const algo::PlannedPath path =
-                    path_planner_->Plan(path_pose_->pose);
-                TrajectoryMsg out;
-                out.header.stamp_s = path_pose_->header.stamp_s;
-                out.ends_at_goal = path.ends_at_goal;
-                out.points = ToMessage(path.points);
-                ctx.ReportWork({static_cast<double>(path.work_units), 0.0, 1});
-                ctx.Publish(path_, std::move(out));
-              });
+  g->AddTimer(
+      path_node, "plan", 1.0 / config_.Get("planning.rate_hz"),
+      [this](CallbackContext& ctx) {
+        TrajectoryMsg out;
+        out.header.stamp_s = -1.0;
+        // Without a route or a pose there is nothing to plan: an
+        // empty path, so the stages downstream say so.
+        if (path_planner_->has_route() && path_pose_) {
+          const algo::PlannedPath path = path_planner_->Plan(path_pose_->pose);
+          out.header.stamp_s = path_pose_->header.stamp_s;
+          out.ends_at_goal = path.ends_at_goal;
+          out.localization_lost = !path_pose_->valid;
+          out.points = ToMessage(path.points);
+          ctx.ReportWork({static_cast<double>(path.work_units), 0.0, 1});
+        }
+        ctx.Publish(path_, std::move(out));
+      });
 
   // behavior_velocity_planner: speed limits along the path, 0 at the goal.
   algo::VelocityLimitParams limits;
@@ -502,6 +512,7 @@ void Stack::BuildPlanning(Graph* g) {
   stop_params.stop_margin_m = config_.Get("planning.stop_margin_m");
   stop_params.ego_front_m =
       inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2;
+  structure_grid_.SetMap(inputs_.map_cloud);
   const int stop_node = g->AddNode("obstacle_stop_planner");
   g->Subscribe<ObjectsMsg>(
       stop_node, topics_.objects, "objects", 1,
@@ -518,16 +529,26 @@ void Stack::BuildPlanning(Graph* g) {
             ob.velocity = o.velocity;
             ob.length_m = o.length_m;
             ob.width_m = o.width_m;
+            ob.static_structure = structure_grid_.IsStructure(
+                o.position, o.length_m, o.width_m, ob.yaw_rad);
             obstacles.push_back(ob);
           }
         }
         std::vector<algo::PlannedPoint> points = ToPlanned(in.points);
         const algo::ObstacleStop stop =
             algo::InsertObstacleStop(&points, obstacles, stop_params);
+        const algo::StopDecision decision = algo::DecideStop(
+            &points, in.ends_at_goal, in.localization_lost, stop);
         TrajectoryMsg out = in;
         out.points = ToMessage(points);
-        out.stop_for_obstacle = stop.stop;
+        out.stop.header = in.header;
+        out.stop.reason = decision.reason;
+        out.stop.stop_distance_m = decision.distance_m;
+        out.stop.track_id = decision.obstacle_id;
+        out.stop.obstacle_gap_m = decision.obstacle_gap_m;
+        out.stop.static_structure = decision.static_structure;
         ctx.ReportWork({static_cast<double>(stop.work_units), 0.0, 1});
+        ctx.Publish(topics_.stop_reason, out.stop);
         ctx.Publish(trajectory_raw_, std::move(out));
       });
 

@@ -44,6 +44,7 @@ struct StackTopics {
   int pose = -1;          // out: PoseMsg (EKF)
   int control = -1;       // out: ControlMsg
   int trajectory = -1;    // out: TrajectoryMsg
+  int stop_reason = -1;   // out: StopReasonMsg, why the trajectory stops
   int objects = -1;       // out: ObjectsMsg
   int parking_path = -1;  // out: ParkingPathMsg (valet_parking only)
   int parking_done = -1;  // out: ParkingDoneMsg (valet_parking only)

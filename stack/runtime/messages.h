@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "stack/algorithms/stop_reason.h"
 #include "stack/geometry/geometry.h"
 
 namespace adse::stack {
@@ -71,11 +72,27 @@ struct TrajectoryPoint {
   double curvature_1pm = 0.0;  // signed path curvature (left positive)
 };
 
+// Why the planned trajectory stops (/planning/stop_reason), published with
+// every trajectory by the stage that decides it (obstacle_stop_planner).
+struct StopReasonMsg {
+  Header header;  // the pose the trajectory was planned from
+  StopReason reason = StopReason::kNone;
+  // From the ego's rear axle to where the speed becomes 0, along the path;
+  // 0 when there or behind; -1 without a stop.
+  double stop_distance_m = -1;
+  // kObstacle: the track id, the gap from the ego's front bumper to the
+  // object's near edge, and whether the map has static structure there.
+  int track_id = -1;
+  double obstacle_gap_m = -1;
+  bool static_structure = false;
+};
+
 struct TrajectoryMsg {
   Header header;
   std::vector<TrajectoryPoint> points;
   bool ends_at_goal = false;       // the path's last point is the goal
-  bool stop_for_obstacle = false;  // an obstacle stop was inserted
+  bool localization_lost = false;  // planned from a pose marked invalid
+  StopReasonMsg stop;              // set by obstacle_stop_planner
 };
 
 // The freespace planner's parking manoeuvre (or why there is none).

@@ -18,8 +18,11 @@ struct MapCloudOptions {
   // Ground points (z = 0): a sparse grid, enough to pin down height and
   // tilt in scan matching; <= 0 leaves the ground out.
   double ground_spacing_m = 1.0;
-  // The ground grid covers the scene bounds grown by this much.
-  double ground_margin_m = 10.0;
+  // The ground grid covers the scene bounds grown by this much: as far as
+  // the LiDAR sees (LidarParams::range_m) past the outermost structure. With
+  // 10 m, a car starting at the fringe of a bare network saw its ground
+  // off the map behind it, never localized and stood the whole run.
+  double ground_margin_m = 60.0;
 };
 
 // Points on every obstacle face (footprint edges from z_min to z_max,

@@ -651,26 +651,46 @@ Status World::Impl::BuildScene() {
         }
         return true;
       };
+      // The outermost lanes of each normal edge carry its roadsides: the
+      // rightmost (index 0) and the leftmost, whose poles stand on the far
+      // side of a one-way street (on a two-way road, the other direction's
+      // lanes are there, and clear_of_roads skips them). With the right
+      // side only, a one-way street left the LiDAR one or two poles in
+      // 40 m, too few for NDT (localization lost on sumo-tools' acosta).
+      std::map<std::string, int> leftmost;  // edge -> highest lane index
+      for (const std::string& id : lanes) {
+        if (id[0] == ':') continue;
+        const size_t cut = id.rfind('_');
+        const int index = std::atoi(id.c_str() + cut + 1);
+        int& top = leftmost.try_emplace(id.substr(0, cut), index).first->second;
+        top = std::max(top, index);
+      }
       for (size_t i = 0; i < lanes.size(); ++i) {
-        // The rightmost lane of each normal edge carries its roadside.
-        if (lanes[i][0] == ':' || lanes[i].substr(lanes[i].rfind('_')) != "_0")
-          continue;
+        if (lanes[i][0] == ':') continue;
+        const size_t cut = lanes[i].rfind('_');
+        const int index = std::atoi(lanes[i].c_str() + cut + 1);
+        std::vector<double> sides;  // +1 right, -1 left
+        if (index == 0) sides.push_back(1.0);
+        if (index == leftmost[lanes[i].substr(0, cut)]) sides.push_back(-1.0);
+        if (sides.empty()) continue;
         geometry::Path2 shape;
         shape.points = shapes[i].points;
         shape.UpdateArcLength();
         const double offset = shapes[i].half_width + 1.0;
-        for (double s = 10.0; s < shape.length_m() - 5.0; s += 20.0) {
-          const double h = shape.HeadingAt(s);
-          const Vec2 p =
-              shape.PointAt(s) + offset * Vec2(std::sin(h), -std::cos(h));
-          if (!clear_of_roads(p)) continue;
-          Obstacle pole;
-          pole.kind = ObstacleKind::kPole;
-          pole.z_max_m = 5.0;
-          const double r = 0.15;
-          pole.footprint = {p + Vec2(-r, -r), p + Vec2(r, -r), p + Vec2(r, r),
-                            p + Vec2(-r, r)};
-          scene.AddObstacle(std::move(pole));
+        for (const double side : sides) {
+          for (double s = 10.0; s < shape.length_m() - 5.0; s += 20.0) {
+            const double h = shape.HeadingAt(s);
+            const Vec2 p = shape.PointAt(s) +
+                           side * offset * Vec2(std::sin(h), -std::cos(h));
+            if (!clear_of_roads(p)) continue;
+            Obstacle pole;
+            pole.kind = ObstacleKind::kPole;
+            pole.z_max_m = 5.0;
+            const double r = 0.15;
+            pole.footprint = {p + Vec2(-r, -r), p + Vec2(r, -r), p + Vec2(r, r),
+                              p + Vec2(-r, r)};
+            scene.AddObstacle(std::move(pole));
+          }
         }
       }
     }
@@ -952,7 +972,9 @@ Result<std::string> World::MapCloudPath() const {
   const Impl& w = *impl_;
   MapCloudOptions options;
   ContentHasher hasher;
-  hasher.Add("adse-cloud-v1")
+  // v2: bare networks' roadside poles also on the left of one-way streets
+  // (a cloud cached before would miss them).
+  hasher.Add("adse-cloud-v2")
       .Add(w.map.key)
       .Add(static_cast<long long>(w.setup.world.traffic.seed))
       .Add(w.setup.world.traffic.parked_occupancy)

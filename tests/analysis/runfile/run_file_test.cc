@@ -188,6 +188,22 @@ std::string Diff(const RunData& a, const RunData& b) {
       num(at + "steer_rad", x.steer_rad, y.steer_rad);
     }
   }
+  if (size("stop_reasons", a.stop_reasons.size(), b.stop_reasons.size())) {
+    for (size_t i = 0; i < a.stop_reasons.size(); ++i) {
+      const StopSample &x = a.stop_reasons[i], &y = b.stop_reasons[i];
+      const std::string at = "stop_reasons[" + std::to_string(i) + "].";
+      num(at + "t_s", x.t_s, y.t_s);
+      num(at + "stamp_s", x.stamp_s, y.stamp_s);
+      if (x.reason != y.reason) {
+        out << at << "reason: " << StopReasonToString(x.reason) << " vs "
+            << StopReasonToString(y.reason) << "\n";
+      }
+      num(at + "stop_distance_m", x.stop_distance_m, y.stop_distance_m);
+      integer(at + "track_id", x.track_id, y.track_id);
+      num(at + "obstacle_gap_m", x.obstacle_gap_m, y.obstacle_gap_m);
+      integer(at + "static_structure", x.static_structure, y.static_structure);
+    }
+  }
   return out.str();
 }
 
@@ -221,6 +237,17 @@ RunData MakeFullRun(size_t events = 5000) {
     run.ego.push_back({t, 1.5 * t, -0.1 * t, 0.001 * i, 12.0 + t,
                        (i % 7) * 0.01, -0.5 + 0.01 * i});
     run.controls.push_back({t, t - 0.05, 0.2 * std::sin(t), -0.01 * i});
+  }
+  // Every stop reason, an obstacle on map structure among them.
+  const std::vector<std::string> reasons = StopReasonNames();
+  for (size_t i = 0; i < 2 * reasons.size(); ++i) {
+    StopReason reason = StopReason::kNone;
+    StringToStopReason(reasons[i % reasons.size()], &reason);
+    const bool obstacle = reason == StopReason::kObstacle;
+    run.stop_reasons.push_back(
+        {0.1 * i, 0.1 * i - 0.07, reason, obstacle ? 4.5 - i : 0.25 * i,
+         obstacle ? static_cast<int32_t>(100 + i) : -1, obstacle ? 7.25 : -1.0,
+         obstacle && i > 5 ? 1 : 0});
   }
   run.ego[3].yaw_rad = std::numeric_limits<double>::quiet_NaN();
   run.ego[4].v_mps = std::numeric_limits<double>::infinity();
@@ -724,6 +751,64 @@ TEST_F(RunFileTest, FileWithoutLanesReadsAsNoLanes) {
   EXPECT_EQ(Diff(run, *back), "");
 }
 
+TEST_F(RunFileTest, StopReasonsAreAnEnumOfTheVocabulary) {
+  const std::string path = Path("run.h5");
+  const RunData run = MakeFullRun(10);
+  ASSERT_TRUE(WriteRunFile(path, run).ok());
+  RawHdf5 raw(path);
+  ASSERT_GE(raw.file(), 0);
+  const std::vector<Member> members =
+      CompoundMembers(raw.file(), "/planning/stop_reasons");
+  EXPECT_EQ(Names(members),
+            (std::vector<std::string>{"t_s", "stamp_s", "reason",
+                                      "stop_distance_m", "track_id",
+                                      "obstacle_gap_m", "static_structure"}));
+  ASSERT_EQ(members.size(), 7u);
+  EXPECT_EQ(members[2].type_class, H5T_ENUM);
+  // The enum's names are the vocabulary's, with its codes.
+  const hid_t dataset =
+      H5Dopen2(raw.file(), "/planning/stop_reasons", H5P_DEFAULT);
+  ASSERT_GE(dataset, 0);
+  const hid_t type = H5Dget_type(dataset);
+  const hid_t reason = H5Tget_member_type(type, 2);
+  for (const std::string& name : StopReasonNames()) {
+    StopReason expected = StopReason::kNone;
+    ASSERT_TRUE(StringToStopReason(name, &expected));
+    int8_t code = -1;
+    ASSERT_GE(H5Tenum_valueof(reason, name.c_str(), &code), 0) << name;
+    EXPECT_EQ(code, static_cast<int8_t>(expected)) << name;
+  }
+  H5Tclose(reason);
+  H5Tclose(type);
+  H5Dclose(dataset);
+}
+
+TEST_F(RunFileTest, FileWithoutStopReasonsReadsAsNone) {
+  // Files written before /planning/stop_reasons existed have the same
+  // schema version.
+  const std::string path = Path("run.h5");
+  RunData run = MakeFullRun(10);
+  ASSERT_TRUE(WriteRunFile(path, run).ok());
+  {
+    RawHdf5 raw(path, H5F_ACC_RDWR);
+    ASSERT_GE(H5Ldelete(raw.file(), "/planning", H5P_DEFAULT), 0);
+  }
+  Result<RunData> back = ReadRunFile(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  run.stop_reasons.clear();
+  EXPECT_EQ(Diff(run, *back), "");
+}
+
+TEST_F(RunFileTest, AStopReasonCodeOutsideTheVocabularyIsRefused) {
+  RunData run = MakeFullRun(10);
+  run.stop_reasons[1].reason = static_cast<StopReason>(42);
+  const Status written = WriteRunFile(Path("run.h5"), run);
+  EXPECT_EQ(written.code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(written.message().find("stop reason 1 has unknown code 42"),
+            std::string::npos)
+      << written.message();
+}
+
 // Found by fuzz_run_file: libhdf5 1.10 loops forever on a global heap whose
 // free-space object is empty, and copies overlapping (or negative-size)
 // memory for an object that claims more than its collection, up to 2^64 - 1
@@ -830,6 +915,11 @@ assert f["world/vehicles"][:]["id"][0] == b"veh0"
 lanes = f["world/lanes"][:]
 assert lanes.dtype.names == ("lane", "x_m", "y_m"), lanes.dtype.names
 assert lanes["lane"].tolist() == [0] * 4 + [1] * 5 + [2] * 6
+stops = f["planning/stop_reasons"][:]
+assert h5py.check_enum_dtype(f["planning/stop_reasons"].dtype["reason"]) == \
+    {"none": 0, "goal": 1, "obstacle": 2, "localization_lost": 3,
+     "no_trajectory": 4}
+assert stops["reason"].tolist() == [0, 1, 2, 3, 4] * 2, stops["reason"]
 assert f["scenario/yaml"].asstr()[()].startswith("name: cut_in")
 assert f["metrics"].attrs["min_ttc_s"] == 0.75
 try:

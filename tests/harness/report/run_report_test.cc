@@ -1,9 +1,12 @@
 // The analysis of real runs of the small robotaxi scenario: the starved
 // computer is diagnosed CPU-bound at its localization/perception nodes, the
-// generous one is not, and both get a deviation score.
+// generous one is not, and both get a deviation score. And what a report
+// says about a car that stood.
 #include "harness/report/run_report.h"
 
 #include <gtest/gtest.h>
+
+#include <gmock/gmock.h>
 
 #include <nlohmann/json.hpp>
 
@@ -15,6 +18,7 @@ namespace adse::report {
 namespace {
 
 using adse::testing::SmallScenario;
+using runfile::StopSample;
 
 RunReport Analyse(double cores, double ghz, double hz) {
   Result<runfile::RunData> run = sim::SimulatePoint(
@@ -94,9 +98,79 @@ TEST(RunReportTest,
   ASSERT_EQ(r.constraints.size(), 3u);
   for (const ConstraintStatus& c : r.constraints)
     EXPECT_TRUE(c.satisfied) << c.expression;
+  // The planner said why its trajectories stop, one reason per trajectory,
+  // and a car that reaches the goal does not stand for long.
+  EXPECT_TRUE(r.standing.has_reasons);
+  EXPECT_LT(r.standing.standing_s, 5.0) << ToJson(r).dump(2);
   const nlohmann::json j = ToJson(r);
   EXPECT_TRUE(j["metrics"].contains("zigzag_index"));
   EXPECT_EQ(j["point"]["cores"], 16.0);
+}
+
+// 60 s: drives 10 s, then stands behind track 7 (map structure) for 40 s
+// and 10 s more with localization lost.
+runfile::RunData StoodRun() {
+  runfile::RunData run;
+  run.status = runfile::kRunComplete;
+  run.termination_reason = "timeout";
+  for (int i = 0; i <= 600; ++i) {
+    const double t = 0.1 * i;
+    run.ego.push_back({t, t < 10 ? t : 10.0, 0, 0, t < 10 ? 1.0 : 0.0, 0, 0});
+    StopSample stop{t, t - 0.05, StopReason::kNone, -1, -1, -1, 0};
+    if (t >= 10 && t < 50)
+      stop = {t, t - 0.05, StopReason::kObstacle, 0.0, 7, 3.3, 1};
+    if (t >= 50) {
+      stop = {t, t - 0.05, StopReason::kLocalizationLost, 0.0, -1, -1, 0};
+    }
+    run.stop_reasons.push_back(stop);
+  }
+  return run;
+}
+
+TEST(RunReportTest, NamesTheDominantStopReasonAndHowLongTheCarStood) {
+  Result<RunReport> r = AnalyzeRun(StoodRun(), "memory", AnalyzeOptions{});
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_NEAR(r->standing.standing_s, 50.0, 1e-6);
+  ASSERT_EQ(r->standing.by_reason.size(), 2u);
+  EXPECT_EQ(r->standing.by_reason[0].reason, StopReason::kObstacle);
+  const std::string text = FormatSummary(*r);
+  EXPECT_THAT(text, ::testing::HasSubstr(
+                        "stood       50.0 s, mostly for obstacle (track 7, "
+                        "static structure, 3.3 m ahead): 40.0 s\n"));
+  EXPECT_THAT(text, ::testing::HasSubstr("also localization_lost: 10.0 s\n"));
+  const nlohmann::json j = ToJson(*r);
+  EXPECT_EQ(j["report_version"], 3);
+  EXPECT_EQ(j["standing"]["standing_s"], 50.0);
+  ASSERT_EQ(j["standing"]["by_reason"].size(), 2u);
+  const nlohmann::json& dominant = j["standing"]["by_reason"][0];
+  EXPECT_EQ(dominant["reason"], "obstacle");
+  EXPECT_EQ(dominant["track_id"], 7);
+  EXPECT_EQ(dominant["static_structure"], true);
+  EXPECT_EQ(dominant["obstacle_gap_m"], 3.3);
+  EXPECT_EQ(j["standing"]["by_reason"][1]["reason"], "localization_lost");
+  EXPECT_FALSE(j["standing"]["by_reason"][1].contains("track_id"));
+}
+
+TEST(RunReportTest, AnObjectBesideTheCarIsSaidToBeBesideIt) {
+  analysis::StandingTime t;
+  t.reason = StopReason::kObstacle;
+  t.standing_s = 33.6;
+  t.track_id = 37;
+  t.obstacle_gap_m = -8.8;
+  EXPECT_EQ(DescribeStanding(t),
+            "obstacle (track 37, beside the car, 8.8 m behind its front): "
+            "33.6 s");
+}
+
+TEST(RunReportTest, AnOldRunFileSaysItHasNoStopReasons) {
+  runfile::RunData run = StoodRun();
+  run.stop_reasons.clear();
+  Result<RunReport> r = AnalyzeRun(run, "memory", AnalyzeOptions{});
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_THAT(FormatSummary(*r),
+              ::testing::HasSubstr("stood       50.0 s (no stop reasons "
+                                   "recorded in this run file)\n"));
+  EXPECT_EQ(ToJson(*r)["standing"]["has_reasons"], false);
 }
 
 TEST(RunReportTest, UnknownThresholdIsAnError) {

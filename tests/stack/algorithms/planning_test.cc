@@ -210,6 +210,118 @@ TEST(PathPlanner, EmptyWithoutRoute) {
   EXPECT_FALSE(InsertObstacleStop(&none, {Car(1, 0, 0)}, {}).stop);
 }
 
+TEST(StopReason, OneNamePerValueAndBack) {
+  const std::vector<std::string> names = StopReasonNames();
+  ASSERT_EQ(names.size(), 5u);
+  for (size_t i = 0; i < names.size(); ++i) {
+    StopReason reason = StopReason::kNone;
+    ASSERT_TRUE(StringToStopReason(names[i], &reason)) << names[i];
+    // Codes are stored in run files: the table is in code order.
+    EXPECT_EQ(static_cast<size_t>(reason), i) << names[i];
+    EXPECT_EQ(StopReasonToString(reason), names[i]);
+  }
+  StopReason unchanged = StopReason::kGoal;
+  EXPECT_FALSE(StringToStopReason("red light", &unchanged));
+  EXPECT_EQ(unchanged, StopReason::kGoal);
+}
+
+TEST(DecideStop, FreeRoadDoesNotStop) {
+  PathPlanner planner;
+  planner.SetRoute(Straight(200, 5));
+  testing::ChainedPlan plan =
+      testing::PlanChain(&planner, geometry::Pose2{10, 0, 0}, {});
+  const StopDecision d =
+      DecideStop(&plan.points, plan.path.ends_at_goal, false, plan.obstacle);
+  EXPECT_EQ(d.reason, StopReason::kNone);
+  EXPECT_EQ(d.distance_m, -1);
+  EXPECT_EQ(d.obstacle_id, -1);
+  for (const PlannedPoint& p : plan.points) EXPECT_GT(p.v_mps, 0.0);
+}
+
+TEST(DecideStop, GoalAheadWithItsDistance) {
+  PathPlanner planner;
+  planner.SetRoute(Straight(100, 5));
+  testing::ChainedPlan plan =
+      testing::PlanChain(&planner, geometry::Pose2{70, 0, 0}, {});
+  const StopDecision d =
+      DecideStop(&plan.points, plan.path.ends_at_goal, false, plan.obstacle);
+  EXPECT_EQ(d.reason, StopReason::kGoal);
+  EXPECT_NEAR(d.distance_m, 30.0, 1e-9);
+  // At the goal: the stop is where the car is.
+  testing::ChainedPlan there =
+      testing::PlanChain(&planner, geometry::Pose2{100, 0, 0}, {});
+  const StopDecision at =
+      DecideStop(&there.points, there.path.ends_at_goal, false, there.obstacle);
+  EXPECT_EQ(at.reason, StopReason::kGoal);
+  EXPECT_NEAR(at.distance_m, 0.0, 1e-9);
+}
+
+TEST(DecideStop, ObstacleBeforeTheGoalWithTrackGapAndStructure) {
+  PathPlanner planner;
+  planner.SetRoute(Straight(100, 5));
+  const ObstacleStopParams params;
+  PlannerObstacle wall_corner = Car(12, 90.0, 0.3);
+  wall_corner.static_structure = true;
+  // The goal (100) and a car (track 12) before it at 90 are both within
+  // the horizon from 60: the car's stop is nearer and holds the car.
+  testing::ChainedPlan plan = testing::PlanChain(
+      &planner, geometry::Pose2{60, 0, 0}, {wall_corner}, {}, params);
+  ASSERT_TRUE(plan.path.ends_at_goal);
+  const StopDecision d =
+      DecideStop(&plan.points, plan.path.ends_at_goal, false, plan.obstacle);
+  EXPECT_EQ(d.reason, StopReason::kObstacle);
+  EXPECT_EQ(d.obstacle_id, 12);
+  EXPECT_TRUE(d.static_structure);
+  const double rear_edge = 90.0 - 2.25;
+  EXPECT_NEAR(d.obstacle_gap_m, rear_edge - (60.0 + params.ego_front_m), 1e-9);
+  EXPECT_NEAR(d.distance_m,
+              rear_edge - params.stop_margin_m - params.ego_front_m - 60.0,
+              1e-9);
+  // Traffic (not map structure) says so; standing at the stop line, the
+  // distance is 0.
+  PathPlanner close;
+  close.SetRoute(Straight(100, 5));
+  const double stop_line =
+      rear_edge - params.stop_margin_m - params.ego_front_m;
+  testing::ChainedPlan at_line =
+      testing::PlanChain(&close, geometry::Pose2{stop_line + 0.2, 0, 0},
+                         {Car(3, 90.0, 0.3)}, {}, params);
+  const StopDecision held = DecideStop(
+      &at_line.points, at_line.path.ends_at_goal, false, at_line.obstacle);
+  EXPECT_EQ(held.reason, StopReason::kObstacle);
+  EXPECT_EQ(held.obstacle_id, 3);
+  EXPECT_FALSE(held.static_structure);
+  EXPECT_EQ(held.distance_m, 0.0);
+  for (const PlannedPoint& p : at_line.points) EXPECT_EQ(p.v_mps, 0.0);
+}
+
+TEST(DecideStop, LostLocalizationHoldsTheCarWhereItIs) {
+  PathPlanner planner;
+  planner.SetRoute(Straight(200, 5));
+  testing::ChainedPlan plan = testing::PlanChain(
+      &planner, geometry::Pose2{10, 0, 0}, {Car(5, 40.0, 0.0)});
+  ASSERT_TRUE(plan.obstacle.stop);
+  const StopDecision d =
+      DecideStop(&plan.points, plan.path.ends_at_goal, true, plan.obstacle);
+  // The pose is not trusted, so neither is an obstacle's place relative
+  // to it: the lost pose is the reason.
+  EXPECT_EQ(d.reason, StopReason::kLocalizationLost);
+  EXPECT_EQ(d.distance_m, 0.0);
+  EXPECT_EQ(d.obstacle_id, -1);
+  ASSERT_FALSE(plan.points.empty());
+  for (const PlannedPoint& p : plan.points) EXPECT_EQ(p.v_mps, 0.0);
+}
+
+TEST(DecideStop, NoPathIsNoTrajectory) {
+  std::vector<PlannedPoint> none;
+  const StopDecision d = DecideStop(&none, false, false, ObstacleStop{});
+  EXPECT_EQ(d.reason, StopReason::kNoTrajectory);
+  EXPECT_EQ(d.distance_m, 0.0);
+  // Even with the pose lost: there is nothing to hold.
+  EXPECT_EQ(DecideStop(&none, false, true, ObstacleStop{}).reason,
+            StopReason::kNoTrajectory);
+}
+
 TEST(SmoothVelocity, RespectsAccelAndDecelLimits) {
   PathPlanner planner;
   planner.SetRoute(Straight(200, 5));

@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -105,6 +106,47 @@ TEST(WorldTest, RealOsmNetworkFromSumoToolsLoadsAndRoutes) {
   EXPECT_LT((*world)->ideal_path().MaxGap(), 0.51);
   // A bare net gets roadside poles for the LiDAR.
   EXPECT_GT((*world)->scene().obstacles().size(), 100u);
+}
+
+TEST(WorldTest, AOneWayStreetOfABareNetHasPolesOnBothSides) {
+  // Edge 69 of sumo-tools' acosta: a one-way, two-lane street. With poles
+  // on its right side only, NDT saw too little structure and got lost.
+  const std::string net =
+      "/usr/share/sumo/tools/sumolib/scenario/scenarios/RealWorld/acosta/"
+      "acosta_buslanes.net.xml";
+  ASSERT_TRUE(std::filesystem::exists(net)) << "sumo-tools is not installed";
+  WorldSetup setup;
+  setup.world.map.net_path = net;
+  setup.task.start = Location::OnEdge("69", 10.0);
+  setup.task.goal = Location::OnEdge("69", 160.0);
+  setup.cache_dir = CacheDir();
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  const geometry::Path2& path = (*world)->ideal_path();
+  int left = 0, right = 0;
+  for (const Obstacle& o : (*world)->scene().obstacles()) {
+    if (o.kind != ObstacleKind::kPole) continue;
+    const Eigen::Vector2d c = 0.25 * (o.footprint[0] + o.footprint[1] +
+                                      o.footprint[2] + o.footprint[3]);
+    // Nearest path point, and on which side of the path the pole stands.
+    double best = INFINITY, side = 0.0, s_best = 0.0;
+    for (size_t i = 0; i + 1 < path.points.size(); ++i) {
+      const Eigen::Vector2d a = path.points[i], ab = path.points[i + 1] - a;
+      const double t = std::clamp(
+          (c - a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
+      const Eigen::Vector2d r = c - (a + t * ab);
+      if (r.norm() < best) {
+        best = r.norm();
+        side = ab.x() * r.y() - ab.y() * r.x();
+        s_best = path.s_m[i] + t * ab.norm();
+      }
+    }
+    if (best > 10.0 || s_best < 5.0 || s_best > path.length_m() - 5.0) continue;
+    (side > 0 ? left : right) += 1;
+  }
+  // 150 m of street, a pole every 20 m on each side.
+  EXPECT_GE(right, 5);
+  EXPECT_GE(left, 5);
 }
 
 std::string TrafficFingerprint(uint64_t seed) {

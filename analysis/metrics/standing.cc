@@ -1,0 +1,80 @@
+#include "analysis/metrics/standing.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+namespace adse::analysis {
+namespace {
+
+// Per reason, and for obstacles per track: time stood and what was seen.
+struct TrackTime {
+  double standing_s = 0.0;
+  // Gaps are negative for an object beside the car (its near edge behind
+  // the front bumper), so no sentinel value can stand for "none yet".
+  double min_gap_m = std::numeric_limits<double>::infinity();
+  bool static_structure = false;
+};
+
+}  // namespace
+
+StandingSummary SummarizeStanding(const runfile::RunData& run,
+                                  const StandingOptions& options) {
+  StandingSummary out;
+  out.has_reasons = !run.stop_reasons.empty();
+  std::map<StopReason, double> per_reason;
+  std::map<int, TrackTime> per_track;
+  const std::vector<runfile::StopSample>& stops = run.stop_reasons;
+  size_t next = 0;  // first stop sample published after the current time
+  for (size_t i = 0; i + 1 < run.ego.size(); ++i) {
+    const runfile::EgoSample& e = run.ego[i];
+    while (next < stops.size() && stops[next].t_s <= e.t_s + 1e-9) ++next;
+    if (std::abs(e.v_mps) >= options.standing_speed_mps) continue;
+    const double dt = std::max(0.0, run.ego[i + 1].t_s - e.t_s);
+    out.standing_s += dt;
+    if (!out.has_reasons) continue;
+    StopReason reason = StopReason::kNoTrajectory;
+    const runfile::StopSample* newest = next > 0 ? &stops[next - 1] : nullptr;
+    if (newest != nullptr && e.t_s - newest->t_s <= options.stale_after_s) {
+      reason = newest->reason;
+      if (reason != StopReason::kNone &&
+          newest->stop_distance_m > options.hold_distance_m) {
+        reason = StopReason::kNone;
+      }
+    }
+    per_reason[reason] += dt;
+    if (reason == StopReason::kObstacle) {
+      TrackTime& t = per_track[newest->track_id];
+      t.standing_s += dt;
+      t.min_gap_m = std::min(t.min_gap_m, newest->obstacle_gap_m);
+      t.static_structure = t.static_structure || newest->static_structure != 0;
+    }
+  }
+  for (const auto& [reason, seconds] : per_reason) {
+    StandingTime t;
+    t.reason = reason;
+    t.standing_s = seconds;
+    if (reason == StopReason::kObstacle) {
+      // The track that held the car longest (the lowest id on a tie).
+      const TrackTime* longest = nullptr;
+      for (const auto& [id, track] : per_track) {
+        if (longest == nullptr || track.standing_s > longest->standing_s) {
+          longest = &track;
+          t.track_id = id;
+        }
+      }
+      t.obstacle_gap_m = longest->min_gap_m;
+      t.static_structure = longest->static_structure;
+    }
+    out.by_reason.push_back(t);
+  }
+  // Longest first; ties in code order, so the order is deterministic.
+  std::stable_sort(out.by_reason.begin(), out.by_reason.end(),
+                   [](const StandingTime& a, const StandingTime& b) {
+                     return a.standing_s > b.standing_s;
+                   });
+  return out;
+}
+
+}  // namespace adse::analysis

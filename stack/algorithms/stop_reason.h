@@ -1,0 +1,33 @@
+// Why the planner holds the car: the one vocabulary the planner publishes
+// (/planning/stop_reason), the run file stores and the run report counts.
+// Readers compare these values, never the text.
+#ifndef ADSE_STACK_ALGORITHMS_STOP_REASON_H_
+#define ADSE_STACK_ALGORITHMS_STOP_REASON_H_
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace adse {
+
+// Stored as int8 codes in run files (an HDF5 enum): never renumber a value;
+// add new ones at the end. The names are in stop_reason.cc's table.
+enum class StopReason : int8_t {
+  kNone = 0,              // "none": the trajectory does not stop
+  kGoal = 1,              // "goal": it ends at the goal
+  kObstacle = 2,          // "obstacle": a tracked object in the corridor
+  kLocalizationLost = 3,  // "localization_lost": no valid pose to drive by
+  kNoTrajectory = 4,      // "no_trajectory": nothing to plan from (no
+                          // route or pose), or no fresh plan at all
+};
+
+const char* StopReasonToString(StopReason reason);
+// False when `name` is no stop reason; `reason` is then unchanged.
+bool StringToStopReason(std::string_view name, StopReason* reason);
+// Every reason's name, in code order.
+std::vector<std::string> StopReasonNames();
+
+}  // namespace adse
+
+#endif  // ADSE_STACK_ALGORITHMS_STOP_REASON_H_

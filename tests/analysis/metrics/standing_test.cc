@@ -1,0 +1,124 @@
+#include "analysis/metrics/standing.h"
+
+#include <gtest/gtest.h>
+
+namespace adse::analysis {
+namespace {
+
+using runfile::StopSample;
+
+// A 100 s run sampled every 0.1 s. Speed 0 in [from, to) intervals.
+runfile::RunData RunStanding(
+    const std::vector<std::pair<double, double>>& stands) {
+  runfile::RunData run;
+  for (int i = 0; i <= 1000; ++i) {
+    const double t = 0.1 * i;
+    double v = 5.0;
+    for (const auto& [from, to] : stands) {
+      if (t >= from - 1e-9 && t < to - 1e-9) v = 0.0;
+    }
+    run.ego.push_back({t, 0, 0, 0, v, 0, 0});
+  }
+  return run;
+}
+
+// The planner publishing `sample` every 0.1 s over [from, to).
+void Publish(runfile::RunData* run, double from, double to, StopSample sample) {
+  for (int i = 0; from + 0.1 * i < to - 1e-9; ++i) {
+    sample.t_s = from + 0.1 * i;
+    sample.stamp_s = sample.t_s - 0.05;
+    run->stop_reasons.push_back(sample);
+  }
+}
+
+StopSample Reason(StopReason reason, double distance_m) {
+  return {0, 0, reason, distance_m, -1, -1, 0};
+}
+
+StopSample Obstacle(int track, double gap_m, bool structure) {
+  return {0, 0, StopReason::kObstacle, 0.0, track, gap_m, structure ? 1 : 0};
+}
+
+TEST(StandingTest, EachStandingStretchGoesToTheReasonThatHeldTheCar) {
+  // 0-10 s: drives; 10-40 s: stands behind track 7 on map structure (its
+  // gap shrinking); 40-45: behind track 9; 50-55: localization lost;
+  // 60-63: the planner silent (no fresh trajectory); 70-72: the plan
+  // stops 30 m ahead only, yet the car stands; 90-100: at the goal.
+  runfile::RunData run = RunStanding(
+      {{10, 40}, {40, 45}, {50, 55}, {60, 63}, {70, 72}, {90, 100}});
+  Publish(&run, 0, 10, Reason(StopReason::kNone, -1));
+  Publish(&run, 10, 20, Obstacle(7, 4.0, true));
+  Publish(&run, 20, 40, Obstacle(7, 3.1, true));
+  Publish(&run, 40, 45, Obstacle(9, 3.0, false));
+  Publish(&run, 45, 50, Reason(StopReason::kNone, -1));
+  Publish(&run, 50, 55, Reason(StopReason::kLocalizationLost, 0.0));
+  Publish(&run, 55, 59, Reason(StopReason::kNone, -1));
+  Publish(&run, 63, 70, Reason(StopReason::kNone, -1));
+  Publish(&run, 70, 90, Reason(StopReason::kGoal, 30.0));
+  Publish(&run, 90, 100.05, Reason(StopReason::kGoal, 0.0));
+
+  const StandingSummary s = SummarizeStanding(run);
+  EXPECT_TRUE(s.has_reasons);
+  // 30 + 5 + 5 + 3 + 2 + 10 s (the last sample covers no time).
+  EXPECT_NEAR(s.standing_s, 55.0, 1e-6);
+  ASSERT_EQ(s.by_reason.size(), 5u);
+  EXPECT_EQ(s.by_reason[0].reason, StopReason::kObstacle);
+  EXPECT_NEAR(s.by_reason[0].standing_s, 35.0, 1e-6);
+  EXPECT_EQ(s.by_reason[0].track_id, 7);  // held longest
+  EXPECT_NEAR(s.by_reason[0].obstacle_gap_m, 3.1, 1e-12);
+  EXPECT_TRUE(s.by_reason[0].static_structure);
+  EXPECT_EQ(s.by_reason[1].reason, StopReason::kGoal);
+  EXPECT_NEAR(s.by_reason[1].standing_s, 10.0, 1e-6);
+  EXPECT_EQ(s.by_reason[2].reason, StopReason::kLocalizationLost);
+  EXPECT_NEAR(s.by_reason[2].standing_s, 5.0, 1e-6);
+  // 59-63 s without a word from the planner: 60-63 is stale after 1 s.
+  EXPECT_EQ(s.by_reason[3].reason, StopReason::kNoTrajectory);
+  EXPECT_NEAR(s.by_reason[3].standing_s, 3.0, 1e-6);
+  // A stop 30 m ahead does not hold a standing car.
+  EXPECT_EQ(s.by_reason[4].reason, StopReason::kNone);
+  EXPECT_NEAR(s.by_reason[4].standing_s, 2.0, 1e-6);
+}
+
+TEST(StandingTest, AnObjectBesideTheCarKeepsItsNearestNegativeGap) {
+  // A car cutting in beside the ego: its near edge 6.5 m, then 8.8 m,
+  // then 7.0 m behind the front bumper.
+  runfile::RunData run = RunStanding({{10, 40}});
+  Publish(&run, 0, 10, Reason(StopReason::kNone, -1));
+  Publish(&run, 10, 20, Obstacle(37, -6.5, false));
+  Publish(&run, 20, 30, Obstacle(37, -8.8, false));
+  Publish(&run, 30, 40, Obstacle(37, -7.0, false));
+  Publish(&run, 40, 100.05, Reason(StopReason::kNone, -1));
+  const StandingSummary s = SummarizeStanding(run);
+  ASSERT_EQ(s.by_reason.size(), 1u);
+  EXPECT_EQ(s.by_reason[0].track_id, 37);
+  EXPECT_DOUBLE_EQ(s.by_reason[0].obstacle_gap_m, -8.8);
+}
+
+TEST(StandingTest, BeforeThePlannerSpeaksThereIsNoTrajectory) {
+  runfile::RunData run = RunStanding({{0, 2}});
+  Publish(&run, 0.55, 100, Reason(StopReason::kNone, -1));
+  const StandingSummary s = SummarizeStanding(run);
+  ASSERT_EQ(s.by_reason.size(), 2u);
+  EXPECT_EQ(s.by_reason[0].reason, StopReason::kNone);
+  EXPECT_NEAR(s.by_reason[0].standing_s, 1.4, 1e-6);
+  EXPECT_EQ(s.by_reason[1].reason, StopReason::kNoTrajectory);
+  EXPECT_NEAR(s.by_reason[1].standing_s, 0.6, 1e-6);
+}
+
+TEST(StandingTest, AnOldRunFileKnowsTheTimeNotTheReasons) {
+  const StandingSummary s = SummarizeStanding(RunStanding({{10, 20}}));
+  EXPECT_FALSE(s.has_reasons);
+  EXPECT_NEAR(s.standing_s, 10.0, 1e-6);
+  EXPECT_TRUE(s.by_reason.empty());
+}
+
+TEST(StandingTest, ACarThatNeverStoodHasNoReasons) {
+  runfile::RunData run = RunStanding({});
+  Publish(&run, 0, 100, Reason(StopReason::kObstacle, 0.0));
+  const StandingSummary s = SummarizeStanding(run);
+  EXPECT_EQ(s.standing_s, 0.0);
+  EXPECT_TRUE(s.by_reason.empty());
+}
+
+}  // namespace
+}  // namespace adse::analysis
