@@ -36,7 +36,6 @@ int TopicIndex(const runfile::RunData& run, const std::string& name) {
   return -1;
 }
 
-
 std::string Ms(const std::optional<double>& v) {
   return v ? fmt::format("{:9.2f}", *v) : fmt::format("{:>9}", "-");
 }
