@@ -29,33 +29,18 @@
 #include <fmt/ranges.h>
 
 #include "stack/base/random.h"
+#include "stack/runtime/internal/executor_parts.h"
 
 namespace adse::stack {
 namespace {
 
+using internal::HeldPublication;
+using internal::QueuedMessage;
+using internal::ThreadCpuSeconds;
+
 using Clock = std::chrono::steady_clock;
 
 constexpr int kMaxRealTimeCores = 256;
-
-double ThreadCpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) +
-         static_cast<double>(ts.tv_nsec) * 1e-9;
-}
-
-struct QueuedMessage {
-  MessagePtr message;
-  uint64_t seq = 0;
-  double stamp_s = 0.0;
-  double arrival_s = 0.0;
-};
-
-struct HeldPublication {
-  int topic;
-  MessagePtr message;
-  double stamp_s;
-};
 
 struct Arrival {
   double t_s;

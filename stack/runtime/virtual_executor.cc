@@ -56,22 +56,20 @@
 #include "stack/base/platform_limits.h"
 #include "stack/base/random.h"
 #include "stack/runtime/executor.h"
+#include "stack/runtime/internal/executor_parts.h"
 
 namespace adse::stack {
 namespace {
+
+using internal::HeldPublication;
+using internal::QueuedMessage;
+using internal::ThreadCpuSeconds;
 
 // Nothing is instantaneous: keeps the clock moving and ends after starts.
 constexpr double kMinCostS = 1e-6;
 // PublishExternal slightly in the past (rounding in the caller's time
 // arithmetic) is moved to now; further back is a caller bug.
 constexpr double kPastToleranceS = 1e-9;
-
-double ThreadCpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) +
-         static_cast<double>(ts.tv_nsec) * 1e-9;
-}
 
 bool IsFinitePositive(double v) { return std::isfinite(v) && v > 0.0; }
 
@@ -110,19 +108,6 @@ struct Arrival {
   int32_t topic = -1;
   MessagePtr message;
   double stamp_s = 0.0;
-};
-
-struct QueuedMessage {
-  MessagePtr message;
-  uint64_t seq = 0;
-  double stamp_s = 0.0;
-  double arrival_s = 0.0;
-};
-
-struct HeldPublication {
-  int32_t topic;
-  MessagePtr message;
-  double stamp_s;
 };
 
 struct CallbackState {
