@@ -14,7 +14,7 @@
 #include <utility>
 
 #include "analysis/pictures/internal/drawing_impl.h"
-#include "analysis/pictures/internal/parking_layer.h"
+#include "analysis/pictures/internal/parking_layer_impl.h"
 
 namespace adse::analysis::internal {
 

@@ -1,4 +1,4 @@
-#include "analysis/pictures/internal/parking_layer.h"
+#include "analysis/pictures/internal/parking_layer_impl.h"
 
 #include <algorithm>
 #include <cmath>

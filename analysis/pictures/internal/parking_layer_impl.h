@@ -1,8 +1,8 @@
 // The valet task's layer of the trajectory image: the lot's slots, its
 // walls, poles and parked cars, the target slot, the stack's planned
 // manoeuvre (forward and reverse legs) and the car as it ended.
-#ifndef ADSE_ANALYSIS_PICTURES_INTERNAL_PARKING_LAYER_H_
-#define ADSE_ANALYSIS_PICTURES_INTERNAL_PARKING_LAYER_H_
+#ifndef ADSE_ANALYSIS_PICTURES_INTERNAL_PARKING_LAYER_IMPL_H_
+#define ADSE_ANALYSIS_PICTURES_INTERNAL_PARKING_LAYER_IMPL_H_
 
 #include <functional>
 #include <opencv2/core.hpp>
@@ -35,4 +35,4 @@ void DrawParkingDetail(cv::Mat* panel, const runfile::RunData& run,
 
 }  // namespace adse::analysis::internal
 
-#endif  // ADSE_ANALYSIS_PICTURES_INTERNAL_PARKING_LAYER_H_
+#endif  // ADSE_ANALYSIS_PICTURES_INTERNAL_PARKING_LAYER_IMPL_H_
