@@ -18,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <limits>
 #include <sstream>
@@ -327,7 +328,6 @@ class RunFileTest : public ::testing::Test {
     std::sort(names.begin(), names.end());
     return names;
   }
-
   std::string dir_;
 };
 
@@ -736,19 +736,26 @@ TEST_F(RunFileTest, LanesAreStoredAsOneRowPerVertex) {
   H5Dclose(dataset);
 }
 
-TEST_F(RunFileTest, FileWithoutLanesReadsAsNoLanes) {
-  // Files written before /world/lanes existed have the same schema version.
-  const std::string path = Path("run.h5");
+// A full run written to `path`, `link` then deleted as in files written
+// before it existed (same schema version): it reads back as the run with
+// `clear` applied.
+void ExpectReadsWithout(const std::string& path, const char* link,
+                        const std::function<void(RunData*)>& clear) {
   RunData run = MakeFullRun(10);
   ASSERT_TRUE(WriteRunFile(path, run).ok());
   {
     RawHdf5 raw(path, H5F_ACC_RDWR);
-    ASSERT_GE(H5Ldelete(raw.file(), "/world/lanes", H5P_DEFAULT), 0);
+    ASSERT_GE(H5Ldelete(raw.file(), link, H5P_DEFAULT), 0);
   }
   Result<RunData> back = ReadRunFile(path);
   ASSERT_TRUE(back.ok()) << back.status().ToString();
-  run.lanes.clear();
+  clear(&run);
   EXPECT_EQ(Diff(run, *back), "");
+}
+
+TEST_F(RunFileTest, FileWithoutLanesReadsAsNoLanes) {
+  ExpectReadsWithout(Path("run.h5"), "/world/lanes",
+                     [](RunData* run) { run->lanes.clear(); });
 }
 
 TEST_F(RunFileTest, StopReasonsAreAnEnumOfTheVocabulary) {
@@ -784,19 +791,8 @@ TEST_F(RunFileTest, StopReasonsAreAnEnumOfTheVocabulary) {
 }
 
 TEST_F(RunFileTest, FileWithoutStopReasonsReadsAsNone) {
-  // Files written before /planning/stop_reasons existed have the same
-  // schema version.
-  const std::string path = Path("run.h5");
-  RunData run = MakeFullRun(10);
-  ASSERT_TRUE(WriteRunFile(path, run).ok());
-  {
-    RawHdf5 raw(path, H5F_ACC_RDWR);
-    ASSERT_GE(H5Ldelete(raw.file(), "/planning", H5P_DEFAULT), 0);
-  }
-  Result<RunData> back = ReadRunFile(path);
-  ASSERT_TRUE(back.ok()) << back.status().ToString();
-  run.stop_reasons.clear();
-  EXPECT_EQ(Diff(run, *back), "");
+  ExpectReadsWithout(Path("run.h5"), "/planning",
+                     [](RunData* run) { run->stop_reasons.clear(); });
 }
 
 TEST_F(RunFileTest, AStopReasonCodeOutsideTheVocabularyIsRefused) {
