@@ -106,12 +106,7 @@ bool RowFeasible(const spec::Spec& spec, const EvaluationRow& row) {
       RowMetric(row, analysis::kCensoredMetric) == 1.0) {
     return false;
   }
-  for (const std::string& constraint : spec.constraints) {
-    Result<bool> holds =
-        spec::EvaluateConstraint(spec, constraint, row.metrics, row.point);
-    if (!holds.ok() || !*holds) return false;
-  }
-  return true;
+  return spec::ViolatedConstraintCount(spec, row.metrics, row.point) == 0;
 }
 
 double RowMetric(const EvaluationRow& row, const std::string& name) {

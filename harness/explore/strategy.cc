@@ -163,15 +163,9 @@ double ConstraintViolation(const spec::Spec& spec,
                            const Observation& observation) {
   if (observation.failed) return std::numeric_limits<double>::infinity();
   if (observation.feasible) return 0.0;
-  int violated = 0;
-  for (const std::string& constraint : spec.constraints) {
-    Result<bool> holds = spec::EvaluateConstraint(
-        spec, constraint, observation.metrics, observation.point);
-    // A constraint that cannot be evaluated (missing metric) counts as
-    // violated: nothing shows it holds.
-    if (!holds.ok() || !*holds) ++violated;
-  }
-  return std::max(violated, 1);
+  return std::max(spec::ViolatedConstraintCount(spec, observation.metrics,
+                                                observation.point),
+                  1);
 }
 
 const std::vector<std::string>& StrategyNames() {

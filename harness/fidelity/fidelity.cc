@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "analysis/metrics/run_metrics.h"
 #include "harness/profile/profile_check.h"
 #include "harness/sim/simulator.h"
 #include "harness/spec/design_point.h"
@@ -23,13 +24,6 @@ constexpr double kCallbackTolerance = 0.20;  // per-callback p50
 // Callbacks cheaper than this on the virtual platform are left out: their
 // latency is the executor's bookkeeping, not the model.
 constexpr double kMinCallbackMs = 1.0;
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // Nearest-rank quantile of `v` (sorted in place).
 double Quantile(std::vector<double>& v, double q) {
@@ -49,7 +43,7 @@ Comparison Compare(const std::string& name, double virtual_value,
   for (double v : realtime) {
     if (!std::isnan(v)) c.realtime.push_back(v);
   }
-  c.realtime_median = Median(c.realtime);
+  c.realtime_median = analysis::Percentile(c.realtime, 0.5);
   c.difference =
       std::isfinite(virtual_value) && virtual_value != 0.0 &&
               std::isfinite(c.realtime_median)

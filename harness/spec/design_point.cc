@@ -174,6 +174,17 @@ Result<bool> EvaluateConstraint(const Spec& spec, const std::string& constraint,
   return std::isfinite(*value) && *value != 0.0;
 }
 
+int ViolatedConstraintCount(const Spec& spec,
+                            const std::map<std::string, double>& metrics,
+                            const DesignPoint& point) {
+  int violated = 0;
+  for (const std::string& constraint : spec.constraints) {
+    Result<bool> holds = EvaluateConstraint(spec, constraint, metrics, point);
+    if (!holds.ok() || !*holds) ++violated;
+  }
+  return violated;
+}
+
 Result<PointConfig> ApplyPoint(const Spec& spec, const DesignPoint& point) {
   ADSE_RETURN_IF_ERROR(spec.design_space.Check(point));
   PointConfig config{spec.platform, spec.stack};

@@ -55,6 +55,13 @@ Result<bool> EvaluateConstraint(const Spec& spec, const std::string& constraint,
                                 const std::map<std::string, double>& metrics,
                                 const DesignPoint& point);
 
+// How many of the spec's constraints `metrics` and the point do not
+// satisfy; one that cannot be evaluated (a missing metric) counts as not
+// satisfied: nothing shows it holds.
+int ViolatedConstraintCount(const Spec& spec,
+                            const std::map<std::string, double>& metrics,
+                            const DesignPoint& point);
+
 // A design point applied to the spec: the platform and stack one run uses.
 struct PointConfig {
   PlatformOptions platform;
