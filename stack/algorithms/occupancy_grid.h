@@ -19,6 +19,18 @@ struct VehicleFootprint {
   double width_m = 1.9;   // body width
 };
 
+// The footprint of a body `length_m` long and `width_m` wide whose centre
+// lies half a wheelbase ahead of the rear axle, as the world's vehicles'
+// bodies do.
+inline VehicleFootprint FootprintOfBody(double length_m, double wheelbase_m,
+                                        double width_m) {
+  VehicleFootprint f;
+  f.front_m = 0.5 * (wheelbase_m + length_m);
+  f.rear_m = 0.5 * (length_m - wheelbase_m);
+  f.width_m = width_m;
+  return f;
+}
+
 class OccupancyGrid {
  public:
   // A grid over the rectangle [min_corner, max_corner] with square cells of

@@ -529,14 +529,22 @@ void Stack::BuildPlanning(Graph* g) {
             ob.velocity = o.velocity;
             ob.length_m = o.length_m;
             ob.width_m = o.width_m;
-            ob.static_structure = structure_grid_.IsStructure(
-                o.position, o.length_m, o.width_m, ob.yaw_rad);
             obstacles.push_back(ob);
           }
         }
         std::vector<algo::PlannedPoint> points = ToPlanned(in.points);
-        const algo::ObstacleStop stop =
+        algo::ObstacleStop stop =
             algo::InsertObstacleStop(&points, obstacles, stop_params);
+        // Whether the map has structure there matters only for the object
+        // stopped for; tracked objects carry no yaw.
+        if (stop.obstacle_id >= 0) {
+          for (const algo::PlannerObstacle& ob : obstacles) {
+            if (ob.id != stop.obstacle_id) continue;
+            stop.static_structure = structure_grid_.IsStructure(
+                ob.position, ob.length_m, ob.width_m, 0.0);
+            break;
+          }
+        }
         const algo::StopDecision decision = algo::DecideStop(
             &points, in.ends_at_goal, in.localization_lost, stop);
         TrajectoryMsg out = in;
@@ -585,11 +593,10 @@ void Stack::BuildParking(Graph* g) {
   params.max_expansions =
       static_cast<int>(config_.Get("parking.max_expansions"));
   params.collision_margin_m = config_.Get("parking.collision_margin_m");
-  algo::VehicleFootprint footprint;
-  footprint.front_m = 0.5 * (inputs_.wheelbase_m + inputs_.vehicle_length_m);
-  footprint.rear_m = 0.5 * (inputs_.vehicle_length_m - inputs_.wheelbase_m);
-  footprint.width_m = inputs_.vehicle_width_m;
-  freespace_ = std::make_unique<algo::FreespacePlanner>(params, footprint);
+  freespace_ = std::make_unique<algo::FreespacePlanner>(
+      params,
+      algo::FootprintOfBody(inputs_.vehicle_length_m, inputs_.wheelbase_m,
+                            inputs_.vehicle_width_m));
   const int node = g->AddNode("freespace_planner");
   g->Subscribe<PoseMsg>(
       node, topics_.pose, "pose", 1,

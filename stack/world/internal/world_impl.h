@@ -1,0 +1,112 @@
+// Internal to stack/world: the state behind World and the helpers its
+// files share. Holds libsumo types, hence _impl.h.
+#ifndef ADSE_STACK_WORLD_INTERNAL_WORLD_IMPL_H_
+#define ADSE_STACK_WORLD_INTERNAL_WORLD_IMPL_H_
+
+#include <libsumo/libsumo.h>
+
+#include <Eigen/Core>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "stack/base/random.h"
+#include "stack/base/status.h"
+#include "stack/geometry/geometry.h"
+#include "stack/world/scene.h"
+#include "stack/world/vehicle_model.h"
+#include "stack/world/world.h"
+
+namespace adse::world {
+namespace internal {
+
+using Vec2 = Eigen::Vector2d;
+
+// Spacing of the ideal path's points.
+inline constexpr double kResampleStepM = 0.5;
+
+inline std::vector<Vec2> ToPoints(const libsumo::TraCIPositionVector& shape) {
+  std::vector<Vec2> out;
+  out.reserve(shape.value.size());
+  for (const auto& p : shape.value) out.emplace_back(p.x, p.y);
+  return out;
+}
+
+// The internal (junction) lanes a connection drives through, starting at
+// its `via` lane; `arrives_on` gets the normal lane it ends on.
+std::vector<std::string> InternalChain(const std::string& via,
+                                       std::string* arrives_on);
+
+// Part of `shape` between arc lengths s0 and s1.
+std::vector<Vec2> Slice(const std::vector<Vec2>& shape, double s0, double s1);
+
+// `points` without repeats, resampled every `step` metres.
+geometry::Path2 Resample(const std::vector<Vec2>& points, double step);
+
+}  // namespace internal
+
+struct World::Impl {
+  WorldSetup setup;
+  MapArtifacts map;
+  RoadLocation start, goal;
+  std::vector<RoadLocation> via;  // task.via, resolved
+  Eigen::Vector2d goal_xy =
+      Eigen::Vector2d::Zero();  // final target (rear axle when valet)
+  bool valet = false;
+  ParkingSlot goal_slot;                 // valet: the slot parked in
+  geometry::Pose2 parking_goal;          // valet: rear axle parked
+  geometry::Path2 road;                  // the route's road part
+  std::vector<ManoeuvrePose> reference;  // valet: the reference manoeuvre
+  std::vector<std::string> route;
+  geometry::Path2 ideal;
+  double lane_width_m = 3.2;
+  double max_join_gap_m = 0.0;
+  Scene scene;
+  std::unique_ptr<BicycleModel> ego;
+  std::vector<OtherVehicle> others;
+  std::set<std::string> in_contact;
+  std::vector<std::string> new_contacts;
+  int collisions = 0;
+  double time_s = 0.0;
+  bool sumo_running = false;
+
+  struct FlowState {
+    std::string route_id;
+    double probability_per_step = 0.0;
+    int spawned = 0;
+  };
+  std::vector<FlowState> flows;
+  std::unique_ptr<Random> traffic_random;
+  std::map<std::string, Eigen::Vector2d> dims;  // vehicle id -> (length, width)
+
+  ~Impl() {
+    if (sumo_running) {
+      try {
+        libsumo::Simulation::close();
+      } catch (...) {
+      }
+    }
+  }
+
+  Status StartSumo();
+  Result<RoadLocation> Resolve(const Location& location,
+                               const std::string& field, double slack_m);
+  // The edges from `from` to `to`, both included; errors name the fields.
+  Result<std::vector<std::string>> RouteLeg(const RoadLocation& from,
+                                            const RoadLocation& to,
+                                            const std::string& to_field,
+                                            const std::string& from_field);
+  Status PlanRoute();
+  Status BuildIdealPath();
+  Status BuildScene();
+  Status SetUpTraffic();
+  Status AddEgo();
+  void PushEgo();
+  Status ReadOthers();
+};
+
+}  // namespace adse::world
+
+#endif  // ADSE_STACK_WORLD_INTERNAL_WORLD_IMPL_H_
