@@ -7,6 +7,8 @@
 #include <limits>
 #include <vector>
 
+#include "stack/geometry/geometry.h"
+
 namespace adse::analysis {
 namespace {
 
@@ -37,20 +39,6 @@ double SegmentSegment(const Vec2& a, const Vec2& b, const Vec2& c,
                    PointSegment(c, a, b), PointSegment(d, a, b)});
 }
 
-bool InsidePolygon(const std::vector<Vec2>& poly, const Vec2& p) {
-  if (poly.size() < 3) return false;
-  bool inside = false;
-  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
-    const Vec2& a = poly[i];
-    const Vec2& b = poly[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) &&
-        p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
-      inside = !inside;
-    }
-  }
-  return inside;
-}
-
 // Distance between two closed outlines (a 2-point outline is a segment);
 // 0 when they touch or one holds the other.
 double OutlineDistance(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
@@ -64,8 +52,11 @@ double OutlineDistance(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
                                            b[(j + 1) % b.size()]));
     }
   }
-  if (best > 0 && (InsidePolygon(a, b.front()) || InsidePolygon(b, a.front())))
-    best = 0.0;
+  // Only an outline of three or more points can hold the other.
+  auto holds = [](const std::vector<Vec2>& outline, const Vec2& p) {
+    return outline.size() >= 3 && geometry::InsidePolygon(outline, p);
+  };
+  if (best > 0 && (holds(a, b.front()) || holds(b, a.front()))) best = 0.0;
   return best;
 }
 

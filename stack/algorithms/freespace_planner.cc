@@ -23,6 +23,7 @@ struct Node {
   double g = 0.0;
   int parent = -1;
   double curvature_1pm = 0.0;  // of the primitive from the parent
+  double rs_to_goal_m = 0.0;   // Reeds–Shepp distance to the goal
 };
 
 struct OpenEntry {
@@ -219,9 +220,12 @@ Result<FreespacePath> FreespacePlanner::Plan(
         p.yaw_bins - 1, static_cast<int64_t>(yaw / kTwoPi * p.yaw_bins));
     return ((it * 3 + (gear + 1)) * ny + iy) * nx + ix;
   };
-  auto heuristic = [&](const Pose2& pose) {
-    const double h2 = holonomic_at(pose);
-    const double rs = ReedsSheppDistance(pose, goal, p.turning_radius_m);
+  // The heuristic of `node`, whose Reeds–Shepp distance to the goal it
+  // keeps for the analytic expansion.
+  auto heuristic = [&](Node* node) {
+    const double h2 = holonomic_at(node->pose);
+    const double rs = ReedsSheppDistance(node->pose, goal, p.turning_radius_m);
+    node->rs_to_goal_m = rs;
     return p.heuristic_weight * (h2 == kUnreached ? rs : std::max(h2, rs));
   };
 
@@ -233,7 +237,7 @@ Result<FreespacePath> FreespacePlanner::Plan(
       open;
   int64_t order = 0;
   nodes.push_back({start, 0, 0.0, -1, 0.0});
-  open.push({heuristic(start), order++, 0});
+  open.push({heuristic(&nodes.back()), order++, 0});
 
   // Curvatures of the primitives: full left to full right.
   std::vector<double> curvatures;
@@ -257,8 +261,7 @@ Result<FreespacePath> FreespacePlanner::Plan(
     if (++stats_.expansions > p.max_expansions) break;
 
     // Analytic expansion: a collision-free Reeds–Shepp path to the goal.
-    if (ReedsSheppDistance(node.pose, goal, p.turning_radius_m) <=
-        p.analytic_range_m) {
+    if (node.rs_to_goal_m <= p.analytic_range_m) {
       ++stats_.analytic_shots;
       const std::vector<ReedsSheppPath> candidates =
           ReedsSheppCandidates(node.pose, goal, p.turning_radius_m);
@@ -299,7 +302,7 @@ Result<FreespacePath> FreespacePlanner::Plan(
         if (it != best_g.end() && it->second <= g) continue;
         best_g[child_key] = g;
         nodes.push_back({child, gear, g, top.node, kappa});
-        open.push({g + heuristic(child), order++,
+        open.push({g + heuristic(&nodes.back()), order++,
                    static_cast<int>(nodes.size()) - 1});
       }
     }

@@ -6,21 +6,6 @@
 namespace adse::algorithms {
 namespace {
 
-// Even-odd rule: is `p` inside the closed polygon?
-bool InsidePolygon(const std::vector<Eigen::Vector2d>& poly,
-                   const Eigen::Vector2d& p) {
-  bool inside = false;
-  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
-    const Eigen::Vector2d& a = poly[i];
-    const Eigen::Vector2d& b = poly[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) &&
-        p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
-      inside = !inside;
-    }
-  }
-  return inside;
-}
-
 constexpr double kFar = 1e20;
 
 // Squared distance transform of one line (Felzenszwalb and Huttenlocher):
@@ -109,7 +94,7 @@ void OccupancyGrid::AddObstacle(const std::vector<Eigen::Vector2d>& outline) {
   y1 = std::min(y1, ny_ - 1);
   for (int iy = y0; iy <= y1; ++iy) {
     for (int ix = x0; ix <= x1; ++ix) {
-      if (InsidePolygon(outline, CellCentre(ix, iy))) {
+      if (geometry::InsidePolygon(outline, CellCentre(ix, iy))) {
         cells_[iy * nx_ + ix] = 1;
       }
     }

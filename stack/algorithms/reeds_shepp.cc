@@ -205,9 +205,12 @@ int ReedsSheppPath::gear_changes() const {
   return changes;
 }
 
-std::vector<ReedsSheppPath> ReedsSheppCandidates(const Pose2& from,
-                                                 const Pose2& to,
-                                                 double turning_radius_m) {
+namespace {
+
+// Every admissible path of the five families, in the order generated.
+std::vector<ReedsSheppPath> AllReedsSheppPaths(const Pose2& from,
+                                               const Pose2& to,
+                                               double turning_radius_m) {
   std::vector<ReedsSheppPath> out;
   if (!(turning_radius_m > 0.0)) return out;
   // The goal in the start's frame, in units of the radius.
@@ -263,19 +266,31 @@ std::vector<ReedsSheppPath> ReedsSheppCandidates(const Pose2& from,
   add.AllSymmetries(LpRmSLmRp, x, y, phi, [h](double t, double u, double v) {
     return Segs{{L, t}, {R, -h}, {S, u}, {L, -h}, {R, v}};
   });
-  std::stable_sort(out.begin(), out.end(),
-                   [](const ReedsSheppPath& a, const ReedsSheppPath& b) {
-                     return a.length_m() < b.length_m();
-                   });
+  return out;
+}
+
+bool Shorter(const ReedsSheppPath& a, const ReedsSheppPath& b) {
+  return a.length_m() < b.length_m();
+}
+
+}  // namespace
+
+std::vector<ReedsSheppPath> ReedsSheppCandidates(const Pose2& from,
+                                                 const Pose2& to,
+                                                 double turning_radius_m) {
+  std::vector<ReedsSheppPath> out =
+      AllReedsSheppPaths(from, to, turning_radius_m);
+  std::stable_sort(out.begin(), out.end(), Shorter);
   return out;
 }
 
 double ReedsSheppDistance(const Pose2& from, const Pose2& to,
                           double turning_radius_m) {
+  // The planner's heuristic, on its hot path: the shortest, unsorted.
   const std::vector<ReedsSheppPath> paths =
-      ReedsSheppCandidates(from, to, turning_radius_m);
-  return paths.empty() ? std::hypot(to.x_m - from.x_m, to.y_m - from.y_m)
-                       : paths.front().length_m();
+      AllReedsSheppPaths(from, to, turning_radius_m);
+  if (paths.empty()) return std::hypot(to.x_m - from.x_m, to.y_m - from.y_m);
+  return std::min_element(paths.begin(), paths.end(), Shorter)->length_m();
 }
 
 Pose2 AdvanceArc(const Pose2& from, double curvature_1pm, double length_m) {

@@ -116,4 +116,18 @@ Pose2 MotionAfter(const Twist2& twist, double dt_s) {
   return out;
 }
 
+bool InsidePolygon(const std::vector<Eigen::Vector2d>& polygon,
+                   const Eigen::Vector2d& p) {
+  bool inside = false;
+  for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
+    const Eigen::Vector2d& a = polygon[i];
+    const Eigen::Vector2d& b = polygon[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) &&
+        p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
+      inside = !inside;
+    }
+  }
+  return inside;
+}
+
 }  // namespace adse::geometry

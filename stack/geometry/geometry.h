@@ -56,6 +56,11 @@ std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box);
 // True when two oriented boxes overlap (separating axis test).
 bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b);
 
+// Even-odd rule: whether `p` lies inside the polygon closed back to its
+// first point. Points on the boundary may go either way.
+bool InsidePolygon(const std::vector<Eigen::Vector2d>& polygon,
+                   const Eigen::Vector2d& p);
+
 }  // namespace adse::geometry
 
 #endif  // ADSE_STACK_GEOMETRY_GEOMETRY_H_

@@ -73,10 +73,13 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
     report.trajectory.push_back({world.time_s(), ego.x_m, ego.y_m, ego.yaw_rad,
                                  ego.v_mps, ego.steer_rad, ego.accel_mps2});
     double s_here = 0.0;
-    DistanceToPath(path, pos, &s_here);
+    const double off_road = DistanceToPath(path, pos, &s_here);
     s_progress = std::max(s_progress, s_here);
-    report.max_lateral_error_m = std::max(
-        report.max_lateral_error_m, DistanceToPath(world.ideal_path(), pos));
+    // Lane driving: the ideal path is the road part, already measured.
+    report.max_lateral_error_m =
+        std::max(report.max_lateral_error_m,
+                 world.parking_task() ? DistanceToPath(world.ideal_path(), pos)
+                                      : off_road);
     if (world.goal_reached() && std::abs(ego.v_mps) < 0.5) {
       report.reached_goal = true;
       break;

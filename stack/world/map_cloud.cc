@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "stack/base/files.h"
+#include "stack/geometry/geometry.h"
 
 namespace adse::world {
 namespace {
@@ -27,22 +28,6 @@ constexpr size_t kMaxPcdBytes = size_t{1} << 30;
 
 int Steps(double length, double spacing) {
   return std::max(1, static_cast<int>(std::ceil(length / spacing - 1e-9)));
-}
-
-// Crossing-number test; points on the boundary may go either way, which is
-// fine for deciding where ground is hidden.
-bool InsidePolygon(const std::vector<Eigen::Vector2d>& poly, double x,
-                   double y) {
-  bool inside = false;
-  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
-    const Eigen::Vector2d& a = poly[i];
-    const Eigen::Vector2d& b = poly[j];
-    if ((a.y() > y) != (b.y() > y) &&
-        x < (b.x() - a.x()) * (y - a.y()) / (b.y() - a.y()) + a.x()) {
-      inside = !inside;
-    }
-  }
-  return inside;
 }
 
 void SampleGround(const Scene& scene, const MapCloudOptions& options,
@@ -98,7 +83,7 @@ void SampleGround(const Scene& scene, const MapCloudOptions& options,
           std::clamp(static_cast<int>((y - lo.y()) / kBucketM), 0, by - 1);
       bool hidden = false;
       for (const int i : buckets[static_cast<size_t>(cy) * bx + cx]) {
-        if (InsidePolygon(obstacles[i].footprint, x, y)) {
+        if (geometry::InsidePolygon(obstacles[i].footprint, {x, y})) {
           hidden = true;
           break;
         }

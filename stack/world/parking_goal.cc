@@ -146,17 +146,4 @@ std::vector<std::vector<Eigen::Vector2d>> ObstacleOutlines(const Scene& scene) {
   return out;
 }
 
-geometry::OrientedBox BodyAt(const geometry::Pose2& rear_axle,
-                             const VehicleLimits& car) {
-  geometry::OrientedBox box;
-  const double half_wb = 0.5 * car.wheelbase_m;
-  box.center = Vec2(rear_axle.x_m + half_wb * std::cos(rear_axle.yaw_rad),
-                    rear_axle.y_m + half_wb * std::sin(rear_axle.yaw_rad));
-  box.yaw_rad = rear_axle.yaw_rad;
-  box.length_m = car.length_m;
-  box.width_m = car.width_m;
-  box.height_m = car.height_m;
-  return box;
-}
-
 }  // namespace adse::world

@@ -38,10 +38,6 @@ Result<Scene> WithParkedCars(const Scene& scene, const TrafficOptions& traffic,
 // map of the lot holds and a parking planner must keep clear of.
 std::vector<std::vector<Eigen::Vector2d>> ObstacleOutlines(const Scene& scene);
 
-// Where a car's body stands for a rear-axle pose.
-geometry::OrientedBox BodyAt(const geometry::Pose2& rear_axle,
-                             const VehicleLimits& car);
-
 }  // namespace adse::world
 
 #endif  // ADSE_STACK_WORLD_PARKING_GOAL_H_

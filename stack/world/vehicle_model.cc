@@ -64,18 +64,23 @@ void BicycleModel::Step(const ControlCommand& command, double dt_s) {
   state_.accel_mps2 = (v1 - v0) / dt_s;
 }
 
-geometry::OrientedBox BicycleModel::Body() const {
-  // The state is the rear axle centre; the body centre is taken half a
-  // wheelbase ahead of it, i.e. equal front and rear overhangs.
+geometry::OrientedBox BodyAt(const geometry::Pose2& rear_axle,
+                             const VehicleLimits& car) {
   geometry::OrientedBox box;
-  const double half_wb = 0.5 * limits_.wheelbase_m;
-  box.center = Eigen::Vector2d(state_.x_m + half_wb * std::cos(state_.yaw_rad),
-                               state_.y_m + half_wb * std::sin(state_.yaw_rad));
-  box.yaw_rad = state_.yaw_rad;
-  box.length_m = limits_.length_m;
-  box.width_m = limits_.width_m;
-  box.height_m = limits_.height_m;
+  const double half_wb = 0.5 * car.wheelbase_m;
+  box.center =
+      Eigen::Vector2d(rear_axle.x_m + half_wb * std::cos(rear_axle.yaw_rad),
+                      rear_axle.y_m + half_wb * std::sin(rear_axle.yaw_rad));
+  box.yaw_rad = rear_axle.yaw_rad;
+  box.length_m = car.length_m;
+  box.width_m = car.width_m;
+  box.height_m = car.height_m;
   return box;
+}
+
+geometry::OrientedBox BicycleModel::Body() const {
+  // The state is the rear axle centre.
+  return BodyAt({state_.x_m, state_.y_m, state_.yaw_rad}, limits_);
 }
 
 }  // namespace adse::world

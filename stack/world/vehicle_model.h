@@ -38,6 +38,11 @@ struct VehicleState {
   double accel_mps2 = 0.0;
 };
 
+// Where a car's body stands for a rear-axle pose: centred half a
+// wheelbase ahead of it (equal front and rear overhangs).
+geometry::OrientedBox BodyAt(const geometry::Pose2& rear_axle,
+                             const VehicleLimits& car);
+
 class BicycleModel {
  public:
   explicit BicycleModel(const VehicleLimits& limits) : limits_(limits) {}

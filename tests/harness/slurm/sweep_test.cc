@@ -41,7 +41,7 @@ void WritePlan(const std::string& scenario, const std::string& campaign,
         sim::RunKey(*spec, *point, spec->world.traffic.seed);
     ASSERT_TRUE(key.ok());
     plan.points.push_back(
-        {static_cast<int64_t>(plan.points.size()), text, *key});
+        {static_cast<int64_t>(plan.points.size()), text, *key, {*key}});
   }
   ASSERT_TRUE(WriteSweepPlan(campaign, plan).ok());
 }

@@ -131,5 +131,21 @@ TEST(MotionAfter, StraightLineAndQuarterCircle) {
   EXPECT_NEAR(right.y_m, -5.0, 1e-9);
 }
 
+TEST(InsidePolygon, ConvexConcaveAndDegenerate) {
+  const std::vector<Eigen::Vector2d> square = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
+  EXPECT_TRUE(InsidePolygon(square, {1, 1}));
+  EXPECT_FALSE(InsidePolygon(square, {3, 1}));
+  EXPECT_FALSE(InsidePolygon(square, {1, -0.5}));
+  // An L shape: the notch at the top right is outside.
+  const std::vector<Eigen::Vector2d> ell = {{0, 0}, {4, 0}, {4, 2},
+                                            {2, 2}, {2, 4}, {0, 4}};
+  EXPECT_TRUE(InsidePolygon(ell, {1, 3}));
+  EXPECT_TRUE(InsidePolygon(ell, {3, 1}));
+  EXPECT_FALSE(InsidePolygon(ell, {3, 3}));
+  // Fewer than three points enclose nothing.
+  EXPECT_FALSE(InsidePolygon({}, {0, 0}));
+  EXPECT_FALSE(InsidePolygon({{0, 0}, {1, 1}}, {0.5, 0.5}));
+}
+
 }  // namespace
 }  // namespace adse::geometry
