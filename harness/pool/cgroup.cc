@@ -31,6 +31,8 @@ constexpr const char* kV1Hint =
 // How long removal waits for killed tasks to leave a group.
 constexpr auto kDrainTime = std::chrono::seconds(1);
 
+}  // namespace
+
 std::string Trim(const std::string& s) {
   const size_t b = s.find_first_not_of(" \t\n");
   if (b == std::string::npos) return "";
@@ -50,28 +52,8 @@ std::vector<std::string> Split(const std::string& s, char sep) {
   return out;
 }
 
-std::string Join(const std::vector<std::string>& parts, const char* sep) {
-  std::string out;
-  for (const std::string& p : parts) {
-    if (!out.empty()) out += sep;
-    out += p;
-  }
-  return out;
-}
-
 bool Contains(const std::vector<std::string>& v, const std::string& s) {
   return std::find(v.begin(), v.end(), s) != v.end();
-}
-
-std::string Basename(const std::string& path) {
-  const size_t slash = path.rfind('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
-
-std::string Dirname(const std::string& path) {
-  const size_t slash = path.rfind('/');
-  if (slash == std::string::npos) return ".";
-  return slash == 0 ? "/" : path.substr(0, slash);
 }
 
 bool Exists(const std::string& path) {
@@ -136,6 +118,35 @@ Status MakeGroup(int version, const std::string& dir) {
   return Status::Unavailable(msg);
 }
 
+bool IsCgroupFs(const std::string& dir) {
+  struct statfs st;
+  // Unknown counts as real: then nothing is created or unlinked.
+  if (::statfs(dir.c_str(), &st) != 0) return true;
+  return st.f_type == CGROUP_SUPER_MAGIC || st.f_type == CGROUP2_SUPER_MAGIC;
+}
+
+namespace {
+
+std::string Join(const std::vector<std::string>& parts, const char* sep) {
+  std::string out;
+  for (const std::string& p : parts) {
+    if (!out.empty()) out += sep;
+    out += p;
+  }
+  return out;
+}
+
+std::string Basename(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+std::string Dirname(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
 std::vector<pid_t> ReadPids(const std::string& procs_file) {
   std::vector<pid_t> pids;
   Result<std::string> text = ReadControl(procs_file);
@@ -159,13 +170,6 @@ int64_t ReadKeyed(const std::string& path, const std::string& key) {
   return -1;
 }
 
-bool IsCgroupFs(const std::string& dir) {
-  struct statfs st;
-  // Unknown counts as real: then nothing is created or unlinked.
-  if (::statfs(dir.c_str(), &st) != 0) return true;
-  return st.f_type == CGROUP_SUPER_MAGIC || st.f_type == CGROUP2_SUPER_MAGIC;
-}
-
 // SIGKILLs the tasks listed in `dir` (but `spare` and this process) until
 // none is left alive. A listed pid that no longer exists counts as gone:
 // that is how a fake root's static file reads, and how cgroupfs reads for
@@ -185,6 +189,23 @@ bool KillTasksIn(const std::string& dir, pid_t spare, Clock::time_point until) {
     ::usleep(1000);
   }
 }
+
+std::string DecodeMountPath(const std::string& s) {
+  std::string out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '\\' && i + 3 < s.size() && s[i + 1] >= '0' &&
+        s[i + 1] <= '7') {
+      out += static_cast<char>((s[i + 1] - '0') * 64 + (s[i + 2] - '0') * 8 +
+                               (s[i + 3] - '0'));
+      i += 3;
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
+}
+
+}  // namespace
 
 // Kills the tasks of `dir` and its sub-groups and removes them, children
 // first. rmdir is retried while killed tasks drain (EBUSY).
@@ -225,21 +246,6 @@ bool RemoveTree(const std::string& dir, bool fake, Clock::time_point until) {
   }
 }
 
-std::string DecodeMountPath(const std::string& s) {
-  std::string out;
-  for (size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '\\' && i + 3 < s.size() && s[i + 1] >= '0' &&
-        s[i + 1] <= '7') {
-      out += static_cast<char>((s[i + 1] - '0') * 64 + (s[i + 2] - '0') * 8 +
-                               (s[i + 3] - '0'));
-      i += 3;
-    } else {
-      out += s[i];
-    }
-  }
-  return out;
-}
-
 // The process's own group directory in a mount: its path with the mount's
 // root taken off, below the mount point.
 Result<std::string> OwnDir(const CgroupMount& mount, const std::string& path,
@@ -268,8 +274,6 @@ Result<std::string> OwnDir(const CgroupMount& mount, const std::string& path,
   }
   return dir;
 }
-
-}  // namespace
 
 std::vector<CgroupMount> ParseMountInfo(const std::string& text,
                                         const std::string& under) {

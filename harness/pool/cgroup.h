@@ -18,6 +18,7 @@
 
 #include <sys/types.h>
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -29,6 +30,30 @@
 #include "stack/base/status.h"
 
 namespace adse::pool::internal {
+
+// ---- Control files, shared by the pool's campaign groups and ThreadGroup.
+std::string Trim(const std::string& s);
+std::vector<std::string> Split(const std::string& s, char sep);
+bool Contains(const std::vector<std::string>& v, const std::string& s);
+bool Exists(const std::string& path);
+// The whole file, read to EOF (cgroupfs reports sizes of 0 or 4096).
+Result<std::string> ReadControl(const std::string& path);
+// Writes `value`; 0 or the errno of the failure. `fake` (a test folder)
+// creates the file.
+int WriteControlErrno(const std::string& path, const std::string& value,
+                      bool fake);
+// The same as Unavailable naming the version, value, file and error.
+Status WriteControl(int version, const std::string& path,
+                    const std::string& value, bool fake);
+// mkdir, with advice on how to get permission when it is refused.
+Status MakeGroup(int version, const std::string& dir);
+// Whether `dir` is on cgroupfs (false: a test folder laid out like it).
+bool IsCgroupFs(const std::string& dir);
+// Kills the tasks of `dir` and its sub-groups (never this process) and
+// removes them, children first, retrying until `until`. False (with a
+// warning on stderr) when something stays.
+bool RemoveTree(const std::string& dir, bool fake,
+                std::chrono::steady_clock::time_point until);
 
 // A cgroup filesystem mount from /proc/self/mountinfo.
 struct CgroupMount {
@@ -45,6 +70,11 @@ std::vector<CgroupMount> ParseMountInfo(const std::string& text,
 // /proc/self/cgroup: each controller to the process's path in its
 // hierarchy; the v2 path under the key "" ("0::/path").
 std::map<std::string, std::string> ParseProcCgroup(const std::string& text);
+
+// The process's group directory in `mount` for its path `path` from
+// /proc/self/cgroup; *is_root when that is the mount's root.
+Result<std::string> OwnDir(const CgroupMount& mount, const std::string& path,
+                           bool* is_root);
 
 // "0-3,6" for {0, 1, 2, 3, 6}.
 std::string FormatCpuList(const std::vector<int>& cpus);

@@ -2,8 +2,12 @@
 
 #include <sched.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <string>
 #include <utility>
 
 #include <fmt/format.h>
@@ -71,6 +75,27 @@ Result<HostPlacement> PlaceOnHost(int cores) {
   Result<std::vector<int>> usable = ThreadCpus();
   if (!usable.ok()) return usable.status();
   return PlaceOnCpus(cores, *usable);
+}
+
+Result<double> HostClockGhz(const std::string& cpuinfo) {
+  std::ifstream in(cpuinfo);
+  if (!in) {
+    return Status::Unavailable(fmt::format(
+        "cannot read {} for the host's clock: set platform.host_ghz", cpuinfo));
+  }
+  double mhz = 0.0;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.compare(0, 7, "cpu MHz") != 0) continue;
+    const size_t colon = line.find(':');
+    if (colon == std::string::npos) continue;
+    mhz = std::max(mhz, std::strtod(line.c_str() + colon + 1, nullptr));
+  }
+  if (!(mhz > 0.0)) {
+    return Status::Unavailable(
+        fmt::format("{} names no 'cpu MHz': set platform.host_ghz", cpuinfo));
+  }
+  return mhz / 1000.0;
 }
 
 Result<AffinityGuard> AffinityGuard::Pin(const std::vector<int>& cpus) {

@@ -26,6 +26,11 @@ Result<HostPlacement> PlaceOnHost(int cores);
 // The same from an explicit list of usable CPUs (tests).
 Result<HostPlacement> PlaceOnCpus(int cores, const std::vector<int>& usable);
 
+// The host's clock in GHz: the largest "cpu MHz" in `cpuinfo` (the
+// current clock of each CPU as the kernel reports it; on a VM the
+// hypervisor's figure). Unavailable naming the file when none is found.
+Result<double> HostClockGhz(const std::string& cpuinfo = "/proc/cpuinfo");
+
 // Pins the calling thread to `cpus` and restores its previous affinity
 // when destroyed.
 class AffinityGuard {

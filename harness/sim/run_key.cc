@@ -88,6 +88,10 @@ Result<std::string> RunKey(const spec::Spec& spec,
   // Keys of virtual runs stay as they were before the real-time platform.
   if (p.kind == spec::PlatformKind::kCgroup) {
     h.Add("time_dilation").Add(p.time_dilation);
+    // Keys of padded runs stay as they were before quotas.
+    if (p.clock_by == spec::ClockBy::kQuota) {
+      h.Add("clock_by_quota").Add(p.host_ghz);
+    }
   }
   if (p.cost_model == spec::CostModel::kCounted) {
     // Keys of calibrated runs stay as they were before profiles existed.

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <ctime>
 #include <fstream>
 #include <map>
@@ -16,7 +17,7 @@
 #include "harness/profile/profile.h"
 #include "harness/sim/calibration.h"
 #include "harness/sim/early_stop.h"
-#include "harness/sim/host_placement.h"
+#include "harness/sim/realtime_platform.h"
 #include "harness/sim/run_key.h"
 #include "harness/spec/spec_parser.h"
 #include "harness/spec/types.h"
@@ -217,7 +218,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     vp.counted = std::move(calibration).value();
   }
   std::map<std::string, std::string> platform_notes;
-  std::optional<AffinityGuard> world_affinity;
+  // Declared before the executor: its threads end before the group goes.
+  std::unique_ptr<RealTimePlatform> realtime;
   Result<std::unique_ptr<stack::Executor>> made =
       Status::Internal("no executor made");
   if (platform.kind == spec::PlatformKind::kCgroup) {
@@ -226,8 +228,6 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
           "platform.kind: cgroup pads every callback to its cost profile: "
           "set platform.cost_model: counted and platform.profile");
     }
-    Result<HostPlacement> placement = PlaceOnHost(platform.cores);
-    if (!placement.ok()) return placement.status();
     stack::RealTimeOptions rt;
     rt.cores = platform.cores;
     rt.freq_ghz = platform.freq_ghz;
@@ -235,15 +235,11 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     rt.profile_seed = vp.profile_seed;
     rt.cost_scale = platform.cost_scale;
     rt.time_dilation = platform.time_dilation;
-    rt.host_cpus = placement->stack_cpus;
-    // The world keeps off the stack's cores where the host has others.
-    if (!placement->world_cpus.empty()) {
-      Result<AffinityGuard> guard = AffinityGuard::Pin(placement->world_cpus);
-      if (!guard.ok()) return guard.status();
-      world_affinity.emplace(std::move(guard).value());
-    }
-    platform_notes["confinement"] = placement->description;
-    platform_notes["time_dilation"] = fmt::format("{}", rt.time_dilation);
+    Result<std::unique_ptr<RealTimePlatform>> prepared =
+        RealTimePlatform::Prepare(platform, &rt);
+    if (!prepared.ok()) return prepared.status();
+    realtime = std::move(prepared).value();
+    platform_notes = realtime->notes();
     made = stack::CreateRealTimeExecutor(&graph, rt);
   } else {
     made = stack::CreateVirtualExecutor(&graph, vp);
@@ -320,7 +316,12 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
       next_odometry += odometry_period;
     }
     const auto t_exec = Clock::now();
-    if (platform.kind == spec::PlatformKind::kCgroup) {
+    if (realtime != nullptr) {
+      if (const int sig = RealTimePlatform::Interrupted()) {
+        return Status::Unavailable(
+            fmt::format("interrupted by {} at t={:.2f} s; nothing was recorded",
+                        sig == SIGINT ? "SIGINT (Ctrl-C)" : "SIGTERM", t));
+      }
       world_lag_max_s =
           std::max(world_lag_max_s,
                    Seconds(t_exec - wall_start) / platform.time_dilation - t);

@@ -55,6 +55,11 @@ struct DesignSpace {
 };
 
 enum class PlatformKind { kVirtual, kCgroup };
+// kind cgroup: what stands for the point's clock on the host.
+// kPadding: each callback busy-works to its cost at the point's clock.
+// kQuota: threads get a CPU quota of f / host_ghz of each core (cpu.max),
+// and callbacks pad to their cost at f scaled by that share.
+enum class ClockBy { kPadding, kQuota };
 enum class CostModel { kMeasured, kCounted };
 
 struct PlatformOptions {
@@ -78,6 +83,10 @@ struct PlatformOptions {
   // clock and stretches every callback cost alike, so a small host can
   // hold a heavy stack.
   double time_dilation = 1.0;
+  // kind cgroup: what stands for the point's clock (see ClockBy).
+  ClockBy clock_by = ClockBy::kPadding;
+  // clock_by quota: the host's clock in GHz; 0 reads it from /proc/cpuinfo.
+  double host_ghz = 0.0;
 };
 
 struct Objective {

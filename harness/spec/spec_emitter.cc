@@ -271,6 +271,21 @@ const std::vector<Field<PlatformOptions>>& PlatformFields() {
           return p.kind == PlatformKind::kCgroup;
         };
         return f;
+      }(),
+      {"clock_by",
+       [](YAML::Emitter& out, const PlatformOptions& p, const Spec&) {
+         out << ClockByToString(p.clock_by);
+       },
+       [](const PlatformOptions& p) {
+         return p.kind == PlatformKind::kCgroup;
+       }},
+      [] {
+        Field<PlatformOptions> f =
+            Number("host_ghz", &PlatformOptions::host_ghz);
+        f.present = [](const PlatformOptions& p) {
+          return p.clock_by == ClockBy::kQuota;
+        };
+        return f;
       }()};
   return kFields;
 }

@@ -15,6 +15,12 @@ const std::vector<Term<PlatformKind>>& PlatformKindTerms() {
   return kTerms;
 }
 
+const std::vector<Term<ClockBy>>& ClockByTerms() {
+  static const std::vector<Term<ClockBy>> kTerms = {
+      {ClockBy::kPadding, "padding"}, {ClockBy::kQuota, "quota"}};
+  return kTerms;
+}
+
 const std::vector<Term<CostModel>>& CostModelTerms() {
   static const std::vector<Term<CostModel>> kTerms = {
       {CostModel::kMeasured, "measured"}, {CostModel::kCounted, "counted"}};
@@ -60,6 +66,14 @@ bool StringToPlatformKind(std::string_view name, PlatformKind* kind) {
 std::vector<std::string> PlatformKindNames() {
   return NamesOf(PlatformKindTerms());
 }
+
+const char* ClockByToString(ClockBy clock_by) {
+  return NameOf(ClockByTerms(), clock_by);
+}
+bool StringToClockBy(std::string_view name, ClockBy* clock_by) {
+  return ValueOf(ClockByTerms(), name, clock_by);
+}
+std::vector<std::string> ClockByNames() { return NamesOf(ClockByTerms()); }
 
 const char* CostModelToString(CostModel model) {
   return NameOf(CostModelTerms(), model);

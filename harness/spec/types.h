@@ -25,6 +25,11 @@ std::vector<std::string> KnobRoleNames();
 // The role a parameter bound to `bind` has unless it says otherwise.
 KnobRole DefaultKnobRole(const std::string& bind);
 
+// platform.clock_by: padding, quota.
+const char* ClockByToString(ClockBy clock_by);
+bool StringToClockBy(std::string_view name, ClockBy* clock_by);
+std::vector<std::string> ClockByNames();
+
 const char* CostModelToString(CostModel model);
 bool StringToCostModel(std::string_view name, CostModel* model);
 std::vector<std::string> CostModelNames();

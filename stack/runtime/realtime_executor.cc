@@ -193,7 +193,7 @@ RealTimeExecutor::RealTimeExecutor(const Graph* graph,
     st.cost = &profile_->callbacks.at(st.spec->name);
     st.factor = FrequencyFactor(*st.cost, profile_->reference_ghz,
                                 options.freq_ghz, options.cost_scale) *
-                dilation_;
+                dilation_ * options.cpu_share;
     st.draw_seed = Random::DeriveSeed(options.profile_seed, st.spec->name);
     if (!st.is_timer)
       topic_subs_[st.spec->topic].push_back(static_cast<int>(c));
@@ -218,14 +218,40 @@ Status RealTimeExecutor::Start() {
     }
     return Status::Ok();
   };
-  clock_thread_ = std::thread([this] { ClockLoop(); });
+  // Each thread enters (options_.enter_thread) before it does anything
+  // else; Start returns once all have, or with the first failure.
+  int entered = 0;
+  std::condition_variable entered_cv;
+  auto enter = [this, &entered, &entered_cv] {
+    Status status =
+        options_.enter_thread ? options_.enter_thread() : Status::Ok();
+    std::lock_guard<std::mutex> lock(mu_);
+    if (!status.ok()) Fail(std::move(status));
+    ++entered;
+    entered_cv.notify_all();
+  };
+  clock_thread_ = std::thread([this, enter] {
+    enter();
+    ClockLoop();
+  });
   Status pinned = pin(clock_thread_);
+  int started = 1;
   for (int i = 0; i < options_.cores && pinned.ok(); ++i) {
-    threads_.emplace_back([this, i] { WorkerLoop(i); });
+    threads_.emplace_back([this, i, enter] {
+      enter();
+      WorkerLoop(i);
+    });
+    ++started;
     pinned = pin(threads_.back());
   }
-  if (!pinned.ok()) Stop();
-  return pinned;
+  Status status = pinned;
+  {
+    std::unique_lock<std::mutex> lock(mu_);
+    entered_cv.wait(lock, [&] { return entered == started; });
+    if (status.ok()) status = error_;
+  }
+  if (!status.ok()) Stop();
+  return status;
 }
 
 void RealTimeExecutor::Stop() {
@@ -506,6 +532,10 @@ Status ValidateRealTimeOptions(const RealTimeOptions& options) {
     return Status::InvalidArgument(
         "profile: the real-time platform pads every callback to its profile "
         "cost and needs a cost profile");
+  }
+  if (!(options.cpu_share > 0.0 && options.cpu_share <= 1.0)) {
+    return Status::InvalidArgument(
+        fmt::format("cpu_share must be in (0, 1], got {}", options.cpu_share));
   }
   ADSE_RETURN_IF_ERROR(ValidateCostProfile(*options.profile));
   std::set<int> seen;

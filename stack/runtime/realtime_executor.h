@@ -8,6 +8,7 @@
 #define ADSE_STACK_RUNTIME_REALTIME_EXECUTOR_H_
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -38,11 +39,20 @@ struct RealTimeOptions {
   // Host CPUs the executor threads may run on (sched_setaffinity, as
   // taskset); empty: wherever the OS likes.
   std::vector<int> host_cpus;
+  // The share of a host CPU each thread is granted over time, in (0, 1]:
+  // < 1 when a CPU quota (cgroup cpu.max) stands for a slower clock. The
+  // padding in CPU time is scaled by it, so that under that quota a
+  // callback's wall time is still its cost at freq_ghz.
+  double cpu_share = 1.0;
+  // Called first on each of the executor's threads (the N workers and the
+  // clock), e.g. to move the thread into a cgroup. A failure stops the
+  // executor and CreateRealTimeExecutor returns it.
+  std::function<Status()> enter_thread;
 };
 
 // InvalidArgument naming the field: cores in [1, 256], freq_ghz and
 // cost_scale finite > 0, time_dilation finite >= 1, a valid profile,
-// host_cpus non-negative and distinct.
+// host_cpus non-negative and distinct, cpu_share in (0, 1].
 Status ValidateRealTimeOptions(const RealTimeOptions& options);
 
 // Starts the executor threads (they wait for the first AdvanceTo; the sim

@@ -38,8 +38,9 @@ const std::vector<std::string> kGoalKeys = {
     "pos_m",       "lane",    "slot",
     "tolerance_m", "yaw_deg", "yaw_tolerance_deg"};
 const std::vector<std::string> kPlatformKeys = {
-    "kind",  "reference_ghz", "cost_model", "calibration",  "profile",
-    "cores", "freq_ghz",      "cost_scale", "time_dilation"};
+    "kind",          "reference_ghz", "cost_model", "calibration",
+    "profile",       "cores",         "freq_ghz",   "cost_scale",
+    "time_dilation", "clock_by",      "host_ghz"};
 
 }  // namespace
 
@@ -567,6 +568,17 @@ void SpecReader::ReadPlatform(const Val& v) {
   }
   if (const Val* e = f.Get("time_dilation")) {
     ReadNumber(*e, &p.time_dilation, {1, 1000, false, false});
+  }
+  if (const Val* e = f.Get("clock_by")) {
+    if (ReadEnum(*e, &p.clock_by, ClockByNames(), StringToClockBy) &&
+        p.clock_by == ClockBy::kQuota && p.kind != PlatformKind::kCgroup) {
+      Error(e->mark, e->path, "kind: cgroup beside it",
+            "kind: " + std::string(PlatformKindToString(p.kind)) +
+                " (only the real-time platform has CPU quotas)");
+    }
+  }
+  if (const Val* e = f.Get("host_ghz")) {
+    ReadNumber(*e, &p.host_ghz, {0, kMaxPlatformFreqGhz, false, false});
   }
 }
 

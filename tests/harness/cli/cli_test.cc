@@ -299,7 +299,7 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
       "fidelity " + file +
       " --points cores=1,freq_ghz=2.1,lidar_hz=7 --runs 1 -o " + out.string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
-  EXPECT_NE(run.out.find("virtual vs real-time (median of 1 run; affinity"),
+  EXPECT_NE(run.out.find("virtual vs real-time (median of 1 run; cgroup v"),
             std::string::npos)
       << run.out;
   EXPECT_NE(run.out.find("ctrl_rate_hz"), std::string::npos) << run.out;

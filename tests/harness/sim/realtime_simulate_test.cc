@@ -1,14 +1,25 @@
 // The real-time platform end to end: the small robotaxi scenario with its
-// stack on one host CPU in real time, the world on another, and the host
-// placement that decides which. Real time is noisy, so the run is checked
-// for what must hold under any load, never for a measured duration.
+// stack's threads in a cgroup of one host CPU in real time, the world on
+// another, and the host placement that decides which. Real time is noisy, so
+// the run is checked for what must hold under any load, never for a measured
+// duration.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
 #include <set>
 #include <string>
+#include <thread>
 
+#include "harness/pool/thread_group.h"
 #include "harness/sim/host_placement.h"
 #include "harness/sim/simulator.h"
 #include "tests/harness/testing/small_scenario.h"
@@ -45,18 +56,86 @@ TEST(HostPlacementTest, MoreCoresThanTheHostGivesAreRefusedNamingBoth) {
       << p.status().message();
 }
 
+// Whether this process may make a stack thread group here; under CI, whose
+// machine runs the tests as root with cgroup v1, it must.
+bool CgroupsHere(std::string* why) {
+  pool::ThreadGroupOptions options;
+  options.cpus = {0};
+  Result<std::unique_ptr<pool::ThreadGroup>> group =
+      pool::ThreadGroup::Create(options);
+  if (!group.ok()) *why = group.status().message();
+  return group.ok();
+}
+
+#define REQUIRE_CGROUPS()                                           \
+  do {                                                              \
+    std::string why;                                                \
+    if (!CgroupsHere(&why)) {                                       \
+      if (std::getenv("CI") != nullptr) FAIL() << why;              \
+      GTEST_SKIP() << "no cgroup for the stack's threads: " << why; \
+    }                                                               \
+  } while (0)
+
+// Reads the stack's group (v1 cpuset and cpu) while a run goes on.
+class GroupWatcher {
+ public:
+  GroupWatcher()
+      : name_("/adse-stack-" + std::to_string(::getpid())),
+        thread_([this] { Loop(); }) {}
+  ~GroupWatcher() { Stop(); }
+  void Stop() {
+    done_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+  size_t max_tasks = 0;
+  std::string cpus, quota_us;
+
+ private:
+  void Loop() {
+    while (!done_) {
+      std::ifstream tasks("/sys/fs/cgroup/cpuset" + name_ + "/tasks");
+      size_t n = 0;
+      for (std::string line; std::getline(tasks, line);) ++n;
+      if (n > max_tasks) {
+        max_tasks = n;
+        std::ifstream("/sys/fs/cgroup/cpuset" + name_ + "/cpuset.cpus") >> cpus;
+        std::ifstream("/sys/fs/cgroup/cpu" + name_ + "/cpu.cfs_quota_us") >>
+            quota_us;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+  std::string name_;
+  std::atomic<bool> done_{false};
+  std::thread thread_;
+};
+
 TEST(RealTimeSimulateTest,
-     AOneCoreRealTimeRunDrivesTheStackAndRecordsWhereItRan) {
+     AOneCoreRealTimeRunDrivesTheStackInACgroupAndRecordsWhereItRan) {
+  REQUIRE_CGROUPS();
   spec::Spec spec = SmallScenario();
   spec.platform.kind = spec::PlatformKind::kCgroup;
   spec.task.timeout_s = 12.0;  // 12 s of real time
+  GroupWatcher watcher;
   Result<runfile::RunData> run = SimulatePoint(spec, SmallPoint(1, 2.1, 7));
+  watcher.Stop();
   ASSERT_TRUE(run.ok()) << run.status().ToString();
   EXPECT_EQ(run->platform.at("kind"), "cgroup");
-  EXPECT_NE(run->platform.at("confinement").find("affinity"),
-            std::string::npos);
+  const std::string& where = run->platform.at("confinement");
+  EXPECT_NE(where.find("cgroup v"), std::string::npos) << where;
+  EXPECT_NE(where.find("cpuset"), std::string::npos) << where;
+  EXPECT_EQ(run->platform.at("clock_by"), "padding");
   EXPECT_EQ(run->platform.at("time_dilation"), "1");
   EXPECT_TRUE(run->platform.count("world_lag_max_s"));
+  if (where.find("cgroup v1") != std::string::npos) {
+    // The executor's thread and its clock were in the group, on one CPU,
+    // and nothing else of this process; the group is gone afterwards.
+    EXPECT_EQ(watcher.max_tasks, 2u);
+    EXPECT_EQ(watcher.cpus.find_first_of(",-"), std::string::npos)
+        << watcher.cpus;
+    EXPECT_FALSE(std::filesystem::exists("/sys/fs/cgroup/cpuset/adse-stack-" +
+                                         std::to_string(::getpid())));
+  }
   // The stack ran: commands reached the car, sensing took scans, and every
   // record is a real interval on the one executor thread.
   // (Bounds that hold however loaded the host is: ctest runs other tests
@@ -74,6 +153,48 @@ TEST(RealTimeSimulateTest,
   ASSERT_FALSE(run->ego.empty());
   EXPECT_NEAR(run->ego.back().t_s, 12.0, 0.1);
   EXPECT_GT(run->metrics.at("ctrl_rate_hz"), 0.0);
+}
+
+TEST(RealTimeSimulateTest, AQuotaStandsForTheClockAsAShareOfTheHostsCpu) {
+  REQUIRE_CGROUPS();
+  spec::Spec spec = SmallScenario();
+  spec.platform.kind = spec::PlatformKind::kCgroup;
+  spec.platform.clock_by = spec::ClockBy::kQuota;
+  spec.platform.host_ghz = 2.0;  // 1 GHz is half of it
+  spec.task.timeout_s = 4.0;
+  GroupWatcher watcher;
+  Result<runfile::RunData> run = SimulatePoint(spec, SmallPoint(1, 1.0, 7));
+  watcher.Stop();
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  const std::string& clock = run->platform.at("clock_by");
+  EXPECT_EQ(clock.rfind("quota (share 0.500 of a 2 GHz host CPU, from "
+                        "platform.host_ghz)",
+                        0),
+            0u)
+      << clock;
+  EXPECT_NE(run->platform.at("confinement").find("cpu quota 0.5 CPUs"),
+            std::string::npos)
+      << run->platform.at("confinement");
+  if (run->platform.at("confinement").find("cgroup v1") != std::string::npos) {
+    EXPECT_EQ(watcher.quota_us, "5000");  // of a 10 ms period
+  }
+  EXPECT_GT(run->controls.size(), 3u) << "the loop closed";
+}
+
+TEST(RealTimeSimulateTest, AQuotaCannotStandForAClockFasterThanTheHost) {
+  spec::Spec spec = SmallScenario();
+  spec.platform.kind = spec::PlatformKind::kCgroup;
+  spec.platform.clock_by = spec::ClockBy::kQuota;
+  spec.platform.host_ghz = 1.5;
+  Result<runfile::RunData> run = SimulatePoint(spec, SmallPoint(1, 2.1, 7));
+  ASSERT_FALSE(run.ok());
+  EXPECT_EQ(run.status().code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(run.status().message().find("platform.clock_by: quota"),
+            std::string::npos)
+      << run.status().message();
+  EXPECT_NE(run.status().message().find("1.5 GHz (platform.host_ghz)"),
+            std::string::npos)
+      << run.status().message();
 }
 
 TEST(RealTimeSimulateTest, TheRealTimePlatformNeedsACostProfile) {

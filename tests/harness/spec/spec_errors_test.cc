@@ -84,6 +84,27 @@ TEST(SpecErrorsTest, MapWhereAListIsExpected) {
               "expected a list");
 }
 
+TEST(SpecErrorsTest, AClockQuotaNeedsTheRealTimePlatform) {
+  ExpectError(std::string(kHead) + "platform: {clock_by: quota}\n",
+              "platform.clock_by", 9, "expected kind: cgroup beside it");
+  ExpectError(std::string(kHead) + "platform: {kind: cgroup, clock_by: cap}\n",
+              "platform.clock_by", 9, "padding, quota");
+  ExpectError(std::string(kHead) + "platform: {kind: cgroup, host_ghz: -1}\n",
+              "platform.host_ghz", 9);
+  Result<Spec> quota = ParseSpec(
+      std::string(kHead) +
+          "platform: {kind: cgroup, clock_by: quota, host_ghz: 2.6}\n",
+      "ok.yaml", "");
+  ASSERT_TRUE(quota.ok()) << quota.status().message();
+  EXPECT_EQ(quota->platform.clock_by, ClockBy::kQuota);
+  EXPECT_DOUBLE_EQ(quota->platform.host_ghz, 2.6);
+  // The normalised spec carries both, and reads back the same.
+  Result<Spec> again = ParseSpec(NormalizedYaml(*quota), "again.yaml", "/");
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  EXPECT_EQ(again->platform.clock_by, ClockBy::kQuota);
+  EXPECT_DOUBLE_EQ(again->platform.host_ghz, 2.6);
+}
+
 TEST(SpecErrorsTest, WaypointsAreAListOfPlacesEachLocated) {
   std::string text = kHead;
   text.replace(text.find("  goal:"), 7, "  via: {x: 5, y: 0}\n  goal:");

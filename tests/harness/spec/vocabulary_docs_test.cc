@@ -61,6 +61,7 @@ TEST(VocabularyDocsTest, EveryChoiceIsDocumentedAsTheParserKnowsIt) {
       {"kind", world::TaskKindNames()},
       {"kind", PlatformKindNames()},
       {"cost_model", CostModelNames()},
+      {"clock_by", ClockByNames()},
       {"strategy", StrategyNames()},
       {"backend", LlmBackendNames()},
       {"isolation", pool::IsolationNames()},
