@@ -173,6 +173,7 @@ struct FidelityArgs {
   std::string scenario;             // names platform.profile
   std::vector<std::string> points;  // "cores=1,freq_ghz=2.1,..."
   int runs = 3;                     // real-time runs per point
+  std::string clock_by;             // "padding"/"quota"; empty: the file's
   std::string out;                  // folder; default <output>/fidelity
 };
 int RunFidelity(const FidelityArgs& args);

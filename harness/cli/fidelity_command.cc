@@ -10,10 +10,12 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/pictures/pictures.h"
+#include "analysis/runfile/run_file.h"
 #include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
 #include "harness/fidelity/fidelity.h"
 #include "harness/spec/design_point.h"
+#include "harness/spec/types.h"
 #include "stack/base/files.h"
 
 namespace adse::cli {
@@ -46,6 +48,9 @@ nlohmann::json ComparisonsJson(
 int RunFidelity(const FidelityArgs& args) {
   std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
   if (!spec) return 2;
+  if (!args.clock_by.empty()) {
+    spec::StringToClockBy(args.clock_by, &spec->platform.clock_by);
+  }
   std::vector<spec::DesignPoint> points;
   for (const std::string& text : args.points) {
     Result<spec::DesignPoint> point =
@@ -87,9 +92,12 @@ int RunFidelity(const FidelityArgs& args) {
     j["points"].push_back(
         {{"point", f->point},
          {"confinement", f->confinement},
+         {"clock_by", f->clock_by},
          {"metrics", ComparisonsJson(f->metrics)},
          {"callback_p50_ms", ComparisonsJson(f->callback_p50_ms)},
-         {"callback_p99_ms", ComparisonsJson(f->callback_p99_ms)}});
+         {"callback_p99_ms", ComparisonsJson(f->callback_p99_ms)},
+         {"callback_p50_ms_per_kunit",
+          ComparisonsJson(f->callback_p50_ms_per_kunit)}});
     // Per point: the callbacks' p50, virtual above real-time.
     std::vector<analysis::ComparisonRow> rows;
     for (const fidelity::Comparison& c : f->callback_p50_ms) {
@@ -113,6 +121,18 @@ int RunFidelity(const FidelityArgs& args) {
         return 1;
       }
     }
+    // The runs themselves, for adse analyze and h5py.
+    for (size_t r = 0; r < f->runs.size(); ++r) {
+      const std::string path =
+          r == 0 ? fmt::format("{}/runs/{}-virtual.h5", dir, i + 1)
+                 : fmt::format("{}/runs/{}-realtime-{}.h5", dir, i + 1, r);
+      Status written = MakeDirs(dir + "/runs");
+      if (written.ok()) written = runfile::WriteRunFile(path, f->runs[r]);
+      if (!written.ok()) {
+        std::fprintf(stderr, "error: %s\n", written.message().c_str());
+        return 1;
+      }
+    }
   }
   Status saved = WriteFileAtomic(dir + "/fidelity.txt", text);
   if (saved.ok()) {
@@ -122,8 +142,9 @@ int RunFidelity(const FidelityArgs& args) {
     std::fprintf(stderr, "error: %s\n", saved.message().c_str());
     return 1;
   }
-  std::printf("wrote %s/fidelity.txt, fidelity.json and fidelity-N.png\n",
-              dir.c_str());
+  std::printf(
+      "wrote %s/fidelity.txt, fidelity.json, fidelity-N.png and runs/\n",
+      dir.c_str());
   return 0;
 }
 

@@ -444,6 +444,11 @@ int main(int argc, char** argv) {
                    "Real-time runs per point (default 3; their median is "
                    "compared)")
       ->check(CLI::Range(1, 100));
+  fidelity_cmd
+      ->add_option("--clock-by", fidelity.clock_by,
+                   "What stands for the clock in the real-time runs: padding "
+                   "or quota (default: the scenario's platform.clock_by)")
+      ->check(CLI::IsMember(adse::spec::ClockByNames()));
   fidelity_cmd->add_option(
       "-o,--out", fidelity.out,
       "Folder for fidelity.txt, fidelity.json and fidelity-N.png (default: "

@@ -67,17 +67,21 @@ double SensingToControlMs(const runfile::RunData& run) {
          static_cast<double>(v.size());
 }
 
-// Per callback name: its execution latencies (start to end), ms.
+// Per callback name: its execution latencies (start to end), ms; with
+// `per_kunit`, per 1000 of the work units each invocation reported (those
+// that reported none left out).
 std::map<std::string, std::vector<double>> CallbackLatenciesMs(
-    const runfile::RunData& run) {
+    const runfile::RunData& run, bool per_kunit = false) {
   std::map<std::string, std::vector<double>> out;
   for (const stack::CallbackRecord& r : run.trace.callbacks) {
     if (r.callback < 0 ||
         r.callback >= static_cast<int>(run.callback_info.size())) {
       continue;
     }
-    out[run.callback_info[r.callback].name].push_back(1000.0 *
-                                                      (r.end_s - r.start_s));
+    if (per_kunit && !(r.work_units > 0.0)) continue;
+    const double ms = 1000.0 * (r.end_s - r.start_s);
+    out[run.callback_info[r.callback].name].push_back(
+        per_kunit ? ms / (r.work_units / 1000.0) : ms);
   }
   return out;
 }
@@ -130,23 +134,36 @@ PointFidelity CompareRuns(const runfile::RunData& virtual_run,
 
   std::map<std::string, std::vector<double>> v =
       CallbackLatenciesMs(virtual_run);
-  std::vector<std::map<std::string, std::vector<double>>> rts;
+  std::map<std::string, std::vector<double>> v_unit =
+      CallbackLatenciesMs(virtual_run, /*per_kunit=*/true);
+  std::vector<std::map<std::string, std::vector<double>>> rts, rts_unit;
   for (const runfile::RunData& r : realtime_runs) {
     rts.push_back(CallbackLatenciesMs(r));
+    rts_unit.push_back(CallbackLatenciesMs(r, /*per_kunit=*/true));
   }
+  // The p50 (and `q`) of `name` in each real-time run that ran it.
+  auto realtime_quantile = [](auto& runs, const std::string& name, double q) {
+    std::vector<double> out;
+    for (auto& run : runs) {
+      auto it = run.find(name);
+      if (it != run.end()) out.push_back(Quantile(it->second, q));
+    }
+    return out;
+  };
   for (auto& [name, latencies] : v) {
     const double p50 = Quantile(latencies, 0.5);
     if (!(p50 >= kMinCallbackMs)) continue;
     const double p99 = Quantile(latencies, 0.99);
-    std::vector<double> rt50, rt99;
-    for (auto& run : rts) {
-      auto it = run.find(name);
-      if (it == run.end()) continue;
-      rt50.push_back(Quantile(it->second, 0.5));
-      rt99.push_back(Quantile(it->second, 0.99));
+    f.callback_p50_ms.push_back(Compare(
+        name, p50, realtime_quantile(rts, name, 0.5), kCallbackTolerance));
+    f.callback_p99_ms.push_back(
+        Compare(name, p99, realtime_quantile(rts, name, 0.99), std::nullopt));
+    auto unit = v_unit.find(name);
+    if (unit != v_unit.end()) {
+      f.callback_p50_ms_per_kunit.push_back(
+          Compare(name, Quantile(unit->second, 0.5),
+                  realtime_quantile(rts_unit, name, 0.5), std::nullopt));
     }
-    f.callback_p50_ms.push_back(Compare(name, p50, rt50, kCallbackTolerance));
-    f.callback_p99_ms.push_back(Compare(name, p99, rt99, std::nullopt));
   }
   return f;
 }
@@ -180,8 +197,9 @@ Result<PointFidelity> ComparePoint(const spec::Spec& input,
   }
   PointFidelity f = CompareRuns(*virtual_run, realtime);
   f.point = text;
-  const auto where = realtime.front().platform.find("confinement");
-  if (where != realtime.front().platform.end()) f.confinement = where->second;
+  const std::map<std::string, std::string>& notes = realtime.front().platform;
+  if (notes.count("confinement")) f.confinement = notes.at("confinement");
+  if (notes.count("clock_by")) f.clock_by = notes.at("clock_by");
   f.runs.push_back(std::move(virtual_run).value());
   for (runfile::RunData& r : realtime) f.runs.push_back(std::move(r));
   return f;
@@ -190,8 +208,9 @@ Result<PointFidelity> ComparePoint(const spec::Spec& input,
 std::string FormatPointFidelity(const PointFidelity& f) {
   std::ostringstream out;
   const size_t k = f.runs.empty() ? 0 : f.runs.size() - 1;
-  out << fmt::format("{}: virtual vs real-time (median of {} run{}; {})\n",
-                     f.point, k, k == 1 ? "" : "s", f.confinement);
+  out << fmt::format(
+      "{}: virtual vs real-time (median of {} run{}; {}; clock by {})\n",
+      f.point, k, k == 1 ? "" : "s", f.confinement, f.clock_by);
   auto table = [&](const char* what, const std::vector<Comparison>& rows) {
     out << fmt::format("  {:<44} {:>10} {:>10} {:>22} {:>8}  {}\n", what,
                        "virtual", "real-time", "real-time runs", "diff",
@@ -219,6 +238,8 @@ std::string FormatPointFidelity(const PointFidelity& f) {
   table("run", f.metrics);
   table("callback p50 latency, start to end (ms)", f.callback_p50_ms);
   table("callback p99 latency (ms)", f.callback_p99_ms);
+  table("callback p50 latency per 1000 work units (ms)",
+        f.callback_p50_ms_per_kunit);
   return out.str();
 }
 

@@ -42,6 +42,7 @@ struct Comparison {
 struct PointFidelity {
   std::string point;        // FormatPoint text
   std::string confinement;  // where the real-time runs ran
+  std::string clock_by;     // what stood for the clock there
   // nav_time_s (only of runs that reached the goal) and ctrl_rate_hz
   // (targets 10 %), e2e_latency_p50_s,
   // dropped_messages, lidar_frames_dropped, and the sensing-to-control
@@ -51,6 +52,12 @@ struct PointFidelity {
   // execution latency, start to end (target 20 %), then its p99.
   std::vector<Comparison> callback_p50_ms;
   std::vector<Comparison> callback_p99_ms;
+  // Per callback above that reports its work (points, iterations x
+  // points): the p50 of its latency per 1000 work units. A callback whose
+  // work depends on the closed loop (NDT's iterations) can disagree in
+  // latency only because one platform gave it more work; this tells the
+  // executor model's error from that.
+  std::vector<Comparison> callback_p50_ms_per_kunit;
   // The runs themselves (the virtual one, then the real-time ones).
   std::vector<runfile::RunData> runs;
 };

@@ -304,7 +304,8 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
       << run.out;
   EXPECT_NE(run.out.find("ctrl_rate_hz"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("callback p50 latency"), std::string::npos);
-  for (const char* name : {"fidelity.txt", "fidelity.json", "fidelity-1.png"}) {
+  for (const char* name : {"fidelity.txt", "fidelity.json", "fidelity-1.png",
+                           "runs/1-virtual.h5", "runs/1-realtime-1.h5"}) {
     EXPECT_TRUE(fs::is_regular_file(out / name)) << name;
   }
   // A point outside the space, and no runs, are bad input.

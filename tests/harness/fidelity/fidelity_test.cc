@@ -91,5 +91,29 @@ TEST(FidelityTest, NavTimesOfRunsThatTimedOutAreNotCompared) {
   EXPECT_NEAR(Find(f.metrics, "ctrl_rate_hz").difference, -0.25, 1e-12);
 }
 
+TEST(FidelityTest, MoreWorkIsToldFromASlowerExecutorPerWorkUnit) {
+  // The real-time run took twice as long because its callback was given
+  // twice the work (as NDT's iterations grow with a worse initial guess):
+  // per 1000 work units the platforms agree.
+  runfile::RunData virtual_run = MadeRun(100.0, 30.0, 10.0);
+  runfile::RunData realtime_run = MadeRun(100.0, 30.0, 20.0);
+  for (stack::CallbackRecord& r : virtual_run.trace.callbacks) {
+    if (r.callback == 0) r.work_units = 5000;
+  }
+  for (stack::CallbackRecord& r : realtime_run.trace.callbacks) {
+    if (r.callback == 0) r.work_units = 10000;
+  }
+  const PointFidelity f = CompareRuns(virtual_run, {realtime_run});
+  EXPECT_NEAR(Find(f.callback_p50_ms, "a/work").difference, 1.0, 1e-9);
+  // The timer reported no work and is under 1 ms: not listed.
+  ASSERT_EQ(f.callback_p50_ms_per_kunit.size(), 1u);
+  const Comparison& unit = f.callback_p50_ms_per_kunit[0];
+  EXPECT_EQ(unit.name, "a/work");
+  EXPECT_NEAR(unit.virtual_value, 2.0, 1e-9);  // 10 ms per 5000 units
+  EXPECT_NEAR(unit.difference, 0.0, 1e-9);
+  EXPECT_NE(FormatPointFidelity(f).find("per 1000 work units"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace adse::fidelity

@@ -9,7 +9,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
+#include <ctime>
 #include <memory>
+#include <mutex>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -53,6 +57,13 @@ std::unique_ptr<Executor> Create(const Graph& graph,
   auto made = CreateRealTimeExecutor(&graph, options);
   EXPECT_TRUE(made.ok()) << made.status().ToString();
   return made.ok() ? std::move(made).value() : nullptr;
+}
+
+double ProcessCpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) +
+         1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 std::vector<CallbackRecord> RecordsOf(const Trace& trace, int callback) {
@@ -255,6 +266,11 @@ TEST(RealTimeExecutorTest, RefusesBadOptionsAndUnknownHostCpusByName) {
   Case twice{Options(1, 2.0, profile), "host_cpus"};
   twice.options.host_cpus = {0, 0};
   cases.push_back(twice);
+  for (double share : {0.0, 1.5}) {
+    Case c{Options(1, 2.0, profile), "cpu_share"};
+    c.options.cpu_share = share;
+    cases.push_back(c);
+  }
   for (const Case& c : cases) {
     auto made = CreateRealTimeExecutor(&chain.graph, c.options);
     ASSERT_FALSE(made.ok()) << c.field;
@@ -273,6 +289,64 @@ TEST(RealTimeExecutorTest, RefusesBadOptionsAndUnknownHostCpusByName) {
   ASSERT_FALSE(pinned.ok());
   EXPECT_EQ(pinned.status().code(), Status::Code::kUnavailable);
   EXPECT_NE(pinned.status().message().find("1000"), std::string::npos);
+}
+
+TEST(RealTimeExecutorTest, EveryThreadEntersFirstAndAFailedEntryIsReturned) {
+  Chain chain;
+  auto profile = FlatProfile({{"a/tick", 0.0001}, {"b/work", 0.001}});
+  // Two workers and the clock each enter once, on their own thread.
+  std::mutex mu;
+  std::set<std::thread::id> entered;
+  RealTimeOptions options = Options(2, 2.0, profile);
+  options.enter_thread = [&] {
+    std::lock_guard<std::mutex> lock(mu);
+    entered.insert(std::this_thread::get_id());
+    return Status::Ok();
+  };
+  auto exec = Create(chain.graph, options);
+  ASSERT_NE(exec, nullptr);
+  {
+    std::lock_guard<std::mutex> lock(mu);
+    EXPECT_EQ(entered.size(), 3u);
+    EXPECT_FALSE(entered.count(std::this_thread::get_id()));
+  }
+  ASSERT_TRUE(exec->AdvanceTo(0.05).ok());
+  exec->Stop();
+
+  // One thread that cannot enter (its cgroup refused it) fails the start.
+  std::atomic<int> calls{0};
+  options.enter_thread = [&] {
+    return ++calls == 2 ? Status::Unavailable("cgroup v1: no room")
+                        : Status::Ok();
+  };
+  auto refused = CreateRealTimeExecutor(&chain.graph, options);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), Status::Code::kUnavailable);
+  EXPECT_EQ(refused.status().message(), "cgroup v1: no room");
+  EXPECT_EQ(calls.load(), 3);
+}
+
+TEST(RealTimeExecutorTest, ACpuShareScalesThePaddingInCpuTime) {
+  Chain chain;
+  // 2 ms at 2 GHz, run at 1 GHz with a share of 0.5: 2 ms of thread CPU
+  // time, which a quota of half a CPU would stretch back to 4 ms of wall.
+  RealTimeOptions options =
+      Options(1, 1.0, FlatProfile({{"a/tick", 0.0001}, {"b/work", 0.002}}));
+  options.cpu_share = 0.5;
+  auto exec = Create(chain.graph, options);
+  ASSERT_NE(exec, nullptr);
+  const double cpu0 = ProcessCpuSeconds();
+  ASSERT_TRUE(exec->AdvanceTo(0.3).ok());
+  exec->Stop();
+  const double cpu_s = ProcessCpuSeconds() - cpu0;
+  const std::vector<CallbackRecord> work = RecordsOf(exec->trace(), chain.sub);
+  ASSERT_GT(work.size(), 3u);
+  for (const CallbackRecord& r : work) {
+    EXPECT_GE(r.cost_s, 0.002 - 1e-5);
+  }
+  // The process used about 2 ms per message, not the 4 ms of a share of 1
+  // (CPU time, which a loaded host cannot inflate; the ticks add 3 ms).
+  EXPECT_LT(cpu_s, 0.003 * static_cast<double>(work.size()) + 0.01);
 }
 
 }  // namespace
