@@ -12,6 +12,8 @@
 #include <ctime>
 #include <filesystem>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -29,6 +31,17 @@ using testing::WriteText;
 const std::string kPid = std::to_string(::getpid());
 
 std::string Tid() { return std::to_string(::syscall(SYS_gettid)); }
+
+// Options that look for cgroups under `tmp` (<tmp>/cgroup, mountinfo,
+// self_cgroup) rather than the machine's.
+ThreadGroupOptions FakeOptions(const TempDir& tmp, std::vector<int> cpus) {
+  ThreadGroupOptions o;
+  o.cpus = std::move(cpus);
+  o.cgroup_root = tmp.path() + "/cgroup";
+  o.proc_self_cgroup = tmp.path() + "/self_cgroup";
+  o.proc_self_mountinfo = tmp.path() + "/mountinfo";
+  return o;
+}
 
 // cpuset and cpu v1 hierarchies at <tmp>/cgroup/{cpuset,cpu}, this process
 // in /jobs/7 of both.
@@ -49,14 +62,7 @@ struct FakeV1 {
     WriteText(tmp.path() + "/mountinfo", mounts);
     WriteText(tmp.path() + "/self_cgroup", self);
   }
-  ThreadGroupOptions Options() const {
-    ThreadGroupOptions o;
-    o.cpus = {2, 3};
-    o.cgroup_root = tmp.path() + "/cgroup";
-    o.proc_self_cgroup = tmp.path() + "/self_cgroup";
-    o.proc_self_mountinfo = tmp.path() + "/mountinfo";
-    return o;
-  }
+  ThreadGroupOptions Options() const { return FakeOptions(tmp, {2, 3}); }
   std::string Own(const char* controller) const {
     return tmp.path() + "/cgroup/" + controller + "/jobs/7";
   }
@@ -142,12 +148,8 @@ TEST(ThreadGroupFakeTest, V2MakesAThreadedChildAndUndoesWhatItEnabled) {
             "22 1 8:1 / / rw - ext4 /dev/root rw\n30 22 0:26 / " + tmp.path() +
                 "/cgroup rw - cgroup2 cgroup2 rw\n");
   WriteText(tmp.path() + "/self_cgroup", "0::/user.slice/run.scope\n");
-  ThreadGroupOptions options;
-  options.cpus = {1};
+  ThreadGroupOptions options = FakeOptions(tmp, {1});
   options.cpu_quota = 0.25;
-  options.cgroup_root = tmp.path() + "/cgroup";
-  options.proc_self_cgroup = tmp.path() + "/self_cgroup";
-  options.proc_self_mountinfo = tmp.path() + "/mountinfo";
   Result<std::unique_ptr<ThreadGroup>> group = ThreadGroup::Create(options);
   ASSERT_TRUE(group.ok()) << group.status().ToString();
   EXPECT_EQ((*group)->version(), 2);
@@ -174,12 +176,8 @@ TEST(ThreadGroupFakeTest, V2WithoutTheCpusetControllerIsRefusedNamingIt) {
   WriteText(tmp.path() + "/mountinfo",
             "30 22 0:26 / " + tmp.path() + "/cgroup rw - cgroup2 cgroup2 rw\n");
   WriteText(tmp.path() + "/self_cgroup", "0::/app.scope\n");
-  ThreadGroupOptions options;
-  options.cpus = {0};
-  options.cgroup_root = tmp.path() + "/cgroup";
-  options.proc_self_cgroup = tmp.path() + "/self_cgroup";
-  options.proc_self_mountinfo = tmp.path() + "/mountinfo";
-  Result<std::unique_ptr<ThreadGroup>> group = ThreadGroup::Create(options);
+  Result<std::unique_ptr<ThreadGroup>> group =
+      ThreadGroup::Create(FakeOptions(tmp, {0}));
   ASSERT_FALSE(group.ok());
   EXPECT_EQ(group.status().code(), Status::Code::kUnavailable);
   EXPECT_NE(
@@ -193,12 +191,8 @@ TEST(ThreadGroupFakeTest, WithoutAnyCgroupMountItRefusesNamingWhatIsMissing) {
   TempDir tmp;
   WriteText(tmp.path() + "/mountinfo", "22 1 8:1 / / rw - ext4 /dev/root rw\n");
   WriteText(tmp.path() + "/self_cgroup", "");
-  ThreadGroupOptions options;
-  options.cpus = {0};
-  options.cgroup_root = tmp.path() + "/cgroup";
-  options.proc_self_cgroup = tmp.path() + "/self_cgroup";
-  options.proc_self_mountinfo = tmp.path() + "/mountinfo";
-  Result<std::unique_ptr<ThreadGroup>> group = ThreadGroup::Create(options);
+  Result<std::unique_ptr<ThreadGroup>> group =
+      ThreadGroup::Create(FakeOptions(tmp, {0}));
   ASSERT_FALSE(group.ok());
   EXPECT_NE(group.status().message().find("needs the cpuset controller"),
             std::string::npos)
