@@ -1,8 +1,9 @@
-// The real-time platform's cgroup is removed on every exit path of
-// `adse simulate`: Ctrl-C and SIGTERM end the run in order (non-zero exit,
-// no run file), and after a SIGKILL the next run removes the stale group.
-// Needs root and cgroup v1 cpuset (CI's machine); skipped elsewhere, and a
-// failure under CI.
+// The real-time platform from the command line: its cgroup is removed on
+// every exit path of `adse simulate` (Ctrl-C and SIGTERM end the run in
+// order, non-zero exit, no run file; after a SIGKILL the next run removes
+// the stale group), and a campaign's worker nests the stack's group in its
+// own. Needs root and cgroup v1 cpuset (CI's machine); skipped elsewhere,
+// and a failure under CI.
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -17,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include "analysis/runfile/run_file.h"
 #include "harness/pool/thread_group.h"
 
 namespace {
@@ -31,7 +33,7 @@ std::string ReadFile(const fs::path& path) {
   return text.str();
 }
 
-class RealTimeExitTest : public ::testing::Test {
+class RealTimeCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
     if (::geteuid() != 0 ||
@@ -57,6 +59,18 @@ class RealTimeExitTest : public ::testing::Test {
       text.replace(text.find(from), from.size(), to);
     }
     std::ofstream(dir_ / "rt.yaml") << text;
+    // A two-point campaign of 3 s runs, in cgroup-isolated workers.
+    for (const auto& [from, to] :
+         {std::pair<std::string, std::string>{"timeout_s: 60", "timeout_s: 3"},
+          {"budget: 20", "budget: 2"},
+          {"output: results/fidelity-small",
+           "output: " + (dir_ / "campaign").string() +
+               "\nharness: {workers: 1, cores_per_worker: 2, "
+               "isolation: cgroup}"}}) {
+      ASSERT_NE(text.find(from), std::string::npos) << from;
+      text.replace(text.find(from), from.size(), to);
+    }
+    std::ofstream(dir_ / "campaign.yaml") << text;
   }
   void TearDown() override {
     if (!dir_.empty()) fs::remove_all(dir_);
@@ -108,7 +122,7 @@ class RealTimeExitTest : public ::testing::Test {
   fs::path dir_;
 };
 
-TEST_F(RealTimeExitTest, CtrlCAndSigtermEndTheRunAndRemoveTheGroup) {
+TEST_F(RealTimeCliTest, CtrlCAndSigtermEndTheRunAndRemoveTheGroup) {
   for (const int sig : {SIGINT, SIGTERM}) {
     const pid_t pid = Start();
     ASSERT_GT(pid, 0);
@@ -125,7 +139,7 @@ TEST_F(RealTimeExitTest, CtrlCAndSigtermEndTheRunAndRemoveTheGroup) {
   }
 }
 
-TEST_F(RealTimeExitTest, AfterASigkillTheNextRunRemovesTheStaleGroup) {
+TEST_F(RealTimeCliTest, AfterASigkillTheNextRunRemovesTheStaleGroup) {
   const pid_t pid = Start();
   ASSERT_GT(pid, 0);
   const int status = SignalAndReap(pid, SIGKILL);
@@ -137,6 +151,42 @@ TEST_F(RealTimeExitTest, AfterASigkillTheNextRunRemovesTheStaleGroup) {
   auto next = adse::pool::ThreadGroup::Create(options);
   ASSERT_TRUE(next.ok()) << next.status().ToString();
   EXPECT_FALSE(fs::exists(GroupOf(pid)));
+}
+
+TEST_F(RealTimeCliTest, ACampaignWorkerNestsTheStacksGroupInItsOwn) {
+  const std::string command = std::string(ADSE_BINARY_DIR) + "/bin/adse run " +
+                              (dir_ / "campaign.yaml").string() +
+                              " -q --no-cache 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  char buffer[4096];
+  size_t n;
+  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) {
+    out.append(buffer, n);
+  }
+  const int status = ::pclose(pipe);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << out;
+  EXPECT_NE(out.find("2 evaluations (2 simulated"), std::string::npos) << out;
+  // Each run file says where its stack ran: in a group below the worker's
+  // slot group, which the campaign removed with its own.
+  int runs = 0;
+  for (const auto& entry : fs::directory_iterator(dir_ / "campaign/runs")) {
+    if (entry.path().extension() != ".h5") continue;
+    ++runs;
+    adse::Result<adse::runfile::RunData> run =
+        adse::runfile::ReadRunFile(entry.path().string());
+    ASSERT_TRUE(run.ok()) << run.status().ToString();
+    EXPECT_NE(run->platform.at("confinement").find("/worker-0/adse-stack-"),
+              std::string::npos)
+        << run->platform.at("confinement");
+  }
+  EXPECT_EQ(runs, 2);
+  for (const auto& entry : fs::directory_iterator("/sys/fs/cgroup/cpuset")) {
+    EXPECT_EQ(entry.path().filename().string().find("adse-" +
+                                                    std::to_string(::getpid())),
+              std::string::npos);
+  }
 }
 
 }  // namespace
