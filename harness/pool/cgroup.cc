@@ -422,7 +422,9 @@ Result<Layout> DetectLayout(const PoolOptions& options) {
     h.own_dir = *dir;
     h.own_is_root = is_root;
     h.fake = !IsCgroupFs(*dir);
-    for (const char* c : {"cpuset", "memory", "pids"}) {
+    // cpu is handed down (no limit set) so that a real-time run inside a
+    // worker can give its stack's thread group a CPU quota.
+    for (const char* c : {"cpuset", "cpu", "memory", "pids"}) {
       if (Contains(controllers, c)) h.controllers.push_back(c);
     }
     layout.cpuset = Contains(controllers, "cpuset");

@@ -86,7 +86,7 @@ int GroupNamePid(const std::string& name);
 // One hierarchy the campaign uses, and the process's own group in it.
 struct Hierarchy {
   std::string own_dir;
-  std::vector<std::string> controllers;  // those of cpuset/memory/pids here
+  std::vector<std::string> controllers;  // of cpuset/(v2: cpu)/memory/pids
   bool own_is_root = false;  // exempt from v2's no-internal-process rule
   bool fake = false;         // not cgroupfs: a test folder
 };

@@ -166,10 +166,11 @@ TEST(CgroupFakeTest, V2DelegatedSubtreeFileProtocol) {
     // The own group held this process: it moved into a leaf first, then
     // enabled the controllers for the sub-groups.
     EXPECT_EQ(ReadText(parent + "/coordinator/cgroup.procs"), kSelf);
+    // cpu too, for a real-time stack's quota inside a worker.
     EXPECT_EQ(ReadText(fake.own + "/cgroup.subtree_control"),
-              "+cpuset +memory +pids");
+              "+cpuset +cpu +memory +pids");
     EXPECT_EQ(ReadText(parent + "/cgroup.subtree_control"),
-              "+cpuset +memory +pids");
+              "+cpuset +cpu +memory +pids");
     for (int i = 0; i < workers; ++i) {
       const std::string slot = parent + "/worker-" + std::to_string(i);
       EXPECT_EQ(ReadText(slot + "/memory.max"), std::to_string(64 << 20));
@@ -194,7 +195,7 @@ TEST(CgroupFakeTest, V2DelegatedSubtreeFileProtocol) {
   EXPECT_FALSE(fs::exists(parent));
   EXPECT_EQ(ReadText(fake.own + "/cgroup.procs"), kSelf);
   EXPECT_EQ(ReadText(fake.own + "/cgroup.subtree_control"),
-            "-cpuset -memory -pids");
+            "-cpuset -cpu -memory -pids");
 }
 
 TEST(CgroupFakeTest, V2WithoutCpusetKeepsCoresApartByAffinity) {
