@@ -223,7 +223,7 @@ std::string MisbehavingWorker(const std::string& dir) {
          "# $1 scenario, $2 --point, $3 the point\n"
          "case \"$3\" in\n"
          "  cores=4,freq_ghz=1,lidar_hz=7) kill -9 $$ ;;\n"
-         "  cores=4,freq_ghz=1,lidar_hz=14) exec sleep 60 ;;\n"
+         "  cores=4,freq_ghz=1,lidar_hz=14) exec sleep 300 ;;\n"
          "  cores=4,freq_ghz=2.1,lidar_hz=7) exec python3 -c "
          "'a = bytearray(1 << 30); a[::4096] = b\"x\" * len(a[::4096]); "
          "import time; time.sleep(30)' ;;\n"
@@ -238,10 +238,11 @@ TEST(CampaignTest,
      CrashTimeoutAndOutOfMemoryAreRecordedRetriedAndDoNotStopTheCampaign) {
   spec::Spec spec = adse::testing::SmallScenario();
   // Four quick points (4 cores take ~3.5 s each on an idle machine; the
-  // timeout leaves room for a loaded one); the worker still checks them
-  // against the file's space, which holds them.
+  // timeout leaves room for one loaded by two parallel builds, where 12 s
+  // was seen to be too little); the worker still checks them against the
+  // file's space, which holds them.
   spec.design_space.parameters[0].values = {4};
-  spec.harness.run_timeout_s = 12;
+  spec.harness.run_timeout_s = 30;
   spec.harness.retries = 1;
   spec.harness.memory_mb = 400;
   const std::string out = TempDir("failures");
