@@ -132,10 +132,8 @@ Status ThreadGroup::SetupV1(const ThreadGroupOptions& options,
     p.threads_file = p.dir + "/tasks";
     p.fake = !internal::IsCgroupFs(*own);
     PrepareParent(p.own_dir, p.dir, p.fake);
-    const Status made = internal::MakeGroup(1, p.dir);
-    if (!made.ok()) {
-      return Status::Unavailable(made.message() + "; " + kPermissionHint);
-    }
+    // MakeGroup's error says how to get permission.
+    ADSE_RETURN_IF_ERROR(internal::MakeGroup(1, p.dir));
     places_.push_back(p);
     dirs_.push_back(p.dir);
     return p;
@@ -246,10 +244,7 @@ Status ThreadGroup::SetupV2(const ThreadGroupOptions& options,
     }
     enabled_in_own_ = text;
   }
-  const Status made = internal::MakeGroup(2, p.dir);
-  if (!made.ok()) {
-    return Status::Unavailable(made.message() + "; " + kPermissionHint);
-  }
+  ADSE_RETURN_IF_ERROR(internal::MakeGroup(2, p.dir));
   places_.push_back(p);
   dirs_.push_back(p.dir);
   ADSE_RETURN_IF_ERROR(
