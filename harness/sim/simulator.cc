@@ -210,6 +210,19 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     Result<profile::Profile> loaded = profile::ReadProfile(platform.profile);
     if (!loaded.ok()) return loaded.status().WithContext("platform.profile");
     profile_name = loaded->name;
+    // The graph has the signal subscription only where the route has
+    // signals; say which profile covers it rather than just what is missing.
+    constexpr char kSignalCallback[] =
+        "behavior_velocity_planner/traffic_signal";
+    if (topics.traffic_signal >= 0 &&
+        loaded->costs.callbacks.count(kSignalCallback) == 0) {
+      return Status::InvalidArgument(fmt::format(
+          "platform.profile: the route has traffic signals, so the stack "
+          "subscribes to its signal detector ({}), which profile '{}' lacks; "
+          "name a profile that has it, such as "
+          "profiles/autoware-2022.12-i9-12900kf-signals.yaml",
+          kSignalCallback, profile_name));
+    }
     vp.profile =
         std::make_shared<const stack::CostProfile>(std::move(loaded->costs));
     vp.profile_seed = Random::DeriveSeed(seed, "cost");

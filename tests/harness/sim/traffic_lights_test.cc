@@ -23,7 +23,8 @@ constexpr char kRilsa[] =
 constexpr double kStopLineY = 511.35;
 constexpr double kGreenAtS = 45.0;
 
-spec::Spec RilsaNorthToSouth() {
+spec::Spec RilsaNorthToSouth(
+    const std::string& profile = "autoware-2022.12-i9-12900kf-signals.yaml") {
   const std::string text =
       std::string("adse: 1\n") +
       "name: rilsa-signal\n"
@@ -38,8 +39,8 @@ spec::Spec RilsaNorthToSouth() {
       "  speed_limit_kmh: 40\n"
       "  timeout_s: 200\n"
       "platform: {kind: virtual, cost_model: counted, profile: " +
-      ADSE_SOURCE_DIR +
-      "/scenarios/profiles/autoware-2022.12-i9-12900kf-signals.yaml}\n"
+      ADSE_SOURCE_DIR + "/scenarios/profiles/" + profile +
+      "}\n"
       "design_space:\n"
       "  cores:    {bind: platform.cores,    range: [1, 16]}\n"
       "  freq_ghz: {bind: platform.freq_ghz, values: [1.2, 2.1]}\n";
@@ -96,6 +97,21 @@ TEST(TrafficLightsTest, TheEgoWaitsAtTheRedLightThenDrivesOnToTheGoal) {
     has_callback |= c.name == "behavior_velocity_planner/traffic_signal";
   EXPECT_TRUE(has_topic);
   EXPECT_TRUE(has_callback);
+}
+
+TEST(TrafficLightsTest, APlainProfileIsRefusedNamingTheOneWithTheSignals) {
+  ASSERT_TRUE(std::filesystem::exists(kRilsa)) << "sumo-tools is not installed";
+  Result<runfile::RunData> run =
+      SimulatePoint(RilsaNorthToSouth("autoware-2022.12-i9-12900kf.yaml"),
+                    {{"cores", 16}, {"freq_ghz", 2.1}});
+  ASSERT_FALSE(run.ok());
+  EXPECT_EQ(run.status().code(), Status::Code::kInvalidArgument);
+  EXPECT_EQ(run.status().message().rfind("platform.profile: ", 0), 0u)
+      << run.status().message();
+  EXPECT_NE(
+      run.status().message().find("autoware-2022.12-i9-12900kf-signals.yaml"),
+      std::string::npos)
+      << run.status().message();
 }
 
 }  // namespace
