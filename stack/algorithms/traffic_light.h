@@ -33,7 +33,7 @@ struct TrafficLightParams {
   double unknown_wait_s = 5.0;
   // Standing at a red line for this long, the signal is taken as broken
   // and the car goes on: no signal blocks a run forever.
-  double max_red_wait_s = 120.0;
+  double max_red_wait_s = 300.0;
   double stop_margin_m = 1.0;       // front bumper to stop line when stopped
   double ego_front_m = 3.8;         // rear axle to front bumper
   double max_decel_mps2 = 2.5;      // a yellow stops the car only within this

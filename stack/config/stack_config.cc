@@ -97,7 +97,7 @@ const std::vector<KnobInfo>& StackKnobs() {
         {"traffic_light.unknown_wait_s", false, 0.0, 600.0, 5.0,
          "standing this long at the line of a signal it cannot read, the car "
          "goes on, s"},
-        {"traffic_light.max_red_wait_s", false, 1.0, 3600.0, 120.0,
+        {"traffic_light.max_red_wait_s", false, 1.0, 3600.0, 300.0,
          "standing this long at a red line, the signal is taken as broken and "
          "the car goes on, s"},
         {"traffic_light.stop_margin_m", false, 0.0, 10.0, 1.0,
