@@ -288,13 +288,20 @@ class Checker {
       Problem(path, "field '" + name + "' must be a fixed-length string");
     }
     if (schema_class == "enum" && field.contains("values")) {
-      CheckEnum(path, name, member, field.at("values"));
+      CheckEnum(path, name, member, field.at("values"), /*required=*/true);
+    }
+    // Codes added later: older files lack them; a file that has one must
+    // have it with its value.
+    if (schema_class == "enum" && field.contains("added_values")) {
+      CheckEnum(path, name, member, field.at("added_values"),
+                /*required=*/false);
     }
   }
 
-  // Every documented code must exist in the file's enum with its value.
+  // Every documented code must exist in the file's enum with its value
+  // (unless not `required`: then only its value is checked).
   void CheckEnum(const std::string& path, const std::string& field,
-                 const Handle& member, const json& values) {
+                 const Handle& member, const json& values, bool required) {
     Handle base(H5Tget_super(member.get()));
     const size_t size = H5Tget_size(member.get());
     for (const auto& [code_name, code] : values.items()) {
@@ -304,8 +311,10 @@ class Checker {
           H5Tconvert(base.get(), H5T_NATIVE_INT64, 1, raw, nullptr,
                      H5P_DEFAULT) < 0) {
         internal::TakeHdf5Error();
-        Problem(path,
-                "field '" + field + "' lacks enum code '" + code_name + "'");
+        if (required) {
+          Problem(path,
+                  "field '" + field + "' lacks enum code '" + code_name + "'");
+        }
         continue;
       }
       int64_t value = 0;

@@ -25,6 +25,19 @@ Status AddFile(ContentHasher* h, const std::string& label,
   return Status::Ok();
 }
 
+// Whether a map may have traffic lights: a net given by path whose text
+// has a signal program (a gzipped one is not looked into: it may). The
+// generated maps (parking_lot, grid) have none.
+Result<bool> MapMayHaveSignals(const world::MapOptions& map) {
+  if (map.net_path.empty()) return false;
+  Result<std::string> bytes = ReadFile(map.net_path, 1u << 30);
+  if (!bytes.ok()) return bytes.status().WithContext("world.map.net");
+  const bool gzipped = bytes->size() >= 2 &&
+                       static_cast<unsigned char>((*bytes)[0]) == 0x1f &&
+                       static_cast<unsigned char>((*bytes)[1]) == 0x8b;
+  return gzipped || bytes->find("<tlLogic") != std::string::npos;
+}
+
 void AddLocation(ContentHasher* h, const world::Location& l) {
   h->Add(static_cast<long long>(l.by_edge));
   if (l.by_edge) {
@@ -74,10 +87,16 @@ Result<std::string> RunKey(const spec::Spec& spec,
   if (valet) h.Add("goal_yaw_tolerance_deg").Add(t.goal_yaw_tolerance_deg);
   // Stack: every knob's effective value, so a changed default changes keys.
   // The parking knobs act only on valet_parking, whose keys alone hold them
-  // (lane-driving keys stay as they were before they existed).
+  // (lane-driving keys stay as they were before they existed); the traffic
+  // light knobs only on maps with signals, whose keys alone hold them (and
+  // so changed when the ego began to obey signals; keys of maps without
+  // signals stay as they were).
+  Result<bool> signals = MapMayHaveSignals(w.map);
+  if (!signals.ok()) return signals.status();
   h.Add("stack");
   for (const KnobInfo& knob : StackKnobs()) {
     if (!valet && knob.path.rfind("parking.", 0) == 0) continue;
+    if (!*signals && knob.path.rfind("traffic_light.", 0) == 0) continue;
     h.Add(knob.path).Add(spec.stack.Get(knob.path));
   }
   // Platform.

@@ -31,6 +31,7 @@
 #include "stack/world/lidar.h"
 #include "stack/world/map_cloud.h"
 #include "stack/world/parking_goal.h"
+#include "stack/world/traffic_signal_detector.h"
 
 namespace adse::sim {
 namespace {
@@ -129,6 +130,9 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   inputs.wheelbase_m = w.ego_limits().wheelbase_m;
   inputs.vehicle_length_m = w.ego_limits().length_m;
   inputs.vehicle_width_m = w.ego_limits().width_m;
+  // Signals on the route: the stack's map holds them, and the world's
+  // detector reports them (runs without keep the graph they always had).
+  inputs.traffic_signals = !w.route_signals().empty();
   if (w.parking_task()) {
     inputs.parking = true;
     inputs.parking_goal = w.parking_goal();
@@ -206,6 +210,19 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     Result<profile::Profile> loaded = profile::ReadProfile(platform.profile);
     if (!loaded.ok()) return loaded.status().WithContext("platform.profile");
     profile_name = loaded->name;
+    // The graph has the signal subscription only where the route has
+    // signals; say which profile covers it rather than just what is missing.
+    constexpr char kSignalCallback[] =
+        "behavior_velocity_planner/traffic_signal";
+    if (topics.traffic_signal >= 0 &&
+        loaded->costs.callbacks.count(kSignalCallback) == 0) {
+      return Status::InvalidArgument(fmt::format(
+          "platform.profile: the route has traffic signals, so the stack "
+          "subscribes to its signal detector ({}), which profile '{}' lacks; "
+          "name a profile that has it, such as "
+          "profiles/autoware-2022.12-i9-12900kf-signals.yaml",
+          kSignalCallback, profile_name));
+    }
     vp.profile =
         std::make_shared<const stack::CostProfile>(std::move(loaded->costs));
     vp.profile_seed = Random::DeriveSeed(seed, "cost");
@@ -254,6 +271,11 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   world::LidarSimulator lidar(&w.scene(), lidar_params, setup.world.weather,
                               Random::DeriveSeed(seed, "lidar"));
   Random odometry_noise(Random::DeriveSeed(seed, "odometry"));
+  std::optional<world::TrafficSignalDetector> signal_detector;
+  if (topics.traffic_signal >= 0) {
+    signal_detector.emplace(w.road_path(), w.route_signals(),
+                            stack_config.SignalDetector());
+  }
   const double lidar_period = 1.0 / lidar_params.rate_hz;
   const double odometry_period = 1.0 / stack_config.Get("odometry.rate_hz");
   double next_lidar = 0.0, next_odometry = 0.0, next_vehicles = 0.0,
@@ -314,6 +336,24 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
                                std::make_shared<const stack::OdometryMsg>(msg),
                                next_odometry, std::max(next_odometry, t));
       next_odometry += odometry_period;
+    }
+    if (signal_detector) {
+      // The detector looks at the signals as they are at this step; each
+      // report comes latency_s after its look.
+      while (signal_detector->next_look_s() < t + dt - 1e-9) {
+        signal_detector->Look({ego.x_m, ego.y_m}, w.RouteSignalStates());
+      }
+      for (world::SignalReport& r : signal_detector->TakeDue(t + dt)) {
+        stack::TrafficSignalMsg msg;
+        msg.header.stamp_s = r.stamp_s;
+        msg.state = r.state;
+        msg.stop_line_distance_m = r.stop_line_distance_m;
+        msg.tls_id = std::move(r.tls_id);
+        executor.PublishExternal(
+            topics.traffic_signal,
+            std::make_shared<const stack::TrafficSignalMsg>(std::move(msg)),
+            r.stamp_s, std::max(r.publish_s, t));
+      }
     }
     const auto t_exec = Clock::now();
     if (realtime != nullptr) {

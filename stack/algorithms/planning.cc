@@ -183,6 +183,37 @@ int64_t LimitVelocity(std::vector<PlannedPoint>* points, bool ends_at_goal,
   return static_cast<int64_t>(points->size());
 }
 
+void InsertStopAt(std::vector<PlannedPoint>* points, double stop_s) {
+  std::vector<PlannedPoint>& pts = *points;
+  if (pts.empty()) return;
+  const double s0 = pts.front().s_m;
+  // A point exactly at the stop line, so v reaches 0 there and not up to
+  // one spacing later.
+  if (stop_s > s0) {
+    auto it = std::lower_bound(
+        pts.begin(), pts.end(), stop_s,
+        [](const PlannedPoint& p, double s) { return p.s_m < s; });
+    if (it != pts.end() && it->s_m - stop_s > 1e-3 &&
+        stop_s - std::prev(it)->s_m > 1e-3) {
+      const PlannedPoint& a = *std::prev(it);
+      const PlannedPoint& b = *it;
+      const double t = (stop_s - a.s_m) / (b.s_m - a.s_m);
+      PlannedPoint q = a;
+      q.x_m = a.x_m + t * (b.x_m - a.x_m);
+      q.y_m = a.y_m + t * (b.y_m - a.y_m);
+      q.yaw_rad = t < 0.5 ? a.yaw_rad : b.yaw_rad;
+      q.curvature_1pm =
+          a.curvature_1pm + t * (b.curvature_1pm - a.curvature_1pm);
+      q.s_m = stop_s;
+      q.v_mps = std::min(a.v_mps, b.v_mps);
+      pts.insert(it, q);
+    }
+  }
+  for (PlannedPoint& p : pts) {
+    if (p.s_m >= stop_s - 1e-6) p.v_mps = 0.0;
+  }
+}
+
 ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
                                 const std::vector<PlannerObstacle>& obstacles,
                                 const ObstacleStopParams& params) {
@@ -241,36 +272,13 @@ ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
   out.stop = true;
   out.stop_s_m = stop_s;
   out.gap_m = near_edge_s - (s0 + params.ego_front_m);
-  // A point exactly at the stop line, so v reaches 0 there and not up to
-  // one spacing later.
-  if (stop_s > s0) {
-    auto it = std::lower_bound(
-        pts.begin(), pts.end(), stop_s,
-        [](const PlannedPoint& p, double s) { return p.s_m < s; });
-    if (it != pts.end() && it->s_m - stop_s > 1e-3 &&
-        stop_s - std::prev(it)->s_m > 1e-3) {
-      const PlannedPoint& a = *std::prev(it);
-      const PlannedPoint& b = *it;
-      const double t = (stop_s - a.s_m) / (b.s_m - a.s_m);
-      PlannedPoint q = a;
-      q.x_m = a.x_m + t * (b.x_m - a.x_m);
-      q.y_m = a.y_m + t * (b.y_m - a.y_m);
-      q.yaw_rad = t < 0.5 ? a.yaw_rad : b.yaw_rad;
-      q.curvature_1pm =
-          a.curvature_1pm + t * (b.curvature_1pm - a.curvature_1pm);
-      q.s_m = stop_s;
-      q.v_mps = std::min(a.v_mps, b.v_mps);
-      pts.insert(it, q);
-    }
-  }
-  for (PlannedPoint& p : pts) {
-    if (p.s_m >= stop_s - 1e-6) p.v_mps = 0.0;
-  }
+  InsertStopAt(&pts, stop_s);
   return out;
 }
 
 StopDecision DecideStop(std::vector<PlannedPoint>* points, bool ends_at_goal,
-                        bool localization_lost, const ObstacleStop& obstacle) {
+                        bool localization_lost, const ObstacleStop& obstacle,
+                        std::optional<double> signal_stop_s_m) {
   StopDecision out;
   if (points == nullptr || points->empty()) {
     out.reason = StopReason::kNoTrajectory;
@@ -296,6 +304,14 @@ StopDecision DecideStop(std::vector<PlannedPoint>* points, bool ends_at_goal,
     out.obstacle_id = obstacle.obstacle_id;
     out.obstacle_gap_m = obstacle.gap_m;
     out.static_structure = obstacle.static_structure;
+  }
+  // A signal's stop lies on the path too; the nearer stop holds the car
+  // (the obstacle on a tie: a queue at the line is what the car waits for).
+  if (signal_stop_s_m &&
+      (!obstacle.stop || *signal_stop_s_m < obstacle.stop_s_m)) {
+    out = StopDecision();
+    out.reason = StopReason::kRedLight;
+    out.distance_m = std::max(0.0, *signal_stop_s_m - s0);
   }
   return out;
 }

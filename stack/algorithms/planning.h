@@ -138,6 +138,11 @@ struct ObstacleStop {
   int64_t work_units = 0;  // obstacles x points
 };
 
+// Inserts a point at arc length stop_s (unless one is within 1 mm, or
+// stop_s lies outside the points) and sets the speed 0 from there on, so v
+// reaches 0 exactly at the stop line and not up to one spacing later.
+void InsertStopAt(std::vector<PlannedPoint>* points, double stop_s);
+
 // Finds the nearest obstacle whose box enters the corridor along `points`
 // (a path from the ego onwards), inserts a point exactly at the stop line
 // stop_margin_m before it, and sets 0 from there on.
@@ -162,10 +167,12 @@ struct StopDecision {
 // The stop the trajectory `points` (from the ego onwards) makes, and why:
 // no points, no trajectory; localization lost holds the car where it is
 // (every speed set to 0: the planner does not drive by a pose it does not
-// trust); otherwise the nearer of the goal's stop (ends_at_goal: its last
-// point) and the obstacle's, or none.
+// trust); otherwise the nearest of the goal's stop (ends_at_goal: its last
+// point), the obstacle's and a traffic signal's (signal_stop_s_m: where
+// the velocity planner set 0 for a signal, rear axle, route s), or none.
 StopDecision DecideStop(std::vector<PlannedPoint>* points, bool ends_at_goal,
-                        bool localization_lost, const ObstacleStop& obstacle);
+                        bool localization_lost, const ObstacleStop& obstacle,
+                        std::optional<double> signal_stop_s_m = std::nullopt);
 
 struct SmootherParams {
   double max_accel_mps2 = 1.0;  // forward pass: speed-up limit

@@ -13,6 +13,7 @@ const std::vector<Term<StopReason>>& StopReasonTerms() {
       {StopReason::kObstacle, "obstacle"},
       {StopReason::kLocalizationLost, "localization_lost"},
       {StopReason::kNoTrajectory, "no_trajectory"},
+      {StopReason::kRedLight, "red_light"},
   };
   return kTerms;
 }

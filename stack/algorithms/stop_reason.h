@@ -20,6 +20,9 @@ enum class StopReason : int8_t {
   kLocalizationLost = 3,  // "localization_lost": no valid pose to drive by
   kNoTrajectory = 4,      // "no_trajectory": nothing to plan from (no
                           // route or pose), or no fresh plan at all
+  kRedLight = 5,          // "red_light": a traffic signal's stop line (red,
+                          // a yellow it can stop for, or a state it cannot
+                          // read until it has waited that out)
 };
 
 const char* StopReasonToString(StopReason reason);

@@ -83,6 +83,25 @@ const std::vector<KnobInfo>& StackKnobs() {
          "the command gate brakes when the newest command is older, s"},
         {"control.emergency_decel_mps2", false, 0.5, 10.0, 3.0,
          "the command gate's braking, m/s^2"},
+        // Traffic signals (maps with signals on the route only): the
+        // world's detector and the velocity planner's signal stage.
+        {"traffic_light.detector_rate_hz", false, 0.5, 100.0, 10.0,
+         "signal detector observations per second, Hz", /*sensor_rate=*/true},
+        {"traffic_light.detector_range_m", false, 5.0, 500.0, 100.0,
+         "farthest stop line (along the route) whose signal the detector "
+         "reads, m"},
+        {"traffic_light.detector_latency_s", false, 0.0, 5.0, 0.1,
+         "from the detector's look to its message, s"},
+        {"traffic_light.state_timeout_s", false, 0.05, 60.0, 1.0,
+         "a signal observation older than this counts as unknown, s"},
+        {"traffic_light.unknown_wait_s", false, 0.0, 600.0, 5.0,
+         "standing this long at the line of a signal it cannot read, the car "
+         "goes on, s"},
+        {"traffic_light.max_red_wait_s", false, 1.0, 3600.0, 300.0,
+         "standing this long at a red line, the signal is taken as broken and "
+         "the car goes on, s"},
+        {"traffic_light.stop_margin_m", false, 0.0, 10.0, 1.0,
+         "front bumper to the stop line when stopped for a signal, m"},
         // Parking (valet_parking only): the freespace planner and the
         // controller's parking mode.
         {"parking.rate_hz", false, 0.2, 50.0, 2.0,
@@ -134,6 +153,14 @@ double StackConfig::Get(const std::string& path) const {
   if (auto it = values_.find(path); it != values_.end()) return it->second;
   const KnobInfo* knob = FindStackKnob(path);
   return knob ? knob->default_value : 0.0;
+}
+
+world::TrafficSignalDetectorParams StackConfig::SignalDetector() const {
+  world::TrafficSignalDetectorParams p;
+  p.rate_hz = Get("traffic_light.detector_rate_hz");
+  p.range_m = Get("traffic_light.detector_range_m");
+  p.latency_s = Get("traffic_light.detector_latency_s");
+  return p;
 }
 
 world::LidarParams StackConfig::Lidar() const {

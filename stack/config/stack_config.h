@@ -11,6 +11,7 @@
 
 #include "stack/base/status.h"
 #include "stack/world/lidar.h"
+#include "stack/world/traffic_signal_detector.h"
 
 namespace adse {
 
@@ -41,6 +42,7 @@ class StackConfig {
   const std::map<std::string, double>& overrides() const { return values_; }
 
   world::LidarParams Lidar() const;
+  world::TrafficSignalDetectorParams SignalDetector() const;
 
  private:
   std::map<std::string, double> values_;

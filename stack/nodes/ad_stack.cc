@@ -16,6 +16,7 @@
 #include "stack/algorithms/planning.h"
 #include "stack/algorithms/point_filters.h"
 #include "stack/algorithms/tracker.h"
+#include "stack/algorithms/traffic_light.h"
 
 namespace adse::stack {
 namespace {
@@ -104,6 +105,7 @@ class Stack final : public AdStack {
   std::unique_ptr<algo::Tracker> tracker_;
   std::unique_ptr<algo::PathPlanner> path_planner_;
   std::optional<PoseMsg> path_pose_;
+  std::unique_ptr<algo::TrafficLightPlanner> traffic_light_;
   std::optional<ObjectsMsg> stop_objects_;
   std::optional<PoseMsg> smoother_pose_;
   std::unique_ptr<algo::TrajectoryFollower> follower_;
@@ -481,6 +483,7 @@ void Stack::BuildPlanning(Graph* g) {
           out.header.stamp_s = path_pose_->header.stamp_s;
           out.ends_at_goal = path.ends_at_goal;
           out.localization_lost = !path_pose_->valid;
+          out.ego_v_mps = path_pose_->v_mps;
           out.points = ToMessage(path.points);
           ctx.ReportWork({static_cast<double>(path.work_units), 0.0, 1});
         }
@@ -496,13 +499,41 @@ void Stack::BuildPlanning(Graph* g) {
       velocity_node, path_, "path", 1,
       [this, limits](const TrajectoryMsg& in, CallbackContext& ctx) {
         std::vector<algo::PlannedPoint> points = ToPlanned(in.points);
-        const int64_t work =
-            algo::LimitVelocity(&points, in.ends_at_goal, limits);
+        int64_t work = algo::LimitVelocity(&points, in.ends_at_goal, limits);
         TrajectoryMsg out = in;
+        if (traffic_light_) {
+          const algo::SignalStop stop = traffic_light_->Apply(
+              ctx.now_s(), in.header.stamp_s, in.ego_v_mps, &points);
+          out.signal_stop = stop.stop;
+          out.signal_stop_s_m = stop.stop_s_m;
+          work += stop.work_units;
+        }
         out.points = ToMessage(points);
         ctx.ReportWork({static_cast<double>(work), 0.0, 1});
         ctx.Publish(path_limited_, std::move(out));
       });
+  if (inputs_.traffic_signals) {
+    // Autoware's traffic-light module: the detector's signal ahead, a stop
+    // at its line (the detector is the world's sensor, never SUMO here).
+    topics_.traffic_signal =
+        g->AddTopic<TrafficSignalMsg>("/perception/traffic_signal");
+    algo::TrafficLightParams signal_params;
+    signal_params.state_timeout_s =
+        config_.Get("traffic_light.state_timeout_s");
+    signal_params.unknown_wait_s = config_.Get("traffic_light.unknown_wait_s");
+    signal_params.max_red_wait_s = config_.Get("traffic_light.max_red_wait_s");
+    signal_params.stop_margin_m = config_.Get("traffic_light.stop_margin_m");
+    signal_params.ego_front_m =
+        inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2;
+    signal_params.max_decel_mps2 = config_.Get("planning.max_decel_mps2");
+    traffic_light_ = std::make_unique<algo::TrafficLightPlanner>(signal_params);
+    g->Subscribe<TrafficSignalMsg>(
+        velocity_node, topics_.traffic_signal, "traffic_signal", 1,
+        [this](const TrafficSignalMsg& in, CallbackContext&) {
+          traffic_light_->Observe({in.header.stamp_s, in.state,
+                                   in.stop_line_distance_m, in.tls_id});
+        });
+  }
 
   // obstacle_stop_planner: a stop before the nearest object in the path's
   // corridor.
@@ -546,7 +577,9 @@ void Stack::BuildPlanning(Graph* g) {
           }
         }
         const algo::StopDecision decision = algo::DecideStop(
-            &points, in.ends_at_goal, in.localization_lost, stop);
+            &points, in.ends_at_goal, in.localization_lost, stop,
+            in.signal_stop ? std::optional<double>(in.signal_stop_s_m)
+                           : std::nullopt);
         TrajectoryMsg out = in;
         out.points = ToMessage(points);
         out.stop.header = in.header;

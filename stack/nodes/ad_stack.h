@@ -35,19 +35,24 @@ struct StackInputs {
   bool parking = false;
   geometry::Pose2 parking_goal;
   std::vector<std::vector<Eigen::Vector2d>> parking_obstacles;
+  // The map has traffic signals on the route (a lanelet map holds them):
+  // the stack then subscribes to the signal detector and its velocity
+  // planner stops for them. Without, the graph has neither.
+  bool traffic_signals = false;
 };
 
 // Topic indices the harness talks to.
 struct StackTopics {
-  int lidar_raw = -1;     // in: PointCloudMsg, vehicle frame
-  int odometry = -1;      // in: OdometryMsg
-  int pose = -1;          // out: PoseMsg (EKF)
-  int control = -1;       // out: ControlMsg
-  int trajectory = -1;    // out: TrajectoryMsg
-  int stop_reason = -1;   // out: StopReasonMsg, why the trajectory stops
-  int objects = -1;       // out: ObjectsMsg
-  int parking_path = -1;  // out: ParkingPathMsg (valet_parking only)
-  int parking_done = -1;  // out: ParkingDoneMsg (valet_parking only)
+  int lidar_raw = -1;       // in: PointCloudMsg, vehicle frame
+  int odometry = -1;        // in: OdometryMsg
+  int pose = -1;            // out: PoseMsg (EKF)
+  int control = -1;         // out: ControlMsg
+  int trajectory = -1;      // out: TrajectoryMsg
+  int stop_reason = -1;     // out: StopReasonMsg, why the trajectory stops
+  int objects = -1;         // out: ObjectsMsg
+  int parking_path = -1;    // out: ParkingPathMsg (valet_parking only)
+  int parking_done = -1;    // out: ParkingDoneMsg (valet_parking only)
+  int traffic_signal = -1;  // in: TrafficSignalMsg (traffic_signals only)
 };
 
 class AdStack {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "stack/algorithms/signal_state.h"
 #include "stack/algorithms/stop_reason.h"
 #include "stack/geometry/geometry.h"
 
@@ -59,6 +60,18 @@ struct ObjectsMsg {
   std::vector<TrackedObject> objects;
 };
 
+// The traffic signal controlling the ego's next link on its route, as the
+// car's detector sees it (/perception/traffic_signal; only in graphs whose
+// map has signals on the route).
+struct TrafficSignalMsg {
+  Header header;  // when the detector saw it
+  SignalState state = SignalState::kUnknown;
+  // Along the route from the rear axle to the signal's stop line; -1 when
+  // no signal is within the detector's range.
+  double stop_line_distance_m = -1;
+  std::string tls_id;  // the signal's id; empty when none is in range
+};
+
 // The route as a reference path in the map frame.
 struct PathMsg {
   Header header;
@@ -92,7 +105,12 @@ struct TrajectoryMsg {
   std::vector<TrajectoryPoint> points;
   bool ends_at_goal = false;       // the path's last point is the goal
   bool localization_lost = false;  // planned from a pose marked invalid
-  StopReasonMsg stop;              // set by obstacle_stop_planner
+  double ego_v_mps = 0.0;          // speed of the pose it was planned from
+  // A traffic signal set the speed to 0 from signal_stop_s_m on (rear
+  // axle, route s; set by behavior_velocity_planner).
+  bool signal_stop = false;
+  double signal_stop_s_m = 0.0;
+  StopReasonMsg stop;  // set by obstacle_stop_planner
 };
 
 // The freespace planner's parking manoeuvre (or why there is none).

@@ -366,6 +366,7 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
   if (!parked.ok()) return parked.status();
   impl->scene = std::move(parked).value();
   ADSE_RETURN_IF_ERROR(impl->BuildIdealPath());
+  ADSE_RETURN_IF_ERROR(impl->FindRouteSignals());
   ADSE_RETURN_IF_ERROR(impl->SetUpTraffic());
   ADSE_RETURN_IF_ERROR(impl->AddEgo());
   world->impl_ = std::move(impl);

@@ -46,6 +46,14 @@ struct OtherVehicle {
   double speed_mps = 0.0;
 };
 
+// A link the route takes through a signalised junction: the traffic light
+// that controls it and the stop line at the end of the route's lane.
+struct RouteSignal {
+  std::string tls_id;
+  int link_index = 0;          // the link's letter in the signal's state
+  double stop_line_s_m = 0.0;  // along road_path()
+};
+
 // Errors from Open() start with the scenario field they concern
 // ("task.goal: ...", "world.map.net: ...") so callers can cite its line.
 class World {
@@ -88,6 +96,12 @@ class World {
   // ideal path's last part), planned on the ground truth; empty when the
   // planner found none or for lane driving.
   const std::vector<ManoeuvrePose>& reference_manoeuvre() const;
+
+  // The signalised links along the road part, in route order (empty on
+  // maps without traffic lights), and SUMO's state letter of each now
+  // ('r', 'y', 'G', 'g', 'u', 'o', 's', ...), in the same order.
+  const std::vector<RouteSignal>& route_signals() const;
+  std::string RouteSignalStates() const;
 
   const geometry::Path2& ideal_path() const;
   const std::vector<std::string>& route_edges() const;

@@ -277,13 +277,18 @@ Status World::Impl::BuildIdealPath() {
     if (route.size() == 1) lane[0] = start.lane;
 
     std::vector<Vec2> points;
+    double raw_s = 0.0;  // arc length of `points`
     auto append = [&](const std::vector<Vec2>& part) {
       if (!points.empty() && !part.empty()) {
         max_join_gap_m =
             std::max(max_join_gap_m, (part.front() - points.back()).norm());
       }
-      points.insert(points.end(), part.begin(), part.end());
+      for (const Vec2& p : part) {
+        if (!points.empty()) raw_s += (p - points.back()).norm();
+        points.push_back(p);
+      }
     };
+    crossings.clear();
     double width_sum = 0.0;
     for (size_t i = 0; i < n; ++i) {
       // Entry lane: the one the previous connection arrives on.
@@ -320,6 +325,11 @@ Status World::Impl::BuildIdealPath() {
         }
       }
       append(part);
+      if (i + 1 < n) {
+        std::string to_lane = route[i + 1] + "_" + std::to_string(lane[i + 1]);
+        if (!via[i].empty()) InternalChain(via[i], &to_lane);
+        crossings.push_back({exit_id, via[i], to_lane, raw_s});
+      }
       if (i + 1 < n && !via[i].empty()) {
         for (const std::string& internal : InternalChain(via[i], nullptr)) {
           append(ToPoints(libsumo::Lane::getShape(internal)));
@@ -330,6 +340,7 @@ Status World::Impl::BuildIdealPath() {
     goal_xy = goal.xy;
 
     road = Resample(points, kResampleStepM);
+    raw_length_m = raw_s;
     ideal = road;
     if (valet) {
       // The reference manoeuvre: the freespace planner's path from where the

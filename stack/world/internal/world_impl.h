@@ -60,6 +60,17 @@ struct World::Impl {
   geometry::Path2 road;                  // the route's road part
   std::vector<ManoeuvrePose> reference;  // valet: the reference manoeuvre
   std::vector<std::string> route;
+  // Where the road part leaves each route edge but the last for the next:
+  // the lane it leaves, the connection's first internal lane (empty on
+  // nets without them), the lane it arrives on, and the arc length of the
+  // joined lane pieces there (before resampling).
+  struct Crossing {
+    std::string from_lane, via_lane, to_lane;
+    double raw_s_m = 0.0;
+  };
+  std::vector<Crossing> crossings;
+  double raw_length_m = 0.0;  // of the joined lane pieces of the road part
+  std::vector<RouteSignal> signals;  // the crossings a traffic light controls
   geometry::Path2 ideal;
   double lane_width_m = 3.2;
   double max_join_gap_m = 0.0;
@@ -100,6 +111,8 @@ struct World::Impl {
                                             const std::string& from_field);
   Status PlanRoute();
   Status BuildIdealPath();
+  // The crossings' traffic lights (world_signals.cc).
+  Status FindRouteSignals();
   Status BuildScene();
   Status SetUpTraffic();
   Status AddEgo();

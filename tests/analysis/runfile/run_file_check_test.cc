@@ -244,6 +244,61 @@ TEST_F(RunFileCheckTest, ReportsAPlainIntegerWhereTheEnumBelongs) {
                 "/trace/topic_events: field 'kind' is int, expected enum"});
 }
 
+// /planning/stop_reasons rebuilt with a `reason` enum of the given codes.
+void RebuildStopReasons(
+    const std::string& path,
+    const std::vector<std::pair<const char*, int8_t>>& codes) {
+  Editable file(path);
+  ASSERT_GE(H5Ldelete(file.get(), "/planning/stop_reasons", H5P_DEFAULT), 0);
+  const hid_t reason = H5Tenum_create(H5T_NATIVE_INT8);
+  for (const auto& [name, code] : codes) H5Tenum_insert(reason, name, &code);
+  const hid_t type = H5Tcreate(H5T_COMPOUND, 8 + 8 + 1 + 8 + 4 + 8 + 4);
+  H5Tinsert(type, "t_s", 0, H5T_IEEE_F64LE);
+  H5Tinsert(type, "stamp_s", 8, H5T_IEEE_F64LE);
+  H5Tinsert(type, "reason", 16, reason);
+  H5Tinsert(type, "stop_distance_m", 17, H5T_IEEE_F64LE);
+  H5Tinsert(type, "track_id", 25, H5T_STD_I32LE);
+  H5Tinsert(type, "obstacle_gap_m", 29, H5T_IEEE_F64LE);
+  H5Tinsert(type, "static_structure", 37, H5T_STD_I32LE);
+  const hsize_t dims[1] = {0};
+  const hid_t space = H5Screate_simple(1, dims, nullptr);
+  const hid_t dataset =
+      H5Dcreate2(file.get(), "/planning/stop_reasons", type, space, H5P_DEFAULT,
+                 H5P_DEFAULT, H5P_DEFAULT);
+  ASSERT_GE(dataset, 0);
+  H5Dclose(dataset);
+  H5Sclose(space);
+  H5Tclose(type);
+  H5Tclose(reason);
+}
+
+// A file written before red_light existed lacks the code and still passes;
+// a file whose red_light has another code does not.
+TEST_F(RunFileCheckTest, StopReasonCodesAddedLaterMayBeMissingButNotWrong) {
+  const std::string older = Copy("older.h5");
+  RebuildStopReasons(older, {{"none", 0},
+                             {"goal", 1},
+                             {"obstacle", 2},
+                             {"localization_lost", 3},
+                             {"no_trajectory", 4}});
+  std::vector<std::string> problems;
+  EXPECT_TRUE(CheckRunFile(older, &problems).ok()) << Join(problems);
+  EXPECT_TRUE(ReadRunFile(older).ok());
+
+  const std::string wrong = Copy("wrong_code.h5");
+  RebuildStopReasons(wrong, {{"none", 0},
+                             {"goal", 1},
+                             {"obstacle", 2},
+                             {"localization_lost", 3},
+                             {"no_trajectory", 4},
+                             {"red_light", 9}});
+  problems.clear();
+  EXPECT_EQ(CheckRunFile(wrong, &problems).code(), Status::Code::kCorruption);
+  EXPECT_EQ(problems, std::vector<std::string>{
+                          "/planning/stop_reasons: field 'reason' enum code "
+                          "'red_light' is 9, expected 5"});
+}
+
 TEST_F(RunFileCheckTest, ReportsBadRootAttributes) {
   const std::string path = Copy("attrs.h5");
   {

@@ -1,7 +1,9 @@
 // Closed-loop runs on real networks that Debian's sumo-tools ships (the
 // CI share of tests/bench/real_nets_bench.sh): a generous computer reaches
 // the goal, and the planner says why the car stood. Costs are counted from
-// the bundled Autoware profile, so results do not depend on the host.
+// the bundled Autoware profile (its variant with the traffic-signal
+// subscription: these nets have signals), so results do not depend on the
+// host.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -42,7 +44,7 @@ spec::Spec RealNetScenario(const std::string& name, const std::string& net,
       "  timeout_s: 600\n"
       "platform: {kind: virtual, cost_model: counted, profile: " +
       std::string(ADSE_SOURCE_DIR) +
-      "/scenarios/profiles/autoware-2022.12-i9-12900kf.yaml}\n"
+      "/scenarios/profiles/autoware-2022.12-i9-12900kf-signals.yaml}\n"
       "design_space:\n"
       "  cores:    {bind: platform.cores,    range: [1, 16]}\n"
       "  freq_ghz: {bind: platform.freq_ghz, values: [1.2, 2.1]}\n";
@@ -52,7 +54,7 @@ spec::Spec RealNetScenario(const std::string& name, const std::string& net,
 }
 
 // Simulates at 16 cores, 2.1 GHz and checks the goal was reached without
-// a collision and without standing long.
+// a collision and without standing long for anything but red lights.
 void DrivesToTheGoal(const spec::Spec& spec) {
   ASSERT_TRUE(std::filesystem::exists(spec.world.map.net_path))
       << "sumo-tools is not installed";
@@ -61,14 +63,16 @@ void DrivesToTheGoal(const spec::Spec& spec) {
   ASSERT_TRUE(run.ok()) << run.status().ToString();
   const analysis::StandingSummary standing = analysis::SummarizeStanding(*run);
   std::string why;
+  double at_signals_s = 0.0;  // waits at red lights are the rules, not harm
   for (const analysis::StandingTime& t : standing.by_reason) {
     why += std::string(StopReasonToString(t.reason)) + " " +
            std::to_string(t.standing_s) + " s; ";
+    if (t.reason == StopReason::kRedLight) at_signals_s += t.standing_s;
   }
   EXPECT_EQ(run->termination_reason, "goal_reached") << "stood for: " << why;
   EXPECT_TRUE(run->collisions.empty());
   EXPECT_TRUE(standing.has_reasons);
-  EXPECT_LT(standing.standing_s, 60.0) << why;
+  EXPECT_LT(standing.standing_s - at_signals_s, 60.0) << why;
 }
 
 // The DRT game's town (scenarios/osm_drt.yaml's route): before NDT scored

@@ -59,6 +59,37 @@ TEST(RunKeyTest, ChangesWithWhatChangesARun) {
   EXPECT_NE(key, Key(platform));
 }
 
+// Keys of maps without signals stay as they were before the ego obeyed
+// them; keys of maps with signals hold the traffic_light knobs.
+TEST(RunKeyTest, TrafficLightKnobsEnterOnlyKeysOfMapsWithSignals) {
+  const spec::Spec lot = Small();  // a generated parking lot
+  spec::Spec lot_knob = lot;
+  ASSERT_TRUE(lot_knob.stack.Set("traffic_light.detector_latency_s", 0.5).ok());
+  EXPECT_EQ(Key(lot), Key(lot_knob));
+
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / "adse_run_key_signals")
+          .string();
+  std::filesystem::create_directories(dir);
+  auto net_key = [&](const std::string& text, double latency_s) {
+    const std::string net = dir + "/map.net.xml";
+    std::ofstream(net) << text;
+    spec::Spec s = lot;
+    s.world.map.generator.clear();
+    s.world.map.generator_params.clear();
+    s.world.map.net_path = net;
+    EXPECT_TRUE(
+        s.stack.Set("traffic_light.detector_latency_s", latency_s).ok());
+    return Key(s);
+  };
+  const std::string plain = "<net>\n  <edge id=\"a\"/>\n</net>\n";
+  const std::string signalled =
+      "<net>\n  <tlLogic id=\"J\" type=\"static\"/>\n</net>\n";
+  EXPECT_EQ(net_key(plain, 0.1), net_key(plain, 0.5));
+  EXPECT_NE(net_key(signalled, 0.1), net_key(signalled, 0.5));
+  std::filesystem::remove_all(dir);
+}
+
 TEST(RunKeyTest, ConstraintsEnterOnlyWhenTheyCanStopTheRunEarly) {
   const spec::Spec base = Small();  // nav_time_s <= 60, ctrl_rate_hz >= 1, ...
   spec::Spec off = base;

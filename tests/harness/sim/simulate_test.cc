@@ -81,6 +81,12 @@ TEST(SimulateTest, GenerousComputerDrivesToTheGoalAtTheNominalControlRate) {
   EXPECT_LT(m.at("e2e_latency_p99_s"), 2.0);
   EXPECT_NEAR(m.at("hardware_cost"), 16 * 2.1, 1e-9);
   EXPECT_EQ(run->content_key.size(), 64u);
+  // A map without traffic signals: the graph has no signal detector topic
+  // and no subscription to it (it is the graph it was before them).
+  for (const std::string& topic : run->topic_names)
+    EXPECT_EQ(topic.find("traffic_signal"), std::string::npos) << topic;
+  for (const runfile::NamedCallback& c : run->callback_info)
+    EXPECT_EQ(c.name.find("traffic_signal"), std::string::npos) << c.name;
 }
 
 TEST(SimulateTest, StarvedComputerControlsLessOftenAndDropsLidarFrames) {

@@ -1,0 +1,87 @@
+// The traffic lights along the route: which signal controls each link the
+// road part takes through a junction, where its stop line lies on the road
+// path, and what each shows now. The stack never calls this: its detector
+// (traffic_signal_detector.h) does, as a camera would look.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <utility>
+
+#include "stack/world/internal/world_impl.h"
+
+namespace adse::world {
+
+Status World::Impl::FindRouteSignals() {
+  signals.clear();
+  try {
+    const std::vector<std::string> ids = libsumo::TrafficLight::getIDList();
+    if (ids.empty() || crossings.empty() || road.points.size() < 2) {
+      return Status::Ok();
+    }
+    // (lane left, first internal lane) -> (signal, link index); on nets
+    // without internal lanes, (lane left, "->" lane arrived on).
+    std::map<std::pair<std::string, std::string>, std::pair<std::string, int>>
+        controlled;
+    for (const std::string& id : ids) {
+      const std::vector<std::vector<libsumo::TraCILink>> links =
+          libsumo::TrafficLight::getControlledLinks(id);
+      for (size_t k = 0; k < links.size(); ++k) {
+        for (const libsumo::TraCILink& l : links[k]) {
+          const std::pair<std::string, int> at(id, static_cast<int>(k));
+          controlled.emplace(std::make_pair(l.fromLane, l.viaLane), at);
+          controlled.emplace(std::make_pair(l.fromLane, "->" + l.toLane), at);
+        }
+      }
+    }
+    // Resample() put road point i at raw arc length L * i / n; a raw arc
+    // length maps to the road's between its neighbours.
+    const int n = static_cast<int>(road.points.size()) - 1;
+    for (const Crossing& c : crossings) {
+      const auto it = controlled.find(
+          c.via_lane.empty() ? std::make_pair(c.from_lane, "->" + c.to_lane)
+                             : std::make_pair(c.from_lane, c.via_lane));
+      if (it == controlled.end()) continue;
+      const double f = raw_length_m > 0
+                           ? std::clamp(c.raw_s_m / raw_length_m, 0.0, 1.0) * n
+                           : 0.0;
+      const int i = std::min(static_cast<int>(std::floor(f)), n - 1);
+      const double s = road.s_m[i] + (f - i) * (road.s_m[i + 1] - road.s_m[i]);
+      signals.push_back({it->second.first, it->second.second, s});
+    }
+  } catch (const std::exception& e) {
+    return Status::Internal(
+        fmt::format("finding the route's traffic lights: {}", e.what()));
+  }
+  return Status::Ok();
+}
+
+const std::vector<RouteSignal>& World::route_signals() const {
+  return impl_->signals;
+}
+
+std::string World::RouteSignalStates() const {
+  std::string out;
+  std::map<std::string, std::string> states;  // one query per signal
+  for (const RouteSignal& s : impl_->signals) {
+    auto it = states.find(s.tls_id);
+    if (it == states.end()) {
+      std::string state;
+      try {
+        state = libsumo::TrafficLight::getRedYellowGreenState(s.tls_id);
+      } catch (const std::exception&) {
+        // Unreadable: the detector reports it as unknown.
+      }
+      it = states.emplace(s.tls_id, std::move(state)).first;
+    }
+    const std::string& state = it->second;
+    out.push_back(s.link_index >= 0 &&
+                          s.link_index < static_cast<int>(state.size())
+                      ? state[s.link_index]
+                      : 'o');
+  }
+  return out;
+}
+
+}  // namespace adse::world

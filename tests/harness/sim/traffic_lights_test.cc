@@ -1,0 +1,118 @@
+// The ego obeys SUMO's traffic signals through its own detector topic, on
+// a real net that Debian's sumo-tools ships (RiLSA1: one signalised
+// crossing). Costs are counted from the Autoware profile with the signal
+// subscription, so the run does not depend on the host.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "analysis/metrics/standing.h"
+#include "analysis/runfile/run_file.h"
+#include "harness/sim/simulator.h"
+#include "harness/spec/spec_parser.h"
+
+namespace adse::sim {
+namespace {
+
+constexpr char kRilsa[] =
+    "/usr/share/sumo/tools/sumolib/scenario/scenarios/RiLSA1/rilsa1.net.xml";
+// nm_1 ends (its stop line) at y = 511.35, heading south; the signal (tls
+// "0", link 1) shows red for this link from 0 to 45 s (its program's first
+// five phases serve east-west), then green.
+constexpr double kStopLineY = 511.35;
+constexpr double kGreenAtS = 45.0;
+
+spec::Spec RilsaNorthToSouth(
+    const std::string& profile = "autoware-2022.12-i9-12900kf-signals.yaml") {
+  const std::string text =
+      std::string("adse: 1\n") +
+      "name: rilsa-signal\n"
+      "world:\n"
+      "  map: {net: " +
+      kRilsa +
+      "}\n"
+      "  traffic: {seed: 1}\n"
+      "task:\n"
+      "  start: {edge: nm, pos_m: 10, lane: 1}\n"
+      "  goal: {edge: ms, pos_m: 60, lane: 1}\n"
+      "  speed_limit_kmh: 40\n"
+      "  timeout_s: 200\n"
+      "platform: {kind: virtual, cost_model: counted, profile: " +
+      ADSE_SOURCE_DIR + "/scenarios/profiles/" + profile +
+      "}\n"
+      "design_space:\n"
+      "  cores:    {bind: platform.cores,    range: [1, 16]}\n"
+      "  freq_ghz: {bind: platform.freq_ghz, values: [1.2, 2.1]}\n";
+  Result<spec::Spec> spec = spec::ParseSpec(text, "rilsa-signal.yaml", "");
+  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
+  return std::move(spec).value();
+}
+
+TEST(TrafficLightsTest, TheEgoWaitsAtTheRedLightThenDrivesOnToTheGoal) {
+  ASSERT_TRUE(std::filesystem::exists(kRilsa)) << "sumo-tools is not installed";
+  const spec::Spec spec = RilsaNorthToSouth();
+  Result<runfile::RunData> run =
+      SimulatePoint(spec, {{"cores", 16}, {"freq_ghz", 2.1}});
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->termination_reason, "goal_reached");
+  EXPECT_TRUE(run->collisions.empty());
+
+  // Never past the stop line while red: the front bumper (3.65 m ahead of
+  // the rear axle, heading south) stays north of it, within 0.3 m.
+  const double front_m = 2.7 / 2 + 4.6 / 2;
+  double crossed_at_s = -1.0;
+  for (const runfile::EgoSample& s : run->ego) {
+    if (s.t_s < kGreenAtS) {
+      ASSERT_GT(s.y_m - front_m, kStopLineY - 0.3) << "at t = " << s.t_s;
+    } else if (crossed_at_s < 0 && s.y_m < kStopLineY) {
+      crossed_at_s = s.t_s;
+    }
+  }
+  // ... and through the junction once green.
+  EXPECT_GT(crossed_at_s, kGreenAtS);
+
+  // The run file says why it stood: red_light, for many seconds (it
+  // arrives at about 16 s and waits for the green at 45 s).
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "adse_traffic_lights_test.h5")
+          .string();
+  ASSERT_TRUE(runfile::WriteRunFile(path, *run).ok());
+  std::vector<std::string> problems;
+  EXPECT_TRUE(runfile::CheckRunFile(path, &problems).ok())
+      << (problems.empty() ? "" : problems.front());
+  Result<runfile::RunData> read = runfile::ReadRunFile(path);
+  ASSERT_TRUE(read.ok()) << read.status().ToString();
+  std::filesystem::remove(path);
+  const analysis::StandingSummary standing = analysis::SummarizeStanding(*read);
+  ASSERT_FALSE(standing.by_reason.empty());
+  EXPECT_EQ(standing.by_reason.front().reason, StopReason::kRedLight);
+  EXPECT_GT(standing.by_reason.front().standing_s, 20.0);
+  EXPECT_LT(standing.by_reason.front().standing_s, kGreenAtS);
+  // The detector's topic and the planner's subscription are in the graph.
+  bool has_topic = false, has_callback = false;
+  for (const std::string& t : read->topic_names)
+    has_topic |= t == "/perception/traffic_signal";
+  for (const runfile::NamedCallback& c : read->callback_info)
+    has_callback |= c.name == "behavior_velocity_planner/traffic_signal";
+  EXPECT_TRUE(has_topic);
+  EXPECT_TRUE(has_callback);
+}
+
+TEST(TrafficLightsTest, APlainProfileIsRefusedNamingTheOneWithTheSignals) {
+  ASSERT_TRUE(std::filesystem::exists(kRilsa)) << "sumo-tools is not installed";
+  Result<runfile::RunData> run =
+      SimulatePoint(RilsaNorthToSouth("autoware-2022.12-i9-12900kf.yaml"),
+                    {{"cores", 16}, {"freq_ghz", 2.1}});
+  ASSERT_FALSE(run.ok());
+  EXPECT_EQ(run.status().code(), Status::Code::kInvalidArgument);
+  EXPECT_EQ(run.status().message().rfind("platform.profile: ", 0), 0u)
+      << run.status().message();
+  EXPECT_NE(
+      run.status().message().find("autoware-2022.12-i9-12900kf-signals.yaml"),
+      std::string::npos)
+      << run.status().message();
+}
+
+}  // namespace
+}  // namespace adse::sim
