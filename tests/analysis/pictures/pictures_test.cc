@@ -11,6 +11,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace adse::analysis {
@@ -336,8 +337,16 @@ TEST_F(PictureTest, StudyPlotDrawsTheCampaignOverTheReferenceWithItsBound) {
   // The reference: every point in grey, its front as a darker line; the
   // campaign's four points as red triangles.
   std::vector<ParetoPlotPoint> reference = StudyPoints();
-  const std::vector<ParetoPlotPoint> points = {
-      {9.0, 505, false}, {12.0, 380, true}, {20.0, 240, true}, {40, 200, true}};
+  std::vector<ParetoPlotPoint> points;
+  for (const auto& [cost, time_s, feasible] :
+       {std::tuple{9.0, 505.0, false}, std::tuple{12.0, 380.0, true},
+        std::tuple{20.0, 240.0, true}, std::tuple{40.0, 200.0, true}}) {
+    ParetoPlotPoint p;
+    p.cost = cost;
+    p.nav_time_s = time_s;
+    p.feasible = feasible;
+    points.push_back(p);
+  }
   StudyPlotOptions options;
   options.time_bounds_s = {400};
   options.title = "agent over the exhaustive study";
