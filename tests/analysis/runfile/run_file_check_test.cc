@@ -215,11 +215,22 @@ TEST_F(RunFileCheckTest, ReportsAWrongFieldType) {
       << back.status().message();
 }
 
+// Replaces the table at `path` with an empty one of compound `type`.
+void ReplaceWithEmptyTable(hid_t file, const char* path, hid_t type) {
+  ASSERT_GE(H5Ldelete(file, path, H5P_DEFAULT), 0);
+  const hsize_t dims[1] = {0};
+  const hid_t space = H5Screate_simple(1, dims, nullptr);
+  const hid_t dataset = H5Dcreate2(file, path, type, space, H5P_DEFAULT,
+                                   H5P_DEFAULT, H5P_DEFAULT);
+  H5Sclose(space);
+  ASSERT_GE(dataset, 0);
+  H5Dclose(dataset);
+}
+
 TEST_F(RunFileCheckTest, ReportsAPlainIntegerWhereTheEnumBelongs) {
   const std::string path = Copy("enum.h5");
   {
     Editable file(path);
-    ASSERT_GE(H5Ldelete(file.get(), "/trace/topic_events", H5P_DEFAULT), 0);
     const hid_t type = H5Tcreate(H5T_COMPOUND, 1 + 4 + 4 + 8 + 8 + 8);
     H5Tinsert(type, "kind", 0, H5T_STD_I8LE);
     H5Tinsert(type, "topic", 1, H5T_STD_I32LE);
@@ -227,14 +238,7 @@ TEST_F(RunFileCheckTest, ReportsAPlainIntegerWhereTheEnumBelongs) {
     H5Tinsert(type, "t_s", 9, H5T_IEEE_F64LE);
     H5Tinsert(type, "seq", 17, H5T_STD_U64LE);
     H5Tinsert(type, "stamp_s", 25, H5T_IEEE_F64LE);
-    const hsize_t dims[1] = {0};
-    const hid_t space = H5Screate_simple(1, dims, nullptr);
-    const hid_t dataset =
-        H5Dcreate2(file.get(), "/trace/topic_events", type, space, H5P_DEFAULT,
-                   H5P_DEFAULT, H5P_DEFAULT);
-    ASSERT_GE(dataset, 0);
-    H5Dclose(dataset);
-    H5Sclose(space);
+    ReplaceWithEmptyTable(file.get(), "/trace/topic_events", type);
     H5Tclose(type);
   }
   std::vector<std::string> problems;
@@ -249,7 +253,6 @@ void RebuildStopReasons(
     const std::string& path,
     const std::vector<std::pair<const char*, int8_t>>& codes) {
   Editable file(path);
-  ASSERT_GE(H5Ldelete(file.get(), "/planning/stop_reasons", H5P_DEFAULT), 0);
   const hid_t reason = H5Tenum_create(H5T_NATIVE_INT8);
   for (const auto& [name, code] : codes) H5Tenum_insert(reason, name, &code);
   const hid_t type = H5Tcreate(H5T_COMPOUND, 8 + 8 + 1 + 8 + 4 + 8 + 4);
@@ -260,14 +263,7 @@ void RebuildStopReasons(
   H5Tinsert(type, "track_id", 25, H5T_STD_I32LE);
   H5Tinsert(type, "obstacle_gap_m", 29, H5T_IEEE_F64LE);
   H5Tinsert(type, "static_structure", 37, H5T_STD_I32LE);
-  const hsize_t dims[1] = {0};
-  const hid_t space = H5Screate_simple(1, dims, nullptr);
-  const hid_t dataset =
-      H5Dcreate2(file.get(), "/planning/stop_reasons", type, space, H5P_DEFAULT,
-                 H5P_DEFAULT, H5P_DEFAULT);
-  ASSERT_GE(dataset, 0);
-  H5Dclose(dataset);
-  H5Sclose(space);
+  ReplaceWithEmptyTable(file.get(), "/planning/stop_reasons", type);
   H5Tclose(type);
   H5Tclose(reason);
 }
