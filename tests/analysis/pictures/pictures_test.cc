@@ -1,6 +1,7 @@
 // Trajectory image and Pareto plot: rendered from synthetic data, decoded
 // back, and probed at pixels whose colour is known from the mapping.
 #include "analysis/pictures/pictures.h"
+#include "tests/analysis/testing/temp_dir_test.h"
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
@@ -78,29 +79,12 @@ RunData SquareRun() {
   return run;
 }
 
-class PictureTest : public ::testing::Test {
+// Lists the folder recursively: pictures may go into sub-folders.
+class PictureTest : public adse::testing::TempDirTest {
  protected:
-  void SetUp() override {
-    std::string pattern = ::testing::TempDir() + "pictures_test_XXXXXX";
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string Path(const std::string& name) const {
-    return (fs::path(dir_) / name).string();
-  }
   std::vector<std::string> Listing() const {
-    std::vector<std::string> names;
-    for (const auto& e : fs::recursive_directory_iterator(dir_)) {
-      names.push_back(fs::relative(e.path(), dir_).string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
+    return TempDirTest::Listing(/*recursive=*/true);
   }
-  std::string dir_;
 };
 
 TEST_F(PictureTest, TrajectoryImageHasTheDrawingWhereTheMappingSays) {

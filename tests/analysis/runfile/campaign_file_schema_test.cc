@@ -23,17 +23,10 @@
 namespace adse::runfile {
 namespace {
 
-namespace fs = std::filesystem;
 using nlohmann::json;
 using testing::CampaignFileTest;
-using testing::Diff;
-using testing::kInf;
-using testing::kMetrics;
-using testing::kNaN;
-using testing::kParameters;
 using testing::MakeIndex;
 using testing::RawFile;
-using testing::ReplaceWithDoubles;
 
 std::string CampaignSchemaPath() {
   return std::string(ADSE_SOURCE_DIR) + "/results-schema/campaign.schema.json";

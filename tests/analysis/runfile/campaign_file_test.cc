@@ -21,13 +21,11 @@ namespace {
 namespace fs = std::filesystem;
 using testing::CampaignFileTest;
 using testing::Diff;
-using testing::kInf;
 using testing::kMetrics;
 using testing::kNaN;
 using testing::kParameters;
 using testing::MakeIndex;
 using testing::RawFile;
-using testing::ReplaceWithDoubles;
 
 class CampaignFileRoundTripTest : public CampaignFileTest,
                                   public ::testing::WithParamInterface<size_t> {

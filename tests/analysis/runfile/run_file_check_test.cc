@@ -20,6 +20,7 @@
 
 #include "analysis/runfile/run_file.h"
 #include "stack/base/hash.h"
+#include "tests/analysis/testing/temp_dir_test.h"
 
 namespace adse::runfile {
 namespace {
@@ -65,21 +66,13 @@ std::string Join(const std::vector<std::string>& lines) {
   return out;
 }
 
-class RunFileCheckTest : public ::testing::Test {
+class RunFileCheckTest : public adse::testing::TempDirTest {
  protected:
   void SetUp() override {
-    std::string pattern = ::testing::TempDir() + "runfile_check_XXXXXX";
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
+    TempDirTest::SetUp();
+    ASSERT_FALSE(HasFatalFailure());
     good_ = Path("good.h5");
     ASSERT_TRUE(WriteRunFile(good_, MakeRun()).ok());
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string Path(const std::string& name) const {
-    return (fs::path(dir_) / name).string();
   }
   // A copy of the good file to damage.
   std::string Copy(const std::string& name) const {
@@ -88,7 +81,6 @@ class RunFileCheckTest : public ::testing::Test {
     return path;
   }
 
-  std::string dir_;
   std::string good_;
 };
 

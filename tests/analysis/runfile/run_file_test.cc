@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "stack/base/hash.h"
+#include "tests/analysis/testing/temp_dir_test.h"
 
 namespace adse::runfile {
 namespace {
@@ -306,30 +307,7 @@ RunData MakeFullRun(size_t events = 5000) {
   return run;
 }
 
-class RunFileTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    std::string pattern = ::testing::TempDir() + "runfile_test_XXXXXX";
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string Path(const std::string& name) const {
-    return (fs::path(dir_) / name).string();
-  }
-  std::vector<std::string> Listing() const {
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(dir_)) {
-      names.push_back(entry.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-  std::string dir_;
-};
+class RunFileTest : public adse::testing::TempDirTest {};
 
 TEST_F(RunFileTest, FullRunRoundTripsExactly) {
   const RunData run = MakeFullRun();

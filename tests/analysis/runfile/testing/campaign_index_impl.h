@@ -26,6 +26,7 @@
 
 #include "analysis/runfile/campaign_file.h"
 #include "stack/base/hash.h"
+#include "tests/analysis/testing/temp_dir_test.h"
 
 namespace adse::runfile::testing {
 
@@ -260,28 +261,8 @@ inline void ReplaceWithDoubles(hid_t file, const char* path, size_t rows) {
   H5Sclose(space);
 }
 
-class CampaignFileTest : public ::testing::Test {
+class CampaignFileTest : public ::adse::testing::TempDirTest {
  protected:
-  void SetUp() override {
-    std::string pattern = ::testing::TempDir() + "campaign_file_test_XXXXXX";
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string Path(const std::string& name) const {
-    return (fs::path(dir_) / name).string();
-  }
-  std::vector<std::string> Listing() const {
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(dir_)) {
-      names.push_back(entry.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-  }
   // Reads `path`, expecting Corruption whose message names the file and
   // contains `detail`.
   void ExpectCorruption(const std::string& path, const std::string& detail) {
@@ -294,8 +275,6 @@ class CampaignFileTest : public ::testing::Test {
     EXPECT_NE(back.status().message().find(detail), std::string::npos)
         << back.status().message();
   }
-
-  std::string dir_;
 };
 
 }  // namespace adse::runfile::testing
