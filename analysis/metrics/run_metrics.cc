@@ -27,7 +27,7 @@ std::map<std::string, double> ComputeRunMetrics(
                          run.termination_reason == "goal_reached";
   const double end_s = run.ego.empty() ? 0.0 : run.ego.back().t_s;
   m["completed"] = completed ? 1.0 : 0.0;
-  m[kCensoredMetric] = run.status == runfile::kRunInfeasible ? 1.0 : 0.0;
+  m[kCensoredMetric] = runfile::EndedEarly(run.status) ? 1.0 : 0.0;
   m["nav_time_s"] = end_s;
 
   auto topic_index = [&](const std::string& name) {

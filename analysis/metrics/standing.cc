@@ -34,15 +34,8 @@ StandingSummary SummarizeStanding(const runfile::RunData& run,
     const double dt = std::max(0.0, run.ego[i + 1].t_s - e.t_s);
     out.standing_s += dt;
     if (!out.has_reasons) continue;
-    StopReason reason = StopReason::kNoTrajectory;
     const runfile::StopSample* newest = next > 0 ? &stops[next - 1] : nullptr;
-    if (newest != nullptr && e.t_s - newest->t_s <= options.stale_after_s) {
-      reason = newest->reason;
-      if (reason != StopReason::kNone &&
-          newest->stop_distance_m > options.hold_distance_m) {
-        reason = StopReason::kNone;
-      }
-    }
+    const StopReason reason = HoldingReason(newest, e.t_s, options);
     per_reason[reason] += dt;
     if (reason == StopReason::kObstacle) {
       TrackTime& t = per_track[newest->track_id];
@@ -75,6 +68,57 @@ StandingSummary SummarizeStanding(const runfile::RunData& run,
                      return a.standing_s > b.standing_s;
                    });
   return out;
+}
+
+StopReason HoldingReason(const runfile::StopSample* newest, double t_s,
+                         const StandingOptions& options) {
+  if (newest == nullptr || t_s - newest->t_s > options.stale_after_s) {
+    return StopReason::kNoTrajectory;
+  }
+  if (newest->reason != StopReason::kNone &&
+      newest->stop_distance_m > options.hold_distance_m) {
+    return StopReason::kNone;
+  }
+  return newest->reason;
+}
+
+bool TrafficWillRelease(StopReason reason, const runfile::StopSample* newest) {
+  if (reason == StopReason::kRedLight) return true;
+  return reason == StopReason::kObstacle && newest != nullptr &&
+         newest->static_structure == 0;
+}
+
+StallWatch::StallWatch(double stall_timeout_s, StandingOptions options)
+    : stall_timeout_s_(stall_timeout_s), options_(options) {}
+
+bool StallWatch::Observe(double t_s, double v_mps,
+                         const std::vector<runfile::StopSample>& stops) {
+  const double dt = last_t_s_ < 0 ? 0.0 : std::max(0.0, t_s - last_t_s_);
+  last_t_s_ = t_s;
+  while (next_ < stops.size() && stops[next_].t_s <= t_s + 1e-9) ++next_;
+  if (stall_timeout_s_ <= 0) return false;
+  if (std::abs(v_mps) >= options_.standing_speed_mps) {
+    stood_s_ = 0.0;
+    by_cause_.clear();
+    return false;
+  }
+  const runfile::StopSample* newest = next_ > 0 ? &stops[next_ - 1] : nullptr;
+  const StopReason reason = HoldingReason(newest, t_s, options_);
+  if (TrafficWillRelease(reason, newest)) return false;
+  stood_s_ += dt;
+  const int track = reason == StopReason::kObstacle ? newest->track_id : -1;
+  by_cause_[{reason, track}] += dt;
+  if (stood_s_ + 1e-9 < stall_timeout_s_) return false;
+  // The longest-held cause (the first in code order on a tie).
+  double longest = -1.0;
+  for (const auto& [cause, seconds] : by_cause_) {
+    if (seconds > longest) {
+      longest = seconds;
+      reason_ = cause.first;
+      track_id_ = cause.second;
+    }
+  }
+  return true;
 }
 
 }  // namespace adse::analysis

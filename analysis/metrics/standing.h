@@ -4,6 +4,8 @@
 #ifndef ADSE_ANALYSIS_METRICS_STANDING_H_
 #define ADSE_ANALYSIS_METRICS_STANDING_H_
 
+#include <map>
+#include <utility>
 #include <vector>
 
 #include "analysis/runfile/run_data.h"
@@ -48,6 +50,51 @@ struct StandingSummary {
 // outside the planner: stale commands at the command gate, a speed cap).
 StandingSummary SummarizeStanding(const runfile::RunData& run,
                                   const StandingOptions& options = {});
+
+// What holds a car standing at `t_s`, given the planner's newest stop
+// sample published at or before then (nullptr: none yet), as
+// SummarizeStanding attributes it.
+StopReason HoldingReason(const runfile::StopSample* newest, double t_s,
+                         const StandingOptions& options = {});
+
+// Whether other traffic or a signal will let the car go by itself: a red
+// light (whose wait the planner bounds with max_red_wait_s) or an obstacle
+// where the map has no structure (another road user, which moves on).
+bool TrafficWillRelease(StopReason reason, const runfile::StopSample* newest);
+
+// Watches a run as it is simulated for a car that stands and will not
+// move again: it has stood without a break for `stall_timeout_s`, counting
+// only time held for reasons that traffic does not release (localization
+// lost, no trajectory, static structure taken for an obstacle, the goal's
+// stop short of the goal, a cause outside the planner such as stale
+// commands). Any movement starts the count again.
+class StallWatch {
+ public:
+  // stall_timeout_s <= 0: never stalls.
+  explicit StallWatch(double stall_timeout_s, StandingOptions options = {});
+
+  // Takes the ego at `t_s` (samples in time order) with every stop sample
+  // published so far; true once the car has stalled.
+  bool Observe(double t_s, double v_mps,
+               const std::vector<runfile::StopSample>& stops);
+
+  // While stalled: the reason that held the car longest in the stand, and
+  // for kObstacle the track.
+  StopReason reason() const { return reason_; }
+  int track_id() const { return track_id_; }
+  // Counted time of the current stand.
+  double stood_s() const { return stood_s_; }
+
+ private:
+  double stall_timeout_s_;
+  StandingOptions options_;
+  size_t next_ = 0;       // first stop sample after the last observation
+  double last_t_s_ = -1;  // the last observation; < 0 before the first
+  double stood_s_ = 0.0;
+  std::map<std::pair<StopReason, int>, double> by_cause_;  // (reason, track)
+  StopReason reason_ = StopReason::kNone;
+  int track_id_ = -1;
+};
 
 }  // namespace adse::analysis
 

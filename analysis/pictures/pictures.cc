@@ -107,7 +107,7 @@ std::string Title(const runfile::RunData& run) {
   if (auto it = run.metrics.find("nav_time_s"); it != run.metrics.end()) {
     // A censored run stopped early: its nav time is only a lower bound.
     outcome +=
-        run.status == runfile::kRunInfeasible
+        runfile::EndedEarly(run.status)
             ? fmt::format(", nav >= {:.1f} s (stopped early)", it->second)
             : fmt::format(", nav {:.1f} s", it->second);
   }

@@ -108,29 +108,46 @@ struct NamedCallback {
 
 // A run's status. complete: the simulation ended at the goal or the
 // timeout; infeasible: it was ended early because a constraint was
-// certainly violated (early stop), so its metrics are censored; failed: it
-// could not finish.
+// certainly violated (early stop); stalled: it was ended early because the
+// car stood for task.stall_timeout_s and nothing would release it. The
+// metrics of both are censored. failed: it could not finish.
 inline constexpr char kRunComplete[] = "complete";
 inline constexpr char kRunInfeasible[] = "infeasible";
+inline constexpr char kRunStalled[] = "stalled";
 inline constexpr char kRunFailed[] = "failed";
+
+// Whether a run with this status was ended early, before the goal or the
+// timeout, so that its metrics are measured only up to then (censored).
+inline bool EndedEarly(const std::string& status) {
+  return status == kRunInfeasible || status == kRunStalled;
+}
 
 // The termination reason of an early-stopped run is this prefix followed
 // by the constraint, exactly as the scenario writes it.
 inline constexpr char kConstraintViolatedPrefix[] = "constraint_violated: ";
 
+// The termination reason of a stalled run is this prefix followed by the
+// stop reason that held the car (StopReasonToString).
+inline constexpr char kStalledPrefix[] = "stalled: ";
+
+// What follows `prefix` in `reason`; empty when it does not start so.
+inline std::string ReasonAfter(const std::string& reason, const char* prefix) {
+  const std::string p = prefix;
+  return reason.compare(0, p.size(), p) == 0 ? reason.substr(p.size())
+                                             : std::string();
+}
+
 // The constraint an early-stopped run's reason names; empty for any other
 // reason.
 inline std::string ViolatedConstraint(const std::string& reason) {
-  const std::string prefix = kConstraintViolatedPrefix;
-  return reason.compare(0, prefix.size(), prefix) == 0
-             ? reason.substr(prefix.size())
-             : std::string();
+  return ReasonAfter(reason, kConstraintViolatedPrefix);
 }
 
 struct RunData {
   // Identity and provenance (root attributes).
-  std::string status = kRunComplete;  // kRunComplete|kRunInfeasible|kRunFailed
-  // goal_reached | timeout | constraint_violated: <constraint> | error text;
+  std::string status = kRunComplete;  // one of the statuses above
+  // goal_reached | timeout | constraint_violated: <constraint> |
+  // stalled: <stop reason> | error text;
   // valet_parking also: no_path (the planner found no manoeuvre),
   // parked_out_of_tolerance (the manoeuvre ended outside the tolerances)
   std::string termination_reason;

@@ -487,10 +487,10 @@ Status WriteContents(hid_t file, const RunData& run) {
 }
 
 Status Validate(const RunData& run) {
-  if (run.status != kRunComplete && run.status != kRunInfeasible &&
+  if (run.status != kRunComplete && !EndedEarly(run.status) &&
       run.status != kRunFailed) {
     return Status::InvalidArgument(
-        "run status must be complete, infeasible or failed, got '" +
+        "run status must be complete, infeasible, stalled or failed, got '" +
         run.status + "'");
   }
   // The hash doubles as the checksum of /scenario/yaml (stored without one).

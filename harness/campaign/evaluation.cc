@@ -22,12 +22,11 @@ Result<EvaluationRow> RowFromJson(const nlohmann::json& j,
   try {
     row.content_key = j.at("content_key").get<std::string>();
     // The row's status says whether a run file exists: an early-stopped
-    // (infeasible) run has one.
+    // (infeasible or stalled) run has one.
     const std::string status = j.at("status").get<std::string>();
-    row.status =
-        status == runfile::kRunComplete || status == runfile::kRunInfeasible
-            ? runfile::kRunComplete
-            : runfile::kRunFailed;
+    row.status = status == runfile::kRunComplete || runfile::EndedEarly(status)
+                     ? runfile::kRunComplete
+                     : runfile::kRunFailed;
     const bool censored = j.value("censored", false);
     row.reason = j.at("termination_reason").get<std::string>();
     row.seed = j.at("seed").get<uint64_t>();

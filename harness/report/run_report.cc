@@ -31,7 +31,7 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
   r.point = run.design_point;
   r.seed = run.seed;
   r.status = run.status;
-  r.censored = run.status == runfile::kRunInfeasible;
+  r.censored = runfile::EndedEarly(run.status);
   r.termination_reason = run.termination_reason;
   r.content_key = run.content_key;
   // Metrics are recomputed from the trace, never copied, so a changed
@@ -276,8 +276,19 @@ std::string FormatSummary(const RunReport& r) {
                ? std::string("n/a")
                : fmt::format("{:.4g}", it->second);
   };
-  out += fmt::format("ended       {} ({})\n", r.termination_reason, r.status);
-  if (r.censored) {
+  if (r.status == runfile::kRunStalled) {
+    out += fmt::format(
+        "ended       stalled: the car stood still until {} s, held by {} "
+        "(task.stall_timeout_s)\n",
+        metric("nav_time_s"),
+        runfile::ReasonAfter(r.termination_reason, runfile::kStalledPrefix));
+    out +=
+        "censored    the metrics below are measured up to then; nav_time_s "
+        "is a lower bound\n";
+  } else {
+    out += fmt::format("ended       {} ({})\n", r.termination_reason, r.status);
+  }
+  if (r.censored && r.status != runfile::kRunStalled) {
     out += fmt::format(
         "censored    early stop at {} s: the metrics below are measured up "
         "to it; nav_time_s is a lower bound\n",

@@ -75,7 +75,7 @@ struct RunReport {
   std::string scenario_name;
   std::map<std::string, double> point;
   uint64_t seed = 0;
-  std::string status;  // runfile::kRunComplete | kRunInfeasible | kRunFailed
+  std::string status;  // a run status (runfile/run_data.h)
   // Early stop ended the run: its metrics are measured up to the stop
   // (metric `censored` = 1), nav_time_s only a lower bound.
   bool censored = false;

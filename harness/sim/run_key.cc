@@ -12,8 +12,10 @@ namespace {
 
 // Bump when the meaning of a run changes without any input changing. v2:
 // NDT's acceptance and the map filter changed (issue 17), so runs cached
-// by earlier versions are not reused.
-constexpr char kKeyVersion[] = "adse-run-key-v2";
+// by earlier versions are not reused. v3: a car that stands held by
+// something traffic will not release ends the run as stalled
+// (task.stall_timeout_s), where it used to drive on to the timeout.
+constexpr char kKeyVersion[] = "adse-run-key-v3";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {
@@ -83,6 +85,7 @@ Result<std::string> RunKey(const spec::Spec& spec,
     for (const world::Location& l : t.via) AddLocation(&h, l);
   }
   h.Add(t.goal_tolerance_m).Add(t.speed_limit_kmh).Add(t.timeout_s);
+  h.Add("stall_timeout_s").Add(t.stall_timeout_s);
   const bool valet = t.kind == world::TaskKind::kValetParking;
   if (valet) h.Add("goal_yaw_tolerance_deg").Add(t.goal_yaw_tolerance_deg);
   // Stack: every knob's effective value, so a changed default changes keys.

@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "analysis/metrics/run_metrics.h"
+#include "analysis/metrics/standing.h"
 #include "harness/profile/profile.h"
 #include "harness/sim/calibration.h"
 #include "harness/sim/early_stop.h"
@@ -285,6 +286,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   Result<EarlyStop> early_stop =
       EarlyStop::Create(spec, point, stack_config.Get("control.rate_hz"));
   if (!early_stop.ok()) return early_stop.status();
+  analysis::StallWatch stall(spec.task.stall_timeout_s);
 
   const double dt = w.step_s();
   const double timeout = spec.task.timeout_s;
@@ -417,6 +419,12 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
         reason = runfile::kConstraintViolatedPrefix + *violated;
         break;
       }
+    }
+    if (stall.Observe(w.time_s(), w.ego().v_mps, run.stop_reasons)) {
+      status = runfile::kRunStalled;
+      reason = runfile::kStalledPrefix +
+               std::string(StopReasonToString(stall.reason()));
+      break;
     }
   }
 

@@ -98,6 +98,9 @@ struct TaskOptions {
   double speed_limit_kmh = 30.0;
   // Simulated time after the start event at which a run is abandoned.
   double timeout_s = 1500.0;
+  // A car that has stood this long without a break, held by something no
+  // other traffic or signal will release, ends the run as stalled; 0: never.
+  double stall_timeout_s = 60.0;
 };
 
 // Names as written in scenario files and run records: the one list each

@@ -31,7 +31,8 @@ const std::vector<std::string> kTrafficKeys = {
     "seed", "flows", "parked_occupancy", "parked_slots"};
 const std::vector<std::string> kFlowKeys = {"from", "to", "vehicles_per_hour"};
 const std::vector<std::string> kTaskKeys = {
-    "kind", "start", "via", "goal", "speed_limit_kmh", "timeout_s"};
+    "kind",      "start",          "via", "goal", "speed_limit_kmh",
+    "timeout_s", "stall_timeout_s"};
 const std::vector<std::string> kStartKeys = {"x", "y", "edge", "pos_m", "lane"};
 const std::vector<std::string> kGoalKeys = {
     "x",           "y",       "edge",
@@ -413,6 +414,9 @@ void SpecReader::ReadTask(const Val& v) {
   }
   if (const Val* e = f.Get("timeout_s")) {
     ReadNumber(*e, &task.timeout_s, Bounds::Positive());
+  }
+  if (const Val* e = f.Get("stall_timeout_s")) {
+    ReadNumber(*e, &task.stall_timeout_s, Bounds::NonNegative());
   }
 }
 

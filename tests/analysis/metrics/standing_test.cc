@@ -120,5 +120,83 @@ TEST(StandingTest, ACarThatNeverStoodHasNoReasons) {
   EXPECT_TRUE(s.by_reason.empty());
 }
 
+// Feeds `run` to a StallWatch sample by sample, as the simulator does;
+// the time it stalled, or -1.
+double StalledAt(const runfile::RunData& run, StallWatch* watch) {
+  std::vector<StopSample> published;
+  size_t next = 0;
+  for (const runfile::EgoSample& e : run.ego) {
+    while (next < run.stop_reasons.size() &&
+           run.stop_reasons[next].t_s <= e.t_s + 1e-9) {
+      published.push_back(run.stop_reasons[next++]);
+    }
+    if (watch->Observe(e.t_s, e.v_mps, published)) return e.t_s;
+  }
+  return -1;
+}
+
+TEST(StallWatchTest, ACarHeldByLostLocalizationStallsAfterTheTimeout) {
+  runfile::RunData run = RunStanding({{10, 100}});
+  Publish(&run, 0, 10, Reason(StopReason::kNone, -1));
+  Publish(&run, 10, 100, Reason(StopReason::kLocalizationLost, 0.0));
+  StallWatch watch(60.0);
+  EXPECT_NEAR(StalledAt(run, &watch), 70.0, 0.11);
+  EXPECT_EQ(watch.reason(), StopReason::kLocalizationLost);
+  EXPECT_EQ(watch.track_id(), -1);
+  EXPECT_NEAR(watch.stood_s(), 60.0, 0.11);
+}
+
+TEST(StallWatchTest, StaticStructureTakenForAnObstacleStallsNamingTheTrack) {
+  // 10-30 s held by the planner's silence, then by track 4 on structure:
+  // the track held the car longest.
+  runfile::RunData run = RunStanding({{10, 100}});
+  Publish(&run, 0, 10, Reason(StopReason::kNone, -1));
+  Publish(&run, 30, 100, Obstacle(4, 2.5, true));
+  StallWatch watch(60.0);
+  EXPECT_NEAR(StalledAt(run, &watch), 70.0, 0.11);
+  EXPECT_EQ(watch.reason(), StopReason::kObstacle);
+  EXPECT_EQ(watch.track_id(), 4);
+}
+
+TEST(StallWatchTest, RedLightsAndOtherTrafficNeverStallACar) {
+  // 95 s at a red light, then behind a road user: traffic releases both.
+  runfile::RunData run = RunStanding({{0, 100}});
+  Publish(&run, 0, 50, Reason(StopReason::kRedLight, 0.5));
+  Publish(&run, 50, 100, Obstacle(3, 4.0, false));
+  StallWatch watch(60.0);
+  EXPECT_EQ(StalledAt(run, &watch), -1);
+}
+
+TEST(StallWatchTest, TimeHeldByTrafficPausesTheCountWithoutResettingIt) {
+  // 40 s lost, 20 s at a red light, 30 s lost: 70 s counted.
+  runfile::RunData run = RunStanding({{0, 100}});
+  Publish(&run, 0, 40, Reason(StopReason::kLocalizationLost, 0.0));
+  Publish(&run, 40, 60, Reason(StopReason::kRedLight, 0.5));
+  Publish(&run, 60, 100, Reason(StopReason::kLocalizationLost, 0.0));
+  StallWatch watch(60.0);
+  EXPECT_NEAR(StalledAt(run, &watch), 80.0, 0.11);
+}
+
+TEST(StallWatchTest, MovingStartsTheCountAgain) {
+  // Two 50 s stands with a drive between them: neither reaches 60 s.
+  runfile::RunData run = RunStanding({{0, 50}, {50.5, 100}});
+  Publish(&run, 0, 100, Reason(StopReason::kLocalizationLost, 0.0));
+  StallWatch watch(60.0);
+  EXPECT_EQ(StalledAt(run, &watch), -1);
+}
+
+TEST(StallWatchTest, APlannerThatNeverSpeaksStallsForNoTrajectory) {
+  runfile::RunData run = RunStanding({{0, 100}});
+  StallWatch watch(60.0);
+  EXPECT_NEAR(StalledAt(run, &watch), 60.0, 0.11);
+  EXPECT_EQ(watch.reason(), StopReason::kNoTrajectory);
+}
+
+TEST(StallWatchTest, ATimeoutOfZeroNeverStalls) {
+  runfile::RunData run = RunStanding({{0, 100}});
+  StallWatch watch(0.0);
+  EXPECT_EQ(StalledAt(run, &watch), -1);
+}
+
 }  // namespace
 }  // namespace adse::analysis

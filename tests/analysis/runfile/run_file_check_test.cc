@@ -305,7 +305,7 @@ TEST_F(RunFileCheckTest, ReportsBadRootAttributes) {
       << Join(problems);
   EXPECT_TRUE(Contains(problems,
                        "/: attribute 'status' is 'done', expected one of "
-                       "[\"complete\",\"infeasible\",\"failed\"]"))
+                       "[\"complete\",\"infeasible\",\"stalled\",\"failed\"]"))
       << Join(problems);
   EXPECT_TRUE(Contains(problems, "/: attribute 'seed' is string, expected int"))
       << Join(problems);

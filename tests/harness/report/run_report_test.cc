@@ -151,6 +151,23 @@ TEST(RunReportTest, NamesTheDominantStopReasonAndHowLongTheCarStood) {
   EXPECT_FALSE(j["standing"]["by_reason"][1].contains("track_id"));
 }
 
+TEST(RunReportTest, AStalledRunSaysWhatHeldTheCarAndIsCensored) {
+  runfile::RunData run = StoodRun();
+  run.status = runfile::kRunStalled;
+  run.termination_reason = "stalled: obstacle";
+  Result<RunReport> r = AnalyzeRun(run, "memory", AnalyzeOptions{});
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_TRUE(r->censored);
+  EXPECT_FALSE(r->feasible);
+  EXPECT_EQ(r->metrics.at("censored"), 1.0);
+  const std::string text = FormatSummary(*r);
+  EXPECT_THAT(text, ::testing::HasSubstr(
+                        "ended       stalled: the car stood still until 60 s, "
+                        "held by obstacle (task.stall_timeout_s)\n"));
+  EXPECT_THAT(text, ::testing::HasSubstr("nav_time_s is a lower bound"));
+  EXPECT_EQ(ToJson(*r)["status"], "stalled");
+}
+
 TEST(RunReportTest, AnObjectBesideTheCarIsSaidToBeBesideIt) {
   analysis::StandingTime t;
   t.reason = StopReason::kObstacle;

@@ -203,6 +203,34 @@ TEST(SimulateTest,
   EXPECT_EQ(back->metrics.at("censored"), 1.0);
 }
 
+TEST(SimulateTest, ACarHeldShortOfItsGoalEndsStalledAfterTheStallTimeout) {
+  // The planner stops the car at the goal, but a 1 cm tolerance is never
+  // met: the car stands, held by the goal stop, and nothing will release
+  // it. It arrives at about 22 s.
+  spec::Spec spec = SmallScenario();
+  spec.harness.early_stop = false;
+  spec.task.goal_tolerance_m = 0.01;
+  spec.task.stall_timeout_s = 20;
+  Result<runfile::RunData> run = SimulatePoint(spec, SmallPoint(16, 2.1, 7));
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->status, runfile::kRunStalled);
+  EXPECT_EQ(run->termination_reason, "stalled: goal");
+  EXPECT_EQ(run->metrics.at("censored"), 1.0);
+  EXPECT_EQ(run->metrics.at("completed"), 0.0);
+  EXPECT_NEAR(run->metrics.at("nav_time_s"), 22.0 + 20.0, 3.0);
+  Result<runfile::RunData> back = WrittenAndReadBack(*run, "stalled");
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->status, runfile::kRunStalled);
+
+  // With the watch off it stands on to the timeout.
+  spec.task.stall_timeout_s = 0;
+  spec.task.timeout_s = 50;
+  Result<runfile::RunData> full = SimulatePoint(spec, SmallPoint(16, 2.1, 7));
+  ASSERT_TRUE(full.ok()) << full.status().ToString();
+  EXPECT_EQ(full->status, runfile::kRunComplete);
+  EXPECT_EQ(full->termination_reason, "timeout");
+}
+
 TEST(SimulateTest, PointOutsideTheSpaceIsRejected) {
   Result<runfile::RunData> run =
       SimulatePoint(SmallScenario(), SmallPoint(3, 2.1, 7));

@@ -121,7 +121,8 @@ TEST(SpecErrorsTest, UnknownKeyWithSuggestion) {
   const std::string message = ErrorOf(text);
   EXPECT_THAT(message, HasSubstr("bad.yaml:6:3: error: task.gaol: expected a "
                                  "key among {kind, start, via, goal, "
-                                 "speed_limit_kmh, timeout_s}, found 'gaol' "
+                                 "speed_limit_kmh, timeout_s, "
+                                 "stall_timeout_s}, found 'gaol' "
                                  "(did you mean 'goal'?)"));
   // ... and the now missing goal is reported too.
   EXPECT_THAT(message, HasSubstr("task.goal: expected a place"));
@@ -326,6 +327,9 @@ TEST(SpecErrorsTest, NonPositiveRatesAndTimeouts) {
                "  timeout_s: 0\n  speed_limit_kmh: -1\n");
   ExpectError(text, "task.timeout_s", 6, "a number > 0");
   ExpectError(text, "task.speed_limit_kmh", 7, "a number in (0, 300]");
+  text = kHead;
+  text.replace(text.find("  goal:"), 0, "  stall_timeout_s: -1\n");
+  ExpectError(text, "task.stall_timeout_s", 6, "a number >= 0");
   text = kHead;
   text.replace(text.find("  map:"), 0, "  step_s: 0\n");
   ExpectError(text, "world.step_s", 3, "a number in (0, 1]");

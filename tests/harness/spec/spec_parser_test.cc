@@ -341,6 +341,8 @@ design_space:
   EXPECT_NEAR(again->task.goal.yaw_deg, -90, kTol);
   EXPECT_NEAR(again->task.goal_tolerance_m, 0.4, kTol);
   EXPECT_NEAR(again->task.goal_yaw_tolerance_deg, 8, kTol);
+  // Unwritten, a car stalls after 60 s.
+  EXPECT_NEAR(again->task.stall_timeout_s, 60, kTol);
   EXPECT_EQ(again->world.traffic.parked_slots,
             (std::vector<std::string>{"slot_r1_s3", "slot_r1_s5"}));
   // Lane driving's normal form carries no heading tolerance.
