@@ -19,13 +19,6 @@ double Cross(const Vec2& a, const Vec2& b) {
   return a.x() * b.y() - a.y() * b.x();
 }
 
-double PointSegment(const Vec2& p, const Vec2& a, const Vec2& b) {
-  const Vec2 ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0;
-  return (a + t * ab - p).norm();
-}
-
 bool SegmentsCross(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
   const double d1 = Cross(b - a, c - a), d2 = Cross(b - a, d - a);
   const double d3 = Cross(d - c, a - c), d4 = Cross(d - c, b - c);
@@ -35,8 +28,10 @@ bool SegmentsCross(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
 double SegmentSegment(const Vec2& a, const Vec2& b, const Vec2& c,
                       const Vec2& d) {
   if (SegmentsCross(a, b, c, d)) return 0.0;
-  return std::min({PointSegment(a, c, d), PointSegment(b, c, d),
-                   PointSegment(c, a, b), PointSegment(d, a, b)});
+  return std::min({geometry::DistanceToSegment(a, c, d),
+                   geometry::DistanceToSegment(b, c, d),
+                   geometry::DistanceToSegment(c, a, b),
+                   geometry::DistanceToSegment(d, a, b)});
 }
 
 // Distance between two closed outlines (a 2-point outline is a segment);
@@ -109,8 +104,9 @@ void AddParkingMetrics(const runfile::RunData& run,
       for (size_t i = 0; i + 1 < p.planned_path.size(); ++i) {
         const auto& a = p.planned_path[i];
         const auto& b = p.planned_path[i + 1];
-        d = std::min(d, PointSegment(Vec2(e.x_m, e.y_m), Vec2(a.x_m, a.y_m),
-                                     Vec2(b.x_m, b.y_m)));
+        d = std::min(
+            d, geometry::DistanceToSegment(
+                   Vec2(e.x_m, e.y_m), Vec2(a.x_m, a.y_m), Vec2(b.x_m, b.y_m)));
       }
       sum += d;
       worst = std::max(worst, d);

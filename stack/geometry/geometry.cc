@@ -130,4 +130,13 @@ bool InsidePolygon(const std::vector<Eigen::Vector2d>& polygon,
   return inside;
 }
 
+double DistanceToSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                         const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t =
+      len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
 }  // namespace adse::geometry

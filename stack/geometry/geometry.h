@@ -61,6 +61,10 @@ bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b);
 bool InsidePolygon(const std::vector<Eigen::Vector2d>& polygon,
                    const Eigen::Vector2d& p);
 
+// Distance from `p` to the segment a-b (to `a` when they coincide).
+double DistanceToSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                         const Eigen::Vector2d& b);
+
 }  // namespace adse::geometry
 
 #endif  // ADSE_STACK_GEOMETRY_GEOMETRY_H_

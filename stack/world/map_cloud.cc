@@ -30,16 +30,89 @@ int Steps(double length, double spacing) {
   return std::max(1, static_cast<int>(std::ceil(length / spacing - 1e-9)));
 }
 
+// The cells of a grid over [lo, hi] whose centre lies within the half
+// width (plus half a cell's diagonal, so no point within the half width is
+// lost) of a polyline. Without a polyline every place is inside.
+class CorridorMask {
+ public:
+  CorridorMask(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,
+               const std::vector<Eigen::Vector2d>& path, double half_width_m)
+      : lo_(lo), active_(!path.empty()) {
+    if (!active_) return;
+    const Eigen::Vector2d extent = (hi - lo).cwiseMax(0.0);
+    nx_ = static_cast<int>(extent.x() / kCellM) + 1;
+    ny_ = static_cast<int>(extent.y() / kCellM) + 1;
+    inside_.assign(static_cast<size_t>(nx_) * ny_, 0);
+    const double reach = half_width_m + kCellM * std::sqrt(0.5);
+    for (size_t i = 0; i < path.size(); ++i) {
+      const Eigen::Vector2d a = path[i];
+      const Eigen::Vector2d b = path[std::min(i + 1, path.size() - 1)];
+      const Eigen::Vector2d pmin = a.cwiseMin(b).array() - reach;
+      const Eigen::Vector2d pmax = a.cwiseMax(b).array() + reach;
+      const int x0 = std::max(0, Cell(pmin.x() - lo_.x()));
+      const int x1 = std::min(nx_ - 1, Cell(pmax.x() - lo_.x()));
+      const int y0 = std::max(0, Cell(pmin.y() - lo_.y()));
+      const int y1 = std::min(ny_ - 1, Cell(pmax.y() - lo_.y()));
+      for (int y = y0; y <= y1; ++y) {
+        for (int x = x0; x <= x1; ++x) {
+          const Eigen::Vector2d c =
+              lo_ + kCellM * Eigen::Vector2d(x + 0.5, y + 0.5);
+          if (geometry::DistanceToSegment(c, a, b) <= reach)
+            inside_[static_cast<size_t>(y) * nx_ + x] = 1;
+        }
+      }
+    }
+    for (const char cell : inside_) area_m2_ += cell ? kCellM * kCellM : 0.0;
+  }
+
+  bool Contains(double x, double y) const {
+    if (!active_) return true;
+    const int cx = Cell(x - lo_.x());
+    const int cy = Cell(y - lo_.y());
+    return cx >= 0 && cy >= 0 && cx < nx_ && cy < ny_ &&
+           inside_[static_cast<size_t>(cy) * nx_ + cx] != 0;
+  }
+
+  // The area inside, m²; negative without a polyline.
+  double area_m2() const { return active_ ? area_m2_ : -1.0; }
+
+ private:
+  static constexpr double kCellM = 8.0;
+  static int Cell(double offset_m) {
+    return static_cast<int>(std::floor(offset_m / kCellM));
+  }
+
+  Eigen::Vector2d lo_;
+  bool active_;
+  int nx_ = 0, ny_ = 0;
+  std::vector<char> inside_;
+  double area_m2_ = 0.0;
+};
+
+// The scene's bounds grown by the ground margin: all a map can hold.
+std::pair<Eigen::Vector2d, Eigen::Vector2d> MapBounds(
+    const Scene& scene, const MapCloudOptions& options) {
+  const Eigen::Vector2d margin =
+      Eigen::Vector2d::Constant(options.ground_margin_m);
+  return {scene.min_corner() - margin, scene.max_corner() + margin};
+}
+
 void SampleGround(const Scene& scene, const MapCloudOptions& options,
+                  const CorridorMask& mask,
                   std::vector<Eigen::Vector3f>* points) {
-  const Eigen::Vector2d lo =
-      scene.min_corner() - Eigen::Vector2d::Constant(options.ground_margin_m);
-  const Eigen::Vector2d hi =
-      scene.max_corner() + Eigen::Vector2d::Constant(options.ground_margin_m);
+  const auto [lo, hi] = MapBounds(scene, options);
   const Eigen::Vector2d extent = (hi - lo).cwiseMax(0.0);
   double step = options.ground_spacing_m;
-  if ((extent.x() / step + 1) * (extent.y() / step + 1) > kMaxGroundPoints) {
-    step = std::sqrt(extent.x() * extent.y() / kMaxGroundPoints) * 1.01 + 1e-9;
+  // The area sampled, and about how many points that gives: with a
+  // corridor, its own (smaller) area.
+  double area = extent.x() * extent.y();
+  double estimate = (extent.x() / step + 1) * (extent.y() / step + 1);
+  if (mask.area_m2() >= 0) {
+    area = std::min(area, mask.area_m2());
+    estimate = area / (step * step);
+  }
+  if (estimate > kMaxGroundPoints) {
+    step = std::sqrt(area / kMaxGroundPoints) * 1.01 + 1e-9;
   }
   const int nx = static_cast<int>(std::floor(extent.x() / step + 1e-9)) + 1;
   const int ny = static_cast<int>(std::floor(extent.y() / step + 1e-9)) + 1;
@@ -77,6 +150,7 @@ void SampleGround(const Scene& scene, const MapCloudOptions& options,
     for (int ix = 0; ix < nx; ++ix) {
       const double x = lo.x() + ix * step;
       const double y = lo.y() + iy * step;
+      if (!mask.Contains(x, y)) continue;
       const int cx =
           std::clamp(static_cast<int>((x - lo.x()) / kBucketM), 0, bx - 1);
       const int cy =
@@ -381,6 +455,9 @@ std::vector<Eigen::Vector3f> SampleSceneSurface(
     const Scene& scene, const MapCloudOptions& options) {
   std::vector<Eigen::Vector3f> points;
   const double spacing = std::max(kMinSpacingM, options.spacing_m);
+  const auto [lo, hi] = MapBounds(scene, options);
+  const CorridorMask mask(lo, hi, options.corridor,
+                          options.corridor_half_width_m);
   for (const Obstacle& obstacle : scene.obstacles()) {
     const auto edges = ObstacleEdges(obstacle);
     // A closed ring's next edge starts where this one ends: sample each
@@ -393,6 +470,7 @@ std::vector<Eigen::Vector3f> SampleSceneSurface(
       const int nu = Steps(len, spacing);
       for (int i = 0; i <= nu - (open ? 0 : 1); ++i) {
         const Eigen::Vector2d p = e[0] + (e[1] - e[0]) * (double(i) / nu);
+        if (!mask.Contains(p.x(), p.y())) continue;
         for (int k = 0; k <= nz; ++k) {
           const double z =
               nz == 0 ? obstacle.z_min_m
@@ -404,7 +482,7 @@ std::vector<Eigen::Vector3f> SampleSceneSurface(
     }
   }
   if (options.ground_spacing_m > 0.0 && !scene.obstacles().empty()) {
-    SampleGround(scene, options, &points);
+    SampleGround(scene, options, mask, &points);
   }
   return points;
 }

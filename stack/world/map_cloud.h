@@ -23,12 +23,20 @@ struct MapCloudOptions {
   // 10 m, a car starting at the fringe of a bare network saw its ground
   // off the map behind it, never localized and stood the whole run.
   double ground_margin_m = 60.0;
+  // The route the car will drive (world x, y); empty: the whole scene.
+  // With a route, only the part of the map within corridor_half_width_m of
+  // it is sampled (a little more, cell-wise): the LiDAR sees 60 m, and a
+  // city's whole map would take gigabytes per run.
+  std::vector<Eigen::Vector2d> corridor;
+  double corridor_half_width_m = 150.0;
 };
 
 // Points on every obstacle face (footprint edges from z_min to z_max,
 // corners and top/bottom rims included) plus the ground grid, skipping
-// ground points inside closed footprints (under buildings, parked cars).
-// Deterministic: same scene and options, same points in the same order.
+// ground points inside closed footprints (under buildings, parked cars),
+// all within the corridor when there is one. Deterministic: same scene and
+// options, same points in the same order; a corridor that covers the whole
+// scene gives the same points as none.
 std::vector<Eigen::Vector3f> SampleSceneSurface(const Scene& scene,
                                                 const MapCloudOptions& options);
 

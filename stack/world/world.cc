@@ -473,16 +473,20 @@ std::vector<std::vector<Eigen::Vector2d>> World::LaneShapes() const {
 Result<std::string> World::MapCloudPath() const {
   const Impl& w = *impl_;
   MapCloudOptions options;
+  options.corridor = w.ideal.points;
   ContentHasher hasher;
   // v2: bare networks' roadside poles also on the left of one-way streets
-  // (a cloud cached before would miss them).
-  hasher.Add("adse-cloud-v2")
+  // (a cloud cached before would miss them). v3: only the route's corridor.
+  hasher.Add("adse-cloud-v3")
       .Add(w.map.key)
       .Add(static_cast<long long>(w.setup.world.traffic.seed))
       .Add(w.setup.world.traffic.parked_occupancy)
       .Add(options.spacing_m)
       .Add(options.ground_spacing_m)
-      .Add(options.ground_margin_m);
+      .Add(options.ground_margin_m)
+      .Add(options.corridor_half_width_m);
+  for (const Eigen::Vector2d& p : options.corridor)
+    hasher.Add(p.x()).Add(p.y());
   const std::string path =
       w.map.cache_folder + "/cloud-" + hasher.Hex().substr(0, 16) + ".pcd";
   std::error_code ec;

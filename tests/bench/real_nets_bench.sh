@@ -4,8 +4,10 @@
 # for passenger cars, checked with sumolib), with seeded traffic flows and
 # the net's own traffic lights, each run once with `adse simulate` at a
 # generous point. Prints a markdown table: net, route, reached goal, nav
-# time, dominant stop reason, peak memory (/usr/bin/time -v) and simulated
-# seconds per wall second.
+# time, dominant stop reason, peak memory (/usr/bin/time -v), simulated
+# seconds per wall second, and how far `adse world --follow-ideal`'s
+# ground-truth controller strays from the ideal path outside junctions
+# (tests/bench/ideal_path_error.py) with the route's U-turns.
 #   tests/bench/real_nets_bench.sh [routes-per-net] [net-name ...]
 # ROUTES_SEED (default 1) seeds the routes and flows; POINT (default
 # cores=16,freq_ghz=2.1) is the design point; KEEP=DIR keeps the scenarios,
@@ -107,8 +109,8 @@ PY
 echo "point: ${point}; routes per net: ${routes}; seed: ${seed}"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1 /proc/loadavg)"
 echo
-echo "| net | route | length m | reached goal | ended | nav time s | dominant stop reason | stood s | collisions | peak RSS MB | sim s / wall s |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| net | route | length m | reached goal | ended | nav time s | dominant stop reason | stood s | collisions | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | U-turns |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 reached=0
 total=0
 for name in "${names[@]}"; do
@@ -122,9 +124,18 @@ for name in "${names[@]}"; do
     if ! /usr/bin/time -v -o "${out}/${run}.time" "${adse}" simulate "${yaml}" \
         --point "${point}" --json -q -o "${out}/${run}.h5" \
         >"${out}/${run}.json" 2>"${out}/${run}.log"; then
-      echo "| ${name} | ${run} | ${length} | error | $(tail -n1 "${out}/${run}.log") | | | | | | |"
+      echo "| ${name} | ${run} | ${length} | error | $(tail -n1 "${out}/${run}.log") | | | | | | | | |"
       total=$((total + 1))
       continue
+    fi
+    ideal="n/a | n/a"
+    # Exit code 1: the goal was not reached; its trajectory still counts.
+    "${adse}" world "${yaml}" --follow-ideal --no-scan \
+      -o "${out}/${run}-ideal" >"${out}/${run}-ideal.log" 2>&1 || true
+    if [ -f "${out}/${run}-ideal/trajectory.csv" ]; then
+      read -r off all turns < <(PYTHONPATH="${tools}" "${py}" \
+        "${root}/tests/bench/ideal_path_error.py" "${net}" "${out}/${run}-ideal")
+      ideal="${off} / ${all} | ${turns}"
     fi
     line="$("${py}" - "${out}/${run}.json" "${out}/${run}.time" "${name}" "${run}" "${length}" <<'PY'
 import json, re, sys
@@ -145,7 +156,7 @@ print("| %s | %s | %s | %s | %s | %.1f | %s | %.1f | %d | %.0f | %.2f |" % (
     int(rss.group(1)) / 1024 if rss else float("nan"), t["simulated"] / t["wall"]))
 PY
 )"
-    echo "${line}"
+    echo "${line} ${ideal} |"
     total=$((total + 1))
     case "${line}" in *"| yes |"*) reached=$((reached + 1)) ;; esac
   done < <(make_scenarios "${name}" "${net}")

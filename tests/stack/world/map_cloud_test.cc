@@ -141,6 +141,56 @@ TEST(MapCloudTest, GroundGridCoversBoundsButNotUnderFootprints) {
   EXPECT_GT(ground, grid - 90);
 }
 
+TEST(MapCloudTest, ACorridorCoveringTheWholeSceneChangesNothing) {
+  const Scene scene = TestScene();
+  MapCloudOptions opt;
+  opt.ground_margin_m = 5.0;
+  const auto whole = SampleSceneSurface(scene, opt);
+  opt.corridor = {{-5, 0}, {5, 0}};
+  opt.corridor_half_width_m = 40.0;  // the farthest corner is 27 m away
+  EXPECT_EQ(SampleSceneSurface(scene, opt), whole);
+}
+
+TEST(MapCloudTest, ACorridorKeepsWhatIsNearTheRouteAndDropsWhatIsFar) {
+  // A 2 km street of poles every 20 m on both sides; the route runs along
+  // its first 200 m only.
+  Scene scene;
+  for (int i = 0; i <= 100; ++i) {
+    for (const double side : {-6.0, 6.0}) {
+      Obstacle pole;
+      pole.kind = ObstacleKind::kPole;
+      const Eigen::Vector2d c(20.0 * i, side);
+      pole.footprint = {
+          c + Eigen::Vector2d(-0.1, -0.1), c + Eigen::Vector2d(0.1, -0.1),
+          c + Eigen::Vector2d(0.1, 0.1), c + Eigen::Vector2d(-0.1, 0.1)};
+      pole.z_max_m = 4.0;
+      scene.AddObstacle(pole);
+    }
+  }
+  scene.Finalize();
+  MapCloudOptions opt;
+  const auto whole = SampleSceneSurface(scene, opt);
+  opt.corridor = {{0, 0}, {100, 0}, {200, 0}};
+  opt.corridor_half_width_m = 50.0;
+  const auto near = SampleSceneSurface(scene, opt);
+  EXPECT_LT(near.size(), whole.size() / 5);
+  // Every point within the half width is kept, as it was sampled; nothing
+  // beyond the half width plus one cell's diagonal (8 m cells) is.
+  auto distance = [](const Eigen::Vector3f& p) {
+    return geometry::DistanceToSegment(p.head<2>().cast<double>(), {0, 0},
+                                       {200, 0});
+  };
+  size_t within = 0;
+  for (const Eigen::Vector3f& p : whole) within += distance(p) <= 50.0;
+  size_t kept_within = 0;
+  for (const Eigen::Vector3f& p : near) {
+    EXPECT_LE(distance(p), 50.0 + 8.0 * std::sqrt(2.0) + 1e-6) << p.transpose();
+    kept_within += distance(p) <= 50.0;
+  }
+  EXPECT_EQ(kept_within, within);
+  EXPECT_GT(within, 0u);
+}
+
 class PcdTest : public ::testing::Test {
  protected:
   void TearDown() override {

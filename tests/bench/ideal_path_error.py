@@ -1,0 +1,88 @@
+"""How far `adse world --follow-ideal`'s ground-truth controller strays from
+the ideal path outside junctions (issue 17's 1 m bound).
+
+  ideal_path_error.py <net.net.xml> <world-check folder>
+
+Prints the largest distance (m) of a trajectory sample from the ideal path
+among the samples outside every junction's shape of the net, the largest
+over all samples, and the number of U-turns on the ideal path (its heading
+turns by more than 150 degrees within 25 m: a car with a 5 m turning radius
+cannot stay on such a path, and leaves the junction wide). Coordinates are
+SUMO net coordinates, as adse's world uses them.
+"""
+import csv
+import sys
+
+import numpy as np
+import sumolib
+
+
+def read_xy(path):
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return np.array([[float(r["x_m"]), float(r["y_m"])] for r in rows])
+
+
+def distances_to_polyline(points, line):
+    a, b = line[:-1], line[1:]
+    ab = b - a
+    len2 = np.maximum((ab * ab).sum(axis=1), 1e-12)
+    out = np.empty(len(points))
+    for i, p in enumerate(points):
+        t = np.clip(((p - a) * ab).sum(axis=1) / len2, 0.0, 1.0)
+        closest = a + t[:, None] * ab
+        out[i] = np.sqrt(((closest - p) ** 2).sum(axis=1)).min()
+    return out
+
+
+def inside(polygon, p):
+    # Even-odd rule, as geometry::InsidePolygon.
+    x, y = p
+    result = False
+    j = len(polygon) - 1
+    for i in range(len(polygon)):
+        (xi, yi), (xj, yj) = polygon[i], polygon[j]
+        if (yi > y) != (yj > y) and x < (xj - xi) * (y - yi) / (yj - yi) + xi:
+            result = not result
+        j = i
+    return result
+
+
+def u_turns(line):
+    step = np.linalg.norm(np.diff(line, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(step)])
+    heading = np.arctan2(np.diff(line[:, 1]), np.diff(line[:, 0]))
+    count, i = 0, 0
+    while i < len(heading):
+        j = np.searchsorted(s, s[i] + 25.0)
+        j = min(j, len(heading) - 1)
+        turn = np.abs(np.angle(np.exp(1j * (heading[j] - heading[i]))))
+        if turn > np.radians(150):
+            count += 1
+            i = j + 1
+        else:
+            i += 1
+    return count
+
+
+def main():
+    net = sumolib.net.readNet(sys.argv[1], withInternal=True)
+    folder = sys.argv[2]
+    trajectory = read_xy(folder + "/trajectory.csv")
+    ideal = read_xy(folder + "/ideal_path.csv")
+    error = distances_to_polyline(trajectory, ideal)
+    shapes = [np.array(n.getShape()) for n in net.getNodes()
+              if len(n.getShape()) >= 3]
+    boxes = np.array([[s[:, 0].min(), s[:, 1].min(), s[:, 0].max(),
+                       s[:, 1].max()] for s in shapes])
+    outside = np.ones(len(trajectory), dtype=bool)
+    for i, p in enumerate(trajectory):
+        near = np.nonzero((boxes[:, 0] <= p[0]) & (p[0] <= boxes[:, 2]) &
+                          (boxes[:, 1] <= p[1]) & (p[1] <= boxes[:, 3]))[0]
+        outside[i] = not any(inside(shapes[k], p) for k in near)
+    print("%.2f %.2f %d" % (error[outside].max() if outside.any() else 0.0,
+                            error.max(), u_turns(ideal)))
+
+
+if __name__ == "__main__":
+    main()
