@@ -17,14 +17,58 @@ struct TrackTime {
   bool static_structure = false;
 };
 
-}  // namespace
+// Time stood, by the reason that held the car.
+class ReasonTally {
+ public:
+  void Add(StopReason reason, const runfile::StopSample* newest, double dt) {
+    per_reason_[reason] += dt;
+    if (reason == StopReason::kObstacle) {
+      TrackTime& t = per_track_[newest->track_id];
+      t.standing_s += dt;
+      t.min_gap_m = std::min(t.min_gap_m, newest->obstacle_gap_m);
+      t.static_structure = t.static_structure || newest->static_structure != 0;
+    }
+  }
 
-StandingSummary SummarizeStanding(const runfile::RunData& run,
-                                  const StandingOptions& options) {
-  StandingSummary out;
-  out.has_reasons = !run.stop_reasons.empty();
-  std::map<StopReason, double> per_reason;
-  std::map<int, TrackTime> per_track;
+  // Longest first; ties in code order, so the order is deterministic.
+  std::vector<StandingTime> ByReason() const {
+    std::vector<StandingTime> out;
+    for (const auto& [reason, seconds] : per_reason_) {
+      StandingTime t;
+      t.reason = reason;
+      t.standing_s = seconds;
+      if (reason == StopReason::kObstacle) {
+        // The track that held the car longest (the lowest id on a tie).
+        const TrackTime* longest = nullptr;
+        for (const auto& [id, track] : per_track_) {
+          if (longest == nullptr || track.standing_s > longest->standing_s) {
+            longest = &track;
+            t.track_id = id;
+          }
+        }
+        t.obstacle_gap_m = longest->min_gap_m;
+        t.static_structure = longest->static_structure;
+      }
+      out.push_back(t);
+    }
+    std::stable_sort(out.begin(), out.end(),
+                     [](const StandingTime& a, const StandingTime& b) {
+                       return a.standing_s > b.standing_s;
+                     });
+    return out;
+  }
+
+ private:
+  std::map<StopReason, double> per_reason_;
+  std::map<int, TrackTime> per_track_;
+};
+
+// Calls visit(i, dt, newest) for every ego sample i below the standing
+// speed but the last, with the time it covers and the planner's newest
+// stop sample at it (nullptr: none yet).
+template <typename Visit>
+void ForEachStandingSample(const runfile::RunData& run,
+                           const StandingOptions& options, Visit visit) {
   const std::vector<runfile::StopSample>& stops = run.stop_reasons;
   size_t next = 0;  // first stop sample published after the current time
   for (size_t i = 0; i + 1 < run.ego.size(); ++i) {
@@ -32,41 +76,65 @@ StandingSummary SummarizeStanding(const runfile::RunData& run,
     while (next < stops.size() && stops[next].t_s <= e.t_s + 1e-9) ++next;
     if (std::abs(e.v_mps) >= options.standing_speed_mps) continue;
     const double dt = std::max(0.0, run.ego[i + 1].t_s - e.t_s);
-    out.standing_s += dt;
-    if (!out.has_reasons) continue;
-    const runfile::StopSample* newest = next > 0 ? &stops[next - 1] : nullptr;
-    const StopReason reason = HoldingReason(newest, e.t_s, options);
-    per_reason[reason] += dt;
-    if (reason == StopReason::kObstacle) {
-      TrackTime& t = per_track[newest->track_id];
-      t.standing_s += dt;
-      t.min_gap_m = std::min(t.min_gap_m, newest->obstacle_gap_m);
-      t.static_structure = t.static_structure || newest->static_structure != 0;
-    }
+    visit(i, dt, next > 0 ? &stops[next - 1] : nullptr);
   }
-  for (const auto& [reason, seconds] : per_reason) {
-    StandingTime t;
-    t.reason = reason;
-    t.standing_s = seconds;
-    if (reason == StopReason::kObstacle) {
-      // The track that held the car longest (the lowest id on a tie).
-      const TrackTime* longest = nullptr;
-      for (const auto& [id, track] : per_track) {
-        if (longest == nullptr || track.standing_s > longest->standing_s) {
-          longest = &track;
-          t.track_id = id;
+}
+
+}  // namespace
+
+StandingSummary SummarizeStanding(const runfile::RunData& run,
+                                  const StandingOptions& options) {
+  StandingSummary out;
+  out.has_reasons = !run.stop_reasons.empty();
+  ReasonTally tally;
+  ForEachStandingSample(
+      run, options,
+      [&](size_t i, double dt, const runfile::StopSample* newest) {
+        out.standing_s += dt;
+        if (out.has_reasons) {
+          tally.Add(HoldingReason(newest, run.ego[i].t_s, options), newest, dt);
         }
-      }
-      t.obstacle_gap_m = longest->min_gap_m;
-      t.static_structure = longest->static_structure;
-    }
-    out.by_reason.push_back(t);
-  }
-  // Longest first; ties in code order, so the order is deterministic.
-  std::stable_sort(out.by_reason.begin(), out.by_reason.end(),
-                   [](const StandingTime& a, const StandingTime& b) {
-                     return a.standing_s > b.standing_s;
-                   });
+      });
+  out.by_reason = tally.ByReason();
+  return out;
+}
+
+std::vector<Stand> ListStands(const runfile::RunData& run,
+                              double min_standing_s,
+                              const StandingOptions& options) {
+  std::vector<Stand> out;
+  const bool has_reasons = !run.stop_reasons.empty();
+  Stand current;
+  ReasonTally tally;
+  size_t last = 0;  // the previous standing sample
+  bool open = false;
+  auto close = [&] {
+    if (!open) return;
+    open = false;
+    if (current.standing_s + 1e-9 < min_standing_s) return;
+    if (has_reasons) current.cause = tally.ByReason().front();
+    out.push_back(current);
+  };
+  ForEachStandingSample(
+      run, options,
+      [&](size_t i, double dt, const runfile::StopSample* newest) {
+        if (open && i != last + 1) close();
+        if (!open) {
+          open = true;
+          current = Stand();
+          current.start_s = run.ego[i].t_s;
+          current.x_m = run.ego[i].x_m;
+          current.y_m = run.ego[i].y_m;
+          current.known = has_reasons;
+          tally = ReasonTally();
+        }
+        last = i;
+        current.standing_s += dt;
+        if (has_reasons) {
+          tally.Add(HoldingReason(newest, run.ego[i].t_s, options), newest, dt);
+        }
+      });
+  close();
   return out;
 }
 

@@ -51,6 +51,25 @@ struct StandingSummary {
 StandingSummary SummarizeStanding(const runfile::RunData& run,
                                   const StandingOptions& options = {});
 
+// One stretch of time the car stood without a break.
+struct Stand {
+  double start_s = 0.0;
+  double standing_s = 0.0;
+  double x_m = 0.0;  // where it stood (world)
+  double y_m = 0.0;
+  // False when the run file has no stop reasons: `cause` is then empty.
+  bool known = false;
+  // The reason that held the car longest in this stretch, with its share
+  // of the stretch's time.
+  StandingTime cause;
+};
+
+// Every stretch the ego stood at least min_standing_s, in time order, each
+// attributed as SummarizeStanding attributes its samples.
+std::vector<Stand> ListStands(const runfile::RunData& run,
+                              double min_standing_s,
+                              const StandingOptions& options = {});
+
 // What holds a car standing at `t_s`, given the planner's newest stop
 // sample published at or before then (nullptr: none yet), as
 // SummarizeStanding attributes it.

@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 #include <utility>
 
+#include "analysis/metrics/standing.h"
 #include "analysis/pictures/internal/drawing_impl.h"
 #include "analysis/pictures/internal/parking_layer_impl.h"
 
@@ -27,6 +28,10 @@ constexpr double kDetailAspect = 0.45;
 // A vehicle that moves further than this between two samples was removed
 // and re-inserted (or teleported): its path is not drawn across the gap.
 constexpr double kVehicleJumpM = 50.0;
+// Stands shorter than this are not marked (the wait for the first
+// trajectory, stop-and-go); only the longest few are labelled.
+constexpr double kMarkStandS = 3.0;
+constexpr size_t kLabelledStands = 6;
 
 // ---------------------------------------------------------------------------
 // Trajectory image.
@@ -134,14 +139,44 @@ void DrawGoalMarker(cv::Mat* img, cv::Point2d at, const Style& s) {
   }
 }
 
+Rgb StandRgb(const analysis::Stand& stand) {
+  if (!stand.known) return kStandOtherRgb;
+  switch (stand.cause.reason) {
+    case StopReason::kRedLight:
+      return kStandRedLightRgb;
+    case StopReason::kObstacle:
+      return kStandObstacleRgb;
+    case StopReason::kLocalizationLost:
+      return kStandLocalizationRgb;
+    default:
+      return kStandOtherRgb;
+  }
+}
+
+void DrawStandMarker(cv::Mat* img, cv::Point2d at, Rgb colour, const Style& s) {
+  if (!Finite(at)) return;
+  const int radius = s.Px(6) * static_cast<int>(kShiftScale);
+  cv::circle(*img, Fixed(at), radius, Bgr(colour), cv::FILLED, cv::LINE_AA,
+             kShift);
+  cv::circle(*img, Fixed(at), radius, Bgr(kBackgroundRgb), 1, cv::LINE_AA,
+             kShift);
+}
+
+// Labels a marker above and right of it; below it where that would run
+// into the header (rows above map_top_px).
 void DrawMarkerLabel(cv::Mat* img, cv::Point2d at, const std::string& text,
-                     const Style& s, const cv::Scalar& colour) {
+                     const Style& s, const cv::Scalar& colour, int map_top_px) {
   if (!Finite(at) || at.x < -1e6 || at.x > 1e6 || at.y < -1e6 || at.y > 1e6) {
     return;
   }
-  DrawText(img, text, static_cast<int>(at.x) + s.Px(12),
-           static_cast<int>(at.y) - s.Px(10), Align::kLeft, s, colour,
-           /*boxed=*/true);
+  int baseline = 0;
+  const int text_h = TextSize(text, s, &baseline).height;
+  int y = static_cast<int>(at.y) - s.Px(10);
+  if (y - text_h - s.Px(3) < map_top_px) {
+    y = static_cast<int>(at.y) + s.Px(12) + text_h;
+  }
+  DrawText(img, text, static_cast<int>(at.x) + s.Px(12), y, Align::kLeft, s,
+           colour, /*boxed=*/true);
 }
 
 // One legend entry of the header: a short sample of the drawing, then its
@@ -248,10 +283,29 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
       break;
     }
   }
+  // Where the car stood, the longest labelled.
+  const std::vector<analysis::Stand> stands =
+      analysis::ListStands(run, kMarkStandS);
+  std::vector<size_t> by_length(stands.size());
+  for (size_t i = 0; i < stands.size(); ++i) by_length[i] = i;
+  std::stable_sort(by_length.begin(), by_length.end(), [&](size_t a, size_t b) {
+    return stands[a].standing_s > stands[b].standing_s;
+  });
+  for (const analysis::Stand& stand : stands) {
+    DrawStandMarker(&img, px(stand.x_m, stand.y_m), StandRgb(stand), s);
+  }
+  for (size_t k = 0; k < std::min(kLabelledStands, by_length.size()); ++k) {
+    const analysis::Stand& stand = stands[by_length[k]];
+    const std::string what =
+        stand.known ? StopReasonToString(stand.cause.reason) : "stood";
+    DrawMarkerLabel(&img, px(stand.x_m, stand.y_m),
+                    fmt::format("{} {:.0f} s", what, stand.standing_s), s,
+                    Bgr(StandRgb(stand)), map.map_top_px);
+  }
   DrawGoalMarker(&img, goal, s);
   DrawStartMarker(&img, start, s);
-  DrawMarkerLabel(&img, goal, "goal", s, Bgr(kGoalRgb));
-  DrawMarkerLabel(&img, start, "start", s, Bgr(kStartRgb));
+  DrawMarkerLabel(&img, goal, "goal", s, Bgr(kGoalRgb), map.map_top_px);
+  DrawMarkerLabel(&img, start, "start", s, Bgr(kStartRgb), map.map_top_px);
 
   // Scale bar, bottom centre.
   const double map_width_m = map.width_px / map.px_per_m;
@@ -329,6 +383,13 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
                   [&](cv::Point2d a, cv::Point2d b) {
                     DrawGoalMarker(&img, 0.5 * (a + b), s);
                   });
+  if (!stands.empty()) {
+    x = LegendEntry(&img, x, legend_y, "stood >= 3 s", s,
+                    [&](cv::Point2d a, cv::Point2d b) {
+                      DrawStandMarker(&img, 0.5 * (a + b),
+                                      StandRgb(stands.front()), s);
+                    });
+  }
   if (run.parking.present) {
     x = LegendEntry(&img, x, legend_y, "target slot", s,
                     line_sample(kTargetSlotRgb, s.Px(3)));

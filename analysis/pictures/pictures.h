@@ -43,6 +43,11 @@ inline constexpr Rgb kTargetSlotRgb{230, 140, 0};  // orange
 inline constexpr Rgb kPlannedForwardRgb{150, 60, 190};  // purple
 inline constexpr Rgb kPlannedReverseRgb{215, 40, 140};  // magenta
 inline constexpr Rgb kEgoBodyRgb{20, 60, 160};          // dark blue
+// Where the car stood, by what held it.
+inline constexpr Rgb kStandRedLightRgb{200, 0, 60};        // crimson
+inline constexpr Rgb kStandObstacleRgb{240, 150, 0};       // amber
+inline constexpr Rgb kStandLocalizationRgb{130, 50, 190};  // violet
+inline constexpr Rgb kStandOtherRgb{90, 90, 90};           // dark grey
 
 struct TrajectoryImageOptions {
   int width_px = 1200;     // 200..4000
@@ -95,7 +100,10 @@ Result<WorldToImage> TrajectoryImageMapping(
 // valet_parking run also shows the lot's slots, walls, poles and parked
 // cars, the target slot, the stack's planned manoeuvre (forward and
 // reverse legs) and the car's body where it ended, and below the map a
-// detail panel with the manoeuvre enlarged. White
+// detail panel with the manoeuvre enlarged. Every place the car stood for
+// 3 s or more is a dot coloured by what held it (red light, obstacle,
+// localization lost, anything else), the longest six labelled with the
+// stop reason and the seconds. White
 // background, y up. Encoded as PNG in memory, then written atomically
 // (adse::WriteFileAtomic): no partial file on any error.
 Status RenderTrajectoryImage(const runfile::RunData& run,

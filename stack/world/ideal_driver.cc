@@ -117,7 +117,15 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
     const double lookahead =
         std::clamp(options.lookahead_time_s * ego.v_mps,
                    options.min_lookahead_m, options.lookahead_m);
-    const Eigen::Vector2d target = path.PointAt(s_progress + lookahead);
+    // The target lies `lookahead` from the car, not from its projection:
+    // a car off the path (after a corner tighter than it can turn) then
+    // aims ahead and rejoins smoothly instead of steering across it.
+    double s_target = s_progress + lookahead;
+    while (s_target < path.length_m() &&
+           (path.PointAt(s_target) - pos).norm() < lookahead) {
+      s_target += 0.25;
+    }
+    const Eigen::Vector2d target = path.PointAt(s_target);
     const Eigen::Vector2d local =
         Eigen::Rotation2Dd(-ego.yaw_rad) * (target - pos);
     const double ld2 = std::max(local.squaredNorm(), 1e-6);

@@ -120,6 +120,44 @@ TEST(StandingTest, ACarThatNeverStoodHasNoReasons) {
   EXPECT_TRUE(s.by_reason.empty());
 }
 
+TEST(StandingTest, EachStandIsListedWithWhereItWasAndWhatHeldTheCarLongest) {
+  // Stands: 10-40 s (behind track 7 on structure), 50-55 (localization
+  // lost), 60-63 (the planner silent), 90-100 (goal);
+  // 70-72 is shorter than the 3 s asked for.
+  runfile::RunData run =
+      RunStanding({{10, 40}, {50, 55}, {60, 63}, {70, 72}, {90, 100}});
+  for (runfile::EgoSample& e : run.ego) e.x_m = e.t_s;  // x = t: the place
+  Publish(&run, 0, 10, Reason(StopReason::kNone, -1));
+  Publish(&run, 10, 40, Obstacle(7, 3.1, true));
+  Publish(&run, 40, 50, Reason(StopReason::kNone, -1));
+  Publish(&run, 50, 55, Reason(StopReason::kLocalizationLost, 0.0));
+  Publish(&run, 55, 59, Reason(StopReason::kNone, -1));
+  Publish(&run, 63, 90, Reason(StopReason::kNone, -1));
+  Publish(&run, 90, 100.05, Reason(StopReason::kGoal, 0.0));
+
+  const std::vector<Stand> stands = ListStands(run, 3.0);
+  ASSERT_EQ(stands.size(), 4u);
+  EXPECT_NEAR(stands[0].start_s, 10.0, 1e-6);
+  EXPECT_NEAR(stands[0].standing_s, 30.0, 1e-6);
+  EXPECT_NEAR(stands[0].x_m, 10.0, 1e-6);
+  EXPECT_TRUE(stands[0].known);
+  EXPECT_EQ(stands[0].cause.reason, StopReason::kObstacle);
+  EXPECT_EQ(stands[0].cause.track_id, 7);
+  EXPECT_TRUE(stands[0].cause.static_structure);
+  EXPECT_EQ(stands[1].cause.reason, StopReason::kLocalizationLost);
+  EXPECT_NEAR(stands[1].standing_s, 5.0, 1e-6);
+  EXPECT_EQ(stands[2].cause.reason, StopReason::kNoTrajectory);
+  EXPECT_NEAR(stands[2].standing_s, 3.0, 1e-6);
+  EXPECT_EQ(stands[3].cause.reason, StopReason::kGoal);
+  EXPECT_NEAR(stands[3].standing_s, 10.0, 1e-6);
+
+  run.stop_reasons.clear();  // an old run file: places and times only
+  const std::vector<Stand> old = ListStands(run, 3.0);
+  ASSERT_EQ(old.size(), 4u);
+  EXPECT_FALSE(old[0].known);
+  EXPECT_NEAR(old[0].standing_s, 30.0, 1e-6);
+}
+
 // Feeds `run` to a StallWatch sample by sample, as the simulator does;
 // the time it stalled, or -1.
 double StalledAt(const runfile::RunData& run, StallWatch* watch) {

@@ -158,6 +158,43 @@ TEST_F(PictureTest, TrajectoryImageHasTheDrawingWhereTheMappingSays) {
   EXPECT_TRUE(dark_in(w / 2 - 100, h - 40, w / 2 + 100, h));  // scale bar
 }
 
+TEST_F(PictureTest, WhereTheCarStoodIsMarkedInTheColourOfWhatHeldIt) {
+  // The car stands 10 s at (50, 1) for a red light and 2 s at (99, 30),
+  // too short to be marked.
+  RunData run = SquareRun();
+  for (runfile::EgoSample& e : run.ego) {
+    if (e.x_m == 50.0 && e.y_m == 1.0) e.v_mps = 0.0;
+    if (e.x_m == 99.0 && e.y_m == 30.0) e.v_mps = 0.0;
+  }
+  RunData stood = run;
+  stood.ego.clear();
+  for (const runfile::EgoSample& e : run.ego) {
+    stood.ego.push_back(e);
+    const int repeats = e.v_mps == 0.0 ? (e.x_m == 50.0 ? 100 : 20) : 0;
+    for (int k = 0; k < repeats; ++k) stood.ego.push_back(e);
+  }
+  double t = 0;
+  for (runfile::EgoSample& e : stood.ego) e.t_s = (t += 0.1);
+  for (double ts = 0; ts <= t; ts += 0.1) {
+    stood.stop_reasons.push_back(
+        {ts, ts, StopReason::kRedLight, 0.0, -1, -1.0, 0});
+  }
+  ASSERT_TRUE(RenderTrajectoryImage(stood, Path("stood.png")).ok());
+  ASSERT_TRUE(RenderTrajectoryImage(SquareRun(), Path("plain.png")).ok());
+  Result<RgbImage> img = ReadImage(Path("stood.png"));
+  Result<RgbImage> plain = ReadImage(Path("plain.png"));
+  ASSERT_TRUE(img.ok() && plain.ok());
+  Result<WorldToImage> map = TrajectoryImageMapping(stood);
+  ASSERT_TRUE(map.ok());
+  EXPECT_TRUE(
+      ColourNear(*img, map->Column(50.0), map->Row(1.0), kStandRedLightRgb, 1));
+  EXPECT_FALSE(ColourNear(*img, map->Column(99.0), map->Row(30.0),
+                          kStandRedLightRgb, 4));
+  // One dot, its label and the legend's sample: a few hundred pixels.
+  EXPECT_GT(CountColour(*img, kStandRedLightRgb), 100);
+  EXPECT_EQ(CountColour(*plain, kStandRedLightRgb), 0);
+}
+
 TEST_F(PictureTest, VehiclesCanBeLeftOut) {
   TrajectoryImageOptions options;
   options.width_px = 600;
