@@ -110,6 +110,8 @@ int RunWorld(const WorldArgs& args) {
   options.speed_limit_mps = spec->task.speed_limit_kmh / 3.6;
   options.timeout_s = spec->task.timeout_s;
   options.scan = args.scan;
+  // Signals are waited out as the stack's planner waits them out.
+  options.max_red_wait_s = spec->stack.Get("traffic_light.max_red_wait_s");
   std::string scan_index = "t_s,x_m,y_m,yaw_rad,points,file\n";
   int scan_number = 0;
   Status scan_status;
@@ -150,6 +152,7 @@ int RunWorld(const WorldArgs& args) {
   summary["time_s"] = report->time_s;
   summary["collisions"] = report->collisions;
   summary["max_lateral_error_m"] = report->max_lateral_error_m;
+  summary["red_light_wait_s"] = report->red_light_wait_s;
   summary["scans"] = report->scans;
   summary["mean_points_per_scan"] = report->mean_points_per_scan;
   summary["lidar_ms_per_scan"] =
@@ -183,13 +186,14 @@ int RunWorld(const WorldArgs& args) {
     std::printf("%s\n", summary.dump(2).c_str());
   } else {
     std::printf(
-        "%s: %s in %.1f s, %d collisions, max distance from the ideal path "
-        "%.2f m, "
+        "%s: %s in %.1f s (%.1f s of it at red lights), %d collisions, max "
+        "distance from the ideal path %.2f m, "
         "%d scans (%.0f points, %.2f ms each), world step %.2f ms\nwrote %s\n",
         spec->name.c_str(),
         report->reached_goal ? "reached the goal" : "did NOT reach the goal",
-        report->time_s, report->collisions, report->max_lateral_error_m,
-        report->scans, report->mean_points_per_scan,
+        report->time_s, report->red_light_wait_s, report->collisions,
+        report->max_lateral_error_m, report->scans,
+        report->mean_points_per_scan,
         summary["lidar_ms_per_scan"].get<double>(),
         summary["world_ms_per_step"].get<double>(), out.c_str());
   }

@@ -7,6 +7,8 @@
 #include <limits>
 
 #include "stack/algorithms/parking_control.h"
+#include "stack/algorithms/traffic_light.h"
+#include "stack/world/traffic_signal_detector.h"
 
 namespace adse::world {
 namespace {
@@ -67,6 +69,10 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
   double next_scan_t = 0.0;
   double point_sum = 0.0;
   double s_progress = 0.0;
+  algorithms::TrafficLightParams signal_params;
+  signal_params.max_red_wait_s = options.max_red_wait_s;
+  algorithms::TrafficLightPlanner signals(signal_params);
+  const std::vector<RouteSignal>& route_signals = world.route_signals();
   while (world.time_s() < options.timeout_s) {
     const VehicleState& ego = world.ego();
     const Eigen::Vector2d pos(ego.x_m, ego.y_m);
@@ -143,11 +149,38 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
         v_target = std::min(v_target, v_allowed);
       }
     }
-    const double remaining = std::max(0.0, path.length_m() - s_progress);
+    // Where the car must stand: the goal, or a signal's stop line before
+    // it. Signals: a perfect detector (the true state, no latency) and the
+    // stack's own rule for when to stop.
+    double remaining = std::max(0.0, path.length_m() - s_progress);
+    if (options.obey_signals && !route_signals.empty()) {
+      algorithms::SignalObservation seen;
+      seen.stamp_s = world.time_s();
+      const std::string letters = world.RouteSignalStates();
+      for (size_t i = 0; i < route_signals.size(); ++i) {
+        const double ahead_m = route_signals[i].stop_line_s_m - s_progress;
+        if (ahead_m <= 0.0) continue;
+        seen.state = SignalStateOfLetter(i < letters.size() ? letters[i] : 'o');
+        seen.stop_line_distance_m = ahead_m;
+        seen.tls_id = route_signals[i].tls_id;
+        break;
+      }
+      signals.Observe(seen);
+      // The planner needs only the path's extent: from here to the goal.
+      std::vector<algorithms::PlannedPoint> ahead(2);
+      ahead[0].s_m = s_progress;
+      ahead[1].s_m = path.length_m();
+      const algorithms::SignalStop stop =
+          signals.Apply(world.time_s(), world.time_s(), ego.v_mps, &ahead);
+      if (stop.stop) {
+        remaining = std::clamp(stop.stop_s_m - s_progress, 0.0, remaining);
+        if (std::abs(ego.v_mps) < 0.1) report.red_light_wait_s += dt;
+      }
+    }
     v_target = std::min(v_target,
                         std::sqrt(2 * options.comfort_decel_mps2 * remaining));
     command.accel_mps2 = 1.5 * (v_target - ego.v_mps);
-    // Near the goal, brake exactly as much as stopping on it needs; a
+    // Near the stop, brake exactly as much as stopping on it needs; a
     // proportional controller alone lags and overshoots.
     if (remaining > 0.05) {
       const double stop_decel = ego.v_mps * ego.v_mps / (2 * remaining);

@@ -27,6 +27,11 @@ struct IdealDriverOptions {
   double timeout_s = 600.0;
   // Scan with the LiDAR (when one is given) at its rate.
   bool scan = true;
+  // Stop at the route's red (and stoppable yellow) signals as the stack's
+  // planner does, reading their true state, and go on after standing
+  // max_red_wait_s at one (traffic_light.max_red_wait_s).
+  bool obey_signals = true;
+  double max_red_wait_s = 300.0;
 };
 
 struct TrajectorySample {
@@ -38,6 +43,7 @@ struct IdealDriveReport {
   double time_s = 0.0;  // time to reach the goal (or timeout)
   int collisions = 0;
   double max_lateral_error_m = 0;  // distance of the ego from the ideal path
+  double red_light_wait_s = 0.0;   // standing at signals' stop lines
   int scans = 0;
   double mean_points_per_scan = 0.0;
   double lidar_wall_s = 0.0;  // wall time spent ray casting

@@ -133,7 +133,10 @@ TEST(CliTest, WorldFollowIdealReachesTheGoalAndWritesWhatItSaw) {
   const nlohmann::json summary = nlohmann::json::parse(summary_file);
   EXPECT_TRUE(summary["reached_goal"].get<bool>());
   EXPECT_EQ(summary["collisions"].get<int>(), 0);
-  EXPECT_LT(summary["max_lateral_error_m"].get<double>(), 0.35);
+  // Within 1 m (issue 17); the lot's right-angle corners are cut by about
+  // 0.4 m.
+  EXPECT_LT(summary["max_lateral_error_m"].get<double>(), 0.5);
+  EXPECT_EQ(summary["red_light_wait_s"].get<double>(), 0.0);  // no signals
   // 168 m of path at 30 km/h with four slow corners.
   EXPECT_NEAR(summary["time_s"].get<double>(), 27.0, 6.0);
   // Scans at the scenario's 10 Hz.

@@ -11,6 +11,8 @@
 #include "analysis/runfile/run_file.h"
 #include "harness/sim/simulator.h"
 #include "harness/spec/spec_parser.h"
+#include "stack/world/ideal_driver.h"
+#include "stack/world/world.h"
 
 namespace adse::sim {
 namespace {
@@ -97,6 +99,43 @@ TEST(TrafficLightsTest, TheEgoWaitsAtTheRedLightThenDrivesOnToTheGoal) {
     has_callback |= c.name == "behavior_velocity_planner/traffic_signal";
   EXPECT_TRUE(has_topic);
   EXPECT_TRUE(has_callback);
+}
+
+TEST(TrafficLightsTest, TheIdealDriverWaitsAtTheRedLightAsTheStackDoes) {
+  ASSERT_TRUE(std::filesystem::exists(kRilsa)) << "sumo-tools is not installed";
+  const spec::Spec spec = RilsaNorthToSouth();
+  auto drive = [&](bool obey) -> Result<world::IdealDriveReport> {
+    Result<std::unique_ptr<world::World>> w =
+        world::World::Open(WorldSetupFromSpec(spec));
+    if (!w.ok()) return w.status();
+    world::IdealDriverOptions options;
+    options.speed_limit_mps = 40 / 3.6;
+    options.timeout_s = 200;
+    options.scan = false;
+    options.obey_signals = obey;
+    Result<world::IdealDriveReport> report =
+        world::DriveIdealPath(**w, nullptr, options);
+    if (report.ok() && obey) {
+      // Never past the stop line while red (front bumper 3.65 m ahead).
+      for (const world::TrajectorySample& s : report->trajectory) {
+        if (s.t_s < kGreenAtS) {
+          EXPECT_GT(s.y_m - (2.7 / 2 + 4.6 / 2), kStopLineY - 0.3)
+              << "at t = " << s.t_s;
+        }
+      }
+    }
+    return report;
+  };
+  Result<world::IdealDriveReport> waits = drive(true);
+  Result<world::IdealDriveReport> drives_through = drive(false);
+  ASSERT_TRUE(waits.ok()) << waits.status().ToString();
+  ASSERT_TRUE(drives_through.ok()) << drives_through.status().ToString();
+  EXPECT_TRUE(waits->reached_goal);
+  EXPECT_GT(waits->red_light_wait_s, 20.0);
+  EXPECT_LT(waits->red_light_wait_s, kGreenAtS);
+  EXPECT_GT(waits->time_s, kGreenAtS);
+  EXPECT_EQ(drives_through->red_light_wait_s, 0.0);
+  EXPECT_LT(drives_through->time_s, waits->time_s - 20.0);
 }
 
 TEST(TrafficLightsTest, APlainProfileIsRefusedNamingTheOneWithTheSignals) {
