@@ -5,10 +5,12 @@ the ideal path outside junctions (issue 17's 1 m bound).
 
 Prints the largest distance (m) of a trajectory sample from the ideal path
 among the samples outside every junction's shape of the net, the largest
-over all samples, and the number of U-turns on the ideal path (its heading
-turns by more than 150 degrees within 25 m: a car with a 5 m turning radius
-cannot stay on such a path, and leaves the junction wide). Coordinates are
-SUMO net coordinates, as adse's world uses them.
+over all samples, and the number of places where the ideal path turns
+tighter than the car can (U-turns, hairpin corners): its heading changes
+faster than 1 / (the ego's minimum turning radius, 2.7 m wheelbase at
+0.6 rad steering: 3.9 m) over 4 m of path. There the car must leave the
+path, and does so beyond the junction's shape. Coordinates are SUMO net
+coordinates, as adse's world uses them.
 """
 import csv
 import sys
@@ -48,18 +50,19 @@ def inside(polygon, p):
     return result
 
 
-def u_turns(line):
+MIN_TURN_RADIUS_M = 2.7 / np.tan(0.6)
+
+
+def tight_turns(line, window_m=4.0):
     step = np.linalg.norm(np.diff(line, axis=0), axis=1)
-    s = np.concatenate([[0.0], np.cumsum(step)])
-    heading = np.arctan2(np.diff(line[:, 1]), np.diff(line[:, 0]))
+    s = np.concatenate([[0.0], np.cumsum(step)])[:-1]
+    heading = np.unwrap(np.arctan2(np.diff(line[:, 1]), np.diff(line[:, 0])))
     count, i = 0, 0
     while i < len(heading):
-        j = np.searchsorted(s, s[i] + 25.0)
-        j = min(j, len(heading) - 1)
-        turn = np.abs(np.angle(np.exp(1j * (heading[j] - heading[i]))))
-        if turn > np.radians(150):
+        j = min(np.searchsorted(s, s[i] + window_m), len(heading) - 1)
+        if abs(heading[j] - heading[i]) > window_m / MIN_TURN_RADIUS_M:
             count += 1
-            i = j + 1
+            i = np.searchsorted(s, s[i] + 25.0)  # one place, not each step
         else:
             i += 1
     return count
@@ -81,7 +84,7 @@ def main():
                           (boxes[:, 1] <= p[1]) & (p[1] <= boxes[:, 3]))[0]
         outside[i] = not any(inside(shapes[k], p) for k in near)
     print("%.2f %.2f %d" % (error[outside].max() if outside.any() else 0.0,
-                            error.max(), u_turns(ideal)))
+                            error.max(), tight_turns(ideal)))
 
 
 if __name__ == "__main__":

@@ -6,8 +6,9 @@
 # generous point. Prints a markdown table: net, route, reached goal, nav
 # time, dominant stop reason, peak memory (/usr/bin/time -v), simulated
 # seconds per wall second, and how far `adse world --follow-ideal`'s
-# ground-truth controller strays from the ideal path outside junctions
-# (tests/bench/ideal_path_error.py) with the route's U-turns.
+# ground-truth controller strays from the ideal path outside junctions,
+# with the number of places the path turns tighter than the car can
+# (tests/bench/ideal_path_error.py).
 #   tests/bench/real_nets_bench.sh [routes-per-net] [net-name ...]
 # ROUTES_SEED (default 1) seeds the routes and flows; POINT (default
 # cores=16,freq_ghz=2.1) is the design point; KEEP=DIR keeps the scenarios,
@@ -109,7 +110,7 @@ PY
 echo "point: ${point}; routes per net: ${routes}; seed: ${seed}"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1 /proc/loadavg)"
 echo
-echo "| net | route | length m | reached goal | ended | nav time s | dominant stop reason | stood s | collisions | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | U-turns |"
+echo "| net | route | length m | reached goal | ended | nav time s | dominant stop reason | stood s | collisions | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 reached=0
 total=0
