@@ -125,8 +125,11 @@ explore::Observation ObservationFromRow(const EvaluationRow& row) {
   }
   o.feasible = row.feasible;
   o.censored = RowMetric(row, analysis::kCensoredMetric) == 1.0;
-  if (o.censored)
+  if (o.censored) {
     o.violated_constraint = runfile::ViolatedConstraint(row.reason);
+    o.stalled =
+        !runfile::ReasonAfter(row.reason, runfile::kStalledPrefix).empty();
+  }
   // The diagnosis is advisory: a row whose JSON does not parse (written by
   // hand, or damaged) is simply told without it.
   const nlohmann::json j =

@@ -354,9 +354,21 @@ std::vector<int> AgentStrategy::RemedyDirections(const Record& record,
 
 std::optional<CensoredBound> AgentStrategy::CensoredAt(
     const Observation& observation) const {
-  const auto found =
-      std::find(constraint_texts_.begin(), constraint_texts_.end(),
-                observation.violated_constraint);
+  auto found = std::find(constraint_texts_.begin(), constraint_texts_.end(),
+                         observation.violated_constraint);
+  if (found == constraint_texts_.end() && observation.stalled) {
+    // A stalled car never arrives: the first constraint on the nav time
+    // alone that an endless drive fails is the one it violates.
+    for (size_t i = 0; i < constraints_.size(); ++i) {
+      const std::vector<std::string> variables = constraints_[i].variables();
+      if (variables.size() != 1 || variables[0] != kNavTimeMetric) continue;
+      const double v = constraints_[i].Evaluate({{kNavTimeMetric, 1e12}});
+      if (std::isfinite(v) && v == 0.0) {
+        found = constraint_texts_.begin() + static_cast<long>(i);
+        break;
+      }
+    }
+  }
   if (found == constraint_texts_.end()) return std::nullopt;
   const spec::Expression& constraint =
       constraints_[found - constraint_texts_.begin()];

@@ -58,6 +58,10 @@ struct Observation {
   // on the violating side of its bound.
   bool censored = false;
   std::string violated_constraint;
+  // The run was ended because the car stood held by something traffic
+  // would not release (status stalled): censored too, and it would never
+  // have arrived, so its nav time lies past any bound on it.
+  bool stalled = false;
   // The run's diagnosis, most severe first (empty when healthy or failed).
   std::vector<BottleneckHint> bottlenecks;
   // The run's content key, when it has a run (agents read its report).

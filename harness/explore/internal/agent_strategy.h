@@ -63,6 +63,7 @@ constexpr int kCheapestEvery = 4;
 constexpr double kMinCheapestSaving = 0.02;
 // The metric computed from the cost expression rather than modelled.
 constexpr char kCostMetric[] = "hardware_cost";
+constexpr char kNavTimeMetric[] = "nav_time_s";
 // The flag of a run that reached its goal.
 constexpr char kCompletedMetric[] = "completed";
 

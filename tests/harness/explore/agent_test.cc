@@ -302,6 +302,38 @@ TEST(AgentTest, RunsStoppedEarlyTeachTheBoundAndSendItToMoreCapacity) {
   EXPECT_GT(points[1].at("cores") * points[1].at("freq_ghz"), 2.0);
 }
 
+TEST(AgentTest, StalledRunsTeachTheTimeBoundToo) {
+  // As above, but the starved runs stall (the car stands, localization
+  // lost) long before the time bound: their reason names no constraint,
+  // yet a car that never arrives is past the nav-time bound.
+  const spec::Spec spec = MakeSpec(
+      "{budget: 12, seed: 4, start_from: {cores: 2, freq_ghz: 1.0, "
+      "lidar_hz: 14}}");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  int stalled = 0;
+  auto evaluate = [&stalled](const spec::DesignPoint& point) {
+    Observation o = Evaluate(point);
+    if (o.metrics.at("completed") == 1 && o.metrics.at("nav_time_s") > 60) {
+      ++stalled;
+      const double cost = o.metrics.at("hardware_cost");
+      o.metrics = {{"hardware_cost", cost}, {"censored", 1}};
+      o.censored = true;
+      o.stalled = true;
+    }
+    return o;
+  };
+  const std::vector<spec::DesignPoint> points = Drive(*strategy, 1, evaluate);
+  ASSERT_EQ(points.size(), 12u);
+  int feasible = 0;
+  for (const spec::DesignPoint& point : points) {
+    feasible += Evaluate(point).feasible ? 1 : 0;
+  }
+  EXPECT_GE(stalled, 1);
+  EXPECT_GE(feasible, 6) << "stalled runs: " << stalled;
+  EXPECT_GT(points[1].at("cores") * points[1].at("freq_ghz"), 2.0);
+}
+
 TEST(AgentTest, BatchesAreDistinctAndSpread) {
   const spec::Spec spec = MakeSpec("{budget: 24, seed: 7, batch: 4}");
   std::unique_ptr<Strategy> strategy = Create(spec);
