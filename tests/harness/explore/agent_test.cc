@@ -267,25 +267,30 @@ TEST(AgentTest, FailedRunsAreSurvivedAndTheirNeighboursAvoided) {
   ExpectDistinctAndAllowed(spec, all_failed);
 }
 
-TEST(AgentTest, RunsStoppedEarlyTeachTheBoundAndSendItToMoreCapacity) {
-  // Starting from a starved point whose runs are stopped at the time bound
-  // (infeasible, metrics withheld but hardware_cost), the agent must read
-  // each stop as "slower than 60 s here" and find feasible designs, not
-  // walk the cheapest corner.
+// Drives the agent from a starved start whose slow runs (over 60 s) are
+// ended early, infeasible with their metrics withheld but hardware_cost:
+// stopped at the time bound (`stalled` false) or stalled, their reason
+// naming no constraint. Either way the agent must read each as "slower
+// than 60 s here" and find feasible designs, not walk the cheapest corner.
+void ExpectEndedEarlyRunsSendItToMoreCapacity(bool stalled) {
   const spec::Spec spec = MakeSpec(
       "{budget: 12, seed: 4, start_from: {cores: 2, freq_ghz: 1.0, "
       "lidar_hz: 14}}");
   std::unique_ptr<Strategy> strategy = Create(spec);
   ASSERT_NE(strategy, nullptr);
-  int stopped = 0;
-  auto evaluate = [&stopped](const spec::DesignPoint& point) {
+  int ended = 0;
+  auto evaluate = [&](const spec::DesignPoint& point) {
     Observation o = Evaluate(point);
     if (o.metrics.at("completed") == 1 && o.metrics.at("nav_time_s") > 60) {
-      ++stopped;
+      ++ended;
       const double cost = o.metrics.at("hardware_cost");
       o.metrics = {{"hardware_cost", cost}, {"censored", 1}};
       o.censored = true;
-      o.violated_constraint = "nav_time_s <= 60";
+      if (stalled) {
+        o.stalled = true;
+      } else {
+        o.violated_constraint = "nav_time_s <= 60";
+      }
     }
     return o;
   };
@@ -296,42 +301,19 @@ TEST(AgentTest, RunsStoppedEarlyTeachTheBoundAndSendItToMoreCapacity) {
   for (const spec::DesignPoint& point : points) {
     feasible += Evaluate(point).feasible ? 1 : 0;
   }
-  EXPECT_GE(stopped, 1);
-  EXPECT_GE(feasible, 6) << "stopped runs: " << stopped;
+  EXPECT_GE(ended, 1);
+  EXPECT_GE(feasible, 6) << "runs ended early: " << ended;
   // The second proposal already moves to more capacity than the start.
   EXPECT_GT(points[1].at("cores") * points[1].at("freq_ghz"), 2.0);
 }
 
+TEST(AgentTest, RunsStoppedEarlyTeachTheBoundAndSendItToMoreCapacity) {
+  ExpectEndedEarlyRunsSendItToMoreCapacity(/*stalled=*/false);
+}
+
 TEST(AgentTest, StalledRunsTeachTheTimeBoundToo) {
-  // As above, but the starved runs stall (the car stands, localization
-  // lost) long before the time bound: their reason names no constraint,
-  // yet a car that never arrives is past the nav-time bound.
-  const spec::Spec spec = MakeSpec(
-      "{budget: 12, seed: 4, start_from: {cores: 2, freq_ghz: 1.0, "
-      "lidar_hz: 14}}");
-  std::unique_ptr<Strategy> strategy = Create(spec);
-  ASSERT_NE(strategy, nullptr);
-  int stalled = 0;
-  auto evaluate = [&stalled](const spec::DesignPoint& point) {
-    Observation o = Evaluate(point);
-    if (o.metrics.at("completed") == 1 && o.metrics.at("nav_time_s") > 60) {
-      ++stalled;
-      const double cost = o.metrics.at("hardware_cost");
-      o.metrics = {{"hardware_cost", cost}, {"censored", 1}};
-      o.censored = true;
-      o.stalled = true;
-    }
-    return o;
-  };
-  const std::vector<spec::DesignPoint> points = Drive(*strategy, 1, evaluate);
-  ASSERT_EQ(points.size(), 12u);
-  int feasible = 0;
-  for (const spec::DesignPoint& point : points) {
-    feasible += Evaluate(point).feasible ? 1 : 0;
-  }
-  EXPECT_GE(stalled, 1);
-  EXPECT_GE(feasible, 6) << "stalled runs: " << stalled;
-  EXPECT_GT(points[1].at("cores") * points[1].at("freq_ghz"), 2.0);
+  // A car that never arrives is past the nav-time bound.
+  ExpectEndedEarlyRunsSendItToMoreCapacity(/*stalled=*/true);
 }
 
 TEST(AgentTest, BatchesAreDistinctAndSpread) {
