@@ -8,61 +8,6 @@
 namespace adse::analysis {
 namespace {
 
-// Per reason, and for obstacles per track: time stood and what was seen.
-struct TrackTime {
-  double standing_s = 0.0;
-  // Gaps are negative for an object beside the car (its near edge behind
-  // the front bumper), so no sentinel value can stand for "none yet".
-  double min_gap_m = std::numeric_limits<double>::infinity();
-  bool static_structure = false;
-};
-
-// Time stood, by the reason that held the car.
-class ReasonTally {
- public:
-  void Add(StopReason reason, const runfile::StopSample* newest, double dt) {
-    per_reason_[reason] += dt;
-    if (reason == StopReason::kObstacle) {
-      TrackTime& t = per_track_[newest->track_id];
-      t.standing_s += dt;
-      t.min_gap_m = std::min(t.min_gap_m, newest->obstacle_gap_m);
-      t.static_structure = t.static_structure || newest->static_structure != 0;
-    }
-  }
-
-  // Longest first; ties in code order, so the order is deterministic.
-  std::vector<StandingTime> ByReason() const {
-    std::vector<StandingTime> out;
-    for (const auto& [reason, seconds] : per_reason_) {
-      StandingTime t;
-      t.reason = reason;
-      t.standing_s = seconds;
-      if (reason == StopReason::kObstacle) {
-        // The track that held the car longest (the lowest id on a tie).
-        const TrackTime* longest = nullptr;
-        for (const auto& [id, track] : per_track_) {
-          if (longest == nullptr || track.standing_s > longest->standing_s) {
-            longest = &track;
-            t.track_id = id;
-          }
-        }
-        t.obstacle_gap_m = longest->min_gap_m;
-        t.static_structure = longest->static_structure;
-      }
-      out.push_back(t);
-    }
-    std::stable_sort(out.begin(), out.end(),
-                     [](const StandingTime& a, const StandingTime& b) {
-                       return a.standing_s > b.standing_s;
-                     });
-    return out;
-  }
-
- private:
-  std::map<StopReason, double> per_reason_;
-  std::map<int, TrackTime> per_track_;
-};
-
 // Calls visit(i, dt, newest) for every ego sample i below the standing
 // speed but the last, with the time it covers and the planner's newest
 // stop sample at it (nullptr: none yet).
@@ -81,6 +26,43 @@ void ForEachStandingSample(const runfile::RunData& run,
 }
 
 }  // namespace
+
+void ReasonTally::Add(StopReason reason, const runfile::StopSample* newest,
+                      double dt) {
+  per_reason_[reason] += dt;
+  if (reason == StopReason::kObstacle) {
+    TrackTime& t = per_track_[newest->track_id];
+    t.standing_s += dt;
+    t.min_gap_m = std::min(t.min_gap_m, newest->obstacle_gap_m);
+    t.static_structure = t.static_structure || newest->static_structure != 0;
+  }
+}
+
+std::vector<StandingTime> ReasonTally::ByReason() const {
+  std::vector<StandingTime> out;
+  for (const auto& [reason, seconds] : per_reason_) {
+    StandingTime t;
+    t.reason = reason;
+    t.standing_s = seconds;
+    if (reason == StopReason::kObstacle) {
+      const TrackTime* longest = nullptr;
+      for (const auto& [id, track] : per_track_) {
+        if (longest == nullptr || track.standing_s > longest->standing_s) {
+          longest = &track;
+          t.track_id = id;
+        }
+      }
+      t.obstacle_gap_m = longest->min_gap_m;
+      t.static_structure = longest->static_structure;
+    }
+    out.push_back(t);
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const StandingTime& a, const StandingTime& b) {
+                     return a.standing_s > b.standing_s;
+                   });
+  return out;
+}
 
 StandingSummary SummarizeStanding(const runfile::RunData& run,
                                   const StandingOptions& options) {
@@ -167,25 +149,16 @@ bool StallWatch::Observe(double t_s, double v_mps,
   if (stall_timeout_s_ <= 0) return false;
   if (std::abs(v_mps) >= options_.standing_speed_mps) {
     stood_s_ = 0.0;
-    by_cause_.clear();
+    stand_ = ReasonTally();
     return false;
   }
   const runfile::StopSample* newest = next_ > 0 ? &stops[next_ - 1] : nullptr;
   const StopReason reason = HoldingReason(newest, t_s, options_);
   if (TrafficWillRelease(reason, newest)) return false;
   stood_s_ += dt;
-  const int track = reason == StopReason::kObstacle ? newest->track_id : -1;
-  by_cause_[{reason, track}] += dt;
+  stand_.Add(reason, newest, dt);
   if (stood_s_ + 1e-9 < stall_timeout_s_) return false;
-  // The longest-held cause (the first in code order on a tie).
-  double longest = -1.0;
-  for (const auto& [cause, seconds] : by_cause_) {
-    if (seconds > longest) {
-      longest = seconds;
-      reason_ = cause.first;
-      track_id_ = cause.second;
-    }
-  }
+  cause_ = stand_.ByReason().front();
   return true;
 }
 

@@ -4,8 +4,8 @@
 #ifndef ADSE_ANALYSIS_METRICS_STANDING_H_
 #define ADSE_ANALYSIS_METRICS_STANDING_H_
 
+#include <limits>
 #include <map>
-#include <utility>
 #include <vector>
 
 #include "analysis/runfile/run_data.h"
@@ -81,6 +81,29 @@ StopReason HoldingReason(const runfile::StopSample* newest, double t_s,
 // where the map has no structure (another road user, which moves on).
 bool TrafficWillRelease(StopReason reason, const runfile::StopSample* newest);
 
+// Time stood, by the reason that held the car (and for obstacles by
+// track): the one attribution of SummarizeStanding, ListStands and
+// StallWatch.
+class ReasonTally {
+ public:
+  // `newest`: the stop sample behind `reason` (its track, for kObstacle).
+  void Add(StopReason reason, const runfile::StopSample* newest, double dt);
+  // Longest first, ties in code order; for kObstacle the track that held
+  // the car longest (the lowest id on a tie).
+  std::vector<StandingTime> ByReason() const;
+
+ private:
+  struct TrackTime {
+    double standing_s = 0.0;
+    // Gaps are negative for an object beside the car (its near edge
+    // behind the front bumper), so no sentinel can stand for "none yet".
+    double min_gap_m = std::numeric_limits<double>::infinity();
+    bool static_structure = false;
+  };
+  std::map<StopReason, double> per_reason_;
+  std::map<int, TrackTime> per_track_;
+};
+
 // Watches a run as it is simulated for a car that stands and will not
 // move again: it has stood without a break for `stall_timeout_s`, counting
 // only time held for reasons that traffic does not release (localization
@@ -99,8 +122,8 @@ class StallWatch {
 
   // While stalled: the reason that held the car longest in the stand, and
   // for kObstacle the track.
-  StopReason reason() const { return reason_; }
-  int track_id() const { return track_id_; }
+  StopReason reason() const { return cause_.reason; }
+  int track_id() const { return cause_.track_id; }
   // Counted time of the current stand.
   double stood_s() const { return stood_s_; }
 
@@ -110,9 +133,8 @@ class StallWatch {
   size_t next_ = 0;       // first stop sample after the last observation
   double last_t_s_ = -1;  // the last observation; < 0 before the first
   double stood_s_ = 0.0;
-  std::map<std::pair<StopReason, int>, double> by_cause_;  // (reason, track)
-  StopReason reason_ = StopReason::kNone;
-  int track_id_ = -1;
+  ReasonTally stand_;  // the counted time of the current stand
+  StandingTime cause_;
 };
 
 }  // namespace adse::analysis
