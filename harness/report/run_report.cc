@@ -287,12 +287,12 @@ std::string FormatSummary(const RunReport& r) {
         "is a lower bound\n";
   } else {
     out += fmt::format("ended       {} ({})\n", r.termination_reason, r.status);
-  }
-  if (r.censored && r.status != runfile::kRunStalled) {
-    out += fmt::format(
-        "censored    early stop at {} s: the metrics below are measured up "
-        "to it; nav_time_s is a lower bound\n",
-        metric("nav_time_s"));
+    if (r.censored) {
+      out += fmt::format(
+          "censored    early stop at {} s: the metrics below are measured up "
+          "to it; nav_time_s is a lower bound\n",
+          metric("nav_time_s"));
+    }
   }
   for (const char* name :
        {"completed", "nav_time_s", "ctrl_rate_hz", "hardware_cost",
