@@ -156,14 +156,13 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
     if (options.obey_signals && !route_signals.empty()) {
       algorithms::SignalObservation seen;
       seen.stamp_s = world.time_s();
-      const std::string letters = world.RouteSignalStates();
-      for (size_t i = 0; i < route_signals.size(); ++i) {
-        const double ahead_m = route_signals[i].stop_line_s_m - s_progress;
-        if (ahead_m <= 0.0) continue;
-        seen.state = SignalStateOfLetter(i < letters.size() ? letters[i] : 'o');
-        seen.stop_line_distance_m = ahead_m;
+      const int i = NextSignalAhead(route_signals, s_progress);
+      if (i >= 0) {
+        const std::string letters = world.RouteSignalStates();
+        seen.state = SignalStateOfLetter(
+            i < static_cast<int>(letters.size()) ? letters[i] : 'o');
+        seen.stop_line_distance_m = route_signals[i].stop_line_s_m - s_progress;
         seen.tls_id = route_signals[i].tls_id;
-        break;
       }
       signals.Observe(seen);
       // The planner needs only the path's extent: from here to the goal.

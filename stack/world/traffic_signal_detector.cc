@@ -67,17 +67,15 @@ void TrafficSignalDetector::Look(const Eigen::Vector2d& rear_axle,
   SignalReport report;
   report.stamp_s = t;
   report.publish_s = t + params_.latency_s;
-  // The next signal whose stop line the rear axle has not passed: a car
-  // stopped with its nose over the line still sees it.
-  for (size_t i = 0; i < signals_.size(); ++i) {
+  const int i = NextSignalAhead(signals_, ego_s_m_);
+  if (i >= 0) {
     const double ahead_m = signals_[i].stop_line_s_m - ego_s_m_;
-    if (ahead_m <= 0.0) continue;
     if (ahead_m <= params_.range_m) {
-      report.state = SignalStateOfLetter(i < letters.size() ? letters[i] : 'o');
+      report.state = SignalStateOfLetter(
+          i < static_cast<int>(letters.size()) ? letters[i] : 'o');
       report.stop_line_distance_m = ahead_m;
       report.tls_id = signals_[i].tls_id;
     }
-    break;
   }
   pending_.push_back(std::move(report));
 }

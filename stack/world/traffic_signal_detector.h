@@ -40,6 +40,18 @@ struct SignalReport {
 // and s (stop, then go) unknown.
 SignalState SignalStateOfLetter(char letter);
 
+// The next signal along the route whose stop line the rear axle, at route
+// s = `rear_axle_s_m`, has not passed (a car stopped with its nose over
+// the line still sees it): its index in `signals` (in route order, each
+// with a stop_line_s_m), or -1 when none is left.
+template <typename Signal>
+int NextSignalAhead(const std::vector<Signal>& signals, double rear_axle_s_m) {
+  for (size_t i = 0; i < signals.size(); ++i) {
+    if (signals[i].stop_line_s_m > rear_axle_s_m) return static_cast<int>(i);
+  }
+  return -1;
+}
+
 class TrafficSignalDetector {
  public:
   // `route`: the road path the signals' stop lines lie on (World's
