@@ -162,21 +162,37 @@ void DrawStandMarker(cv::Mat* img, cv::Point2d at, Rgb colour, const Style& s) {
              kShift);
 }
 
-// Labels a marker above and right of it; below it where that would run
-// into the header (rows above map_top_px).
+// Labels a marker: above and right of it, else (header above, image edge
+// right, another label there) below it or on its left; a label that fits
+// nowhere free is left out. `taken` holds the labels placed so far.
 void DrawMarkerLabel(cv::Mat* img, cv::Point2d at, const std::string& text,
-                     const Style& s, const cv::Scalar& colour, int map_top_px) {
+                     const Style& s, const cv::Scalar& colour, int map_top_px,
+                     std::vector<cv::Rect>* taken) {
   if (!Finite(at) || at.x < -1e6 || at.x > 1e6 || at.y < -1e6 || at.y > 1e6) {
     return;
   }
   int baseline = 0;
-  const int text_h = TextSize(text, s, &baseline).height;
-  int y = static_cast<int>(at.y) - s.Px(10);
-  if (y - text_h - s.Px(3) < map_top_px) {
-    y = static_cast<int>(at.y) + s.Px(12) + text_h;
+  const cv::Size size = TextSize(text, s, &baseline);
+  const int pad = s.Px(3);
+  const int x = static_cast<int>(at.x), y = static_cast<int>(at.y);
+  const int right = x + s.Px(12), left = x - s.Px(12) - size.width;
+  const int above = y - s.Px(10), below = y + s.Px(12) + size.height;
+  for (const auto& [lx, ly] :
+       {std::pair{right, above}, std::pair{right, below},
+        std::pair{left, above}, std::pair{left, below}}) {
+    const cv::Rect box(lx - pad, ly - size.height - pad, size.width + 2 * pad,
+                       size.height + baseline + 2 * pad);
+    if (box.y < map_top_px || box.x < 0 || box.br().x > img->cols ||
+        box.br().y > img->rows) {
+      continue;
+    }
+    bool free = true;
+    for (const cv::Rect& other : *taken) free = free && (box & other).empty();
+    if (!free) continue;
+    DrawText(img, text, lx, ly, Align::kLeft, s, colour, /*boxed=*/true);
+    taken->push_back(box);
+    return;
   }
-  DrawText(img, text, static_cast<int>(at.x) + s.Px(12), y, Align::kLeft, s,
-           colour, /*boxed=*/true);
 }
 
 // One legend entry of the header: a short sample of the drawing, then its
@@ -294,18 +310,22 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   for (const analysis::Stand& stand : stands) {
     DrawStandMarker(&img, px(stand.x_m, stand.y_m), StandRgb(stand), s);
   }
+  // Start and goal labelled first, so they get the first choice of place.
+  std::vector<cv::Rect> labels;
+  DrawGoalMarker(&img, goal, s);
+  DrawStartMarker(&img, start, s);
+  DrawMarkerLabel(&img, goal, "goal", s, Bgr(kGoalRgb), map.map_top_px,
+                  &labels);
+  DrawMarkerLabel(&img, start, "start", s, Bgr(kStartRgb), map.map_top_px,
+                  &labels);
   for (size_t k = 0; k < std::min(kLabelledStands, by_length.size()); ++k) {
     const analysis::Stand& stand = stands[by_length[k]];
     const std::string what =
         stand.known ? StopReasonToString(stand.cause.reason) : "stood";
     DrawMarkerLabel(&img, px(stand.x_m, stand.y_m),
                     fmt::format("{} {:.0f} s", what, stand.standing_s), s,
-                    Bgr(StandRgb(stand)), map.map_top_px);
+                    Bgr(StandRgb(stand)), map.map_top_px, &labels);
   }
-  DrawGoalMarker(&img, goal, s);
-  DrawStartMarker(&img, start, s);
-  DrawMarkerLabel(&img, goal, "goal", s, Bgr(kGoalRgb), map.map_top_px);
-  DrawMarkerLabel(&img, start, "start", s, Bgr(kStartRgb), map.map_top_px);
 
   // Scale bar, bottom centre.
   const double map_width_m = map.width_px / map.px_per_m;
