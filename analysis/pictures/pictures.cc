@@ -87,7 +87,9 @@ Result<WorldToImage> MappingImpl(const runfile::RunData& run,
   WorldToImage map;
   map.width_px = o.width_px;
   map.px_per_m = o.width_px / extent_x;
-  map.map_top_px = 2 * line_px + style.Px(8);
+  // The title, then the legend: a parking run's has a second line for the
+  // lot's entries.
+  map.map_top_px = (run.parking.present ? 3 : 2) * line_px + style.Px(8);
   const int map_height_px =
       std::max(1, static_cast<int>(std::lround(extent_y * map.px_per_m)));
   map.height_px = map.map_top_px + map_height_px;
@@ -195,18 +197,38 @@ void DrawMarkerLabel(cv::Mat* img, cv::Point2d at, const std::string& text,
   }
 }
 
-// One legend entry of the header: a short sample of the drawing, then its
-// name. Returns the x after it.
-int LegendEntry(cv::Mat* img, int x, int y, const std::string& name,
-                const Style& s,
-                const std::function<void(cv::Point2d, cv::Point2d)>& draw) {
-  int baseline = 0;
-  const int mid = y - TextSize("A", s, &baseline).height / 2;
-  draw(cv::Point2d(x, mid), cv::Point2d(x + s.Px(26), mid));
-  x += s.Px(32);
-  x += DrawText(img, name, x, y, Align::kLeft, s, kBlack, false);
-  return x + s.Px(18);
-}
+// The header's legend: entries left to right, each a short sample of the
+// drawing and its name, on the next line where one would leave the picture.
+class HeaderLegend {
+ public:
+  HeaderLegend(cv::Mat* img, int y, int line_px, const Style& s)
+      : img_(img), x_(s.Px(8)), y_(y), line_px_(line_px), s_(s) {}
+  void Add(const std::string& name,
+           const std::function<void(cv::Point2d, cv::Point2d)>& draw) {
+    int baseline = 0;
+    const int width = s_.Px(32) + TextSize(Ascii(name), s_, &baseline).width;
+    if (x_ > s_.Px(8) && x_ + width > img_->cols - s_.Px(8)) {
+      x_ = s_.Px(8);
+      y_ += line_px_;
+    }
+    const int mid = y_ - TextSize("A", s_, &baseline).height / 2;
+    draw(cv::Point2d(x_, mid), cv::Point2d(x_ + s_.Px(26), mid));
+    x_ += s_.Px(32);
+    x_ += DrawText(img_, name, x_, y_, Align::kLeft, s_, kBlack, false);
+    x_ += s_.Px(18);
+  }
+  // Starts the next line.
+  void Break() {
+    x_ = s_.Px(8);
+    y_ += line_px_;
+  }
+
+ private:
+  cv::Mat* img_;
+  int x_, y_;
+  const int line_px_;
+  const Style& s_;
+};
 
 Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
                                       const TrajectoryImageOptions& o) {
@@ -374,53 +396,39 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   // Header: title, then the legend; a rule above the map.
   cv::rectangle(img, cv::Rect(0, 0, map.width_px, map.map_top_px),
                 Bgr(kBackgroundRgb), cv::FILLED);
-  const int line_px = (map.map_top_px - s.Px(8)) / 2;
+  const int header_lines = run.parking.present ? 3 : 2;
+  const int line_px = (map.map_top_px - s.Px(8)) / header_lines;
   DrawText(&img, Title(run), s.Px(8), line_px - baseline, Align::kLeft, s,
            kBlack, false);
-  const int legend_y = 2 * line_px - baseline;
-  int x = s.Px(8);
+  HeaderLegend legend(&img, 2 * line_px - baseline, line_px, s);
   auto line_sample = [&](Rgb c, int thickness) {
     return [&img, c, thickness](cv::Point2d a, cv::Point2d b) {
       DrawSegment(&img, a, b, Bgr(c), thickness);
     };
   };
-  if (!lanes.empty())
-    x = LegendEntry(&img, x, legend_y, "lane", s,
-                    line_sample(kLaneCentreRgb, s.Px(2)));
-  x = LegendEntry(&img, x, legend_y, "ideal path", s,
-                  line_sample(kIdealPathRgb, s.Px(2)));
-  x = LegendEntry(&img, x, legend_y, "trajectory", s,
-                  line_sample(kTrajectoryRgb, s.Px(5)));
-  if (any_vehicle) {
-    x = LegendEntry(&img, x, legend_y, "other vehicles", s,
-                    line_sample(kVehiclePathRgb, s.Px(2)));
-  }
-  x = LegendEntry(&img, x, legend_y, "start", s,
-                  [&](cv::Point2d a, cv::Point2d b) {
-                    DrawStartMarker(&img, 0.5 * (a + b), s);
-                  });
-  x = LegendEntry(&img, x, legend_y, "goal", s,
-                  [&](cv::Point2d a, cv::Point2d b) {
-                    DrawGoalMarker(&img, 0.5 * (a + b), s);
-                  });
+  if (!lanes.empty()) legend.Add("lane", line_sample(kLaneCentreRgb, s.Px(2)));
+  legend.Add("ideal path", line_sample(kIdealPathRgb, s.Px(2)));
+  legend.Add("trajectory", line_sample(kTrajectoryRgb, s.Px(5)));
+  if (any_vehicle)
+    legend.Add("other vehicles", line_sample(kVehiclePathRgb, s.Px(2)));
+  legend.Add("start", [&](cv::Point2d a, cv::Point2d b) {
+    DrawStartMarker(&img, 0.5 * (a + b), s);
+  });
+  legend.Add("goal", [&](cv::Point2d a, cv::Point2d b) {
+    DrawGoalMarker(&img, 0.5 * (a + b), s);
+  });
   if (!stands.empty()) {
-    x = LegendEntry(&img, x, legend_y, "stood >= 3 s", s,
-                    [&](cv::Point2d a, cv::Point2d b) {
-                      DrawStandMarker(&img, 0.5 * (a + b),
-                                      StandRgb(stands.front()), s);
-                    });
+    legend.Add("stood >= 3 s", [&](cv::Point2d a, cv::Point2d b) {
+      DrawStandMarker(&img, 0.5 * (a + b), StandRgb(stands.front()), s);
+    });
   }
   if (run.parking.present) {
-    x = LegendEntry(&img, x, legend_y, "target slot", s,
-                    line_sample(kTargetSlotRgb, s.Px(3)));
-    x = LegendEntry(&img, x, legend_y, "parked car / wall", s,
-                    line_sample(kObstacleRgb, s.Px(5)));
-    x = LegendEntry(&img, x, legend_y, "plan fwd", s,
-                    line_sample(kPlannedForwardRgb, s.Px(2)));
-    x = LegendEntry(&img, x, legend_y, "plan rev", s,
-                    line_sample(kPlannedReverseRgb, s.Px(2)));
-    LegendEntry(&img, x, legend_y, "car at end", s,
-                line_sample(kEgoBodyRgb, s.Px(2)));
+    legend.Break();
+    legend.Add("target slot", line_sample(kTargetSlotRgb, s.Px(3)));
+    legend.Add("parked car / wall", line_sample(kObstacleRgb, s.Px(5)));
+    legend.Add("plan fwd", line_sample(kPlannedForwardRgb, s.Px(2)));
+    legend.Add("plan rev", line_sample(kPlannedReverseRgb, s.Px(2)));
+    legend.Add("car at end", line_sample(kEgoBodyRgb, s.Px(2)));
   }
   cv::line(img, cv::Point(0, map.map_top_px - 1),
            cv::Point(map.width_px - 1, map.map_top_px - 1), Bgr(kLaneCentreRgb),

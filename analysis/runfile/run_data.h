@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "stack/algorithms/signal_state.h"
 #include "stack/algorithms/stop_reason.h"
 #include "stack/runtime/trace.h"
 
@@ -51,6 +52,16 @@ struct StopSample {
   int32_t track_id;          // kObstacle: the track; else -1
   double obstacle_gap_m;     // kObstacle: front bumper to its near edge
   int32_t static_structure;  // kObstacle: 1 when the map has structure there
+};
+
+// What the car's signal detector reported, as published on
+// /perception/traffic_signal (only on routes with signals).
+struct SignalSample {
+  double t_s;      // publish time: the look plus the detector's latency
+  double stamp_s;  // when the detector looked
+  SignalState state;
+  double stop_line_distance_m;  // along the route to it; -1 none in range
+  std::string tls_id;           // the signal; empty when none is in range
 };
 
 struct CollisionEvent {
@@ -179,6 +190,8 @@ struct RunData {
   stack::Trace trace;
   std::vector<ControlSample> controls;
   std::vector<StopSample> stop_reasons;  // may be empty (older files)
+  // May be empty (no signals on the route, or older files).
+  std::vector<SignalSample> signals;
 
   // Metrics by name (see scenarios/README.md); booleans as 0/1.
   std::map<std::string, double> metrics;

@@ -3,6 +3,7 @@
 #include <cstring>
 #include <exception>
 #include <functional>
+#include <iterator>
 #include <new>
 
 #include "analysis/runfile/hdf5_util_impl.h"
@@ -251,6 +252,23 @@ const std::vector<Column<ControlSample>>& ControlColumns() {
 
 // The planner's stop reason as an HDF5 enum whose codes are the
 // vocabulary's (stack/algorithms/stop_reason.h), so readers see names.
+// A one-byte enum column whose codes and names come from the enum's own
+// vocabulary, so that h5py shows the names.
+template <typename Row, typename E>
+Column<Row> Enum8(const char* name, E Row::*member,
+                  std::vector<std::pair<std::string, int8_t>> codes) {
+  return {FieldDesc{name, FieldType::kEnum8, 0, std::move(codes)},
+          [member](const Row& row, char* out) {
+            const int8_t code = static_cast<int8_t>(row.*member);
+            std::memcpy(out, &code, 1);
+          },
+          [member](const char* in, Row* row) {
+            int8_t code = 0;
+            std::memcpy(&code, in, 1);
+            row->*member = static_cast<E>(code);
+          }};
+}
+
 Column<StopSample> StopReasonColumn() {
   std::vector<std::pair<std::string, int8_t>> codes;
   for (const std::string& name : StopReasonNames()) {
@@ -258,16 +276,28 @@ Column<StopSample> StopReasonColumn() {
     StringToStopReason(name, &reason);
     codes.emplace_back(name, static_cast<int8_t>(reason));
   }
-  return {FieldDesc{"reason", FieldType::kEnum8, 0, std::move(codes)},
-          [](const StopSample& row, char* out) {
-            const int8_t code = static_cast<int8_t>(row.reason);
-            std::memcpy(out, &code, 1);
-          },
-          [](const char* in, StopSample* row) {
-            int8_t code = 0;
-            std::memcpy(&code, in, 1);
-            row->reason = static_cast<StopReason>(code);
-          }};
+  return Enum8("reason", &StopSample::reason, std::move(codes));
+}
+
+// Every signal state, from its lowest code to its highest.
+constexpr SignalState kSignalStates[] = {
+    SignalState::kUnknown, SignalState::kRed, SignalState::kYellow,
+    SignalState::kGreen};
+
+const std::vector<Column<SignalSample>>& SignalColumns() {
+  static const auto* columns = [] {
+    std::vector<std::pair<std::string, int8_t>> codes;
+    for (SignalState state : kSignalStates) {
+      codes.emplace_back(SignalStateToString(state),
+                         static_cast<int8_t>(state));
+    }
+    return new std::vector<Column<SignalSample>>{
+        F64("t_s", &SignalSample::t_s), F64("stamp_s", &SignalSample::stamp_s),
+        Enum8("state", &SignalSample::state, std::move(codes)),
+        F64("stop_line_distance_m", &SignalSample::stop_line_distance_m),
+        Str("tls_id", kNameBytes, &SignalSample::tls_id)};
+  }();
+  return *columns;
 }
 
 const std::vector<Column<StopSample>>& StopReasonColumns() {
@@ -477,6 +507,12 @@ Status WriteContents(hid_t file, const RunData& run) {
                                     run.stop_reasons, StopReasonColumns()));
   }
   {
+    Result<Handle> group = CreateGroup(file, "perception");
+    if (!group.ok()) return group.status();
+    ADSE_RETURN_IF_ERROR(WriteTable(group->get(), "traffic_signals",
+                                    run.signals, SignalColumns()));
+  }
+  {
     Result<Handle> group = CreateGroup(file, "metrics");
     if (!group.ok()) return group.status();
     for (const auto& [name, value] : run.metrics) {
@@ -507,6 +543,15 @@ Status Validate(const RunData& run) {
       return Status::InvalidArgument(
           "stop reason " + std::to_string(i) + " has unknown code " +
           std::to_string(static_cast<int>(run.stop_reasons[i].reason)));
+    }
+  }
+  for (size_t i = 0; i < run.signals.size(); ++i) {
+    const int code = static_cast<int>(run.signals[i].state);
+    if (code < static_cast<int>(kSignalStates[0]) ||
+        code > static_cast<int>(std::end(kSignalStates)[-1])) {
+      return Status::InvalidArgument(
+          "traffic signal report " + std::to_string(i) +
+          " has unknown state code " + std::to_string(code));
     }
   }
   const auto& events = run.trace.topic_events;
@@ -741,6 +786,15 @@ Status ReadContents(hid_t file, RunData* run) {
     ADSE_RETURN_IF_ERROR(
         Assign(ReadTable(group->get(), "stop_reasons", StopReasonColumns()),
                &run->stop_reasons));
+  }
+  // ... nor, before /perception/traffic_signals, the detector's reports.
+  if (internal::GetObjectKind(file, "/perception/traffic_signals") !=
+      internal::ObjectKind::kMissing) {
+    Result<Handle> group = OpenGroup(file, "/perception");
+    if (!group.ok()) return group.status();
+    ADSE_RETURN_IF_ERROR(
+        Assign(ReadTable(group->get(), "traffic_signals", SignalColumns()),
+               &run->signals));
   }
   return Status::Ok();
 }

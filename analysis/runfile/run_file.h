@@ -21,9 +21,10 @@ inline constexpr int kSchemaVersion = 1;
 
 // Widths of fixed-length strings inside compound datasets (bytes, UTF-8,
 // NUL-padded). Longer values are cut at a character boundary on write.
-inline constexpr size_t kIdBytes = 64;     // vehicle ids, collision other_id
-inline constexpr size_t kNameBytes = 128;  // node, callback and topic names
-inline constexpr size_t kKindBytes = 32;   // callback kind
+inline constexpr size_t kIdBytes = 64;  // vehicle ids, collision other_id
+inline constexpr size_t kNameBytes =
+    128;  // node, callback, topic and signal names
+inline constexpr size_t kKindBytes = 32;  // callback kind
 
 // Writes `run` to `<path>.tmp.<host>.<pid>`, flushes it to disk and
 // renames it over `path` (creating parent folders), so readers see either

@@ -426,7 +426,8 @@ int main(int argc, char** argv) {
       "fidelity",
       "Hold the virtual platform against real execution: run each point on "
       "the virtual platform and --runs times on the real-time one (the "
-      "stack's threads on as many host CPUs as the point has cores), and "
+      "stack in a process of its own on as many host CPUs as the point has "
+      "cores), and "
       "compare nav time, control rate, drops, the sensing-to-control chain "
       "and each callback's p50/p99 latency; writes fidelity.txt, "
       "fidelity.json and a picture per point");

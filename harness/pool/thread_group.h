@@ -1,6 +1,6 @@
-// A cgroup that holds some threads of this process: the real-time stack's
-// executor threads, confined to a cpuset of N host cores and, optionally,
-// to a CPU quota that stands for a slower clock. The rest of the process
+// A cgroup for some threads of this process or of its children: the
+// real-time stack's process, confined to a cpuset of N host cores and,
+// optionally, to a CPU quota that stands for a slower clock. This process
 // (the world) stays in its own group.
 //
 // v1: a group <own>/<name>-<pid> in the cpuset hierarchy (and the cpu

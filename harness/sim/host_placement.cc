@@ -30,6 +30,8 @@ Result<std::vector<int>> ThreadCpus() {
   return cpus;
 }
 
+}  // namespace
+
 Status SetThreadCpus(const std::vector<int>& cpus) {
   cpu_set_t set;
   CPU_ZERO(&set);
@@ -41,8 +43,6 @@ Status SetThreadCpus(const std::vector<int>& cpus) {
   }
   return Status::Ok();
 }
-
-}  // namespace
 
 Result<HostPlacement> PlaceOnCpus(int cores, const std::vector<int>& usable) {
   const int n = static_cast<int>(usable.size());

@@ -31,6 +31,9 @@ Result<HostPlacement> PlaceOnCpus(int cores, const std::vector<int>& usable);
 // hypervisor's figure). Unavailable naming the file when none is found.
 Result<double> HostClockGhz(const std::string& cpuinfo = "/proc/cpuinfo");
 
+// Pins the calling thread to `cpus` (as `taskset`).
+Status SetThreadCpus(const std::vector<int>& cpus);
+
 // Pins the calling thread to `cpus` and restores its previous affinity
 // when destroyed.
 class AffinityGuard {

@@ -45,7 +45,7 @@ Result<std::unique_ptr<RealTimePlatform>> RealTimePlatform::Prepare(
       pool::ThreadGroup::Create(group);
   if (!made.ok()) {
     return made.status().WithContext(
-        "platform.kind: cgroup confines the stack's threads in a cgroup");
+        "platform.kind: cgroup confines the stack's process in a cgroup");
   }
   rt->group_ = std::move(made).value();
   const pool::ThreadGroup* stack_group = rt->group_.get();

@@ -1,5 +1,5 @@
 // What a run on the real-time platform (platform.kind: cgroup) holds while
-// it runs: the stack's threads in a cgroup of N host CPUs (and a CPU quota
+// it runs: a cgroup of N host CPUs for the stack's process (and a CPU quota
 // when a quota stands for the clock), the world's thread on the other CPUs,
 // and handlers that turn Ctrl-C and SIGTERM into an orderly end, so that the
 // group is removed on every exit path but SIGKILL (after which the next

@@ -18,8 +18,10 @@
 #include "harness/profile/profile.h"
 #include "harness/sim/calibration.h"
 #include "harness/sim/early_stop.h"
+#include "harness/sim/host_placement.h"
 #include "harness/sim/realtime_platform.h"
 #include "harness/sim/run_key.h"
+#include "harness/sim/stack_process.h"
 #include "harness/spec/spec_parser.h"
 #include "harness/spec/types.h"
 #include "stack/algorithms/command_gate.h"
@@ -238,6 +240,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   std::map<std::string, std::string> platform_notes;
   // Declared before the executor: its threads end before the group goes.
   std::unique_ptr<RealTimePlatform> realtime;
+  StackProcess* stack_process = nullptr;  // the executor, in real time
   Result<std::unique_ptr<stack::Executor>> made =
       Status::Internal("no executor made");
   if (platform.kind == spec::PlatformKind::kCgroup) {
@@ -258,7 +261,23 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     if (!prepared.ok()) return prepared.status();
     realtime = std::move(prepared).value();
     platform_notes = realtime->notes();
-    made = stack::CreateRealTimeExecutor(&graph, rt);
+    // The stack runs in a process of its own, which joins the stack's group
+    // before its executor starts; the world stays here.
+    Result<std::unique_ptr<StackProcess>> started = StackProcess::Start(
+        &graph,
+        [rt](
+            const stack::Graph* g) -> Result<std::unique_ptr<stack::Executor>> {
+          if (rt.enter_thread) ADSE_RETURN_IF_ERROR(rt.enter_thread());
+          if (!rt.host_cpus.empty())
+            ADSE_RETURN_IF_ERROR(SetThreadCpus(rt.host_cpus));
+          return stack::CreateRealTimeExecutor(g, rt);
+        });
+    if (started.ok()) {
+      stack_process = started->get();
+      made = std::unique_ptr<stack::Executor>(std::move(started).value());
+    } else {
+      made = started.status();
+    }
   } else {
     made = stack::CreateVirtualExecutor(&graph, vp);
   }
@@ -346,6 +365,9 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
         signal_detector->Look({ego.x_m, ego.y_m}, w.RouteSignalStates());
       }
       for (world::SignalReport& r : signal_detector->TakeDue(t + dt)) {
+        const double publish_s = std::max(r.publish_s, t);
+        run.signals.push_back(
+            {publish_s, r.stamp_s, r.state, r.stop_line_distance_m, r.tls_id});
         stack::TrafficSignalMsg msg;
         msg.header.stamp_s = r.stamp_s;
         msg.state = r.state;
@@ -354,7 +376,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
         executor.PublishExternal(
             topics.traffic_signal,
             std::make_shared<const stack::TrafficSignalMsg>(std::move(msg)),
-            r.stamp_s, std::max(r.publish_s, t));
+            r.stamp_s, publish_s);
       }
     }
     const auto t_exec = Clock::now();
@@ -476,6 +498,11 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
          c.topic, c.period_s});
   }
   executor.Stop();
+  if (stack_process != nullptr) {
+    if (!stack_process->stop_status().ok())
+      return stack_process->stop_status().WithContext("stopping the stack");
+    run.platform["stack_process"] = stack_process->Describe();
+  }
   run.trace = executor.trace();
   // executor_s so far is the wall time inside AdvanceTo: the callbacks plus
   // the executor's own bookkeeping. Only the measured model records the

@@ -104,6 +104,13 @@ class Graph {
                       }});
   }
 
+  // Gives sink `index` another function, e.g. one that carries its
+  // messages to the process where the first one runs.
+  void RebindSink(size_t index,
+                  std::function<void(const MessagePtr&, double t_s)> fn) {
+    sinks_.at(index).fn = std::move(fn);
+  }
+
   const std::vector<TopicSpec>& topics() const { return topics_; }
   const std::vector<NodeSpec>& nodes() const { return nodes_; }
   const std::vector<CallbackSpec>& callbacks() const { return callbacks_; }

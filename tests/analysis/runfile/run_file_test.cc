@@ -206,6 +206,22 @@ std::string Diff(const RunData& a, const RunData& b) {
       integer(at + "static_structure", x.static_structure, y.static_structure);
     }
   }
+  if (size("signals", a.signals.size(), b.signals.size())) {
+    for (size_t i = 0; i < a.signals.size(); ++i) {
+      const SignalSample &x = a.signals[i], &y = b.signals[i];
+      const std::string at = "signals[" + std::to_string(i) + "].";
+      num(at + "t_s", x.t_s, y.t_s);
+      num(at + "stamp_s", x.stamp_s, y.stamp_s);
+      if (x.state != y.state) {
+        out << at << "state: " << SignalStateToString(x.state) << " vs "
+            << SignalStateToString(y.state) << "\n";
+      }
+      num(at + "stop_line_distance_m", x.stop_line_distance_m,
+          y.stop_line_distance_m);
+      if (x.tls_id != y.tls_id)
+        out << at << "tls_id: " << x.tls_id << " vs " << y.tls_id << "\n";
+    }
+  }
   return out.str();
 }
 
@@ -250,6 +266,14 @@ RunData MakeFullRun(size_t events = 5000) {
         {0.1 * i, 0.1 * i - 0.07, reason, obstacle ? 4.5 - i : 0.25 * i,
          obstacle ? static_cast<int32_t>(100 + i) : -1, obstacle ? 7.25 : -1.0,
          obstacle && i > 5 ? 1 : 0});
+  }
+  // Every signal state; none in range at the end.
+  const SignalState states[] = {SignalState::kRed, SignalState::kYellow,
+                                SignalState::kGreen, SignalState::kUnknown};
+  for (int i = 0; i < 4; ++i) {
+    run.signals.push_back(
+        {0.5 + 0.2 * i, 0.4 + 0.2 * i, states[i], i == 3 ? -1.0 : 40.0 - 5 * i,
+         i == 3 ? "" : "cluster_25578772_ü_" + std::to_string(i)});
   }
   run.ego[3].yaw_rad = std::numeric_limits<double>::quiet_NaN();
   run.ego[4].v_mps = std::numeric_limits<double>::infinity();
@@ -736,6 +760,24 @@ TEST_F(RunFileTest, FileWithoutLanesReadsAsNoLanes) {
                      [](RunData* run) { run->lanes.clear(); });
 }
 
+// Member `member` of the rows of `path` is an HDF5 enum with these names
+// and codes.
+void ExpectEnumCodes(hid_t file, const char* path, unsigned member,
+                     const std::vector<std::pair<std::string, int8_t>>& codes) {
+  const hid_t dataset = H5Dopen2(file, path, H5P_DEFAULT);
+  ASSERT_GE(dataset, 0) << path;
+  const hid_t type = H5Dget_type(dataset);
+  const hid_t values = H5Tget_member_type(type, member);
+  for (const auto& [name, code] : codes) {
+    int8_t value = -1;
+    EXPECT_GE(H5Tenum_valueof(values, name.c_str(), &value), 0) << name;
+    EXPECT_EQ(value, code) << name;
+  }
+  H5Tclose(values);
+  H5Tclose(type);
+  H5Dclose(dataset);
+}
+
 TEST_F(RunFileTest, StopReasonsAreAnEnumOfTheVocabulary) {
   const std::string path = Path("run.h5");
   const RunData run = MakeFullRun(10);
@@ -751,26 +793,51 @@ TEST_F(RunFileTest, StopReasonsAreAnEnumOfTheVocabulary) {
   ASSERT_EQ(members.size(), 7u);
   EXPECT_EQ(members[2].type_class, H5T_ENUM);
   // The enum's names are the vocabulary's, with its codes.
-  const hid_t dataset =
-      H5Dopen2(raw.file(), "/planning/stop_reasons", H5P_DEFAULT);
-  ASSERT_GE(dataset, 0);
-  const hid_t type = H5Dget_type(dataset);
-  const hid_t reason = H5Tget_member_type(type, 2);
+  std::vector<std::pair<std::string, int8_t>> codes;
   for (const std::string& name : StopReasonNames()) {
     StopReason expected = StopReason::kNone;
     ASSERT_TRUE(StringToStopReason(name, &expected));
-    int8_t code = -1;
-    ASSERT_GE(H5Tenum_valueof(reason, name.c_str(), &code), 0) << name;
-    EXPECT_EQ(code, static_cast<int8_t>(expected)) << name;
+    codes.emplace_back(name, static_cast<int8_t>(expected));
   }
-  H5Tclose(reason);
-  H5Tclose(type);
-  H5Dclose(dataset);
+  ExpectEnumCodes(raw.file(), "/planning/stop_reasons", 2, codes);
 }
 
 TEST_F(RunFileTest, FileWithoutStopReasonsReadsAsNone) {
   ExpectReadsWithout(Path("run.h5"), "/planning",
                      [](RunData* run) { run->stop_reasons.clear(); });
+}
+
+TEST_F(RunFileTest, SignalReportsAreStoredWithTheirStatesNamed) {
+  const std::string path = Path("run.h5");
+  const RunData run = MakeFullRun(10);
+  ASSERT_TRUE(WriteRunFile(path, run).ok());
+  RawHdf5 raw(path);
+  ASSERT_GE(raw.file(), 0);
+  const std::vector<Member> members =
+      CompoundMembers(raw.file(), "/perception/traffic_signals");
+  EXPECT_EQ(Names(members),
+            (std::vector<std::string>{"t_s", "stamp_s", "state",
+                                      "stop_line_distance_m", "tls_id"}));
+  ASSERT_EQ(members.size(), 5u);
+  EXPECT_EQ(members[2].type_class, H5T_ENUM);
+  ExpectEnumCodes(raw.file(), "/perception/traffic_signals", 2,
+                  {{"unknown", 0}, {"red", 1}, {"yellow", 2}, {"green", 3}});
+}
+
+TEST_F(RunFileTest, FileWithoutSignalReportsReadsAsNone) {
+  ExpectReadsWithout(Path("run.h5"), "/perception",
+                     [](RunData* run) { run->signals.clear(); });
+}
+
+TEST_F(RunFileTest, ASignalStateOutsideTheVocabularyIsRefused) {
+  RunData run = MakeFullRun(10);
+  run.signals[2].state = static_cast<SignalState>(9);
+  const Status written = WriteRunFile(Path("run.h5"), run);
+  EXPECT_EQ(written.code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(written.message().find(
+                "traffic signal report 2 has unknown state code 9"),
+            std::string::npos)
+      << written.message();
 }
 
 TEST_F(RunFileTest, AStopReasonCodeOutsideTheVocabularyIsRefused) {

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -109,10 +110,30 @@ class RealTimeCliTest : public ::testing::Test {
     return false;
   }
 
-  // Signals the child once its group holds threads, and reaps it.
+  // Whether process `pid` is gone (or a zombie no one will reap, as an
+  // orphan may be in a container without an init), within 5 s.
+  static bool Ends(pid_t pid) {
+    const auto until = Clock::now() + std::chrono::seconds(5);
+    while (Clock::now() < until) {
+      const std::string stat =
+          ReadFile("/proc/" + std::to_string(pid) + "/stat");
+      const size_t paren = stat.rfind(')');
+      if (stat.empty() ||
+          (paren != std::string::npos && stat.compare(paren, 4, ") Z ") == 0))
+        return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  }
+
+  // Signals the child once its group holds threads, and reaps it; keeps the
+  // stack's processes (those in the group) in stack_pids_.
   int SignalAndReap(pid_t pid, int sig) {
     EXPECT_TRUE(WaitForGroup(pid)) << ReadFile(dir_ / "log.txt");
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    stack_pids_.clear();
+    std::ifstream procs(GroupOf(pid) + "/cgroup.procs");
+    for (pid_t p = 0; procs >> p;) stack_pids_.push_back(p);
     ::kill(pid, sig);
     int status = 0;
     ::waitpid(pid, &status, 0);
@@ -120,6 +141,7 @@ class RealTimeCliTest : public ::testing::Test {
   }
 
   fs::path dir_;
+  std::vector<pid_t> stack_pids_;
 };
 
 TEST_F(RealTimeCliTest, CtrlCAndSigtermEndTheRunAndRemoveTheGroup) {
@@ -136,6 +158,10 @@ TEST_F(RealTimeCliTest, CtrlCAndSigtermEndTheRunAndRemoveTheGroup) {
         << log;
     EXPECT_FALSE(fs::exists(GroupOf(pid))) << "group left behind";
     EXPECT_FALSE(fs::exists(dir_ / "run.h5")) << "a partial run file";
+    // The stack ran in a process of its own, which ended with the run.
+    ASSERT_EQ(stack_pids_.size(), 1u);
+    EXPECT_NE(stack_pids_[0], pid);
+    EXPECT_TRUE(Ends(stack_pids_[0]));
   }
 }
 
@@ -144,6 +170,10 @@ TEST_F(RealTimeCliTest, AfterASigkillTheNextRunRemovesTheStaleGroup) {
   ASSERT_GT(pid, 0);
   const int status = SignalAndReap(pid, SIGKILL);
   ASSERT_TRUE(WIFSIGNALED(status));
+  // The stack's process dies with the world's (PR_SET_PDEATHSIG) ...
+  ASSERT_EQ(stack_pids_.size(), 1u);
+  EXPECT_TRUE(Ends(stack_pids_[0])) << "an orphaned stack";
+  // ... but its group stays.
   ASSERT_TRUE(fs::exists(GroupOf(pid))) << "nothing could remove it";
   // What the next run does first.
   adse::pool::ThreadGroupOptions options;

@@ -89,6 +89,7 @@ class GroupWatcher {
   }
   size_t max_tasks = 0;
   std::string cpus, quota_us;
+  std::set<pid_t> processes;  // cgroup.procs: the processes with threads in it
 
  private:
   void Loop() {
@@ -96,6 +97,8 @@ class GroupWatcher {
       std::ifstream tasks("/sys/fs/cgroup/cpuset" + name_ + "/tasks");
       size_t n = 0;
       for (std::string line; std::getline(tasks, line);) ++n;
+      std::ifstream procs("/sys/fs/cgroup/cpuset" + name_ + "/cgroup.procs");
+      for (pid_t pid = 0; procs >> pid;) processes.insert(pid);
       if (n > max_tasks) {
         max_tasks = n;
         std::ifstream("/sys/fs/cgroup/cpuset" + name_ + "/cpuset.cpus") >> cpus;
@@ -127,10 +130,23 @@ TEST(RealTimeSimulateTest,
   EXPECT_EQ(run->platform.at("clock_by"), "padding");
   EXPECT_EQ(run->platform.at("time_dilation"), "1");
   EXPECT_TRUE(run->platform.count("world_lag_max_s"));
+  // The stack ran in a process of its own, which says what crossed.
+  const std::string& process = run->platform.at("stack_process");
+  EXPECT_EQ(process.rfind("process ", 0), 0u) << process;
+  EXPECT_NE(process.find("over a Unix socket"), std::string::npos) << process;
+  EXPECT_EQ(process.find("process " + std::to_string(::getpid()) + ","),
+            std::string::npos)
+      << process;
   if (where.find("cgroup v1") != std::string::npos) {
-    // The executor's thread and its clock were in the group, on one CPU,
-    // and nothing else of this process; the group is gone afterwards.
-    EXPECT_EQ(watcher.max_tasks, 2u);
+    // The stack's process was in the group, its main thread, the executor's
+    // thread and its clock, on one CPU, and nothing of this process; the
+    // group is gone afterwards.
+    ASSERT_EQ(watcher.processes.size(), 1u);
+    EXPECT_NE(*watcher.processes.begin(), ::getpid());
+    EXPECT_NE(process.find(std::to_string(*watcher.processes.begin())),
+              std::string::npos)
+        << process;
+    EXPECT_EQ(watcher.max_tasks, 3u);
     EXPECT_EQ(watcher.cpus.find_first_of(",-"), std::string::npos)
         << watcher.cpus;
     EXPECT_FALSE(std::filesystem::exists("/sys/fs/cgroup/cpuset/adse-stack-" +

@@ -99,6 +99,20 @@ TEST(TrafficLightsTest, TheEgoWaitsAtTheRedLightThenDrivesOnToTheGoal) {
     has_callback |= c.name == "behavior_velocity_planner/traffic_signal";
   EXPECT_TRUE(has_topic);
   EXPECT_TRUE(has_callback);
+  // The detector's reports are in the run file: red on approach until the
+  // green, then green, each published after its look.
+  ASSERT_FALSE(read->signals.empty());
+  bool red_before_green = false, green_after = false;
+  for (const runfile::SignalSample& r : read->signals) {
+    EXPECT_GE(r.t_s, r.stamp_s);
+    if (r.tls_id.empty()) continue;
+    red_before_green |= r.state == SignalState::kRed && r.stamp_s < kGreenAtS;
+    green_after |= r.state == SignalState::kGreen && r.stamp_s >= kGreenAtS;
+    if (r.state == SignalState::kRed) EXPECT_LT(r.stamp_s, kGreenAtS + 0.5);
+    EXPECT_GE(r.stop_line_distance_m, 0.0);
+  }
+  EXPECT_TRUE(red_before_green);
+  EXPECT_TRUE(green_after);
 }
 
 TEST(TrafficLightsTest, TheIdealDriverWaitsAtTheRedLightAsTheStackDoes) {
