@@ -92,7 +92,11 @@ void AddParkingMetrics(const runfile::RunData& run,
                          : 0.0;
   }
   const double end_s = run.ego.empty() ? 0.0 : run.ego.back().t_s;
-  (*m)["parking_time_s"] = p.planned_at_s >= 0 ? end_s - p.planned_at_s : nan;
+  // From the first plan (a record without one has only its last).
+  const double first_s =
+      p.first_planned_at_s >= 0 ? p.first_planned_at_s : p.planned_at_s;
+  (*m)["parking_time_s"] = first_s >= 0 ? end_s - first_s : nan;
+  (*m)["parking_replans"] = p.replans;
 
   // Deviation from the plan while driving it.
   if (p.planned_path.size() >= 2) {

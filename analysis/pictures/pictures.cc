@@ -118,6 +118,13 @@ std::string Title(const runfile::RunData& run) {
             ? fmt::format(", nav >= {:.1f} s (stopped early)", it->second)
             : fmt::format(", nav {:.1f} s", it->second);
   }
+  // The picture shows the last plan; say when there were others.
+  if (run.parking.replans > 0) {
+    outcome += fmt::format(
+        ", plan shown is re-plan {} (the car left the "
+        "course of the one before)",
+        run.parking.replans);
+  }
   return fmt::format(
       "{} | {} | {}",
       run.scenario_name.empty() ? "(no scenario)" : run.scenario_name,

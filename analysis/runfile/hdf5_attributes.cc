@@ -78,6 +78,12 @@ herr_t CollectAttrName(hid_t /*loc*/, const char* name,
 }
 }  // namespace
 
+Result<bool> HasAttr(hid_t loc, const std::string& name) {
+  const htri_t exists = H5Aexists(loc, name.c_str());
+  if (exists < 0) return ReadHdf5Error(PathOf(loc, ""), "attribute " + name);
+  return exists > 0;
+}
+
 Status WriteStringAttr(hid_t loc, const std::string& name,
                        const std::string& value) {
   Handle type = MakeFixedStringType(value);

@@ -139,6 +139,8 @@ Status WriteF64Attr(hid_t loc, const std::string& name, double value);
 Status WriteI32Attr(hid_t loc, const std::string& name, int32_t value);
 Status WriteI64Attr(hid_t loc, const std::string& name, int64_t value);
 Status WriteU64Attr(hid_t loc, const std::string& name, uint64_t value);
+// Whether `loc` has the attribute `name` (for attributes added later).
+Result<bool> HasAttr(hid_t loc, const std::string& name);
 Result<std::string> ReadStringAttr(hid_t loc, const std::string& name);
 Result<double> ReadF64Attr(hid_t loc, const std::string& name);
 Result<int64_t> ReadI64Attr(hid_t loc, const std::string& name);

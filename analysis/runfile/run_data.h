@@ -101,9 +101,14 @@ struct ParkingRecord {
   // The ego's body (the rear axle is half a wheelbase behind its centre).
   double wheelbase_m = 2.7, length_m = 4.6, width_m = 1.9;
   // When the stack planned the manoeuvre (-1: it never did) and whether
-  // it found one.
+  // it found one: its last plan, the one planned_path holds.
   double planned_at_s = -1.0;
   int32_t path_found = 0;
+  // Its first plan (-1: none), and the paths found after it, each planned
+  // where the car stood after leaving the course of the one before. Files
+  // written before re-planning read as planned_at_s and 0.
+  double first_planned_at_s = -1.0;
+  int32_t replans = 0;
   std::vector<ParkingSlotRow> slots;
   std::vector<OutlinePoint> obstacles;
   std::vector<ParkingPathRow> planned_path;  // empty when none was found

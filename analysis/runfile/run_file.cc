@@ -490,10 +490,12 @@ Status WriteContents(hid_t file, const RunData& run) {
           {"wheelbase_m", p.wheelbase_m},
           {"length_m", p.length_m},
           {"width_m", p.width_m},
-          {"planned_at_s", p.planned_at_s}}) {
+          {"planned_at_s", p.planned_at_s},
+          {"first_planned_at_s", p.first_planned_at_s}}) {
       ADSE_RETURN_IF_ERROR(WriteF64Attr(g, name, value));
     }
     ADSE_RETURN_IF_ERROR(internal::WriteI32Attr(g, "path_found", p.path_found));
+    ADSE_RETURN_IF_ERROR(internal::WriteI32Attr(g, "replans", p.replans));
     ADSE_RETURN_IF_ERROR(WriteTable(g, "slots", p.slots, ParkingSlotColumns()));
     ADSE_RETURN_IF_ERROR(
         WriteTable(g, "obstacles", p.obstacles, OutlineColumns()));
@@ -712,6 +714,17 @@ Status ReadContents(hid_t file, RunData* run) {
     Result<int64_t> found = internal::ReadI64Attr(g, "path_found");
     if (!found.ok()) return found.status();
     p.path_found = static_cast<int32_t>(*found);
+    Result<bool> replanning = internal::HasAttr(g, "replans");
+    if (!replanning.ok()) return replanning.status();
+    p.first_planned_at_s = p.planned_at_s;
+    if (*replanning) {
+      ADSE_RETURN_IF_ERROR(
+          Assign(internal::ReadF64Attr(g, "first_planned_at_s"),
+                 &p.first_planned_at_s));
+      Result<int64_t> replans = internal::ReadI64Attr(g, "replans");
+      if (!replans.ok()) return replans.status();
+      p.replans = static_cast<int32_t>(*replans);
+    }
     ADSE_RETURN_IF_ERROR(
         Assign(ReadTable(g, "slots", ParkingSlotColumns()), &p.slots));
     ADSE_RETURN_IF_ERROR(

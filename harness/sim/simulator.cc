@@ -170,6 +170,11 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   if (topics.parking_path >= 0) {
     graph.AddSink<stack::ParkingPathMsg>(
         topics.parking_path, [&](const stack::ParkingPathMsg& m, double t_s) {
+          if (run.parking.first_planned_at_s < 0) {
+            run.parking.first_planned_at_s = t_s;
+          } else if (m.found) {
+            ++run.parking.replans;
+          }
           run.parking.planned_at_s = t_s;
           run.parking.path_found = m.found ? 1 : 0;
           run.parking.planned_path.clear();

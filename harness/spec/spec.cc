@@ -133,7 +133,11 @@ const std::vector<MetricInfo>& KnownMetrics() {
        "valet_parking: heading error from the parked heading at the end, "
        "degrees"},
       {"parking_time_s",
-       "valet_parking: from the manoeuvre's plan to the end of the run, s"},
+       "valet_parking: from the manoeuvre's first plan to the end of the "
+       "run, s"},
+      {"parking_replans",
+       "valet_parking: paths found after the first, each planned where the "
+       "car stood off the course of the one before, count"},
       {"parking_path_deviation_m",
        "valet_parking: mean distance of the rear axle from the planned "
        "manoeuvre while driving it, m"},

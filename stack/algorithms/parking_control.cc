@@ -9,7 +9,22 @@ namespace adse::algorithms {
 ParkingFollower::ParkingFollower(const ParkingFollowerParams& params)
     : params_(params), pid_(params.pid) {}
 
+double DistanceFromPath(const std::vector<GearedPose>& poses,
+                        const Eigen::Vector2d& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < poses.size(); ++i) {
+    const Eigen::Vector2d a(poses[i].pose.x_m, poses[i].pose.y_m);
+    const Eigen::Vector2d b =
+        i + 1 < poses.size()
+            ? Eigen::Vector2d(poses[i + 1].pose.x_m, poses[i + 1].pose.y_m)
+            : a;
+    best = std::min(best, geometry::DistanceToSegment(p, a, b));
+  }
+  return best;
+}
+
 void ParkingFollower::SetPath(const std::vector<GearedPose>& poses) {
+  path_ = poses;
   segments_.clear();
   current_ = 0;
   finished_ = false;
@@ -103,6 +118,16 @@ ParkingCommand ParkingFollower::Update(const geometry::Pose2& pose,
     return out;
   }
   const Eigen::Vector2d pos(pose.x_m, pose.y_m);
+  if (p.course_out_m > 0 && DistanceFromPath(path_, pos) > p.course_out_m) {
+    // Off course: stop where it is and wait for a path from here.
+    out.course_out = true;
+    out.segment = current_;
+    out.reverse = segments_[current_].reverse;
+    const bool standing = std::abs(v_mps) < p.standstill_mps;
+    out.accel_mps2 = standing ? -p.stop_decel_mps2 : -p.max_brake_mps2;
+    pid_.Reset();
+    return out;
+  }
   double s = 0.0, remaining = 0.0, lateral = 0.0;
   for (;;) {
     const Segment& seg = segments_[current_];

@@ -27,6 +27,11 @@ struct ParkingFollowerParams {
   double max_brake_mps2 = 3.0;
   // A segment's end counts as reached this close to it (along the path).
   double arrive_tolerance_m = 0.1;
+  // Farther than this from the path (DistanceFromPath), the car is off its
+  // course: it brakes and holds until a new path comes (the freespace
+  // planner re-plans from where it stands, as Autoware's does past its
+  // th_course_out_distance_m). 0: never.
+  double course_out_m = 0.0;
   // Slower than this counts as standing: the gear may change.
   double standstill_mps = 0.05;
   PidParams pid;  // speed loop
@@ -39,11 +44,19 @@ struct ParkingCommand {
   // At the end of the last segment, standing: from then on it holds (a
   // parked car does not creep when its pose estimate moves).
   bool finished = false;
+  // Off the path by more than course_out_m: braking to hold where it is.
+  bool course_out = false;
   int segment = 0;  // index of the segment being driven
   double target_speed_mps = 0.0;
   double lateral_error_m = 0.0;  // from the segment, left positive
   double remaining_m = 0.0;      // to the segment's end (negative: past it)
 };
+
+// From `p` to the nearest point of the polyline through `poses`
+// (infinity for an empty path): the one measure of being off course that
+// the controller (it holds) and the freespace planner (it re-plans) share.
+double DistanceFromPath(const std::vector<GearedPose>& poses,
+                        const Eigen::Vector2d& p);
 
 class ParkingFollower {
  public:
@@ -78,6 +91,7 @@ class ParkingFollower {
 
   ParkingFollowerParams params_;
   Pid pid_;
+  std::vector<GearedPose> path_;  // as given, for the course-out check
   std::vector<Segment> segments_;
   int current_ = 0;
   bool finished_ = false;

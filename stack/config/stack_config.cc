@@ -117,6 +117,12 @@ const std::vector<KnobInfo>& StackKnobs() {
          "parking speed forwards, m/s"},
         {"parking.reverse_speed_mps", false, 0.2, 3.0, 1.0,
          "parking speed in reverse, m/s"},
+        {"parking.course_out_m", false, 0.0, 10.0, 1.0,
+         "farther than this from the parking path the car stops and the "
+         "planner plans again from there (0: never), m"},
+        {"parking.max_replans", true, 0, 100, 3,
+         "plans after the first one, past which an off-course car ends the "
+         "run with no_path"},
     };
   }();
   return kKnobs;

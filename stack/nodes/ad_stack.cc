@@ -1,5 +1,7 @@
 #include "stack/nodes/ad_stack.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <deque>
@@ -114,6 +116,8 @@ class Stack final : public AdStack {
   double follower_last_t_ = -1.0;
   std::unique_ptr<algo::FreespacePlanner> freespace_;
   std::optional<PoseMsg> freespace_pose_;
+  std::vector<algo::GearedPose> freespace_path_;  // the last plan found
+  int freespace_replans_ = 0;
   bool parking_planned_ = false;  // the planner has answered (path or not)
   std::unique_ptr<algo::ParkingFollower> parking_follower_;
   bool parking_mode_ = false;  // the follower drives the parking path
@@ -617,7 +621,8 @@ void Stack::BuildPlanning(Graph* g) {
 void Stack::BuildParking(Graph* g) {
   // Autoware's parking scenario: once the car stands at the end of its
   // road route (on the aisle beside the slot), the freespace planner plans
-  // the manoeuvre into the slot from the localization pose, once.
+  // the manoeuvre into the slot from the localization pose; again from
+  // where it stands whenever the car has left that path's course.
   topics_.parking_path =
       g->AddTopic<ParkingPathMsg>("/planning/scenario_planning/parking/path");
   topics_.parking_done = g->AddTopic<ParkingDoneMsg>("/control/parking_done");
@@ -634,32 +639,54 @@ void Stack::BuildParking(Graph* g) {
   g->Subscribe<PoseMsg>(
       node, topics_.pose, "pose", 1,
       [this](const PoseMsg& in, CallbackContext&) { freespace_pose_ = in; });
+  const double course_out_m = config_.Get("parking.course_out_m");
+  const int max_replans = static_cast<int>(config_.Get("parking.max_replans"));
   g->AddTimer(
       node, "plan", 1.0 / config_.Get("parking.rate_hz"),
-      [this](CallbackContext& ctx) {
-        if (parking_planned_ || !freespace_pose_ || !freespace_pose_->valid)
-          return;
+      [this, course_out_m, max_replans](CallbackContext& ctx) {
+        if (!freespace_pose_ || !freespace_pose_->valid) return;
         const geometry::Pose2& pose = freespace_pose_->pose;
-        const Eigen::Vector2d end = inputs_.route.points.back();
-        // Handed over when standing within reach of the route's end.
-        const bool arrived =
-            (Eigen::Vector2d(pose.x_m, pose.y_m) - end).norm() <=
-                std::max(3.0, inputs_.goal_tolerance_m) &&
-            std::abs(freespace_pose_->v_mps) < 0.1;
-        if (!arrived) return;
-        parking_planned_ = true;
+        const Eigen::Vector2d at(pose.x_m, pose.y_m);
+        const bool standing = std::abs(freespace_pose_->v_mps) < 0.1;
         ParkingPathMsg out;
         out.header.stamp_s = freespace_pose_->header.stamp_s;
+        if (!parking_planned_) {
+          // Handed over when standing within reach of the route's end.
+          const Eigen::Vector2d end = inputs_.route.points.back();
+          if (!standing ||
+              (at - end).norm() > std::max(3.0, inputs_.goal_tolerance_m))
+            return;
+          parking_planned_ = true;
+        } else {
+          // Standing off the course of its path (where the controller
+          // holds it), the car gets a new path from there.
+          if (freespace_path_.empty() || course_out_m <= 0 || !standing ||
+              algo::DistanceFromPath(freespace_path_, at) <= course_out_m)
+            return;
+          if (freespace_replans_ == max_replans) {
+            out.found = false;
+            out.failure = fmt::format(
+                "off the course of its path ({:.2f} m > parking.course_out_m) "
+                "after {} re-plans (parking.max_replans)",
+                algo::DistanceFromPath(freespace_path_, at), max_replans);
+            freespace_path_.clear();
+            ctx.Publish(topics_.parking_path, std::move(out));
+            return;
+          }
+          ++freespace_replans_;
+        }
         const Result<algo::FreespacePath> path = freespace_->Plan(
             pose, inputs_.parking_goal, inputs_.parking_obstacles);
         out.found = path.ok();
         out.expansions = freespace_->last_stats().expansions;
         if (path.ok()) {
+          freespace_path_ = path->poses;
           for (const algo::GearedPose& p : path->poses) {
             out.poses.push_back(
                 {p.pose.x_m, p.pose.y_m, p.pose.yaw_rad, p.reverse});
           }
         } else {
+          freespace_path_.clear();
           out.failure = path.status().message();
         }
         ctx.ReportWork(
@@ -705,6 +732,7 @@ void Stack::BuildControl(Graph* g) {
     parking.wheelbase_m = inputs_.wheelbase_m;
     parking.forward_speed_mps = config_.Get("parking.forward_speed_mps");
     parking.reverse_speed_mps = config_.Get("parking.reverse_speed_mps");
+    parking.course_out_m = config_.Get("parking.course_out_m");
     parking_follower_ = std::make_unique<algo::ParkingFollower>(parking);
     g->Subscribe<ParkingPathMsg>(
         node, topics_.parking_path, "parking_path", 1,

@@ -354,6 +354,8 @@ TEST_F(RunFileTest, ParkingRecordRoundTripsAndIsAbsentOtherwise) {
   p.yaw_tolerance_rad = 0.17;
   p.planned_at_s = 20.0;
   p.path_found = 1;
+  p.first_planned_at_s = 12.5;
+  p.replans = 2;
   p.slots = {{20.75, 20.0, M_PI / 2, 5.0, 2.5, 0, 1},
              {18.25, 20.0, M_PI / 2, 5.0, 2.5, 1, 0}};
   p.obstacles = {{0, 0, 0}, {0, 10, 0}, {1, 5, 5}, {1, 6, 5}, {1, 6, 6}};
@@ -371,6 +373,8 @@ TEST_F(RunFileTest, ParkingRecordRoundTripsAndIsAbsentOtherwise) {
   EXPECT_EQ(q.yaw_tolerance_rad, p.yaw_tolerance_rad);
   EXPECT_EQ(q.planned_at_s, 20.0);
   EXPECT_EQ(q.path_found, 1);
+  EXPECT_EQ(q.first_planned_at_s, 12.5);
+  EXPECT_EQ(q.replans, 2);
   ASSERT_EQ(q.slots.size(), 2u);
   EXPECT_EQ(q.slots[1].occupied, 1);
   EXPECT_EQ(q.slots[0].target, 1);
@@ -753,6 +757,27 @@ void ExpectReadsWithout(const std::string& path, const char* link,
   ASSERT_TRUE(back.ok()) << back.status().ToString();
   clear(&run);
   EXPECT_EQ(Diff(run, *back), "");
+}
+
+TEST_F(RunFileTest, AParkingRecordWrittenBeforeReplanningReadsAsOnePlan) {
+  RunData run = MakeFullRun(10);
+  run.parking.present = true;
+  run.parking.planned_at_s = 20.0;
+  run.parking.first_planned_at_s = 12.5;
+  run.parking.replans = 2;
+  const std::string path = Path("valet.h5");
+  ASSERT_TRUE(WriteRunFile(path, run).ok());
+  {
+    RawHdf5 raw(path, H5F_ACC_RDWR);
+    for (const char* name : {"replans", "first_planned_at_s"}) {
+      ASSERT_GE(H5Adelete_by_name(raw.file(), "/parking", name, H5P_DEFAULT), 0)
+          << name;
+    }
+  }
+  Result<RunData> older = ReadRunFile(path);
+  ASSERT_TRUE(older.ok()) << older.status().ToString();
+  EXPECT_EQ(older->parking.first_planned_at_s, 20.0);
+  EXPECT_EQ(older->parking.replans, 0);
 }
 
 TEST_F(RunFileTest, FileWithoutLanesReadsAsNoLanes) {

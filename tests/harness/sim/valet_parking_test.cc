@@ -59,6 +59,9 @@ TEST(ValetParkingTest, BacksIntoTheSlot) {
   // one change from forward to reverse.
   ExpectParked(*run, 1);
   EXPECT_EQ(run->parking.planned_path.back().reverse, 1);
+  // Within the default course (1 m) all the way: one plan.
+  EXPECT_EQ(run->metrics.at("parking_replans"), 0.0);
+  EXPECT_EQ(run->parking.first_planned_at_s, run->parking.planned_at_s);
 }
 
 TEST(ValetParkingTest, DrivesNoseFirstIntoTheSlot) {
@@ -109,6 +112,39 @@ TEST(ValetParkingTest, ParkedOutsideTheToleranceEndsTheRunAtOnce) {
   EXPECT_LT(run->metrics.at("parking_position_error_m"), 0.5);
   // Standing in the slot, not waiting for the 300 s timeout.
   EXPECT_LT(run->metrics.at("nav_time_s"), 60.0);
+}
+
+TEST(ValetParkingTest, OffTheCourseOfItsPathTheCarStopsAndGetsANewOne) {
+  spec::Spec spec = Bundled("valet_parking.yaml");
+  // A course narrower than the car follows the plan here (within a few
+  // centimetres): it leaves it, stops, and the planner plans again from
+  // there.
+  ASSERT_TRUE(spec.stack.Set("parking.course_out_m", 0.05).ok());
+  ASSERT_TRUE(spec.stack.Set("parking.max_replans", 20).ok());
+  Result<runfile::RunData> run = SimulatePoint(spec, kGenerous);
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  ExpectParked(*run, 1);
+  EXPECT_GE(run->metrics.at("parking_replans"), 1.0);
+  EXPECT_EQ(run->parking.replans, run->metrics.at("parking_replans"));
+  // The last plan came later than the first; the parking time counts from
+  // the first.
+  EXPECT_GT(run->parking.planned_at_s, run->parking.first_planned_at_s);
+  EXPECT_NEAR(run->metrics.at("parking_time_s"),
+              run->ego.back().t_s - run->parking.first_planned_at_s, 1e-9);
+}
+
+TEST(ValetParkingTest, PastItsReplansAnOffCourseCarEndsTheRunWithNoPath) {
+  spec::Spec spec = Bundled("valet_parking.yaml");
+  ASSERT_TRUE(spec.stack.Set("parking.course_out_m", 0.05).ok());
+  ASSERT_TRUE(spec.stack.Set("parking.max_replans", 0).ok());
+  Result<runfile::RunData> run = SimulatePoint(spec, kGenerous);
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->termination_reason, "no_path");
+  EXPECT_EQ(run->parking.replans, 0);
+  EXPECT_EQ(run->parking.path_found, 0);
+  EXPECT_EQ(run->metrics.at("parked"), 0.0);
+  // Ended where it stopped, not at the 300 s timeout.
+  EXPECT_LT(run->metrics.at("nav_time_s"), 90.0);
 }
 
 }  // namespace

@@ -136,5 +136,50 @@ TEST(ParkingFollower, ReverseSteeringTurnsTowardsThePath) {
   EXPECT_GT(c.steer_rad, 0.05);
 }
 
+TEST(ParkingFollower, OffItsCourseItBrakesAndHoldsUntilANewPath) {
+  // A straight path forwards along y = 0, course out beyond 1 m.
+  std::vector<GearedPose> poses;
+  for (int i = 0; i <= 20; ++i) poses.push_back({{0.5 * i, 0.0, 0}, false});
+  ParkingFollowerParams params;
+  params.course_out_m = 1.0;
+  ParkingFollower follower(params);
+  follower.SetPath(poses);
+  // On course (0.8 m off): it drives.
+  ParkingCommand c = follower.Update({2.0, 0.8, 0}, 1.0, 0.05);
+  EXPECT_FALSE(c.course_out);
+  EXPECT_GT(c.target_speed_mps, 0.0);
+  // 1.2 m off, moving: full brake; standing: holds; never finished.
+  c = follower.Update({2.5, 1.2, 0}, 1.0, 0.05);
+  EXPECT_TRUE(c.course_out);
+  EXPECT_DOUBLE_EQ(c.accel_mps2, -params.max_brake_mps2);
+  EXPECT_FALSE(c.finished);
+  c = follower.Update({2.6, 1.2, 0}, 0.0, 0.05);
+  EXPECT_TRUE(c.course_out);
+  EXPECT_LT(c.accel_mps2, 0.0);
+  EXPECT_FALSE(c.finished);
+  // A path from where it stands: it drives again.
+  std::vector<GearedPose> from_here;
+  for (int i = 0; i <= 20; ++i)
+    from_here.push_back({{2.6 + 0.5 * i, 1.2, 0}, false});
+  follower.SetPath(from_here);
+  c = follower.Update({2.6, 1.2, 0}, 0.0, 0.05);
+  EXPECT_FALSE(c.course_out);
+  EXPECT_GT(c.accel_mps2, 0.0);
+  // course_out_m 0: never off course.
+  ParkingFollower lenient;
+  lenient.SetPath(poses);
+  EXPECT_FALSE(lenient.Update({2.5, 5.0, 0}, 1.0, 0.05).course_out);
+}
+
+TEST(DistanceFromPath, IsTheDistanceToTheNearestStretchOfThePolyline) {
+  const std::vector<GearedPose> poses = {
+      {{0, 0, 0}, false}, {{4, 0, 0}, false}, {{4, 3, 0}, true}};
+  EXPECT_NEAR(DistanceFromPath(poses, {2, 1}), 1.0, 1e-12);
+  EXPECT_NEAR(DistanceFromPath(poses, {5, 2}), 1.0, 1e-12);
+  EXPECT_NEAR(DistanceFromPath(poses, {-3, 4}), 5.0, 1e-12);
+  EXPECT_NEAR(DistanceFromPath({poses[0]}, {3, 4}), 5.0, 1e-12);
+  EXPECT_TRUE(std::isinf(DistanceFromPath({}, {0, 0})));
+}
+
 }  // namespace
 }  // namespace adse::algorithms

@@ -200,7 +200,9 @@ TEST(RealTimeExecutorTest, CallbacksOfOneNodeNeverOverlap) {
                                                  {"b/first", 0.004},
                                                  {"b/second", 0.004}})));
   ASSERT_NE(exec, nullptr);
-  ASSERT_TRUE(exec->AdvanceTo(0.6).ok());
+  // Long enough that both of b's callbacks run several times even on a
+  // loaded host (0.6 s once gave the second a single run beside a build).
+  ASSERT_TRUE(exec->AdvanceTo(1.5).ok());
   exec->Stop();
   std::vector<CallbackRecord> b_runs = RecordsOf(exec->trace(), first);
   const std::vector<CallbackRecord> more = RecordsOf(exec->trace(), second);
