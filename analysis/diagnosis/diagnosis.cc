@@ -239,6 +239,8 @@ struct RemedyEvidence {
   double exec_load = 0.0;
   bool has_wait_ratio = false;
   double core_wait_ratio = 0.0;
+  double core_wait_mean_s = 0.0;  // per run, for the message
+  double cost_mean_s = 0.0;
 };
 
 // exec_load = p50(cost of the subscription's runs) x publish_hz
@@ -276,8 +278,10 @@ RemedyEvidence ComputeRemedyEvidence(const runfile::RunData& run,
 
   std::sort(node_busy.begin(), node_busy.end());
   double wait_s = 0.0, cost_s = 0.0;
+  int runs = 0;
   for (const auto& r : run.trace.callbacks) {
     if (r.callback != callback || !view.InWindow(r.ready_s)) continue;
+    ++runs;
     double node_busy_s = 0.0;
     // Intervals of one node are disjoint; only those before r.start_s can
     // overlap its wait.
@@ -293,6 +297,8 @@ RemedyEvidence ComputeRemedyEvidence(const runfile::RunData& run,
   if (cost_s > 0.0) {
     ev.has_wait_ratio = true;
     ev.core_wait_ratio = wait_s / cost_s;
+    ev.core_wait_mean_s = wait_s / runs;
+    ev.cost_mean_s = cost_s / runs;
   }
   return ev;
 }
@@ -501,10 +507,12 @@ Diagnosis Diagnose(const runfile::RunData& run,
     f.remedy = RemediesText(f.remedies);
 
     const std::string wait_text =
-        ev.has_wait_ratio
-            ? fmt::format("waits for a core {:.2f}x its execution time",
-                          ev.core_wait_ratio)
-            : std::string("never ran in the window");
+        ev.has_wait_ratio ? fmt::format(
+                                "waits for a core {:.2f}x its execution time "
+                                "({:.3g} ms against {:.3g} ms a run)",
+                                ev.core_wait_ratio, 1e3 * ev.core_wait_mean_s,
+                                1e3 * ev.cost_mean_s)
+                          : std::string("never ran in the window");
     f.message = fmt::format(
         "{} cannot keep up with {}: takes {:.2f} Hz of {:.2f} Hz published "
         "(deficit {:.1f}% > allowed {:.1f}% = {:g}/(1+{:.2f}/{:g})+{:g}); "
