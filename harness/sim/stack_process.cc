@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <string_view>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -74,6 +75,13 @@ Status StatusFrom(int32_t code, std::string message) {
       break;
   }
   return Status::Internal(std::move(message));
+}
+
+// Appends a frame to `out`: the frames of one step leave as one write.
+void AppendFrame(const FrameHeader& header, std::string_view payload,
+                 std::string* out) {
+  out->append(reinterpret_cast<const char*>(&header), sizeof header);
+  out->append(payload);
 }
 
 // Writes all of header and payload; false when the other end is gone.
@@ -145,9 +153,8 @@ bool ReadFrame(int fd, FrameHeader* header, std::string* payload) {
                                              double t_s) {
       std::string payload;
       (void)stack::EncodeMessage(type, m, &payload);  // checked at Start
-      FrameHeader h{kSink, static_cast<int32_t>(i), t_s, 0.0, payload.size()};
-      outgoing.append(reinterpret_cast<const char*>(&h), sizeof h);
-      outgoing += payload;
+      AppendFrame({kSink, static_cast<int32_t>(i), t_s, 0.0, payload.size()},
+                  payload, &outgoing);
     });
   }
 
@@ -174,10 +181,9 @@ bool ReadFrame(int fd, FrameHeader* header, std::string* payload) {
       executor.PublishExternal(topic, *message, in.a_s, in.b_s);
     } else if (in.kind == kAdvance) {
       const Status s = executor.AdvanceTo(in.a_s);
-      const FrameHeader done{kAdvanced, static_cast<int32_t>(s.code()),
-                             executor.now_s(), 0.0, s.message().size()};
-      outgoing.append(reinterpret_cast<const char*>(&done), sizeof done);
-      outgoing += s.message();
+      AppendFrame({kAdvanced, static_cast<int32_t>(s.code()), executor.now_s(),
+                   0.0, s.message().size()},
+                  s.message(), &outgoing);
       const bool sent =
           WriteFrame(fd, {kStep, 0, 0, 0, outgoing.size()}, outgoing);
       outgoing.clear();
