@@ -14,8 +14,10 @@ namespace {
 // NDT's acceptance and the map filter changed (issue 17), so runs cached
 // by earlier versions are not reused. v3: a car that stands held by
 // something traffic will not release ends the run as stalled
-// (task.stall_timeout_s), where it used to drive on to the timeout.
-constexpr char kKeyVersion[] = "adse-run-key-v3";
+// (task.stall_timeout_s), where it used to drive on to the timeout. v4: a
+// parking car is parked only once its manoeuvre is over (it used to count
+// as parked standing within the tolerances at a cusp).
+constexpr char kKeyVersion[] = "adse-run-key-v4";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

@@ -421,7 +421,9 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
       options.progress(w.time_s(), timeout);
       next_progress += 1.0;
     }
-    if (w.goal_reached()) {
+    // A parking car is parked once its manoeuvre is over: standing within
+    // the tolerances at a cusp, before a last short leg, it is not yet.
+    if (w.goal_reached() && (!w.parking_task() || parking_done_at_s >= 0)) {
       reason = "goal_reached";
       break;
     }

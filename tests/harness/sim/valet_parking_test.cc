@@ -80,6 +80,10 @@ TEST(ValetParkingTest, DrivesNoseFirstIntoTheSlot) {
   });
   ASSERT_NE(entering, plan.end());
   EXPECT_EQ(entering->reverse, 0);
+  // Here the plan runs 0.55 m past the goal and backs up to it; standing
+  // at that cusp the car is within the 0.5 m tolerance (0.48 m), but it is
+  // parked only once the manoeuvre is over, at the goal.
+  EXPECT_LT(run->metrics.at("parking_position_error_m"), 0.15);
 }
 
 TEST(ValetParkingTest, UnreachableSlotEndsTheRunWithNoPathNotATimeout) {
