@@ -660,15 +660,15 @@ void Stack::BuildParking(Graph* g) {
         } else {
           // Standing off the course of its path (where the controller
           // holds it), the car gets a new path from there.
-          if (freespace_path_.empty() || course_out_m <= 0 || !standing ||
-              algo::DistanceFromPath(freespace_path_, at) <= course_out_m)
-            return;
+          if (freespace_path_.empty() || course_out_m <= 0 || !standing) return;
+          const double off_m = algo::DistanceFromPath(freespace_path_, at);
+          if (off_m <= course_out_m) return;
           if (freespace_replans_ == max_replans) {
             out.found = false;
             out.failure = fmt::format(
                 "off the course of its path ({:.2f} m > parking.course_out_m) "
                 "after {} re-plans (parking.max_replans)",
-                algo::DistanceFromPath(freespace_path_, at), max_replans);
+                off_m, max_replans);
             freespace_path_.clear();
             ctx.Publish(topics_.parking_path, std::move(out));
             return;
