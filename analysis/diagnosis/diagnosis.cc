@@ -37,6 +37,8 @@ constexpr OptionSpec kOptionSpecs[] = {
      Range::kPositive},
     {"cpu_bound_floor_fraction", &DiagnosisOptions::cpu_bound_floor_fraction,
      Range::kNonNegative},
+    {"cpu_bound_state_inputs_per_output",
+     &DiagnosisOptions::cpu_bound_state_inputs_per_output, Range::kFlag},
     {"frequency_bound_fraction", &DiagnosisOptions::frequency_bound_fraction,
      Range::kFraction},
     {"frequency_bound_driving_inputs_only",
@@ -243,17 +245,18 @@ struct RemedyEvidence {
   double cost_mean_s = 0.0;
 };
 
-// exec_load = p50(cost of the subscription's runs) x publish_hz
-//           + sum over the node's other callbacks of their busy time / window.
-// Callbacks of one node exclude each other, so this is the share of time the
-// node alone would need to take every message: >= 1 means no number of
-// cores helps, only faster ones.
+// exec_load = p50(cost of the subscription's runs) x needed_hz
+//           + sum over the node's other callbacks of their busy time / window,
+// needed_hz being the rate it must take (the publish rate, or its node's
+// output rate for a state input). Callbacks of one node exclude each other,
+// so this is the share of time the node alone would need to take what it
+// must: >= 1 means no number of cores helps, only faster ones.
 // core_wait_ratio = sum over the subscription's runs of the part of
 // [ready, start] during which no callback of its node was running (so it
 // waited for a core, not for its own node) / sum of their costs.
 RemedyEvidence ComputeRemedyEvidence(const runfile::RunData& run,
                                      const TraceView& view, int callback,
-                                     double publish_hz) {
+                                     double needed_hz) {
   RemedyEvidence ev;
   const std::string node = view.NodeOfCallback(callback);
   std::vector<std::pair<double, double>> node_busy;  // [start, end]
@@ -274,7 +277,7 @@ RemedyEvidence ComputeRemedyEvidence(const runfile::RunData& run,
   const double other_load =
       view.window_s() > 0.0 ? other_busy_s / view.window_s() : 0.0;
   const double exec_p50 = costs.empty() ? 0.0 : Percentile(costs, 0.5);
-  ev.exec_load = exec_p50 * publish_hz + other_load;
+  ev.exec_load = exec_p50 * needed_hz + other_load;
 
   std::sort(node_busy.begin(), node_busy.end());
   double wait_s = 0.0, cost_s = 0.0;
@@ -457,6 +460,13 @@ Diagnosis Diagnose(const runfile::RunData& run,
   };
 
   // ---- CPU-bound: a subscription taking fewer messages than published ----
+  // (or, for a state input, than its node's outputs need; see the option)
+  std::map<int32_t, double> node_output_hz;
+  for (int c = 0; c < num_callbacks; ++c) {
+    if (!published_in_window[c]) continue;
+    double& hz = node_output_hz[run.callback_info[c].node];
+    hz = std::max(hz, view.Rate(d.callbacks[c].runs));
+  }
   std::set<std::string> cpu_bound_nodes;
   for (const auto& [key, counts] : subs) {
     const auto [topic, callback] = key;
@@ -466,8 +476,14 @@ Diagnosis Diagnose(const runfile::RunData& run,
     }
     const double publish_hz = view.Rate(publishes[topic]);
     const double take_hz = view.Rate(counts.first);
-    const double deficit = 1.0 - take_hz / publish_hz;
-    const double allowed = AllowedDeficit(options, publish_hz);
+    const auto output = node_output_hz.find(run.callback_info[callback].node);
+    const bool state_input =
+        options.cpu_bound_state_inputs_per_output != 0 &&
+        !published_in_window[callback] && output != node_output_hz.end() &&
+        output->second > 0.0 && output->second < publish_hz;
+    const double needed_hz = state_input ? output->second : publish_hz;
+    const double deficit = 1.0 - take_hz / needed_hz;
+    const double allowed = AllowedDeficit(options, needed_hz);
     if (!(deficit > allowed)) continue;
 
     Finding f;
@@ -477,12 +493,13 @@ Diagnosis Diagnose(const runfile::RunData& run,
     f.upstream = d.topics[topic].publisher;
     f.severity = deficit;
     const RemedyEvidence ev =
-        ComputeRemedyEvidence(run, view, callback, publish_hz);
+        ComputeRemedyEvidence(run, view, callback, needed_hz);
     f.rates_hz = {{"publish_hz", publish_hz},
                   {"take_hz", take_hz},
                   {"deficit", deficit},
                   {"allowed_deficit", allowed},
                   {"exec_load", ev.exec_load}};
+    if (state_input) f.rates_hz["needed_hz"] = needed_hz;
     if (ev.has_wait_ratio) f.rates_hz["core_wait_ratio"] = ev.core_wait_ratio;
 
     const bool exec_limited = ev.exec_load >= options.remedy_exec_load;
@@ -513,13 +530,19 @@ Diagnosis Diagnose(const runfile::RunData& run,
                                 ev.core_wait_ratio, 1e3 * ev.core_wait_mean_s,
                                 1e3 * ev.cost_mean_s)
                           : std::string("never ran in the window");
+    const std::string needed_text =
+        state_input ? fmt::format(
+                          ", needing {:.2f} Hz (a state input: one message "
+                          "per output of the node)",
+                          needed_hz)
+                    : std::string();
     f.message = fmt::format(
-        "{} cannot keep up with {}: takes {:.2f} Hz of {:.2f} Hz published "
+        "{} cannot keep up with {}: takes {:.2f} Hz of {:.2f} Hz published{} "
         "(deficit {:.1f}% > allowed {:.1f}% = {:g}/(1+{:.2f}/{:g})+{:g}); "
         "execution load {:.2f} (>= {:g} needs faster cores), {} "
         "(>= {:g} needs more cores) -> {}",
-        f.node, f.topics[0], take_hz, publish_hz, 100.0 * deficit,
-        100.0 * allowed, options.cpu_bound_base_fraction, publish_hz,
+        f.node, f.topics[0], take_hz, publish_hz, needed_text, 100.0 * deficit,
+        100.0 * allowed, options.cpu_bound_base_fraction, needed_hz,
         options.cpu_bound_tighten_hz, options.cpu_bound_floor_fraction,
         ev.exec_load, options.remedy_exec_load, wait_text,
         options.remedy_wait_ratio, f.remedy);

@@ -29,6 +29,14 @@ struct DiagnosisOptions {
   double cpu_bound_base_fraction = 0.3;    // extra allowance at low rates
   double cpu_bound_tighten_hz = 10.0;      // rate at which it has halved
   double cpu_bound_floor_fraction = 0.05;  // allowance at any rate (edges)
+  // 1: a state input (a subscription whose callback publishes nothing, in a
+  // node whose other callbacks do) needs one fresh message per output of
+  // its node, not every message, so its deficit is measured against the
+  // smaller of the publish rate and the node's output rate (the run rate of
+  // its busiest publishing callback): a 50 Hz pose kept last-1 by a 10 Hz
+  // LiDAR node is not flagged for the poses that went stale unread. 0:
+  // against the publish rate, as the rule is stated.
+  double cpu_bound_state_inputs_per_output = 1;
   // Frequency-bound: a node's slowest input is more than this fraction below
   // the median rate of its other inputs.
   double frequency_bound_fraction = 0.10;

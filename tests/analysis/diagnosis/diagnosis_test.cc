@@ -255,6 +255,57 @@ TEST(DiagnosisCpuBoundTest, FewMessagesAreIgnored) {
 }
 
 // Node "fusion" takes every message of inputs at the given rates (10 s).
+// Node "filter" turns an external 10 Hz /points into /out and keeps the
+// last of an external 50 Hz /pose, taken at `pose_take_hz`.
+runfile::RunData StateInputRun(double pose_take_hz) {
+  TraceBuilder b(10.0);
+  const int points = b.Topic("/points");
+  const int out = b.Topic("/out");
+  const int pose = b.Topic("/pose");
+  const int on_points = b.Subscription("filter", "on_points", "/points");
+  const int on_pose = b.Subscription("filter", "on_pose", "/pose");
+  b.Publishes(points, -1, 10.0, 100);
+  b.Takes(points, on_points, 10.0, 100, 0.05);
+  b.Publishes(out, on_points, 10.0, 100, 0.05);
+  b.Publishes(pose, -1, 50.0, 500);
+  b.Takes(pose, on_pose, pose_take_hz,
+          static_cast<int>(std::lround(10.0 * pose_take_hz)), 0.0001);
+  return b.run();
+}
+
+TEST(DiagnosisCpuBoundTest, StateInputNeedsOneMessagePerOutputOfItsNode) {
+  // 15 of 50 poses a second are more than one per output at 10 Hz.
+  EXPECT_EQ(FindKind(Diagnose(StateInputRun(15.0)), "cpu_bound"), nullptr);
+
+  // As the rule is stated, against the publish rate: 70 % behind.
+  DiagnosisOptions every_message;
+  ASSERT_TRUE(
+      SetOption(&every_message, "cpu_bound_state_inputs_per_output", 0).ok());
+  const Diagnosis d = Diagnose(StateInputRun(15.0), every_message);
+  const Finding* f = FindKind(d, "cpu_bound");
+  ASSERT_NE(f, nullptr);
+  EXPECT_EQ(f->topics, std::vector<std::string>{"/pose"});
+  EXPECT_NEAR(f->rates_hz.at("deficit"), 0.7, 1e-9);
+  EXPECT_EQ(f->rates_hz.count("needed_hz"), 0u);
+}
+
+TEST(DiagnosisCpuBoundTest, StateInputTakenLessThanItsNodeOutputsIsFlagged) {
+  // 5 poses a second for 10 outputs: half of them use a stale pose.
+  const Diagnosis d = Diagnose(StateInputRun(5.0));
+  const Finding* found = FindKind(d, "cpu_bound");
+  ASSERT_NE(found, nullptr);
+  const Finding& f = *found;
+  EXPECT_EQ(f.node, "filter");
+  EXPECT_EQ(f.topics, std::vector<std::string>{"/pose"});
+  EXPECT_NEAR(f.rates_hz.at("publish_hz"), 50.0, 1e-9);
+  EXPECT_NEAR(f.rates_hz.at("needed_hz"), 10.0, 1e-9);
+  EXPECT_NEAR(f.rates_hz.at("deficit"), 0.5, 1e-9);
+  EXPECT_NEAR(f.rates_hz.at("allowed_deficit"), 0.3 / 2.0 + 0.05, 1e-12);
+  EXPECT_NE(f.message.find("needing 10.00 Hz (a state input"),
+            std::string::npos)
+      << f.message;
+}
+
 runfile::RunData FusionRun(const std::vector<double>& rates_hz) {
   TraceBuilder b(10.0);
   for (size_t i = 0; i < rates_hz.size(); ++i) {
@@ -476,7 +527,9 @@ TEST(DiagnosisOptionsTest, SetOptionByName) {
   EXPECT_EQ(o.frequency_bound_fraction, 0.2);
   EXPECT_TRUE(SetOption(&o, "end_s", -1.0).ok());
   for (const std::string& name : DiagnosisOptionNames()) {
-    const double v = name == "frequency_bound_driving_inputs_only" ? 1 : 0.5;
+    const bool flag = name == "frequency_bound_driving_inputs_only" ||
+                      name == "cpu_bound_state_inputs_per_output";
+    const double v = flag ? 1 : 0.5;
     EXPECT_TRUE(SetOption(&o, name, v).ok()) << name;
   }
 

@@ -77,14 +77,11 @@ TEST(RunReportTest,
 TEST(RunReportTest,
      GenerousComputerKeepsUpWithTheScansAndDrivesCloseToThePath) {
   const RunReport r = Analyse(16, 2.1, 7);
-  // With Autoware's measured costs a node busy with a 40 ms scan misses
-  // some of the 50 Hz poses it samples (keep-last, the latest one wins):
-  // the diagnosis reports that, but no node falls behind the scans.
+  // No node falls behind: with Autoware's measured costs a node busy with
+  // a 40 ms scan skips some of the 50 Hz poses it keeps last-1, but it
+  // takes a fresh one for each of its outputs, which is all it needs.
   for (const FindingSummary& f : r.findings) {
-    if (f.kind != "cpu_bound") continue;
-    for (const std::string& topic : f.topics) {
-      EXPECT_EQ(topic, "/localization/pose") << ToJson(r).dump(2);
-    }
+    EXPECT_NE(f.kind, "cpu_bound") << ToJson(r).dump(2);
   }
   EXPECT_TRUE(r.feasible) << ToJson(r).dump(2);
   EXPECT_TRUE(r.deviation_complete);
