@@ -34,24 +34,57 @@ double SegmentSegment(const Vec2& a, const Vec2& b, const Vec2& c,
                    geometry::DistanceToSegment(d, a, b)});
 }
 
+size_t Edges(const std::vector<Vec2>& outline) {
+  return outline.size() == 2 ? 1 : outline.size();
+}
+
+// Only an outline of three or more points can hold the other.
+bool Holds(const std::vector<Vec2>& outline, const Vec2& p) {
+  return outline.size() >= 3 && geometry::InsidePolygon(outline, p);
+}
+
 // Distance between two closed outlines (a 2-point outline is a segment);
 // 0 when they touch or one holds the other.
 double OutlineDistance(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
-  auto edges = [](const std::vector<Vec2>& o) {
-    return o.size() == 2 ? 1 : o.size();
-  };
   double best = kInf;
-  for (size_t i = 0; i < edges(a); ++i) {
-    for (size_t j = 0; j < edges(b); ++j) {
+  for (size_t i = 0; i < Edges(a); ++i) {
+    for (size_t j = 0; j < Edges(b); ++j) {
       best = std::min(best, SegmentSegment(a[i], a[(i + 1) % a.size()], b[j],
                                            b[(j + 1) % b.size()]));
     }
   }
-  // Only an outline of three or more points can hold the other.
-  auto holds = [](const std::vector<Vec2>& outline, const Vec2& p) {
-    return outline.size() >= 3 && geometry::InsidePolygon(outline, p);
-  };
-  if (best > 0 && (holds(a, b.front()) || holds(b, a.front()))) best = 0.0;
+  if (best > 0 && (Holds(a, b.front()) || Holds(b, a.front()))) best = 0.0;
+  return best;
+}
+
+// A point where two touching outlines meet: the mean of their edges'
+// crossings, or of the vertices of one inside the other.
+Vec2 MeetingPoint(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
+  Vec2 sum = Vec2::Zero();
+  int n = 0;
+  for (size_t i = 0; i < Edges(a); ++i) {
+    const Vec2 &p = a[i], &r = a[(i + 1) % a.size()];
+    for (size_t j = 0; j < Edges(b); ++j) {
+      const Vec2 &q = b[j], &t = b[(j + 1) % b.size()];
+      if (!SegmentsCross(p, r, q, t)) continue;
+      const double u = Cross(q - p, t - q) / Cross(r - p, t - q);
+      sum += p + u * (r - p);
+      ++n;
+    }
+  }
+  for (const Vec2& v : a) {
+    if (Holds(b, v)) sum += v, ++n;
+  }
+  for (const Vec2& v : b) {
+    if (Holds(a, v)) sum += v, ++n;
+  }
+  if (n > 0) return sum / n;
+  // Touching without crossing (within rounding): the nearest vertex of b.
+  const Vec2 centre = 0.25 * (a[0] + a[1] + a[2] + a[3]);
+  Vec2 best = b.front();
+  for (const Vec2& v : b) {
+    if ((v - centre).norm() < (best - centre).norm()) best = v;
+  }
   return best;
 }
 
@@ -66,7 +99,54 @@ std::vector<Vec2> Body(const runfile::EgoSample& e,
           centre + hl - hw};
 }
 
+struct Clearance {
+  double min_m = kInf;
+  std::vector<ParkingContact> contacts;
+};
+
+// One pass over the trajectory: the smallest gap between the body and the
+// lot's obstacles, and each contact as it begins.
+Clearance MeasureClearance(const runfile::RunData& run) {
+  const runfile::ParkingRecord& p = run.parking;
+  std::vector<std::vector<Vec2>> outlines;
+  for (const runfile::OutlinePoint& v : p.obstacles) {
+    if (static_cast<size_t>(v.obstacle) >= outlines.size())
+      outlines.resize(v.obstacle + 1);
+    outlines[v.obstacle].emplace_back(v.x_m, v.y_m);
+  }
+  Clearance out;
+  bool touching = false;
+  for (const runfile::EgoSample& e : run.ego) {
+    const std::vector<Vec2> body = Body(e, p);
+    const Vec2 centre = 0.25 * (body[0] + body[1] + body[2] + body[3]);
+    double nearest = kInf;
+    const std::vector<Vec2>* touched = nullptr;
+    for (const std::vector<Vec2>& o : outlines) {
+      if (o.size() < 2) continue;
+      // Skip what is far away (the body's half-diagonal is under 3 m).
+      double far = kInf;
+      for (const Vec2& v : o) far = std::min(far, (v - centre).norm());
+      if (o.size() > 2 && far > 30.0) continue;
+      const double d = OutlineDistance(body, o);
+      if (d < nearest) nearest = d;
+      if (d <= 0.0 && touched == nullptr) touched = &o;
+    }
+    out.min_m = std::min(out.min_m, nearest);
+    if (touched != nullptr && !touching) {
+      const Vec2 at = MeetingPoint(body, *touched);
+      out.contacts.push_back({e, at.x(), at.y()});
+    }
+    touching = touched != nullptr;
+  }
+  return out;
+}
+
 }  // namespace
+
+std::vector<ParkingContact> ParkingContacts(const runfile::RunData& run) {
+  if (!run.parking.present) return {};
+  return MeasureClearance(run).contacts;
+}
 
 void AddParkingMetrics(const runfile::RunData& run,
                        std::map<std::string, double>* m) {
@@ -124,34 +204,9 @@ void AddParkingMetrics(const runfile::RunData& run,
   }
 
   // Clearance and contacts with the lot's obstacles.
-  std::vector<std::vector<Vec2>> outlines;
-  for (const runfile::OutlinePoint& v : p.obstacles) {
-    if (static_cast<size_t>(v.obstacle) >= outlines.size())
-      outlines.resize(v.obstacle + 1);
-    outlines[v.obstacle].emplace_back(v.x_m, v.y_m);
-  }
-  double clearance = kInf;
-  int contacts = 0;
-  bool touching = false;
-  for (const runfile::EgoSample& e : run.ego) {
-    const std::vector<Vec2> body = Body(e, p);
-    const Vec2 centre = 0.25 * (body[0] + body[1] + body[2] + body[3]);
-    double nearest = kInf;
-    for (const std::vector<Vec2>& o : outlines) {
-      if (o.size() < 2) continue;
-      // Skip what is far away (the body's half-diagonal is under 3 m).
-      double far = kInf;
-      for (const Vec2& v : o) far = std::min(far, (v - centre).norm());
-      if (o.size() > 2 && far > 30.0) continue;
-      nearest = std::min(nearest, OutlineDistance(body, o));
-    }
-    clearance = std::min(clearance, nearest);
-    const bool now = nearest <= 0.0;
-    if (now && !touching) ++contacts;
-    touching = now;
-  }
-  (*m)["min_clearance_m"] = std::isfinite(clearance) ? clearance : nan;
-  (*m)["obstacle_collisions"] = contacts;
+  const Clearance c = MeasureClearance(run);
+  (*m)["min_clearance_m"] = std::isfinite(c.min_m) ? c.min_m : nan;
+  (*m)["obstacle_collisions"] = static_cast<double>(c.contacts.size());
 
   // Gear changes: the direction of motion reversing.
   int changes = 0, last = 0;

@@ -7,6 +7,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include "analysis/runfile/run_data.h"
 
@@ -31,6 +32,18 @@ inline constexpr double kStandstillMps = 1e-3;
 //   gear_changes: reversals of the direction of motion.
 void AddParkingMetrics(const runfile::RunData& run,
                        std::map<std::string, double>* metrics);
+
+// One contact of the body with an obstacle of the lot: the first ego sample
+// touching it and a point where the outlines meet (m).
+struct ParkingContact {
+  runfile::EgoSample ego;
+  double x_m = 0.0;
+  double y_m = 0.0;
+};
+
+// The run's contacts in time order (obstacle_collisions counts them); empty
+// without a /parking record.
+std::vector<ParkingContact> ParkingContacts(const runfile::RunData& run);
 
 }  // namespace adse::analysis
 

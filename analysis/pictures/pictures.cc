@@ -273,6 +273,7 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   // valet_parking: the lot under the drive.
   const ToPixel to_px = px;
   DrawParkingLot(&img, run.parking, to_px, s);
+  const std::vector<ParkingContact> contacts = ParkingContacts(run);
 
   // Other vehicles, faintly, one path per id in time order.
   bool any_vehicle = false;
@@ -305,7 +306,7 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   for (const auto& p : run.ideal_path) ideal.push_back(px(p.x_m, p.y_m));
   DrawPolyline(&img, ego, Bgr(kTrajectoryRgb), s.Px(5));
   DrawPolyline(&img, ideal, Bgr(kIdealPathRgb), s.Px(2));
-  DrawParkingManoeuvre(&img, run, to_px, s);
+  DrawParkingManoeuvre(&img, run, contacts, to_px, s);
 
   cv::Point2d start(NAN, NAN), goal(NAN, NAN);
   for (const auto& p : ego) {
@@ -394,7 +395,7 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   if (map.detail_px > 0) {
     cv::Mat panel =
         img(cv::Rect(0, map.MapBottomPx(), map.width_px, map.detail_px));
-    DrawParkingDetail(&panel, run, lanes_world, s);
+    DrawParkingDetail(&panel, run, contacts, lanes_world, s);
     cv::line(img, cv::Point(0, map.MapBottomPx()),
              cv::Point(map.width_px - 1, map.MapBottomPx()),
              Bgr(kLaneCentreRgb), 1);
@@ -436,6 +437,13 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
     legend.Add("plan fwd", line_sample(kPlannedForwardRgb, s.Px(2)));
     legend.Add("plan rev", line_sample(kPlannedReverseRgb, s.Px(2)));
     legend.Add("car at end", line_sample(kEgoBodyRgb, s.Px(2)));
+    if (!contacts.empty()) {
+      legend.Add(fmt::format("car touching ({})", contacts.size()),
+                 [&](cv::Point2d a, cv::Point2d b) {
+                   DrawSegment(&img, a, b, Bgr(kContactRgb), s.Px(2));
+                   DrawContactMarker(&img, 0.5 * (a + b), s);
+                 });
+    }
   }
   cv::line(img, cv::Point(0, map.map_top_px - 1),
            cv::Point(map.width_px - 1, map.map_top_px - 1), Bgr(kLaneCentreRgb),

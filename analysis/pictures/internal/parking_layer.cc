@@ -78,6 +78,7 @@ void DrawParkingLot(cv::Mat* img, const runfile::ParkingRecord& parking,
 }
 
 void DrawParkingManoeuvre(cv::Mat* img, const runfile::RunData& run,
+                          const std::vector<ParkingContact>& contacts,
                           const ToPixel& px, const Style& s) {
   const runfile::ParkingRecord& parking = run.parking;
   if (!parking.present) return;
@@ -90,23 +91,38 @@ void DrawParkingManoeuvre(cv::Mat* img, const runfile::RunData& run,
                 Bgr(b.reverse ? kPlannedReverseRgb : kPlannedForwardRgb),
                 s.Px(2));
   }
-  if (run.ego.empty()) return;
-  // The car as it ended: its body, centre half a wheelbase ahead of the
-  // rear axle, with a tick on its nose.
-  const runfile::EgoSample& e = run.ego.back();
-  const double ahead = 0.5 * parking.wheelbase_m;
-  const double cx = e.x_m + ahead * std::cos(e.yaw_rad);
-  const double cy = e.y_m + ahead * std::sin(e.yaw_rad);
-  Outline(img, BoxPx(cx, cy, e.yaw_rad, parking.length_m, parking.width_m, px),
-          Bgr(kEgoBodyRgb), s.Px(2));
-  const double nose = 0.5 * parking.length_m;
-  DrawSegment(
-      img, px(cx, cy),
-      px(cx + nose * std::cos(e.yaw_rad), cy + nose * std::sin(e.yaw_rad)),
-      Bgr(kEgoBodyRgb), s.Px(2));
+  // The car's body, centre half a wheelbase ahead of the rear axle, with a
+  // tick on its nose.
+  auto body = [&](const runfile::EgoSample& e, Rgb colour) {
+    const double ahead = 0.5 * parking.wheelbase_m;
+    const double cx = e.x_m + ahead * std::cos(e.yaw_rad);
+    const double cy = e.y_m + ahead * std::sin(e.yaw_rad);
+    Outline(img,
+            BoxPx(cx, cy, e.yaw_rad, parking.length_m, parking.width_m, px),
+            Bgr(colour), s.Px(2));
+    const double nose = 0.5 * parking.length_m;
+    DrawSegment(
+        img, px(cx, cy),
+        px(cx + nose * std::cos(e.yaw_rad), cy + nose * std::sin(e.yaw_rad)),
+        Bgr(colour), s.Px(2));
+  };
+  for (const ParkingContact& c : contacts) body(c.ego, kContactRgb);
+  if (!run.ego.empty()) body(run.ego.back(), kEgoBodyRgb);
+  // The meeting points last, on top of everything.
+  for (const ParkingContact& c : contacts)
+    DrawContactMarker(img, px(c.x_m, c.y_m), s);
+}
+
+void DrawContactMarker(cv::Mat* img, cv::Point2d at, const Style& s) {
+  if (!Finite(at)) return;
+  const int radius = s.Px(5) * static_cast<int>(kShiftScale);
+  cv::circle(*img, Fixed(at), radius, Bgr(kContactRgb), cv::FILLED, cv::LINE_AA,
+             kShift);
+  cv::circle(*img, Fixed(at), radius, kBlack, 1, cv::LINE_AA, kShift);
 }
 
 void DrawParkingDetail(cv::Mat* panel, const runfile::RunData& run,
+                       const std::vector<ParkingContact>& contacts,
                        const std::vector<std::vector<cv::Point2d>>& lanes,
                        const Style& s) {
   const runfile::ParkingRecord& parking = run.parking;
@@ -153,7 +169,7 @@ void DrawParkingDetail(cv::Mat* panel, const runfile::RunData& run,
   for (const auto& p : run.ideal_path) ideal.push_back(px(p.x_m, p.y_m));
   DrawPolyline(panel, ego, Bgr(kTrajectoryRgb), s.Px(5));
   DrawPolyline(panel, ideal, Bgr(kIdealPathRgb), s.Px(2));
-  DrawParkingManoeuvre(panel, run, px, s);
+  DrawParkingManoeuvre(panel, run, contacts, px, s);
 
   // Scale bar and caption, bottom left.
   const double bar_m = NiceBelow(0.2 * panel->cols / px_per_m);

@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "analysis/metrics/parking_metrics.h"
 #include "analysis/pictures/internal/drawing_impl.h"
 #include "analysis/pictures/pictures.h"
 
@@ -21,15 +22,21 @@ void DrawParkingLot(cv::Mat* img, const runfile::ParkingRecord& parking,
                     const ToPixel& px, const Style& s);
 
 // Over the trajectory: the planned manoeuvre, forward and reverse legs in
-// their own colours, and the car's body at the run's last sample.
+// their own colours, the car's body at each contact with an obstacle (with
+// a dot where they met) and at the run's last sample.
 void DrawParkingManoeuvre(cv::Mat* img, const runfile::RunData& run,
+                          const std::vector<ParkingContact>& contacts,
                           const ToPixel& px, const Style& s);
+
+// A contact's meeting point: a red dot ringed in black.
+void DrawContactMarker(cv::Mat* img, cv::Point2d at, const Style& s);
 
 // The detail panel (drawn into `panel`, which clips): the manoeuvre's
 // surroundings enlarged — lanes (world coordinates), the lot, the
-// trajectory, the plan and the car at the end, with a scale bar and a
-// caption.
+// trajectory, the plan, the contacts and the car at the end, with a scale
+// bar and a caption.
 void DrawParkingDetail(cv::Mat* panel, const runfile::RunData& run,
+                       const std::vector<ParkingContact>& contacts,
                        const std::vector<std::vector<cv::Point2d>>& lanes,
                        const Style& s);
 

@@ -85,6 +85,18 @@ TEST(ParkingMetrics, TouchingAnObstacleCountsOnce) {
   AddParkingMetrics(run, &m);
   EXPECT_EQ(m["obstacle_collisions"], 1.0);
   EXPECT_EQ(m["min_clearance_m"], 0.0);
+  // Where: the car's tail reaches the pole's north edge (y = -3) first,
+  // while reversing (its axle 0.95 m short of the body's rear, backing
+  // along -y with the body's half-width 0.95 m either side of x = 2).
+  const std::vector<ParkingContact> contacts = ParkingContacts(run);
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_LT(contacts[0].ego.v_mps, 0.0);
+  EXPECT_NEAR(contacts[0].ego.y_m, -3.0 + 0.95, 0.1 + 1e-9);
+  EXPECT_NEAR(contacts[0].y_m, -3.0, 0.1 + 1e-9);
+  EXPECT_GE(contacts[0].x_m, 2.0 - 1e-9);
+  EXPECT_LE(contacts[0].x_m, 2.2 + 1e-9);
+  run.parking.present = false;
+  EXPECT_TRUE(ParkingContacts(run).empty());
 }
 
 TEST(ParkingMetrics, OnlyValetRunsHaveThem) {

@@ -257,6 +257,33 @@ TEST_F(PictureTest, ValetRunShowsTheLotTheTargetAndTheManoeuvre) {
   }
 }
 
+TEST_F(PictureTest, ValetRunMarksWhereTheCarTouchedAnObstacle) {
+  RunData run = SquareRun();
+  run.parking.present = true;
+  run.parking.planned_path = {{0, 1, 0, 0}, {99, 1, 0, 0}};
+  // A pole reaching into the first leg's left half (the body spans y 0.05
+  // to 1.95 there).
+  run.parking.obstacles = {
+      {0, 60.0, 1.5}, {0, 60.4, 1.5}, {0, 60.4, 1.9}, {0, 60.0, 1.9}};
+  TrajectoryImageOptions options;
+  Result<WorldToImage> map = TrajectoryImageMapping(run, options);
+  ASSERT_TRUE(map.ok());
+  ASSERT_TRUE(RenderTrajectoryImage(run, Path("touch.png"), options).ok());
+  Result<RgbImage> img = ReadImage(Path("touch.png"));
+  ASSERT_TRUE(img.ok());
+  // The body in red where it met the pole, a dot there, and the legend.
+  EXPECT_TRUE(
+      ColourNear(*img, map->Column(60.0), map->Row(1.7), kContactRgb, 3));
+  EXPECT_GT(CountColour(*img, kContactRgb), 100);
+
+  // Passing 0.2 m clear of it: nothing red.
+  for (runfile::OutlinePoint& v : run.parking.obstacles) v.y_m += 0.6;
+  ASSERT_TRUE(RenderTrajectoryImage(run, Path("clear.png"), options).ok());
+  Result<RgbImage> clear = ReadImage(Path("clear.png"));
+  ASSERT_TRUE(clear.ok());
+  EXPECT_EQ(CountColour(*clear, kContactRgb), 0);
+}
+
 TEST_F(PictureTest, PngBytesAreAPng) {
   Result<std::string> png = TrajectoryImagePng(SquareRun());
   ASSERT_TRUE(png.ok()) << png.status().ToString();
