@@ -120,10 +120,7 @@ std::string Title(const runfile::RunData& run) {
   }
   // The picture shows the last plan; say when there were others.
   if (run.parking.replans > 0) {
-    outcome += fmt::format(
-        ", plan shown is re-plan {} (the car left the "
-        "course of the one before)",
-        run.parking.replans);
+    outcome += fmt::format(", plan shown is re-plan {}", run.parking.replans);
   }
   return fmt::format(
       "{} | {} | {}",

@@ -17,7 +17,7 @@ namespace {
 // (task.stall_timeout_s), where it used to drive on to the timeout. v4: a
 // parking car is parked only once its manoeuvre is over (it used to count
 // as parked standing within the tolerances at a cusp).
-constexpr char kKeyVersion[] = "adse-run-key-v4";
+constexpr char kKeyVersion[] = "adse-run-key-v5";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

@@ -130,6 +130,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   inputs.initial_pose = {w.ego().x_m, w.ego().y_m, w.ego().yaw_rad};
   inputs.speed_limit_mps = spec.task.speed_limit_kmh / 3.6;
   inputs.goal_tolerance_m = spec.task.goal_tolerance_m;
+  inputs.goal_yaw_tolerance_rad =
+      spec.task.goal_yaw_tolerance_deg * M_PI / 180.0;
   inputs.wheelbase_m = w.ego_limits().wheelbase_m;
   inputs.vehicle_length_m = w.ego_limits().length_m;
   inputs.vehicle_width_m = w.ego_limits().width_m;
@@ -187,11 +189,12 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   }
   // ... and its word that the car stands at the manoeuvre's end: parked
   // as far as it can tell. Outside the tolerances nothing more will happen.
-  double parking_done_at_s = -1.0;
-  if (topics.parking_done >= 0) {
+  double parking_completed_at_s = -1.0;
+  if (topics.parking_completed >= 0) {
     graph.AddSink<stack::ParkingDoneMsg>(
-        topics.parking_done, [&](const stack::ParkingDoneMsg&, double t_s) {
-          if (parking_done_at_s < 0) parking_done_at_s = t_s;
+        topics.parking_completed,
+        [&](const stack::ParkingDoneMsg&, double t_s) {
+          if (parking_completed_at_s < 0) parking_completed_at_s = t_s;
         });
   }
   graph.AddSink<stack::StopReasonMsg>(
@@ -421,9 +424,11 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
       options.progress(w.time_s(), timeout);
       next_progress += 1.0;
     }
-    // A parking car is parked once its manoeuvre is over: standing within
-    // the tolerances at a cusp, before a last short leg, it is not yet.
-    if (w.goal_reached() && (!w.parking_task() || parking_done_at_s >= 0)) {
+    // A parking car is parked once the stack says so (the planner, when the
+    // manoeuvre is over and needs no correction): standing within the
+    // tolerances at a cusp, before a last short leg, it is not yet.
+    if (w.goal_reached() &&
+        (!w.parking_task() || parking_completed_at_s >= 0)) {
       reason = "goal_reached";
       break;
     }
@@ -433,7 +438,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     }
     // Once the car truly stands (the stack's speed estimate lags), and a
     // second after the stack's word at the earliest.
-    if (parking_done_at_s >= 0 && w.time_s() > parking_done_at_s + 1.0 &&
+    if (parking_completed_at_s >= 0 &&
+        w.time_s() > parking_completed_at_s + 1.0 &&
         std::abs(w.ego().v_mps) < 0.01) {
       reason = "parked_out_of_tolerance";
       break;

@@ -137,7 +137,8 @@ const std::vector<MetricInfo>& KnownMetrics() {
        "run, s"},
       {"parking_replans",
        "valet_parking: paths found after the first, each planned where the "
-       "car stood off the course of the one before, count"},
+       "car stood off the course of the one before or at its end outside "
+       "the goal's tolerances, count"},
       {"parking_path_deviation_m",
        "valet_parking: mean distance of the rear axle from the planned "
        "manoeuvre while driving it, m"},

@@ -135,6 +135,11 @@ Status ValidateFreespacePlannerParams(const FreespacePlannerParams& p) {
                                        ? "steer_penalty: expected >= 0"
                                        : "collision_margin_m: expected >= 0");
   }
+  if (!(p.min_start_clearance_m >= 0.0)) {
+    return Status::InvalidArgument(
+        fmt::format("min_start_clearance_m: expected >= 0, found {}",
+                    p.min_start_clearance_m));
+  }
   if (!(p.heuristic_weight >= 1.0)) {
     return Status::InvalidArgument(fmt::format(
         "heuristic_weight: expected >= 1, found {}", p.heuristic_weight));
@@ -168,8 +173,9 @@ Result<FreespacePath> FreespacePlanner::Plan(
   grid.ComputeDistances();
   stats_.work_units +=
       static_cast<int64_t>(grid.width_cells()) * grid.height_cells();
+  double margin_m = p.collision_margin_m;
   auto collides = [&](const Pose2& pose) {
-    return grid.FootprintCollides(pose, footprint_, p.collision_margin_m,
+    return grid.FootprintCollides(pose, footprint_, margin_m,
                                   &stats_.work_units);
   };
   if (collides(goal)) {
@@ -179,16 +185,29 @@ Result<FreespacePath> FreespacePlanner::Plan(
         goal.x_m, goal.y_m, goal.yaw_rad, p.collision_margin_m));
   }
   if (collides(start)) {
-    return Status::NotFound(fmt::format(
-        "no path: the car at the start ({:.2f}, {:.2f}) is within {:.2f} m "
-        "of an obstacle",
-        start.x_m, start.y_m, p.collision_margin_m));
+    // Standing closer than the margin already: the path keeps the
+    // clearance the car has (to 1 cm), if that is enough.
+    double fits_m = std::min(p.min_start_clearance_m, p.collision_margin_m);
+    margin_m = fits_m;
+    if (collides(start)) {
+      return Status::NotFound(fmt::format(
+          "no path: the car at the start ({:.2f}, {:.2f}) is within {:.2f} m "
+          "of an obstacle",
+          start.x_m, start.y_m, fits_m));
+    }
+    double too_close_m = p.collision_margin_m;
+    while (too_close_m - fits_m > 0.01) {
+      margin_m = 0.5 * (fits_m + too_close_m);
+      (collides(start) ? too_close_m : fits_m) = margin_m;
+    }
+    margin_m = fits_m;
   }
+  stats_.collision_margin_m = margin_m;
   // The rear axle is at least this far inside the body's outline.
   const double axle_clearance =
       std::min(
           {0.5 * footprint_.width_m, footprint_.rear_m, footprint_.front_m}) +
-      p.collision_margin_m - 1.5 * p.grid_resolution_m;
+      margin_m - 1.5 * p.grid_resolution_m;
   const std::vector<float> holonomic =
       HolonomicDistances(grid, g_xy, axle_clearance, &stats_.work_units);
   auto holonomic_at = [&](const Pose2& pose) -> double {

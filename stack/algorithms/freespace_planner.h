@@ -42,8 +42,12 @@ struct FreespacePlannerParams {
   double steer_penalty = 0.3;
   // Heuristic weight: above 1 trades optimality for speed.
   double heuristic_weight = 1.5;
-  // Footprint grown by this on every side in every collision check.
+  // Footprint grown by this on every side in every collision check. A car
+  // already standing closer than this to an obstacle (correcting its pose
+  // in a tight slot) is planned for with the clearance it has, down to
+  // min_start_clearance_m; closer than that, there is no path.
   double collision_margin_m = 0.25;
+  double min_start_clearance_m = 0.05;
   // The grid spans start and goal plus this margin on every side.
   double search_margin_m = 15.0;
   // A Reeds–Shepp shot to the goal is tried from nodes within this
@@ -76,6 +80,9 @@ struct FreespaceStats {
   // Footprint points tested and grid cells rasterised: the work units the
   // platform charges.
   int64_t work_units = 0;
+  // The margin the search kept: collision_margin_m, or less for a start
+  // already closer than that to an obstacle.
+  double collision_margin_m = 0.0;
 };
 
 class FreespacePlanner {

@@ -112,7 +112,9 @@ const std::vector<KnobInfo>& StackKnobs() {
         {"parking.max_expansions", true, 100, 1000000, 50000,
          "freespace search budget (node expansions) before no_path"},
         {"parking.collision_margin_m", false, 0.0, 2.0, 0.25,
-         "clearance the parking path keeps around the car's body, m"},
+         "clearance the parking path keeps around the car's body (from a "
+         "start already closer than this, the clearance the car has, at "
+         "least 0.05), m"},
         {"parking.forward_speed_mps", false, 0.2, 5.0, 1.5,
          "parking speed forwards, m/s"},
         {"parking.reverse_speed_mps", false, 0.2, 3.0, 1.0,
@@ -121,8 +123,10 @@ const std::vector<KnobInfo>& StackKnobs() {
          "farther than this from the parking path the car stops and the "
          "planner plans again from there (0: never), m"},
         {"parking.max_replans", true, 0, 100, 3,
-         "plans after the first one, past which an off-course car ends the "
-         "run with no_path"},
+         "plans after the first one (for leaving the course or for ending "
+         "the manoeuvre outside the goal's tolerances); past them an "
+         "off-course car ends the run with no_path and one off the goal "
+         "stays where it stands"},
     };
   }();
   return kKnobs;

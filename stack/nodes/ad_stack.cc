@@ -78,6 +78,7 @@ class Stack final : public AdStack {
   void BuildPerception(Graph* g);
   void BuildPlanning(Graph* g);
   void BuildParking(Graph* g);
+  void PlanParking(CallbackContext& ctx, double course_out_m, int max_replans);
   void BuildControl(Graph* g);
   // The controller's parking mode: one command along the manoeuvre, gear
   // and all, published.
@@ -118,10 +119,13 @@ class Stack final : public AdStack {
   std::optional<PoseMsg> freespace_pose_;
   std::vector<algo::GearedPose> freespace_path_;  // the last plan found
   int freespace_replans_ = 0;
-  bool parking_planned_ = false;  // the planner has answered (path or not)
+  bool parking_planned_ = false;    // the planner has answered (path or not)
+  bool path_driven_ = false;        // the controller says: driven to its end
+  bool parking_completed_ = false;  // the planner has said: parked
+  int parking_done_ = -1;  // topic: the controller drove its path's end
   std::unique_ptr<algo::ParkingFollower> parking_follower_;
-  bool parking_mode_ = false;  // the follower drives the parking path
-  bool parking_done_ = false;  // ... and has reached its end
+  bool parking_mode_ = false;       // the follower drives the parking path
+  bool path_end_reported_ = false;  // ... and has reported reaching its end
 };
 
 Status Stack::Build(Graph* g) {
@@ -622,10 +626,14 @@ void Stack::BuildParking(Graph* g) {
   // Autoware's parking scenario: once the car stands at the end of its
   // road route (on the aisle beside the slot), the freespace planner plans
   // the manoeuvre into the slot from the localization pose; again from
-  // where it stands whenever the car has left that path's course.
+  // where it stands whenever the car has left that path's course, or has
+  // driven it to its end outside the goal's tolerances. It says when the
+  // car is parked (Autoware's is_completed).
   topics_.parking_path =
       g->AddTopic<ParkingPathMsg>("/planning/scenario_planning/parking/path");
-  topics_.parking_done = g->AddTopic<ParkingDoneMsg>("/control/parking_done");
+  topics_.parking_completed = g->AddTopic<ParkingDoneMsg>(
+      "/planning/scenario_planning/parking/is_completed");
+  parking_done_ = g->AddTopic<ParkingDoneMsg>("/control/parking_done");
   algo::FreespacePlannerParams params;
   params.turning_radius_m = config_.Get("parking.turning_radius_m");
   params.max_expansions =
@@ -639,60 +647,94 @@ void Stack::BuildParking(Graph* g) {
   g->Subscribe<PoseMsg>(
       node, topics_.pose, "pose", 1,
       [this](const PoseMsg& in, CallbackContext&) { freespace_pose_ = in; });
+  g->Subscribe<ParkingDoneMsg>(
+      node, parking_done_, "parking_done", 1,
+      [this](const ParkingDoneMsg&, CallbackContext&) { path_driven_ = true; });
   const double course_out_m = config_.Get("parking.course_out_m");
   const int max_replans = static_cast<int>(config_.Get("parking.max_replans"));
-  g->AddTimer(
-      node, "plan", 1.0 / config_.Get("parking.rate_hz"),
-      [this, course_out_m, max_replans](CallbackContext& ctx) {
-        if (!freespace_pose_ || !freespace_pose_->valid) return;
-        const geometry::Pose2& pose = freespace_pose_->pose;
-        const Eigen::Vector2d at(pose.x_m, pose.y_m);
-        const bool standing = std::abs(freespace_pose_->v_mps) < 0.1;
-        ParkingPathMsg out;
-        out.header.stamp_s = freespace_pose_->header.stamp_s;
-        if (!parking_planned_) {
-          // Handed over when standing within reach of the route's end.
-          const Eigen::Vector2d end = inputs_.route.points.back();
-          if (!standing ||
-              (at - end).norm() > std::max(3.0, inputs_.goal_tolerance_m))
-            return;
-          parking_planned_ = true;
-        } else {
-          // Standing off the course of its path (where the controller
-          // holds it), the car gets a new path from there.
-          if (freespace_path_.empty() || course_out_m <= 0 || !standing) return;
-          const double off_m = algo::DistanceFromPath(freespace_path_, at);
-          if (off_m <= course_out_m) return;
-          if (freespace_replans_ == max_replans) {
-            out.found = false;
-            out.failure = fmt::format(
-                "off the course of its path ({:.2f} m > parking.course_out_m) "
-                "after {} re-plans (parking.max_replans)",
-                off_m, max_replans);
-            freespace_path_.clear();
-            ctx.Publish(topics_.parking_path, std::move(out));
-            return;
-          }
-          ++freespace_replans_;
-        }
-        const Result<algo::FreespacePath> path = freespace_->Plan(
-            pose, inputs_.parking_goal, inputs_.parking_obstacles);
-        out.found = path.ok();
-        out.expansions = freespace_->last_stats().expansions;
-        if (path.ok()) {
-          freespace_path_ = path->poses;
-          for (const algo::GearedPose& p : path->poses) {
-            out.poses.push_back(
-                {p.pose.x_m, p.pose.y_m, p.pose.yaw_rad, p.reverse});
-          }
-        } else {
-          freespace_path_.clear();
-          out.failure = path.status().message();
-        }
-        ctx.ReportWork(
-            {static_cast<double>(freespace_->last_stats().work_units), 0.0, 1});
-        ctx.Publish(topics_.parking_path, std::move(out));
-      });
+  g->AddTimer(node, "plan", 1.0 / config_.Get("parking.rate_hz"),
+              [this, course_out_m, max_replans](CallbackContext& ctx) {
+                PlanParking(ctx, course_out_m, max_replans);
+              });
+}
+
+void Stack::PlanParking(CallbackContext& ctx, double course_out_m,
+                        int max_replans) {
+  if (parking_completed_ || !freespace_pose_ || !freespace_pose_->valid) return;
+  const geometry::Pose2& pose = freespace_pose_->pose;
+  const Eigen::Vector2d at(pose.x_m, pose.y_m);
+  const bool standing = std::abs(freespace_pose_->v_mps) < 0.1;
+  const double stamp_s = freespace_pose_->header.stamp_s;
+  auto complete = [&] {
+    parking_completed_ = true;
+    ParkingDoneMsg done;
+    done.header.stamp_s = stamp_s;
+    ctx.Publish(topics_.parking_completed, std::move(done));
+  };
+  ParkingPathMsg out;
+  out.header.stamp_s = stamp_s;
+  bool correcting = false;
+  if (!parking_planned_) {
+    // Handed over when standing within reach of the route's end.
+    const Eigen::Vector2d end = inputs_.route.points.back();
+    if (!standing ||
+        (at - end).norm() > std::max(3.0, inputs_.goal_tolerance_m))
+      return;
+    parking_planned_ = true;
+  } else if (path_driven_) {
+    // At the path's end: parked if the stack's pose is within the goal's
+    // tolerances, or if no re-plan is left; otherwise a new path from
+    // here corrects it.
+    path_driven_ = false;
+    if (algo::WithinParkingGoal(pose, inputs_.parking_goal,
+                                inputs_.goal_tolerance_m,
+                                inputs_.goal_yaw_tolerance_rad) ||
+        freespace_replans_ == max_replans) {
+      complete();
+      return;
+    }
+    ++freespace_replans_;
+    correcting = true;
+  } else {
+    // Standing off the course of its path (where the controller holds
+    // it), the car gets a new path from there.
+    if (freespace_path_.empty() || course_out_m <= 0 || !standing) return;
+    const double off_m = algo::DistanceFromPath(freespace_path_, at);
+    if (off_m <= course_out_m) return;
+    if (freespace_replans_ == max_replans) {
+      out.found = false;
+      out.failure = fmt::format(
+          "off the course of its path ({:.2f} m > parking.course_out_m) "
+          "after {} re-plans (parking.max_replans)",
+          off_m, max_replans);
+      freespace_path_.clear();
+      ctx.Publish(topics_.parking_path, std::move(out));
+      return;
+    }
+    ++freespace_replans_;
+  }
+  const Result<algo::FreespacePath> path =
+      freespace_->Plan(pose, inputs_.parking_goal, inputs_.parking_obstacles);
+  ctx.ReportWork(
+      {static_cast<double>(freespace_->last_stats().work_units), 0.0, 1});
+  if (!path.ok() && correcting) {
+    // No way to the goal from where it stands: parked there, off the goal
+    // (the planner's failure would end the run as no_path).
+    complete();
+    return;
+  }
+  out.found = path.ok();
+  out.expansions = freespace_->last_stats().expansions;
+  if (path.ok()) {
+    freespace_path_ = path->poses;
+    for (const algo::GearedPose& p : path->poses) {
+      out.poses.push_back({p.pose.x_m, p.pose.y_m, p.pose.yaw_rad, p.reverse});
+    }
+  } else {
+    freespace_path_.clear();
+    out.failure = path.status().message();
+  }
+  ctx.Publish(topics_.parking_path, std::move(out));
 }
 
 void Stack::Park(CallbackContext& ctx, double dt_s, double speed_cap_mps,
@@ -703,13 +745,13 @@ void Stack::Park(CallbackContext& ctx, double dt_s, double speed_cap_mps,
   out->steer_rad = c.steer_rad;
   out->reverse = c.reverse;
   ctx.ReportWork({1.0, 0.0, 1});
-  if (c.finished && !parking_done_) {
-    // Once: the car stands at the manoeuvre's end (parked, as far as the
-    // stack can tell).
-    parking_done_ = true;
+  if (c.finished && !path_end_reported_) {
+    // Once per path: the car stands at its end (the planner decides
+    // whether that is parked).
+    path_end_reported_ = true;
     ParkingDoneMsg done;
     done.header.stamp_s = out->header.stamp_s;
-    ctx.Publish(topics_.parking_done, std::move(done));
+    ctx.Publish(parking_done_, std::move(done));
   }
   ctx.Publish(topics_.control, std::move(*out));
 }
@@ -743,6 +785,7 @@ void Stack::BuildControl(Graph* g) {
             poses.push_back({{p.x_m, p.y_m, p.yaw_rad}, p.reverse});
           parking_follower_->SetPath(poses);
           parking_mode_ = true;
+          path_end_reported_ = false;
         });
   }
   const double max_travel_per_fix_m =

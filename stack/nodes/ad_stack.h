@@ -26,6 +26,7 @@ struct StackInputs {
   geometry::Pose2 initial_pose;  // given at start, as an operator does
   double speed_limit_mps = 30.0 / 3.6;
   double goal_tolerance_m = 2.0;
+  double goal_yaw_tolerance_rad = M_PI;  // valet_parking's heading tolerance
   double wheelbase_m = 2.7;
   double vehicle_length_m = 4.6;
   double vehicle_width_m = 1.9;
@@ -43,15 +44,17 @@ struct StackInputs {
 
 // Topic indices the harness talks to.
 struct StackTopics {
-  int lidar_raw = -1;       // in: PointCloudMsg, vehicle frame
-  int odometry = -1;        // in: OdometryMsg
-  int pose = -1;            // out: PoseMsg (EKF)
-  int control = -1;         // out: ControlMsg
-  int trajectory = -1;      // out: TrajectoryMsg
-  int stop_reason = -1;     // out: StopReasonMsg, why the trajectory stops
-  int objects = -1;         // out: ObjectsMsg
-  int parking_path = -1;    // out: ParkingPathMsg (valet_parking only)
-  int parking_done = -1;    // out: ParkingDoneMsg (valet_parking only)
+  int lidar_raw = -1;     // in: PointCloudMsg, vehicle frame
+  int odometry = -1;      // in: OdometryMsg
+  int pose = -1;          // out: PoseMsg (EKF)
+  int control = -1;       // out: ControlMsg
+  int trajectory = -1;    // out: TrajectoryMsg
+  int stop_reason = -1;   // out: StopReasonMsg, why the trajectory stops
+  int objects = -1;       // out: ObjectsMsg
+  int parking_path = -1;  // out: ParkingPathMsg (valet_parking only)
+  // out: ParkingDoneMsg (valet_parking only), the freespace planner's
+  // is_completed: parked, as far as the stack can tell
+  int parking_completed = -1;
   int traffic_signal = -1;  // in: TrafficSignalMsg (traffic_signals only)
 };
 

@@ -103,10 +103,42 @@ TEST(ValetParkingTest, UnreachableSlotEndsTheRunWithNoPathNotATimeout) {
   EXPECT_GE(run->parking.planned_at_s, 0.0);
 }
 
+TEST(ValetParkingTest, AManoeuvreEndingOutsideTheTolerancesIsCorrected) {
+  spec::Spec spec = Bundled("valet_parking.yaml");
+  // Tighter than the manoeuvre ends here (0.09 m off): the planner plans
+  // again from where the car stands, and that short manoeuvre ends within.
+  spec.task.goal_tolerance_m = 0.08;
+  Result<runfile::RunData> run = SimulatePoint(spec, kGenerous);
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->termination_reason, "goal_reached");
+  EXPECT_EQ(run->metrics.at("parked"), 1.0);
+  EXPECT_LE(run->metrics.at("parking_position_error_m"), 0.08);
+  EXPECT_EQ(run->metrics.at("obstacle_collisions"), 0.0);
+  // The plan recorded is the correction: a short one, ending at the goal.
+  ASSERT_GE(run->parking.planned_path.size(), 2u);
+  EXPECT_NEAR(run->parking.planned_path.back().x_m, run->parking.goal_x_m,
+              1e-6);
+  EXPECT_NEAR(run->parking.planned_path.back().y_m, run->parking.goal_y_m,
+              1e-6);
+  EXPECT_GE(run->parking.replans, 1);
+  EXPECT_EQ(run->metrics.at("parking_replans"), run->parking.replans);
+
+  // With no re-plan left it stays where the first manoeuvre ended.
+  ASSERT_TRUE(spec.stack.Set("parking.max_replans", 0).ok());
+  Result<runfile::RunData> first = SimulatePoint(spec, kGenerous);
+  ASSERT_TRUE(first.ok()) << first.status().ToString();
+  EXPECT_EQ(first->termination_reason, "parked_out_of_tolerance");
+  EXPECT_EQ(first->parking.replans, 0);
+  EXPECT_GT(first->metrics.at("parking_position_error_m"), 0.08);
+  EXPECT_LT(first->metrics.at("nav_time_s"), run->metrics.at("nav_time_s"));
+}
+
 TEST(ValetParkingTest, ParkedOutsideTheToleranceEndsTheRunAtOnce) {
   spec::Spec spec = Bundled("valet_parking.yaml");
-  // Tighter than the manoeuvre ends (about 1.4 degrees off at this point).
+  // Tighter than the manoeuvre ends (about 1.4 degrees off at this point),
+  // and no re-plan to correct it.
   spec.task.goal_yaw_tolerance_deg = 0.2;
+  ASSERT_TRUE(spec.stack.Set("parking.max_replans", 0).ok());
   Result<runfile::RunData> run = SimulatePoint(spec, kGenerous);
   ASSERT_TRUE(run.ok()) << run.status().ToString();
   EXPECT_EQ(run->termination_reason, "parked_out_of_tolerance");

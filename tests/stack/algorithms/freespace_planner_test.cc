@@ -133,6 +133,37 @@ TEST(FreespacePlanner, WalledOffSlotHasNoPathWithoutSearching) {
   EXPECT_EQ(planner.last_stats().expansions, 0);
 }
 
+TEST(FreespacePlanner, ACarCloserThanTheMarginKeepsTheClearanceItHas) {
+  // Backed in but 0.3 m to the right: 0.25 m from the car parked there,
+  // which the 0.2 m grid sees as less than the 0.25 m margin. The
+  // correction keeps the clearance the grid sees.
+  const Lot lot = MakeLot();
+  Pose2 start = SlotGoal(false);
+  start.x_m += 0.3;
+  FreespacePlanner planner({}, Footprint());
+  const Result<FreespacePath> path =
+      planner.Plan(start, SlotGoal(false), lot.Outlines());
+  ASSERT_TRUE(path.ok()) << path.status().ToString();
+  ExpectEndsAt(*path, SlotGoal(false));
+  ExpectNoCollision(*path, lot);
+  const double kept_m = planner.last_stats().collision_margin_m;
+  EXPECT_GT(kept_m, 0.1);
+  EXPECT_LT(kept_m, 0.2);
+
+  // From the aisle the full margin holds.
+  ASSERT_TRUE(planner.Plan(kStart, SlotGoal(false), lot.Outlines()).ok());
+  EXPECT_EQ(planner.last_stats().collision_margin_m, 0.25);
+
+  // Against the parked car (0.05 m off, closer on the grid): no path.
+  start.x_m += 0.2;
+  const Result<FreespacePath> touching =
+      planner.Plan(start, SlotGoal(false), lot.Outlines());
+  ASSERT_FALSE(touching.ok());
+  EXPECT_NE(touching.status().message().find("within 0.05 m of an obstacle"),
+            std::string::npos)
+      << touching.status().message();
+}
+
 TEST(FreespacePlanner, ExpansionBudgetEndsTheSearch) {
   const Lot lot = MakeLot();
   FreespacePlannerParams params;
@@ -175,6 +206,11 @@ TEST(FreespacePlanner, ParamsValidationNamesTheField) {
   EXPECT_EQ(
       ValidateFreespacePlannerParams(p).message().rfind("reverse_penalty", 0),
       0u);
+  p = {};
+  p.min_start_clearance_m = -0.1;
+  EXPECT_EQ(ValidateFreespacePlannerParams(p).message().rfind(
+                "min_start_clearance_m", 0),
+            0u);
   EXPECT_TRUE(ValidateFreespacePlannerParams({}).ok());
 }
 
