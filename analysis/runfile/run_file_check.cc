@@ -4,6 +4,8 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 
 #include "analysis/runfile/hdf5_util_impl.h"
@@ -332,10 +334,9 @@ class Checker {
   std::vector<std::string>* problems_;
 };
 
-Result<json> LoadSchema(const std::string& schema_path) {
-  Result<std::string> text = ReadFile(schema_path);
-  if (!text.ok()) return text.status().WithContext("loading the run schema");
-  json schema = json::parse(*text, nullptr, /*allow_exceptions=*/false);
+Result<std::shared_ptr<const json>> ParseSchema(const std::string& schema_path,
+                                                const std::string& text) {
+  json schema = json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (schema.is_discarded() || !schema.is_object()) {
     return Status::Corruption(schema_path + ": not valid JSON");
   }
@@ -345,12 +346,34 @@ Result<json> LoadSchema(const std::string& schema_path) {
       return Status::Corruption(schema_path + ": lacks '" + key + "'");
     }
   }
-  return schema;
+  return std::make_shared<const json>(std::move(schema));
+}
+
+// Parsing the schema costs more than checking a small run file, and callers
+// check many files against one schema (a campaign's runs, the fuzzer), so
+// the last schema parsed is kept while its path and text stay the same.
+Result<std::shared_ptr<const json>> LoadSchema(const std::string& schema_path) {
+  Result<std::string> text = ReadFile(schema_path);
+  if (!text.ok()) return text.status().WithContext("loading the run schema");
+  static std::mutex mutex;
+  static std::string cached_path;
+  static std::string cached_text;
+  static std::shared_ptr<const json> cached;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (cached == nullptr || cached_path != schema_path || cached_text != *text) {
+    Result<std::shared_ptr<const json>> parsed =
+        ParseSchema(schema_path, *text);
+    if (!parsed.ok()) return parsed.status();
+    cached = *parsed;
+    cached_path = schema_path;
+    cached_text = std::move(*text);
+  }
+  return cached;
 }
 
 Status CheckImpl(const std::string& path, const std::string& schema_path,
                  std::vector<std::string>* problems) {
-  Result<json> schema = LoadSchema(schema_path);
+  Result<std::shared_ptr<const json>> schema = LoadSchema(schema_path);
   if (!schema.ok()) return schema.status();
   std::error_code ec;
   if (!fs::exists(path, ec)) return Status::NotFound(path + ": no such file");
@@ -372,7 +395,7 @@ Status CheckImpl(const std::string& path, const std::string& schema_path,
                         internal::TakeHdf5Error());
       } else {
         try {
-          Checker(file.get(), *schema, &found).Run();
+          Checker(file.get(), **schema, &found).Run();
         } catch (const json::exception& e) {
           return Status::Corruption(schema_path +
                                     ": malformed schema: " + e.what());

@@ -390,6 +390,20 @@ TEST_F(RunFileCheckTest, SchemaErrorsAreReported) {
   EXPECT_NE(status.message().find("malformed.json"), std::string::npos);
 }
 
+// The parsed schema is kept between checks (callers check many files), but
+// a schema changed on disk is read again.
+TEST_F(RunFileCheckTest, ASchemaChangedOnDiskIsReadAgain) {
+  const std::string schema = Path("changing.json");
+  fs::copy_file(SchemaPath(), schema);
+  EXPECT_TRUE(CheckRunFile(good_, schema, nullptr).ok());
+  std::ofstream(schema, std::ios::trunc) << "{ not json";
+  EXPECT_EQ(CheckRunFile(good_, schema, nullptr).code(),
+            Status::Code::kCorruption);
+  fs::remove(schema);
+  fs::copy_file(SchemaPath(), schema);
+  EXPECT_TRUE(CheckRunFile(good_, schema, nullptr).ok());
+}
+
 // The schema documents everything the writer puts in a file, with the same
 // version and string widths: the two cannot drift apart silently.
 TEST_F(RunFileCheckTest, SchemaDocumentsEverythingTheWriterWrites) {
