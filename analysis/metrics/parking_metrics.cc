@@ -72,12 +72,16 @@ Vec2 MeetingPoint(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
       ++n;
     }
   }
-  for (const Vec2& v : a) {
-    if (Holds(b, v)) sum += v, ++n;
-  }
-  for (const Vec2& v : b) {
-    if (Holds(a, v)) sum += v, ++n;
-  }
+  auto add_inside = [&](const std::vector<Vec2>& points,
+                        const std::vector<Vec2>& outline) {
+    for (const Vec2& v : points) {
+      if (!Holds(outline, v)) continue;
+      sum += v;
+      ++n;
+    }
+  };
+  add_inside(a, b);
+  add_inside(b, a);
   if (n > 0) return sum / n;
   // Touching without crossing (within rounding): the nearest vertex of b.
   const Vec2 centre = 0.25 * (a[0] + a[1] + a[2] + a[3]);

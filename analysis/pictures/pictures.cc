@@ -130,11 +130,7 @@ std::string Title(const runfile::RunData& run) {
 }
 
 void DrawStartMarker(cv::Mat* img, cv::Point2d at, const Style& s) {
-  if (!Finite(at)) return;
-  const int radius = s.Px(8) * static_cast<int>(kShiftScale);
-  cv::circle(*img, Fixed(at), radius, Bgr(kStartRgb), cv::FILLED, cv::LINE_AA,
-             kShift);
-  cv::circle(*img, Fixed(at), radius, kBlack, 1, cv::LINE_AA, kShift);
+  DrawRingedDot(img, at, s.Px(8), Bgr(kStartRgb), kBlack);
 }
 
 void DrawGoalMarker(cv::Mat* img, cv::Point2d at, const Style& s) {
@@ -160,12 +156,7 @@ Rgb StandRgb(const analysis::Stand& stand) {
 }
 
 void DrawStandMarker(cv::Mat* img, cv::Point2d at, Rgb colour, const Style& s) {
-  if (!Finite(at)) return;
-  const int radius = s.Px(6) * static_cast<int>(kShiftScale);
-  cv::circle(*img, Fixed(at), radius, Bgr(colour), cv::FILLED, cv::LINE_AA,
-             kShift);
-  cv::circle(*img, Fixed(at), radius, Bgr(kBackgroundRgb), 1, cv::LINE_AA,
-             kShift);
+  DrawRingedDot(img, at, s.Px(6), Bgr(colour), Bgr(kBackgroundRgb));
 }
 
 // Labels a marker: above and right of it, else (header above, image edge

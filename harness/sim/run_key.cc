@@ -16,7 +16,9 @@ namespace {
 // something traffic will not release ends the run as stalled
 // (task.stall_timeout_s), where it used to drive on to the timeout. v4: a
 // parking car is parked only once its manoeuvre is over (it used to count
-// as parked standing within the tolerances at a cusp).
+// as parked standing within the tolerances at a cusp). v5: the freespace
+// planner says when the car is parked and corrects a manoeuvre ending
+// outside the tolerances.
 constexpr char kKeyVersion[] = "adse-run-key-v5";
 
 Status AddFile(ContentHasher* h, const std::string& label,

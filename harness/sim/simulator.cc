@@ -187,8 +187,9 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
           no_path = !m.found;
         });
   }
-  // ... and its word that the car stands at the manoeuvre's end: parked
-  // as far as it can tell. Outside the tolerances nothing more will happen.
+  // ... and the planner's word that the car is parked (its is_completed):
+  // the manoeuvre is over and needs no correction, as far as the stack can
+  // tell. Outside the tolerances nothing more will happen.
   double parking_completed_at_s = -1.0;
   if (topics.parking_completed >= 0) {
     graph.AddSink<stack::ParkingDoneMsg>(

@@ -123,6 +123,14 @@ void DrawPolyline(cv::Mat* img, const std::vector<cv::Point2d>& points,
   }
 }
 
+void DrawRingedDot(cv::Mat* img, cv::Point2d at, int radius_px,
+                   const cv::Scalar& fill, const cv::Scalar& ring) {
+  if (!Finite(at)) return;
+  const int radius = radius_px * static_cast<int>(kShiftScale);
+  cv::circle(*img, Fixed(at), radius, fill, cv::FILLED, cv::LINE_AA, kShift);
+  cv::circle(*img, Fixed(at), radius, ring, 1, cv::LINE_AA, kShift);
+}
+
 void DrawDashed(cv::Mat* img, cv::Point2d a, cv::Point2d b,
                 const cv::Scalar& colour, int thickness, double dash_px) {
   const double length = cv::norm(b - a);

@@ -76,6 +76,11 @@ void DrawPolyline(cv::Mat* img, const std::vector<cv::Point2d>& points,
 void DrawDashed(cv::Mat* img, cv::Point2d a, cv::Point2d b,
                 const cv::Scalar& colour, int thickness, double dash_px);
 
+// A filled dot of `radius_px` with a 1-px ring (a marker); nothing at a
+// non-finite point.
+void DrawRingedDot(cv::Mat* img, cv::Point2d at, int radius_px,
+                   const cv::Scalar& fill, const cv::Scalar& ring);
+
 // 1, 2 or 5 times a power of ten, at most `limit` (> 0).
 double NiceBelow(double limit);
 

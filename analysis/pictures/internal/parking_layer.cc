@@ -114,11 +114,7 @@ void DrawParkingManoeuvre(cv::Mat* img, const runfile::RunData& run,
 }
 
 void DrawContactMarker(cv::Mat* img, cv::Point2d at, const Style& s) {
-  if (!Finite(at)) return;
-  const int radius = s.Px(5) * static_cast<int>(kShiftScale);
-  cv::circle(*img, Fixed(at), radius, Bgr(kContactRgb), cv::FILLED, cv::LINE_AA,
-             kShift);
-  cv::circle(*img, Fixed(at), radius, kBlack, 1, cv::LINE_AA, kShift);
+  DrawRingedDot(img, at, s.Px(5), Bgr(kContactRgb), kBlack);
 }
 
 void DrawParkingDetail(cv::Mat* panel, const runfile::RunData& run,

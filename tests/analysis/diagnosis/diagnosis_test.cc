@@ -254,7 +254,6 @@ TEST(DiagnosisCpuBoundTest, FewMessagesAreIgnored) {
   EXPECT_EQ(Diagnose(b.run(), o).findings.size(), 1u);
 }
 
-// Node "fusion" takes every message of inputs at the given rates (10 s).
 // Node "filter" turns an external 10 Hz /points into /out and keeps the
 // last of an external 50 Hz /pose, taken at `pose_take_hz`.
 runfile::RunData StateInputRun(double pose_take_hz) {
@@ -306,6 +305,7 @@ TEST(DiagnosisCpuBoundTest, StateInputTakenLessThanItsNodeOutputsIsFlagged) {
       << f.message;
 }
 
+// Node "fusion" takes every message of inputs at the given rates (10 s).
 runfile::RunData FusionRun(const std::vector<double>& rates_hz) {
   TraceBuilder b(10.0);
   for (size_t i = 0; i < rates_hz.size(); ++i) {
