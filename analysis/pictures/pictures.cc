@@ -118,9 +118,9 @@ std::string Title(const runfile::RunData& run) {
             ? fmt::format(", nav >= {:.1f} s (stopped early)", it->second)
             : fmt::format(", nav {:.1f} s", it->second);
   }
-  // The picture shows the last plan; say when there were others.
+  // The picture shows the last plan in colour; say when there were others.
   if (run.parking.replans > 0) {
-    outcome += fmt::format(", plan shown is re-plan {}", run.parking.replans);
+    outcome += fmt::format(", re-planned {}x", run.parking.replans);
   }
   return fmt::format(
       "{} | {} | {}",
@@ -424,6 +424,8 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
     legend.Add("parked car / wall", line_sample(kObstacleRgb, s.Px(5)));
     legend.Add("plan fwd", line_sample(kPlannedForwardRgb, s.Px(2)));
     legend.Add("plan rev", line_sample(kPlannedReverseRgb, s.Px(2)));
+    if (!run.parking.earlier_plans.empty())
+      legend.Add("earlier plans", line_sample(kEarlierPlanRgb, s.Px(2)));
     legend.Add("car at end", line_sample(kEgoBodyRgb, s.Px(2)));
     if (!contacts.empty()) {
       legend.Add(fmt::format("car touching ({})", contacts.size()),

@@ -42,6 +42,7 @@ inline constexpr Rgb kObstacleRgb{112, 104, 96};   // warm grey: walls, cars
 inline constexpr Rgb kTargetSlotRgb{230, 140, 0};  // orange
 inline constexpr Rgb kPlannedForwardRgb{150, 60, 190};  // purple
 inline constexpr Rgb kPlannedReverseRgb{215, 40, 140};  // magenta
+inline constexpr Rgb kEarlierPlanRgb{205, 180, 230};    // pale violet
 inline constexpr Rgb kEgoBodyRgb{20, 60, 160};          // dark blue
 inline constexpr Rgb kContactRgb{230, 20, 20};          // red: touching
 // Where the car stood, by what held it.

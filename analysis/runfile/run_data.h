@@ -90,6 +90,13 @@ struct ParkingPathRow {
   int32_t reverse;  // 1: driven in reverse
 };
 
+// A pose of a plan that a later one replaced.
+struct EarlierPlanRow {
+  int32_t plan;  // 0: the first plan, then in order
+  double x_m, y_m, yaw_rad;
+  int32_t reverse;
+};
+
 // valet_parking's record (the /parking group): the goal and the lot the
 // manoeuvre was planned in, and the plan itself.
 struct ParkingRecord {
@@ -105,13 +112,17 @@ struct ParkingRecord {
   double planned_at_s = -1.0;
   int32_t path_found = 0;
   // Its first plan (-1: none), and the paths found after it, each planned
-  // where the car stood after leaving the course of the one before. Files
-  // written before re-planning read as planned_at_s and 0.
+  // where the car stood after leaving the course of the one before or at
+  // its end outside the tolerances. Files written before re-planning read
+  // as planned_at_s and 0.
   double first_planned_at_s = -1.0;
   int32_t replans = 0;
   std::vector<ParkingSlotRow> slots;
   std::vector<OutlinePoint> obstacles;
   std::vector<ParkingPathRow> planned_path;  // empty when none was found
+  // The paths the last one replaced, in order (empty without re-plans and
+  // in files written before they were kept).
+  std::vector<EarlierPlanRow> earlier_plans;
 };
 
 struct NamedCallback {

@@ -190,6 +190,15 @@ const std::vector<Column<ParkingPathRow>>& ParkingPathColumns() {
   return *columns;
 }
 
+const std::vector<Column<EarlierPlanRow>>& EarlierPlanColumns() {
+  static const auto* columns = new std::vector<Column<EarlierPlanRow>>{
+      I32("plan", &EarlierPlanRow::plan), F64("x_m", &EarlierPlanRow::x_m),
+      F64("y_m", &EarlierPlanRow::y_m),
+      F64("yaw_rad", &EarlierPlanRow::yaw_rad),
+      I32("reverse", &EarlierPlanRow::reverse)};
+  return *columns;
+}
+
 const std::vector<Column<IndexedName>>& IndexedNameColumns() {
   static const auto* columns = new std::vector<Column<IndexedName>>{
       I32("index", &IndexedName::index),
@@ -501,6 +510,8 @@ Status WriteContents(hid_t file, const RunData& run) {
         WriteTable(g, "obstacles", p.obstacles, OutlineColumns()));
     ADSE_RETURN_IF_ERROR(
         WriteTable(g, "planned_path", p.planned_path, ParkingPathColumns()));
+    ADSE_RETURN_IF_ERROR(
+        WriteTable(g, "earlier_plans", p.earlier_plans, EarlierPlanColumns()));
   }
   {
     Result<Handle> group = CreateGroup(file, "planning");
@@ -731,6 +742,13 @@ Status ReadContents(hid_t file, RunData* run) {
         Assign(ReadTable(g, "obstacles", OutlineColumns()), &p.obstacles));
     ADSE_RETURN_IF_ERROR(Assign(
         ReadTable(g, "planned_path", ParkingPathColumns()), &p.planned_path));
+    // Files written before earlier plans were kept lack them.
+    if (internal::GetObjectKind(file, "/parking/earlier_plans") !=
+        internal::ObjectKind::kMissing) {
+      ADSE_RETURN_IF_ERROR(
+          Assign(ReadTable(g, "earlier_plans", EarlierPlanColumns()),
+                 &p.earlier_plans));
+    }
   }
   {
     Result<Handle> group = OpenGroup(file, "/trace");

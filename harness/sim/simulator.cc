@@ -179,6 +179,15 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
           }
           run.parking.planned_at_s = t_s;
           run.parking.path_found = m.found ? 1 : 0;
+          // The plan this one replaces is kept, numbered in order.
+          if (!run.parking.planned_path.empty()) {
+            std::vector<runfile::EarlierPlanRow>& earlier =
+                run.parking.earlier_plans;
+            const int32_t plan = earlier.empty() ? 0 : earlier.back().plan + 1;
+            for (const runfile::ParkingPathRow& r : run.parking.planned_path) {
+              earlier.push_back({plan, r.x_m, r.y_m, r.yaw_rad, r.reverse});
+            }
+          }
           run.parking.planned_path.clear();
           for (const stack::ParkingPathPoint& p : m.poses) {
             run.parking.planned_path.push_back(

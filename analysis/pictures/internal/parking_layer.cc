@@ -82,6 +82,14 @@ void DrawParkingManoeuvre(cv::Mat* img, const runfile::RunData& run,
                           const ToPixel& px, const Style& s) {
   const runfile::ParkingRecord& parking = run.parking;
   if (!parking.present) return;
+  // Plans a later one replaced, pale, under the last.
+  const std::vector<runfile::EarlierPlanRow>& earlier = parking.earlier_plans;
+  for (size_t i = 1; i < earlier.size(); ++i) {
+    if (earlier[i].plan != earlier[i - 1].plan) continue;
+    DrawSegment(img, px(earlier[i - 1].x_m, earlier[i - 1].y_m),
+                px(earlier[i].x_m, earlier[i].y_m), Bgr(kEarlierPlanRgb),
+                s.Px(2));
+  }
   // Each leg of the plan in its gear's colour (a pose's gear is the gear
   // driving to it).
   for (size_t i = 1; i < parking.planned_path.size(); ++i) {

@@ -21,9 +21,10 @@ using ToPixel = std::function<cv::Point2d(double x_m, double y_m)>;
 void DrawParkingLot(cv::Mat* img, const runfile::ParkingRecord& parking,
                     const ToPixel& px, const Style& s);
 
-// Over the trajectory: the planned manoeuvre, forward and reverse legs in
-// their own colours, the car's body at each contact with an obstacle (with
-// a dot where they met) and at the run's last sample.
+// Over the trajectory: plans a later one replaced (pale), the planned
+// manoeuvre, forward and reverse legs in their own colours, the car's body at
+// each contact with an obstacle (with a dot where they met) and at the run's
+// last sample.
 void DrawParkingManoeuvre(cv::Mat* img, const runfile::RunData& run,
                           const std::vector<ParkingContact>& contacts,
                           const ToPixel& px, const Style& s);

@@ -221,6 +221,8 @@ TEST_F(PictureTest, ValetRunShowsTheLotTheTargetAndTheManoeuvre) {
   p.obstacles = {
       {0, 39.1, 7.8}, {0, 40.9, 7.8}, {0, 40.9, 12.2}, {0, 39.1, 12.2}};
   p.planned_path = {{40, 3, 0, 0}, {46, 3, 0, 0}, {42.5, 8.65, -M_PI / 2, 1}};
+  // A first plan the last one replaced, further east.
+  p.earlier_plans = {{0, 50, 3, 0, 0}, {0, 56, 3, 0, 0}, {0, 60, 8, 0, 0}};
   RunData plain = SquareRun();
   TrajectoryImageOptions options;
   Result<WorldToImage> map = TrajectoryImageMapping(run, options);
@@ -250,8 +252,10 @@ TEST_F(PictureTest, ValetRunShowsTheLotTheTargetAndTheManoeuvre) {
   Result<WorldToImage> plain_map = TrajectoryImageMapping(plain, options);
   ASSERT_TRUE(plain_map.ok());
   EXPECT_EQ(plain_map->detail_px, 0);
+  EXPECT_TRUE(
+      ColourNear(*img, map->Column(58.0), map->Row(5.5), kEarlierPlanRgb, 2));
   for (Rgb c : {kObstacleRgb, kTargetSlotRgb, kPlannedForwardRgb,
-                kPlannedReverseRgb, kEgoBodyRgb, kSlotRgb}) {
+                kPlannedReverseRgb, kEgoBodyRgb, kSlotRgb, kEarlierPlanRgb}) {
     EXPECT_GT(CountColour(*img, c), 20) << Name(c);
     EXPECT_EQ(CountColour(*none, c), 0) << Name(c);
   }

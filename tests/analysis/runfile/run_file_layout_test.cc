@@ -157,6 +157,23 @@ TEST_F(RunFileTest, AParkingRecordWrittenBeforeReplanningReadsAsOnePlan) {
   EXPECT_EQ(older->parking.replans, 0);
 }
 
+TEST_F(RunFileTest, AParkingRecordWrittenBeforeEarlierPlansWereKeptHasNone) {
+  RunData run = MakeFullRun(10);
+  run.parking.present = true;
+  run.parking.earlier_plans = {{0, 1.0, 2.0, 0.0, 0}};
+  const std::string path = Path("valet.h5");
+  ASSERT_TRUE(WriteRunFile(path, run).ok());
+  {
+    RawHdf5 raw(path, H5F_ACC_RDWR);
+    ASSERT_GE(H5Ldelete(raw.file(), "/parking/earlier_plans", H5P_DEFAULT), 0);
+  }
+  Result<RunData> older = ReadRunFile(path);
+  ASSERT_TRUE(older.ok()) << older.status().ToString();
+  EXPECT_TRUE(older->parking.earlier_plans.empty());
+  std::vector<std::string> problems;
+  EXPECT_TRUE(CheckRunFile(path, &problems).ok()) << problems.front();
+}
+
 TEST_F(RunFileTest, FileWithoutLanesReadsAsNoLanes) {
   ExpectReadsWithout(Path("run.h5"), "/world/lanes",
                      [](RunData* run) { run->lanes.clear(); });

@@ -50,6 +50,7 @@ TEST_F(RunFileTest, ParkingRecordRoundTripsAndIsAbsentOtherwise) {
              {18.25, 20.0, M_PI / 2, 5.0, 2.5, 1, 0}};
   p.obstacles = {{0, 0, 0}, {0, 10, 0}, {1, 5, 5}, {1, 6, 5}, {1, 6, 6}};
   p.planned_path = {{20.0, 15.75, M_PI, 0}, {24.0, 15.75, M_PI, 1}};
+  p.earlier_plans = {{0, 19.0, 15.0, M_PI, 0}, {1, 19.5, 15.5, -M_PI, 1}};
   const std::string path = Path("valet.h5");
   ASSERT_TRUE(WriteRunFile(path, run).ok());
   Result<RunData> back = ReadRunFile(path);
@@ -73,6 +74,11 @@ TEST_F(RunFileTest, ParkingRecordRoundTripsAndIsAbsentOtherwise) {
   EXPECT_EQ(q.obstacles[4].y_m, 6.0);
   ASSERT_EQ(q.planned_path.size(), 2u);
   EXPECT_EQ(q.planned_path[1].reverse, 1);
+  ASSERT_EQ(q.earlier_plans.size(), 2u);
+  EXPECT_EQ(q.earlier_plans[1].plan, 1);
+  EXPECT_EQ(q.earlier_plans[1].yaw_rad, -M_PI);
+  EXPECT_EQ(q.earlier_plans[1].reverse, 1);
+  EXPECT_EQ(q.earlier_plans[0].x_m, 19.0);
   std::vector<std::string> problems;
   EXPECT_TRUE(CheckRunFile(path, &problems).ok()) << problems.size();
   // A lane-driving run has no /parking and reads back without one.

@@ -108,7 +108,9 @@ TEST(TrafficLightsTest, TheEgoWaitsAtTheRedLightThenDrivesOnToTheGoal) {
     if (r.tls_id.empty()) continue;
     red_before_green |= r.state == SignalState::kRed && r.stamp_s < kGreenAtS;
     green_after |= r.state == SignalState::kGreen && r.stamp_s >= kGreenAtS;
-    if (r.state == SignalState::kRed) EXPECT_LT(r.stamp_s, kGreenAtS + 0.5);
+    if (r.state == SignalState::kRed) {
+      EXPECT_LT(r.stamp_s, kGreenAtS + 0.5);
+    }
     EXPECT_GE(r.stop_line_distance_m, 0.0);
   }
   EXPECT_TRUE(red_before_green);

@@ -122,6 +122,10 @@ TEST(ValetParkingTest, AManoeuvreEndingOutsideTheTolerancesIsCorrected) {
               1e-6);
   EXPECT_GE(run->parking.replans, 1);
   EXPECT_EQ(run->metrics.at("parking_replans"), run->parking.replans);
+  // The manoeuvre it replaced is kept: the first plan, from the aisle.
+  ASSERT_GT(run->parking.earlier_plans.size(), 10u);
+  EXPECT_EQ(run->parking.earlier_plans.front().plan, 0);
+  EXPECT_EQ(run->parking.earlier_plans.back().plan, run->parking.replans - 1);
 
   // With no re-plan left it stays where the first manoeuvre ended.
   ASSERT_TRUE(spec.stack.Set("parking.max_replans", 0).ok());
