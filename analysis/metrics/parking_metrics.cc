@@ -170,8 +170,11 @@ void AddParkingMetrics(const runfile::RunData& run,
         std::abs(std::remainder(end.yaw_rad - p.goal_yaw_rad, 2 * M_PI));
     (*m)["parking_position_error_m"] = pos;
     (*m)["parking_yaw_error_deg"] = yaw * 180.0 / M_PI;
-    (*m)["parked"] = std::abs(end.v_mps) < 0.05 && pos <= p.tolerance_m &&
-                             yaw <= p.yaw_tolerance_rad
+    (*m)["parked"] = std::abs(end.v_mps) < 0.05 &&
+                             geometry::WithinTolerance(
+                                 {end.x_m, end.y_m, end.yaw_rad},
+                                 {p.goal_x_m, p.goal_y_m, p.goal_yaw_rad},
+                                 p.tolerance_m, p.yaw_tolerance_rad)
                          ? 1.0
                          : 0.0;
   }

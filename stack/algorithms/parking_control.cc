@@ -23,14 +23,6 @@ double DistanceFromPath(const std::vector<GearedPose>& poses,
   return best;
 }
 
-bool WithinParkingGoal(const geometry::Pose2& pose, const geometry::Pose2& goal,
-                       double tolerance_m, double yaw_tolerance_rad) {
-  const double yaw_error =
-      std::abs(std::remainder(pose.yaw_rad - goal.yaw_rad, 2 * M_PI));
-  return std::hypot(pose.x_m - goal.x_m, pose.y_m - goal.y_m) <= tolerance_m &&
-         yaw_error <= yaw_tolerance_rad;
-}
-
 void ParkingFollower::SetPath(const std::vector<GearedPose>& poses) {
   path_ = poses;
   segments_.clear();

@@ -58,12 +58,6 @@ struct ParkingCommand {
 double DistanceFromPath(const std::vector<GearedPose>& poses,
                         const Eigen::Vector2d& p);
 
-// Whether a rear-axle pose is parked at `goal` (rear axle): within
-// `tolerance_m` of it and `yaw_tolerance_rad` of its heading. The same test
-// the world applies to the true pose, here on the stack's own estimate.
-bool WithinParkingGoal(const geometry::Pose2& pose, const geometry::Pose2& goal,
-                       double tolerance_m, double yaw_tolerance_rad);
-
 class ParkingFollower {
  public:
   explicit ParkingFollower(const ParkingFollowerParams& params = {});

@@ -100,6 +100,14 @@ bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b) {
   return true;
 }
 
+bool WithinTolerance(const Pose2& pose, const Pose2& goal, double tolerance_m,
+                     double yaw_tolerance_rad) {
+  const double yaw_error =
+      std::abs(std::remainder(pose.yaw_rad - goal.yaw_rad, 2 * M_PI));
+  return std::hypot(pose.x_m - goal.x_m, pose.y_m - goal.y_m) <= tolerance_m &&
+         yaw_error <= yaw_tolerance_rad;
+}
+
 Pose2 MotionAfter(const Twist2& twist, double dt_s) {
   const double yaw = twist.yaw_rate_rps * dt_s;
   const double d = twist.v_mps * dt_s;

@@ -50,6 +50,13 @@ struct Twist2 {
 // the exact constant-twist arc, a straight line when the yaw rate is ~0.
 Pose2 MotionAfter(const Twist2& twist, double dt_s);
 
+// Whether `pose` lies within `tolerance_m` of `goal` and within
+// `yaw_tolerance_rad` of its heading: the one test of "at the goal pose"
+// that the world (true pose), the stack (its estimate) and the metrics
+// (the run file) apply alike.
+bool WithinTolerance(const Pose2& pose, const Pose2& goal, double tolerance_m,
+                     double yaw_tolerance_rad);
+
 // The four corners of a box, counter-clockwise.
 std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box);
 

@@ -686,9 +686,9 @@ void Stack::PlanParking(CallbackContext& ctx, double course_out_m,
     // tolerances, or if no re-plan is left; otherwise a new path from
     // here corrects it.
     path_driven_ = false;
-    if (algo::WithinParkingGoal(pose, inputs_.parking_goal,
-                                inputs_.goal_tolerance_m,
-                                inputs_.goal_yaw_tolerance_rad) ||
+    if (geometry::WithinTolerance(pose, inputs_.parking_goal,
+                                  inputs_.goal_tolerance_m,
+                                  inputs_.goal_yaw_tolerance_rad) ||
         freespace_replans_ == max_replans) {
       complete();
       return;

@@ -426,10 +426,12 @@ bool World::goal_reached() const {
   if (!w.valet) return distance_to_goal_m() <= w.setup.task.goal_tolerance_m;
   // Parked: standing in the slot, as the tolerances allow. The rear axles'
   // distance equals the bodies' (same heading up to the tolerance).
-  return std::abs(w.ego->state().v_mps) < 0.05 &&
-         distance_to_goal_m() <= w.setup.task.goal_tolerance_m &&
-         goal_yaw_error_rad() <=
-             w.setup.task.goal_yaw_tolerance_deg * M_PI / 180.0;
+  const VehicleState& s = w.ego->state();
+  return std::abs(s.v_mps) < 0.05 &&
+         geometry::WithinTolerance(
+             {s.x_m, s.y_m, s.yaw_rad}, w.parking_goal,
+             w.setup.task.goal_tolerance_m,
+             w.setup.task.goal_yaw_tolerance_deg * M_PI / 180.0);
 }
 bool World::parking_task() const { return impl_->valet; }
 const ParkingSlot& World::goal_slot() const { return impl_->goal_slot; }

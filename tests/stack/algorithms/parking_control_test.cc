@@ -181,16 +181,5 @@ TEST(DistanceFromPath, IsTheDistanceToTheNearestStretchOfThePolyline) {
   EXPECT_TRUE(std::isinf(DistanceFromPath({}, {0, 0})));
 }
 
-TEST(WithinParkingGoal, BothPositionAndHeadingWithinTheirTolerances) {
-  const Pose2 goal{10, 5, -M_PI / 2};
-  EXPECT_TRUE(WithinParkingGoal({10.3, 5.39, -M_PI / 2}, goal, 0.5, 0.1));
-  EXPECT_FALSE(WithinParkingGoal({10.3, 5.41, -M_PI / 2}, goal, 0.5, 0.1));
-  EXPECT_TRUE(WithinParkingGoal({10, 5, -M_PI / 2 + 0.099}, goal, 0.5, 0.1));
-  EXPECT_FALSE(WithinParkingGoal({10, 5, -M_PI / 2 - 0.11}, goal, 0.5, 0.1));
-  // Headings compare across the +-pi seam.
-  EXPECT_TRUE(
-      WithinParkingGoal({0, 0, M_PI - 0.05}, {0, 0, -M_PI + 0.04}, 0.1, 0.1));
-}
-
 }  // namespace
 }  // namespace adse::algorithms

@@ -147,5 +147,16 @@ TEST(InsidePolygon, ConvexConcaveAndDegenerate) {
   EXPECT_FALSE(InsidePolygon({{0, 0}, {1, 1}}, {0.5, 0.5}));
 }
 
+TEST(WithinToleranceTest, BothPositionAndHeadingWithinTheirTolerances) {
+  const Pose2 goal{10, 5, -M_PI / 2};
+  EXPECT_TRUE(WithinTolerance({10.3, 5.39, -M_PI / 2}, goal, 0.5, 0.1));
+  EXPECT_FALSE(WithinTolerance({10.3, 5.41, -M_PI / 2}, goal, 0.5, 0.1));
+  EXPECT_TRUE(WithinTolerance({10, 5, -M_PI / 2 + 0.099}, goal, 0.5, 0.1));
+  EXPECT_FALSE(WithinTolerance({10, 5, -M_PI / 2 - 0.11}, goal, 0.5, 0.1));
+  // Headings compare across the +-pi seam.
+  EXPECT_TRUE(
+      WithinTolerance({0, 0, M_PI - 0.05}, {0, 0, -M_PI + 0.04}, 0.1, 0.1));
+}
+
 }  // namespace
 }  // namespace adse::geometry
