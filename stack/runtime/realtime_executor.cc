@@ -30,6 +30,7 @@
 
 #include "stack/base/random.h"
 #include "stack/runtime/internal/executor_parts.h"
+#include "stack/runtime/internal/padding_team.h"
 
 namespace adse::stack {
 namespace {
@@ -145,6 +146,9 @@ class RealTimeExecutor final : public Executor {
            (st.is_timer ? st.fire_pending : !st.queue.empty());
   }
   void RunOne(int c, int thread, std::unique_lock<std::mutex>* lock);
+  // First step of a padding helper: the executor threads' CPUs and
+  // enter_thread.
+  Status EnterHelper();
 
   const Graph* graph_;
   RealTimeOptions options_;
@@ -172,6 +176,9 @@ class RealTimeExecutor final : public Executor {
 
   std::vector<std::thread> threads_;
   std::thread clock_thread_;
+  // Helper threads of data-parallel callbacks; they enter like the
+  // executor's threads and are pinned to the same CPUs.
+  internal::PaddingTeam team_;
 };
 
 RealTimeExecutor::RealTimeExecutor(const Graph* graph,
@@ -179,7 +186,8 @@ RealTimeExecutor::RealTimeExecutor(const Graph* graph,
     : graph_(graph),
       options_(options),
       dilation_(options.time_dilation),
-      profile_(options.profile) {
+      profile_(options.profile),
+      team_([this] { return EnterHelper(); }) {
   const auto& callbacks = graph->callbacks();
   topic_subs_.resize(graph->topics().size());
   topic_sinks_.resize(graph->topics().size());
@@ -267,6 +275,22 @@ void RealTimeExecutor::Stop() {
   }
   threads_.clear();
   if (clock_thread_.joinable()) clock_thread_.join();
+  team_.Stop();  // after the workers, whose callbacks may still use it
+}
+
+Status RealTimeExecutor::EnterHelper() {
+  if (!options_.host_cpus.empty()) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    for (int cpu : options_.host_cpus) CPU_SET(cpu, &set);
+    const int rc = pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+    if (rc != 0) {
+      return Status::Unavailable(
+          fmt::format("cannot pin a padding thread to host CPUs {}: {}",
+                      fmt::join(options_.host_cpus, ","), std::strerror(rc)));
+    }
+  }
+  return options_.enter_thread ? options_.enter_thread() : Status::Ok();
 }
 
 void RealTimeExecutor::PublishExternal(int topic, MessagePtr message,
@@ -473,18 +497,25 @@ void RealTimeExecutor::RunOne(int c, int thread,
   const double host_cpu_s = ThreadCpuSeconds() - cpu0;
   message.reset();
   // Busy-work to the profile's cost at the point's clock: a real callback
-  // of that cost keeps its core this busy, and the OS may preempt it.
+  // of that cost keeps its core this busy, and the OS may preempt it. A
+  // data-parallel callback's parallel part is split over k threads that
+  // all busy-work at once, as its OpenMP team would, so it occupies k CPUs
+  // whether or not they are free.
   const WorkReport& work = context.work();
   const int k = std::max(
       1, std::min({st.cost->max_threads, work.max_threads, options_.cores}));
-  const double pad_s = AmdahlS(DrawnCostS(*st.cost, u, work.units),
-                               st.cost->parallel_fraction, k) *
-                       st.factor;
-  // Mostly user-mode work between clock reads (each read is a system
-  // call), as the code it stands for would be.
-  volatile double sink = 1.0;
-  while (ThreadCpuSeconds() - cpu0 < pad_s) {
-    for (int i = 0; i < 2000; ++i) sink = sink * 1.0000001 + 1e-9;
+  const double total_s = DrawnCostS(*st.cost, u, work.units) * st.factor;
+  const double p = k > 1 ? st.cost->parallel_fraction : 0.0;
+  const double serial_s = total_s * (1.0 - p);
+  const double share_s = total_s * p / k;
+  internal::BusyUntilThreadCpu(cpu0, serial_s);
+  if (k > 1) {
+    Status team = team_.Run(k - 1, share_s, [&] {
+      internal::BusyUntilThreadCpu(cpu0, serial_s + share_s);
+    });
+    if (!team.ok() && failure.ok()) failure = std::move(team);
+  } else {
+    internal::BusyUntilThreadCpu(cpu0, serial_s + share_s);
   }
 
   lock->lock();
@@ -498,7 +529,7 @@ void RealTimeExecutor::RunOne(int c, int thread,
   rec.cost_s = rec.end_s - rec.start_s;
   rec.host_cpu_s = host_cpu_s;
   rec.work_units = std::isfinite(work.units) ? work.units : 0.0;
-  rec.cores = 1;
+  rec.cores = k;
   trace_.callbacks.push_back(rec);
   for (const HeldPublication& p : held) {
     Deliver(p.topic, p.message, p.stamp_s, c, rec.end_s);

@@ -65,8 +65,12 @@ Status ValidateRealTimeOptions(const RealTimeOptions& options);
 // - Dispatch: any idle thread takes the ready callback (its node idle)
 //   with the earliest ready time; the OS preempts freely. A callback's
 //   publications are held to its end, as on the virtual platform.
-// - Data-parallel callbacks run on their one thread; their padding is the
-//   Amdahl time on min(max_threads, cores) threads.
+// - Data-parallel callbacks: k = min(max_threads, cores) threads pad the
+//   parallel part together (the callback's thread and k - 1 helpers, in
+//   the same CPUs and group), each its 1/k share in thread CPU time after
+//   the serial part; the OS shares the CPUs between them and everything
+//   else (the virtual platform gives such a callback only the cores free
+//   when it starts).
 // - Sinks run on the thread that calls AdvanceTo, in publication order,
 //   with their publication time, before AdvanceTo returns.
 // - CallbackRecord: times are sim seconds read from the clock; cost_s =

@@ -81,13 +81,14 @@ size_t Count(const Trace& trace, TopicEvent::Kind kind, int topic) {
 }
 
 // A 100 Hz timer on node "a" publishes to "t"; "b" takes it and publishes
-// to "out", which a sink reads.
+// to "out", which a sink reads. With `threads` > 1, "b" reports itself
+// data-parallel on up to that many threads.
 struct Chain {
   Graph graph;
   int t = -1, out = -1, timer = -1, sub = -1;
   std::vector<double> sink_times;
   std::vector<std::thread::id> sink_threads;
-  explicit Chain(int depth = 1) {
+  explicit Chain(int depth = 1, int threads = 1) {
     t = graph.AddTopic<Msg>("t");
     out = graph.AddTopic<Msg>("out");
     const int a = graph.AddNode("a");
@@ -97,11 +98,15 @@ struct Chain {
       m.header.stamp_s = ctx.now_s();
       ctx.Publish(t, m);
     });
-    sub = graph.Subscribe<Msg>(b, t, "work", depth,
-                               [this](const Msg& m, CallbackContext& ctx) {
-                                 Msg o = m;
-                                 ctx.Publish(out, o);
-                               });
+    sub = graph.Subscribe<Msg>(
+        b, t, "work", depth,
+        [this, threads](const Msg& m, CallbackContext& ctx) {
+          if (threads > 1) {
+            ctx.ReportWork({1.0, 1.0, threads});
+          }
+          Msg o = m;
+          ctx.Publish(out, o);
+        });
     graph.AddSink<Msg>(out, [this](const Msg&, double t_s) {
       sink_times.push_back(t_s);
       sink_threads.push_back(std::this_thread::get_id());
@@ -349,6 +354,33 @@ TEST(RealTimeExecutorTest, ACpuShareScalesThePaddingInCpuTime) {
   // The process used about 2 ms per message, not the 4 ms of a share of 1
   // (CPU time, which a loaded host cannot inflate; the ticks add 3 ms).
   EXPECT_LT(cpu_s, 0.003 * static_cast<double>(work.size()) + 0.01);
+}
+
+TEST(RealTimeExecutorTest,
+     ADataParallelCallbackOccupiesItsThreadsForItsWholeCost) {
+  Chain chain(/*depth=*/1, /*threads=*/4);
+  // 8 ms at 2 GHz, 75 % of it parallel over up to 4 threads, on 2 cores:
+  // 2 ms serial, then 3 ms on each of two threads, 8 ms of CPU time in all
+  // (an Amdahl time of 5 ms), not the 5 ms of one thread standing for two.
+  auto profile = std::make_shared<CostProfile>(
+      *FlatProfile({{"a/tick", 0.0001}, {"b/work", 0.008}}));
+  CallbackCost& work_cost = profile->callbacks.at("b/work");
+  work_cost.parallel_fraction = 0.75;
+  work_cost.max_threads = 4;
+  auto exec = Create(chain.graph, Options(2, 2.0, profile));
+  ASSERT_NE(exec, nullptr);
+  const double cpu0 = ProcessCpuSeconds();
+  ASSERT_TRUE(exec->AdvanceTo(0.3).ok());
+  exec->Stop();
+  const double cpu_s = ProcessCpuSeconds() - cpu0;
+  const std::vector<CallbackRecord> work = RecordsOf(exec->trace(), chain.sub);
+  ASSERT_GT(work.size(), 3u);
+  for (const CallbackRecord& r : work) {
+    EXPECT_GE(r.cost_s, 0.005 - 1e-5);
+    EXPECT_EQ(r.cores, 2);
+  }
+  // CPU time a loaded host cannot deflate: at least 8 ms per message.
+  EXPECT_GE(cpu_s, 0.008 * static_cast<double>(work.size()) * 0.99);
 }
 
 }  // namespace
