@@ -114,6 +114,26 @@ struct Chain {
   }
 };
 
+// The process's CPU time over a run of the chain to `until_s`, and the
+// records of its "work" callback.
+struct ProcessCpuRun {
+  double cpu_s = 0.0;
+  std::vector<CallbackRecord> work;
+};
+
+ProcessCpuRun RunChain(const Chain& chain, const RealTimeOptions& options,
+                       double until_s) {
+  ProcessCpuRun run;
+  auto exec = Create(chain.graph, options);
+  if (exec == nullptr) return run;
+  const double cpu0 = ProcessCpuSeconds();
+  EXPECT_TRUE(exec->AdvanceTo(until_s).ok());
+  exec->Stop();
+  run.cpu_s = ProcessCpuSeconds() - cpu0;
+  run.work = RecordsOf(exec->trace(), chain.sub);
+  return run;
+}
+
 TEST(RealTimeExecutorTest, EveryCallbackKeepsItsThreadBusyForItsProfileCost) {
   Chain chain;
   // 2 ms at 2 GHz, run at 1 GHz: 4 ms of thread CPU time per message.
@@ -340,13 +360,9 @@ TEST(RealTimeExecutorTest, ACpuShareScalesThePaddingInCpuTime) {
   RealTimeOptions options =
       Options(1, 1.0, FlatProfile({{"a/tick", 0.0001}, {"b/work", 0.002}}));
   options.cpu_share = 0.5;
-  auto exec = Create(chain.graph, options);
-  ASSERT_NE(exec, nullptr);
-  const double cpu0 = ProcessCpuSeconds();
-  ASSERT_TRUE(exec->AdvanceTo(0.3).ok());
-  exec->Stop();
-  const double cpu_s = ProcessCpuSeconds() - cpu0;
-  const std::vector<CallbackRecord> work = RecordsOf(exec->trace(), chain.sub);
+  const ProcessCpuRun run = RunChain(chain, options, 0.3);
+  const double cpu_s = run.cpu_s;
+  const std::vector<CallbackRecord>& work = run.work;
   ASSERT_GT(work.size(), 3u);
   for (const CallbackRecord& r : work) {
     EXPECT_GE(r.cost_s, 0.002 - 1e-5);
@@ -367,13 +383,9 @@ TEST(RealTimeExecutorTest,
   CallbackCost& work_cost = profile->callbacks.at("b/work");
   work_cost.parallel_fraction = 0.75;
   work_cost.max_threads = 4;
-  auto exec = Create(chain.graph, Options(2, 2.0, profile));
-  ASSERT_NE(exec, nullptr);
-  const double cpu0 = ProcessCpuSeconds();
-  ASSERT_TRUE(exec->AdvanceTo(0.3).ok());
-  exec->Stop();
-  const double cpu_s = ProcessCpuSeconds() - cpu0;
-  const std::vector<CallbackRecord> work = RecordsOf(exec->trace(), chain.sub);
+  const ProcessCpuRun run = RunChain(chain, Options(2, 2.0, profile), 0.3);
+  const double cpu_s = run.cpu_s;
+  const std::vector<CallbackRecord>& work = run.work;
   ASSERT_GT(work.size(), 3u);
   for (const CallbackRecord& r : work) {
     EXPECT_GE(r.cost_s, 0.005 - 1e-5);
