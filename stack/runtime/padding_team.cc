@@ -1,6 +1,8 @@
 #include "stack/runtime/internal/padding_team.h"
 
 #include <algorithm>
+#include <string>
+#include <system_error>
 #include <utility>
 
 #include "stack/runtime/internal/executor_parts.h"
@@ -30,14 +32,21 @@ Status PaddingTeam::Run(int helpers, double cpu_s,
   {
     std::lock_guard<std::mutex> lock(mu_);
     if (stopping_) return Status::Internal("padding team stopped");
-    // Idle helpers not already claimed by queued jobs.
+    // A parallel region gets its whole team at once, as OpenMP's does:
+    // helpers are started for the jobs that idle ones (not yet claimed by
+    // queued jobs) cannot take, before any job is queued, so that a thread
+    // the system refuses leaves no job waiting for it.
     const int available = std::max(0, idle_ - static_cast<int>(jobs_.size()));
+    for (int missing = helpers - available; missing > 0; --missing) {
+      try {
+        threads_.emplace_back([this] { HelperLoop(); });
+      } catch (const std::system_error& e) {
+        return Status::Unavailable(
+            std::string("cannot start a padding thread: ") + e.what());
+      }
+    }
     batch.remaining = helpers;
     for (int i = 0; i < helpers; ++i) jobs_.push_back({cpu_s, &batch});
-    // A parallel region gets its whole team at once, as OpenMP's does.
-    for (int missing = helpers - available; missing > 0; --missing) {
-      threads_.emplace_back([this] { HelperLoop(); });
-    }
   }
   work_cv_.notify_all();
   if (own_share) own_share();
