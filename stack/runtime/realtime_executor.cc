@@ -146,6 +146,8 @@ class RealTimeExecutor final : public Executor {
            (st.is_timer ? st.fire_pending : !st.queue.empty());
   }
   void RunOne(int c, int thread, std::unique_lock<std::mutex>* lock);
+  // Pins a thread to options_.host_cpus (when given).
+  Status Pin(pthread_t thread) const;
   // First step of a padding helper: the executor threads' CPUs and
   // enter_thread.
   Status EnterHelper();
@@ -212,20 +214,22 @@ RealTimeExecutor::RealTimeExecutor(const Graph* graph,
   trace_.timer_overruns.assign(callbacks.size(), 0);
 }
 
-Status RealTimeExecutor::Start() {
+Status RealTimeExecutor::Pin(pthread_t thread) const {
+  if (options_.host_cpus.empty()) return Status::Ok();
   cpu_set_t set;
   CPU_ZERO(&set);
   for (int cpu : options_.host_cpus) CPU_SET(cpu, &set);
-  auto pin = [&](std::thread& t) -> Status {
-    if (options_.host_cpus.empty()) return Status::Ok();
-    const int rc = pthread_setaffinity_np(t.native_handle(), sizeof(set), &set);
-    if (rc != 0) {
-      return Status::Unavailable(
-          fmt::format("cannot pin the stack's threads to host CPUs {}: {}",
-                      fmt::join(options_.host_cpus, ","), std::strerror(rc)));
-    }
-    return Status::Ok();
-  };
+  const int rc = pthread_setaffinity_np(thread, sizeof(set), &set);
+  if (rc != 0) {
+    return Status::Unavailable(
+        fmt::format("cannot pin the stack's threads to host CPUs {}: {}",
+                    fmt::join(options_.host_cpus, ","), std::strerror(rc)));
+  }
+  return Status::Ok();
+}
+
+Status RealTimeExecutor::Start() {
+  auto pin = [this](std::thread& t) { return Pin(t.native_handle()); };
   // Each thread enters (options_.enter_thread) before it does anything
   // else; Start returns once all have, or with the first failure.
   int entered = 0;
@@ -279,17 +283,7 @@ void RealTimeExecutor::Stop() {
 }
 
 Status RealTimeExecutor::EnterHelper() {
-  if (!options_.host_cpus.empty()) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    for (int cpu : options_.host_cpus) CPU_SET(cpu, &set);
-    const int rc = pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
-    if (rc != 0) {
-      return Status::Unavailable(
-          fmt::format("cannot pin a padding thread to host CPUs {}: {}",
-                      fmt::join(options_.host_cpus, ","), std::strerror(rc)));
-    }
-  }
+  ADSE_RETURN_IF_ERROR(Pin(pthread_self()));
   return options_.enter_thread ? options_.enter_thread() : Status::Ok();
 }
 
