@@ -73,7 +73,10 @@ Result<std::string> ComparisonChartPng(const std::vector<ComparisonRow>& rows,
     for (const ComparisonRow& r : rows) {
       top = std::max({top, r.adse, r.reference.value_or(0.0)});
     }
-    top = internal::NiceAbove(top > 0 ? top : 1.0);
+    // Five ticks of a round step: the axis ends at most one step past
+    // the longest bar (a round top alone, 500 for a bar of 217, left half
+    // the chart empty).
+    top = 5.0 * internal::NiceAbove((top > 0 ? top : 1.0) / 5.0);
     auto x_of = [&](double v) {
       return x0 + static_cast<int>(std::lround((x1 - x0) * v / top));
     };

@@ -552,6 +552,23 @@ TEST_F(PictureTest, AComparisonChartDrawsLongerBarsForLargerValues) {
               0.05);
   EXPECT_LT(adse[3], adse[1]);
 
+  // The axis ends one round step past the longest bar (0-250 for 216.5):
+  // that bar spans most of the plot, not half of it.
+  ASSERT_TRUE(RenderComparisonChart({{"ndt", 216.5, 199.9}, {"ekf", 3.4, 3.6}},
+                                    o, Path("tight.png"))
+                  .ok());
+  Result<RgbImage> tight = ReadImage(Path("tight.png"));
+  ASSERT_TRUE(tight.ok()) << tight.status().ToString();
+  int longest = 0;
+  for (int r = 0; r < tight->height_px; ++r) {
+    int n = 0;
+    for (int c = 0; c < tight->width_px; ++c) {
+      n += tight->At(c, r) == kAdseBarRgb;
+    }
+    longest = std::max(longest, n);
+  }
+  EXPECT_GT(longest, tight->width_px / 2);
+
   EXPECT_FALSE(RenderComparisonChart({}, o, Path("none.png")).ok());
   EXPECT_FALSE(
       RenderComparisonChart({{"bad", -1.0, 2.0}}, o, Path("bad.png")).ok());
