@@ -10,7 +10,10 @@
 //     say more cores / GHz help, so one or two points already extrapolate;
 //     plus a small Gaussian process on the trend's residuals, which
 //     interpolates the runs and gives an uncertainty that grows with the
-//     distance from them;
+//     distance from them; the nav time, once 10 runs measured it, also as
+//     a rate (1 / time), kept when its leave-one-out predictions fit the
+//     runs better (a rate falls to zero where the computer cannot keep up,
+//     as a starved stack's time climbs without bound);
 //  2. scores unseen points (all of them when the space is small, a sample
 //     plus the neighbours of seen points otherwise) by the expected gain in
 //     hypervolume of the feasible front, over joint samples of the predicted
@@ -200,6 +203,7 @@ void AgentStrategy::SetUpMetrics() {
     for (const spec::MetricInfo& info : spec::KnownMetrics()) {
       if (info.name == metric) model.boolean_hint = info.boolean;
     }
+    model.rate_hint = metric == kNavTimeMetric;
     models_.push_back(model);
     return &models_.back();
   };

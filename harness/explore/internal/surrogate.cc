@@ -24,6 +24,10 @@ constexpr double kOptimismRoom = 0.025;
 // How far past its bound a censored value is taken, in model units (log
 // for positive metrics: about 10 %; standard deviations otherwise).
 constexpr double kCensoredMargin = 0.1;
+// Measured runs a time needs before its rate is tried as its model: a
+// leave-one-out comparison of fewer runs chose badly (README, "Strategies
+// and replay").
+constexpr int kMinRateChoicePoints = 10;
 
 template <typename T>
 T Softplus(const T& x) {
@@ -127,10 +131,26 @@ double ResidualGp::Fit(const std::vector<std::vector<double>>& x,
   Eigen::VectorXd y(n);
   for (int i = 0; i < n; ++i) y(i) = r[i];
   alpha_ = llt_.solve(y);
+  y_ = y;
   double log_det = 0.0;
   const Eigen::MatrixXd& l = llt_.matrixLLT();
   for (int i = 0; i < n; ++i) log_det += 2.0 * std::log(l(i, i));
   return -0.5 * y.dot(alpha_) - 0.5 * log_det;
+}
+
+void ResidualGp::LeaveOneOut(std::vector<double>* mean,
+                             std::vector<double>* variance) const {
+  const int n = static_cast<int>(x_.size());
+  mean->assign(n, 0.0);
+  variance->assign(n, 1.0);
+  if (n == 0 || alpha_.size() != n) return;
+  const Eigen::MatrixXd inverse = llt_.solve(Eigen::MatrixXd::Identity(n, n));
+  for (int i = 0; i < n; ++i) {
+    const double d = inverse(i, i);
+    if (!(d > 0.0)) continue;
+    (*mean)[i] = y_(i) - alpha_(i) / d;
+    (*variance)[i] = 1.0 / d;
+  }
 }
 
 void ResidualGp::Predict(const std::vector<double>& u, double* mean,
@@ -167,6 +187,55 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
                       const std::vector<int>& sides,
                       const std::vector<double>& prior_slope,
                       const std::vector<double>& lengths) {
+  int measured = 0;
+  bool positive = true;
+  for (size_t i = 0; i < values.size(); ++i) {
+    positive = positive && values[i] > 0.0;
+    measured += (i >= sides.size() || sides[i] == 0) ? 1 : 0;
+  }
+  if (!rate_hint || boolean_hint || !positive ||
+      measured < kMinRateChoicePoints) {
+    FitIn(u, values, sides, prior_slope, lengths, nullptr);
+    return;
+  }
+  MetricModel as_log = *this;
+  MetricSpace log_space = MetricSpace::kLog;
+  as_log.FitIn(u, values, sides, prior_slope, lengths, &log_space);
+  MetricModel as_rate = *this;
+  MetricSpace rate_space = MetricSpace::kReciprocal;
+  as_rate.FitIn(u, values, sides, prior_slope, lengths, &rate_space);
+  const double log_score = as_log.LeaveOneOutLogDensity(u, values, sides);
+  const double rate_score = as_rate.LeaveOneOutLogDensity(u, values, sides);
+  *this = rate_score > log_score ? std::move(as_rate) : std::move(as_log);
+}
+
+double MetricModel::LeaveOneOutLogDensity(
+    const std::vector<std::vector<double>>& u,
+    const std::vector<double>& values, const std::vector<int>& sides) const {
+  std::vector<double> mean, variance;
+  gp_.LeaveOneOut(&mean, &variance);
+  double sum = 0.0;
+  for (size_t i = 0; i < values.size() && i < mean.size(); ++i) {
+    if (i < sides.size() && sides[i] != 0) continue;
+    const double y = values[i];
+    const double t =
+        space_ == MetricSpace::kReciprocal ? scale_ / y : std::log(y);
+    // |dt/dy| carries the density from model units to metric units.
+    const double jacobian =
+        space_ == MetricSpace::kReciprocal ? scale_ / (y * y) : 1.0 / y;
+    const double sd = std::sqrt(std::max(variance[i], 1e-12));
+    const double z = (t - trend_.Value(u[i]) - mean[i]) / sd;
+    sum += -0.5 * z * z - std::log(sd) + std::log(jacobian);
+  }
+  return sum;
+}
+
+void MetricModel::FitIn(const std::vector<std::vector<double>>& u,
+                        const std::vector<double>& values,
+                        const std::vector<int>& sides,
+                        const std::vector<double>& prior_slope,
+                        const std::vector<double>& lengths,
+                        const MetricSpace* forced) {
   fitted_ = false;
   points_ = static_cast<int>(values.size());
   if (values.empty()) return;
@@ -183,7 +252,9 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
     all_flags = all_flags && (v == 0.0 || v == 1.0);
     any_measured = any_measured || sided[i] == 0;
   }
-  if (boolean_hint || (all_flags && !all_positive && any_measured)) {
+  if (forced != nullptr) {
+    space_ = *forced;
+  } else if (boolean_hint || (all_flags && !all_positive && any_measured)) {
     space_ = MetricSpace::kBoolean;
   } else if (all_positive) {
     space_ = MetricSpace::kLog;
@@ -201,12 +272,17 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
       measured_u.push_back(u[i]);
       measured.push_back(values[i]);
     }
-    Fit(measured_u, measured, {}, prior_slope, lengths);
+    FitIn(measured_u, measured, {}, prior_slope, lengths, nullptr);
     return;
   }
   std::vector<double> t(values.size());
   shift_ = 0.0;
   scale_ = 1.0;
+  if (space_ == MetricSpace::kReciprocal) {
+    std::vector<double> sorted = values;
+    std::sort(sorted.begin(), sorted.end());
+    scale_ = sorted[sorted.size() / 2];
+  }
   if (space_ == MetricSpace::kLinear) {
     const double mean =
         std::accumulate(values.begin(), values.end(), 0.0) / values.size();
@@ -218,19 +294,29 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
   }
   // A censored bound is taken a margin beyond itself (in model units): the
   // run was stopped because its value was certainly past the bound.
+  // In reciprocal space a rate is modelled: its direction is the time's
+  // reversed, and so is a censored bound's side.
+  const int sign = space_ == MetricSpace::kReciprocal ? -1 : 1;
+  const int direction = sign * good_direction;
   for (size_t i = 0; i < values.size(); ++i) {
-    t[i] = space_ == MetricSpace::kLog ? std::log(values[i])
-                                       : (values[i] - shift_) / scale_;
+    sided[i] *= sign;
+    if (space_ == MetricSpace::kReciprocal) {
+      t[i] = scale_ / values[i];
+    } else {
+      t[i] = space_ == MetricSpace::kLog ? std::log(values[i])
+                                         : (values[i] - shift_) / scale_;
+    }
     t[i] += sided[i] * kCensoredMargin;
   }
   // Residual scale of the trend and the prior slope size, in model units.
-  const double sigma = space_ == MetricSpace::kLog       ? 0.1
-                       : space_ == MetricSpace::kBoolean ? 0.25
-                                                         : 0.3;
+  const double sigma =
+      space_ == MetricSpace::kLog || space_ == MetricSpace::kReciprocal ? 0.1
+      : space_ == MetricSpace::kBoolean                                 ? 0.25
+                                                                        : 0.3;
   const double slope_size = space_ == MetricSpace::kBoolean ? kFlagSlope : 1.0;
   std::vector<double> mu(dims, 0.0);
   for (size_t i = 0; i < dims; ++i) {
-    mu[i] = good_direction * slope_size * prior_slope[i];
+    mu[i] = direction * slope_size * prior_slope[i];
   }
   const double slope_sd = space_ == MetricSpace::kBoolean ? kFlagSlopeSd : 1.5;
 
@@ -239,8 +325,8 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
   // starts saturating towards the good side; with data enough the shapes
   // compete, a little penalised per extra parameter.
   TrendShape preferred = TrendShape::kLinear;
-  if (space_ != MetricSpace::kBoolean && good_direction != 0) {
-    preferred = good_direction < 0 ? TrendShape::kFloor : TrendShape::kCeiling;
+  if (space_ != MetricSpace::kBoolean && direction != 0) {
+    preferred = direction < 0 ? TrendShape::kFloor : TrendShape::kCeiling;
   }
   trend_ = FitTrend(preferred, u, t, sided, mu, slope_sd, sigma);
   if (space_ != MetricSpace::kBoolean && values.size() >= dims + 3) {
@@ -269,9 +355,9 @@ void MetricModel::Fit(const std::vector<std::vector<double>>& u,
   rms = std::sqrt(rms / t.size());
   // Hyperparameters: a small grid by marginal likelihood once there is
   // data enough, defaults scaled to the metric otherwise.
-  const double base_noise = space_ == MetricSpace::kLog       ? 0.03
-                            : space_ == MetricSpace::kBoolean ? 0.1
-                                                              : 0.1;
+  const double base_noise =
+      space_ == MetricSpace::kLog || space_ == MetricSpace::kReciprocal ? 0.03
+                                                                        : 0.1;
   const double signal = std::max(rms, 2.0 * base_noise);
   ResidualGp::Hyper hyper;
   hyper.constant2 = 0.01;
@@ -327,7 +413,7 @@ void MetricModel::Predict(const std::vector<double>& u, double* mean,
 double MetricModel::Bounded(double value) const {
   if (std::isnan(best_) || good_direction == 0) return value;
   double bound;
-  if (space_ == MetricSpace::kLog) {
+  if (space_ == MetricSpace::kLog || space_ == MetricSpace::kReciprocal) {
     bound = best_ * std::exp(good_direction * kOptimismRoom);
   } else {
     bound = best_ + good_direction * kOptimismRoom * scale_;
@@ -341,6 +427,8 @@ double MetricModel::ToMetric(double t) const {
       return std::exp(std::clamp(t, -700.0, 700.0));
     case MetricSpace::kBoolean:
       return t >= 0.5 ? 1.0 : 0.0;
+    case MetricSpace::kReciprocal:
+      return t > 0.0 ? scale_ / t : kInf;  // a rate of 0: never done
     case MetricSpace::kLinear:
       break;
   }

@@ -46,6 +46,11 @@ class ResidualGp {
     double noise2 = 4e-4;
   };
 
+  // Leave-one-out predictions of the fitted residuals (mean, variance),
+  // in closed form (Rasmussen & Williams, 5.12).
+  void LeaveOneOut(std::vector<double>* mean,
+                   std::vector<double>* variance) const;
+
   // Returns the log marginal likelihood (or -inf when singular).
   double Fit(const std::vector<std::vector<double>>& x,
              const std::vector<double>& r, const Hyper& hyper);
@@ -62,11 +67,13 @@ class ResidualGp {
   std::vector<std::vector<double>> x_;
   Eigen::LLT<Eigen::MatrixXd> llt_;
   Eigen::VectorXd alpha_;
+  Eigen::VectorXd y_;
 };
 
 // How a metric is modelled: log of a positive metric, a standardised
-// value, or a 0/1 flag.
-enum class MetricSpace { kLog, kLinear, kBoolean };
+// value, a 0/1 flag, or the reciprocal of a time (its rate, scaled by the
+// runs' median time).
+enum class MetricSpace { kLog, kLinear, kBoolean, kReciprocal };
 
 class MetricModel {
  public:
@@ -76,6 +83,10 @@ class MetricModel {
   int good_direction = 0;
   bool in_constraint = false;
   bool boolean_hint = false;  // documented as 0/1
+  // A time to finish, which may also be modelled as its rate (1 / time,
+  // falling to zero where a computer cannot keep up); the space whose
+  // leave-one-out predictions fit the runs better is used.
+  bool rate_hint = false;
 
   bool fitted() const { return fitted_; }
   int points() const { return points_; }
@@ -104,6 +115,19 @@ class MetricModel {
   double ToMetric(double t) const;
 
  private:
+  // Fits in `*forced` (kLog or kReciprocal for a positive metric), or in
+  // the space the values suggest when it is null.
+  void FitIn(const std::vector<std::vector<double>>& u,
+             const std::vector<double>& values, const std::vector<int>& sides,
+             const std::vector<double>& prior_slope,
+             const std::vector<double>& lengths, const MetricSpace* forced);
+
+  // Sum over the measured runs of the log density (in metric units) of
+  // each run's value under the leave-one-out prediction at its point.
+  double LeaveOneOutLogDensity(const std::vector<std::vector<double>>& u,
+                               const std::vector<double>& values,
+                               const std::vector<int>& sides) const;
+
   static Trend FitTrend(TrendShape shape,
                         const std::vector<std::vector<double>>& u,
                         const std::vector<double>& t,

@@ -88,11 +88,11 @@ TEST(AgentReplayTest, OnANoisyLandscape) {
 }
 
 TEST(AgentReplayTest, OnALandscapePricedByAnotherCostExpression) {
-  ExpectAgentOn("landscapes/other_cost", {4, 0.92, 14});
+  ExpectAgentOn("landscapes/other_cost", {2.5, 0.92, 15});
 }
 
 TEST(AgentReplayTest, OnALandscapeWithAKnobThatDoesNothing) {
-  ExpectAgentOn("landscapes/dead_knob", {5, 0.98, 12});
+  ExpectAgentOn("landscapes/dead_knob", {5, 0.98, 18});
 }
 
 TEST(AgentReplayTest, OnAFourDimensionalLandscape) {

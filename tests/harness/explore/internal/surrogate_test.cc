@@ -52,6 +52,43 @@ TEST(SurrogateTest, RunsStoppedPastABoundArePredictedPastIt) {
   EXPECT_LT(Predicted(only, 1.0), Predicted(only, 0.1));
 }
 
+TEST(SurrogateTest, ATimeThatBlowsUpWhereCapacityRunsOutIsModelledAsARate) {
+  // 12 runs of a stack that needs capacity 0.2: the time is the route's
+  // 100 s over the share of capacity left, which no trend in log time
+  // follows towards 0.2; as a rate (1 / time) it is a straight line.
+  std::vector<std::vector<double>> u;
+  std::vector<double> pole, power;
+  for (int i = 0; i < 12; ++i) {
+    const double x = 0.25 + 0.065 * i;
+    u.push_back({x});
+    pole.push_back(100.0 / (1.0 - 0.2 / x));
+    power.push_back(300.0 * std::exp(-1.2 * x));  // log-linear
+  }
+  MetricModel rate = NavTimeModel();
+  rate.rate_hint = true;
+  rate.Fit(u, pole, {}, {1.0}, {0.25});
+  ASSERT_TRUE(rate.fitted());
+  EXPECT_EQ(rate.space(), MetricSpace::kReciprocal);
+
+  MetricModel log = NavTimeModel();
+  log.rate_hint = true;
+  log.Fit(u, power, {}, {1.0}, {0.25});
+  EXPECT_EQ(log.space(), MetricSpace::kLog);
+  // Without the hint, or with fewer than 10 measured runs, never a rate.
+  MetricModel unhinted = NavTimeModel();
+  unhinted.Fit(u, pole, {}, {1.0}, {0.25});
+  EXPECT_EQ(unhinted.space(), MetricSpace::kLog);
+  // Just past the last run towards the capacity the stack needs (0.22 of
+  // 0.2; the truth is 1100 s), the rate model follows the climb further.
+  EXPECT_GT(Predicted(rate, 0.22), Predicted(unhinted, 0.22)) << "log model";
+  EXPECT_GT(Predicted(rate, 0.22), 500);
+  MetricModel few = NavTimeModel();
+  few.rate_hint = true;
+  few.Fit({u.begin(), u.begin() + 9}, {pole.begin(), pole.begin() + 9}, {},
+          {1.0}, {0.25});
+  EXPECT_EQ(few.space(), MetricSpace::kLog);
+}
+
 TEST(SurrogateTest, ABoundOnAFlagIsIgnoredRatherThanTakenForAValue) {
   MetricModel model;
   model.name = "completed";
