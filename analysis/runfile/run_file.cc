@@ -378,6 +378,23 @@ Result<std::vector<Row>> ReadTable(hid_t parent, const std::string& name,
   return rows;
 }
 
+// A table added after files of the same schema version were written
+// (results-schema/README.md, "Versioning"): older files lack it and read as
+// no rows.
+template <typename Row>
+Status ReadOptionalTable(hid_t file, const std::string& group_path,
+                         const std::string& name,
+                         const std::vector<Column<Row>>& columns,
+                         std::vector<Row>* out) {
+  if (internal::GetObjectKind(file, group_path + "/" + name) ==
+      internal::ObjectKind::kMissing) {
+    return Status::Ok();
+  }
+  Result<Handle> group = OpenGroup(file, group_path);
+  if (!group.ok()) return group.status();
+  return Assign(ReadTable(group->get(), name, columns), out);
+}
+
 // ---------------------------------------------------------------------------
 // Writing.
 
@@ -688,13 +705,8 @@ Status ReadContents(hid_t file, RunData* run) {
     ADSE_RETURN_IF_ERROR(
         Assign(ReadTable(group->get(), "ideal_path", PathColumns()),
                &run->ideal_path));
-    // Files written before /world/lanes existed (same schema version, see
-    // results-schema/README.md "Versioning") simply have no lanes.
-    if (internal::GetObjectKind(file, "/world/lanes") !=
-        internal::ObjectKind::kMissing) {
-      ADSE_RETURN_IF_ERROR(
-          Assign(ReadTable(group->get(), "lanes", LaneColumns()), &run->lanes));
-    }
+    ADSE_RETURN_IF_ERROR(
+        ReadOptionalTable(file, "/world", "lanes", LaneColumns(), &run->lanes));
     ADSE_RETURN_IF_ERROR(Assign(
         ReadTable(group->get(), "vehicles", VehicleColumns()), &run->vehicles));
     ADSE_RETURN_IF_ERROR(
@@ -742,13 +754,9 @@ Status ReadContents(hid_t file, RunData* run) {
         Assign(ReadTable(g, "obstacles", OutlineColumns()), &p.obstacles));
     ADSE_RETURN_IF_ERROR(Assign(
         ReadTable(g, "planned_path", ParkingPathColumns()), &p.planned_path));
-    // Files written before earlier plans were kept lack them.
-    if (internal::GetObjectKind(file, "/parking/earlier_plans") !=
-        internal::ObjectKind::kMissing) {
-      ADSE_RETURN_IF_ERROR(
-          Assign(ReadTable(g, "earlier_plans", EarlierPlanColumns()),
-                 &p.earlier_plans));
-    }
+    ADSE_RETURN_IF_ERROR(ReadOptionalTable(file, "/parking", "earlier_plans",
+                                           EarlierPlanColumns(),
+                                           &p.earlier_plans));
   }
   {
     Result<Handle> group = OpenGroup(file, "/trace");
@@ -808,26 +816,11 @@ Status ReadContents(hid_t file, RunData* run) {
     ADSE_RETURN_IF_ERROR(Assign(
         ReadTable(group->get(), "commands", ControlColumns()), &run->controls));
   }
-  // Files written before /planning/stop_reasons existed (same schema
-  // version) have no stop reasons.
-  if (internal::GetObjectKind(file, "/planning/stop_reasons") !=
-      internal::ObjectKind::kMissing) {
-    Result<Handle> group = OpenGroup(file, "/planning");
-    if (!group.ok()) return group.status();
-    ADSE_RETURN_IF_ERROR(
-        Assign(ReadTable(group->get(), "stop_reasons", StopReasonColumns()),
-               &run->stop_reasons));
-  }
-  // ... nor, before /perception/traffic_signals, the detector's reports.
-  if (internal::GetObjectKind(file, "/perception/traffic_signals") !=
-      internal::ObjectKind::kMissing) {
-    Result<Handle> group = OpenGroup(file, "/perception");
-    if (!group.ok()) return group.status();
-    ADSE_RETURN_IF_ERROR(
-        Assign(ReadTable(group->get(), "traffic_signals", SignalColumns()),
-               &run->signals));
-  }
-  return Status::Ok();
+  ADSE_RETURN_IF_ERROR(ReadOptionalTable(file, "/planning", "stop_reasons",
+                                         StopReasonColumns(),
+                                         &run->stop_reasons));
+  return ReadOptionalTable(file, "/perception", "traffic_signals",
+                           SignalColumns(), &run->signals);
 }
 
 Result<RunData> ReadRunFileImpl(const std::string& path) {
