@@ -502,14 +502,12 @@ void RealTimeExecutor::RunOne(int c, int thread,
   const double p = k > 1 ? st.cost->parallel_fraction : 0.0;
   const double serial_s = total_s * (1.0 - p);
   const double share_s = total_s * p / k;
-  internal::BusyUntilThreadCpu(cpu0, serial_s);
+  internal::BusyUntilThreadCpu(cpu0, serial_s);  // all of it when k = 1
   if (k > 1) {
     Status team = team_.Run(k - 1, share_s, [&] {
       internal::BusyUntilThreadCpu(cpu0, serial_s + share_s);
     });
     if (!team.ok() && failure.ok()) failure = std::move(team);
-  } else {
-    internal::BusyUntilThreadCpu(cpu0, serial_s + share_s);
   }
 
   lock->lock();
