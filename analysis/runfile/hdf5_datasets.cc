@@ -345,12 +345,15 @@ Result<PackedRows> ReadRows(hid_t parent, const std::string& name,
                        " lies outside the row)");
     }
   }
+  PackedRows packed;
   for (const FieldDesc& field : fields) {
     const int index = H5Tget_member_index(type.get(), field.name.c_str());
     if (index < 0) {
       H5Eclear2(H5E_DEFAULT);
+      if (field.optional) continue;
       return ReadError(what + ": missing field '" + field.name + "'");
     }
+    packed.fields.push_back(field);
     const H5T_class_t member_class =
         H5Tget_member_class(type.get(), static_cast<unsigned>(index));
     if (member_class != FieldClass(field.type)) {
@@ -374,11 +377,10 @@ Result<PackedRows> ReadRows(hid_t parent, const std::string& name,
   if (H5Sget_simple_extent_dims(space.get(), dims, nullptr) < 0) {
     return ReadHdf5Error(what, "shape");
   }
-  Handle mem_type = MakeCompoundType(fields, /*file=*/false);
+  Handle mem_type = MakeCompoundType(packed.fields, /*file=*/false);
   if (!mem_type.valid()) return ReadHdf5Error(what, "building the row type");
-  PackedRows packed;
   packed.rows = static_cast<size_t>(dims[0]);
-  packed.bytes.assign(packed.rows * RowSize(fields), '\0');
+  packed.bytes.assign(packed.rows * RowSize(packed.fields), '\0');
   if (packed.rows > 0 &&
       H5Dread(dataset.get(), mem_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT,
               packed.bytes.data()) < 0) {

@@ -238,6 +238,9 @@ struct FieldDesc {
   FieldType type = FieldType::kFloat64;
   size_t string_bytes = 0;                                  // kString only
   std::vector<std::pair<std::string, int8_t>> enum_values;  // kEnum8 only
+  // Added after files of the same schema version were written: a file may
+  // lack it, and readers then keep the row's default.
+  bool optional = false;
 };
 size_t FieldSize(const FieldDesc& field);
 size_t RowSize(const std::vector<FieldDesc>& fields);
@@ -252,11 +255,14 @@ Status WriteRows(hid_t parent, const std::string& name,
 
 struct PackedRows {
   size_t rows = 0;
+  // The fields read, in order: all but the optional ones the file lacks.
+  std::vector<FieldDesc> fields;
   std::vector<char> bytes;  // rows * RowSize(fields)
 };
 // Reads a compound row dataset into packed rows, converting by field name
 // (field order and extra fields in the file do not matter). Fails naming
-// the dataset if it is missing, not 1-D compound, or lacks a field.
+// the dataset if it is missing, not 1-D compound, or lacks a field that is
+// not optional.
 Result<PackedRows> ReadRows(hid_t parent, const std::string& name,
                             const std::vector<FieldDesc>& fields);
 

@@ -39,8 +39,11 @@ struct VehicleSample {
 // A control command as the vehicle received it.
 struct ControlSample {
   double t_s;      // publish time
-  double stamp_s;  // originating sensor time
+  double stamp_s;  // originating sensor time (through localization)
   double accel_mps2, steer_rad;
+  // The scan whose tracked objects the followed trajectory was checked
+  // against (the chain through perception); -1 when none.
+  double perception_stamp_s = -1.0;
 };
 
 // Why the planner's trajectory stops, as published on /planning/stop_reason.

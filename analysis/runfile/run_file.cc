@@ -59,6 +59,14 @@ Column<Row> U64(const char* name, uint64_t Row::*member) {
   return Scalar(name, FieldType::kUInt64, member);
 }
 
+// A column added after files of the same schema version were written
+// (results-schema/README.md, "Versioning").
+template <typename Row>
+Column<Row> Optional(Column<Row> column) {
+  column.desc.optional = true;
+  return column;
+}
+
 // Copies at most `width` bytes, backing off so a UTF-8 character is never
 // split; the rest of the field stays NUL (the buffer is zeroed).
 void PackString(const std::string& value, size_t width, char* out) {
@@ -255,7 +263,8 @@ const std::vector<Column<ControlSample>>& ControlColumns() {
   static const auto* columns = new std::vector<Column<ControlSample>>{
       F64("t_s", &ControlSample::t_s), F64("stamp_s", &ControlSample::stamp_s),
       F64("accel_mps2", &ControlSample::accel_mps2),
-      F64("steer_rad", &ControlSample::steer_rad)};
+      F64("steer_rad", &ControlSample::steer_rad),
+      Optional(F64("perception_stamp_s", &ControlSample::perception_stamp_s))};
   return *columns;
 }
 
@@ -361,13 +370,19 @@ Result<std::vector<Row>> ReadTable(hid_t parent, const std::string& name,
   const std::vector<FieldDesc> descs = Descs(columns);
   Result<internal::PackedRows> packed = internal::ReadRows(parent, name, descs);
   if (!packed.ok()) return packed.status();
-  const size_t row_size = internal::RowSize(descs);
+  const size_t row_size = internal::RowSize(packed->fields);
   std::vector<Row> rows(packed->rows);
   // An empty table's bytes may have a null data(), and null + offset is
   // undefined (found by fuzz_run_file on a run without collisions).
   if (rows.empty()) return rows;
-  size_t offset = 0;
+  size_t offset = 0, read = 0;
   for (const auto& column : columns) {
+    // An optional column the file lacks keeps the rows' default.
+    if (read == packed->fields.size() ||
+        packed->fields[read].name != column.desc.name) {
+      continue;
+    }
+    ++read;
     const char* in = packed->bytes.data() + offset;
     for (Row& row : rows) {
       column.unpack(in, &row);

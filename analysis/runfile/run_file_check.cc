@@ -269,7 +269,8 @@ class Checker {
     const int index = H5Tget_member_index(type.get(), name.c_str());
     if (index < 0) {
       internal::TakeHdf5Error();
-      Problem(path, "missing field '" + name + "'");
+      if (!field.value("optional", false))
+        Problem(path, "missing field '" + name + "'");
       return;
     }
     Handle member(H5Tget_member_type(type.get(), static_cast<unsigned>(index)));

@@ -40,8 +40,10 @@ struct CallbackProvenance {
 
 // The chains whose latency `adse profile check` compares: sensing (a raw
 // scan to the preprocessed cloud), localization (the preprocessed cloud to
-// the fused pose) and sensing_to_control (a scan to the command built on
-// it). The one list of their names.
+// the fused pose) and sensing_to_control (a scan to the command whose
+// trajectory was checked against that scan's tracked objects: through
+// perception, planning and control, the path of CARET's e2e chain). The
+// one list of their names.
 const std::vector<std::string>& ChainNames();
 
 // A chain's response time as the source measured it (CARET's path

@@ -98,9 +98,12 @@ std::map<std::string, std::vector<double>> ChainLatencies(
       out["localization"].push_back(*fused - from->second);
     }
   }
+  // Through perception, as CARET's e2e path runs (its planning stages take
+  // the newest objects): the command's perception stamp, not the
+  // localization stamp the controller steers by.
   for (const runfile::ControlSample& c : run.controls) {
-    if (c.stamp_s >= 0.0)
-      out["sensing_to_control"].push_back(c.t_s - c.stamp_s);
+    if (c.perception_stamp_s >= 0.0)
+      out["sensing_to_control"].push_back(c.t_s - c.perception_stamp_s);
   }
   return out;
 }

@@ -18,8 +18,9 @@ namespace {
 // parking car is parked only once its manoeuvre is over (it used to count
 // as parked standing within the tolerances at a cusp). v5: the freespace
 // planner says when the car is parked and corrects a manoeuvre ending
-// outside the tolerances.
-constexpr char kKeyVersion[] = "adse-run-key-v5";
+// outside the tolerances. v6: the tracker publishes on its own timer,
+// its tracks predicted to that time (Autoware 2022.12's), not per scan.
+constexpr char kKeyVersion[] = "adse-run-key-v6";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

@@ -160,12 +160,12 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   gate_params.emergency_decel_mps2 =
       stack_config.Get("control.emergency_decel_mps2");
   algorithms::CommandGate gate(gate_params);
-  graph.AddSink<stack::ControlMsg>(topics.control, [&](const stack::ControlMsg&
-                                                           m,
-                                                       double t_s) {
-    gate.OnCommand(t_s, m.accel_mps2, m.steer_rad, m.reverse);
-    run.controls.push_back({t_s, m.header.stamp_s, m.accel_mps2, m.steer_rad});
-  });
+  graph.AddSink<stack::ControlMsg>(
+      topics.control, [&](const stack::ControlMsg& m, double t_s) {
+        gate.OnCommand(t_s, m.accel_mps2, m.steer_rad, m.reverse);
+        run.controls.push_back({t_s, m.header.stamp_s, m.accel_mps2,
+                                m.steer_rad, m.header.perception_stamp_s});
+      });
   // valet_parking: the stack's manoeuvre, or its word that there is none
   // (which ends the run: waiting longer changes nothing).
   bool no_path = false;

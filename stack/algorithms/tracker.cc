@@ -125,4 +125,12 @@ std::vector<Track> Tracker::ConfirmedTracks() const {
   return out;  // tracks_ is ordered by id: births are appended
 }
 
+std::vector<Track> Tracker::ConfirmedTracksAt(double t_s) const {
+  std::vector<Track> out = ConfirmedTracks();
+  const double dt =
+      has_time_ ? std::min(t_s - last_t_s_, params_.max_dt_s) : 0.0;
+  for (Track& track : out) Predict(&track, dt);
+  return out;
+}
+
 }  // namespace adse::algorithms

@@ -50,6 +50,14 @@ class Tracker {
 
   // Confirmed tracks, ordered by id.
   std::vector<Track> ConfirmedTracks() const;
+  // Confirmed tracks predicted by their motion to t_s (at most max_dt_s
+  // ahead of the last update), the filter's state untouched: what a tracker
+  // that publishes on its own timer reports (Autoware's delay
+  // compensation). At or before the last update, ConfirmedTracks().
+  std::vector<Track> ConfirmedTracksAt(double t_s) const;
+  // Whether a frame has been applied, and the time of the newest.
+  bool has_time() const { return has_time_; }
+  double last_update_s() const { return last_t_s_; }
   // All tracks including tentative ones, ordered by id.
   const std::vector<Track>& tracks() const { return tracks_; }
   void Reset();

@@ -59,6 +59,9 @@ const std::vector<KnobInfo>& StackKnobs() {
          "cores the data-parallel clustering can use"},
         {"perception.max_object_size_m", false, 1.0, 100.0, 12.0,
          "clusters longer than this are static structure, not objects, m"},
+        {"perception.tracker_rate_hz", false, 1.0, 100.0, 10.0,
+         "rate at which the tracker publishes its tracks, predicted to the "
+         "time of publishing (Autoware's publish_rate), Hz"},
         // Planning.
         {"planning.rate_hz", false, 0.5, 100.0, 10.0,
          "behaviour/velocity planner rate, Hz"},

@@ -422,6 +422,10 @@ void Stack::BuildPerception(Graph* g) {
         ctx.Publish(detections_, std::move(out));
       });
 
+  // Autoware 2022.12's multi_object_tracker: its detections callback
+  // associates and updates; its own timer predicts the tracks to the time
+  // of publishing and publishes them (delay compensation), so objects reach
+  // planning at the tracker's rate whatever the scan rate.
   tracker_ = std::make_unique<algo::Tracker>();
   const int tracker_node = g->AddNode("multi_object_tracker");
   g->Subscribe<ObjectsMsg>(
@@ -436,9 +440,17 @@ void Stack::BuildPerception(Graph* g) {
           detections.push_back(d);
         }
         tracker_->Update(in.header.stamp_s, detections);
+        ctx.ReportWork(
+            {static_cast<double>(tracker_->last_work_units()), 0.0, 1});
+      });
+  g->AddTimer(
+      tracker_node, "publish", 1.0 / config_.Get("perception.tracker_rate_hz"),
+      [this](CallbackContext& ctx) {
+        // Nothing to report before the first scan's detections.
+        if (!tracker_->has_time()) return;
         ObjectsMsg out;
-        out.header = in.header;
-        for (const algo::Track& t : tracker_->ConfirmedTracks()) {
+        out.header.stamp_s = tracker_->last_update_s();
+        for (const algo::Track& t : tracker_->ConfirmedTracksAt(ctx.now_s())) {
           TrackedObject o;
           o.id = t.id;
           o.position = t.position;
@@ -448,8 +460,7 @@ void Stack::BuildPerception(Graph* g) {
           o.age = t.age;
           out.objects.push_back(o);
         }
-        ctx.ReportWork(
-            {static_cast<double>(tracker_->last_work_units()), 0.0, 1});
+        ctx.ReportWork({static_cast<double>(out.objects.size()), 0.0, 1});
         ctx.Publish(topics_.objects, std::move(out));
       });
 }
@@ -590,6 +601,8 @@ void Stack::BuildPlanning(Graph* g) {
                            : std::nullopt);
         TrajectoryMsg out = in;
         out.points = ToMessage(points);
+        out.header.perception_stamp_s =
+            stop_objects_ ? stop_objects_->header.stamp_s : -1.0;
         out.stop.header = in.header;
         out.stop.reason = decision.reason;
         out.stop.stop_distance_m = decision.distance_m;
@@ -819,6 +832,10 @@ void Stack::BuildControl(Graph* g) {
                           : std::vector<algo::PlannedPoint>{};
                   const algo::FollowerCommand c = follower_->Update(
                       follower_pose_->pose, follower_pose_->v_mps, points, dt);
+                  if (follower_trajectory_) {
+                    out.header.perception_stamp_s =
+                        follower_trajectory_->header.perception_stamp_s;
+                  }
                   out.accel_mps2 = c.accel_mps2;
                   out.steer_rad = c.steer_rad;
                   ctx.ReportWork({static_cast<double>(points.size()), 0.0, 1});

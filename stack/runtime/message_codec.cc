@@ -123,7 +123,7 @@ bool All(IO& io, Fields&... fields) {
 
 template <typename IO>
 bool Io(IO& io, Header& m) {
-  return All(io, m.stamp_s);
+  return All(io, m.stamp_s, m.perception_stamp_s);
 }
 template <typename IO>
 bool Io(IO& io, geometry::Pose2& m) {

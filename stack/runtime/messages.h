@@ -20,6 +20,11 @@ struct Header {
   // Time of the sensor sample this message derives from (for end-to-end
   // latency); for timer-born messages, the stamp of the input they used.
   double stamp_s = 0.0;
+  // Stamp of the scan whose tracked objects this message's decisions rest
+  // on, carried from the obstacle stop planner to the command: the
+  // sensing-to-control chain through perception, the path CARET's e2e
+  // latency follows. -1 when no objects were used.
+  double perception_stamp_s = -1.0;
 };
 
 // A LiDAR scan or a filtered cloud, points in the vehicle frame (x forward,

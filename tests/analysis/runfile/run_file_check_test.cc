@@ -46,7 +46,7 @@ RunData MakeRun() {
   run.trace.callbacks.resize(3);
   run.trace.topic_events.resize(5);
   run.trace.timer_overruns = {0};
-  run.controls = {{0.1, 0.05, 0.3, 0.0}};
+  run.controls = {{0.1, 0.05, 0.3, 0.0, 0.02}};
   // A valet run's /parking, so every dataset the writer can write is here.
   run.parking.present = true;
   run.parking.slot = "slot_r0_s3";
@@ -285,6 +285,68 @@ TEST_F(RunFileCheckTest, StopReasonCodesAddedLaterMayBeMissingButNotWrong) {
   EXPECT_EQ(problems, std::vector<std::string>{
                           "/planning/stop_reasons: field 'reason' enum code "
                           "'red_light' is 9, expected 5"});
+}
+
+// /control/commands as files written before perception_stamp_s had it:
+// one row, the other four fields.
+void WriteCommandsWithoutPerceptionStamp(const std::string& path) {
+  Editable file(path);
+  ASSERT_GE(H5Ldelete(file.get(), "/control/commands", H5P_DEFAULT), 0);
+  const hid_t type = H5Tcreate(H5T_COMPOUND, 4 * 8);
+  H5Tinsert(type, "t_s", 0, H5T_IEEE_F64LE);
+  H5Tinsert(type, "stamp_s", 8, H5T_IEEE_F64LE);
+  H5Tinsert(type, "accel_mps2", 16, H5T_IEEE_F64LE);
+  H5Tinsert(type, "steer_rad", 24, H5T_IEEE_F64LE);
+  const hsize_t dims[1] = {1};
+  const hid_t space = H5Screate_simple(1, dims, nullptr);
+  const hid_t dataset = H5Dcreate2(file.get(), "/control/commands", type, space,
+                                   H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  const double row[4] = {0.1, 0.05, 0.3, 0.0};
+  EXPECT_GE(H5Dwrite(dataset, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, row), 0);
+  H5Dclose(dataset);
+  H5Sclose(space);
+  H5Tclose(type);
+}
+
+// A field added later (optional in the schema) may be missing: the file
+// passes and reads with the field's default; a required one may not.
+TEST_F(RunFileCheckTest, FieldsAddedLaterMayBeMissingFromOlderFiles) {
+  const std::string older = Copy("older_commands.h5");
+  WriteCommandsWithoutPerceptionStamp(older);
+  std::vector<std::string> problems;
+  EXPECT_TRUE(CheckRunFile(older, &problems).ok()) << Join(problems);
+  Result<RunData> back = ReadRunFile(older);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  ASSERT_EQ(back->controls.size(), 1u);
+  EXPECT_EQ(back->controls[0].stamp_s, 0.05);
+  EXPECT_EQ(back->controls[0].accel_mps2, 0.3);
+  EXPECT_EQ(back->controls[0].perception_stamp_s, -1.0);
+
+  // What this version writes round-trips.
+  Result<RunData> now = ReadRunFile(Copy("now.h5"));
+  ASSERT_TRUE(now.ok());
+  EXPECT_EQ(now->controls[0].perception_stamp_s, 0.02);
+
+  const std::string broken = Copy("no_accel.h5");
+  {
+    Editable file(broken);
+    const hid_t type = H5Tcreate(H5T_COMPOUND, 3 * 8);
+    H5Tinsert(type, "t_s", 0, H5T_IEEE_F64LE);
+    H5Tinsert(type, "stamp_s", 8, H5T_IEEE_F64LE);
+    H5Tinsert(type, "steer_rad", 16, H5T_IEEE_F64LE);
+    ReplaceWithEmptyTable(file.get(), "/control/commands", type);
+    H5Tclose(type);
+  }
+  problems.clear();
+  EXPECT_EQ(CheckRunFile(broken, &problems).code(), Status::Code::kCorruption);
+  EXPECT_EQ(problems, std::vector<std::string>{
+                          "/control/commands: missing field 'accel_mps2'"});
+  Result<RunData> refused = ReadRunFile(broken);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find(
+                "/control/commands: missing field 'accel_mps2'"),
+            std::string::npos)
+      << refused.status().message();
 }
 
 TEST_F(RunFileCheckTest, ReportsBadRootAttributes) {

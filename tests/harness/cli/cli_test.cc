@@ -518,7 +518,7 @@ TEST(CliProfileTest, ImportWritesTheProfileAndShowPrintsItsTotalLoad) {
   ASSERT_EQ(import.exit_code, 0) << import.out;
   // Every callback of the stack graph, from the CARET callbacks mapped.
   EXPECT_NE(import.out.find("wrote " + out.string() +
-                            ": profile 'autoware-2022.12-i9-12900kf', 29 "
+                            ": profile 'autoware-2022.12-i9-12900kf', 30 "
                             "callbacks from 34 CARET callbacks; total load"),
             std::string::npos)
       << import.out;

@@ -191,14 +191,15 @@ TEST(CaretImportTest, TheBundledProfileParsesAndCoversEveryStackCallback) {
 TEST(CaretImportTest, TheStackGraphListsItsCallbacksWithoutAWorld) {
   Result<std::vector<std::string>> names = StackCallbackNames();
   ASSERT_TRUE(names.ok()) << names.status().ToString();
-  EXPECT_EQ(names->size(), 29u);
+  EXPECT_EQ(names->size(), 30u);
   for (const char* expected :
        {"lidar_driver/points_raw", "crop_box_filter_self/points",
         "distortion_corrector/points", "ring_outlier_filter/points",
         "behavior_path_planner/plan", "behavior_velocity_planner/path",
         "obstacle_stop_planner/trajectory", "ndt_scan_matcher/points",
         "ndt_scan_matcher_pose_buffer/ekf_pose", "ekf_localizer/publish",
-        "mission_planner/route", "trajectory_follower/control"}) {
+        "mission_planner/route", "trajectory_follower/control",
+        "multi_object_tracker/detections", "multi_object_tracker/publish"}) {
     EXPECT_NE(std::find(names->begin(), names->end(), expected), names->end())
         << expected;
   }

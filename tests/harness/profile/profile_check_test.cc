@@ -32,8 +32,10 @@ runfile::RunData TwoScans() {
   events.push_back({TopicEvent::kPublish, 1, 0, 2.10, 1, 2.0});
   run.trace.callbacks.push_back({0, 0, 1.00, 1.00, 1.08, 0.08});
   run.trace.callbacks.push_back({0, 0, 2.00, 2.00, 2.10, 0.10});
-  run.controls.push_back({1.40, 1.0, 0.0, 0.0});
-  run.controls.push_back({1.50, -1.0, 0.0, 0.0});  // built on no scan
+  // Steered by the pose of scan 1.2, its trajectory checked against the
+  // objects of scan 1.0: the chain runs through perception.
+  run.controls.push_back({1.40, 1.2, 0.0, 0.0, 1.0});
+  run.controls.push_back({1.50, 1.2, 0.0, 0.0, -1.0});  // no objects yet
   return run;
 }
 

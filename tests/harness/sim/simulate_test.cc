@@ -79,6 +79,20 @@ TEST(SimulateTest, GenerousComputerDrivesToTheGoalAtTheNominalControlRate) {
   // Autoware's sensing-to-control chain averaged 370 ms (667 ms at worst)
   // at about 4.9 GHz; at 2.1 GHz its stages take 2.3 times as long.
   EXPECT_LT(m.at("e2e_latency_p99_s"), 2.0);
+  // Each command also carries the scan whose tracked objects its trajectory
+  // was checked against: older than the localization fix it steers by, as
+  // perception and the tracker's and planner's timers lie between.
+  size_t with_objects = 0;
+  double through_perception_s = 0.0, through_localization_s = 0.0;
+  for (const runfile::ControlSample& c : run->controls) {
+    if (c.perception_stamp_s < 0.0 || c.stamp_s < 0.0) continue;
+    ++with_objects;
+    EXPECT_LE(c.perception_stamp_s, c.t_s);
+    through_perception_s += c.t_s - c.perception_stamp_s;
+    through_localization_s += c.t_s - c.stamp_s;
+  }
+  EXPECT_GT(with_objects, 9 * run->controls.size() / 10);
+  EXPECT_GT(through_perception_s, through_localization_s);
   EXPECT_NEAR(m.at("hardware_cost"), 16 * 2.1, 1e-9);
   EXPECT_EQ(run->content_key.size(), 64u);
   // A map without traffic signals: the graph has no signal detector topic

@@ -112,5 +112,35 @@ TEST(Tracker, GateSeparatesFarDetections) {
   EXPECT_EQ(tracker.last_work_units(), 1);
 }
 
+TEST(Tracker, TracksPublishedLaterArePredictedToThatTime) {
+  Tracker tracker;
+  EXPECT_TRUE(tracker.ConfirmedTracksAt(1.0).empty());
+  EXPECT_FALSE(tracker.has_time());
+  // A car at 10 m/s along x, seen every 0.1 s.
+  for (int k = 0; k < 10; ++k) tracker.Update(0.1 * k, {At(1.0 * k, 2.0)});
+  ASSERT_EQ(tracker.ConfirmedTracks().size(), 1u);
+  const Track seen = tracker.ConfirmedTracks()[0];
+  EXPECT_NEAR(tracker.last_update_s(), 0.9, 1e-12);
+
+  // 60 ms after the last scan it stands 0.6 m further on, less certain.
+  const std::vector<Track> later = tracker.ConfirmedTracksAt(0.96);
+  ASSERT_EQ(later.size(), 1u);
+  EXPECT_EQ(later[0].id, seen.id);
+  EXPECT_NEAR(later[0].position.x(),
+              seen.position.x() + 0.06 * seen.velocity.x(), 1e-9);
+  EXPECT_NEAR(later[0].position.x(), 9.6, 0.1);
+  EXPECT_NEAR(later[0].position.y(), 2.0, 0.05);
+  EXPECT_GT(later[0].covariance(0, 0), seen.covariance(0, 0));
+  // The filter itself is untouched, and a time before the last update
+  // predicts nothing.
+  EXPECT_EQ(tracker.ConfirmedTracks()[0].position, seen.position);
+  EXPECT_EQ(tracker.ConfirmedTracksAt(0.5)[0].position, seen.position);
+  // At most max_dt_s ahead.
+  const double far = tracker.ConfirmedTracksAt(100.0)[0].position.x();
+  EXPECT_NEAR(far,
+              seen.position.x() + tracker.params().max_dt_s * seen.velocity.x(),
+              1e-9);
+}
+
 }  // namespace
 }  // namespace adse::algorithms

@@ -162,9 +162,9 @@ TEST(MessageCodecTest, ACountTheBytesCannotHoldIsRefusedBeforeAllocating) {
                             std::make_shared<const PointCloudMsg>(cloud),
                             &bytes)
                   .ok());
-  // The header's stamp, then the points' count: claim 2^60 points.
+  // The header's two stamps, then the points' count: claim 2^60 points.
   const uint64_t huge = uint64_t{1} << 60;
-  bytes.replace(sizeof(double), sizeof huge,
+  bytes.replace(sizeof(Header), sizeof huge,
                 reinterpret_cast<const char*>(&huge), sizeof huge);
   Result<MessagePtr> decoded = DecodeMessage(typeid(PointCloudMsg), bytes);
   ASSERT_FALSE(decoded.ok());

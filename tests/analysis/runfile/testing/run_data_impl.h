@@ -180,6 +180,8 @@ inline std::string Diff(const RunData& a, const RunData& b) {
       num(at + "stamp_s", x.stamp_s, y.stamp_s);
       num(at + "accel_mps2", x.accel_mps2, y.accel_mps2);
       num(at + "steer_rad", x.steer_rad, y.steer_rad);
+      num(at + "perception_stamp_s", x.perception_stamp_s,
+          y.perception_stamp_s);
     }
   }
   if (size("stop_reasons", a.stop_reasons.size(), b.stop_reasons.size())) {
@@ -246,7 +248,8 @@ inline RunData MakeFullRun(size_t events = 5000) {
     const double t = 0.01 * i;
     run.ego.push_back({t, 1.5 * t, -0.1 * t, 0.001 * i, 12.0 + t,
                        (i % 7) * 0.01, -0.5 + 0.01 * i});
-    run.controls.push_back({t, t - 0.05, 0.2 * std::sin(t), -0.01 * i});
+    run.controls.push_back(
+        {t, t - 0.05, 0.2 * std::sin(t), -0.01 * i, i % 3 ? t - 0.3 : -1.0});
   }
   // Every stop reason, an obstacle on map structure among them.
   const std::vector<std::string> reasons = StopReasonNames();
