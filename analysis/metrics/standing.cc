@@ -138,23 +138,37 @@ bool TrafficWillRelease(StopReason reason, const runfile::StopSample* newest) {
          newest->static_structure == 0;
 }
 
-StallWatch::StallWatch(double stall_timeout_s, StandingOptions options)
-    : stall_timeout_s_(stall_timeout_s), options_(options) {}
+StallWatch::StallWatch(double stall_timeout_s, double traffic_stall_timeout_s,
+                       StandingOptions options)
+    : stall_timeout_s_(stall_timeout_s),
+      traffic_stall_timeout_s_(traffic_stall_timeout_s),
+      options_(options) {}
 
 bool StallWatch::Observe(double t_s, double v_mps,
                          const std::vector<runfile::StopSample>& stops) {
   const double dt = last_t_s_ < 0 ? 0.0 : std::max(0.0, t_s - last_t_s_);
   last_t_s_ = t_s;
   while (next_ < stops.size() && stops[next_].t_s <= t_s + 1e-9) ++next_;
-  if (stall_timeout_s_ <= 0) return false;
+  if (stall_timeout_s_ <= 0 && traffic_stall_timeout_s_ <= 0) return false;
   if (std::abs(v_mps) >= options_.standing_speed_mps) {
-    stood_s_ = 0.0;
-    stand_ = ReasonTally();
+    stood_s_ = traffic_s_ = 0.0;
+    stand_ = traffic_ = ReasonTally();
     return false;
   }
   const runfile::StopSample* newest = next_ > 0 ? &stops[next_ - 1] : nullptr;
   const StopReason reason = HoldingReason(newest, t_s, options_);
-  if (TrafficWillRelease(reason, newest)) return false;
+  if (TrafficWillRelease(reason, newest)) {
+    if (reason != StopReason::kObstacle || traffic_stall_timeout_s_ <= 0)
+      return false;
+    traffic_s_ += dt;
+    traffic_.Add(reason, newest, dt);
+    if (traffic_s_ + 1e-9 < traffic_stall_timeout_s_) return false;
+    cause_ = traffic_.ByReason().front();
+    stood_s_ = traffic_s_;
+    held_by_traffic_ = true;
+    return true;
+  }
+  if (stall_timeout_s_ <= 0) return false;
   stood_s_ += dt;
   stand_.Add(reason, newest, dt);
   if (stood_s_ + 1e-9 < stall_timeout_s_) return false;

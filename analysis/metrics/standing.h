@@ -105,15 +105,20 @@ class ReasonTally {
 };
 
 // Watches a run as it is simulated for a car that stands and will not
-// move again: it has stood without a break for `stall_timeout_s`, counting
-// only time held for reasons that traffic does not release (localization
-// lost, no trajectory, static structure taken for an obstacle, the goal's
-// stop short of the goal, a cause outside the planner such as stale
-// commands). Any movement starts the count again.
+// move again. It stalls when it has stood without a break for
+// `stall_timeout_s`, counting only time held for reasons that traffic does
+// not release (localization lost, no trajectory, static structure taken
+// for an obstacle, the goal's stop short of the goal, a cause outside the
+// planner such as stale commands); or, when `traffic_stall_timeout_s` > 0,
+// once other road users have held it that long within one stand (one that
+// never moves on: a broken-down car, a jam). Red lights pause both counts
+// (the planner bounds their wait itself). Any movement starts them again.
 class StallWatch {
  public:
-  // stall_timeout_s <= 0: never stalls.
-  explicit StallWatch(double stall_timeout_s, StandingOptions options = {});
+  // A timeout <= 0: never stalls for that cause.
+  explicit StallWatch(double stall_timeout_s,
+                      double traffic_stall_timeout_s = 0.0,
+                      StandingOptions options = {});
 
   // Takes the ego at `t_s` (samples in time order) with every stop sample
   // published so far; true once the car has stalled.
@@ -124,17 +129,24 @@ class StallWatch {
   // for kObstacle the track.
   StopReason reason() const { return cause_.reason; }
   int track_id() const { return cause_.track_id; }
-  // Counted time of the current stand.
+  // Whether it stalled behind other road users (traffic_stall_timeout_s).
+  bool held_by_traffic() const { return held_by_traffic_; }
+  // Counted time of the current stand: held by causes traffic does not
+  // release, or by road users when it stalled behind them.
   double stood_s() const { return stood_s_; }
 
  private:
   double stall_timeout_s_;
+  double traffic_stall_timeout_s_;
   StandingOptions options_;
   size_t next_ = 0;       // first stop sample after the last observation
   double last_t_s_ = -1;  // the last observation; < 0 before the first
   double stood_s_ = 0.0;
-  ReasonTally stand_;  // the counted time of the current stand
+  double traffic_s_ = 0.0;  // held by road users in the current stand
+  ReasonTally stand_;       // the counted time of the current stand
+  ReasonTally traffic_;     // the time road users held it in this stand
   StandingTime cause_;
+  bool held_by_traffic_ = false;
 };
 
 }  // namespace adse::analysis

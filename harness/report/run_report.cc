@@ -277,11 +277,21 @@ std::string FormatSummary(const RunReport& r) {
                : fmt::format("{:.4g}", it->second);
   };
   if (r.status == runfile::kRunStalled) {
+    // An obstacle stalls the car by either bound: static structure by the
+    // stall timeout, another road user by the traffic one (the stood line
+    // below says which it was).
+    const std::string held_by =
+        runfile::ReasonAfter(r.termination_reason, runfile::kStalledPrefix);
+    StopReason reason = StopReason::kNone;
+    const bool obstacle =
+        StringToStopReason(held_by, &reason) && reason == StopReason::kObstacle;
     out += fmt::format(
         "ended       stalled: the car stood still until {} s, held by {} "
-        "(task.stall_timeout_s)\n",
-        metric("nav_time_s"),
-        runfile::ReasonAfter(r.termination_reason, runfile::kStalledPrefix));
+        "({})\n",
+        metric("nav_time_s"), held_by,
+        obstacle ? "task.stall_timeout_s on map structure, "
+                   "task.traffic_stall_timeout_s behind a road user"
+                 : "task.stall_timeout_s");
     out +=
         "censored    the metrics below are measured up to then; nav_time_s "
         "is a lower bound\n";

@@ -91,6 +91,7 @@ Result<std::string> RunKey(const spec::Spec& spec,
   }
   h.Add(t.goal_tolerance_m).Add(t.speed_limit_kmh).Add(t.timeout_s);
   h.Add("stall_timeout_s").Add(t.stall_timeout_s);
+  h.Add("traffic_stall_timeout_s").Add(t.traffic_stall_timeout_s);
   const bool valet = t.kind == world::TaskKind::kValetParking;
   if (valet) h.Add("goal_yaw_tolerance_deg").Add(t.goal_yaw_tolerance_deg);
   // Stack: every knob's effective value, so a changed default changes keys.

@@ -323,7 +323,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   Result<EarlyStop> early_stop =
       EarlyStop::Create(spec, point, stack_config.Get("control.rate_hz"));
   if (!early_stop.ok()) return early_stop.status();
-  analysis::StallWatch stall(spec.task.stall_timeout_s);
+  analysis::StallWatch stall(spec.task.stall_timeout_s,
+                             spec.task.traffic_stall_timeout_s);
 
   const double dt = w.step_s();
   const double timeout = spec.task.timeout_s;

@@ -246,7 +246,8 @@ const std::vector<Field<TaskOptions>>& TaskFields() {
                   const Spec&) { EmitLocation(out, t.goal, &t); }},
       Number("speed_limit_kmh", &TaskOptions::speed_limit_kmh),
       Number("timeout_s", &TaskOptions::timeout_s),
-      Number("stall_timeout_s", &TaskOptions::stall_timeout_s)};
+      Number("stall_timeout_s", &TaskOptions::stall_timeout_s),
+      Number("traffic_stall_timeout_s", &TaskOptions::traffic_stall_timeout_s)};
   return kFields;
 }
 

@@ -101,6 +101,10 @@ struct TaskOptions {
   // A car that has stood this long without a break, held by something no
   // other traffic or signal will release, ends the run as stalled; 0: never.
   double stall_timeout_s = 60.0;
+  // A car that has stood this long without a break held by other road
+  // users (one that never moves on) ends the run as stalled; 0: never.
+  // Longer than a signal's red phase, so a queue at a red light never does.
+  double traffic_stall_timeout_s = 300.0;
 };
 
 // Names as written in scenario files and run records: the one list each

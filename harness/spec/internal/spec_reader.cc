@@ -30,9 +30,14 @@ const std::vector<std::string> kMapKeys = {"generate", "params", "net",
 const std::vector<std::string> kTrafficKeys = {
     "seed", "flows", "parked_occupancy", "parked_slots"};
 const std::vector<std::string> kFlowKeys = {"from", "to", "vehicles_per_hour"};
-const std::vector<std::string> kTaskKeys = {
-    "kind",      "start",          "via", "goal", "speed_limit_kmh",
-    "timeout_s", "stall_timeout_s"};
+const std::vector<std::string> kTaskKeys = {"kind",
+                                            "start",
+                                            "via",
+                                            "goal",
+                                            "speed_limit_kmh",
+                                            "timeout_s",
+                                            "stall_timeout_s",
+                                            "traffic_stall_timeout_s"};
 const std::vector<std::string> kStartKeys = {"x", "y", "edge", "pos_m", "lane"};
 const std::vector<std::string> kGoalKeys = {
     "x",           "y",       "edge",
@@ -417,6 +422,9 @@ void SpecReader::ReadTask(const Val& v) {
   }
   if (const Val* e = f.Get("stall_timeout_s")) {
     ReadNumber(*e, &task.stall_timeout_s, Bounds::NonNegative());
+  }
+  if (const Val* e = f.Get("traffic_stall_timeout_s")) {
+    ReadNumber(*e, &task.traffic_stall_timeout_s, Bounds::NonNegative());
   }
 }
 

@@ -2,16 +2,20 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace adse::analysis {
 namespace {
 
 using runfile::StopSample;
 
-// A 100 s run sampled every 0.1 s. Speed 0 in [from, to) intervals.
+// A run of end_s seconds sampled every 0.1 s. Speed 0 in [from, to)
+// intervals.
 runfile::RunData RunStanding(
-    const std::vector<std::pair<double, double>>& stands) {
+    const std::vector<std::pair<double, double>>& stands,
+    double end_s = 100.0) {
   runfile::RunData run;
-  for (int i = 0; i <= 1000; ++i) {
+  for (int i = 0; i <= static_cast<int>(std::lround(10 * end_s)); ++i) {
     const double t = 0.1 * i;
     double v = 5.0;
     for (const auto& [from, to] : stands) {
@@ -203,6 +207,39 @@ TEST(StallWatchTest, RedLightsAndOtherTrafficNeverStallACar) {
   Publish(&run, 50, 100, Obstacle(3, 4.0, false));
   StallWatch watch(60.0);
   EXPECT_EQ(StalledAt(run, &watch), -1);
+}
+
+TEST(StallWatchTest,
+     ARoadUserThatNeverMovesOnStallsTheCarAfterTheTrafficTimeout) {
+  // 20 s at a red light, then 280 s behind track 3 (no map structure
+  // there): a 120 s traffic bound stalls it at 140 s, naming the track;
+  // the red light paused the count.
+  runfile::RunData run = RunStanding({{0, 300}}, 300.0);
+  Publish(&run, 0, 20, Reason(StopReason::kRedLight, 0.5));
+  Publish(&run, 20, 300, Obstacle(3, 4.0, false));
+  StallWatch watch(60.0, 120.0);
+  EXPECT_NEAR(StalledAt(run, &watch), 140.0, 0.11);
+  EXPECT_EQ(watch.reason(), StopReason::kObstacle);
+  EXPECT_EQ(watch.track_id(), 3);
+  EXPECT_TRUE(watch.held_by_traffic());
+  EXPECT_NEAR(watch.stood_s(), 120.0, 0.11);
+
+  // Shorter than the bound, or with the bound off, it waits.
+  StallWatch longer(60.0, 300.0);
+  EXPECT_EQ(StalledAt(run, &longer), -1);
+  StallWatch off(60.0, 0.0);
+  EXPECT_EQ(StalledAt(run, &off), -1);
+  // Moving on between two road users starts the count again.
+  runfile::RunData twice = RunStanding({{0, 100}, {100.5, 200}}, 200.0);
+  Publish(&twice, 0, 200, Obstacle(3, 4.0, false));
+  StallWatch split(60.0, 120.0);
+  EXPECT_EQ(StalledAt(twice, &split), -1);
+  // Static structure still stalls by the stall timeout, not the traffic one.
+  runfile::RunData wall = RunStanding({{0, 300}}, 300.0);
+  Publish(&wall, 0, 300, Obstacle(5, 2.0, true));
+  StallWatch by_wall(60.0, 120.0);
+  EXPECT_NEAR(StalledAt(wall, &by_wall), 60.0, 0.11);
+  EXPECT_FALSE(by_wall.held_by_traffic());
 }
 
 TEST(StallWatchTest, TimeHeldByTrafficPausesTheCountWithoutResettingIt) {

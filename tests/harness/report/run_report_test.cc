@@ -160,7 +160,9 @@ TEST(RunReportTest, AStalledRunSaysWhatHeldTheCarAndIsCensored) {
   const std::string text = FormatSummary(*r);
   EXPECT_THAT(text, ::testing::HasSubstr(
                         "ended       stalled: the car stood still until 60 s, "
-                        "held by obstacle (task.stall_timeout_s)\n"));
+                        "held by obstacle (task.stall_timeout_s on map "
+                        "structure, task.traffic_stall_timeout_s behind a "
+                        "road user)\n"));
   EXPECT_THAT(text, ::testing::HasSubstr("nav_time_s is a lower bound"));
   EXPECT_EQ(ToJson(*r)["status"], "stalled");
 }
