@@ -68,7 +68,6 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
   const double scan_period = lidar ? 1.0 / lidar->params().rate_hz : 0.0;
   double next_scan_t = 0.0;
   double point_sum = 0.0;
-  double s_progress = 0.0;
   algorithms::TrafficLightParams signal_params;
   signal_params.max_red_wait_s = options.max_red_wait_s;
   algorithms::TrafficLightPlanner signals(signal_params);
@@ -78,9 +77,8 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
     const Eigen::Vector2d pos(ego.x_m, ego.y_m);
     report.trajectory.push_back({world.time_s(), ego.x_m, ego.y_m, ego.yaw_rad,
                                  ego.v_mps, ego.steer_rad, ego.accel_mps2});
-    double s_here = 0.0;
-    const double off_road = DistanceToPath(path, pos, &s_here);
-    s_progress = std::max(s_progress, s_here);
+    const double s_progress = world.road_progress_m();
+    const double off_road = world.road_offset_m();
     // Lane driving: the ideal path is the road part, already measured.
     report.max_lateral_error_m =
         std::max(report.max_lateral_error_m,

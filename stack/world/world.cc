@@ -22,6 +22,7 @@
 #include <set>
 
 #include "stack/algorithms/freespace_planner.h"
+#include "stack/algorithms/planning.h"
 #include "stack/base/files.h"
 #include "stack/base/hash.h"
 #include "stack/base/random.h"
@@ -42,6 +43,9 @@ std::atomic<bool> g_world_open{false};
 constexpr char kEgoId[] = "ego";
 // How far a start/goal may lie from a lane centre, beyond half its width.
 constexpr double kOffRoadSlackM = 1.5;
+// A car within the goal's tolerance projects at most that far before the
+// route's end; this much more for the projection on a bend.
+constexpr double kGoalSlackM = 1.0;
 constexpr double kValetSlackM = 8.0;
 
 double SumoAngleToYaw(double angle_deg) {
@@ -369,6 +373,7 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
   ADSE_RETURN_IF_ERROR(impl->FindRouteSignals());
   ADSE_RETURN_IF_ERROR(impl->SetUpTraffic());
   ADSE_RETURN_IF_ERROR(impl->AddEgo());
+  impl->UpdateProgress();
   world->impl_ = std::move(impl);
   return world;
 }
@@ -377,6 +382,7 @@ Status World::Step(const ControlCommand& command) {
   Impl& w = *impl_;
   const double dt = w.setup.world.step_s;
   w.ego->Step(command, dt);
+  w.UpdateProgress();
   return Guard("world step", [&] {
     for (size_t i = 0; i < w.flows.size(); ++i) {
       Impl::FlowState& flow = w.flows[i];
@@ -421,9 +427,27 @@ double World::distance_to_goal_m() const {
   const VehicleState& s = impl_->ego->state();
   return (Vec2(s.x_m, s.y_m) - impl_->goal_xy).norm();
 }
+void World::Impl::UpdateProgress() {
+  const VehicleState& s = ego->state();
+  const algorithms::PathPlannerParams window;
+  double lateral = 0.0;
+  road_progress_m = std::max(
+      road_progress_m,
+      algorithms::ProjectOnPath(road, Vec2(s.x_m, s.y_m),
+                                road_progress_m - window.projection_back_m,
+                                road_progress_m + window.projection_ahead_m,
+                                road_progress_m, &lateral, &road_offset_m));
+}
+
 bool World::goal_reached() const {
   const Impl& w = *impl_;
-  if (!w.valet) return distance_to_goal_m() <= w.setup.task.goal_tolerance_m;
+  if (!w.valet) {
+    // Near the goal at the end of the route, not where the route passes
+    // the goal earlier on the other side of the street.
+    const double tolerance = w.setup.task.goal_tolerance_m;
+    return distance_to_goal_m() <= tolerance &&
+           w.road_progress_m >= w.road.length_m() - tolerance - kGoalSlackM;
+  }
   // Parked: standing in the slot, as the tolerances allow. The rear axles'
   // distance equals the bodies' (same heading up to the tolerance).
   const VehicleState& s = w.ego->state();
@@ -444,6 +468,8 @@ double World::goal_yaw_error_rad() const {
       impl_->ego->state().yaw_rad - impl_->parking_goal.yaw_rad, 2 * M_PI));
 }
 const geometry::Path2& World::road_path() const { return impl_->road; }
+double World::road_progress_m() const { return impl_->road_progress_m; }
+double World::road_offset_m() const { return impl_->road_offset_m; }
 const std::vector<ManoeuvrePose>& World::reference_manoeuvre() const {
   return impl_->reference;
 }

@@ -78,7 +78,8 @@ class World {
   int collisions() const;
   // Vehicles whose contact with the ego began in the last step.
   const std::vector<std::string>& new_contacts() const;
-  // Lane driving: within goal_tolerance_m of the goal. valet_parking:
+  // Lane driving: within goal_tolerance_m of the goal, at the end of the
+  // route (see road_progress_m). valet_parking:
   // parked, i.e. standing with the body's centre within goal_tolerance_m of
   // the slot's and the heading within goal_yaw_tolerance_deg.
   bool goal_reached() const;
@@ -92,6 +93,11 @@ class World {
   const geometry::Pose2& parking_goal() const;
   double goal_yaw_error_rad() const;
   const geometry::Path2& road_path() const;
+  // How far along the road part the ego has come (its projection, searched
+  // near the progress so far, so a route that passes itself does not jump
+  // ahead) and its distance from the road part there.
+  double road_progress_m() const;
+  double road_offset_m() const;
   // The reference manoeuvre from the road part's end into the slot (the
   // ideal path's last part), planned on the ground truth; empty when the
   // planner found none or for lane driving.

@@ -5,7 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <map>
+#include <optional>
+#include <queue>
+#include <set>
+#include <utility>
 
 #include "stack/algorithms/freespace_planner.h"
 #include "stack/world/internal/world_impl.h"
@@ -157,6 +163,125 @@ Result<RoadLocation> World::Impl::Resolve(const Location& location,
   return out;
 }
 
+namespace {
+
+bool OpenToCars(const std::string& lane_id) {
+  const std::vector<std::string> disallowed =
+      libsumo::Lane::getDisallowed(lane_id);
+  return std::find(disallowed.begin(), disallowed.end(), "passenger") ==
+         disallowed.end();
+}
+
+// How far across the road a U-turn from `from_lane` to `to_lane` must
+// turn: the arrival lane's start off the departure lane's end, square to
+// its last heading.
+double UTurnWidthM(const std::string& from_lane, const std::string& to_lane) {
+  const std::vector<Vec2> from = ToPoints(libsumo::Lane::getShape(from_lane));
+  const std::vector<Vec2> to = ToPoints(libsumo::Lane::getShape(to_lane));
+  if (from.size() < 2 || to.empty()) return 0.0;
+  const Vec2 heading = (from.back() - from[from.size() - 2]).normalized();
+  const Vec2 d = to.front() - from.back();
+  return std::abs(heading.x() * d.y() - heading.y() * d.x());
+}
+
+// Where a route turns around tighter than the car can.
+struct TightUTurn {
+  std::string from_edge, to_edge;
+  double width_m = 0.0;  // across the road, lane centre to lane centre
+};
+
+// The edges a car may drive to from `edge`, with whether it can: through
+// any link but a U-turn, or a U-turn at least two turning radii wide (a
+// car that turns no tighter than `min_radius_m` needs that much road to
+// turn around without reversing). Only lanes open to passenger cars.
+std::map<std::string, TightUTurn> Successors(const std::string& edge,
+                                             double min_radius_m,
+                                             std::set<std::string>* drivable) {
+  std::map<std::string, TightUTurn> tight;
+  for (int l = 0; l < libsumo::Edge::getLaneNumber(edge); ++l) {
+    const std::string lane_id = edge + "_" + std::to_string(l);
+    if (!OpenToCars(lane_id)) continue;
+    for (const auto& link : libsumo::Lane::getLinks(lane_id)) {
+      const std::string next = EdgeOfLane(link.approachedLane);
+      const bool turnaround = link.direction == "t";
+      const double width =
+          turnaround ? UTurnWidthM(lane_id, link.approachedLane) : 0.0;
+      if (!turnaround || width >= 2.0 * min_radius_m) {
+        drivable->insert(next);
+      } else if (!tight.count(next) || width > tight[next].width_m) {
+        tight[next] = TightUTurn{edge, next, width};
+      }
+    }
+  }
+  for (const std::string& next : *drivable) tight.erase(next);
+  return tight;
+}
+
+// The first U-turn of `route` that the car cannot drive, if any.
+std::optional<TightUTurn> FirstTightUTurn(const std::vector<std::string>& route,
+                                          double min_radius_m) {
+  for (size_t i = 0; i + 1 < route.size(); ++i) {
+    std::set<std::string> drivable;
+    std::map<std::string, TightUTurn> tight =
+        Successors(route[i], min_radius_m, &drivable);
+    auto it = tight.find(route[i + 1]);
+    if (it != tight.end()) return it->second;
+  }
+  return std::nullopt;
+}
+
+// The quickest route (travel time at the lanes' speed limits, as SUMO's
+// router weighs it) from `from` to `to` that leaves `from` and takes only
+// turns the car can drive; empty when there is none. `to` may equal
+// `from` (the goal behind the start): then the route comes round to it.
+std::vector<std::string> DrivableRoute(const std::string& from,
+                                       const std::string& to,
+                                       double min_radius_m) {
+  std::map<std::string, double> best;
+  std::map<std::string, std::string> previous;
+  using Entry = std::pair<double, std::string>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
+  auto relax = [&](const std::string& edge, double t) {
+    std::set<std::string> drivable;
+    Successors(edge, min_radius_m, &drivable);
+    for (const std::string& next : drivable) {
+      const std::string lane = next + "_0";
+      const double cost =
+          t + libsumo::Lane::getLength(lane) /
+                  std::max(0.1, libsumo::Lane::getMaxSpeed(lane));
+      auto it = best.find(next);
+      if (it == best.end() || cost < it->second) {
+        best[next] = cost;
+        previous[next] = edge;
+        open.emplace(cost, next);
+      }
+    }
+  };
+  relax(from, 0.0);
+  std::set<std::string> settled;
+  while (!open.empty()) {
+    const auto [t, edge] = open.top();
+    open.pop();
+    if (!settled.insert(edge).second) continue;
+    if (edge == to) {
+      // Back along the predecessors to `from`, which the search left at
+      // time 0, so every chain ends there.
+      std::vector<std::string> route = {to};
+      std::string e = to;
+      do {
+        e = previous.at(e);
+        route.push_back(e);
+      } while (e != from);
+      std::reverse(route.begin(), route.end());
+      return route;
+    }
+    relax(edge, t);
+  }
+  return {};
+}
+
+}  // namespace
+
 Result<std::vector<std::string>> World::Impl::RouteLeg(
     const RoadLocation& from, const RoadLocation& to,
     const std::string& to_field, const std::string& from_field) {
@@ -194,6 +319,24 @@ Result<std::vector<std::string>> World::Impl::RouteLeg(
       return Status::InvalidArgument(fmt::format(
           "{}: unreachable from {} (no route from edge '{}' to edge '{}')",
           to_field, from_field, from.edge, to.edge));
+    }
+    // SUMO's router turns around wherever the net has a turnaround link;
+    // a car cannot follow a U-turn narrower than its turning circle
+    // without reversing, so such a route goes round the block instead.
+    const double min_radius_m =
+        setup.ego.wheelbase_m / std::tan(setup.ego.max_steer_rad);
+    if (std::optional<TightUTurn> uturn = FirstTightUTurn(best, min_radius_m)) {
+      best = DrivableRoute(from.edge, to.edge, min_radius_m);
+      if (best.empty()) {
+        return Status::InvalidArgument(fmt::format(
+            "{}: unreachable from {} without a U-turn the car cannot drive: "
+            "SUMO's route turns around from edge '{}' to edge '{}', {:.1f} m "
+            "across, where turning without reversing needs {:.1f} m (twice "
+            "the car's {:.1f} m turning radius), and no route avoids such a "
+            "turn",
+            to_field, from_field, uturn->from_edge, uturn->to_edge,
+            uturn->width_m, 2.0 * min_radius_m, min_radius_m));
+      }
     }
     return best;
   } catch (const std::exception& e) {

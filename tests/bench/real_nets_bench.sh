@@ -3,7 +3,10 @@
 # each net, seeded random routes of 500 m to 2 km (SUMO's shortest route
 # for passenger cars, checked with sumolib), with seeded traffic flows and
 # the net's own traffic lights, each run once with `adse simulate` at a
-# generous point. Prints a markdown table: net, route, reached goal, nav
+# generous point. adse routes them itself (round the block where SUMO's
+# route turns around tighter than the car can) and refuses a goal that
+# only such a U-turn reaches; those rows say "refused". Prints a markdown
+# table: net, route (SUMO's length and adse's), reached goal, nav
 # time, dominant stop reason, peak memory (/usr/bin/time -v), simulated
 # seconds per wall second, and how far `adse world --follow-ideal`'s
 # ground-truth controller strays from the ideal path outside junctions,
@@ -110,10 +113,11 @@ PY
 echo "point: ${point}; routes per net: ${routes}; seed: ${seed}"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1 /proc/loadavg)"
 echo
-echo "| net | route | length m | reached goal | ended | nav time s | dominant stop reason | stood s | collisions | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's |"
+echo "| net | route | length m, SUMO's shortest / adse's | reached goal | ended | nav time s | dominant stop reason | stood s | collisions | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 reached=0
 total=0
+refused=0
 for name in "${names[@]}"; do
   net="${nets[${name}]:-}"
   if [ -z "${net}" ] || [ ! -f "${net}" ]; then
@@ -122,6 +126,16 @@ for name in "${names[@]}"; do
   fi
   while read -r run length; do
     yaml="${out}/${run}.yaml"
+    # adse's own route first: it goes round the block where SUMO's turns
+    # around tighter than the car can, and refuses a goal only such a
+    # U-turn reaches (a three-point turn it cannot drive).
+    if ! "${adse}" world "${yaml}" --no-scan --json -o "${out}/${run}-route" \
+        >"${out}/${run}-route.json" 2>"${out}/${run}-route.log"; then
+      echo "| ${name} | ${run} | ${length} / - | refused | $(tail -n1 "${out}/${run}-route.log") | | | | | | | | |"
+      refused=$((refused + 1))
+      continue
+    fi
+    length="${length} / $("${py}" -c 'import json,sys; print("%.0f" % json.load(open(sys.argv[1]))["ideal_path_length_m"])' "${out}/${run}-route.json")"
     if ! /usr/bin/time -v -o "${out}/${run}.time" "${adse}" simulate "${yaml}" \
         --point "${point}" --json -q -o "${out}/${run}.h5" \
         >"${out}/${run}.json" 2>"${out}/${run}.log"; then
@@ -163,4 +177,4 @@ PY
   done < <(make_scenarios "${name}" "${net}")
 done
 echo
-echo "reached the goal: ${reached} of ${total}"
+echo "reached the goal: ${reached} of ${total}; refused (only a U-turn too tight for the car reaches the goal): ${refused}"

@@ -72,6 +72,10 @@ struct World::Impl {
   double raw_length_m = 0.0;  // of the joined lane pieces of the road part
   std::vector<RouteSignal> signals;  // the crossings a traffic light controls
   geometry::Path2 ideal;
+  // The ego on the road part: arc length reached so far and its distance
+  // from the road part there (UpdateProgress).
+  double road_progress_m = 0.0;
+  double road_offset_m = 0.0;
   double lane_width_m = 3.2;
   double max_join_gap_m = 0.0;
   Scene scene;
@@ -117,6 +121,10 @@ struct World::Impl {
   Status SetUpTraffic();
   Status AddEgo();
   void PushEgo();
+  // Projects the ego on the road part near its progress so far, as the
+  // stack's path planner does: a route that comes back along the other
+  // side of a street passes a lane width from where the car is.
+  void UpdateProgress();
   Status ReadOthers();
 };
 
