@@ -21,7 +21,8 @@ namespace {
 // outside the tolerances. v6: the tracker publishes on its own timer,
 // its tracks predicted to that time (Autoware 2022.12's), not per scan.
 // v7: a route goes round the block where SUMO's turns around tighter than
-// the car can (and the ideal driver projects near its progress).
+// the car can, the ideal path drops lane shapes' folds, and a lane-driving
+// goal is reached only near the route's end.
 constexpr char kKeyVersion[] = "adse-run-key-v7";
 
 Status AddFile(ContentHasher* h, const std::string& label,

@@ -165,6 +165,9 @@ Result<RoadLocation> World::Impl::Resolve(const Location& location,
 
 namespace {
 
+// A path vertex turning by more than 150 degrees folds the path back.
+constexpr double kFoldCos = -0.866;
+
 bool OpenToCars(const std::string& lane_id) {
   const std::vector<std::string> disallowed =
       libsumo::Lane::getDisallowed(lane_id);
@@ -193,7 +196,8 @@ struct TightUTurn {
 // The edges a car may drive to from `edge`, with whether it can: through
 // any link but a U-turn, or a U-turn at least two turning radii wide (a
 // car that turns no tighter than `min_radius_m` needs that much road to
-// turn around without reversing). Only lanes open to passenger cars.
+// turn around without reversing). Only links between lanes open to
+// passenger cars.
 std::map<std::string, TightUTurn> Successors(const std::string& edge,
                                              double min_radius_m,
                                              std::set<std::string>* drivable) {
@@ -202,6 +206,7 @@ std::map<std::string, TightUTurn> Successors(const std::string& edge,
     const std::string lane_id = edge + "_" + std::to_string(l);
     if (!OpenToCars(lane_id)) continue;
     for (const auto& link : libsumo::Lane::getLinks(lane_id)) {
+      if (!OpenToCars(link.approachedLane)) continue;
       const std::string next = EdgeOfLane(link.approachedLane);
       const bool turnaround = link.direction == "t";
       const double width =
@@ -427,6 +432,22 @@ Status World::Impl::BuildIdealPath() {
             std::max(max_join_gap_m, (part.front() - points.back()).norm());
       }
       for (const Vec2& p : part) {
+        if (!points.empty() && (p - points.back()).norm() < 1e-6) continue;
+        // OSM-derived lane shapes can fold back on themselves (acosta's
+        // edge 224[1] starts 9 m past its corner and comes back): no car
+        // drives a vertex that reverses the path, so it is dropped.
+        while (points.size() >= 2) {
+          const Vec2 in = points.back() - points[points.size() - 2];
+          const Vec2 out = p - points.back();
+          if (out.norm() < 1e-6 ||
+              in.dot(out) > kFoldCos * in.norm() * out.norm()) {
+            break;
+          }
+          raw_s -= in.norm();
+          points.pop_back();
+          // A crossing recorded on the dropped part lies where it ends now.
+          for (Crossing& c : crossings) c.raw_s_m = std::min(c.raw_s_m, raw_s);
+        }
         if (!points.empty()) raw_s += (p - points.back()).norm();
         points.push_back(p);
       }

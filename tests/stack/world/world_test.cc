@@ -134,6 +134,41 @@ TEST(WorldTest, OnARealTownTheRouteAvoidsAUTurnTheCarCannotDrive) {
   EXPECT_LT(report->max_lateral_error_m, 1.0);
 }
 
+// The real-nets bench's route acosta-1: the lane shape of edge 224[1]
+// starts 9 m past its corner and folds back; the ideal path took the fold
+// and the ideal driver ended 9 m off it. The path drops the fold.
+TEST(WorldTest, OnARealTownALaneShapeThatFoldsBackIsDrivenAsTheCorner) {
+  const std::string net =
+      "/usr/share/sumo/tools/sumolib/scenario/scenarios/RealWorld/acosta/"
+      "acosta_buslanes.net.xml";
+  ASSERT_TRUE(std::filesystem::exists(net)) << "sumo-tools is not installed";
+  WorldSetup setup;
+  setup.world.map.net_path = net;
+  setup.task.start = Location::OnEdge("224[0]", 10.0, 0);
+  setup.task.goal = Location::OnEdge("2", 22.2, 0);
+  setup.task.speed_limit_kmh = 40.0;
+  setup.cache_dir = CacheDir();
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  // Nowhere does the path turn back on itself.
+  const geometry::Path2& path = (*world)->ideal_path();
+  for (size_t i = 1; i + 1 < path.points.size(); ++i) {
+    const Eigen::Vector2d in = path.points[i] - path.points[i - 1];
+    const Eigen::Vector2d out = path.points[i + 1] - path.points[i];
+    ASSERT_GT(in.dot(out), -0.5 * in.norm() * out.norm())
+        << "folds at (" << path.points[i].x() << ", " << path.points[i].y()
+        << ")";
+  }
+  IdealDriverOptions options;
+  options.scan = false;
+  options.speed_limit_mps = 40.0 / 3.6;
+  options.timeout_s = 400.0;
+  Result<IdealDriveReport> report = DriveIdealPath(**world, nullptr, options);
+  ASSERT_TRUE(report.ok()) << report.status().ToString();
+  EXPECT_TRUE(report->reached_goal);
+  EXPECT_LT(report->max_lateral_error_m, 1.0);  // 0.84 m measured
+}
+
 TEST(WorldTest, AOneWayStreetOfABareNetHasPolesOnBothSides) {
   // Edge 69 of sumo-tools' acosta: a one-way, two-lane street. With poles
   // on its right side only, NDT saw too little structure and got lost.
