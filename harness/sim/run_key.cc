@@ -81,6 +81,13 @@ Result<std::string> RunKey(const spec::Spec& spec,
     h.Add("parked_slots");
     for (const std::string& name : w.traffic.parked_slots) h.Add(name);
   }
+  // Keys of scenarios without them stay as they were.
+  if (!w.traffic.stopped_vehicles.empty()) {
+    h.Add("stopped_vehicles");
+    for (const world::Location& l : w.traffic.stopped_vehicles) {
+      AddLocation(&h, l);
+    }
+  }
   h.Add(static_cast<long long>(w.weather)).Add(w.step_s);
   // Task.
   const world::TaskOptions& t = spec.task;

@@ -209,7 +209,16 @@ const std::vector<Field<TrafficOptions>>& TrafficFields() {
          for (const std::string& name : t.parked_slots) out << name;
          out << YAML::EndSeq;
        },
-       [](const TrafficOptions& t) { return !t.parked_slots.empty(); }}};
+       [](const TrafficOptions& t) { return !t.parked_slots.empty(); }},
+      {"stopped_vehicles",
+       [](YAML::Emitter& out, const TrafficOptions& t, const Spec&) {
+         out << YAML::BeginSeq;
+         for (const world::Location& l : t.stopped_vehicles) {
+           EmitLocation(out, l, nullptr);
+         }
+         out << YAML::EndSeq;
+       },
+       [](const TrafficOptions& t) { return !t.stopped_vehicles.empty(); }}};
   return kFields;
 }
 

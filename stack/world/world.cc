@@ -235,6 +235,24 @@ Status World::Impl::SetUpTraffic() {
       return Status::InvalidArgument(field + ": " + e.what());
     }
   }
+  const auto& stopped = setup.world.traffic.stopped_vehicles;
+  for (size_t i = 0; i < stopped.size(); ++i) {
+    const std::string field =
+        fmt::format("world.traffic.stopped_vehicles[{}]", i);
+    Result<RoadLocation> at = Resolve(stopped[i], field, kOffRoadSlackM);
+    if (!at.ok()) return at.status();
+    try {
+      // A one-edge route, inserted where it stands and held there.
+      const std::string id = fmt::format("stopped{}", i);
+      libsumo::Route::add("adse_" + id, {at->edge});
+      libsumo::Vehicle::add(id, "adse_" + id, "DEFAULT_VEHTYPE", "now",
+                            std::to_string(at->lane),
+                            fmt::format("{}", at->pos_m), "0");
+      libsumo::Vehicle::setSpeed(id, 0.0);
+    } catch (const std::exception& e) {
+      return Status::InvalidArgument(field + ": " + e.what());
+    }
+  }
   return Status::Ok();
 }
 

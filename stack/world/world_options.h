@@ -8,6 +8,7 @@
 #include <map>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace adse::world {
@@ -23,31 +24,6 @@ struct MapOptions {
   std::string generator;
   // Generator parameters by name (see scenarios/README.md).
   std::map<std::string, double> generator_params;
-};
-
-struct Flow {
-  std::string from_edge;
-  std::string to_edge;
-  double vehicles_per_hour = 60.0;
-};
-
-struct TrafficOptions {
-  // Seeds SUMO's randomness and the parked-car layout.
-  uint64_t seed = 1;
-  std::vector<Flow> flows;
-  // Fraction of parking slots holding a parked car, in [0, 1].
-  double parked_occupancy = 0.0;
-  // Slots (by name) holding a parked car; when given, exactly these do and
-  // parked_occupancy is not drawn.
-  std::vector<std::string> parked_slots;
-};
-
-struct WorldOptions {
-  MapOptions map;
-  TrafficOptions traffic;
-  Weather weather = Weather::kClear;
-  // World (SUMO and ego dynamics) step.
-  double step_s = 0.05;
 };
 
 // A place on the map: either a world coordinate or an edge position.
@@ -79,6 +55,34 @@ struct Location {
   // counter-clockwise from +x.
   bool has_yaw = false;
   double yaw_deg = 0.0;
+};
+
+struct Flow {
+  std::string from_edge;
+  std::string to_edge;
+  double vehicles_per_hour = 60.0;
+};
+
+struct TrafficOptions {
+  // Seeds SUMO's randomness and the parked-car layout.
+  uint64_t seed = 1;
+  std::vector<Flow> flows;
+  // Fraction of parking slots holding a parked car, in [0, 1].
+  double parked_occupancy = 0.0;
+  // Slots (by name) holding a parked car; when given, exactly these do and
+  // parked_occupancy is not drawn.
+  std::vector<std::string> parked_slots;
+  // Road users that stand where they are placed for the whole run (a
+  // broken-down car, a delivery van): SUMO vehicles held at speed 0.
+  std::vector<Location> stopped_vehicles;
+};
+
+struct WorldOptions {
+  MapOptions map;
+  TrafficOptions traffic;
+  Weather weather = Weather::kClear;
+  // World (SUMO and ego dynamics) step.
+  double step_s = 0.05;
 };
 
 enum class TaskKind { kLaneDriving, kValetParking };

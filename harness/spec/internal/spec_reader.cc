@@ -28,7 +28,7 @@ const std::vector<std::string> kWorldKeys = {"map", "traffic", "weather",
 const std::vector<std::string> kMapKeys = {"generate", "params", "net",
                                            "polygons"};
 const std::vector<std::string> kTrafficKeys = {
-    "seed", "flows", "parked_occupancy", "parked_slots"};
+    "seed", "flows", "parked_occupancy", "parked_slots", "stopped_vehicles"};
 const std::vector<std::string> kFlowKeys = {"from", "to", "vehicles_per_hour"};
 const std::vector<std::string> kTaskKeys = {"kind",
                                             "start",
@@ -349,6 +349,15 @@ void SpecReader::ReadTraffic(const Val& v) {
       traffic.parked_slots.assign(items.size(), std::string());
       for (size_t i = 0; i < items.size(); ++i)
         ReadString(items[i], &traffic.parked_slots[i], "a parking slot name");
+    }
+  }
+  if (const Val* e = f.Get("stopped_vehicles")) {
+    std::vector<Val> items;
+    if (ReadList(*e, &items,
+                 "a list of places {x, y} or {edge, pos_m, lane}")) {
+      traffic.stopped_vehicles.assign(items.size(), world::Location());
+      for (size_t i = 0; i < items.size(); ++i)
+        ReadLocation(items[i], false, &traffic.stopped_vehicles[i]);
     }
   }
   if (const Val* e = f.Get("flows")) {

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 
+#include "analysis/metrics/standing.h"
 #include "analysis/runfile/run_file.h"
 #include "harness/sim/calibration.h"
 #include "harness/spec/spec_parser.h"
@@ -243,6 +244,38 @@ TEST(SimulateTest, ACarHeldShortOfItsGoalEndsStalledAfterTheStallTimeout) {
   ASSERT_TRUE(full.ok()) << full.status().ToString();
   EXPECT_EQ(full->status, runfile::kRunComplete);
   EXPECT_EQ(full->termination_reason, "timeout");
+}
+
+TEST(SimulateTest, ACarBehindARoadUserThatNeverMovesOnEndsStalledByIt) {
+  // A broken-down car stands on the ego's lane 14 m ahead of the start;
+  // adse plans no way round it (Autoware's avoidance planner would), so
+  // the car stops behind it and waits.
+  spec::Spec spec = SmallScenario();
+  spec.harness.early_stop = false;
+  spec.world.traffic.flows.clear();
+  spec.world.traffic.stopped_vehicles = {world::Location::Xy(22.0, -1.75)};
+  spec.task.traffic_stall_timeout_s = 20;
+  Result<runfile::RunData> run = SimulatePoint(spec, SmallPoint(16, 2.1, 7));
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->status, runfile::kRunStalled);
+  EXPECT_EQ(run->termination_reason, "stalled: obstacle");
+  EXPECT_EQ(run->metrics.at("collisions"), 0.0);
+  const analysis::StandingSummary standing = analysis::SummarizeStanding(*run);
+  ASSERT_FALSE(standing.by_reason.empty());
+  const analysis::StandingTime& top = standing.by_reason.front();
+  EXPECT_EQ(top.reason, StopReason::kObstacle);
+  EXPECT_FALSE(top.static_structure);  // a road user, not the map
+  EXPECT_GT(top.obstacle_gap_m, 0.0);  // stopped short of it
+  // It stands from a few seconds in for the 20 s of the bound.
+  EXPECT_NEAR(top.standing_s, 20.0, 2.0);
+  EXPECT_LT(run->metrics.at("nav_time_s"), 30.0);
+
+  // The default bound (300 s) outlasts this 60 s run: it times out.
+  spec.task.traffic_stall_timeout_s = 300;
+  spec.task.timeout_s = 60;
+  Result<runfile::RunData> waits = SimulatePoint(spec, SmallPoint(16, 2.1, 7));
+  ASSERT_TRUE(waits.ok()) << waits.status().ToString();
+  EXPECT_EQ(waits->termination_reason, "timeout");
 }
 
 TEST(SimulateTest, PointOutsideTheSpaceIsRejected) {

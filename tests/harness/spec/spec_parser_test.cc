@@ -356,6 +356,44 @@ design_space: {cores: {bind: platform.cores, range: [1, 4]}}
             std::string::npos);
 }
 
+TEST(SpecParserTest, StoppedVehiclesRoundTripAndABadOneIsNamedByIndex) {
+  const std::string text = R"(adse: 1
+world:
+  map: {generate: grid}
+  traffic: {stopped_vehicles: [{x: 40, y: -1.6}, {edge: A0B0, pos_m: 30, lane: 0}]}
+task: {start: {x: 0, y: 0}, goal: {x: 100, y: 0}}
+design_space: {cores: {bind: platform.cores, range: [1, 4]}}
+)";
+  Result<Spec> first = ParseSpec(text, "stopped.yaml", "/");
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  const std::string yaml = NormalizedYaml(*first);
+  Result<Spec> again = ParseSpec(yaml, "normalized.yaml", "/");
+  ASSERT_TRUE(again.ok()) << again.status().message() << "\n" << yaml;
+  EXPECT_EQ(NormalizedYaml(*again), yaml);
+  const auto& stopped = again->world.traffic.stopped_vehicles;
+  ASSERT_EQ(stopped.size(), 2u);
+  EXPECT_FALSE(stopped[0].by_edge);
+  EXPECT_NEAR(stopped[0].x_m, 40, kTol);
+  EXPECT_TRUE(stopped[1].by_edge);
+  EXPECT_EQ(stopped[1].edge, "A0B0");
+  EXPECT_NEAR(stopped[1].pos_m, 30, kTol);
+
+  Result<Spec> bad = ParseSpec(R"(adse: 1
+world:
+  map: {generate: grid}
+  traffic: {stopped_vehicles: [{x: 40, y: -1.6}, {x: 40, edge: A0B0}]}
+task: {start: {x: 0, y: 0}, goal: {x: 100, y: 0}}
+design_space: {cores: {bind: platform.cores, range: [1, 4]}}
+)",
+                               "bad.yaml", "/");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("world.traffic.stopped_vehicles[1]"),
+            std::string::npos)
+      << bad.status().message();
+  EXPECT_NE(bad.status().message().find("bad.yaml:4:"), std::string::npos)
+      << bad.status().message();
+}
+
 TEST(SpecParserTest, NormalizedYamlRoundTripsNetMapsAndEdges) {
   const std::string dir = MakeTempDir();
   WriteText(fs::path(dir) / "a.net.xml", "<net version=\"1.16\"></net>\n");
