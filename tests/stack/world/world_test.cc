@@ -352,6 +352,18 @@ TEST(WorldTest, StartOffTheRoadIsRejected) {
       << world.status().message();
 }
 
+TEST(WorldTest, AStoppedVehicleOffTheRoadIsRejectedByItsIndex) {
+  WorldSetup setup = SmallLot();
+  setup.world.traffic.stopped_vehicles = {Location::Xy(20.0, -1.75),
+                                          Location::Xy(15.0, 8.0)};
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_FALSE(world.ok());
+  EXPECT_NE(world.status().message().find(
+                "world.traffic.stopped_vehicles[1]: (15, 8) is off the road"),
+            std::string::npos)
+      << world.status().message();
+}
+
 TEST(WorldTest, UnreachableGoalIsRejected) {
   // Two separate road pieces: no route joins them.
   const auto dir = std::filesystem::temp_directory_path() / "adse_islands";
