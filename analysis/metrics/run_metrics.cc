@@ -62,6 +62,10 @@ std::map<std::string, double> ComputeRunMetrics(
   m["e2e_latency_p50_s"] = Percentile(latencies, 0.5);
   m["e2e_latency_p99_s"] = Percentile(latencies, 0.99);
   m["collisions"] = static_cast<double>(run.collisions.size());
+  // Contacts not known to be the other's doing count against the ego.
+  m["ego_collisions"] = static_cast<double>(std::count_if(
+      run.collisions.begin(), run.collisions.end(),
+      [](const runfile::CollisionEvent& c) { return c.ego_caused != 0; }));
 
   double busy_core_s = 0.0;
   for (const stack::CallbackRecord& r : run.trace.callbacks) {

@@ -28,7 +28,8 @@ inline constexpr char kCensoredMetric[] = "censored";
 // commands per second over the navigation), e2e_latency_p50_s /
 // e2e_latency_p99_s (control command publish time minus the stamp of the LiDAR
 // scan it derives from), dropped_messages (all topics), lidar_frames_dropped,
-// collisions, callbacks (executions), cpu_utilization (busy core-seconds /
+// collisions, ego_collisions (those the ego caused, or not known not to
+// have), callbacks (executions), cpu_utilization (busy core-seconds /
 // cores x nav time).
 std::map<std::string, double> ComputeRunMetrics(
     const runfile::RunData& run, const RunMetricsOptions& options = {});

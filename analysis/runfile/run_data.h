@@ -70,6 +70,10 @@ struct SignalSample {
 struct CollisionEvent {
   double t_s;
   std::string other_id;
+  // 1: the ego caused it (at the contact it moved towards the other at
+  // least as fast as the other moved towards it); 0: the other drove into
+  // it; -1: not known (files written before it was recorded).
+  int32_t ego_caused = -1;
 };
 
 // valet_parking: a parking slot of the lot.

@@ -167,7 +167,8 @@ const std::vector<Column<VehicleSample>>& VehicleColumns() {
 const std::vector<Column<CollisionEvent>>& CollisionColumns() {
   static const auto* columns = new std::vector<Column<CollisionEvent>>{
       F64("t_s", &CollisionEvent::t_s),
-      Str("other_id", kIdBytes, &CollisionEvent::other_id)};
+      Str("other_id", kIdBytes, &CollisionEvent::other_id),
+      Optional(I32("ego_caused", &CollisionEvent::ego_caused))};
   return *columns;
 }
 

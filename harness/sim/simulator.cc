@@ -44,6 +44,15 @@ double Seconds(Clock::duration d) {
   return std::chrono::duration<double>(d).count();
 }
 
+// 1 when the ego caused its new contact with vehicle `id`, 0 when that one
+// drove into it (world::EgoCausedContact); -1 when `id` is gone.
+int32_t EgoCaused(const world::World& w, const std::string& id) {
+  for (const world::OtherVehicle& v : w.others()) {
+    if (v.id == id) return world::EgoCausedContact(w.ego(), w.ego_body(), v);
+  }
+  return -1;
+}
+
 std::string HostDescription() {
   char name[256] = {0};
   ::gethostname(name, sizeof(name) - 1);
@@ -422,7 +431,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     if (!stepped.ok()) return stepped;
     record_ego();
     for (const std::string& id : w.new_contacts())
-      run.collisions.push_back({w.time_s(), id});
+      run.collisions.push_back({w.time_s(), id, EgoCaused(w, id)});
     if (w.time_s() + 1e-9 >= next_vehicles) {
       for (const world::OtherVehicle& v : w.others()) {
         run.vehicles.push_back({w.time_s(), v.id, v.box.center.x(),

@@ -121,6 +121,9 @@ const std::vector<MetricInfo>& KnownMetrics() {
       {"e2e_latency_p99_s", "99th percentile LiDAR-to-control latency, s"},
       {"dropped_messages", "messages dropped by keep-last queues, count"},
       {"collisions", "collisions of the ego with vehicles or obstacles, count"},
+      {"ego_collisions",
+       "collisions the ego caused: at the contact it moved towards the other "
+       "vehicle at least as fast as that one moved towards it, count"},
       // valet_parking runs only (analysis/metrics/parking_metrics.h).
       {"parked",
        "valet_parking: the run ended standing in the slot within the goal's "

@@ -445,6 +445,20 @@ double World::distance_to_goal_m() const {
   const VehicleState& s = impl_->ego->state();
   return (Vec2(s.x_m, s.y_m) - impl_->goal_xy).norm();
 }
+bool EgoCausedContact(const VehicleState& ego,
+                      const geometry::OrientedBox& ego_body,
+                      const OtherVehicle& other) {
+  const Vec2 towards_other = other.box.center - ego_body.center;
+  const double d = towards_other.norm();
+  if (d < 1e-9) return true;
+  const Vec2 u = towards_other / d;
+  const Vec2 ego_v =
+      ego.v_mps * Vec2(std::cos(ego.yaw_rad), std::sin(ego.yaw_rad));
+  const Vec2 other_v = other.speed_mps * Vec2(std::cos(other.box.yaw_rad),
+                                              std::sin(other.box.yaw_rad));
+  return ego_v.dot(u) >= other_v.dot(-u);
+}
+
 void World::Impl::UpdateProgress() {
   const VehicleState& s = ego->state();
   const algorithms::PathPlannerParams window;

@@ -46,6 +46,14 @@ struct OtherVehicle {
   double speed_mps = 0.0;
 };
 
+// Whether the ego caused its contact with `other`: along the line between
+// their centres it moved towards the other at least as fast as the other
+// moved towards it. A car standing or braking that is driven into from
+// behind or the side did not; one that drives into a slower car did.
+bool EgoCausedContact(const VehicleState& ego,
+                      const geometry::OrientedBox& ego_body,
+                      const OtherVehicle& other);
+
 // A link the route takes through a signalised junction: the traffic light
 // that controls it and the stop line at the end of the route's lane.
 struct RouteSignal {

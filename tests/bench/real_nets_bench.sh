@@ -113,7 +113,7 @@ PY
 echo "point: ${point}; routes per net: ${routes}; seed: ${seed}"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1 /proc/loadavg)"
 echo
-echo "| net | route | length m, SUMO's shortest / adse's | reached goal | ended | nav time s | dominant stop reason | stood s | collisions | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's |"
+echo "| net | route | length m, SUMO's shortest / adse's | reached goal | ended | nav time s | dominant stop reason | stood s | collisions (caused by the ego) | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 reached=0
 total=0
@@ -165,9 +165,10 @@ if s["by_reason"]:
             ", static structure" if top["static_structure"] else "", top["obstacle_gap_m"])
 else:
     why = "-"
-print("| %s | %s | %s | %s | %s | %.1f | %s | %.1f | %d | %.0f | %.2f |" % (
+print("| %s | %s | %s | %s | %s | %.1f | %s | %.1f | %d (%d) | %.0f | %.2f |" % (
     sys.argv[3], sys.argv[4], sys.argv[5], "yes" if m["completed"] else "no",
     d["termination_reason"], m["nav_time_s"], why, s["standing_s"], m["collisions"],
+    m["ego_collisions"],
     int(rss.group(1)) / 1024 if rss else float("nan"), t["simulated"] / t["wall"]))
 PY
 )"

@@ -36,7 +36,9 @@ runfile::RunData TenSecondRun() {
   r.cost_s = 5.0;
   r.cores = 2;
   run.trace.callbacks.push_back(r);
-  run.collisions.push_back({3.0, "car"});
+  run.collisions.push_back({3.0, "car", 1});
+  run.collisions.push_back({4.0, "truck", 0});  // it drove into the ego
+  run.collisions.push_back({5.0, "bus", -1});   // not known: counted
   return run;
 }
 
@@ -47,7 +49,8 @@ TEST(RunMetricsTest, KnownRunGivesKnownMetrics) {
   EXPECT_NEAR(m.at("ctrl_rate_hz"), 20.1, 1e-9);  // 201 commands up to t = 10 s
   EXPECT_EQ(m.at("dropped_messages"), 7.0);
   EXPECT_EQ(m.at("lidar_frames_dropped"), 7.0);
-  EXPECT_EQ(m.at("collisions"), 1.0);
+  EXPECT_EQ(m.at("collisions"), 3.0);
+  EXPECT_EQ(m.at("ego_collisions"), 2.0);
   EXPECT_NEAR(m.at("e2e_latency_p50_s"), 0.195, 0.011);
   EXPECT_NEAR(m.at("e2e_latency_p99_s"), 0.29, 0.002);
   EXPECT_NEAR(m.at("cpu_utilization"), 10.0 / 20.0, 1e-9);

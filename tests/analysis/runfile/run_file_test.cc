@@ -151,7 +151,7 @@ TEST_F(RunFileTest, LongStringsAreCutAtACharacterBoundary) {
   // 63 ASCII bytes then a 2-byte character: 65 bytes, the cut must not keep
   // half of the character.
   run.vehicles.push_back({0, std::string(63, 'a') + "é", 0, 0, 0, 0, 0, 0});
-  run.collisions.push_back({0, std::string(100, 'b')});
+  run.collisions.push_back({0, std::string(100, 'b'), 0});
   run.node_names.push_back(std::string(kNameBytes + 5, 'n'));
   const std::string path = Path("long.h5");
   ASSERT_TRUE(WriteRunFile(path, run).ok());
@@ -159,6 +159,7 @@ TEST_F(RunFileTest, LongStringsAreCutAtACharacterBoundary) {
   ASSERT_TRUE(back.ok()) << back.status().ToString();
   EXPECT_EQ(back->vehicles[0].id, std::string(63, 'a'));
   EXPECT_EQ(back->collisions[0].other_id, std::string(kIdBytes, 'b'));
+  EXPECT_EQ(back->collisions[0].ego_caused, 0);
   EXPECT_EQ(back->node_names[0], std::string(kNameBytes, 'n'));
 }
 

@@ -342,6 +342,39 @@ TEST(WorldTest, CorruptNetIsReportedWithSumosCause) {
       << world.status().message();
 }
 
+TEST(WorldTest, AContactIsTheEgosWhenItClosedOnTheOtherAtLeastAsFast) {
+  // The ego heading +x with its body centred at the origin.
+  VehicleState ego;
+  ego.yaw_rad = 0.0;
+  geometry::OrientedBox body;
+  body.center = Eigen::Vector2d::Zero();
+  auto other_at = [](double x, double y, double yaw, double speed) {
+    OtherVehicle v;
+    v.id = "v";
+    v.box.center = Eigen::Vector2d(x, y);
+    v.box.yaw_rad = yaw;
+    v.speed_mps = speed;
+    return v;
+  };
+  // Standing, driven into from behind or the side: not the ego's.
+  ego.v_mps = 0.0;
+  EXPECT_FALSE(EgoCausedContact(ego, body, other_at(-4, 0, 0, 10)));
+  EXPECT_FALSE(EgoCausedContact(ego, body, other_at(-2, -1.5, 0.2, 14)));
+  // Braking at 2 m/s, passed by a car at 14 m/s that cuts in: not either.
+  ego.v_mps = 2.0;
+  EXPECT_FALSE(EgoCausedContact(ego, body, other_at(-2, 2, -0.3, 14)));
+  // Into a slower car ahead, or a standing one: the ego's.
+  ego.v_mps = 8.0;
+  EXPECT_TRUE(EgoCausedContact(ego, body, other_at(4.5, 0, 0, 3)));
+  EXPECT_TRUE(EgoCausedContact(ego, body, other_at(4.5, 0.5, 0, 0)));
+  // Backing into a standing car behind: the ego's.
+  ego.v_mps = -1.0;
+  EXPECT_TRUE(EgoCausedContact(ego, body, other_at(-4.5, 0, 0, 0)));
+  // Head on, both at 5 m/s: the ego closed as fast, so it counts.
+  ego.v_mps = 5.0;
+  EXPECT_TRUE(EgoCausedContact(ego, body, other_at(4.5, 0, M_PI, 5)));
+}
+
 TEST(WorldTest, StartOffTheRoadIsRejected) {
   WorldSetup setup = SmallLot();
   setup.task.start = Location::Xy(15.0, 8.0);  // in the parking rows
