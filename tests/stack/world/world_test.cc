@@ -43,6 +43,21 @@ WorldSetup SmallLot() {
   return setup;
 }
 
+// The ground-truth driver over the whole route without the LiDAR; expects
+// it to reach the goal.
+IdealDriveReport DriveToTheGoal(World& world, double speed_limit_kmh,
+                                double timeout_s) {
+  IdealDriverOptions options;
+  options.scan = false;
+  options.speed_limit_mps = speed_limit_kmh / 3.6;
+  options.timeout_s = timeout_s;
+  Result<IdealDriveReport> report = DriveIdealPath(world, nullptr, options);
+  EXPECT_TRUE(report.ok()) << report.status().ToString();
+  if (!report.ok()) return {};
+  EXPECT_TRUE(report->reached_goal);
+  return *report;
+}
+
 TEST(WorldTest, GeneratedParkingLotLoadsAndIdealPathIsContinuous) {
   Result<std::unique_ptr<World>> world = World::Open(SmallLot());
   ASSERT_TRUE(world.ok()) << world.status().ToString();
@@ -123,15 +138,9 @@ TEST(WorldTest, OnARealTownTheRouteAvoidsAUTurnTheCarCannotDrive) {
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   EXPECT_NEAR((*world)->ideal_path().length_m(), 1228.0, 20.0);
-  IdealDriverOptions options;
-  options.scan = false;
-  options.speed_limit_mps = 40.0 / 3.6;
-  options.timeout_s = 400.0;
-  Result<IdealDriveReport> report = DriveIdealPath(**world, nullptr, options);
-  ASSERT_TRUE(report.ok()) << report.status().ToString();
-  EXPECT_TRUE(report->reached_goal);
+  const IdealDriveReport report = DriveToTheGoal(**world, 40.0, 400.0);
   // Issue 17's 1 m, junctions included (0.54 m measured).
-  EXPECT_LT(report->max_lateral_error_m, 1.0);
+  EXPECT_LT(report.max_lateral_error_m, 1.0);
 }
 
 // The real-nets bench's route acosta-1: the lane shape of edge 224[1]
@@ -159,14 +168,8 @@ TEST(WorldTest, OnARealTownALaneShapeThatFoldsBackIsDrivenAsTheCorner) {
         << "folds at (" << path.points[i].x() << ", " << path.points[i].y()
         << ")";
   }
-  IdealDriverOptions options;
-  options.scan = false;
-  options.speed_limit_mps = 40.0 / 3.6;
-  options.timeout_s = 400.0;
-  Result<IdealDriveReport> report = DriveIdealPath(**world, nullptr, options);
-  ASSERT_TRUE(report.ok()) << report.status().ToString();
-  EXPECT_TRUE(report->reached_goal);
-  EXPECT_LT(report->max_lateral_error_m, 1.0);  // 0.84 m measured
+  const IdealDriveReport report = DriveToTheGoal(**world, 40.0, 400.0);
+  EXPECT_LT(report.max_lateral_error_m, 1.0);  // 0.84 m measured
 }
 
 TEST(WorldTest, AOneWayStreetOfABareNetHasPolesOnBothSides) {
@@ -481,15 +484,10 @@ TEST(WorldTest, ARouteGoesRoundTheBlockRatherThanAUTurnTooTightForTheCar) {
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   // 80 + 4 x 100 + 40 m round either block; the U-turn was about 125 m.
   EXPECT_NEAR((*world)->ideal_path().length_m(), 520.0, 30.0);
-  IdealDriverOptions options;
-  options.scan = false;
-  options.timeout_s = 200.0;
-  Result<IdealDriveReport> report = DriveIdealPath(**world, nullptr, options);
-  ASSERT_TRUE(report.ok()) << report.status().ToString();
-  EXPECT_TRUE(report->reached_goal);
+  const IdealDriveReport report = DriveToTheGoal(**world, 30.0, 200.0);
   // No U-turn to swing wide of (4.9-10 m on the real nets): about 1.1 m
   // where the right turns at the blocks' corners bend within 2 m.
-  EXPECT_LT(report->max_lateral_error_m, 1.5);
+  EXPECT_LT(report.max_lateral_error_m, 1.5);
 }
 
 TEST(WorldTest, PassingTheGoalOnTheOtherSideOfTheStreetDoesNotReachIt) {
