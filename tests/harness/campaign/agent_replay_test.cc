@@ -68,7 +68,7 @@ void ExpectAgentOn(const std::string& data, const Expected& expected) {
 }
 
 TEST(AgentReplayTest, OnTheRecordedRobotaxiCampaign) {
-  ExpectAgentOn("robotaxi_exhaustive", {4, 0.85, 4});
+  ExpectAgentOn("robotaxi_exhaustive", {6, 0.86, 4});
 }
 
 TEST(AgentReplayTest, OnTheReferenceStudyWhereStarvedRunsAreStoppedEarly) {
