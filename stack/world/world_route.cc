@@ -70,10 +70,19 @@ geometry::Path2 Resample(const std::vector<Vec2>& points, double step) {
   return out;
 }
 
+// Whether passenger cars may use the lane (not a sidewalk, bus lane, ...).
+bool OpenToCars(const std::string& lane_id) {
+  const std::vector<std::string> disallowed =
+      libsumo::Lane::getDisallowed(lane_id);
+  return std::find(disallowed.begin(), disallowed.end(), "passenger") ==
+         disallowed.end();
+}
+
 }  // namespace internal
 
 using internal::InternalChain;
 using internal::kResampleStepM;
+using internal::OpenToCars;
 using internal::Resample;
 using internal::Slice;
 using internal::ToPoints;
@@ -99,10 +108,7 @@ Result<RoadLocation> World::Impl::Resolve(const Location& location,
       }
       const std::string lane_id =
           location.edge + "_" + std::to_string(location.lane);
-      const std::vector<std::string> disallowed =
-          libsumo::Lane::getDisallowed(lane_id);
-      if (std::find(disallowed.begin(), disallowed.end(), "passenger") !=
-          disallowed.end()) {
+      if (!OpenToCars(lane_id)) {
         return Status::InvalidArgument(fmt::format(
             "{}.edge: lane {} of edge '{}' is closed to passenger cars", field,
             location.lane, location.edge));
@@ -167,13 +173,6 @@ namespace {
 
 // A path vertex turning by more than 150 degrees folds the path back.
 constexpr double kFoldCos = -0.866;
-
-bool OpenToCars(const std::string& lane_id) {
-  const std::vector<std::string> disallowed =
-      libsumo::Lane::getDisallowed(lane_id);
-  return std::find(disallowed.begin(), disallowed.end(), "passenger") ==
-         disallowed.end();
-}
 
 // How far across the road a U-turn from `from_lane` to `to_lane` must
 // turn: the arrival lane's start off the departure lane's end, square to
@@ -389,12 +388,7 @@ Status World::Impl::BuildIdealPath() {
       int fallback = -1;
       for (int l = 0; l < lanes && chosen < 0; ++l) {
         const std::string lane_id = route[i] + "_" + std::to_string(l);
-        const std::vector<std::string> disallowed =
-            libsumo::Lane::getDisallowed(lane_id);
-        if (std::find(disallowed.begin(), disallowed.end(), "passenger") !=
-            disallowed.end()) {
-          continue;  // sidewalks, bus lanes, ...
-        }
+        if (!OpenToCars(lane_id)) continue;  // sidewalks, bus lanes, ...
         for (const auto& link : libsumo::Lane::getLinks(lane_id)) {
           if (link.approachedLane == target) {
             chosen = l;
