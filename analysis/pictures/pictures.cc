@@ -28,6 +28,8 @@ constexpr double kDetailAspect = 0.45;
 // A vehicle that moves further than this between two samples was removed
 // and re-inserted (or teleported): its path is not drawn across the gap.
 constexpr double kVehicleJumpM = 50.0;
+// A vehicle whose samples all lie this close to its first stood throughout.
+constexpr double kStoodM = 0.5;
 // Stands shorter than this are not marked (the wait for the first
 // trajectory, stop-and-go); only the longest few are labelled.
 constexpr double kMarkStandS = 3.0;
@@ -294,6 +296,26 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   for (const auto& p : run.ideal_path) ideal.push_back(px(p.x_m, p.y_m));
   DrawPolyline(&img, ego, Bgr(kTrajectoryRgb), s.Px(5));
   DrawPolyline(&img, ideal, Bgr(kIdealPathRgb), s.Px(2));
+  // A vehicle that never moved (world.traffic.stopped_vehicles, a parked
+  // queue) has no path to draw: its body, over the paths, shows what held
+  // the car.
+  if (o.draw_vehicles) {
+    std::map<std::string, std::pair<const runfile::VehicleSample*, bool>> first;
+    for (const auto& v : run.vehicles) {
+      auto [it, added] = first.try_emplace(v.id, &v, true);
+      if (!added && std::hypot(v.x_m - it->second.first->x_m,
+                               v.y_m - it->second.first->y_m) > kStoodM) {
+        it->second.second = false;
+      }
+    }
+    for (const auto& [id, seen] : first) {
+      const runfile::VehicleSample& v = *seen.first;
+      if (!seen.second) continue;
+      Outline(&img,
+              BoxPx(v.x_m, v.y_m, v.yaw_rad, v.length_m, v.width_m, to_px),
+              Bgr(kVehiclePathRgb), s.Px(2.5));
+    }
+  }
   DrawParkingManoeuvre(&img, run, contacts, to_px, s);
 
   cv::Point2d start(NAN, NAN), goal(NAN, NAN);

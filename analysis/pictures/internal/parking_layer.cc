@@ -8,7 +8,19 @@
 namespace adse::analysis::internal {
 namespace {
 
-// Corners of a box (centre, heading along its length) in pixels.
+void Fill(cv::Mat* img, const std::vector<cv::Point2d>& corners,
+          const cv::Scalar& colour) {
+  std::vector<cv::Point> pts;
+  for (const cv::Point2d& p : corners) {
+    if (!Finite(p) || std::abs(p.x) > 1e6 || std::abs(p.y) > 1e6) return;
+    pts.push_back(Fixed(p));
+  }
+  cv::fillPoly(*img, std::vector<std::vector<cv::Point>>{pts}, colour,
+               cv::LINE_AA, kShift);
+}
+
+}  // namespace
+
 std::vector<cv::Point2d> BoxPx(double cx, double cy, double yaw, double length,
                                double width, const ToPixel& px) {
   const double c = std::cos(yaw), s = std::sin(yaw);
@@ -22,24 +34,10 @@ std::vector<cv::Point2d> BoxPx(double cx, double cy, double yaw, double length,
 }
 
 void Outline(cv::Mat* img, std::vector<cv::Point2d> corners,
-             const cv::Scalar& colour, int thickness,
-             cv::LineTypes type = cv::LINE_AA) {
+             const cv::Scalar& colour, int thickness, cv::LineTypes type) {
   corners.push_back(corners.front());
   DrawPolyline(img, corners, colour, thickness, type);
 }
-
-void Fill(cv::Mat* img, const std::vector<cv::Point2d>& corners,
-          const cv::Scalar& colour) {
-  std::vector<cv::Point> pts;
-  for (const cv::Point2d& p : corners) {
-    if (!Finite(p) || std::abs(p.x) > 1e6 || std::abs(p.y) > 1e6) return;
-    pts.push_back(Fixed(p));
-  }
-  cv::fillPoly(*img, std::vector<std::vector<cv::Point>>{pts}, colour,
-               cv::LINE_AA, kShift);
-}
-
-}  // namespace
 
 void DrawParkingLot(cv::Mat* img, const runfile::ParkingRecord& parking,
                     const ToPixel& px, const Style& s) {

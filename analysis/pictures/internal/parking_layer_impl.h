@@ -16,6 +16,15 @@ namespace adse::analysis::internal {
 
 using ToPixel = std::function<cv::Point2d(double x_m, double y_m)>;
 
+// Corners of a box (centre, heading along its length) in pixels.
+std::vector<cv::Point2d> BoxPx(double cx, double cy, double yaw, double length,
+                               double width, const ToPixel& px);
+
+// The closed outline through `corners`.
+void Outline(cv::Mat* img, std::vector<cv::Point2d> corners,
+             const cv::Scalar& colour, int thickness,
+             cv::LineTypes type = cv::LINE_AA);
+
 // Under everything else: slots (outlines), obstacles (filled), the target
 // slot (a thick outline).
 void DrawParkingLot(cv::Mat* img, const runfile::ParkingRecord& parking,
