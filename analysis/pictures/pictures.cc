@@ -265,21 +265,33 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   DrawParkingLot(&img, run.parking, to_px, s);
   const std::vector<ParkingContact> contacts = ParkingContacts(run);
 
-  // Other vehicles, faintly, one path per id in time order.
+  // Other vehicles, faintly, one path per id in time order. One that never
+  // moved (world.traffic.stopped_vehicles, a queue that never cleared) has
+  // no path: its body is drawn over the paths below, to show what held
+  // the car.
   bool any_vehicle = false;
+  std::vector<const runfile::VehicleSample*> stood;
   if (o.draw_vehicles) {
-    std::map<std::string, std::vector<std::pair<double, cv::Point2d>>> paths;
-    for (const auto& v : run.vehicles) {
-      paths[v.id].emplace_back(v.t_s, cv::Point2d(v.x_m, v.y_m));
-    }
+    std::map<std::string, std::vector<const runfile::VehicleSample*>> paths;
+    for (const auto& v : run.vehicles) paths[v.id].push_back(&v);
     for (auto& [id, samples] : paths) {
       std::stable_sort(
           samples.begin(), samples.end(),
-          [](const auto& a, const auto& b) { return a.first < b.first; });
+          [](const auto* a, const auto* b) { return a->t_s < b->t_s; });
+      const runfile::VehicleSample& first = *samples.front();
+      if (std::all_of(samples.begin(), samples.end(), [&](const auto* v) {
+            return std::hypot(v->x_m - first.x_m, v->y_m - first.y_m) <=
+                   kStoodM;
+          })) {
+        stood.push_back(&first);
+        any_vehicle = true;
+        continue;
+      }
       std::vector<cv::Point2d> line;
       for (size_t i = 0; i < samples.size(); ++i) {
-        const cv::Point2d& w = samples[i].second;
-        if (i > 0 && cv::norm(w - samples[i - 1].second) > kVehicleJumpM) {
+        const cv::Point2d w(samples[i]->x_m, samples[i]->y_m);
+        if (i > 0 && std::hypot(w.x - samples[i - 1]->x_m,
+                                w.y - samples[i - 1]->y_m) > kVehicleJumpM) {
           line.emplace_back(NAN, NAN);  // break
         }
         line.push_back(px(w.x, w.y));
@@ -296,25 +308,10 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   for (const auto& p : run.ideal_path) ideal.push_back(px(p.x_m, p.y_m));
   DrawPolyline(&img, ego, Bgr(kTrajectoryRgb), s.Px(5));
   DrawPolyline(&img, ideal, Bgr(kIdealPathRgb), s.Px(2));
-  // A vehicle that never moved (world.traffic.stopped_vehicles, a parked
-  // queue) has no path to draw: its body, over the paths, shows what held
-  // the car.
-  if (o.draw_vehicles) {
-    std::map<std::string, std::pair<const runfile::VehicleSample*, bool>> first;
-    for (const auto& v : run.vehicles) {
-      auto [it, added] = first.try_emplace(v.id, &v, true);
-      if (!added && std::hypot(v.x_m - it->second.first->x_m,
-                               v.y_m - it->second.first->y_m) > kStoodM) {
-        it->second.second = false;
-      }
-    }
-    for (const auto& [id, seen] : first) {
-      const runfile::VehicleSample& v = *seen.first;
-      if (!seen.second) continue;
-      Outline(&img,
-              BoxPx(v.x_m, v.y_m, v.yaw_rad, v.length_m, v.width_m, to_px),
-              Bgr(kVehiclePathRgb), s.Px(2.5));
-    }
+  for (const runfile::VehicleSample* v : stood) {
+    Outline(&img,
+            BoxPx(v->x_m, v->y_m, v->yaw_rad, v->length_m, v->width_m, to_px),
+            Bgr(kVehiclePathRgb), s.Px(2.5));
   }
   DrawParkingManoeuvre(&img, run, contacts, to_px, s);
 

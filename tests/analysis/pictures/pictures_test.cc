@@ -195,6 +195,30 @@ TEST_F(PictureTest, WhereTheCarStoodIsMarkedInTheColourOfWhatHeldIt) {
   EXPECT_EQ(CountColour(*plain, kStandRedLightRgb), 0);
 }
 
+TEST_F(PictureTest, AVehicleThatNeverMovedIsDrawnAsItsBody) {
+  // A broken-down car at (50, 30), 4.5 m by 1.8 m along x, every sample
+  // where the first was: no path, so its outline shows where it stood.
+  RunData run = SquareRun();
+  for (int i = 0; i <= 6; ++i) {
+    run.vehicles.push_back({0.5 * i, "stopped0", 50, 30, 0, 0, 4.5, 1.8});
+  }
+  const TrajectoryImageOptions options;
+  ASSERT_TRUE(RenderTrajectoryImage(run, Path("t.png"), options).ok());
+  Result<RgbImage> img = ReadImage(Path("t.png"));
+  ASSERT_TRUE(img.ok());
+  Result<WorldToImage> map = TrajectoryImageMapping(run, options);
+  ASSERT_TRUE(map.ok());
+  auto at = [&](double x, double y) {
+    return ColourNear(*img, map->Column(x), map->Row(y), kVehiclePathRgb, 1);
+  };
+  EXPECT_TRUE(at(47.75, 30.0));  // rear edge
+  EXPECT_TRUE(at(52.25, 30.0));  // front edge
+  EXPECT_TRUE(at(50.0, 30.9));   // a side
+  EXPECT_FALSE(at(50.0, 30.0));  // not filled
+  // The moving car (veh0) keeps its path, not a box.
+  EXPECT_FALSE(at(50.0, 50.9));
+}
+
 TEST_F(PictureTest, VehiclesCanBeLeftOut) {
   TrajectoryImageOptions options;
   options.width_px = 600;
