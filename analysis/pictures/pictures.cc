@@ -124,11 +124,13 @@ std::string Title(const runfile::RunData& run) {
   if (run.parking.replans > 0) {
     outcome += fmt::format(", re-planned {}x", run.parking.replans);
   }
-  return fmt::format(
-      "{} | {} | {}",
-      run.scenario_name.empty() ? "(no scenario)" : run.scenario_name,
-      point.empty() ? "(no design point)" : point,
-      outcome.empty() ? "(no outcome)" : outcome);
+  // A run of one of the scenario's task.cases names it.
+  const std::string scenario =
+      (run.scenario_name.empty() ? "(no scenario)" : run.scenario_name) +
+      (run.task_case.empty() ? "" : " (" + run.task_case + ")");
+  return fmt::format("{} | {} | {}", scenario,
+                     point.empty() ? "(no design point)" : point,
+                     outcome.empty() ? "(no outcome)" : outcome);
 }
 
 void DrawStartMarker(cv::Mat* img, cv::Point2d at, const Style& s) {

@@ -195,6 +195,9 @@ Status WriteEvaluationTable(hid_t file, const char* name,
                                    Gather<std::string>(rows, [](const Row& r) {
                                      return r.bottlenecks_json;
                                    })));
+  ADSE_RETURN_IF_ERROR(WriteColumn(
+      g, "task_case",
+      Gather<int64_t>(rows, [](const Row& r) { return r.task_case; })));
   if (replica_table) {
     ADSE_RETURN_IF_ERROR(WriteColumn(
         g, "replica",
@@ -409,6 +412,12 @@ Status ReadEvaluationTable(hid_t file, const std::string& path,
   ADSE_RETURN_IF_ERROR(
       ReadMember<uint8_t>(g, path, "feasible", rows, &Row::feasible));
   ADSE_RETURN_IF_ERROR(ReadMember<uint64_t>(g, path, "seed", rows, &Row::seed));
+  // Indexes written before task.cases existed lack the column.
+  if (internal::GetObjectKind(file, path + "/task_case") !=
+      internal::ObjectKind::kMissing) {
+    ADSE_RETURN_IF_ERROR(
+        ReadMember<int64_t>(g, path, "task_case", rows, &Row::task_case));
+  }
   if (replica_table) {
     ADSE_RETURN_IF_ERROR(
         ReadMember<int64_t>(g, path, "replica", rows, &Row::replica));

@@ -42,12 +42,16 @@ struct EvaluationRow {
   // Replica number (harness.replicas): 0 for an evaluation; in `replicas`,
   // the run's number, which its seed is derived from.
   int64_t replica = 0;
+  // The case of the scenario's task.cases the run drove (0 without cases);
+  // for an evaluation, its representative run's.
+  int64_t task_case = 0;
   // Feasibility differs across the point's replicas.
   bool unstable = false;
-  // A point run more than once (harness.replicas > 1): its runs, each a row
-  // of its own (index and iteration the evaluation's, `replica` its number),
-  // of which this row is the aggregate (harness/campaign/replicas.h). Empty
-  // for a point run once, whose row is its run.
+  // A point run more than once (harness.replicas > 1, or task.cases): its
+  // runs, each a row of its own (index and iteration the evaluation's,
+  // `task_case` and `replica` its numbers), of which this row is the
+  // aggregate (harness/campaign/replicas.h). Empty for a point run once,
+  // whose row is its run.
   std::vector<EvaluationRow> replicas;
 };
 

@@ -188,7 +188,9 @@ struct RunData {
   std::string scenario_name;
   std::string scenario_text;  // the scenario file, verbatim
   std::string scenario_hash;  // sha256 of scenario_text
-  std::string content_key;    // run key (empty until the harness sets it)
+  // The scenario's task.cases entry the run drove; empty without cases.
+  std::string task_case;
+  std::string content_key;  // run key (empty until the harness sets it)
   std::string adse_version;
   std::string host;         // hostname, CPU model, cores
   std::string created_utc;  // ISO 8601

@@ -433,6 +433,9 @@ Status WriteContents(hid_t file, const RunData& run) {
   ADSE_RETURN_IF_ERROR(WriteStringAttr(file, "host", run.host));
   ADSE_RETURN_IF_ERROR(WriteStringAttr(file, "created_utc", run.created_utc));
   ADSE_RETURN_IF_ERROR(WriteF64Attr(file, "lane_width_m", run.lane_width_m));
+  if (!run.task_case.empty()) {
+    ADSE_RETURN_IF_ERROR(WriteStringAttr(file, "task_case", run.task_case));
+  }
 
   {
     Result<Handle> group = CreateGroup(file, "scenario");
@@ -665,6 +668,14 @@ Status ReadContents(hid_t file, RunData* run) {
   ADSE_RETURN_IF_ERROR(Assign(internal::ReadU64Attr(file, "seed"), &run->seed));
   ADSE_RETURN_IF_ERROR(
       Assign(internal::ReadF64Attr(file, "lane_width_m"), &run->lane_width_m));
+  {
+    Result<bool> has_case = internal::HasAttr(file, "task_case");
+    if (!has_case.ok()) return has_case.status();
+    if (*has_case) {
+      ADSE_RETURN_IF_ERROR(
+          Assign(ReadStringAttr(file, "task_case"), &run->task_case));
+    }
+  }
 
   {
     Result<Handle> group = OpenGroup(file, "/scenario");

@@ -77,6 +77,9 @@ class Checker {
   void CheckRootAttr(const json& spec) {
     const std::string name = spec.at("name").get<std::string>();
     const std::string schema_class = spec.at("class").get<std::string>();
+    if (spec.value("optional", false) && H5Aexists(file_, name.c_str()) <= 0) {
+      return;
+    }
     Handle attr = OpenAttr(file_, "/", name, schema_class);
     if (!attr.valid()) return;
     attr.Reset();

@@ -62,7 +62,11 @@ std::string ReplicaSection(const spec::Spec& spec,
                            const std::vector<std::string>& columns) {
   std::ostringstream md;
   bool any = false;
-  for (const EvaluationRow& row : rows) any = any || row.replicas.size() > 1;
+  // Points of several cases have their own section (CaseSection).
+  auto replicated = [](const EvaluationRow& row) {
+    return row.replicas.size() > 1 && CaseCountOf(row) == 1;
+  };
+  for (const EvaluationRow& row : rows) any = any || replicated(row);
   if (!any) return "";
   auto value = [](double v) {
     return std::isinf(v) ? std::string(v > 0 ? "stopped↑" : "stopped↓")
@@ -78,7 +82,7 @@ std::string ReplicaSection(const spec::Spec& spec,
   for (size_t i = 0; i < columns.size(); ++i) md << "---|";
   md << "\n";
   for (const EvaluationRow& row : rows) {
-    if (row.replicas.size() <= 1) continue;
+    if (!replicated(row)) continue;
     md << "| " << row.index << " | "
        << spec::FormatPoint(spec.design_space, row.point) << " | "
        << (row.unstable ? "**" + ReplicaSummary(row) + "**"
@@ -119,6 +123,7 @@ nlohmann::json RowJson(const spec::Spec& spec, const EvaluationRow& row) {
   if (j["bottlenecks"].is_discarded())
     j["bottlenecks"] = nlohmann::json::array();
   j["replicas"] = std::max<size_t>(1, row.replicas.size());
+  j["cases"] = CaseCountOf(row);
   j["unstable"] = row.unstable;
   if (row.replicas.size() > 1) {
     // Infinite quantiles (runs stopped beyond a bound) are null; `censored`
@@ -147,6 +152,7 @@ nlohmann::json RowJson(const spec::Spec& spec, const EvaluationRow& row) {
       for (const auto& [name, value] : run.metrics)
         run_metrics[name] = number(value);
       runs.push_back({{"replica", run.replica},
+                      {"task_case", run.task_case},
                       {"content_key", run.content_key},
                       {"seed", run.seed},
                       {"status", run.status},
@@ -178,6 +184,46 @@ std::string Cell(std::string text) {
     out += c;
   }
   return out;
+}
+
+// With task.cases: every run of each point, case by case, with its own
+// picture. Empty without cases.
+std::string CaseSection(const spec::Spec& spec,
+                        const std::vector<EvaluationRow>& rows,
+                        const std::vector<std::string>& columns,
+                        const std::string& image_dir) {
+  if (spec.cases.empty()) return "";
+  std::ostringstream md;
+  md << "\n## Cases\n\nEach point ran once per case of `task.cases` ("
+     << spec::CaseNames(spec)
+     << "). A point is feasible only when it is feasible in every case; a "
+        "metric an objective or constraint judges is its worst over the "
+        "cases, any other the mean.\n\n| # | point | case | outcome | "
+     << fmt::format("{}", fmt::join(columns, " | "))
+     << " | feasible | picture |\n|---|---|---|---|";
+  for (size_t i = 0; i < columns.size(); ++i) md << "---|";
+  md << "---|---|\n";
+  for (const EvaluationRow& row : rows) {
+    for (const EvaluationRow& run : row.replicas.empty()
+                                        ? std::vector<EvaluationRow>{row}
+                                        : row.replicas) {
+      const size_t c = static_cast<size_t>(run.task_case);
+      std::string name = c < spec.cases.size() ? spec.cases[c].name : "?";
+      if (spec.harness.replicas > 1) {
+        name += fmt::format(" (run {})", run.replica);
+      }
+      md << "| " << row.index << " | "
+         << spec::FormatPoint(spec.design_space, row.point) << " | " << name
+         << " | " << Cell(run.status == "complete" ? run.reason : run.status)
+         << " | ";
+      for (const std::string& col : columns) {
+        md << Number(RowMetric(run, col)) << " | ";
+      }
+      md << (run.feasible ? "yes" : "no") << " | [png](" << image_dir << "/"
+         << run.content_key << "/trajectory.png) |\n";
+    }
+  }
+  return md.str();
 }
 
 std::string LlmMarkdown(const LlmRecords& llm) {
@@ -300,6 +346,7 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
     md << (row.feasible ? "yes" : "no") << " | [png](" << image_dir << "/"
        << row.content_key << "/trajectory.png) |\n";
   }
+  md << CaseSection(spec, rows, columns, image_dir);
   md << ReplicaSection(spec, rows, columns);
 
   md << "\n## Iterations\n\nEach round's proposal and the strategy's "
@@ -440,6 +487,7 @@ Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
   j["exploration_seed"] = spec.exploration.seed;
   j["budget"] = spec.exploration.budget;
   j["replicas"] = spec.harness.replicas;
+  j["cases"] = spec::CaseCount(spec);
   j["workers"] = summary.workers;
   j["isolation"] = summary.isolation;
   j["isolation_note"] = summary.isolation_note;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include "analysis/metrics/run_metrics.h"
@@ -58,7 +59,15 @@ std::string Facts(const spec::Spec& spec,
                   const std::vector<EvaluationRow>& rows, int i, int runs) {
   const EvaluationRow& row = rows[i];
   std::string sureness;
-  if (row.replicas.size() > 1) {
+  const int cases = CaseCountOf(row);
+  if (cases > 1) {
+    const size_t per_case = row.replicas.size() / static_cast<size_t>(cases);
+    sureness = fmt::format("worst of {} cases", cases);
+    if (per_case > 1) {
+      sureness += fmt::format(", each the median of {} runs", per_case);
+    }
+    if (row.unstable) sureness += ", " + ReplicaSummary(row);
+  } else if (row.replicas.size() > 1) {
     sureness = fmt::format("median of {} runs", row.replicas.size());
     if (std::optional<MetricSpread> nav = SpreadOf(spec, row, kTimeMetric)) {
       sureness += fmt::format(", nav {}–{}", Value(nav->min, ""),
@@ -200,6 +209,31 @@ std::string HeadlineText(const spec::Spec& spec,
   return out.str();
 }
 
+namespace {
+
+// "[trajectory](...)"; with task.cases one picture per case, named by it
+// (each case's first run).
+std::string PictureLinks(const spec::Spec& spec, const EvaluationRow& row,
+                         const std::string& image_dir) {
+  if (CaseCountOf(row) <= 1) {
+    return fmt::format("[trajectory]({}/{}/trajectory.png)", image_dir,
+                       row.content_key);
+  }
+  std::vector<std::string> links;
+  std::set<int64_t> seen;
+  for (const EvaluationRow& run : row.replicas) {
+    if (!seen.insert(run.task_case).second) continue;
+    const size_t c = static_cast<size_t>(run.task_case);
+    links.push_back(
+        fmt::format("[{}]({}/{}/trajectory.png)",
+                    c < spec.cases.size() ? spec.cases[c].name : "case",
+                    image_dir, run.content_key));
+  }
+  return fmt::format("{}", fmt::join(links, ", "));
+}
+
+}  // namespace
+
 std::string HeadlineMarkdown(const spec::Spec& spec,
                              const std::vector<EvaluationRow>& rows,
                              const Headline& h, const std::string& image_dir) {
@@ -216,10 +250,10 @@ std::string HeadlineMarkdown(const spec::Spec& spec,
     const EvaluationRow& row = rows[line.row];
     std::string what = line.what;
     what[0] = static_cast<char>(std::toupper(what[0]));
-    md << fmt::format(
-        "- **{}:** `{}` — {}. [trajectory]({}/{}/trajectory.png)\n", what,
-        spec::FormatPoint(spec.design_space, row.point),
-        Facts(spec, rows, line.row, line.runs), image_dir, row.content_key);
+    md << fmt::format("- **{}:** `{}` — {}. {}\n", what,
+                      spec::FormatPoint(spec.design_space, row.point),
+                      Facts(spec, rows, line.row, line.runs),
+                      PictureLinks(spec, row, image_dir));
   }
   if (spec.objectives.size() > 2 ||
       (spec.objectives.size() == 2 &&

@@ -59,11 +59,19 @@ PoolEvaluator::PoolEvaluator(const spec::Spec& spec,
                              const CampaignFolder& folder,
                              pool::WorkerPool* pool,
                              PoolEvaluatorOptions options)
-    : spec_(spec), folder_(folder), pool_(pool), options_(std::move(options)) {}
+    : spec_(spec),
+      folder_(folder),
+      pool_(pool),
+      options_(std::move(options)),
+      runs_(sim::PointRuns(spec)) {
+  for (int c = 0; c < spec::CaseCount(spec); ++c) {
+    case_specs_.push_back(sim::CaseSpec(spec, c));
+  }
+}
 
 int PoolEvaluator::capacity() const {
-  // In points: each takes harness.replicas runs.
-  return std::max(1, pool_->slots() / std::max(1, spec_.harness.replicas));
+  // In points: each takes a run per case and replica.
+  return std::max(1, pool_->slots() / static_cast<int>(runs_.size()));
 }
 
 int PoolEvaluator::outstanding() const {
@@ -121,6 +129,7 @@ std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
   row->index = p.request.index;
   row->iteration = p.request.iteration;
   row->replica = p.replica;
+  row->task_case = p.task_case;
   // Feasibility under this campaign's constraints: a run reused from the
   // cache was analysed under the scenario that ran it, whose constraints
   // that do not stop runs early may differ.
@@ -138,6 +147,7 @@ EvaluationRow PoolEvaluator::FailedRow(const Pending& p,
   row.index = p.request.index;
   row.iteration = p.request.iteration;
   row.replica = p.replica;
+  row.task_case = p.task_case;
   row.content_key = p.key;
   row.status = "failed";
   row.reason = record.outcome + ": " + record.detail;
@@ -151,11 +161,14 @@ EvaluationRow PoolEvaluator::FailedRow(const Pending& p,
 }
 
 std::optional<EvaluationRow> PoolEvaluator::Prepare(const EvalRequest& request,
-                                                    int replica, Pending* p) {
+                                                    int run, Pending* p) {
   p->request = request;
-  p->replica = replica;
-  p->seed = sim::ReplicaSeed(spec_, replica);
-  Result<std::string> key = sim::RunKey(spec_, request.point, p->seed);
+  p->run = run;
+  p->task_case = runs_[run].task_case;
+  p->replica = runs_[run].replica;
+  p->seed = sim::ReplicaSeed(spec_, p->replica);
+  Result<std::string> key =
+      sim::RunKey(case_specs_[p->task_case], request.point, p->seed);
   if (!key.ok()) {
     // Only an unreadable input file makes this fail; no run can help.
     FailureRecord record;
@@ -179,19 +192,18 @@ std::optional<EvaluationRow> PoolEvaluator::Prepare(const EvalRequest& request,
 std::optional<EvaluationRow> PoolEvaluator::Recorded(
     const EvalRequest& request) {
   std::vector<EvaluationRow> runs;
-  for (int r = 0; r < std::max(1, spec_.harness.replicas); ++r) {
+  for (int r = 0; r < static_cast<int>(runs_.size()); ++r) {
     Pending p;
     std::optional<EvaluationRow> row = Prepare(request, r, &p);
     if (!row) return std::nullopt;
     runs.push_back(*std::move(row));
   }
-  return AggregateReplicas(spec_, std::move(runs));
+  return AggregatePoint(spec_, std::move(runs));
 }
 
 void PoolEvaluator::Start(const EvalRequest& request) {
-  const int replicas = std::max(1, spec_.harness.replicas);
-  points_[request.index].assign(replicas, std::nullopt);
-  for (int r = 0; r < replicas; ++r) {
+  points_[request.index].assign(runs_.size(), std::nullopt);
+  for (int r = 0; r < static_cast<int>(runs_.size()); ++r) {
     Pending p;
     if (std::optional<EvaluationRow> known = Prepare(request, r, &p)) {
       Deliver(p, *std::move(known));
@@ -213,16 +225,16 @@ void PoolEvaluator::Start(const EvalRequest& request) {
 void PoolEvaluator::Deliver(const Pending& p, EvaluationRow row) {
   auto point = points_.find(p.request.index);
   if (point == points_.end()) return;
-  point->second[p.replica] = std::move(row);
+  point->second[p.run] = std::move(row);
   for (const std::optional<EvaluationRow>& run : point->second) {
-    if (!run) return;  // replicas still to come
+    if (!run) return;  // runs still to come
   }
   std::vector<EvaluationRow> runs;
   for (std::optional<EvaluationRow>& run : point->second) {
     runs.push_back(*std::move(run));
   }
   points_.erase(point);
-  ready_.push_back(AggregateReplicas(spec_, std::move(runs)));
+  ready_.push_back(AggregatePoint(spec_, std::move(runs)));
 }
 
 void PoolEvaluator::Dispatch() {
@@ -241,6 +253,10 @@ void PoolEvaluator::Dispatch() {
           std::string("--report"), folder_.ReportPath(p.key),
           std::string("--image-dir"), folder_.ImageDir(p.key)}) {
       job.argv.push_back(arg);
+    }
+    if (!spec_.cases.empty()) {
+      job.argv.push_back("--case");
+      job.argv.push_back(spec_.cases[p.task_case].name);
     }
     job.log_path = folder_.LogPath(p.key, p.attempt);
     job.timeout_s = options_.run_timeout_s;
@@ -358,7 +374,7 @@ std::vector<EvaluationRow> PoolEvaluator::Cancel() {
       }
     }
   }
-  // A point with replicas still to run stays unevaluated; the runs it has
+  // A point with runs still to go stays unevaluated; the runs it has
   // are in runs/, and a resumed campaign takes them from there.
   points_.clear();
   running_.clear();

@@ -18,6 +18,7 @@
 #include "harness/campaign/explorer.h"
 #include "harness/campaign/run_store.h"
 #include "harness/pool/worker_pool.h"
+#include "harness/sim/run_key.h"
 #include "harness/spec/spec.h"
 
 namespace adse::campaign {
@@ -59,22 +60,24 @@ class PoolEvaluator : public Evaluator {
   std::optional<EvaluationRow> Recorded(const EvalRequest& request);
 
  private:
-  // One run of a point: replica `replica` of harness.replicas.
+  // One run of a point: its run `run` (an index into sim::PointRuns), of
+  // case `task_case` and replica `replica`.
   struct Pending {
     EvalRequest request;
+    int run = 0;
+    int task_case = 0;
     int replica = 0;
     std::string key;
     uint64_t seed = 0;
     int attempt = 0;  // 1-based once started
   };
 
-  // Fills `p` for replica `replica` of `request`; returns the run's row
-  // when it is already known (in the folder, or the key cannot be
-  // computed).
-  std::optional<EvaluationRow> Prepare(const EvalRequest& request, int replica,
+  // Fills `p` for run `run` of `request`; returns the run's row when it is
+  // already known (in the folder, or the key cannot be computed).
+  std::optional<EvaluationRow> Prepare(const EvalRequest& request, int run,
                                        Pending* p);
-  // Takes a finished run's row; once all of its point's replicas are in,
-  // the point's row (AggregateReplicas) is ready.
+  // Takes a finished run's row; once all of its point's runs are in, the
+  // point's row (AggregatePoint) is ready.
   void Deliver(const Pending& p, EvaluationRow row);
   // A row from an existing run file; nullopt when the file is unusable
   // (then it is moved aside and the point simulated again).
@@ -89,7 +92,11 @@ class PoolEvaluator : public Evaluator {
   const CampaignFolder& folder_;
   pool::WorkerPool* pool_;
   PoolEvaluatorOptions options_;
-  // Points started and not yet ready: their replicas' rows so far.
+  // The runs each point takes (cases x replicas).
+  std::vector<sim::PointRun> runs_;
+  // The spec of each case (spec::ForCase), which its runs' keys hash.
+  std::vector<spec::Spec> case_specs_;
+  // Points started and not yet ready: their runs' rows so far.
   std::map<int64_t, std::vector<std::optional<EvaluationRow>>> points_;
   std::deque<Pending> queued_;
   std::map<uint64_t, Pending> running_;  // job id -> attempt

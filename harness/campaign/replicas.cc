@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -22,6 +24,26 @@ bool Censored(const EvaluationRow& row) {
   return RowMetric(row, analysis::kCensoredMetric) == 1.0;
 }
 
+// Which way `constraint` fails on `metric`, the row's other metrics and
+// point held: +1 when it holds at `low` and not at `high` (a bound from
+// above), -1 the other way round, 0 when it does not read the metric so
+// or cannot be evaluated.
+int FailingSide(const spec::Spec& spec, const std::string& constraint,
+                const std::string& metric, const EvaluationRow& row, double low,
+                double high) {
+  std::map<std::string, double> metrics = row.metrics;
+  auto holds = [&](double v) -> std::optional<bool> {
+    metrics[metric] = v;
+    Result<bool> ok =
+        spec::EvaluateConstraint(spec, constraint, metrics, row.point);
+    if (!ok.ok()) return std::nullopt;
+    return *ok;
+  };
+  const std::optional<bool> at_high = holds(high), at_low = holds(low);
+  if (!at_high || !at_low || *at_high == *at_low) return 0;
+  return *at_high ? -1 : 1;
+}
+
 // The replica's value of `metric`: measured, or for a run stopped early on
 // a constraint of it, the side of the bound the run lies on (+inf when the
 // constraint fails for large values, -inf for small ones). Nothing when
@@ -34,19 +56,9 @@ std::optional<double> ValueOf(const spec::Spec& spec, const EvaluationRow& row,
   if (!Censored(row)) return std::nullopt;
   const std::string constraint = runfile::ViolatedConstraint(row.reason);
   if (constraint.empty()) return std::nullopt;
-  // Whether the constraint reads this metric, and which way it fails: it
-  // is decided by the metric's value alone at the extremes.
-  std::map<std::string, double> metrics = row.metrics;
-  auto holds = [&](double v) -> std::optional<bool> {
-    metrics[metric] = v;
-    Result<bool> ok =
-        spec::EvaluateConstraint(spec, constraint, metrics, row.point);
-    if (!ok.ok()) return std::nullopt;
-    return *ok;
-  };
-  const std::optional<bool> high = holds(1e12), low = holds(-1e12);
-  if (!high || !low || *high == *low) return std::nullopt;
-  return *high ? -kInf : kInf;
+  const int side = FailingSide(spec, constraint, metric, row, -1e12, 1e12);
+  if (side == 0) return std::nullopt;
+  return side > 0 ? kInf : -kInf;
 }
 
 // The p-quantile of sorted `v` by linear interpolation; between a finite
@@ -86,7 +98,167 @@ std::optional<MetricSpread> Spread(const spec::Spec& spec,
   return s;
 }
 
+// Which way `metric` gets worse as the spec judges it: +1 when larger is
+// worse (a minimised objective, a constraint failing above a bound), -1
+// when smaller is, 0 when no objective or constraint says. Constraints are
+// probed at the metric's extremes (0 and 1 for a boolean), the other
+// metrics as in `sample`.
+int WorseDirection(const spec::Spec& spec, const std::string& metric,
+                   const EvaluationRow& sample) {
+  for (const spec::Objective& o : spec.objectives) {
+    if (o.metric == metric) return o.minimize ? 1 : -1;
+  }
+  bool boolean = false;
+  for (const spec::MetricInfo& m : spec::KnownMetrics()) {
+    if (m.name == metric) boolean = m.boolean;
+  }
+  for (const std::string& constraint : spec.constraints) {
+    const int side = FailingSide(spec, constraint, metric, sample,
+                                 boolean ? 0.0 : -1e12, boolean ? 1.0 : 1e12);
+    if (side != 0) return side;
+  }
+  return 0;
+}
+
+// The cases' rows (one per case, in case order) folded into the point's.
+EvaluationRow AggregateCases(const spec::Spec& spec,
+                             std::vector<EvaluationRow> cases) {
+  if (cases.size() == 1) return std::move(cases.front());
+  bool complete = true, feasible = true, unstable = false, censored = false;
+  bool simulated = false, has_censored_metric = false;
+  int64_t attempts = 0;
+  double wall_s = 0.0;
+  std::set<std::string> names;
+  for (const EvaluationRow& c : cases) {
+    complete = complete && Complete(c);
+    feasible = feasible && Complete(c) && c.feasible;
+    unstable = unstable || c.unstable;
+    censored = censored || (Complete(c) && Censored(c));
+    simulated = simulated || c.source == "simulated";
+    attempts += c.attempts;
+    wall_s += c.wall_s;
+    for (const auto& [name, value] : c.metrics) names.insert(name);
+  }
+  has_censored_metric = names.erase(analysis::kCensoredMetric) > 0;
+
+  EvaluationRow row;
+  if (complete) {
+    for (const std::string& name : names) {
+      const int worse = WorseDirection(spec, name, cases.front());
+      std::vector<double> values;
+      for (const EvaluationRow& c : cases) {
+        if (std::optional<double> v = ValueOf(spec, c, name)) {
+          values.push_back(*v);
+        }
+      }
+      if (values.empty()) continue;
+      if (worse != 0) {
+        const double worst =
+            worse > 0 ? *std::max_element(values.begin(), values.end())
+                      : *std::min_element(values.begin(), values.end());
+        if (std::isfinite(worst)) {
+          row.metrics[name] = worst;
+        } else {
+          censored = true;
+        }
+      } else if (values.size() == cases.size() &&
+                 std::all_of(values.begin(), values.end(),
+                             [](double v) { return std::isfinite(v); })) {
+        double sum = 0.0;
+        for (double v : values) sum += v;
+        row.metrics[name] = sum / static_cast<double>(values.size());
+      }
+    }
+    if (has_censored_metric) {
+      row.metrics[analysis::kCensoredMetric] = censored ? 1.0 : 0.0;
+    }
+  }
+
+  // The representative case.
+  const EvaluationRow* representative = &cases.front();
+  auto first = [&](auto&& pred) -> const EvaluationRow* {
+    for (const EvaluationRow& c : cases) {
+      if (pred(c)) return &c;
+    }
+    return nullptr;
+  };
+  if (!complete) {
+    representative = first([](const EvaluationRow& c) { return !Complete(c); });
+  } else if (!feasible) {
+    const EvaluationRow* stopped = first(
+        [](const EvaluationRow& c) { return !c.feasible && Censored(c); });
+    representative =
+        censored && stopped != nullptr
+            ? stopped
+            : first([](const EvaluationRow& c) { return !c.feasible; });
+  } else {
+    for (const spec::Objective& o : spec.objectives) {
+      const EvaluationRow* worst = nullptr;
+      bool differ = false;
+      for (const EvaluationRow& c : cases) {
+        const double v = RowMetric(c, o.metric);
+        if (std::isnan(v)) continue;
+        if (worst == nullptr) {
+          worst = &c;
+          continue;
+        }
+        const double w = RowMetric(*worst, o.metric);
+        differ = differ || v != w;
+        if (o.minimize ? v > w : v < w) worst = &c;
+      }
+      if (differ) {
+        representative = worst;
+        break;
+      }
+    }
+  }
+
+  row.index = cases.front().index;
+  row.iteration = cases.front().iteration;
+  row.task_case = representative->task_case;
+  row.point = representative->point;
+  row.content_key = representative->content_key;
+  row.seed = representative->seed;
+  row.status = complete ? "complete" : representative->status;
+  row.reason = representative->reason;
+  row.bottlenecks_json = representative->bottlenecks_json;
+  row.feasible = feasible;
+  row.unstable = unstable;
+  row.source = simulated ? "simulated" : cases.front().source;
+  row.attempts = attempts;
+  row.wall_s = wall_s;
+  for (EvaluationRow& c : cases) {
+    if (c.replicas.empty()) {
+      row.replicas.push_back(std::move(c));
+    } else {
+      for (EvaluationRow& run : c.replicas) {
+        row.replicas.push_back(std::move(run));
+      }
+    }
+  }
+  return row;
+}
+
 }  // namespace
+
+EvaluationRow AggregatePoint(const spec::Spec& spec,
+                             std::vector<EvaluationRow> runs) {
+  std::map<int64_t, std::vector<EvaluationRow>> by_case;
+  for (EvaluationRow& run : runs) {
+    by_case[run.task_case].push_back(std::move(run));
+  }
+  std::vector<EvaluationRow> cases;
+  for (auto& [task_case, replicas] : by_case) {
+    cases.push_back(AggregateReplicas(spec, std::move(replicas)));
+  }
+  return AggregateCases(spec, std::move(cases));
+}
+
+int CaseCountOf(const EvaluationRow& row) {
+  std::set<int64_t> cases;
+  for (const EvaluationRow& run : row.replicas) cases.insert(run.task_case);
+  return std::max<int>(1, static_cast<int>(cases.size()));
+}
 
 EvaluationRow AggregateReplicas(const spec::Spec& spec,
                                 std::vector<EvaluationRow> replicas) {
@@ -142,6 +314,7 @@ EvaluationRow AggregateReplicas(const spec::Spec& spec,
   }
   row.index = replicas.front().index;
   row.iteration = replicas.front().iteration;
+  row.task_case = representative->task_case;
   row.point = representative->point;
   row.content_key = representative->content_key;
   row.seed = representative->seed;
@@ -159,13 +332,24 @@ EvaluationRow AggregateReplicas(const spec::Spec& spec,
 std::optional<MetricSpread> SpreadOf(const spec::Spec& spec,
                                      const EvaluationRow& row,
                                      const std::string& metric) {
-  if (row.replicas.size() <= 1) return std::nullopt;
+  if (row.replicas.size() <= 1 || CaseCountOf(row) > 1) return std::nullopt;
   return Spread(spec, row.replicas, metric);
 }
 
 std::string ReplicaSummary(const EvaluationRow& row) {
   const size_t n = std::max<size_t>(1, row.replicas.size());
   if (n == 1) return "1 run";
+  const int cases = CaseCountOf(row);
+  if (cases > 1) {
+    std::string text = fmt::format("{} cases", cases);
+    if (n > static_cast<size_t>(cases)) {
+      text += fmt::format(" x {} runs", n / static_cast<size_t>(cases));
+    }
+    size_t failed = 0;
+    for (const EvaluationRow& r : row.replicas) failed += !Complete(r);
+    if (failed > 0) text += fmt::format(", {} failed", failed);
+    return text;
+  }
   size_t feasible = 0, failed = 0;
   for (const EvaluationRow& r : row.replicas) {
     feasible += Complete(r) && r.feasible;

@@ -40,14 +40,35 @@ struct MetricSpread {
 EvaluationRow AggregateReplicas(const spec::Spec& spec,
                                 std::vector<EvaluationRow> replicas);
 
-// `metric` across the row's replicas; nullopt when the row ran once or no
-// replica measured or bounded the metric.
+// The point's row from all its runs (any order; each run's task_case set):
+// each case's replicas folded by AggregateReplicas, then the cases, when
+// the scenario has task.cases, folded into one row:
+// - complete when every case is, else failed (the first failed case's
+//   reason); feasible only when feasible in every case; unstable when any
+//   case is;
+// - a metric an objective or constraint judges: its worst over the cases
+//   (a case stopped early on it ranks beyond the bound, and the row is
+//   then censored); any other metric: the mean over the cases;
+// - content_key, seed, reason, task_case and diagnosis: the representative
+//   case's: the first case that made the point fail, then the first
+//   infeasible one (stopped early where the point is censored), else the
+//   case worst in the first objective the cases differ in;
+// - replicas: every run, case by case.
+EvaluationRow AggregatePoint(const spec::Spec& spec,
+                             std::vector<EvaluationRow> runs);
+
+// How many of the scenario's cases the row's runs drove (1 without cases).
+int CaseCountOf(const EvaluationRow& row);
+
+// `metric` across the row's replicas; nullopt when the row ran once, ran
+// several cases, or no replica measured or bounded the metric.
 std::optional<MetricSpread> SpreadOf(const spec::Spec& spec,
                                      const EvaluationRow& row,
                                      const std::string& metric);
 
 // "feasible in 2 of 3 runs" for an unstable row, "3 runs" for a stable one,
-// "1 run" for a point run once.
+// "1 run" for a point run once; "2 cases" or "2 cases x 3 runs" for a
+// scenario with task.cases.
 std::string ReplicaSummary(const EvaluationRow& row);
 
 }  // namespace adse::campaign

@@ -19,6 +19,32 @@ std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path) {
   return std::move(loaded).value();
 }
 
+std::optional<spec::Spec> SelectCase(const spec::Spec& spec,
+                                     const std::string& name) {
+  if (spec.cases.empty()) {
+    if (name.empty()) return spec;
+    std::fprintf(stderr, "error: --case: %s has no task.cases\n",
+                 spec.source_path.c_str());
+    return std::nullopt;
+  }
+  if (name.empty()) {
+    std::fprintf(stderr,
+                 "error: --case: %s has %zu task.cases (%s); name the one "
+                 "to run\n",
+                 spec.source_path.c_str(), spec.cases.size(),
+                 spec::CaseNames(spec).c_str());
+    return std::nullopt;
+  }
+  const int index = spec::FindCase(spec, name);
+  if (index < 0) {
+    std::fprintf(stderr, "error: --case: %s has no case '%s' (its cases: %s)\n",
+                 spec.source_path.c_str(), name.c_str(),
+                 spec::CaseNames(spec).c_str());
+    return std::nullopt;
+  }
+  return spec::ForCase(spec, index);
+}
+
 void ReportError(const spec::Spec& spec, const Status& status) {
   const std::string& message = status.message();
   const size_t colon = message.find(": ");

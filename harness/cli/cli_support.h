@@ -14,6 +14,13 @@ namespace adse::cli {
 // Loads and validates `path`; on failure prints the errors to stderr.
 std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path);
 
+// The spec `--case` names (spec::ForCase): the scenario itself when it has
+// no task.cases and `name` is empty. Otherwise prints what is wrong (a case
+// missing, unknown, or named for a scenario without cases) and returns
+// nullopt.
+std::optional<spec::Spec> SelectCase(const spec::Spec& spec,
+                                     const std::string& name);
+
 // Prints `status` as "file:line:col: error: message", locating the field
 // path that starts the message ("task.goal: ...") in the scenario.
 void ReportError(const spec::Spec& spec, const Status& status);

@@ -19,6 +19,7 @@ int RunValidate(const ValidateArgs& args);
 
 struct WorldArgs {
   std::string scenario;
+  std::string task_case;  // --case: one of task.cases (required with them)
   bool follow_ideal = false;
   std::string out;               // default: <output>/world-check
   std::optional<uint64_t> seed;  // overrides world.traffic.seed
@@ -30,7 +31,8 @@ int RunWorld(const WorldArgs& args);
 
 struct SimulateArgs {
   std::string scenario;
-  std::string point;             // "cores=4,freq_ghz=1.2"; empty: start_from
+  std::string task_case;  // --case: one of task.cases (required with them)
+  std::string point;      // "cores=4,freq_ghz=1.2"; empty: start_from
   std::optional<uint64_t> seed;  // overrides world.traffic.seed
   std::string out;               // default: <output>/simulate/<point>.h5
   bool json = false;
@@ -40,8 +42,9 @@ int RunSimulate(const SimulateArgs& args);
 
 struct CalibrateArgs {
   std::string scenario;
-  std::string point;  // empty: start_from
-  int runs = 2;       // measured runs fitted together (seeds seed, seed+1, ...)
+  std::string task_case;  // --case: one of task.cases (required with them)
+  std::string point;      // empty: start_from
+  int runs = 2;  // measured runs fitted together (seeds seed, seed+1, ...)
   std::string out = "calibration.json";
 };
 int RunCalibrate(const CalibrateArgs& args);
@@ -65,7 +68,8 @@ int RunAnalyze(const AnalyzeArgs& args);
 
 struct WorkerArgs {
   std::string scenario;
-  std::string point;             // required
+  std::string task_case;  // --case: one of task.cases (required with them)
+  std::string point;      // required
   std::optional<uint64_t> seed;  // overrides world.traffic.seed
   std::string out;               // run file to write (atomically)
   std::string expect_key;        // refuse to run when the key differs

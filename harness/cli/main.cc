@@ -39,6 +39,9 @@ int main(int argc, char** argv) {
       "controller while the LiDAR scans");
   world_cmd->add_option("scenario", world.scenario, "Scenario YAML file")
       ->required();
+  world_cmd->add_option(
+      "--case", world.task_case,
+      "Which of the scenario's task.cases to run (required when it has cases)");
   world_cmd->add_flag("--follow-ideal", world.follow_ideal,
                       "Drive the ideal path with a ground-truth controller");
   world_cmd->add_option("-o,--out", world.out,
@@ -61,6 +64,9 @@ int main(int argc, char** argv) {
   simulate_cmd->add_option("scenario", simulate.scenario, "Scenario YAML file")
       ->required();
   simulate_cmd->add_option(
+      "--case", simulate.task_case,
+      "Which of the scenario's task.cases to run (required when it has cases)");
+  simulate_cmd->add_option(
       "-p,--point", simulate.point,
       "Design point, e.g. cores=4,freq_ghz=1.2,lidar_hz=14 "
       "(default: exploration.start_from)");
@@ -81,6 +87,9 @@ int main(int argc, char** argv) {
   calibrate_cmd
       ->add_option("scenario", calibrate.scenario, "Scenario YAML file")
       ->required();
+  calibrate_cmd->add_option(
+      "--case", calibrate.task_case,
+      "Which of the scenario's task.cases to run (required when it has cases)");
   calibrate_cmd->add_option(
       "-p,--point", calibrate.point,
       "Design point to run (default: exploration.start_from)");
@@ -181,6 +190,9 @@ int main(int argc, char** argv) {
       "campaign's pool starts; rarely used by hand)");
   worker_cmd->add_option("scenario", worker.scenario, "Scenario YAML file")
       ->required();
+  worker_cmd->add_option(
+      "--case", worker.task_case,
+      "Which of the scenario's task.cases to run (required when it has cases)");
   worker_cmd->add_option("-p,--point", worker.point, "Design point")
       ->required();
   CLI::Option* worker_seed_opt =

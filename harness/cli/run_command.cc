@@ -87,10 +87,18 @@ class Progress : public campaign::ExplorerListener {
       // says which bound stopped it.
       const bool censored =
           campaign::RowMetric(row, analysis::kCensoredMetric) == 1.0;
+      // A point of several cases: its reason is its representative case's.
+      const std::string reason =
+          spec_.cases.empty() ||
+                  static_cast<size_t>(row.task_case) >= spec_.cases.size()
+              ? row.reason
+              : fmt::format("{} in case {} (the worst of {})", row.reason,
+                            spec_.cases[row.task_case].name,
+                            spec_.cases.size());
       line = fmt::format(
           "[{}/{}] {}: {}{}, cost {:.3g}, {} "
           "({}{})",
-          done_, budget_, point, row.reason,
+          done_, budget_, point, reason,
           censored ? std::string(" (stopped early, metrics censored)")
                    : fmt::format(", nav {:.1f} s, ctrl {:.1f} Hz",
                                  campaign::RowMetric(row, "nav_time_s"),

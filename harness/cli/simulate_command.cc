@@ -59,7 +59,9 @@ std::string FormatMetric(double value) {
 }  // namespace
 
 int RunSimulate(const SimulateArgs& args) {
-  std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
+  std::optional<spec::Spec> loaded = LoadScenarioOrReport(args.scenario);
+  if (!loaded) return 2;
+  std::optional<spec::Spec> spec = SelectCase(*loaded, args.task_case);
   if (!spec) return 2;
   std::optional<spec::DesignPoint> point = ResolvePoint(*spec, args.point);
   if (!point) return 2;
@@ -82,8 +84,10 @@ int RunSimulate(const SimulateArgs& args) {
     return ExitCodeFor(run.status());
   }
   const std::string out =
-      args.out.empty() ? spec->output + "/simulate/" + PointSlug(*point) + ".h5"
-                       : args.out;
+      args.out.empty()
+          ? spec->output + "/simulate/" + PointSlug(*point) +
+                (spec->task_case.empty() ? "" : "_" + spec->task_case) + ".h5"
+          : args.out;
   // The analysis (deviation fit, diagnosis) of the fresh run; its metrics
   // are stored with the run's own.
   Result<report::RunReport> analysed =
@@ -124,6 +128,9 @@ int RunSimulate(const SimulateArgs& args) {
   }
   std::printf("point       %s (seed %llu)\n", PointSlug(*point).c_str(),
               static_cast<unsigned long long>(run->seed));
+  if (!spec->task_case.empty()) {
+    std::printf("case        %s\n", spec->task_case.c_str());
+  }
   std::fputs(report::FormatSummary(*analysed).c_str(), stdout);
   std::printf("run file    %s\n", out.c_str());
   std::printf(
@@ -138,7 +145,9 @@ int RunSimulate(const SimulateArgs& args) {
 }
 
 int RunCalibrate(const CalibrateArgs& args) {
-  std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
+  std::optional<spec::Spec> loaded = LoadScenarioOrReport(args.scenario);
+  if (!loaded) return 2;
+  std::optional<spec::Spec> spec = SelectCase(*loaded, args.task_case);
   if (!spec) return 2;
   std::optional<spec::DesignPoint> point = ResolvePoint(*spec, args.point);
   if (!point) return 2;

@@ -39,7 +39,9 @@ std::string PathCsv(const geometry::Path2& path) {
 }  // namespace
 
 int RunWorld(const WorldArgs& args) {
-  std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
+  std::optional<spec::Spec> loaded = LoadScenarioOrReport(args.scenario);
+  if (!loaded) return 2;
+  std::optional<spec::Spec> spec = SelectCase(*loaded, args.task_case);
   if (!spec) return 2;
   world::WorldSetup setup = sim::WorldSetupFromSpec(*spec);
   if (args.seed) setup.world.traffic.seed = *args.seed;
@@ -92,7 +94,10 @@ int RunWorld(const WorldArgs& args) {
   // Everything goes into a private folder renamed into place at the end, so
   // an interrupted check never leaves output that looks complete.
   const std::string out =
-      args.out.empty() ? spec->output + "/world-check" : args.out;
+      args.out.empty()
+          ? spec->output + "/world-check" +
+                (spec->task_case.empty() ? "" : "/" + spec->task_case)
+          : args.out;
   const std::string tmp =
       out + ".tmp." + std::to_string(static_cast<long>(::getpid()));
   std::error_code ec;

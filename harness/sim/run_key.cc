@@ -64,6 +64,10 @@ void AddLocation(ContentHasher* h, const world::Location& l) {
 
 Result<std::string> RunKey(const spec::Spec& spec,
                            const spec::DesignPoint& point, uint64_t seed) {
+  if (!spec.cases.empty()) {
+    return Status::InvalidArgument(
+        "task.cases: a run drives one case; its key is its case's");
+  }
   ContentHasher h;
   h.Add(kKeyVersion).Add(ADSE_VERSION);
   // World.
@@ -163,11 +167,30 @@ uint64_t ReplicaSeed(const spec::Spec& spec, int replica) {
   return Random::DeriveSeed(seed, "replica " + std::to_string(replica));
 }
 
-Result<std::vector<std::string>> ReplicaKeys(const spec::Spec& spec,
-                                             const spec::DesignPoint& point) {
+std::vector<PointRun> PointRuns(const spec::Spec& spec) {
+  std::vector<PointRun> runs;
+  for (int c = 0; c < spec::CaseCount(spec); ++c) {
+    for (int r = 0; r < std::max(1, spec.harness.replicas); ++r) {
+      runs.push_back({c, r});
+    }
+  }
+  return runs;
+}
+
+spec::Spec CaseSpec(const spec::Spec& spec, int task_case) {
+  return spec.cases.empty() ? spec : spec::ForCase(spec, task_case);
+}
+
+Result<std::vector<std::string>> PointRunKeys(const spec::Spec& spec,
+                                              const spec::DesignPoint& point) {
+  std::vector<spec::Spec> cases;
+  for (int c = 0; c < spec::CaseCount(spec); ++c) {
+    cases.push_back(CaseSpec(spec, c));
+  }
   std::vector<std::string> keys;
-  for (int r = 0; r < std::max(1, spec.harness.replicas); ++r) {
-    Result<std::string> key = RunKey(spec, point, ReplicaSeed(spec, r));
+  for (const PointRun& run : PointRuns(spec)) {
+    Result<std::string> key =
+        RunKey(cases[run.task_case], point, ReplicaSeed(spec, run.replica));
     if (!key.ok()) return key.status();
     keys.push_back(*std::move(key));
   }

@@ -16,7 +16,8 @@
 
 namespace adse::sim {
 
-// 64 hex characters. Files the run reads (a given net, its polygons, the
+// 64 hex characters; a spec with task.cases has none (each case's spec,
+// spec::ForCase, has one). Files the run reads (a given net, its polygons, the
 // calibration) enter by content, so editing one changes the key. Fails
 // only when such a file cannot be read.
 Result<std::string> RunKey(const spec::Spec& spec,
@@ -28,9 +29,23 @@ Result<std::string> RunKey(const spec::Spec& spec,
 // its key; replica r > 0 with a seed derived from it.
 uint64_t ReplicaSeed(const spec::Spec& spec, int replica);
 
-// The content keys of the point's harness.replicas runs, in replica order.
-Result<std::vector<std::string>> ReplicaKeys(const spec::Spec& spec,
-                                             const spec::DesignPoint& point);
+// One run of a point: case `task_case` of task.cases (0 when there are
+// none), replica `replica` of harness.replicas.
+struct PointRun {
+  int task_case = 0;
+  int replica = 0;
+};
+
+// A point's runs, case by case: each case's harness.replicas runs.
+std::vector<PointRun> PointRuns(const spec::Spec& spec);
+
+// The spec a run of case `task_case` drives: spec::ForCase, or `spec`
+// itself when it has no cases.
+spec::Spec CaseSpec(const spec::Spec& spec, int task_case);
+
+// The content keys of the point's runs, in PointRuns order.
+Result<std::vector<std::string>> PointRunKeys(const spec::Spec& spec,
+                                              const spec::DesignPoint& point);
 
 }  // namespace adse::sim
 

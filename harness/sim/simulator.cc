@@ -111,6 +111,12 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
                                        SimulationStats* stats_out) {
   const auto t_begin = Clock::now();
   SimulationStats stats;
+  if (!spec.cases.empty()) {
+    // A run drives one task; a caller picks the case (spec::ForCase).
+    return Status::InvalidArgument(fmt::format(
+        "task.cases: the scenario has {} cases; a run drives one of them",
+        spec.cases.size()));
+  }
   Result<spec::PointConfig> config = spec::ApplyPoint(spec, point);
   if (!config.ok()) return config.status();
   const spec::PlatformOptions& platform = config->platform;
@@ -489,6 +495,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   run.scenario_name = spec.name;
   run.scenario_text = spec.source_text;
   run.scenario_hash = Sha256Hex(spec.source_text);
+  run.task_case = spec.task_case;
   run.adse_version = ADSE_VERSION;
   run.host = HostDescription();
   run.created_utc = UtcTimestamp();

@@ -27,8 +27,9 @@ std::string SlurmDir(const std::string& campaign_dir);
 struct PlannedPoint {
   int64_t index = 0;
   std::string point;  // spec::FormatPoint text
-  std::string key;    // content key of its first replica (replica 0)
-  // Content keys of all its runs (harness.replicas), key first.
+  std::string key;    // content key of its first run
+  // Content keys of all its runs (each case's harness.replicas runs, as
+  // sim::PointRuns orders them), key first.
   std::vector<std::string> replica_keys;
 };
 

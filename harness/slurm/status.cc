@@ -99,9 +99,12 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
       if (st.strategy.empty()) st.strategy = j.value("strategy", "");
       if (st.scenario.empty()) st.scenario = j.value("scenario_file", "");
       if (st.total == 0) st.total = j.value("budget", 0);
-      // Without a plan, status counts run files: a point with replicas
-      // has one per replica.
-      if (!plan.ok()) st.total *= std::max(1, j.value("replicas", 1));
+      // Without a plan, status counts run files: a point has one per
+      // case and replica.
+      if (!plan.ok()) {
+        st.total *= std::max(1, j.value("replicas", 1)) *
+                    std::max(1, j.value("cases", 1));
+      }
     }
   }
   Result<std::string> holder = ReadFile(folder + "/.lock", 4096);

@@ -268,7 +268,7 @@ Result<std::vector<PlannedPoint>> PlanPoints(const spec::Spec& spec,
         strategy.Ask(std::max(1, spec.exploration.budget));
     if (batch.empty()) break;
     for (const spec::DesignPoint& point : batch) {
-      Result<std::vector<std::string>> keys = sim::ReplicaKeys(spec, point);
+      Result<std::vector<std::string>> keys = sim::PointRunKeys(spec, point);
       if (!keys.ok()) return keys.status();
       points.push_back({static_cast<int64_t>(points.size()),
                         spec::FormatPoint(spec.design_space, point),

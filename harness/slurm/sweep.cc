@@ -58,7 +58,7 @@ Result<LoadedPlan> LoadPlan(const std::string& campaign_dir, size_t begin,
           plan->scenario, p.point, point.status().message()));
     }
     if (i >= begin && i < end) {
-      Result<std::vector<std::string>> keys = sim::ReplicaKeys(*spec, *point);
+      Result<std::vector<std::string>> keys = sim::PointRunKeys(*spec, *point);
       if (!keys.ok()) return keys.status();
       if (*keys != p.replica_keys) {
         return Status::InvalidArgument(fmt::format(
@@ -197,7 +197,7 @@ Result<campaign::CampaignSummary> BuildSweepIndex(
         missing.push_back(plan.points[i].point);
         continue;
       }
-      // Each run as its shard recorded it; a point with replicas is
+      // Each run as its shard recorded it; a point of several runs is
       // aggregated again from its runs so recorded.
       auto as_recorded = [&](campaign::EvaluationRow* run) {
         run->source = "campaign";
@@ -213,7 +213,7 @@ Result<campaign::CampaignSummary> BuildSweepIndex(
       } else {
         std::vector<campaign::EvaluationRow> runs = std::move(row->replicas);
         for (campaign::EvaluationRow& run : runs) as_recorded(&run);
-        row = campaign::AggregateReplicas(spec, std::move(runs));
+        row = campaign::AggregatePoint(spec, std::move(runs));
       }
       it.content_keys.push_back(row->content_key);
       summary.exploration.evaluations.push_back(*row);

@@ -176,6 +176,40 @@ std::string Spec::Where(const std::string& field_path) const {
   return source_path + ": ";
 }
 
+int CaseCount(const Spec& spec) {
+  return std::max<int>(1, static_cast<int>(spec.cases.size()));
+}
+
+std::string CaseNames(const Spec& spec) {
+  std::string names;
+  for (const TaskCase& c : spec.cases) {
+    names += (names.empty() ? "" : ", ") + c.name;
+  }
+  return names;
+}
+
+int FindCase(const Spec& spec, const std::string& name) {
+  for (size_t i = 0; i < spec.cases.size(); ++i) {
+    if (spec.cases[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+Spec ForCase(const Spec& spec, int index) {
+  Spec out = spec;
+  const TaskCase& c = spec.cases.at(static_cast<size_t>(index));
+  out.task = c.task;
+  out.task_case = c.name;
+  out.cases.clear();
+  const std::string prefix = "task.cases[" + std::to_string(index) + "].";
+  for (const auto& [path, mark] : spec.marks) {
+    if (path.compare(0, prefix.size(), prefix) == 0) {
+      out.marks["task." + path.substr(prefix.size())] = mark;
+    }
+  }
+  return out;
+}
+
 std::string Spec::ResolvedOutput() const {
   fs::path path(output);
   if (path.is_relative()) {

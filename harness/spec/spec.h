@@ -160,6 +160,15 @@ struct HarnessOptions {
   SlurmOptions slurm;
 };
 
+// A variant of the task (task.cases): every design point runs once per
+// case, and is feasible only when it is feasible in each. A case changes
+// the task's start, waypoints or goal (a parking goal's heading, another
+// slot); everything else is the scenario's.
+struct TaskCase {
+  std::string name;         // unique in the scenario; names its runs
+  world::TaskOptions task;  // the scenario's task with the case's places
+};
+
 // Where in the file a field was written, for messages after parsing.
 struct SourceMark {
   int line = 0;    // 1-based; 0 when the field took its default
@@ -175,6 +184,10 @@ struct Spec {
 
   world::WorldOptions world;
   world::TaskOptions task;
+  // task.cases, in file order; empty when the task has no variants. A spec
+  // made for one case (ForCase) has none and names it in `task_case`.
+  std::vector<TaskCase> cases;
+  std::string task_case;
   StackConfig stack;
   PlatformOptions platform;
   DesignSpace design_space;
@@ -198,6 +211,20 @@ struct Spec {
   // working directory (the parser refused any that escape it).
   std::string ResolvedOutput() const;
 };
+
+// The runs a point takes per seed: one per case, one without cases.
+int CaseCount(const Spec& spec);
+
+// "backing_in, nose_in": the names of the cases.
+std::string CaseNames(const Spec& spec);
+
+// The index of the case named `name`, or -1.
+int FindCase(const Spec& spec, const std::string& name);
+
+// The spec of case `index` (0 <= index < cases.size()): the case's task,
+// no cases, `task_case` its name, and the case's fields' marks under
+// task.* too, so an error about the case's goal cites its line.
+Spec ForCase(const Spec& spec, int index);
 
 }  // namespace adse::spec
 

@@ -29,15 +29,22 @@ struct Field {
   std::function<bool(const T&)> present = nullptr;
 };
 
+// The fields' keys and values, inside a map the caller opened.
 template <typename T>
-void EmitFields(YAML::Emitter& out, const T& value, const Spec& spec,
-                const std::vector<Field<T>>& fields) {
-  out << YAML::BeginMap;
+void EmitEntries(YAML::Emitter& out, const T& value, const Spec& spec,
+                 const std::vector<Field<T>>& fields) {
   for (const Field<T>& f : fields) {
     if (f.present && !f.present(value)) continue;
     out << YAML::Key << f.key << YAML::Value;
     f.emit(out, value, spec);
   }
+}
+
+template <typename T>
+void EmitFields(YAML::Emitter& out, const T& value, const Spec& spec,
+                const std::vector<Field<T>>& fields) {
+  out << YAML::BeginMap;
+  EmitEntries(out, value, spec, fields);
   out << YAML::EndMap;
 }
 
@@ -260,6 +267,34 @@ const std::vector<Field<TaskOptions>>& TaskFields() {
   return kFields;
 }
 
+// The task's fields, then its cases, each with its places in full.
+void EmitTask(YAML::Emitter& out, const Spec& spec) {
+  out << YAML::BeginMap;
+  EmitEntries(out, spec.task, spec, TaskFields());
+  if (!spec.cases.empty()) {
+    out << YAML::Key << "cases" << YAML::Value << YAML::BeginSeq;
+    for (const TaskCase& c : spec.cases) {
+      out << YAML::BeginMap;
+      out << YAML::Key << "name" << YAML::Value << c.name;
+      out << YAML::Key << "start" << YAML::Value;
+      EmitLocation(out, c.task.start, nullptr);
+      if (!c.task.via.empty() || !spec.task.via.empty()) {
+        out << YAML::Key << "via" << YAML::Value << YAML::Flow
+            << YAML::BeginSeq;
+        for (const world::Location& l : c.task.via) {
+          EmitLocation(out, l, nullptr);
+        }
+        out << YAML::EndSeq;
+      }
+      out << YAML::Key << "goal" << YAML::Value;
+      EmitLocation(out, c.task.goal, &c.task);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
+  out << YAML::EndMap;
+}
+
 const std::vector<Field<PlatformOptions>>& PlatformFields() {
   static const std::vector<Field<PlatformOptions>> kFields = {
       {"kind", [](YAML::Emitter& out, const PlatformOptions& p,
@@ -390,7 +425,7 @@ const std::vector<Field<Spec>>& SpecFields() {
          EmitFields(out, s.world, s, WorldFields());
        }},
       {"task", [](YAML::Emitter& out, const Spec& s,
-                  const Spec&) { EmitFields(out, s.task, s, TaskFields()); }},
+                  const Spec&) { EmitTask(out, s); }},
       {"stack", [](YAML::Emitter& out, const Spec& s,
                    const Spec&) { EmitStack(out, s.stack, ""); }},
       {"platform",

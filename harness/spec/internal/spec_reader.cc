@@ -37,7 +37,11 @@ const std::vector<std::string> kTaskKeys = {"kind",
                                             "speed_limit_kmh",
                                             "timeout_s",
                                             "stall_timeout_s",
-                                            "traffic_stall_timeout_s"};
+                                            "traffic_stall_timeout_s",
+                                            "cases"};
+const std::vector<std::string> kCaseKeys = {"name", "start", "via", "goal"};
+// Each case is a run of every point: a few, not a sweep.
+constexpr size_t kMaxCases = 16;
 const std::vector<std::string> kStartKeys = {"x", "y", "edge", "pos_m", "lane"};
 const std::vector<std::string> kGoalKeys = {
     "x",           "y",       "edge",
@@ -357,7 +361,7 @@ void SpecReader::ReadTraffic(const Val& v) {
                  "a list of places {x, y} or {edge, pos_m, lane}")) {
       traffic.stopped_vehicles.assign(items.size(), world::Location());
       for (size_t i = 0; i < items.size(); ++i)
-        ReadLocation(items[i], false, &traffic.stopped_vehicles[i]);
+        ReadLocation(items[i], nullptr, &traffic.stopped_vehicles[i]);
     }
   }
   if (const Val* e = f.Get("flows")) {
@@ -402,24 +406,13 @@ void SpecReader::ReadTask(const Val& v) {
     ReadEnum(*e, &task.kind, world::TaskKindNames(), world::StringToTaskKind);
   }
   if (const Val* e = f.Get("start")) {
-    ReadLocation(*e, false, &task.start);
+    ReadLocation(*e, nullptr, &task.start);
   } else {
     Missing(v, "start", "a place {x, y} or {edge, pos_m, lane}");
   }
-  if (const Val* e = f.Get("via")) {
-    std::vector<Val> items;
-    const std::string expected =
-        "a list of at most 100 places {x, y} or {edge, pos_m, lane}";
-    if (ReadList(*e, &items, expected) && items.size() > 100) {
-      Error(*e, expected, fmt::format(" with {} places", items.size()));
-    } else if (!items.empty()) {
-      task.via.assign(items.size(), world::Location());
-      for (size_t i = 0; i < items.size(); ++i)
-        ReadLocation(items[i], false, &task.via[i]);
-    }
-  }
+  if (const Val* e = f.Get("via")) ReadVia(*e, &task.via);
   if (const Val* e = f.Get("goal")) {
-    ReadLocation(*e, true, &task.goal);
+    ReadLocation(*e, &task, &task.goal);
   } else {
     Missing(v, "goal", "a place {x, y} or {edge, pos_m, lane}");
   }
@@ -435,10 +428,76 @@ void SpecReader::ReadTask(const Val& v) {
   if (const Val* e = f.Get("traffic_stall_timeout_s")) {
     ReadNumber(*e, &task.traffic_stall_timeout_s, Bounds::NonNegative());
   }
+  // Last: a case starts from the task as read above.
+  if (const Val* e = f.Get("cases")) ReadCases(*e);
 }
 
-void SpecReader::ReadLocation(const Val& v, bool goal,
+void SpecReader::ReadVia(const Val& v, std::vector<world::Location>* via) {
+  std::vector<Val> items;
+  const std::string expected =
+      "a list of at most 100 places {x, y} or {edge, pos_m, lane}";
+  if (ReadList(v, &items, expected) && items.size() > 100) {
+    Error(v, expected, fmt::format(" with {} places", items.size()));
+  } else if (!items.empty()) {
+    via->assign(items.size(), world::Location());
+    for (size_t i = 0; i < items.size(); ++i)
+      ReadLocation(items[i], nullptr, &(*via)[i]);
+  }
+}
+
+void SpecReader::ReadCases(const Val& v) {
+  const std::string expected = fmt::format(
+      "a list of 2 to {} cases {{name, start, via, goal}}, each changing "
+      "the task's start, waypoints or goal",
+      kMaxCases);
+  std::vector<Val> items;
+  if (!ReadList(v, &items, expected)) return;
+  if (items.size() < 2 || items.size() > kMaxCases) {
+    Error(v, expected, fmt::format(" with {} case(s)", items.size()));
+    return;
+  }
+  for (const Val& item : items) {
+    Fields f;
+    if (!ReadFields(item, &kCaseKeys, &f, expected)) continue;
+    TaskCase c;
+    c.task = spec_.task;
+    if (const Val* e = f.Get("name")) {
+      const std::string what =
+          "a case name of letters, digits and '_' (not starting with a "
+          "digit), unique in task.cases";
+      if (ReadString(*e, &c.name, what)) {
+        if (!IsIdentifier(c.name)) {
+          Error(*e, what);
+        } else if (FindCase(spec_, c.name) >= 0) {
+          Error(*e, what, " (a second case of that name)");
+        }
+      }
+    } else {
+      Missing(item, "name", "the case's name, e.g. nose_in");
+    }
+    // A place given replaces the task's whole place, tolerances aside.
+    if (const Val* e = f.Get("start")) {
+      c.task.start = world::Location();
+      ReadLocation(*e, nullptr, &c.task.start);
+    }
+    if (const Val* e = f.Get("via")) {
+      c.task.via.clear();
+      ReadVia(*e, &c.task.via);
+    }
+    if (const Val* e = f.Get("goal")) {
+      c.task.goal = world::Location();
+      ReadLocation(*e, &c.task, &c.task.goal);
+    }
+    if (!f.Get("start") && !f.Get("via") && !f.Get("goal")) {
+      Error(item, "a case that changes the task's start, via or goal");
+    }
+    spec_.cases.push_back(std::move(c));
+  }
+}
+
+void SpecReader::ReadLocation(const Val& v, world::TaskOptions* goal_of,
                               world::Location* location) {
+  const bool goal = goal_of != nullptr;
   const std::string expected =
       goal ? "a place {x, y, tolerance_m}, {edge, pos_m, lane, tolerance_m} "
              "or {slot, yaw_deg, tolerance_m, yaw_tolerance_deg}"
@@ -482,14 +541,14 @@ void SpecReader::ReadLocation(const Val& v, bool goal,
     }
   }
   if (const Val* e = f.Get("tolerance_m")) {
-    ReadNumber(*e, &spec_.task.goal_tolerance_m, Bounds::Positive());
+    ReadNumber(*e, &goal_of->goal_tolerance_m, Bounds::Positive());
   }
   if (const Val* e = f.Get("yaw_deg")) {
     location->has_yaw = true;
     ReadNumber(*e, &location->yaw_deg, Bounds::Closed(-360, 360));
   }
   if (const Val* e = f.Get("yaw_tolerance_deg")) {
-    ReadNumber(*e, &spec_.task.goal_yaw_tolerance_deg,
+    ReadNumber(*e, &goal_of->goal_yaw_tolerance_deg,
                Bounds{0, 180, true, false});
   }
 }

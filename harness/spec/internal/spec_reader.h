@@ -49,7 +49,12 @@ class SpecReader : public YamlReader {
   void ReadMapSource(const Val& v);
   void ReadTraffic(const Val& v);
   void ReadTask(const Val& v);
-  void ReadLocation(const Val& v, bool goal, world::Location* location);
+  void ReadVia(const Val& v, std::vector<world::Location>* via);
+  void ReadCases(const Val& v);
+  // A start or waypoint; a goal when `goal_of` is given, whose tolerances
+  // it may set.
+  void ReadLocation(const Val& v, world::TaskOptions* goal_of,
+                    world::Location* location);
   void ReadStack(const Val& v, const std::string& prefix);
   void ReadPlatform(const Val& v);
   void ReadDesignSpace(const Val& v);

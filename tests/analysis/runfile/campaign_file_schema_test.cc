@@ -224,7 +224,7 @@ with h5py.File(sys.argv[1], "r") as f:
     assert sorted(columns) == sorted(
         ["index", "iteration", "content_key", "status", "reason", "source",
          "attempts", "wall_s", "feasible", "seed", "bottlenecks_json",
-         "replicas", "unstable"]), columns
+         "replicas", "unstable", "task_case"]), columns
     df = pd.DataFrame({k: ev[k][...] for k in columns})
     for k in ("content_key", "status", "reason", "source", "bottlenecks_json"):
         df[k] = df[k].str.decode("utf-8")

@@ -34,6 +34,7 @@ RunData MakeRun() {
   run.scenario_name = "follow";
   run.scenario_text = "name: follow\n";
   run.scenario_hash = Sha256Hex(run.scenario_text);
+  run.task_case = "nose_in";  // optional: written, so checked as documented
   run.design_point = {{"v0_mps", 10.0}};
   run.platform = {{"kind", "desktop"}};
   run.metrics = {{"collision", 0.0}};

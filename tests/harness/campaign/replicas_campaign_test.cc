@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/runfile/campaign_file.h"
+#include "analysis/runfile/run_file.h"
 #include "harness/campaign/campaign.h"
 #include "harness/campaign/replicas.h"
 #include "harness/sim/run_key.h"
@@ -229,6 +230,77 @@ TEST(ReplicasCampaignTest, APointWhoseReplicasDisagreeIsFlaggedUnstable) {
       runfile::ReadCampaignIndex(dir + "/strict/campaign.h5");
   ASSERT_TRUE(index.ok());
   EXPECT_TRUE(index->evaluations[0].unstable);
+}
+
+TEST(ReplicasCampaignTest, EachPointDrivesEveryCaseAndIsJudgedByItsWorst) {
+  const std::string dir = adse::testing::TestTempDir("adse-cases");
+  spec::Spec spec = Scenario(
+      dir,
+      "  cores:    {bind: platform.cores,    values: [16]}\n"
+      "  freq_ghz: {bind: platform.freq_ghz, values: [2.1]}\n",
+      "[nav_time_s <= 60, ctrl_rate_hz >= 1, completed]", "{replicas: 1}");
+  // Two destinations: the scenario's, across the lot, and one on the
+  // entrance road.
+  std::string text = spec.source_text;
+  const size_t goal = text.find("  goal: {x: 10.0, y: 29.75}");
+  ASSERT_NE(goal, std::string::npos);
+  text.insert(text.find('\n', goal) + 1,
+              "  cases:\n"
+              "    - {name: across, goal: {x: 10.0, y: 29.75}}\n"
+              "    - {name: along, goal: {x: 40.0, y: -1.75}}\n");
+  ASSERT_TRUE(WriteFileAtomic(dir + "/scenario.yaml", text).ok());
+  Result<spec::Spec> loaded = spec::LoadSpec(dir + "/scenario.yaml");
+  ASSERT_TRUE(loaded.ok()) << loaded.status().ToString();
+  spec = *loaded;
+  const std::string out = dir + "/campaign";
+  CampaignOptions options = Options(out);
+  options.strategy = "exhaustive";
+  options.budget = 1;
+  Result<CampaignSummary> first = RunCampaign(spec, options);
+  ASSERT_TRUE(first.ok()) << first.status().ToString();
+  ASSERT_EQ(first->exploration.evaluations.size(), 1u);
+  EXPECT_EQ(RunFileCount(out), 2u) << "one run per case";
+  const EvaluationRow& row = first->exploration.evaluations[0];
+  ASSERT_EQ(row.replicas.size(), 2u);
+  const EvaluationRow& across = row.replicas[0];
+  const EvaluationRow& along = row.replicas[1];
+  EXPECT_EQ(across.task_case, 0);
+  EXPECT_EQ(along.task_case, 1);
+  EXPECT_NE(across.content_key, along.content_key);
+  // Both reach their goals; the point takes the longer drive.
+  EXPECT_EQ(across.reason, "goal_reached");
+  EXPECT_EQ(along.reason, "goal_reached");
+  const double worst =
+      std::max(RowMetric(across, "nav_time_s"), RowMetric(along, "nav_time_s"));
+  EXPECT_GT(std::fabs(RowMetric(across, "nav_time_s") -
+                      RowMetric(along, "nav_time_s")),
+            1.0);
+  EXPECT_DOUBLE_EQ(RowMetric(row, "nav_time_s"), worst);
+  EXPECT_EQ(row.feasible, across.feasible && along.feasible);
+
+  // Each run file names its case; the index and the report keep both.
+  Result<runfile::RunData> run =
+      runfile::ReadRunFile(out + "/runs/" + along.content_key + ".h5");
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->task_case, "along");
+  Result<runfile::CampaignIndex> index =
+      runfile::ReadCampaignIndex(out + "/campaign.h5");
+  ASSERT_TRUE(index.ok()) << index.status().ToString();
+  ASSERT_EQ(index->evaluations[0].replicas.size(), 2u);
+  EXPECT_EQ(index->evaluations[0].replicas[1].task_case, 1);
+  EXPECT_EQ(index->evaluations[0].task_case, row.task_case);
+  const std::string report = ReadFile(out + "/report.md").value();
+  EXPECT_NE(report.find("## Cases"), std::string::npos) << report;
+  EXPECT_NE(report.find("worst of 2 cases"), std::string::npos) << report;
+  EXPECT_NE(report.find("[along](images/" + along.content_key),
+            std::string::npos)
+      << report;
+
+  // Resumed: nothing runs again, and the row is the same.
+  Result<CampaignSummary> second = RunCampaign(spec, options);
+  ASSERT_TRUE(second.ok()) << second.status().ToString();
+  EXPECT_EQ(second->simulated, 0);
+  EXPECT_EQ(second->exploration.evaluations[0].metrics, row.metrics);
 }
 
 }  // namespace

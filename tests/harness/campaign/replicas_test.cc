@@ -199,5 +199,89 @@ TEST(ReplicasTest, FailedRunsCountAgainstFeasibilityButNotStability) {
   EXPECT_EQ(none.reason, "crashed: killed by signal 11");
 }
 
+// Case `task_case`'s run: as Reached, with a deviation (a metric no
+// objective or constraint judges).
+EvaluationRow CaseRun(int task_case, int replica, double nav_time_s,
+                      double ctrl_rate_hz, double deviation_m) {
+  EvaluationRow row = Reached(replica, nav_time_s, ctrl_rate_hz);
+  row.task_case = task_case;
+  row.content_key =
+      std::string(64, static_cast<char>('k' + 3 * task_case + replica));
+  row.metrics["max_deviation_m"] = deviation_m;
+  return row;
+}
+
+TEST(CasesTest, APointIsTheWorstOfItsCasesWithEveryRunKept) {
+  spec::Spec spec = Scenario();
+  spec.harness.replicas = 1;
+  // Given in any order: folded case by case.
+  const EvaluationRow row = AggregatePoint(
+      spec, {CaseRun(1, 0, 55.0, 3.0, 0.4), CaseRun(0, 0, 40.0, 6.0, 0.2)});
+  EXPECT_EQ(row.status, "complete");
+  EXPECT_TRUE(row.feasible);
+  // Judged metrics: the worst (nav time minimised, control rate bounded
+  // from below); the others: the mean.
+  EXPECT_DOUBLE_EQ(row.metrics.at("nav_time_s"), 55.0);
+  EXPECT_DOUBLE_EQ(row.metrics.at("ctrl_rate_hz"), 3.0);
+  EXPECT_DOUBLE_EQ(row.metrics.at("max_deviation_m"), 0.3);
+  EXPECT_DOUBLE_EQ(row.metrics.at("hardware_cost"), 4.0);
+  EXPECT_DOUBLE_EQ(row.metrics.at("censored"), 0.0);
+  // The representative: the case worst in the first objective that differs
+  // (nav time; the cost is the same).
+  EXPECT_EQ(row.task_case, 1);
+  EXPECT_EQ(row.content_key, CaseRun(1, 0, 0, 0, 0).content_key);
+  ASSERT_EQ(row.replicas.size(), 2u);
+  EXPECT_EQ(row.replicas[0].task_case, 0);
+  EXPECT_EQ(row.replicas[1].task_case, 1);
+  EXPECT_EQ(row.attempts, 2);
+  EXPECT_EQ(CaseCountOf(row), 2);
+  EXPECT_EQ(ReplicaSummary(row), "2 cases");
+  // A spread across cases would mix two tasks.
+  EXPECT_FALSE(SpreadOf(spec, row, "nav_time_s"));
+}
+
+TEST(CasesTest, OneInfeasibleCaseMakesThePointInfeasibleAndStandsForIt) {
+  spec::Spec spec = Scenario();
+  spec.harness.replicas = 1;
+  EvaluationRow stopped = Stopped(0, "nav_time_s <= 60");
+  stopped.task_case = 1;
+  const EvaluationRow row =
+      AggregatePoint(spec, {CaseRun(0, 0, 40.0, 6.0, 0.2), stopped});
+  EXPECT_EQ(row.status, "complete");
+  EXPECT_FALSE(row.feasible);
+  // Stopped beyond the bound: the worst nav time is unknown, the row
+  // censored, and its reason the stopped case's.
+  EXPECT_EQ(row.metrics.count("nav_time_s"), 0u);
+  EXPECT_DOUBLE_EQ(row.metrics.at("censored"), 1.0);
+  EXPECT_EQ(row.task_case, 1);
+  EXPECT_EQ(row.reason, stopped.reason);
+
+  // A case that failed makes the point fail.
+  EvaluationRow failed = Failed(0);
+  failed.task_case = 1;
+  const EvaluationRow broken =
+      AggregatePoint(spec, {CaseRun(0, 0, 40.0, 6.0, 0.2), failed});
+  EXPECT_EQ(broken.status, "failed");
+  EXPECT_FALSE(broken.feasible);
+  EXPECT_EQ(broken.reason, failed.reason);
+  EXPECT_TRUE(broken.metrics.empty());
+  EXPECT_EQ(ReplicaSummary(broken), "2 cases, 1 failed");
+}
+
+TEST(CasesTest, EachCasesReplicasAreFoldedBeforeTheCases) {
+  // Three replicas per case: medians 45 and 52, the point 52.
+  const EvaluationRow row = AggregatePoint(
+      Scenario(),
+      {CaseRun(0, 0, 50.0, 4.0, 0.1), CaseRun(0, 1, 40.0, 6.0, 0.1),
+       CaseRun(0, 2, 45.0, 5.0, 0.1), CaseRun(1, 0, 52.0, 5.0, 0.3),
+       CaseRun(1, 1, 58.0, 5.0, 0.3), CaseRun(1, 2, 51.0, 5.0, 0.3)});
+  EXPECT_DOUBLE_EQ(row.metrics.at("nav_time_s"), 52.0);
+  EXPECT_DOUBLE_EQ(row.metrics.at("ctrl_rate_hz"), 5.0);
+  EXPECT_DOUBLE_EQ(row.metrics.at("max_deviation_m"), 0.2);
+  EXPECT_TRUE(row.feasible);
+  ASSERT_EQ(row.replicas.size(), 6u);
+  EXPECT_EQ(ReplicaSummary(row), "2 cases x 3 runs");
+}
+
 }  // namespace
 }  // namespace adse::campaign

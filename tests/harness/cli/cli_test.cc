@@ -98,6 +98,68 @@ TEST(CliTest, UnknownFlowEdgeIsReportedAtItsLine) {
       << run.out;
 }
 
+// The valet example's task.cases with a case's line replaced, written with
+// the profile beside it.
+std::string ValetVariant(const std::string& name, const std::string& from,
+                         const std::string& to) {
+  std::ifstream in(std::string(ADSE_SOURCE_DIR) +
+                   "/scenarios/valet_parking.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)),
+                   std::istreambuf_iterator<char>());
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  const fs::path profile = fs::temp_directory_path() /
+                           "profiles/autoware-2022.12-i9-12900kf-valet.yaml";
+  fs::create_directories(profile.parent_path());
+  fs::copy_file(
+      std::string(ADSE_SOURCE_DIR) +
+          "/scenarios/profiles/autoware-2022.12-i9-12900kf-valet.yaml",
+      profile, fs::copy_options::overwrite_existing);
+  return WriteScenario(name, text);
+}
+
+TEST(CliTest, AnOccupiedSlotInOneCaseIsReportedAtThatCasesLine) {
+  const std::string file = ValetVariant(
+      "valet_case", "{name: nose_in, goal: {slot: slot_r1_s4, yaw_deg: 90}}",
+      "{name: nose_in, goal: {slot: slot_r1_s3, yaw_deg: 90}}");
+  const CommandRun run = Adse("validate -q " + file);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  // The nose_in case is on line 27 of the example.
+  EXPECT_TRUE(std::regex_search(
+      run.out, std::regex("adse_cli_valet_case\\.yaml:27:[0-9]+: error: "
+                          "task\\.goal\\.slot: slot 'slot_r1_s3' is occupied")))
+      << run.out;
+  EXPECT_NE(run.out.find("checking task.cases[1] ('nose_in')"),
+            std::string::npos)
+      << run.out;
+}
+
+TEST(CliTest, ACommandThatRunsOneCaseNeedsItNamed) {
+  const std::string valet =
+      std::string(ADSE_SOURCE_DIR) + "/scenarios/valet_parking.yaml";
+  for (const std::string& command :
+       {"simulate " + valet + " -p cores=8,freq_ghz=3.0",
+        "world " + valet + " --no-scan"}) {
+    const CommandRun run = Adse(command);
+    EXPECT_EQ(run.exit_code, 2) << command << "\n" << run.out;
+    EXPECT_NE(run.out.find("has 2 task.cases (backing_in, nose_in); name the "
+                           "one to run"),
+              std::string::npos)
+        << run.out;
+  }
+  const CommandRun unknown =
+      Adse("simulate " + valet + " -p cores=8,freq_ghz=3.0 --case sideways");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.out.find("no case 'sideways' (its cases: backing_in, "
+                             "nose_in)"),
+            std::string::npos)
+      << unknown.out;
+  const CommandRun none = Adse("world " + Example() + " --case nose_in");
+  EXPECT_EQ(none.exit_code, 2);
+  EXPECT_NE(none.out.find("has no task.cases"), std::string::npos) << none.out;
+}
+
 TEST(CliTest, MisspelledKeyGetsADidYouMeanAndNothingIsWritten) {
   const std::string file = Variant("typo", "weather: clear", "wether: clear");
   const fs::path out = fs::temp_directory_path() / "adse_cli_typo_out";

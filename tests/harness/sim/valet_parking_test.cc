@@ -1,6 +1,7 @@
-// The bundled valet scenarios end to end: SUMO, the stack on the virtual
-// platform costed by the valet profile, the freespace planner and the
-// controller's parking mode. Each case is its own process (one SUMO each).
+// The bundled valet scenario end to end, each of its task.cases: SUMO, the
+// stack on the virtual platform costed by the valet profile, the freespace
+// planner and the controller's parking mode. Each test is its own process
+// (one SUMO each).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,11 +16,14 @@
 namespace adse::sim {
 namespace {
 
-spec::Spec Bundled(const std::string& name) {
-  Result<spec::Spec> spec =
-      spec::LoadSpec(std::string(ADSE_SOURCE_DIR) + "/scenarios/" + name);
+// scenarios/valet_parking.yaml as case `task_case` runs it.
+spec::Spec Bundled(const std::string& task_case) {
+  Result<spec::Spec> spec = spec::LoadSpec(std::string(ADSE_SOURCE_DIR) +
+                                           "/scenarios/valet_parking.yaml");
   EXPECT_TRUE(spec.ok()) << spec.status().ToString();
-  return *spec;
+  const int index = spec::FindCase(*spec, task_case);
+  EXPECT_GE(index, 0) << task_case;
+  return spec::ForCase(*spec, index);
 }
 
 const spec::DesignPoint kGenerous = {{"cores", 8}, {"freq_ghz", 3.0}};
@@ -53,8 +57,9 @@ void ExpectParked(const runfile::RunData& run, int min_gear_changes) {
 
 TEST(ValetParkingTest, BacksIntoTheSlot) {
   Result<runfile::RunData> run =
-      SimulatePoint(Bundled("valet_parking.yaml"), kGenerous);
+      SimulatePoint(Bundled("backing_in"), kGenerous);
   ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->task_case, "backing_in");
   // The road ends beside the slot facing west; backing in needs at least
   // one change from forward to reverse.
   ExpectParked(*run, 1);
@@ -65,9 +70,9 @@ TEST(ValetParkingTest, BacksIntoTheSlot) {
 }
 
 TEST(ValetParkingTest, DrivesNoseFirstIntoTheSlot) {
-  Result<runfile::RunData> run =
-      SimulatePoint(Bundled("valet_parking_nose_in.yaml"), kGenerous);
+  Result<runfile::RunData> run = SimulatePoint(Bundled("nose_in"), kGenerous);
   ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->task_case, "nose_in");
   ExpectParked(*run, 1);
   // Nose first: the manoeuvre enters the slot driving forward (the first
   // planned pose within 2 m of the goal); a short reverse to straighten up
@@ -87,7 +92,7 @@ TEST(ValetParkingTest, DrivesNoseFirstIntoTheSlot) {
 }
 
 TEST(ValetParkingTest, UnreachableSlotEndsTheRunWithNoPathNotATimeout) {
-  spec::Spec spec = Bundled("valet_parking.yaml");
+  spec::Spec spec = Bundled("backing_in");
   // A planner that keeps 0.8 m around the body cannot fit the car between
   // the parked neighbours (3.2 m apart, the car 1.9 m wide).
   ASSERT_TRUE(spec.stack.Set("parking.collision_margin_m", 0.8).ok());
@@ -104,7 +109,7 @@ TEST(ValetParkingTest, UnreachableSlotEndsTheRunWithNoPathNotATimeout) {
 }
 
 TEST(ValetParkingTest, AManoeuvreEndingOutsideTheTolerancesIsCorrected) {
-  spec::Spec spec = Bundled("valet_parking.yaml");
+  spec::Spec spec = Bundled("backing_in");
   // Tighter than the manoeuvre ends here (0.09 m off): the planner plans
   // again from where the car stands, and that short manoeuvre ends within.
   spec.task.goal_tolerance_m = 0.08;
@@ -138,7 +143,7 @@ TEST(ValetParkingTest, AManoeuvreEndingOutsideTheTolerancesIsCorrected) {
 }
 
 TEST(ValetParkingTest, ParkedOutsideTheToleranceEndsTheRunAtOnce) {
-  spec::Spec spec = Bundled("valet_parking.yaml");
+  spec::Spec spec = Bundled("backing_in");
   // Tighter than the manoeuvre ends (about 1.4 degrees off at this point),
   // and no re-plan to correct it.
   spec.task.goal_yaw_tolerance_deg = 0.2;
@@ -155,7 +160,7 @@ TEST(ValetParkingTest, ParkedOutsideTheToleranceEndsTheRunAtOnce) {
 }
 
 TEST(ValetParkingTest, OffTheCourseOfItsPathTheCarStopsAndGetsANewOne) {
-  spec::Spec spec = Bundled("valet_parking.yaml");
+  spec::Spec spec = Bundled("backing_in");
   // A course narrower than the car follows the plan here (within a few
   // centimetres): it leaves it, stops, and the planner plans again from
   // there.
@@ -174,7 +179,7 @@ TEST(ValetParkingTest, OffTheCourseOfItsPathTheCarStopsAndGetsANewOne) {
 }
 
 TEST(ValetParkingTest, PastItsReplansAnOffCourseCarEndsTheRunWithNoPath) {
-  spec::Spec spec = Bundled("valet_parking.yaml");
+  spec::Spec spec = Bundled("backing_in");
   ASSERT_TRUE(spec.stack.Set("parking.course_out_m", 0.05).ok());
   ASSERT_TRUE(spec.stack.Set("parking.max_replans", 0).ok());
   Result<runfile::RunData> run = SimulatePoint(spec, kGenerous);
@@ -185,6 +190,16 @@ TEST(ValetParkingTest, PastItsReplansAnOffCourseCarEndsTheRunWithNoPath) {
   EXPECT_EQ(run->metrics.at("parked"), 0.0);
   // Ended where it stopped, not at the 300 s timeout.
   EXPECT_LT(run->metrics.at("nav_time_s"), 90.0);
+}
+
+TEST(ValetParkingTest, TheScenarioWithItsCasesIsNotOneRun) {
+  Result<spec::Spec> spec = spec::LoadSpec(std::string(ADSE_SOURCE_DIR) +
+                                           "/scenarios/valet_parking.yaml");
+  ASSERT_TRUE(spec.ok()) << spec.status().ToString();
+  Result<runfile::RunData> run = SimulatePoint(*spec, kGenerous);
+  ASSERT_FALSE(run.ok());
+  EXPECT_NE(run.status().message().find("task.cases"), std::string::npos)
+      << run.status().message();
 }
 
 }  // namespace

@@ -122,7 +122,8 @@ TEST(SpecErrorsTest, UnknownKeyWithSuggestion) {
   EXPECT_THAT(message, HasSubstr("bad.yaml:6:3: error: task.gaol: expected a "
                                  "key among {kind, start, via, goal, "
                                  "speed_limit_kmh, timeout_s, "
-                                 "stall_timeout_s, traffic_stall_timeout_s}, "
+                                 "stall_timeout_s, traffic_stall_timeout_s, "
+                                 "cases}, "
                                  "found 'gaol' "
                                  "(did you mean 'goal'?)"));
   // ... and the now missing goal is reported too.

@@ -394,6 +394,97 @@ design_space: {cores: {bind: platform.cores, range: [1, 4]}}
       << bad.status().message();
 }
 
+TEST(SpecParserTest, TaskCasesRoundTripAndEachCaseIsTheTaskWithItsPlaces) {
+  const std::string text = R"(adse: 1
+world:
+  map: {generate: parking_lot, params: {rows: 2}}
+task:
+  kind: valet_parking
+  start: {x: 12, y: -1.75}
+  goal: {slot: slot_r1_s4, yaw_deg: -90, tolerance_m: 0.4, yaw_tolerance_deg: 8}
+  cases:
+    - {name: backing_in, goal: {slot: slot_r1_s4, yaw_deg: -90}}
+    - name: nose_in
+      goal: {slot: slot_r1_s7, yaw_deg: 90, tolerance_m: 0.3}
+  timeout_s: 200
+design_space:
+  cores: {bind: platform.cores, range: [1, 4]}
+)";
+  Result<Spec> first = ParseSpec(text, "valet.yaml", "/");
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  const std::string yaml = NormalizedYaml(*first);
+  Result<Spec> again = ParseSpec(yaml, "normalized.yaml", "/");
+  ASSERT_TRUE(again.ok()) << again.status().message() << "\n" << yaml;
+  EXPECT_EQ(NormalizedYaml(*again), yaml);
+  ASSERT_EQ(again->cases.size(), 2u);
+  EXPECT_EQ(CaseCount(*again), 2);
+  EXPECT_EQ(CaseNames(*again), "backing_in, nose_in");
+  EXPECT_EQ(FindCase(*again, "nose_in"), 1);
+  EXPECT_EQ(FindCase(*again, "sideways"), -1);
+
+  // A case is the task with its places: the rest, and the tolerances it
+  // leaves out, are the task's.
+  const Spec nose = ForCase(*first, 1);
+  EXPECT_TRUE(nose.cases.empty());
+  EXPECT_EQ(nose.task_case, "nose_in");
+  EXPECT_EQ(nose.task.goal.slot, "slot_r1_s7");
+  EXPECT_NEAR(nose.task.goal.yaw_deg, 90, kTol);
+  EXPECT_NEAR(nose.task.goal_tolerance_m, 0.3, kTol);
+  EXPECT_NEAR(nose.task.goal_yaw_tolerance_deg, 8, kTol);
+  EXPECT_NEAR(nose.task.timeout_s, 200, kTol);
+  EXPECT_NEAR(nose.task.start.x_m, 12, kTol);
+  const Spec back = ForCase(*first, 0);
+  EXPECT_NEAR(back.task.goal_tolerance_m, 0.4, kTol);
+  // An error about the case's goal cites the case's line.
+  EXPECT_EQ(nose.Where("task.goal.slot"), "valet.yaml:11:14: ");
+  EXPECT_EQ(back.Where("task.goal"), "valet.yaml:9:26: ");
+  // Without cases a scenario is one case.
+  EXPECT_EQ(CaseCount(ForCase(*first, 0)), 1);
+}
+
+TEST(SpecParserTest, BadTaskCasesAreNamedByIndex) {
+  auto error = [](const std::string& cases) {
+    Result<Spec> spec = ParseSpec(R"(adse: 1
+world: {map: {generate: grid}}
+task:
+  start: {x: 0, y: 0}
+  goal: {x: 100, y: 0}
+  cases: )" + cases + R"(
+design_space: {cores: {bind: platform.cores, range: [1, 4]}}
+)",
+                                  "cases.yaml", "/");
+    return spec.ok() ? std::string("ok") : spec.status().message();
+  };
+  EXPECT_NE(error("[{name: a, goal: {x: 50, y: 0}}]").find("task.cases"),
+            std::string::npos);
+  EXPECT_NE(error("[{name: a, goal: {x: 50, y: 0}}, {name: a, goal: {x: 60, "
+                  "y: 0}}]")
+                .find("a second case of that name"),
+            std::string::npos);
+  EXPECT_NE(error("[{name: a, goal: {x: 50, y: 0}}, {name: b}]")
+                .find("task.cases[1]: expected a case that changes the task's "
+                      "start, via or goal"),
+            std::string::npos)
+      << error("[{name: a, goal: {x: 50, y: 0}}, {name: b}]");
+  EXPECT_NE(error("[{name: a, goal: {x: 50, y: 0}}, {goal: {x: 60, y: 0}}]")
+                .find("task.cases[1]"),
+            std::string::npos);
+  EXPECT_NE(error("[{name: 1a, goal: {x: 50, y: 0}}, {name: b, goal: {x: 60, "
+                  "y: 0}}]")
+                .find("task.cases[0].name"),
+            std::string::npos);
+  EXPECT_NE(error("[{name: a, goal: {x: 50}}, {name: b, goal: {x: 60, y: 0}}]")
+                .find("task.cases[0].goal"),
+            std::string::npos);
+  EXPECT_NE(error("[{name: a, goal: {x: 50, y: 0}, speed_limit_kmh: 20}, "
+                  "{name: b, goal: {x: 60, y: 0}}]")
+                .find("speed_limit_kmh"),
+            std::string::npos);
+  EXPECT_EQ(error("[{name: a, goal: {x: 50, y: 0}}, {name: b, start: {x: 10, "
+                  "y: 0}, via: [{x: 30, y: 0}]}]"),
+            "ok");
+}
+
 TEST(SpecParserTest, NormalizedYamlRoundTripsNetMapsAndEdges) {
   const std::string dir = MakeTempDir();
   WriteText(fs::path(dir) / "a.net.xml", "<net version=\"1.16\"></net>\n");
