@@ -273,6 +273,38 @@ TEST_F(CampaignOnSlurmTest, ASweepWithReplicasRunsEveryReplicaAsItsOwnStep) {
   EXPECT_TRUE(JobOf(resubmitted, "array").empty());
 }
 
+TEST_F(CampaignOnSlurmTest, ASweepWithCasesRunsEveryCaseAsItsOwnStep) {
+  const std::string scenario = SmallScenarioIn(
+      dir_, "{strategy: random, budget: 1}",
+      "{memory_mb: 1024, slurm: {shard_size: 1, signal_lead_s: 60}}");
+  // Two destinations for every point (task.cases).
+  std::string text = ReadFile(scenario).value();
+  const std::string goal = "  goal: {x: 10.0, y: 29.75}\n";
+  const size_t at = text.find(goal);
+  ASSERT_NE(at, std::string::npos) << "robotaxi_small.yaml changed";
+  text.insert(at + goal.size(),
+              "  cases:\n"
+              "    - {name: across, goal: {x: 10.0, y: 29.75}}\n"
+              "    - {name: along, goal: {x: 40.0, y: -1.75}}\n");
+  std::ofstream(scenario) << text;
+  const std::string out = dir_ + "/sweep";
+  const json submitted = Submit(scenario, out);
+  EXPECT_EQ(submitted["points"], 1);
+  WaitForJob(JobOf(submitted, "index"));
+  EXPECT_EQ(RunFiles(out).size(), 2u) << "1 point x 2 cases";
+  EXPECT_EQ(StatusOf(out)["counts"],
+            json({{"done", 1}, {"failed", 0}, {"running", 0}, {"pending", 0}}));
+  // The same point as a local campaign: the same runs, case by case.
+  const runfile::CampaignIndex slurm_index = Index(out);
+  ExpectSameAsLocal(scenario, dir_ + "/local", slurm_index, 1);
+  ASSERT_EQ(slurm_index.evaluations.size(), 1u);
+  const runfile::EvaluationRow& row = slurm_index.evaluations[0];
+  ASSERT_EQ(row.replicas.size(), 2u);
+  EXPECT_EQ(row.replicas[0].task_case, 0);
+  EXPECT_EQ(row.replicas[1].task_case, 1);
+  EXPECT_EQ(row.replicas[1].reason, "goal_reached");
+}
+
 TEST_F(CampaignOnSlurmTest,
        AdaptiveCampaignInsideAnAllocationRunsTwoStepsAtOnceOnTwoCpus) {
   if (cluster_->cpus() < 2) {
