@@ -4,6 +4,7 @@
 
 #include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
+#include "harness/sim/run_key.h"
 #include "harness/sim/simulator.h"
 #include "harness/spec/spec_parser.h"
 
@@ -14,8 +15,7 @@ int RunValidate(const ValidateArgs& args) {
   if (!spec) return 2;
   // Each case's world: its own start and goal must resolve.
   for (int i = 0; args.check_world && i < spec::CaseCount(*spec); ++i) {
-    const spec::Spec task =
-        spec->cases.empty() ? *spec : spec::ForCase(*spec, i);
+    const spec::Spec task = sim::CaseSpec(*spec, i);
     Result<std::unique_ptr<world::World>> world =
         world::World::Open(sim::WorldSetupFromSpec(task));
     if (!world.ok()) {
