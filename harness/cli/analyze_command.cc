@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
@@ -19,6 +20,7 @@
 #include "harness/campaign/evaluation.h"
 #include "harness/campaign/headline.h"
 #include "harness/campaign/replay.h"
+#include "harness/campaign/replicas.h"
 #include "harness/campaign/run_store.h"
 #include "harness/cli/commands.h"
 #include "harness/report/run_report.h"
@@ -193,7 +195,9 @@ int AnalyzeFolder(const std::string& target,
     }
     index = std::move(*read);
   }
-  // The runs to analyse, each with the row it had (bookkeeping kept).
+  // The runs to analyse, each with the row it had (bookkeeping kept). A
+  // point of several runs (replicas, task.cases) has an item per run and
+  // is folded again from them below, as the campaign folded it.
   struct Item {
     campaign::EvaluationRow row;
     std::string file;  // empty: a failed run, kept as recorded
@@ -204,9 +208,13 @@ int AnalyzeFolder(const std::string& target,
     scenario_text = index->scenario_text;
     scenario_source = folder.Path("campaign.h5") + " (stored scenario)";
     for (const campaign::EvaluationRow& row : index->evaluations) {
-      items.push_back({row, row.status == "complete"
-                                ? folder.RunPath(row.content_key)
-                                : std::string()});
+      for (const campaign::EvaluationRow& run :
+           row.replicas.empty() ? std::vector<campaign::EvaluationRow>{row}
+                                : row.replicas) {
+        items.push_back({run, run.status == "complete"
+                                  ? folder.RunPath(run.content_key)
+                                  : std::string()});
+      }
     }
   } else {
     for (const std::string& file : RunFilesIn(target)) {
@@ -302,14 +310,25 @@ int AnalyzeFolder(const std::string& target,
     campaign::EvaluationRow row = campaign::RowFromReport(*report);
     row.index = item.row.index;
     row.iteration = item.row.iteration;
+    row.replica = item.row.replica;
+    row.task_case = item.row.task_case;
     row.source = item.row.source;
     row.attempts = item.row.attempts;
     row.wall_s = item.row.wall_s;
     rows.push_back(std::move(row));
   }
   rows.insert(rows.end(), recorded_rows.begin(), recorded_rows.end());
-  std::sort(rows.begin(), rows.end(),
-            [](const auto& a, const auto& b) { return a.index < b.index; });
+  {
+    // Each point's runs folded into its row (one run: itself).
+    std::map<int64_t, std::vector<campaign::EvaluationRow>> runs_of;
+    for (campaign::EvaluationRow& run : rows) {
+      runs_of[run.index].push_back(std::move(run));
+    }
+    rows.clear();
+    for (auto& [point_index, runs] : runs_of) {
+      rows.push_back(campaign::AggregatePoint(*spec, std::move(runs)));
+    }
+  }
 
   campaign::CampaignSummary summary;
   summary.output_dir = target;

@@ -494,6 +494,35 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
       << diff.out;
 }
 
+TEST(CliRunTest, AnalyzeOfACampaignWithCasesFoldsEveryCaseAsRunDid) {
+  // The small scenario at one point, with two destinations.
+  std::ifstream in(Small());
+  std::string text((std::istreambuf_iterator<char>(in)),
+                   std::istreambuf_iterator<char>());
+  const std::string goal = "  goal: {x: 10.0, y: 29.75}\n";
+  const size_t at = text.find(goal);
+  ASSERT_NE(at, std::string::npos);
+  text.insert(at + goal.size(),
+              "  cases:\n"
+              "    - {name: across, goal: {x: 10.0, y: 29.75}}\n"
+              "    - {name: along, goal: {x: 40.0, y: -1.75}}\n");
+  const std::string scenario = WriteScenario("cases", text);
+  const fs::path out = fs::temp_directory_path() / "adse_cli_cases";
+  fs::remove_all(out);
+  const CommandRun run = Adse(
+      "run " + scenario +
+      " --budget 1 --strategy exhaustive -q --no-cache -o " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const CommandRun analyze = Adse("analyze " + out.string());
+  ASSERT_EQ(analyze.exit_code, 0) << analyze.out;
+  EXPECT_NE(analyze.out.find("2 runs analysed"), std::string::npos)
+      << analyze.out;
+  EXPECT_EQ(FrontSection(analyze.out), FrontSection(run.out)) << analyze.out;
+  EXPECT_NE(FrontSection(analyze.out).find("1 of 1 evaluations"),
+            std::string::npos)
+      << analyze.out;
+}
+
 TEST(CliRunTest, AnalyzeWithAReferenceDrawsTheStudysFigureOrRefusesClearly) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_study_figure";
   fs::remove_all(out);
