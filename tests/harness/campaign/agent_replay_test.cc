@@ -72,7 +72,7 @@ TEST(AgentReplayTest, OnTheRecordedRobotaxiCampaign) {
 }
 
 TEST(AgentReplayTest, OnTheReferenceStudyWhereStarvedRunsAreStoppedEarly) {
-  ExpectAgentOn("reference_study", {6, 0.96, 0});
+  ExpectAgentOn("reference_study", {7, 0.98, 18});
 }
 
 TEST(AgentReplayTest, OnALandscapeThatSaturates) {
