@@ -98,6 +98,20 @@ std::optional<MetricSpread> Spread(const spec::Spec& spec,
   return s;
 }
 
+// The folded row's identity: the evaluation of `first`, and the run that
+// stands for it (its key, seed, case, reason and diagnosis).
+void TakeIdentity(const EvaluationRow& first,
+                  const EvaluationRow& representative, EvaluationRow* row) {
+  row->index = first.index;
+  row->iteration = first.iteration;
+  row->task_case = representative.task_case;
+  row->point = representative.point;
+  row->content_key = representative.content_key;
+  row->seed = representative.seed;
+  row->reason = representative.reason;
+  row->bottlenecks_json = representative.bottlenecks_json;
+}
+
 // Which way `metric` gets worse as the spec judges it: +1 when larger is
 // worse (a minimised objective, a constraint failing above a bound), -1
 // when smaller is, 0 when no objective or constraint says. Constraints are
@@ -213,15 +227,8 @@ EvaluationRow AggregateCases(const spec::Spec& spec,
     }
   }
 
-  row.index = cases.front().index;
-  row.iteration = cases.front().iteration;
-  row.task_case = representative->task_case;
-  row.point = representative->point;
-  row.content_key = representative->content_key;
-  row.seed = representative->seed;
+  TakeIdentity(cases.front(), *representative, &row);
   row.status = complete ? "complete" : representative->status;
-  row.reason = representative->reason;
-  row.bottlenecks_json = representative->bottlenecks_json;
   row.feasible = feasible;
   row.unstable = unstable;
   row.source = simulated ? "simulated" : cases.front().source;
@@ -312,15 +319,8 @@ EvaluationRow AggregateReplicas(const spec::Spec& spec,
       representative = &r;
     }
   }
-  row.index = replicas.front().index;
-  row.iteration = replicas.front().iteration;
-  row.task_case = representative->task_case;
-  row.point = representative->point;
-  row.content_key = representative->content_key;
-  row.seed = representative->seed;
+  TakeIdentity(replicas.front(), *representative, &row);
   row.status = complete > 0 ? "complete" : representative->status;
-  row.reason = representative->reason;
-  row.bottlenecks_json = representative->bottlenecks_json;
   row.source = simulated ? "simulated" : replicas.front().source;
   row.attempts = attempts;
   row.wall_s = wall_s;
