@@ -207,8 +207,7 @@ std::string CaseSection(const spec::Spec& spec,
     for (const EvaluationRow& run : row.replicas.empty()
                                         ? std::vector<EvaluationRow>{row}
                                         : row.replicas) {
-      const size_t c = static_cast<size_t>(run.task_case);
-      std::string name = c < spec.cases.size() ? spec.cases[c].name : "?";
+      std::string name = spec::CaseName(spec, run.task_case);
       if (spec.harness.replicas > 1) {
         name += fmt::format(" (run {})", run.replica);
       }

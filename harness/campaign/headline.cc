@@ -223,11 +223,9 @@ std::string PictureLinks(const spec::Spec& spec, const EvaluationRow& row,
   std::set<int64_t> seen;
   for (const EvaluationRow& run : row.replicas) {
     if (!seen.insert(run.task_case).second) continue;
-    const size_t c = static_cast<size_t>(run.task_case);
-    links.push_back(
-        fmt::format("[{}]({}/{}/trajectory.png)",
-                    c < spec.cases.size() ? spec.cases[c].name : "case",
-                    image_dir, run.content_key));
+    links.push_back(fmt::format("[{}]({}/{}/trajectory.png)",
+                                spec::CaseName(spec, run.task_case), image_dir,
+                                run.content_key));
   }
   return fmt::format("{}", fmt::join(links, ", "));
 }

@@ -19,10 +19,13 @@ std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path) {
   return std::move(loaded).value();
 }
 
-std::optional<spec::Spec> SelectCase(const spec::Spec& spec,
-                                     const std::string& name) {
+std::optional<spec::Spec> LoadCaseOrReport(const std::string& path,
+                                           const std::string& name) {
+  std::optional<spec::Spec> loaded = LoadScenarioOrReport(path);
+  if (!loaded) return std::nullopt;
+  const spec::Spec& spec = *loaded;
   if (spec.cases.empty()) {
-    if (name.empty()) return spec;
+    if (name.empty()) return loaded;
     std::fprintf(stderr, "error: --case: %s has no task.cases\n",
                  spec.source_path.c_str());
     return std::nullopt;

@@ -14,12 +14,12 @@ namespace adse::cli {
 // Loads and validates `path`; on failure prints the errors to stderr.
 std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path);
 
-// The spec `--case` names (spec::ForCase): the scenario itself when it has
-// no task.cases and `name` is empty. Otherwise prints what is wrong (a case
-// missing, unknown, or named for a scenario without cases) and returns
-// nullopt.
-std::optional<spec::Spec> SelectCase(const spec::Spec& spec,
-                                     const std::string& name);
+// LoadScenarioOrReport, then the spec of the case `--case` names
+// (spec::ForCase): the scenario itself when it has no task.cases and
+// `task_case` is empty. Otherwise prints what is wrong (a case missing,
+// unknown, or named for a scenario without cases) and returns nullopt.
+std::optional<spec::Spec> LoadCaseOrReport(const std::string& path,
+                                           const std::string& task_case);
 
 // Prints `status` as "file:line:col: error: message", locating the field
 // path that starts the message ("task.goal: ...") in the scenario.

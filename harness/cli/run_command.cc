@@ -89,11 +89,10 @@ class Progress : public campaign::ExplorerListener {
           campaign::RowMetric(row, analysis::kCensoredMetric) == 1.0;
       // A point of several cases: its reason is its representative case's.
       const std::string reason =
-          spec_.cases.empty() ||
-                  static_cast<size_t>(row.task_case) >= spec_.cases.size()
+          spec_.cases.empty()
               ? row.reason
               : fmt::format("{} in case {} (the worst of {})", row.reason,
-                            spec_.cases[row.task_case].name,
+                            spec::CaseName(spec_, row.task_case),
                             spec_.cases.size());
       line = fmt::format(
           "[{}/{}] {}: {}{}, cost {:.3g}, {} "

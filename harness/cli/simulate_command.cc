@@ -59,9 +59,8 @@ std::string FormatMetric(double value) {
 }  // namespace
 
 int RunSimulate(const SimulateArgs& args) {
-  std::optional<spec::Spec> loaded = LoadScenarioOrReport(args.scenario);
-  if (!loaded) return 2;
-  std::optional<spec::Spec> spec = SelectCase(*loaded, args.task_case);
+  std::optional<spec::Spec> spec =
+      LoadCaseOrReport(args.scenario, args.task_case);
   if (!spec) return 2;
   std::optional<spec::DesignPoint> point = ResolvePoint(*spec, args.point);
   if (!point) return 2;
@@ -145,9 +144,8 @@ int RunSimulate(const SimulateArgs& args) {
 }
 
 int RunCalibrate(const CalibrateArgs& args) {
-  std::optional<spec::Spec> loaded = LoadScenarioOrReport(args.scenario);
-  if (!loaded) return 2;
-  std::optional<spec::Spec> spec = SelectCase(*loaded, args.task_case);
+  std::optional<spec::Spec> spec =
+      LoadCaseOrReport(args.scenario, args.task_case);
   if (!spec) return 2;
   std::optional<spec::DesignPoint> point = ResolvePoint(*spec, args.point);
   if (!point) return 2;

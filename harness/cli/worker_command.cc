@@ -22,9 +22,8 @@ namespace adse::cli {
 namespace {
 
 int Work(const WorkerArgs& args) {
-  std::optional<spec::Spec> loaded = LoadScenarioOrReport(args.scenario);
-  if (!loaded) return 2;
-  std::optional<spec::Spec> spec = SelectCase(*loaded, args.task_case);
+  std::optional<spec::Spec> spec =
+      LoadCaseOrReport(args.scenario, args.task_case);
   if (!spec) return 2;
   Result<spec::DesignPoint> point =
       spec::ParsePoint(spec->design_space, args.point);

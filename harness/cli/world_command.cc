@@ -39,9 +39,8 @@ std::string PathCsv(const geometry::Path2& path) {
 }  // namespace
 
 int RunWorld(const WorldArgs& args) {
-  std::optional<spec::Spec> loaded = LoadScenarioOrReport(args.scenario);
-  if (!loaded) return 2;
-  std::optional<spec::Spec> spec = SelectCase(*loaded, args.task_case);
+  std::optional<spec::Spec> spec =
+      LoadCaseOrReport(args.scenario, args.task_case);
   if (!spec) return 2;
   world::WorldSetup setup = sim::WorldSetupFromSpec(*spec);
   if (args.seed) setup.world.traffic.seed = *args.seed;

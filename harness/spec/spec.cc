@@ -188,6 +188,12 @@ std::string CaseNames(const Spec& spec) {
   return names;
 }
 
+std::string CaseName(const Spec& spec, int64_t index) {
+  return index >= 0 && static_cast<size_t>(index) < spec.cases.size()
+             ? spec.cases[static_cast<size_t>(index)].name
+             : "case " + std::to_string(index);
+}
+
 int FindCase(const Spec& spec, const std::string& name) {
   for (size_t i = 0; i < spec.cases.size(); ++i) {
     if (spec.cases[i].name == name) return static_cast<int>(i);

@@ -218,6 +218,10 @@ int CaseCount(const Spec& spec);
 // "backing_in, nose_in": the names of the cases.
 std::string CaseNames(const Spec& spec);
 
+// The name of case `index` ("case <index>" for one the spec lacks, as a
+// campaign file of another scenario may name).
+std::string CaseName(const Spec& spec, int64_t index);
+
 // The index of the case named `name`, or -1.
 int FindCase(const Spec& spec, const std::string& name);
 
