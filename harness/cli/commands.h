@@ -166,15 +166,17 @@ struct ProfileShowArgs {
 int RunProfileShow(const ProfileShowArgs& args);
 
 struct ProfileCheckArgs {
-  std::string scenario;  // names platform.profile
-  int cores = 16;        // the reference machine's cores (i9-12900KF: 16)
-  double lidar_hz = 10;  // the source's LiDAR rate (CARET: 9.6 Hz observed)
-  std::string out;       // folder; default <output>/profile-check
+  std::string scenario;   // names platform.profile
+  std::string task_case;  // which of task.cases; required when it has any
+  int cores = 16;         // the reference machine's cores (i9-12900KF: 16)
+  double lidar_hz = 10;   // the source's LiDAR rate (CARET: 9.6 Hz observed)
+  std::string out;        // folder; default <output>/profile-check
 };
 int RunProfileCheck(const ProfileCheckArgs& args);
 
 struct FidelityArgs {
   std::string scenario;             // names platform.profile
+  std::string task_case;            // which of task.cases (when it has any)
   std::vector<std::string> points;  // "cores=1,freq_ghz=2.1,..."
   int runs = 3;                     // real-time runs per point
   std::string clock_by;             // "padding"/"quota"; empty: the file's

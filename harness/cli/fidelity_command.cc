@@ -46,7 +46,8 @@ nlohmann::json ComparisonsJson(
 }  // namespace
 
 int RunFidelity(const FidelityArgs& args) {
-  std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
+  std::optional<spec::Spec> spec =
+      LoadCaseOrReport(args.scenario, args.task_case);
   if (!spec) return 2;
   if (!args.clock_by.empty()) {
     spec::StringToClockBy(args.clock_by, &spec->platform.clock_by);
@@ -77,6 +78,7 @@ int RunFidelity(const FidelityArgs& args) {
   nlohmann::json j = {{"scenario", spec->name},
                       {"runs", args.runs},
                       {"points", nlohmann::json::array()}};
+  if (!args.task_case.empty()) j["task_case"] = args.task_case;
   for (size_t i = 0; i < points.size(); ++i) {
     Result<fidelity::PointFidelity> f =
         fidelity::ComparePoint(*spec, points[i], options);

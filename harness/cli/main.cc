@@ -10,6 +10,17 @@
 #include "harness/pool/worker_pool.h"
 #include "harness/spec/types.h"
 
+namespace {
+
+// Every command that drives one run of a scenario takes the case it drives.
+void AddCaseOption(CLI::App* command, std::string* task_case) {
+  command->add_option(
+      "--case", *task_case,
+      "Which of the scenario's task.cases to run (required when it has cases)");
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{
       "adse: find the cheapest computer on which a self-driving stack still "
@@ -39,9 +50,7 @@ int main(int argc, char** argv) {
       "controller while the LiDAR scans");
   world_cmd->add_option("scenario", world.scenario, "Scenario YAML file")
       ->required();
-  world_cmd->add_option(
-      "--case", world.task_case,
-      "Which of the scenario's task.cases to run (required when it has cases)");
+  AddCaseOption(world_cmd, &world.task_case);
   world_cmd->add_flag("--follow-ideal", world.follow_ideal,
                       "Drive the ideal path with a ground-truth controller");
   world_cmd->add_option("-o,--out", world.out,
@@ -63,9 +72,7 @@ int main(int argc, char** argv) {
       "virtual platform) and print its metrics");
   simulate_cmd->add_option("scenario", simulate.scenario, "Scenario YAML file")
       ->required();
-  simulate_cmd->add_option(
-      "--case", simulate.task_case,
-      "Which of the scenario's task.cases to run (required when it has cases)");
+  AddCaseOption(simulate_cmd, &simulate.task_case);
   simulate_cmd->add_option(
       "-p,--point", simulate.point,
       "Design point, e.g. cores=4,freq_ghz=1.2,lidar_hz=14 "
@@ -87,9 +94,7 @@ int main(int argc, char** argv) {
   calibrate_cmd
       ->add_option("scenario", calibrate.scenario, "Scenario YAML file")
       ->required();
-  calibrate_cmd->add_option(
-      "--case", calibrate.task_case,
-      "Which of the scenario's task.cases to run (required when it has cases)");
+  AddCaseOption(calibrate_cmd, &calibrate.task_case);
   calibrate_cmd->add_option(
       "-p,--point", calibrate.point,
       "Design point to run (default: exploration.start_from)");
@@ -190,9 +195,7 @@ int main(int argc, char** argv) {
       "campaign's pool starts; rarely used by hand)");
   worker_cmd->add_option("scenario", worker.scenario, "Scenario YAML file")
       ->required();
-  worker_cmd->add_option(
-      "--case", worker.task_case,
-      "Which of the scenario's task.cases to run (required when it has cases)");
+  AddCaseOption(worker_cmd, &worker.task_case);
   worker_cmd->add_option("-p,--point", worker.point, "Design point")
       ->required();
   CLI::Option* worker_seed_opt =
@@ -418,6 +421,7 @@ int main(int argc, char** argv) {
       ->add_option("scenario", profile_check.scenario,
                    "Scenario YAML file naming platform.profile")
       ->required();
+  AddCaseOption(profile_check_cmd, &profile_check.task_case);
   profile_check_cmd
       ->add_option("--cores", profile_check.cores,
                    "Cores of the reference machine (default 16, the "
@@ -447,6 +451,7 @@ int main(int argc, char** argv) {
       ->add_option("scenario", fidelity.scenario,
                    "Scenario YAML file (cost_model: counted with a profile)")
       ->required();
+  AddCaseOption(fidelity_cmd, &fidelity.task_case);
   fidelity_cmd
       ->add_option("--points", fidelity.points,
                    "Design points, e.g. cores=1,freq_ghz=2.1,lidar_hz=7; at "

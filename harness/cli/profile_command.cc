@@ -12,6 +12,7 @@
 
 #include "analysis/pictures/pictures.h"
 #include "analysis/runfile/run_file.h"
+#include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
 #include "harness/profile/profile.h"
 #include "harness/profile/profile_check.h"
@@ -61,12 +62,10 @@ int RunProfileShow(const ProfileShowArgs& args) {
 }
 
 int RunProfileCheck(const ProfileCheckArgs& args) {
-  Result<spec::Spec> loaded = spec::LoadSpec(args.scenario);
-  if (!loaded.ok()) {
-    std::fprintf(stderr, "%s\n", loaded.status().message().c_str());
-    return ExitCodeFor(loaded.status());
-  }
-  spec::Spec spec = std::move(loaded).value();
+  std::optional<spec::Spec> loaded =
+      LoadCaseOrReport(args.scenario, args.task_case);
+  if (!loaded) return 2;
+  spec::Spec spec = std::move(*loaded);
   if (spec.platform.profile.empty()) {
     std::fprintf(stderr,
                  "error: %s: platform.profile: expected a cost profile to "
@@ -117,11 +116,13 @@ int RunProfileCheck(const ProfileCheckArgs& args) {
   }
   const profile::ProfileCheck check = profile::CompareWithProfile(*run, *costs);
   const std::string text =
-      fmt::format("profile check of '{}' ({}): {} after {:.1f} s simulated\n\n",
-                  costs->name, costs->source.cpu, run->termination_reason,
-                  run->metrics.count("nav_time_s")
-                      ? run->metrics.at("nav_time_s")
-                      : 0.0) +
+      fmt::format(
+          "profile check of '{}' ({}){}: {} after {:.1f} s simulated\n\n",
+          costs->name, costs->source.cpu,
+          args.task_case.empty() ? "" : ", case " + args.task_case,
+          run->termination_reason,
+          run->metrics.count("nav_time_s") ? run->metrics.at("nav_time_s")
+                                           : 0.0) +
       profile::FormatProfileCheck(check);
   std::printf("%s", text.c_str());
 

@@ -22,8 +22,9 @@ namespace {
 // its tracks predicted to that time (Autoware 2022.12's), not per scan.
 // v7: a route goes round the block where SUMO's turns around tighter than
 // the car can, the ideal path drops lane shapes' folds, and a lane-driving
-// goal is reached only near the route's end.
-constexpr char kKeyVersion[] = "adse-run-key-v7";
+// goal is reached only near the route's end. v8: tracked objects carry
+// their heading to planning (they were axis-aligned boxes there).
+constexpr char kKeyVersion[] = "adse-run-key-v8";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

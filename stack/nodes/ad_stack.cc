@@ -19,6 +19,7 @@
 #include "stack/algorithms/point_filters.h"
 #include "stack/algorithms/tracker.h"
 #include "stack/algorithms/traffic_light.h"
+#include "stack/nodes/objects.h"
 
 namespace adse::stack {
 namespace {
@@ -410,12 +411,7 @@ void Stack::BuildPerception(Graph* g) {
           // corner fits a box spanning the road); the map, not the object
           // list, describes them.
           if (std::max(d.length_m, d.width_m) > max_object_m) continue;
-          const algo::Detection m = algo::ToMapFrame(d, pose);
-          TrackedObject o;
-          o.position = m.center;
-          o.length_m = m.length_m;
-          o.width_m = m.width_m;
-          out.objects.push_back(o);
+          out.objects.push_back(ObjectFromDetection(algo::ToMapFrame(d, pose)));
         }
         ctx.ReportWork({static_cast<double>(r.work_units),
                         kClusteringParallelFraction, threads});
@@ -433,11 +429,7 @@ void Stack::BuildPerception(Graph* g) {
       [this](const ObjectsMsg& in, CallbackContext& ctx) {
         std::vector<algo::Detection> detections;
         for (const TrackedObject& o : in.objects) {
-          algo::Detection d;
-          d.center = o.position;
-          d.length_m = o.length_m;
-          d.width_m = o.width_m;
-          detections.push_back(d);
+          detections.push_back(DetectionFromObject(o));
         }
         tracker_->Update(in.header.stamp_s, detections);
         ctx.ReportWork(
@@ -451,14 +443,7 @@ void Stack::BuildPerception(Graph* g) {
         ObjectsMsg out;
         out.header.stamp_s = tracker_->last_update_s();
         for (const algo::Track& t : tracker_->ConfirmedTracksAt(ctx.now_s())) {
-          TrackedObject o;
-          o.id = t.id;
-          o.position = t.position;
-          o.velocity = t.velocity;
-          o.length_m = t.length_m;
-          o.width_m = t.width_m;
-          o.age = t.age;
-          out.objects.push_back(o);
+          out.objects.push_back(ObjectFromTrack(t));
         }
         ctx.ReportWork({static_cast<double>(out.objects.size()), 0.0, 1});
         ctx.Publish(topics_.objects, std::move(out));
@@ -573,25 +558,19 @@ void Stack::BuildPlanning(Graph* g) {
         std::vector<algo::PlannerObstacle> obstacles;
         if (stop_objects_) {
           for (const TrackedObject& o : stop_objects_->objects) {
-            algo::PlannerObstacle ob;
-            ob.id = o.id;
-            ob.position = o.position;
-            ob.velocity = o.velocity;
-            ob.length_m = o.length_m;
-            ob.width_m = o.width_m;
-            obstacles.push_back(ob);
+            obstacles.push_back(ObstacleFromObject(o));
           }
         }
         std::vector<algo::PlannedPoint> points = ToPlanned(in.points);
         algo::ObstacleStop stop =
             algo::InsertObstacleStop(&points, obstacles, stop_params);
         // Whether the map has structure there matters only for the object
-        // stopped for; tracked objects carry no yaw.
+        // stopped for.
         if (stop.obstacle_id >= 0) {
           for (const algo::PlannerObstacle& ob : obstacles) {
             if (ob.id != stop.obstacle_id) continue;
             stop.static_structure = structure_grid_.IsStructure(
-                ob.position, ob.length_m, ob.width_m, 0.0);
+                ob.position, ob.length_m, ob.width_m, ob.yaw_rad);
             break;
           }
         }

@@ -135,7 +135,8 @@ bool Io(IO& io, geometry::Path2& m) {
 }
 template <typename IO>
 bool Io(IO& io, TrackedObject& m) {
-  return All(io, m.id, m.position, m.velocity, m.length_m, m.width_m, m.age);
+  return All(io, m.id, m.position, m.velocity, m.length_m, m.width_m, m.yaw_rad,
+             m.age);
 }
 template <typename IO>
 bool Io(IO& io, TrajectoryPoint& m) {

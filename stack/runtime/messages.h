@@ -55,8 +55,13 @@ struct TrackedObject {
   int id = 0;
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // map frame
   Eigen::Vector2d velocity = Eigen::Vector2d::Zero();
-  double length_m = 0.0;
+  double length_m = 0.0;  // along yaw_rad
   double width_m = 0.0;
+  // Heading of the box's length (map frame, modulo a half turn). Planning
+  // needs it: a car standing across the map's axes is not an axis-aligned
+  // box (taken as one, a car waiting in the crossing lane of a turn reached
+  // into the ego's corridor).
+  double yaw_rad = 0.0;
   int age = 0;  // updates seen
 };
 

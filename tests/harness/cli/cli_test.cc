@@ -140,7 +140,8 @@ TEST(CliTest, ACommandThatRunsOneCaseNeedsItNamed) {
       std::string(ADSE_SOURCE_DIR) + "/scenarios/valet_parking.yaml";
   for (const std::string& command :
        {"simulate " + valet + " -p cores=8,freq_ghz=3.0",
-        "world " + valet + " --no-scan"}) {
+        "world " + valet + " --no-scan", "profile check " + valet,
+        "fidelity " + valet + " --points cores=8,freq_ghz=3.0 --runs 1"}) {
     const CommandRun run = Adse(command);
     EXPECT_EQ(run.exit_code, 2) << command << "\n" << run.out;
     EXPECT_NE(run.out.find("has 2 task.cases (backing_in, nose_in); name the "
@@ -687,6 +688,17 @@ TEST(CliProfileTest, CheckComparesTheChainsOnTheReferenceMachine) {
                             "+116\\.72 +[-+][0-9]+ %  within 15 %: ")))
       << check.out;
   EXPECT_NE(check.out.find("lidar_driver/points_raw"), std::string::npos);
+
+  // A scenario with task.cases checks the case it is told to drive.
+  const fs::path parked = fs::temp_directory_path() / "adse_cli_check_case";
+  fs::remove_all(parked);
+  const CommandRun nose_in = Adse(
+      "profile check " + std::string(ADSE_SOURCE_DIR) +
+      "/scenarios/valet_parking.yaml --case nose_in -o " + parked.string());
+  ASSERT_EQ(nose_in.exit_code, 0) << nose_in.out;
+  EXPECT_NE(nose_in.out.find(", case nose_in: goal_reached"), std::string::npos)
+      << nose_in.out;
+  EXPECT_TRUE(fs::is_regular_file(parked / "run.h5"));
 
   // A scenario without a profile has nothing to check.
   const std::string calibrated =

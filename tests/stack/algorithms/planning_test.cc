@@ -136,6 +136,36 @@ TEST(ObstacleStopPlanner, IgnoresObstaclesOutsideCorridorOrBehind) {
           .obstacle.stop);
 }
 
+TEST(ObstacleStopPlanner, ACarWaitingInTheCrossLaneOfALeftTurnDoesNotBlockIt) {
+  // The east end of a parking-lot aisle (eastbound, y = 46.25) turning left
+  // onto the ring road's northbound lane (x = 170.75), as the reference
+  // study drives it. A car heading south in the ring road's other lane
+  // (x = 167.25) waits 3 m short of the junction for the ego.
+  const geometry::Path2 turn = Polyline({{150.0, 46.25},
+                                         {161.43, 46.25},
+                                         {165.39, 46.81},
+                                         {168.41, 48.54},
+                                         {170.18, 51.54},
+                                         {170.75, 55.5},
+                                         {170.75, 90.0}});
+  const geometry::Pose2 ego{164.2, 46.75, 0.23};
+  PlannerObstacle waiting = Car(4261, 167.25, 54.6);
+  waiting.length_m = 5.0;
+  waiting.yaw_rad = kPi / 2;  // along the ring road
+  PathPlanner planner;
+  planner.SetRoute(turn);
+  EXPECT_FALSE(testing::PlanChain(&planner, ego, {waiting}).obstacle.stop);
+  // The same car taken as a box along the map's x axis reaches 2.5 m
+  // sideways, into the turn's corridor: the stand-off that tracked objects
+  // without their heading caused.
+  waiting.yaw_rad = 0.0;
+  planner.SetRoute(turn);
+  const testing::ChainedPlan blocked =
+      testing::PlanChain(&planner, ego, {waiting});
+  ASSERT_TRUE(blocked.obstacle.stop);
+  EXPECT_EQ(blocked.obstacle.obstacle_id, 4261);
+}
+
 TEST(ObstacleStopPlanner, SeesAnObstacleJustPastThePathsEnd) {
   // The path ends at the horizon (50 m); a car 4 m past it still sets a
   // stop inside it, as it would on the full route.

@@ -64,6 +64,19 @@ TEST(Tracker, TwoObjectsKeepIdsAndVelocities) {
   }
 }
 
+TEST(Tracker, ATrackTakesTheHeadingOfItsLatestBox) {
+  Tracker tracker;
+  Detection d = At(10.0, 5.0);
+  d.yaw_rad = 1.2;
+  tracker.Update(0.0, {d});
+  ASSERT_EQ(tracker.tracks().size(), 1u);
+  EXPECT_EQ(tracker.tracks()[0].yaw_rad, 1.2);
+  d.yaw_rad = -1.5;  // boxes have no front: any heading in a half turn
+  tracker.Update(0.1, {d});
+  ASSERT_EQ(tracker.tracks().size(), 1u);
+  EXPECT_EQ(tracker.tracks()[0].yaw_rad, -1.5);
+}
+
 TEST(Tracker, FalsePositiveSeenOnceIsNeverConfirmed) {
   Tracker tracker;
   for (int k = 0; k < 10; ++k) {

@@ -51,11 +51,13 @@ TEST(MessageCodecTest, EveryMessageTypeOfTheStackComesBackFieldForField) {
   objects.objects.resize(2);
   objects.objects[1].id = 42;
   objects.objects[1].velocity = {1.5, -0.5};
+  objects.objects[1].yaw_rad = -1.25;
   objects.objects[1].age = 9;
   const ObjectsMsg objects2 = RoundTrip(objects);
   ASSERT_EQ(objects2.objects.size(), 2u);
   EXPECT_EQ(objects2.objects[1].id, 42);
   EXPECT_EQ(objects2.objects[1].velocity, objects.objects[1].velocity);
+  EXPECT_EQ(objects2.objects[1].yaw_rad, -1.25);
   EXPECT_EQ(objects2.objects[1].age, 9);
 
   TrafficSignalMsg signal;
