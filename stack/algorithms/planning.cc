@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace adse::algorithms {
 namespace {
@@ -214,66 +215,250 @@ void InsertStopAt(std::vector<PlannedPoint>* points, double stop_s) {
   }
 }
 
+namespace {
+
+// The trajectory as a polyline for obstacle search: extended straight back
+// from its first point to the rear of the ego's front bumper window and on
+// past its end, with the route arc length of the polyline's start.
+struct SearchPath {
+  geometry::Path2 path;
+  double offset_s_m = 0.0;  // route s of path's s = 0
+  double back_m = 0.0;      // path s of the trajectory's first point
+};
+
+SearchPath MakeSearchPath(const std::vector<PlannedPoint>& pts,
+                          const ObstacleStopParams& params) {
+  const auto heading = [](double yaw) {
+    return Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
+  };
+  SearchPath out;
+  out.back_m = params.ego_front_m;
+  out.path.points.push_back(Eigen::Vector2d(pts.front().x_m, pts.front().y_m) -
+                            out.back_m * heading(pts.front().yaw_rad));
+  for (const PlannedPoint& p : pts) out.path.points.emplace_back(p.x_m, p.y_m);
+  out.path.points.push_back(Eigen::Vector2d(pts.back().x_m, pts.back().y_m) +
+                            params.beyond_end_m * heading(pts.back().yaw_rad));
+  out.path.UpdateArcLength();
+  out.offset_s_m = pts.front().s_m - out.back_m;
+  return out;
+}
+
+// Where a box centred at `center` with its length along `yaw_rad` meets the
+// path: its route s, its half extents across and along the path there, and
+// whether it enters the corridor.
+struct BoxOnPath {
+  double s_m = 0.0;
+  double half_across_m = 0.0;
+  double half_along_m = 0.0;
+  double relative_yaw_rad = 0.0;  // box heading minus the path's
+  bool in_corridor = false;
+};
+
+BoxOnPath PlaceBox(const SearchPath& search, const Eigen::Vector2d& center,
+                   double length_m, double width_m, double yaw_rad,
+                   double corridor_half_width_m) {
+  BoxOnPath out;
+  double lateral = 0.0, distance = 0.0;
+  const double local_s =
+      ProjectOnPath(search.path, center, 0.0, search.path.length_m(),
+                    search.back_m, &lateral, &distance);
+  out.s_m = local_s + search.offset_s_m;
+  out.relative_yaw_rad = yaw_rad - search.path.HeadingAt(local_s);
+  const double cr = std::abs(std::cos(out.relative_yaw_rad));
+  const double sr = std::abs(std::sin(out.relative_yaw_rad));
+  out.half_across_m = 0.5 * (length_m * sr + width_m * cr);
+  out.half_along_m = 0.5 * (length_m * cr + width_m * sr);
+  out.in_corridor = distance - out.half_across_m <= corridor_half_width_m;
+  return out;
+}
+
+// Time to cover distance_m from speed v0_mps, speeding up at accel_mps2 up
+// to cap_mps (>= v0_mps).
+double EarliestArrival(double distance_m, double v0_mps, double accel_mps2,
+                       double cap_mps) {
+  if (distance_m <= 0.0) return 0.0;
+  if (accel_mps2 <= 0.0 || cap_mps <= v0_mps) {
+    return v0_mps > 0.0 ? distance_m / v0_mps
+                        : std::numeric_limits<double>::infinity();
+  }
+  const double t_cap = (cap_mps - v0_mps) / accel_mps2;
+  const double d_cap = v0_mps * t_cap + 0.5 * accel_mps2 * t_cap * t_cap;
+  if (distance_m <= d_cap) {
+    return (std::sqrt(v0_mps * v0_mps + 2 * accel_mps2 * distance_m) - v0_mps) /
+           accel_mps2;
+  }
+  return t_cap + (distance_m - d_cap) / cap_mps;
+}
+
+// Stops the trajectory at `stop_s` for `out`'s obstacle (already set) and
+// fills in the stop; or, past the trajectory's end, clears it.
+void FinishStop(std::vector<PlannedPoint>* points, double stop_s,
+                double near_edge_s, double ego_front_m, ObstacleStop* out) {
+  if (stop_s > points->back().s_m) {
+    out->obstacle_id = -1;
+    out->static_structure = false;
+    return;
+  }
+  out->stop = true;
+  out->stop_s_m = stop_s;
+  out->gap_m = near_edge_s - (points->front().s_m + ego_front_m);
+  InsertStopAt(points, stop_s);
+}
+
+}  // namespace
+
 ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
                                 const std::vector<PlannerObstacle>& obstacles,
                                 const ObstacleStopParams& params) {
   ObstacleStop out;
   if (points == nullptr || points->empty()) return out;
-  std::vector<PlannedPoint>& pts = *points;
+  const std::vector<PlannedPoint>& pts = *points;
   const double s0 = pts.front().s_m;
-  const double end_s = pts.back().s_m;
-  // The path as a polyline, extended straight back to the rear of the
-  // search window and on past its end, with arc lengths offset to the
-  // route's.
-  geometry::Path2 path;
-  const auto heading = [](double yaw) {
-    return Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
-  };
-  const double back_m = params.ego_front_m;
-  path.points.push_back(Eigen::Vector2d(pts.front().x_m, pts.front().y_m) -
-                        back_m * heading(pts.front().yaw_rad));
-  for (const PlannedPoint& p : pts) path.points.emplace_back(p.x_m, p.y_m);
-  path.points.push_back(Eigen::Vector2d(pts.back().x_m, pts.back().y_m) +
-                        params.beyond_end_m * heading(pts.back().yaw_rad));
-  path.UpdateArcLength();
-  const double offset = s0 - back_m;  // route s of the polyline's start
-
+  const SearchPath search = MakeSearchPath(pts, params);
   double stop_s = std::numeric_limits<double>::infinity();
   double near_edge_s = 0.0;
   for (const PlannerObstacle& ob : obstacles) {
     if (!ob.position.allFinite()) continue;
     out.work_units += 1 + static_cast<int64_t>(pts.size());
-    double ob_lateral = 0.0, ob_distance = 0.0;
-    const double local_s =
-        ProjectOnPath(path, ob.position, 0.0, path.length_m(), back_m,
-                      &ob_lateral, &ob_distance);
-    const double ob_s = local_s + offset;
-    // The box's half extents across and along the path at that point.
-    const double rel = ob.yaw_rad - path.HeadingAt(local_s);
-    const double cr = std::abs(std::cos(rel)), sr = std::abs(std::sin(rel));
-    const double half_across = 0.5 * (ob.length_m * sr + ob.width_m * cr);
-    const double half_along = 0.5 * (ob.length_m * cr + ob.width_m * sr);
-    if (ob_distance - half_across > params.corridor_half_width_m) continue;
-    if (ob_s + half_along < s0) continue;  // behind the rear axle
+    const BoxOnPath box = PlaceBox(search, ob.position, ob.length_m, ob.width_m,
+                                   ob.yaw_rad, params.corridor_half_width_m);
+    if (!box.in_corridor) continue;
+    if (box.s_m + box.half_along_m < s0) continue;  // behind the rear axle
     const double stop =
-        ob_s - half_along - params.stop_margin_m - params.ego_front_m;
+        box.s_m - box.half_along_m - params.stop_margin_m - params.ego_front_m;
     if (stop < stop_s) {
       stop_s = stop;
-      near_edge_s = ob_s - half_along;
+      near_edge_s = box.s_m - box.half_along_m;
       out.obstacle_id = ob.id;
       out.static_structure = ob.static_structure;
     }
   }
-  if (stop_s > end_s) {
-    out.obstacle_id = -1;
-    out.static_structure = false;
+  FinishStop(points, stop_s, near_edge_s, params.ego_front_m, &out);
+  return out;
+}
+
+ObstacleStop InsertCrossingYield(std::vector<PlannedPoint>* points,
+                                 const std::vector<PlannerObstacle>& obstacles,
+                                 double ego_v_mps,
+                                 const ObstacleStopParams& stop_params,
+                                 const CrossingYieldParams& params,
+                                 bool yielding) {
+  ObstacleStop out;
+  if (points == nullptr || points->empty() || params.horizon_s <= 0.0 ||
+      params.step_s <= 0.0) {
     return out;
   }
-  out.stop = true;
-  out.stop_s_m = stop_s;
-  out.gap_m = near_edge_s - (s0 + params.ego_front_m);
-  InsertStopAt(&pts, stop_s);
+  const std::vector<PlannedPoint>& pts = *points;
+  const double s0 = pts.front().s_m;
+  const double front_s = s0 + stop_params.ego_front_m;
+  const SearchPath search = MakeSearchPath(pts, stop_params);
+  const double min_sin = std::sin(params.min_crossing_angle_rad);
+  const double ego_v = std::max(std::abs(ego_v_mps), params.min_ego_speed_mps);
+  const double braking_m = ego_v_mps * ego_v_mps / (2 * params.max_decel_mps2);
+  const int steps = static_cast<int>(params.horizon_s / params.step_s + 1e-9);
+  double stop_s = std::numeric_limits<double>::infinity();
+  double near_edge_s = 0.0;
+  for (const PlannerObstacle& ob : obstacles) {
+    if (!ob.position.allFinite() || !ob.velocity.allFinite()) continue;
+    const double speed = ob.velocity.norm();
+    if (speed < params.min_object_speed_mps || ob.age < params.min_track_age)
+      continue;
+    const double heading = std::atan2(ob.velocity.y(), ob.velocity.x());
+    // Its box along its straight-line prediction: when it first enters the
+    // corridor (not now: the stop planner has what is there now) and when
+    // it has left it again.
+    std::optional<BoxOnPath> entry;
+    double t_in = 0.0, t_out = params.horizon_s;
+    for (int k = 0; k <= steps; ++k) {
+      const double t = k * params.step_s;
+      out.work_units += 1 + static_cast<int64_t>(pts.size());
+      const BoxOnPath box =
+          PlaceBox(search, ob.position + t * ob.velocity, ob.length_m,
+                   ob.width_m, heading, stop_params.corridor_half_width_m);
+      if (k == 0 && box.in_corridor) break;
+      if (!entry && box.in_corridor) {
+        entry = box;
+        t_in = t;
+      } else if (entry && !box.in_corridor) {
+        t_out = t;
+        break;
+      }
+    }
+    if (!entry) continue;
+    // Following and oncoming traffic does not cross the path.
+    if (std::abs(std::sin(entry->relative_yaw_rad)) < min_sin) continue;
+    const double near_edge = entry->s_m - entry->half_along_m;
+    const double gap = near_edge - front_s;
+    if (gap <= 0.0) continue;  // the ego is already in the crossing
+    // The ego's time in the crossing, from the earliest it could arrive
+    // (speeding up at max_accel_mps2 to the fastest it plans before it) to
+    // the latest it could leave (at its speed now, at least
+    // min_ego_speed_mps): yield only when it overlaps the object's. Judged
+    // at its speed now, an ego speeding up out of a turn came too late to
+    // stop for a car it then met in the junction.
+    double fastest = std::abs(ego_v_mps);
+    for (const PlannedPoint& p : pts) {
+      if (p.s_m > near_edge) break;
+      fastest = std::max(fastest, p.v_mps);
+    }
+    const double t_ego_in = EarliestArrival(gap, std::abs(ego_v_mps),
+                                            params.max_accel_mps2, fastest);
+    const double t_ego_out =
+        (gap + 2 * entry->half_along_m + stop_params.ego_front_m) / ego_v;
+    if (t_ego_in > t_out + params.time_margin_s ||
+        t_ego_out + params.time_margin_s < t_in) {
+      continue;
+    }
+    const double stop =
+        near_edge - stop_params.stop_margin_m - stop_params.ego_front_m;
+    // Past the point where it can still stop comfortably: go through,
+    // unless it is braking for crossing traffic already (or the plan would
+    // flicker between yielding and going as it slows).
+    if (stop - s0 < braking_m && !yielding) continue;
+    if (stop < stop_s) {
+      stop_s = stop;
+      near_edge_s = near_edge;
+      out.obstacle_id = ob.id;
+      out.static_structure = ob.static_structure;
+    }
+  }
+  FinishStop(points, stop_s, near_edge_s, stop_params.ego_front_m, &out);
   return out;
+}
+
+ObstacleStop CrossingYielder::Plan(
+    std::vector<PlannedPoint>* points,
+    const std::vector<PlannerObstacle>& obstacles, double ego_v_mps,
+    double now_s, const ObstacleStopParams& stop_params) {
+  const bool recent =
+      held_ && now_s - last_t_s_ <= params_.transit_margin_s + 1e-9;
+  ObstacleStop out = InsertCrossingYield(points, obstacles, ego_v_mps,
+                                         stop_params, params_, recent);
+  if (points == nullptr || points->empty()) return out;
+  const bool reason_to_yield = out.stop;
+  const bool keep_last = recent && last_.stop_s_m <= points->back().s_m &&
+                         (!out.stop || last_.stop_s_m < out.stop_s_m);
+  if (keep_last) {
+    const int64_t work = out.work_units;
+    const double near_edge =
+        last_.stop_s_m + stop_params.stop_margin_m + stop_params.ego_front_m;
+    out = last_;
+    out.work_units = work;
+    out.gap_m = near_edge - (points->front().s_m + stop_params.ego_front_m);
+    InsertStopAt(points, out.stop_s_m);
+  }
+  // A held stop lapses transit_margin_s after the last plan that had a
+  // reason to yield.
+  if (reason_to_yield) last_t_s_ = now_s;
+  held_ = out.stop;
+  if (out.stop) last_ = out;
+  return out;
+}
+
+const ObstacleStop& NearerStop(const ObstacleStop& a, const ObstacleStop& b) {
+  if (!b.stop) return a;
+  if (!a.stop) return b;
+  return b.stop_s_m < a.stop_s_m ? b : a;
 }
 
 StopDecision DecideStop(std::vector<PlannedPoint>* points, bool ends_at_goal,

@@ -29,13 +29,14 @@ struct PlannedPoint {
 struct PlannerObstacle {
   int id = 0;
   Eigen::Vector2d position = Eigen::Vector2d::Zero();
-  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  // unused for now
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  // m/s, map frame
   double length_m = 0.0;
   double width_m = 0.0;
   double yaw_rad = 0.0;
   // The map has structure where it stands (StructureGrid): static
   // structure taken for an object, not traffic.
   bool static_structure = false;
+  int age = 0;  // tracker updates seen (its velocity's history)
 };
 
 // Nearest point of `path` to p over arc lengths [s_lo, s_hi]: returns its
@@ -149,6 +150,90 @@ void InsertStopAt(std::vector<PlannedPoint>* points, double stop_s);
 ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
                                 const std::vector<PlannerObstacle>& obstacles,
                                 const ObstacleStopParams& params);
+
+// --- Crossing traffic: yield before a road user about to cross ----------
+// Autoware's intersection module yields to what its map says will cross
+// the ego's lane; adse's stack has no lanelet map, so it predicts each
+// moving track straight along its velocity and yields where that box will
+// cross the corridor while the ego would be there. Without it the ego
+// turned into a junction in front of traffic and stood there, the other
+// car waiting for it.
+
+struct CrossingYieldParams {
+  // How far ahead a crossing is foreseen; 0, the default, never yields
+  // (README, "Crossing traffic": tracks of parked cars still move too much
+  // for it to be on by default); 3 s is a working value.
+  double horizon_s = 0.0;
+  double step_s = 0.25;  // prediction step
+  // Slower tracks are left to the obstacle stop: waiting cars, and parked
+  // ones whose box centre wanders as the ego passes and more of them is
+  // seen (at 1 m/s such tracks made the car brake along every aisle).
+  double min_object_speed_mps = 2.5;
+  // Tracks younger than this (updates) are not predicted: a new track's
+  // speed is a guess, and parked cars' tracks, broken up and born again as
+  // the ego passes, are young.
+  int min_track_age = 5;
+  // The ego's speed counts as at least this when it judges how long it
+  // would take to clear a crossing.
+  double min_ego_speed_mps = 1.0;
+  // A track moving within this angle of the path (following, oncoming)
+  // does not cross it.
+  double min_crossing_angle_rad = 0.5236;  // 30 degrees
+  // Yield only when the ego's time in the crossing and the track's come
+  // within this of each other.
+  double time_margin_s = 1.0;
+  // How fast the ego can speed up towards a crossing (the smoother's).
+  double max_accel_mps2 = 1.5;
+  // CrossingYielder goes again only after this long without a reason to
+  // yield (Autoware: state_transit_margin_time).
+  double transit_margin_s = 1.0;
+  // A crossing the ego cannot stop before at this deceleration it drives
+  // through (it is committed, as Autoware's pass judge line says).
+  double max_decel_mps2 = 2.5;
+};
+
+// Stops `points` stop_margin_m before the first crossing a moving obstacle
+// (not in the corridor now: that is InsertObstacleStop's) will make of the
+// corridor within horizon_s, when the ego would be in that crossing within
+// time_margin_s of the obstacle: from the earliest it could arrive
+// (speeding up from ego_v_mps at max_accel_mps2 to the fastest `points`
+// plan before it) to the latest it could leave (at ego_v_mps, at least
+// min_ego_speed_mps). A crossing it can no longer stop before at
+// max_decel_mps2 it drives through, unless `yielding` (the last plan
+// yielded: braking for crossing traffic, it stays stopped). The returned
+// stop names the obstacle; gap_m is to the crossing's near edge.
+ObstacleStop InsertCrossingYield(std::vector<PlannedPoint>* points,
+                                 const std::vector<PlannerObstacle>& obstacles,
+                                 double ego_v_mps,
+                                 const ObstacleStopParams& stop_params,
+                                 const CrossingYieldParams& params,
+                                 bool yielding = false);
+
+// InsertCrossingYield with the hysteresis of Autoware's intersection
+// module (its state transit margin): once stopped for crossing traffic it
+// goes again only after transit_margin_s without a reason to yield, and
+// keeps the nearer of its last stop line and a new one meanwhile. The
+// tracks of a fast crossing car break up and are born again without their
+// speed; without this the stop flickered and the car drove into the
+// junction between two of them.
+class CrossingYielder {
+ public:
+  explicit CrossingYielder(const CrossingYieldParams& params = {})
+      : params_(params) {}
+  ObstacleStop Plan(std::vector<PlannedPoint>* points,
+                    const std::vector<PlannerObstacle>& obstacles,
+                    double ego_v_mps, double now_s,
+                    const ObstacleStopParams& stop_params);
+
+ private:
+  CrossingYieldParams params_;
+  bool held_ = false;  // a yield is remembered
+  ObstacleStop last_;  // the stop it made (route s)
+  double last_t_s_ = 0.0;
+};
+
+// The stop of the two that comes first along the path (or the one there is).
+const ObstacleStop& NearerStop(const ObstacleStop& a, const ObstacleStop& b);
 
 // --- Why the trajectory stops ---------------------------------------------
 

@@ -111,6 +111,7 @@ class Stack final : public AdStack {
   std::optional<PoseMsg> path_pose_;
   std::unique_ptr<algo::TrafficLightPlanner> traffic_light_;
   std::optional<ObjectsMsg> stop_objects_;
+  std::unique_ptr<algo::CrossingYielder> crossing_yield_;
   std::optional<PoseMsg> smoother_pose_;
   std::unique_ptr<algo::TrajectoryFollower> follower_;
   std::optional<PoseMsg> follower_pose_;
@@ -547,6 +548,11 @@ void Stack::BuildPlanning(Graph* g) {
   stop_params.stop_margin_m = config_.Get("planning.stop_margin_m");
   stop_params.ego_front_m =
       inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2;
+  algo::CrossingYieldParams yield_params;
+  yield_params.horizon_s = config_.Get("planning.yield_horizon_s");
+  yield_params.max_decel_mps2 = config_.Get("planning.max_decel_mps2");
+  yield_params.max_accel_mps2 = config_.Get("planning.max_accel_mps2");
+  crossing_yield_ = std::make_unique<algo::CrossingYielder>(yield_params);
   structure_grid_.SetMap(inputs_.map_cloud);
   const int stop_node = g->AddNode("obstacle_stop_planner");
   g->Subscribe<ObjectsMsg>(
@@ -562,8 +568,11 @@ void Stack::BuildPlanning(Graph* g) {
           }
         }
         std::vector<algo::PlannedPoint> points = ToPlanned(in.points);
-        algo::ObstacleStop stop =
+        const algo::ObstacleStop in_path =
             algo::InsertObstacleStop(&points, obstacles, stop_params);
+        const algo::ObstacleStop crossing = crossing_yield_->Plan(
+            &points, obstacles, in.ego_v_mps, ctx.now_s(), stop_params);
+        algo::ObstacleStop stop = algo::NearerStop(in_path, crossing);
         // Whether the map has structure there matters only for the object
         // stopped for.
         if (stop.obstacle_id >= 0) {
@@ -588,7 +597,9 @@ void Stack::BuildPlanning(Graph* g) {
         out.stop.track_id = decision.obstacle_id;
         out.stop.obstacle_gap_m = decision.obstacle_gap_m;
         out.stop.static_structure = decision.static_structure;
-        ctx.ReportWork({static_cast<double>(stop.work_units), 0.0, 1});
+        ctx.ReportWork(
+            {static_cast<double>(in_path.work_units + crossing.work_units), 0.0,
+             1});
         ctx.Publish(topics_.stop_reason, out.stop);
         ctx.Publish(trajectory_raw_, std::move(out));
       });

@@ -40,6 +40,7 @@ algorithms::PlannerObstacle ObstacleFromObject(const TrackedObject& object) {
   ob.length_m = object.length_m;
   ob.width_m = object.width_m;
   ob.yaw_rad = object.yaw_rad;
+  ob.age = object.age;
   return ob;
 }
 

@@ -177,6 +177,164 @@ TEST(ObstacleStopPlanner, SeesAnObstacleJustPastThePathsEnd) {
   EXPECT_NEAR(plan.obstacle.stop_s_m, 54.0 - 3.0 - 3.8, 1e-9);
 }
 
+// A straight road east along y = 0 and a car 12 m north of it at x = 30,
+// driving south across it at 7 m/s: its box (4.5 m along its heading)
+// enters the corridor after 1.2 s and leaves it after 2.2 s.
+struct CrossingCase {
+  std::vector<PlannedPoint> points;
+  PlannerObstacle car = Car(5, 30.0, 12.0);
+};
+
+// The yield is off by default (planning.yield_horizon_s 0); on, it looks
+// 3 s ahead.
+CrossingYieldParams On() {
+  CrossingYieldParams params;
+  params.horizon_s = 3.0;
+  return params;
+}
+
+CrossingCase Crossing(double ego_x_m) {
+  PathPlanner planner;
+  planner.SetRoute(Straight(200, 5));
+  CrossingCase c;
+  c.points = planner.Plan(geometry::Pose2{ego_x_m, 0, 0}).points;
+  c.car.velocity = {0.0, -7.0};
+  c.car.yaw_rad = -kPi / 2;
+  c.car.age = 10;
+  return c;
+}
+
+TEST(CrossingYield, StopsBeforeACarAboutToCrossWhileTheEgoWouldBeThere) {
+  // Ego front at 18.8 m, 10.3 m from the crossing's near edge (29.1): at
+  // 5 m/s it would be there after 2.1 s, while the car crosses.
+  CrossingCase c = Crossing(15.0);
+  const ObstacleStopParams stop;
+  const ObstacleStop yield =
+      InsertCrossingYield(&c.points, {c.car}, 5.0, stop, On());
+  ASSERT_TRUE(yield.stop);
+  EXPECT_EQ(yield.obstacle_id, 5);
+  EXPECT_NEAR(yield.stop_s_m, 29.1 - stop.stop_margin_m - stop.ego_front_m,
+              1e-6);
+  EXPECT_NEAR(yield.gap_m, 29.1 - 18.8, 1e-6);
+  for (const PlannedPoint& p : c.points) {
+    EXPECT_EQ(p.v_mps == 0.0, p.s_m >= yield.stop_s_m - 1e-6) << p.s_m;
+  }
+  EXPECT_GT(yield.work_units, 0);
+}
+
+TEST(CrossingYield, LetsTheCarCrossWhenTheEgoWouldArriveAfterIt) {
+  // From x = 0 the ego's front needs 5.1 s at 5 m/s; the car is gone at 2.2.
+  CrossingCase c = Crossing(0.0);
+  EXPECT_FALSE(InsertCrossingYield(&c.points, {c.car}, 5.0, {}, On()).stop);
+  // At walking pace (the ego's speed counts as at least 1 m/s) from 15 m
+  // back it would be there after 10 s: no yield either.
+  c = Crossing(15.0);
+  CrossingYieldParams slow = On();
+  slow.min_ego_speed_mps = 1.0;
+  EXPECT_FALSE(InsertCrossingYield(&c.points, {c.car}, 0.0, {}, slow).stop);
+}
+
+TEST(CrossingYield, CountsOnTheEgoSpeedingUpTowardsTheCrossing) {
+  // At 2 m/s, 13.3 m short of the crossing: at that speed it would arrive
+  // after 6.7 s, long after the car; speeding up at 1.5 m/s^2 towards the
+  // 8.3 m/s it plans, after 3.1 s, within a second of the car leaving.
+  CrossingCase c = Crossing(12.0);
+  EXPECT_TRUE(InsertCrossingYield(&c.points, {c.car}, 2.0, {}, On()).stop);
+  c = Crossing(12.0);
+  CrossingYieldParams steady = On();
+  steady.max_accel_mps2 = 0.0;
+  EXPECT_FALSE(InsertCrossingYield(&c.points, {c.car}, 2.0, {}, steady).stop);
+}
+
+TEST(CrossingYield, DrivesThroughACrossingItCanNoLongerStopBefore) {
+  // Ego front at 23.8 m: the yield line (22.3) is 2.3 m ahead of the rear
+  // axle, short of the 5 m it needs to stop from 5 m/s at 2.5 m/s^2.
+  CrossingCase c = Crossing(20.0);
+  EXPECT_FALSE(InsertCrossingYield(&c.points, {c.car}, 5.0, {}, On()).stop);
+  // Unless it was yielding already: braking for crossing traffic, it stops.
+  c = Crossing(20.0);
+  EXPECT_TRUE(
+      InsertCrossingYield(&c.points, {c.car}, 5.0, {}, On(), /*yielding=*/true)
+          .stop);
+  // At 2 m/s it stops in 0.8 m and is there after 2.7 s: it yields.
+  c = Crossing(20.0);
+  EXPECT_TRUE(InsertCrossingYield(&c.points, {c.car}, 2.0, {}, On()).stop);
+}
+
+TEST(CrossingYield, FollowingOncomingSlowNewAndPresentTracksAreNotYieldedTo) {
+  CrossingCase c = Crossing(15.0);
+  PlannerObstacle ahead = Car(1, 40.0, 0.0);  // in the lane, driving away
+  ahead.velocity = {6.0, 0.0};
+  PlannerObstacle oncoming = Car(2, 60.0, 3.5);  // next lane, towards us
+  oncoming.velocity = {-8.0, 0.0};
+  PlannerObstacle creeping = c.car;  // the crossing car, at 2 m/s
+  creeping.id = 3;
+  creeping.velocity = {0.0, -2.0};
+  PlannerObstacle young = c.car;  // a track of 2 updates: speed unknown
+  young.id = 7;
+  young.age = 2;
+  PlannerObstacle crossing_now = c.car;  // already in the corridor
+  crossing_now.id = 4;
+  crossing_now.position = {30.0, 1.0};
+  for (const PlannerObstacle& ob :
+       {ahead, oncoming, creeping, young, crossing_now}) {
+    std::vector<PlannedPoint> points = c.points;
+    EXPECT_FALSE(InsertCrossingYield(&points, {ob}, 5.0, {}, On()).stop)
+        << "obstacle " << ob.id;
+  }
+  // A horizon of 0 yields to nothing.
+  CrossingYieldParams never = On();
+  never.horizon_s = 0.0;
+  EXPECT_FALSE(InsertCrossingYield(&c.points, {c.car}, 5.0, {}, never).stop);
+}
+
+TEST(CrossingYield, AYieldIsHeldUntilTheWayHasBeenClearForTheMargin) {
+  CrossingYielder yielder(On());  // transit margin 1 s
+  const ObstacleStopParams stop;
+  CrossingCase c = Crossing(15.0);
+  const ObstacleStop first = yielder.Plan(&c.points, {c.car}, 5.0, 10.0, stop);
+  ASSERT_TRUE(first.stop);
+  // A second car crossing further on (x = 35) is a reason to yield too,
+  // but does not move the line forward.
+  c = Crossing(15.0);
+  PlannerObstacle later = c.car;
+  later.id = 6;
+  later.position = {35.0, 12.0};
+  const ObstacleStop kept = yielder.Plan(&c.points, {later}, 5.0, 10.5, stop);
+  ASSERT_TRUE(kept.stop);
+  EXPECT_EQ(kept.obstacle_id, 5);
+  EXPECT_NEAR(kept.stop_s_m, first.stop_s_m, 1e-9);
+  // The tracks break up: for 1 s after that no track says a car is
+  // crossing, and the stop line stays where it was, for the same car.
+  for (double t : {11.0, 11.5}) {
+    c = Crossing(15.0);
+    const ObstacleStop held = yielder.Plan(&c.points, {}, 3.0, t, stop);
+    ASSERT_TRUE(held.stop) << t;
+    EXPECT_EQ(held.obstacle_id, 5);
+    EXPECT_NEAR(held.stop_s_m, first.stop_s_m, 1e-9);
+    EXPECT_NEAR(held.gap_m, first.gap_m, 1e-9);
+    EXPECT_EQ(c.points.back().v_mps, 0.0);
+  }
+  // Clear for longer than the margin: it goes.
+  c = Crossing(15.0);
+  EXPECT_FALSE(yielder.Plan(&c.points, {}, 0.0, 11.6, stop).stop);
+  for (const PlannedPoint& p : c.points) EXPECT_GT(p.v_mps, 0.0);
+}
+
+TEST(CrossingYield, TheNearerOfTwoStopsHoldsTheCar) {
+  ObstacleStop far, near, none;
+  far.stop = near.stop = true;
+  far.stop_s_m = 40.0;
+  far.obstacle_id = 1;
+  near.stop_s_m = 20.0;
+  near.obstacle_id = 2;
+  EXPECT_EQ(NearerStop(far, near).obstacle_id, 2);
+  EXPECT_EQ(NearerStop(near, far).obstacle_id, 2);
+  EXPECT_EQ(NearerStop(none, far).obstacle_id, 1);
+  EXPECT_EQ(NearerStop(far, none).obstacle_id, 1);
+  EXPECT_FALSE(NearerStop(none, none).stop);
+}
+
 TEST(VelocityPlanner, CurvatureLimitsSpeedInCurve) {
   // 50 m straight, a quarter circle of radius 10 m (1 m chords), straight.
   std::vector<Eigen::Vector2d> pts;

@@ -46,6 +46,7 @@ TEST(ObjectsTest, ATrackReachesThePlannerWithItsHeading) {
   EXPECT_EQ(obstacle.length_m, 5.0);
   EXPECT_EQ(obstacle.width_m, 1.8);
   EXPECT_EQ(obstacle.yaw_rad, 1.5);
+  EXPECT_EQ(obstacle.age, object.age);
 }
 
 }  // namespace
