@@ -109,8 +109,9 @@ int RunFidelity(const FidelityArgs& args) {
     }
     if (!rows.empty()) {
       analysis::ComparisonChartOptions o;
-      o.title = fmt::format("p50 callback latency at {}: virtual vs real time",
-                            f->point);
+      o.title = fmt::format(
+          "p50 callback latency at {}{}: virtual vs real time", f->point,
+          args.task_case.empty() ? "" : ", case " + args.task_case);
       o.adse_name = "virtual platform";
       o.reference_name =
           args.runs == 1

@@ -115,12 +115,13 @@ int RunProfileCheck(const ProfileCheckArgs& args) {
     return ExitCodeFor(run.status());
   }
   const profile::ProfileCheck check = profile::CompareWithProfile(*run, *costs);
+  // The text and the picture both say which case was driven.
+  const std::string of_case =
+      args.task_case.empty() ? "" : ", case " + args.task_case;
   const std::string text =
       fmt::format(
           "profile check of '{}' ({}){}: {} after {:.1f} s simulated\n\n",
-          costs->name, costs->source.cpu,
-          args.task_case.empty() ? "" : ", case " + args.task_case,
-          run->termination_reason,
+          costs->name, costs->source.cpu, of_case, run->termination_reason,
           run->metrics.count("nav_time_s") ? run->metrics.at("nav_time_s")
                                            : 0.0) +
       profile::FormatProfileCheck(check);
@@ -143,8 +144,8 @@ int RunProfileCheck(const ProfileCheckArgs& args) {
     }
     analysis::ComparisonChartOptions o;
     o.title = fmt::format(
-        "profile check: mean latency, adse on {} cores at {} GHz vs {}",
-        args.cores, costs->costs.reference_ghz, costs->name);
+        "profile check{}: mean latency, adse on {} cores at {} GHz vs {}",
+        of_case, args.cores, costs->costs.reference_ghz, costs->name);
     o.reference_name = "measured by CARET";
     saved = analysis::RenderComparisonChart(rows, o, dir + "/check.png");
   }
