@@ -67,6 +67,19 @@ struct SignalSample {
   std::string tls_id;           // the signal; empty when none is in range
 };
 
+// A confirmed track as published on /perception/objects: what the stack
+// saw, in the map frame.
+struct ObjectSample {
+  double t_s;      // publish time
+  double stamp_s;  // the scan the tracks were last updated from
+  int32_t track_id;
+  double x_m, y_m;  // box centre
+  double vx_mps, vy_mps;
+  double length_m, width_m;
+  double yaw_rad;  // of the box's length, modulo a half turn
+  int32_t age;     // tracker updates since the track's birth
+};
+
 struct CollisionEvent {
   double t_s;
   std::string other_id;
@@ -217,6 +230,7 @@ struct RunData {
   std::vector<StopSample> stop_reasons;  // may be empty (older files)
   // May be empty (no signals on the route, or older files).
   std::vector<SignalSample> signals;
+  std::vector<ObjectSample> objects;  // may be empty (older files)
 
   // Metrics by name (see scenarios/README.md); booleans as 0/1.
   std::map<std::string, double> metrics;

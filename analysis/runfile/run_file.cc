@@ -331,6 +331,22 @@ const std::vector<Column<StopSample>>& StopReasonColumns() {
   return *columns;
 }
 
+const std::vector<Column<ObjectSample>>& ObjectColumns() {
+  static const auto* columns = new std::vector<Column<ObjectSample>>{
+      F64("t_s", &ObjectSample::t_s),
+      F64("stamp_s", &ObjectSample::stamp_s),
+      I32("track_id", &ObjectSample::track_id),
+      F64("x_m", &ObjectSample::x_m),
+      F64("y_m", &ObjectSample::y_m),
+      F64("vx_mps", &ObjectSample::vx_mps),
+      F64("vy_mps", &ObjectSample::vy_mps),
+      F64("length_m", &ObjectSample::length_m),
+      F64("width_m", &ObjectSample::width_m),
+      F64("yaw_rad", &ObjectSample::yaw_rad),
+      I32("age", &ObjectSample::age)};
+  return *columns;
+}
+
 template <typename Row>
 std::vector<FieldDesc> Descs(const std::vector<Column<Row>>& columns) {
   std::vector<FieldDesc> descs;
@@ -560,6 +576,8 @@ Status WriteContents(hid_t file, const RunData& run) {
     if (!group.ok()) return group.status();
     ADSE_RETURN_IF_ERROR(WriteTable(group->get(), "traffic_signals",
                                     run.signals, SignalColumns()));
+    ADSE_RETURN_IF_ERROR(
+        WriteTable(group->get(), "objects", run.objects, ObjectColumns()));
   }
   {
     Result<Handle> group = CreateGroup(file, "metrics");
@@ -846,8 +864,10 @@ Status ReadContents(hid_t file, RunData* run) {
   ADSE_RETURN_IF_ERROR(ReadOptionalTable(file, "/planning", "stop_reasons",
                                          StopReasonColumns(),
                                          &run->stop_reasons));
-  return ReadOptionalTable(file, "/perception", "traffic_signals",
-                           SignalColumns(), &run->signals);
+  ADSE_RETURN_IF_ERROR(ReadOptionalTable(file, "/perception", "traffic_signals",
+                                         SignalColumns(), &run->signals));
+  return ReadOptionalTable(file, "/perception", "objects", ObjectColumns(),
+                           &run->objects);
 }
 
 Result<RunData> ReadRunFileImpl(const std::string& path) {

@@ -23,8 +23,9 @@ namespace {
 // v7: a route goes round the block where SUMO's turns around tighter than
 // the car can, the ideal path drops lane shapes' folds, and a lane-driving
 // goal is reached only near the route's end. v8: tracked objects carry
-// their heading to planning (they were axis-aligned boxes there).
-constexpr char kKeyVersion[] = "adse-run-key-v8";
+// their heading to planning (they were axis-aligned boxes there). v9:
+// perception places a scan by the pose at its stamp (it used the newest).
+constexpr char kKeyVersion[] = "adse-run-key-v9";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

@@ -228,6 +228,14 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
             {t_s, m.header.stamp_s, m.reason, m.stop_distance_m, m.track_id,
              m.obstacle_gap_m, m.static_structure ? 1 : 0});
       });
+  graph.AddSink<stack::ObjectsMsg>(
+      topics.objects, [&](const stack::ObjectsMsg& m, double t_s) {
+        for (const stack::TrackedObject& o : m.objects) {
+          run.objects.push_back({t_s, m.header.stamp_s, o.id, o.position.x(),
+                                 o.position.y(), o.velocity.x(), o.velocity.y(),
+                                 o.length_m, o.width_m, o.yaw_rad, o.age});
+        }
+      });
   graph.AddSink<stack::PoseMsg>(topics.pose,
                                 [&](const stack::PoseMsg& m, double t_s) {
                                   gate.OnLocalization(t_s, m.valid);

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace adse::algorithms {
 namespace {
@@ -31,14 +32,6 @@ double AngleFrom(double a, double b) {
 }
 
 }  // namespace
-
-geometry::Pose2 PoseAhead(const geometry::Pose2& pose, double v_mps,
-                          double dt_s) {
-  geometry::Pose2 out = pose;
-  out.x_m += v_mps * dt_s * std::cos(pose.yaw_rad);
-  out.y_m += v_mps * dt_s * std::sin(pose.yaw_rad);
-  return out;
-}
 
 Ekf::Ekf(const EkfParams& params) : params_(params) {}
 
@@ -188,29 +181,19 @@ void Ekf::UpdateOdometry(double v_mps, double yaw_rate_rps) {
                  params_.odometry_yaw_rate_std_rps);
 }
 
-void Ekf::RememberPose(double t_s) {
-  history_.push_back({t_s, pose()});
-  while (history_.size() > 1 &&
-         history_.front().t_s < t_s - params_.history_window_s) {
-    history_.pop_front();
-  }
-}
+void Ekf::RememberPose(double t_s) { history_.Add(t_s, pose(), v_mps()); }
 
 bool Ekf::UpdateDelayedPose(const geometry::Pose2& pose,
                             const Eigen::Matrix3d& cov, double stamp_s) {
   geometry::Pose2 measured = pose;
-  const auto then =
-      std::lower_bound(history_.begin(), history_.end(), stamp_s,
-                       [](const PoseAt& p, double t) { return p.t_s < t; });
-  if (then != history_.end()) {
+  if (const std::optional<geometry::Pose2> then = history_.At(stamp_s)) {
     // The motion since then, in the frame of the pose remembered then,
     // applied in the frame of the measurement.
     const geometry::Pose2 now = this->pose();
-    const double dyaw = AngleFrom(then->pose.yaw_rad, now.yaw_rad);
-    const Eigen::Vector2d moved(now.x_m - then->pose.x_m,
-                                now.y_m - then->pose.y_m);
-    const double c = std::cos(measured.yaw_rad - then->pose.yaw_rad);
-    const double s = std::sin(measured.yaw_rad - then->pose.yaw_rad);
+    const double dyaw = AngleFrom(then->yaw_rad, now.yaw_rad);
+    const Eigen::Vector2d moved(now.x_m - then->x_m, now.y_m - then->y_m);
+    const double c = std::cos(measured.yaw_rad - then->yaw_rad);
+    const double s = std::sin(measured.yaw_rad - then->yaw_rad);
     measured.x_m += c * moved.x() - s * moved.y();
     measured.y_m += s * moved.x() + c * moved.y();
     measured.yaw_rad = AngleFrom(0.0, measured.yaw_rad + dyaw);

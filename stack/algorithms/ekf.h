@@ -6,8 +6,8 @@
 
 #include <Eigen/Core>
 #include <cstddef>
-#include <deque>
 
+#include "stack/algorithms/pose_buffer.h"
 #include "stack/geometry/geometry.h"
 
 namespace adse::algorithms {
@@ -36,11 +36,6 @@ struct EkfParams {
   // than any scan-matching latency that still deserves to be fused.
   double history_window_s = 3.0;
 };
-
-// `pose` moved straight along its heading at `v_mps` for `dt_s` (negative:
-// back): where a pose stamped earlier is now, to first order.
-geometry::Pose2 PoseAhead(const geometry::Pose2& pose, double v_mps,
-                          double dt_s);
 
 class Ekf {
  public:
@@ -74,8 +69,8 @@ class Ekf {
   void RememberPose(double t_s);
   // A pose measured at `stamp_s`, before now (a scan matched late): carried
   // forward by the motion the filter estimated since the first remembered
-  // pose at or after `stamp_s`, then fused by UpdatePose. Used as it is
-  // when no remembered pose is that recent.
+  // pose at `stamp_s` (PoseBuffer::At), then fused by UpdatePose. Used as
+  // it is when no pose was remembered.
   bool UpdateDelayedPose(const geometry::Pose2& pose,
                          const Eigen::Matrix3d& cov, double stamp_s);
   // Poses kept by RememberPose.
@@ -109,11 +104,7 @@ class Ekf {
   double last_pose_t_s_ = 0.0;
   double last_d2_ = 0.0;
   int rejected_ = 0;
-  struct PoseAt {
-    double t_s;
-    geometry::Pose2 pose;
-  };
-  std::deque<PoseAt> history_;  // oldest first
+  PoseBuffer history_{params_.history_window_s};
 };
 
 }  // namespace adse::algorithms

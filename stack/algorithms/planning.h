@@ -121,8 +121,8 @@ int64_t LimitVelocity(std::vector<PlannedPoint>* points, bool ends_at_goal,
 struct ObstacleStopParams {
   // Half width of the swept corridor: an obstacle whose box comes closer
   // than this to the path blocks it.
-  double corridor_half_width_m = 1.4;
-  double stop_margin_m = 3.0;  // gap left between ego front and obstacle
+  double corridor_half_width_m = 1.5;
+  double stop_margin_m = 5.0;  // gap left between ego front and obstacle
   double ego_front_m = 3.8;    // rear axle to front bumper
   // Obstacles are looked for from the ego's front bumper back to the rear
   // axle (ego_front_m behind the path's start) up to this far past its end.
@@ -160,18 +160,15 @@ ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
 // car waiting for it.
 
 struct CrossingYieldParams {
-  // How far ahead a crossing is foreseen; 0, the default, never yields
-  // (README, "Crossing traffic": tracks of parked cars still move too much
-  // for it to be on by default); 3 s is a working value.
-  double horizon_s = 0.0;
+  // How far ahead a crossing is foreseen; 0 never yields.
+  double horizon_s = 3.0;
   double step_s = 0.25;  // prediction step
   // Slower tracks are left to the obstacle stop: waiting cars, and parked
   // ones whose box centre wanders as the ego passes and more of them is
   // seen (at 1 m/s such tracks made the car brake along every aisle).
   double min_object_speed_mps = 2.5;
   // Tracks younger than this (updates) are not predicted: a new track's
-  // speed is a guess, and parked cars' tracks, broken up and born again as
-  // the ego passes, are young.
+  // speed is a guess.
   int min_track_age = 5;
   // The ego's speed counts as at least this when it judges how long it
   // would take to clear a crossing.

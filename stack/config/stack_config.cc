@@ -77,10 +77,10 @@ const std::vector<KnobInfo>& StackKnobs() {
          "acceleration limit, m/s^2"},
         {"planning.max_decel_mps2", false, 0.1, 10.0, 2.5,
          "comfortable deceleration, m/s^2"},
-        {"planning.yield_horizon_s", false, 0.0, 30.0, 0.0,
+        {"planning.yield_horizon_s", false, 0.0, 30.0, 3.0,
          "a moving road user predicted to cross the path within this time, "
-         "while the car would be there, is yielded to (0: never, the "
-         "default; README, \"Crossing traffic\"), s"},
+         "while the car would be there, is yielded to (0: never; README, "
+         "\"Crossing traffic\"), s"},
         // Control.
         {"control.rate_hz", false, 1.0, 500.0, 30.0,
          "trajectory follower rate (control-command topic), Hz"},

@@ -20,6 +20,7 @@
 #include "stack/algorithms/tracker.h"
 #include "stack/algorithms/traffic_light.h"
 #include "stack/nodes/objects.h"
+#include "stack/nodes/pose_listener.h"
 
 namespace adse::stack {
 namespace {
@@ -34,6 +35,8 @@ constexpr double kNdtParallelFraction = 0.85;
 constexpr double kClusteringParallelFraction = 0.6;
 // Odometry samples the distortion corrector keeps (2 s at 50 Hz).
 constexpr size_t kTwistHistory = 100;
+// Queue of a tf listener's pose subscription (tf2_ros's /tf QoS depth).
+constexpr int kTfListenerDepth = 100;
 // Braking asked for while there is no valid pose to steer by.
 constexpr double kNoPoseDecelMps2 = 3.0;
 
@@ -94,18 +97,20 @@ class Stack final : public AdStack {
       trajectory_raw_ = -1;
 
   // Node state. Callbacks of one node never overlap (the executor's
-  // mutual exclusion), so none of this needs locking.
+  // mutual exclusion), so none of this needs locking, but for the
+  // PoseListeners, which a listener node fills for another.
   std::deque<OdometryMsg> corrector_twists_;  // newest odometry samples
   std::unique_ptr<algo::NdtMatcher> ndt_;
-  std::optional<PoseMsg> ndt_latest_ekf_;
-  double ndt_latest_ekf_t_ = 0.0;  // when that EKF pose was received
+  PoseListener ndt_poses_;  // the EKF's, for the alignment's first guess
   algo::Ekf ekf_;
   double ekf_last_t_ = 0.0;
   double ekf_stamp_ = -1.0;  // stamp of the newest fused NDT pose
   algo::MapFilter map_filter_;
   algo::StructureGrid structure_grid_;  // obstacle_stop_planner's map view
-  std::optional<PoseMsg> ground_pose_;
-  std::optional<PoseMsg> cluster_pose_;
+  // Poses by time, so that a scan is placed where the car was when it was
+  // taken, not where it is when processing reaches it.
+  PoseListener ground_poses_;
+  PoseListener cluster_poses_;
   std::unique_ptr<algo::Tracker> tracker_;
   std::unique_ptr<algo::PathPlanner> path_planner_;
   std::optional<PoseMsg> path_pose_;
@@ -287,24 +292,20 @@ Status Stack::BuildLocalization(Graph* g) {
   // own here), as in Autoware: a long alignment must not starve it, or the
   // next alignment starts from a stale guess.
   const int ndt_buffer = g->AddNode("ndt_scan_matcher_pose_buffer");
-  g->Subscribe<PoseMsg>(ndt_buffer, topics_.pose, "ekf_pose", 1,
-                        [this](const PoseMsg& in, CallbackContext& ctx) {
-                          ndt_latest_ekf_ = in;
-                          ndt_latest_ekf_t_ = ctx.now_s();
-                        });
+  g->Subscribe<PoseMsg>(
+      ndt_buffer, topics_.pose, "ekf_pose", 1,
+      [this](const PoseMsg& in, CallbackContext&) { ndt_poses_.Add(in); });
   g->Subscribe<PointCloudMsg>(
       ndt_node, downsampled_, "points", 1,
       [this, threads](const PointCloudMsg& in, CallbackContext& ctx) {
-        geometry::Pose2 guess = inputs_.initial_pose;
-        if (ndt_latest_ekf_) {
-          // The EKF pose moved to the scan's time along its motion.
-          const PoseMsg& e = *ndt_latest_ekf_;
-          guess = algo::PoseAhead(e.pose, e.v_mps,
-                                  in.header.stamp_s - ndt_latest_ekf_t_);
-        }
+        // The EKF's poses interpolated to the scan's time (Autoware's
+        // SmartPoseBuffer), moved on along the motion past the newest.
+        const geometry::Pose2 guess =
+            ndt_poses_.At(in.header.stamp_s).value_or(inputs_.initial_pose);
         Result<algo::NdtResult> r = ndt_->Align(in.points, guess);
         PoseMsg out;
         out.header = in.header;
+        out.time_s = in.header.stamp_s;
         out.valid = r.ok() && r->accepted;
         if (r.ok()) {
           out.pose = r->pose;
@@ -347,6 +348,7 @@ Status Stack::BuildLocalization(Graph* g) {
                 ekf_.RememberPose(ctx.now_s());
                 PoseMsg out;
                 out.header.stamp_s = ekf_stamp_;
+                out.time_s = ctx.now_s();
                 out.pose = ekf_.pose();
                 out.v_mps = ekf_.v_mps();
                 out.covariance = ekf_.PoseCovariance();
@@ -365,9 +367,13 @@ void Stack::BuildPerception(Graph* g) {
   map_filter_ = algo::MapFilter(map_params);
   map_filter_.SetMap(inputs_.map_cloud);
   const int ground_node = g->AddNode("ground_filter");
+  // Autoware's filters look the pose up in tf, whose listener has its own
+  // thread: in the scans' node a saturated filter starved it, and scans
+  // were placed by poses a second old. tf2's subscription keeps 100.
   g->Subscribe<PoseMsg>(
-      ground_node, topics_.pose, "pose", 1,
-      [this](const PoseMsg& in, CallbackContext&) { ground_pose_ = in; });
+      g->AddNode("ground_filter_tf_listener"), topics_.pose, "pose",
+      kTfListenerDepth,
+      [this](const PoseMsg& in, CallbackContext&) { ground_poses_.Add(in); });
   g->Subscribe<PointCloudMsg>(
       ground_node, points_, "points", 1,
       [this, ground, max_range](const PointCloudMsg& in, CallbackContext& ctx) {
@@ -382,7 +388,8 @@ void Stack::BuildPerception(Graph* g) {
         PointCloudMsg out;
         out.header = in.header;
         out.points = map_filter_.Filter(
-            near, ground_pose_ ? ground_pose_->pose : inputs_.initial_pose);
+            near,
+            ground_poses_.At(in.header.stamp_s).value_or(inputs_.initial_pose));
         ctx.ReportWork(
             {static_cast<double>(r.work_units + near.size()), 0.0, 1});
         ctx.Publish(obstacle_points_, std::move(out));
@@ -396,8 +403,9 @@ void Stack::BuildPerception(Graph* g) {
   const double max_object_m = config_.Get("perception.max_object_size_m");
   const int cluster_node = g->AddNode("euclidean_cluster");
   g->Subscribe<PoseMsg>(
-      cluster_node, topics_.pose, "pose", 1,
-      [this](const PoseMsg& in, CallbackContext&) { cluster_pose_ = in; });
+      g->AddNode("euclidean_cluster_tf_listener"), topics_.pose, "pose",
+      kTfListenerDepth,
+      [this](const PoseMsg& in, CallbackContext&) { cluster_poses_.Add(in); });
   g->Subscribe<PointCloudMsg>(
       cluster_node, obstacle_points_, "points", 1,
       [this, clustering, threads, max_object_m](const PointCloudMsg& in,
@@ -406,7 +414,7 @@ void Stack::BuildPerception(Graph* g) {
         ObjectsMsg out;
         out.header = in.header;
         const geometry::Pose2 pose =
-            cluster_pose_ ? cluster_pose_->pose : inputs_.initial_pose;
+            cluster_poses_.At(in.header.stamp_s).value_or(inputs_.initial_pose);
         for (const algo::Detection& d : r.detections) {
           // Clusters larger than any vehicle are static structure (a wall's
           // corner fits a box spanning the road); the map, not the object

@@ -161,7 +161,8 @@ bool Io(IO& io, OdometryMsg& m) {
 }
 template <typename IO>
 bool Io(IO& io, PoseMsg& m) {
-  return All(io, m.header, m.pose, m.covariance, m.v_mps, m.fitness, m.valid);
+  return All(io, m.header, m.time_s, m.pose, m.covariance, m.v_mps, m.fitness,
+             m.valid);
 }
 template <typename IO>
 bool Io(IO& io, ObjectsMsg& m) {

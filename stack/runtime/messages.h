@@ -44,6 +44,9 @@ struct OdometryMsg {
 // A pose estimate in the map frame with its covariance (x, y, yaw).
 struct PoseMsg {
   Header header;
+  // The time the pose describes. header.stamp_s is the scan it last rests
+  // on (for latency); the EKF's pose is of the moment it is published.
+  double time_s = 0.0;
   geometry::Pose2 pose;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   double v_mps = 0.0;    // filtered speed (EKF output)

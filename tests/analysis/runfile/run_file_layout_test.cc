@@ -243,9 +243,16 @@ TEST_F(RunFileTest, SignalReportsAreStoredWithTheirStatesNamed) {
                   {{"unknown", 0}, {"red", 1}, {"yellow", 2}, {"green", 3}});
 }
 
-TEST_F(RunFileTest, FileWithoutSignalReportsReadsAsNone) {
-  ExpectReadsWithout(Path("run.h5"), "/perception",
-                     [](RunData* run) { run->signals.clear(); });
+TEST_F(RunFileTest, FileWithoutPerceptionReadsAsNoSignalReportsAndNoObjects) {
+  ExpectReadsWithout(Path("run.h5"), "/perception", [](RunData* run) {
+    run->signals.clear();
+    run->objects.clear();
+  });
+}
+
+TEST_F(RunFileTest, FileWithoutObjectsReadsAsNone) {
+  ExpectReadsWithout(Path("run.h5"), "/perception/objects",
+                     [](RunData* run) { run->objects.clear(); });
 }
 
 TEST_F(RunFileTest, ASignalStateOutsideTheVocabularyIsRefused) {

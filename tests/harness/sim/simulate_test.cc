@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
+#include <set>
 
 #include "analysis/metrics/standing.h"
 #include "analysis/runfile/run_file.h"
@@ -102,6 +104,35 @@ TEST(SimulateTest, GenerousComputerDrivesToTheGoalAtTheNominalControlRate) {
     EXPECT_EQ(topic.find("traffic_signal"), std::string::npos) << topic;
   for (const runfile::NamedCallback& c : run->callback_info)
     EXPECT_EQ(c.name.find("traffic_signal"), std::string::npos) << c.name;
+}
+
+// The stack places each scan by the pose at its stamp, looked up from
+// listeners a busy filter cannot starve: parked cars the map holds are
+// explained by it and never become objects, so what is tracked is traffic.
+// Placed by the newest pose a filter had received (up to a second old at
+// 14 Hz), 85 % of this run's objects were parked cars and walls, tracks
+// breaking up into 152 ids.
+TEST(SimulateTest, WhatTheStackTracksIsTrafficNotTheParkedCarsItDrivesPast) {
+  spec::Spec spec = SmallScenario();
+  ASSERT_EQ(spec.world.traffic.flows.size(), 1u);
+  spec.world.traffic.flows[0].vehicles_per_hour = 900;  // cars to see
+  Result<runfile::RunData> run = SimulatePoint(spec, SmallPoint(16, 2.1, 14));
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  ASSERT_GT(run->objects.size(), 50u) << "the SUMO cars are seen";
+  size_t near_traffic = 0;
+  std::set<int32_t> ids;
+  for (const runfile::ObjectSample& o : run->objects) {
+    ids.insert(o.track_id);
+    for (const runfile::VehicleSample& v : run->vehicles) {
+      if (std::abs(v.t_s - o.t_s) <= 0.5 &&
+          std::hypot(v.x_m - o.x_m, v.y_m - o.y_m) < 3.0) {
+        ++near_traffic;
+        break;
+      }
+    }
+  }
+  EXPECT_GT(near_traffic, 8 * run->objects.size() / 10);
+  EXPECT_LT(ids.size(), 30u);
 }
 
 TEST(SimulateTest, StarvedComputerControlsLessOftenAndDropsLidarFrames) {

@@ -132,15 +132,6 @@ TEST(Ekf, LostWhenPositionUncertaintyGrows) {
   EXPECT_NEAR(k, 10, 2);
 }
 
-TEST(Ekf, PoseAheadMovesAlongTheHeading) {
-  const geometry::Pose2 p = PoseAhead({1.0, 2.0, kPi / 2}, 4.0, 0.5);
-  EXPECT_NEAR(p.x_m, 1.0, 1e-12);
-  EXPECT_NEAR(p.y_m, 4.0, 1e-12);
-  EXPECT_EQ(p.yaw_rad, kPi / 2);
-  const geometry::Pose2 back = PoseAhead({0.0, 0.0, 0.0}, 2.0, -1.0);
-  EXPECT_NEAR(back.x_m, -2.0, 1e-12);
-}
-
 TEST(Ekf, OdometryWithoutNoiseArgumentsUsesTheParameters) {
   EkfParams params;
   params.odometry_speed_std_mps = 0.3;

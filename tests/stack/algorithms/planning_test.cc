@@ -174,7 +174,8 @@ TEST(ObstacleStopPlanner, SeesAnObstacleJustPastThePathsEnd) {
   const testing::ChainedPlan plan = testing::PlanChain(
       &planner, geometry::Pose2{0, 0, 0}, {Car(4, 54.0 + 2.25, 0.0)});
   ASSERT_TRUE(plan.obstacle.stop);
-  EXPECT_NEAR(plan.obstacle.stop_s_m, 54.0 - 3.0 - 3.8, 1e-9);
+  EXPECT_NEAR(plan.obstacle.stop_s_m,
+              54.0 - ObstacleStopParams().stop_margin_m - 3.8, 1e-9);
 }
 
 // A straight road east along y = 0 and a car 12 m north of it at x = 30,
@@ -185,11 +186,11 @@ struct CrossingCase {
   PlannerObstacle car = Car(5, 30.0, 12.0);
 };
 
-// The yield is off by default (planning.yield_horizon_s 0); on, it looks
-// 3 s ahead.
-CrossingYieldParams On() {
-  CrossingYieldParams params;
-  params.horizon_s = 3.0;
+// The obstacle planner's parameters the cases below are worked out for.
+ObstacleStopParams CaseStop() {
+  ObstacleStopParams params;
+  params.corridor_half_width_m = 1.4;
+  params.stop_margin_m = 3.0;
   return params;
 }
 
@@ -208,9 +209,9 @@ TEST(CrossingYield, StopsBeforeACarAboutToCrossWhileTheEgoWouldBeThere) {
   // Ego front at 18.8 m, 10.3 m from the crossing's near edge (29.1): at
   // 5 m/s it would be there after 2.1 s, while the car crosses.
   CrossingCase c = Crossing(15.0);
-  const ObstacleStopParams stop;
+  const ObstacleStopParams stop = CaseStop();
   const ObstacleStop yield =
-      InsertCrossingYield(&c.points, {c.car}, 5.0, stop, On());
+      InsertCrossingYield(&c.points, {c.car}, 5.0, stop, CrossingYieldParams());
   ASSERT_TRUE(yield.stop);
   EXPECT_EQ(yield.obstacle_id, 5);
   EXPECT_NEAR(yield.stop_s_m, 29.1 - stop.stop_margin_m - stop.ego_front_m,
@@ -225,13 +226,16 @@ TEST(CrossingYield, StopsBeforeACarAboutToCrossWhileTheEgoWouldBeThere) {
 TEST(CrossingYield, LetsTheCarCrossWhenTheEgoWouldArriveAfterIt) {
   // From x = 0 the ego's front needs 5.1 s at 5 m/s; the car is gone at 2.2.
   CrossingCase c = Crossing(0.0);
-  EXPECT_FALSE(InsertCrossingYield(&c.points, {c.car}, 5.0, {}, On()).stop);
+  EXPECT_FALSE(InsertCrossingYield(&c.points, {c.car}, 5.0, CaseStop(),
+                                   CrossingYieldParams())
+                   .stop);
   // At walking pace (the ego's speed counts as at least 1 m/s) from 15 m
   // back it would be there after 10 s: no yield either.
   c = Crossing(15.0);
-  CrossingYieldParams slow = On();
+  CrossingYieldParams slow = CrossingYieldParams();
   slow.min_ego_speed_mps = 1.0;
-  EXPECT_FALSE(InsertCrossingYield(&c.points, {c.car}, 0.0, {}, slow).stop);
+  EXPECT_FALSE(
+      InsertCrossingYield(&c.points, {c.car}, 0.0, CaseStop(), slow).stop);
 }
 
 TEST(CrossingYield, CountsOnTheEgoSpeedingUpTowardsTheCrossing) {
@@ -239,26 +243,33 @@ TEST(CrossingYield, CountsOnTheEgoSpeedingUpTowardsTheCrossing) {
   // after 6.7 s, long after the car; speeding up at 1.5 m/s^2 towards the
   // 8.3 m/s it plans, after 3.1 s, within a second of the car leaving.
   CrossingCase c = Crossing(12.0);
-  EXPECT_TRUE(InsertCrossingYield(&c.points, {c.car}, 2.0, {}, On()).stop);
+  EXPECT_TRUE(InsertCrossingYield(&c.points, {c.car}, 2.0, CaseStop(),
+                                  CrossingYieldParams())
+                  .stop);
   c = Crossing(12.0);
-  CrossingYieldParams steady = On();
+  CrossingYieldParams steady = CrossingYieldParams();
   steady.max_accel_mps2 = 0.0;
-  EXPECT_FALSE(InsertCrossingYield(&c.points, {c.car}, 2.0, {}, steady).stop);
+  EXPECT_FALSE(
+      InsertCrossingYield(&c.points, {c.car}, 2.0, CaseStop(), steady).stop);
 }
 
 TEST(CrossingYield, DrivesThroughACrossingItCanNoLongerStopBefore) {
   // Ego front at 23.8 m: the yield line (22.3) is 2.3 m ahead of the rear
   // axle, short of the 5 m it needs to stop from 5 m/s at 2.5 m/s^2.
   CrossingCase c = Crossing(20.0);
-  EXPECT_FALSE(InsertCrossingYield(&c.points, {c.car}, 5.0, {}, On()).stop);
+  EXPECT_FALSE(InsertCrossingYield(&c.points, {c.car}, 5.0, CaseStop(),
+                                   CrossingYieldParams())
+                   .stop);
   // Unless it was yielding already: braking for crossing traffic, it stops.
   c = Crossing(20.0);
-  EXPECT_TRUE(
-      InsertCrossingYield(&c.points, {c.car}, 5.0, {}, On(), /*yielding=*/true)
-          .stop);
+  EXPECT_TRUE(InsertCrossingYield(&c.points, {c.car}, 5.0, CaseStop(),
+                                  CrossingYieldParams(), /*yielding=*/true)
+                  .stop);
   // At 2 m/s it stops in 0.8 m and is there after 2.7 s: it yields.
   c = Crossing(20.0);
-  EXPECT_TRUE(InsertCrossingYield(&c.points, {c.car}, 2.0, {}, On()).stop);
+  EXPECT_TRUE(InsertCrossingYield(&c.points, {c.car}, 2.0, CaseStop(),
+                                  CrossingYieldParams())
+                  .stop);
 }
 
 TEST(CrossingYield, FollowingOncomingSlowNewAndPresentTracksAreNotYieldedTo) {
@@ -279,18 +290,21 @@ TEST(CrossingYield, FollowingOncomingSlowNewAndPresentTracksAreNotYieldedTo) {
   for (const PlannerObstacle& ob :
        {ahead, oncoming, creeping, young, crossing_now}) {
     std::vector<PlannedPoint> points = c.points;
-    EXPECT_FALSE(InsertCrossingYield(&points, {ob}, 5.0, {}, On()).stop)
+    EXPECT_FALSE(InsertCrossingYield(&points, {ob}, 5.0, CaseStop(),
+                                     CrossingYieldParams())
+                     .stop)
         << "obstacle " << ob.id;
   }
   // A horizon of 0 yields to nothing.
-  CrossingYieldParams never = On();
+  CrossingYieldParams never = CrossingYieldParams();
   never.horizon_s = 0.0;
-  EXPECT_FALSE(InsertCrossingYield(&c.points, {c.car}, 5.0, {}, never).stop);
+  EXPECT_FALSE(
+      InsertCrossingYield(&c.points, {c.car}, 5.0, CaseStop(), never).stop);
 }
 
 TEST(CrossingYield, AYieldIsHeldUntilTheWayHasBeenClearForTheMargin) {
-  CrossingYielder yielder(On());  // transit margin 1 s
-  const ObstacleStopParams stop;
+  CrossingYielder yielder{CrossingYieldParams()};  // transit margin 1 s
+  const ObstacleStopParams stop = CaseStop();
   CrossingCase c = Crossing(15.0);
   const ObstacleStop first = yielder.Plan(&c.points, {c.car}, 5.0, 10.0, stop);
   ASSERT_TRUE(first.stop);

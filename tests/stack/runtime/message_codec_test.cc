@@ -36,12 +36,14 @@ TEST(MessageCodecTest, EveryMessageTypeOfTheStackComesBackFieldForField) {
   EXPECT_EQ(cloud2.points[1], cloud.points[1]);
 
   PoseMsg pose;
+  pose.time_s = 12.5;
   pose.pose = {3.0, -2.0, 0.5};
   pose.covariance(1, 2) = 0.25;
   pose.v_mps = 7.5;
   pose.fitness = 0.125;
   pose.valid = false;
   const PoseMsg pose2 = RoundTrip(pose);
+  EXPECT_EQ(pose2.time_s, 12.5);
   EXPECT_EQ(pose2.pose.y_m, -2.0);
   EXPECT_EQ(pose2.covariance, pose.covariance);
   EXPECT_EQ(pose2.v_mps, 7.5);

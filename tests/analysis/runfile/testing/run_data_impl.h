@@ -216,6 +216,23 @@ inline std::string Diff(const RunData& a, const RunData& b) {
         out << at << "tls_id: " << x.tls_id << " vs " << y.tls_id << "\n";
     }
   }
+  if (size("objects", a.objects.size(), b.objects.size())) {
+    for (size_t i = 0; i < a.objects.size(); ++i) {
+      const ObjectSample &x = a.objects[i], &y = b.objects[i];
+      const std::string at = "objects[" + std::to_string(i) + "].";
+      num(at + "t_s", x.t_s, y.t_s);
+      num(at + "stamp_s", x.stamp_s, y.stamp_s);
+      integer(at + "track_id", x.track_id, y.track_id);
+      num(at + "x_m", x.x_m, y.x_m);
+      num(at + "y_m", x.y_m, y.y_m);
+      num(at + "vx_mps", x.vx_mps, y.vx_mps);
+      num(at + "vy_mps", x.vy_mps, y.vy_mps);
+      num(at + "length_m", x.length_m, y.length_m);
+      num(at + "width_m", x.width_m, y.width_m);
+      num(at + "yaw_rad", x.yaw_rad, y.yaw_rad);
+      integer(at + "age", x.age, y.age);
+    }
+  }
   return out.str();
 }
 
@@ -269,6 +286,15 @@ inline RunData MakeFullRun(size_t events = 5000) {
     run.signals.push_back(
         {0.5 + 0.2 * i, 0.4 + 0.2 * i, states[i], i == 3 ? -1.0 : 40.0 - 5 * i,
          i == 3 ? "" : "cluster_25578772_ü_" + std::to_string(i)});
+  }
+  // Two tracks over three publishes, one born late.
+  for (int i = 0; i < 3; ++i) {
+    run.objects.push_back({0.1 * i, 0.1 * i - 0.04, 7, 12.5 + 0.8 * i, -3.25,
+                           8.0, 0.0, 4.5, 1.8, -0.01 * i, 10 + i});
+    if (i > 0) {
+      run.objects.push_back({0.1 * i, 0.1 * i - 0.04, 1000 + i, -40.0, 2.0 * i,
+                             0.0, -1.5, 0.6, 0.5, 1.5707963267948966, i});
+    }
   }
   run.ego[3].yaw_rad = std::numeric_limits<double>::quiet_NaN();
   run.ego[4].v_mps = std::numeric_limits<double>::infinity();
