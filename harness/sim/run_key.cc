@@ -25,7 +25,8 @@ namespace {
 // goal is reached only near the route's end. v8: tracked objects carry
 // their heading to planning (they were axis-aligned boxes there). v9:
 // perception places a scan by the pose at its stamp (it used the newest).
-constexpr char kKeyVersion[] = "adse-run-key-v9";
+// v10: the obstacle stop also sweeps the car's footprint along the path.
+constexpr char kKeyVersion[] = "adse-run-key-v10";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

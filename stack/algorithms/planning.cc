@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <optional>
 
 namespace adse::algorithms {
@@ -272,6 +273,43 @@ BoxOnPath PlaceBox(const SearchPath& search, const Eigen::Vector2d& center,
   return out;
 }
 
+// The rear axle's first arc length along `pts` (from its start) at which
+// the car's footprint from the rear axle to the front bumper,
+// corridor_half_width_m either side, would touch `box`; none when it never
+// does. (Behind the rear axle the car cannot stop for anything.)
+std::optional<double> FootprintTouchS(const std::vector<PlannedPoint>& pts,
+                                      const geometry::OrientedBox& box,
+                                      const ObstacleStopParams& params) {
+  geometry::OrientedBox footprint;
+  footprint.length_m = params.ego_front_m;
+  footprint.width_m = 2 * params.corridor_half_width_m;
+  const double centre_ahead_m = 0.5 * params.ego_front_m;
+  // Nothing within reach of the footprint's far corner is skipped.
+  const double reach_m =
+      std::hypot(params.ego_front_m, params.corridor_half_width_m) +
+      0.5 * std::hypot(box.length_m, box.width_m);
+  const double step = std::max(params.footprint_step_m, 0.01);
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const PlannedPoint& b = pts[i];
+    const PlannedPoint& a = i == 0 ? b : pts[i - 1];
+    const double seg = b.s_m - a.s_m;
+    const int n = seg > step ? static_cast<int>(std::ceil(seg / step)) : 1;
+    for (int k = i == 0 ? n : 1; k <= n; ++k) {
+      const double w = static_cast<double>(k) / n;
+      const double yaw = a.yaw_rad + w * std::remainder(b.yaw_rad - a.yaw_rad,
+                                                        2 * std::numbers::pi);
+      const Eigen::Vector2d rear(a.x_m + w * (b.x_m - a.x_m),
+                                 a.y_m + w * (b.y_m - a.y_m));
+      if ((rear - box.center).norm() > reach_m) continue;
+      footprint.yaw_rad = yaw;
+      footprint.center =
+          rear + centre_ahead_m * Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
+      if (geometry::BoxesOverlap(footprint, box)) return a.s_m + w * seg;
+    }
+  }
+  return std::nullopt;
+}
+
 // Time to cover distance_m from speed v0_mps, speeding up at accel_mps2 up
 // to cap_mps (>= v0_mps).
 double EarliestArrival(double distance_m, double v0_mps, double accel_mps2,
@@ -322,13 +360,28 @@ ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
     out.work_units += 1 + static_cast<int64_t>(pts.size());
     const BoxOnPath box = PlaceBox(search, ob.position, ob.length_m, ob.width_m,
                                    ob.yaw_rad, params.corridor_half_width_m);
-    if (!box.in_corridor) continue;
-    if (box.s_m + box.half_along_m < s0) continue;  // behind the rear axle
-    const double stop =
-        box.s_m - box.half_along_m - params.stop_margin_m - params.ego_front_m;
+    double stop = std::numeric_limits<double>::infinity();
+    double near_edge = 0.0;
+    if (box.in_corridor && box.s_m + box.half_along_m >= s0) {
+      near_edge = box.s_m - box.half_along_m;
+      stop = near_edge - params.stop_margin_m - params.ego_front_m;
+    }
+    // Where the swept footprint touches it first, if earlier: the outside
+    // of a tight turn.
+    geometry::OrientedBox ob_box;
+    ob_box.center = ob.position;
+    ob_box.yaw_rad = ob.yaw_rad;
+    ob_box.length_m = ob.length_m;
+    ob_box.width_m = ob.width_m;
+    if (const std::optional<double> touch =
+            FootprintTouchS(pts, ob_box, params);
+        touch && *touch - params.stop_margin_m < stop) {
+      stop = *touch - params.stop_margin_m;
+      near_edge = *touch + params.ego_front_m;
+    }
     if (stop < stop_s) {
       stop_s = stop;
-      near_edge_s = box.s_m - box.half_along_m;
+      near_edge_s = near_edge;
       out.obstacle_id = ob.id;
       out.static_structure = ob.static_structure;
     }

@@ -120,10 +120,14 @@ int64_t LimitVelocity(std::vector<PlannedPoint>* points, bool ends_at_goal,
 
 struct ObstacleStopParams {
   // Half width of the swept corridor: an obstacle whose box comes closer
-  // than this to the path blocks it.
+  // than this to the path blocks it. The car's footprint ahead of its rear
+  // axle, this wide, is also swept along the path: in a tight turn its
+  // front corner swings out past a corridor around the rear axle's path.
   double corridor_half_width_m = 1.5;
   double stop_margin_m = 5.0;  // gap left between ego front and obstacle
   double ego_front_m = 3.8;    // rear axle to front bumper
+  // The footprint is placed along the path at most this far apart.
+  double footprint_step_m = 0.25;
   // Obstacles are looked for from the ego's front bumper back to the rear
   // axle (ego_front_m behind the path's start) up to this far past its end.
   double beyond_end_m = 10.0;

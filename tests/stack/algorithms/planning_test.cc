@@ -166,6 +166,38 @@ TEST(ObstacleStopPlanner, ACarWaitingInTheCrossLaneOfALeftTurnDoesNotBlockIt) {
   EXPECT_EQ(blocked.obstacle.obstacle_id, 4261);
 }
 
+// A tight left turn: north along x = 0, a quarter circle of 5 m radius
+// round (-5, 0), then west along y = 5. The car's front corner on the
+// outside swings out to 7.5 m from the circle's centre, 2.5 m off the rear
+// axle's path, where the corridor around that path (1.5 m) does not look.
+TEST(ObstacleStopPlanner, SeesWhatTheFrontCornerWouldSweepInATightTurn) {
+  std::vector<Eigen::Vector2d> route = {{0.0, -40.0}, {0.0, 0.0}};
+  for (int k = 1; k <= 18; ++k) {
+    const double a = kPi / 2 * k / 18;
+    route.emplace_back(-5.0 + 5.0 * std::cos(a), 5.0 * std::sin(a));
+  }
+  route.emplace_back(-60.0, 5.0);
+  PathPlanner planner;
+  planner.SetRoute(Polyline(route));
+  const ObstacleStopParams params;
+  PlannerObstacle post = Car(9, -2.9, 7.1);  // 2.4 m outside the arc
+  post.length_m = post.width_m = 0.5;
+  std::vector<PlannedPoint> points =
+      planner.Plan(geometry::Pose2{0.0, -12.0, kPi / 2}).points;
+  const ObstacleStop stop = InsertObstacleStop(&points, {post}, params);
+  ASSERT_TRUE(stop.stop);
+  EXPECT_EQ(stop.obstacle_id, 9);
+  // The corner reaches it with the rear axle about 40 deg round the arc,
+  // which starts at route s = 40 (the car is at 28); the car stops the
+  // margin short of that.
+  EXPECT_GT(stop.stop_s_m, 40.0 - params.stop_margin_m);
+  EXPECT_LT(stop.stop_s_m, 40.0 + 3.9 - params.stop_margin_m);
+  // 1.5 m further out the corner misses it.
+  post.position = {-2.9 + 1.1, 7.1 + 1.1};
+  points = planner.Plan(geometry::Pose2{0.0, -12.0, kPi / 2}).points;
+  EXPECT_FALSE(InsertObstacleStop(&points, {post}, params).stop);
+}
+
 TEST(ObstacleStopPlanner, SeesAnObstacleJustPastThePathsEnd) {
   // The path ends at the horizon (50 m); a car 4 m past it still sets a
   // stop inside it, as it would on the full route.
