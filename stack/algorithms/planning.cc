@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <optional>
 
 namespace adse::algorithms {
@@ -275,11 +274,16 @@ BoxOnPath PlaceBox(const SearchPath& search, const Eigen::Vector2d& center,
 
 // The rear axle's first arc length along `pts` (from its start) at which
 // the car's footprint from the rear axle to the front bumper,
-// corridor_half_width_m either side, would touch `box`; none when it never
+// corridor_half_width_m either side, would touch `ob`; none when it never
 // does. (Behind the rear axle the car cannot stop for anything.)
 std::optional<double> FootprintTouchS(const std::vector<PlannedPoint>& pts,
-                                      const geometry::OrientedBox& box,
+                                      const PlannerObstacle& ob,
                                       const ObstacleStopParams& params) {
+  geometry::OrientedBox box;
+  box.center = ob.position;
+  box.yaw_rad = ob.yaw_rad;
+  box.length_m = ob.length_m;
+  box.width_m = ob.width_m;
   geometry::OrientedBox footprint;
   footprint.length_m = params.ego_front_m;
   footprint.width_m = 2 * params.corridor_half_width_m;
@@ -296,14 +300,14 @@ std::optional<double> FootprintTouchS(const std::vector<PlannedPoint>& pts,
     const int n = seg > step ? static_cast<int>(std::ceil(seg / step)) : 1;
     for (int k = i == 0 ? n : 1; k <= n; ++k) {
       const double w = static_cast<double>(k) / n;
-      const double yaw = a.yaw_rad + w * std::remainder(b.yaw_rad - a.yaw_rad,
-                                                        2 * std::numbers::pi);
-      const Eigen::Vector2d rear(a.x_m + w * (b.x_m - a.x_m),
-                                 a.y_m + w * (b.y_m - a.y_m));
-      if ((rear - box.center).norm() > reach_m) continue;
-      footprint.yaw_rad = yaw;
-      footprint.center =
-          rear + centre_ahead_m * Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
+      const geometry::Pose2 rear = geometry::InterpolatePose(
+          {a.x_m, a.y_m, a.yaw_rad}, {b.x_m, b.y_m, b.yaw_rad}, w);
+      const Eigen::Vector2d heading(std::cos(rear.yaw_rad),
+                                    std::sin(rear.yaw_rad));
+      const Eigen::Vector2d at(rear.x_m, rear.y_m);
+      if ((at - box.center).norm() > reach_m) continue;
+      footprint.yaw_rad = rear.yaw_rad;
+      footprint.center = at + centre_ahead_m * heading;
       if (geometry::BoxesOverlap(footprint, box)) return a.s_m + w * seg;
     }
   }
@@ -326,6 +330,17 @@ double EarliestArrival(double distance_m, double v0_mps, double accel_mps2,
            accel_mps2;
   }
   return t_cap + (distance_m - d_cap) / cap_mps;
+}
+
+// Makes `stop` (rear axle) for `ob`, whose near edge is at near_edge, the
+// stop found so far when it is nearer than *stop_s.
+void KeepNearer(double stop, double near_edge, const PlannerObstacle& ob,
+                double* stop_s, double* near_edge_s, ObstacleStop* out) {
+  if (!(stop < *stop_s)) return;
+  *stop_s = stop;
+  *near_edge_s = near_edge;
+  out->obstacle_id = ob.id;
+  out->static_structure = ob.static_structure;
 }
 
 // Stops the trajectory at `stop_s` for `out`'s obstacle (already set) and
@@ -368,23 +383,12 @@ ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
     }
     // Where the swept footprint touches it first, if earlier: the outside
     // of a tight turn.
-    geometry::OrientedBox ob_box;
-    ob_box.center = ob.position;
-    ob_box.yaw_rad = ob.yaw_rad;
-    ob_box.length_m = ob.length_m;
-    ob_box.width_m = ob.width_m;
-    if (const std::optional<double> touch =
-            FootprintTouchS(pts, ob_box, params);
+    if (const std::optional<double> touch = FootprintTouchS(pts, ob, params);
         touch && *touch - params.stop_margin_m < stop) {
       stop = *touch - params.stop_margin_m;
       near_edge = *touch + params.ego_front_m;
     }
-    if (stop < stop_s) {
-      stop_s = stop;
-      near_edge_s = near_edge;
-      out.obstacle_id = ob.id;
-      out.static_structure = ob.static_structure;
-    }
+    KeepNearer(stop, near_edge, ob, &stop_s, &near_edge_s, &out);
   }
   FinishStop(points, stop_s, near_edge_s, params.ego_front_m, &out);
   return out;
@@ -468,12 +472,7 @@ ObstacleStop InsertCrossingYield(std::vector<PlannedPoint>* points,
     // unless it is braking for crossing traffic already (or the plan would
     // flicker between yielding and going as it slows).
     if (stop - s0 < braking_m && !yielding) continue;
-    if (stop < stop_s) {
-      stop_s = stop;
-      near_edge_s = near_edge;
-      out.obstacle_id = ob.id;
-      out.static_structure = ob.static_structure;
-    }
+    KeepNearer(stop, near_edge, ob, &stop_s, &near_edge_s, &out);
   }
   FinishStop(points, stop_s, near_edge_s, stop_params.ego_front_m, &out);
   return out;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
 namespace adse::algorithms {
 
@@ -35,14 +34,8 @@ std::optional<geometry::Pose2> PoseBuffer::At(double t_s) const {
                        [](const Stamped& p, double t) { return p.t_s < t; });
   const Stamped& b = *after;
   const Stamped& a = *(after - 1);
-  const double w = (t_s - a.t_s) / (b.t_s - a.t_s);
-  // The shorter way round for the heading.
-  const double dyaw =
-      std::remainder(b.pose.yaw_rad - a.pose.yaw_rad, 2 * std::numbers::pi);
-  return geometry::Pose2{
-      a.pose.x_m + w * (b.pose.x_m - a.pose.x_m),
-      a.pose.y_m + w * (b.pose.y_m - a.pose.y_m),
-      std::remainder(a.pose.yaw_rad + w * dyaw, 2 * std::numbers::pi)};
+  return geometry::InterpolatePose(a.pose, b.pose,
+                                   (t_s - a.t_s) / (b.t_s - a.t_s));
 }
 
 }  // namespace adse::algorithms

@@ -100,6 +100,12 @@ bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b) {
   return true;
 }
 
+Pose2 InterpolatePose(const Pose2& a, const Pose2& b, double w) {
+  const double dyaw = std::remainder(b.yaw_rad - a.yaw_rad, 2 * M_PI);
+  return {a.x_m + w * (b.x_m - a.x_m), a.y_m + w * (b.y_m - a.y_m),
+          std::remainder(a.yaw_rad + w * dyaw, 2 * M_PI)};
+}
+
 bool WithinTolerance(const Pose2& pose, const Pose2& goal, double tolerance_m,
                      double yaw_tolerance_rad) {
   const double yaw_error =

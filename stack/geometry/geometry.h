@@ -50,6 +50,11 @@ struct Twist2 {
 // the exact constant-twist arc, a straight line when the yaw rate is ~0.
 Pose2 MotionAfter(const Twist2& twist, double dt_s);
 
+// The pose a fraction `w` (0: a, 1: b) of the way from `a` to `b`: the
+// position along the straight line, the heading turned the shorter way
+// round (in (-pi, pi]).
+Pose2 InterpolatePose(const Pose2& a, const Pose2& b, double w);
+
 // Whether `pose` lies within `tolerance_m` of `goal` and within
 // `yaw_tolerance_rad` of its heading: the one test of "at the goal pose"
 // that the world (true pose), the stack (its estimate) and the metrics

@@ -147,6 +147,17 @@ TEST(InsidePolygon, ConvexConcaveAndDegenerate) {
   EXPECT_FALSE(InsidePolygon({{0, 0}, {1, 1}}, {0.5, 0.5}));
 }
 
+TEST(InterpolatePoseTest, MovesAlongTheLineAndTurnsTheShortWay) {
+  const Pose2 p = InterpolatePose({0, 0, 0.1}, {2, 4, 0.3}, 0.25);
+  EXPECT_NEAR(p.x_m, 0.5, 1e-12);
+  EXPECT_NEAR(p.y_m, 1.0, 1e-12);
+  EXPECT_NEAR(p.yaw_rad, 0.15, 1e-12);
+  // Across the +-pi seam: half way from 170 deg to -170 deg is 180 deg.
+  const Pose2 q = InterpolatePose({0, 0, M_PI - 0.2}, {0, 0, -M_PI + 0.2}, 0.5);
+  EXPECT_NEAR(std::abs(q.yaw_rad), M_PI, 1e-9);
+  EXPECT_NEAR(InterpolatePose({1, 2, 3}, {5, 6, -3}, 1.0).x_m, 5.0, 1e-12);
+}
+
 TEST(WithinToleranceTest, BothPositionAndHeadingWithinTheirTolerances) {
   const Pose2 goal{10, 5, -M_PI / 2};
   EXPECT_TRUE(WithinTolerance({10.3, 5.39, -M_PI / 2}, goal, 0.5, 0.1));
