@@ -30,8 +30,8 @@ void ForEachStandingSample(const runfile::RunData& run,
 void ReasonTally::Add(StopReason reason, const runfile::StopSample* newest,
                       double dt) {
   per_reason_[reason] += dt;
-  if (reason == StopReason::kObstacle) {
-    TrackTime& t = per_track_[newest->track_id];
+  if (StopReasonNamesTrack(reason)) {
+    TrackTime& t = per_track_[{reason, newest->track_id}];
     t.standing_s += dt;
     t.min_gap_m = std::min(t.min_gap_m, newest->obstacle_gap_m);
     t.static_structure = t.static_structure || newest->static_structure != 0;
@@ -44,12 +44,13 @@ std::vector<StandingTime> ReasonTally::ByReason() const {
     StandingTime t;
     t.reason = reason;
     t.standing_s = seconds;
-    if (reason == StopReason::kObstacle) {
+    if (StopReasonNamesTrack(reason)) {
       const TrackTime* longest = nullptr;
-      for (const auto& [id, track] : per_track_) {
+      for (const auto& [key, track] : per_track_) {
+        if (key.first != reason) continue;
         if (longest == nullptr || track.standing_s > longest->standing_s) {
           longest = &track;
-          t.track_id = id;
+          t.track_id = key.second;
         }
       }
       t.obstacle_gap_m = longest->min_gap_m;
@@ -134,6 +135,7 @@ StopReason HoldingReason(const runfile::StopSample* newest, double t_s,
 
 bool TrafficWillRelease(StopReason reason, const runfile::StopSample* newest) {
   if (reason == StopReason::kRedLight) return true;
+  if (reason == StopReason::kLaneChange) return true;
   return reason == StopReason::kObstacle && newest != nullptr &&
          newest->static_structure == 0;
 }
@@ -158,7 +160,8 @@ bool StallWatch::Observe(double t_s, double v_mps,
   const runfile::StopSample* newest = next_ > 0 ? &stops[next_ - 1] : nullptr;
   const StopReason reason = HoldingReason(newest, t_s, options_);
   if (TrafficWillRelease(reason, newest)) {
-    if (reason != StopReason::kObstacle || traffic_stall_timeout_s_ <= 0)
+    // A red light's wait the planner bounds itself.
+    if (!StopReasonNamesTrack(reason) || traffic_stall_timeout_s_ <= 0)
       return false;
     traffic_s_ += dt;
     traffic_.Add(reason, newest, dt);

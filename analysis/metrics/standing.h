@@ -6,6 +6,7 @@
 
 #include <limits>
 #include <map>
+#include <utility>
 #include <vector>
 
 #include "analysis/runfile/run_data.h"
@@ -77,19 +78,21 @@ StopReason HoldingReason(const runfile::StopSample* newest, double t_s,
                          const StandingOptions& options = {});
 
 // Whether other traffic or a signal will let the car go by itself: a red
-// light (whose wait the planner bounds with max_red_wait_s) or an obstacle
-// where the map has no structure (another road user, which moves on).
+// light (whose wait the planner bounds with max_red_wait_s), a lane change
+// waiting for a gap, or an obstacle where the map has no structure
+// (another road user, which moves on).
 bool TrafficWillRelease(StopReason reason, const runfile::StopSample* newest);
 
-// Time stood, by the reason that held the car (and for obstacles by
-// track): the one attribution of SummarizeStanding, ListStands and
-// StallWatch.
+// Time stood, by the reason that held the car (and for the reasons that
+// name a track, StopReasonNamesTrack, by track): the one attribution of
+// SummarizeStanding, ListStands and StallWatch.
 class ReasonTally {
  public:
-  // `newest`: the stop sample behind `reason` (its track, for kObstacle).
+  // `newest`: the stop sample behind `reason` (its track, for reasons that
+  // name one).
   void Add(StopReason reason, const runfile::StopSample* newest, double dt);
-  // Longest first, ties in code order; for kObstacle the track that held
-  // the car longest (the lowest id on a tie).
+  // Longest first, ties in code order; for reasons that name a track the
+  // one that held the car longest (the lowest id on a tie).
   std::vector<StandingTime> ByReason() const;
 
  private:
@@ -101,7 +104,7 @@ class ReasonTally {
     bool static_structure = false;
   };
   std::map<StopReason, double> per_reason_;
-  std::map<int, TrackTime> per_track_;
+  std::map<std::pair<StopReason, int>, TrackTime> per_track_;  // by track
 };
 
 // Watches a run as it is simulated for a car that stands and will not

@@ -151,6 +151,7 @@ Rgb StandRgb(const analysis::Stand& stand) {
     case StopReason::kRedLight:
       return kStandRedLightRgb;
     case StopReason::kObstacle:
+    case StopReason::kLaneChange:
       return kStandObstacleRgb;
     case StopReason::kLocalizationLost:
       return kStandLocalizationRgb;

@@ -171,7 +171,7 @@ nlohmann::json ToJson(const RunReport& r) {
   for (const analysis::StandingTime& t : r.standing.by_reason) {
     nlohmann::json entry = {{"reason", StopReasonToString(t.reason)},
                             {"standing_s", Number(t.standing_s)}};
-    if (t.reason == StopReason::kObstacle) {
+    if (StopReasonNamesTrack(t.reason)) {
       entry["track_id"] = t.track_id;
       entry["obstacle_gap_m"] = Number(t.obstacle_gap_m);
       entry["static_structure"] = t.static_structure;
@@ -252,7 +252,7 @@ Result<std::vector<analysis::Remedy>> RemediesFromJson(
 
 std::string DescribeStanding(const analysis::StandingTime& t) {
   std::string what = StopReasonToString(t.reason);
-  if (t.reason == StopReason::kObstacle) {
+  if (StopReasonNamesTrack(t.reason)) {
     // A negative gap: the object's near edge is behind the front bumper
     // (it cut in beside the car).
     what += fmt::format(
@@ -284,7 +284,7 @@ std::string FormatSummary(const RunReport& r) {
         runfile::ReasonAfter(r.termination_reason, runfile::kStalledPrefix);
     StopReason reason = StopReason::kNone;
     const bool obstacle =
-        StringToStopReason(held_by, &reason) && reason == StopReason::kObstacle;
+        StringToStopReason(held_by, &reason) && StopReasonNamesTrack(reason);
     out += fmt::format(
         "ended       stalled: the car stood still until {} s, held by {} "
         "({})\n",

@@ -26,7 +26,8 @@ namespace {
 // their heading to planning (they were axis-aligned boxes there). v9:
 // perception places a scan by the pose at its stamp (it used the newest).
 // v10: the obstacle stop also sweeps the car's footprint along the path.
-constexpr char kKeyVersion[] = "adse-run-key-v10";
+// v11: the planner changes lane only when the target lane has a gap.
+constexpr char kKeyVersion[] = "adse-run-key-v11";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

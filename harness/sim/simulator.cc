@@ -153,6 +153,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   // Signals on the route: the stack's map holds them, and the world's
   // detector reports them (runs without keep the graph they always had).
   inputs.traffic_signals = !w.route_signals().empty();
+  inputs.lane_changes = w.route_lane_changes();
   if (w.parking_task()) {
     inputs.parking = true;
     inputs.parking_goal = w.parking_goal();

@@ -536,7 +536,7 @@ StopDecision DecideStop(std::vector<PlannedPoint>* points, bool ends_at_goal,
   // The obstacle's stop lies on the path (never past its end), so at the
   // goal or before it: it is the one that holds the car.
   if (obstacle.stop) {
-    out.reason = StopReason::kObstacle;
+    out.reason = obstacle.reason;
     out.distance_m = std::max(0.0, obstacle.stop_s_m - s0);
     out.obstacle_id = obstacle.obstacle_id;
     out.obstacle_gap_m = obstacle.gap_m;

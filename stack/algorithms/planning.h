@@ -140,6 +140,9 @@ struct ObstacleStop {
   double stop_s_m = -1;           // where v becomes 0 (rear axle), -1: nowhere
   // From the ego's front bumper to the obstacle's near edge, along the path.
   double gap_m = -1;
+  // kObstacle (in the corridor, or crossing it) or kLaneChange (no gap in
+  // the lane the route changes into).
+  StopReason reason = StopReason::kObstacle;
   int64_t work_units = 0;  // obstacles x points
 };
 
@@ -243,8 +246,10 @@ struct StopDecision {
   // Along the path from the ego (rear axle) to where the speed becomes 0;
   // 0 when the stop is there or behind; -1 without a stop.
   double distance_m = -1;
-  // kObstacle only: the track, the gap from the ego's front bumper to its
-  // near edge, and whether the map has structure there.
+  // kObstacle and kLaneChange only: the track, the gap from the ego's
+  // front bumper to its near edge (kLaneChange: along the route, from the
+  // nearer bumper; negative alongside), and whether the map has structure
+  // there.
   int obstacle_id = -1;
   double obstacle_gap_m = -1;
   bool static_structure = false;
@@ -254,8 +259,9 @@ struct StopDecision {
 // no points, no trajectory; localization lost holds the car where it is
 // (every speed set to 0: the planner does not drive by a pose it does not
 // trust); otherwise the nearest of the goal's stop (ends_at_goal: its last
-// point), the obstacle's and a traffic signal's (signal_stop_s_m: where
-// the velocity planner set 0 for a signal, rear axle, route s), or none.
+// point), the obstacle's (for its reason) and a traffic signal's
+// (signal_stop_s_m: where the velocity planner set 0 for a signal, rear axle,
+// route s), or none.
 StopDecision DecideStop(std::vector<PlannedPoint>* points, bool ends_at_goal,
                         bool localization_lost, const ObstacleStop& obstacle,
                         std::optional<double> signal_stop_s_m = std::nullopt);

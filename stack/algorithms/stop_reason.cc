@@ -14,6 +14,7 @@ const std::vector<Term<StopReason>>& StopReasonTerms() {
       {StopReason::kLocalizationLost, "localization_lost"},
       {StopReason::kNoTrajectory, "no_trajectory"},
       {StopReason::kRedLight, "red_light"},
+      {StopReason::kLaneChange, "lane_change"},
   };
   return kTerms;
 }
@@ -30,6 +31,10 @@ bool StringToStopReason(std::string_view name, StopReason* reason) {
 
 std::vector<std::string> StopReasonNames() {
   return NamesOf(StopReasonTerms());
+}
+
+bool StopReasonNamesTrack(StopReason reason) {
+  return reason == StopReason::kObstacle || reason == StopReason::kLaneChange;
 }
 
 }  // namespace adse

@@ -23,6 +23,8 @@ enum class StopReason : int8_t {
   kRedLight = 5,          // "red_light": a traffic signal's stop line (red,
                           // a yellow it can stop for, or a state it cannot
                           // read until it has waited that out)
+  kLaneChange = 6,        // "lane_change": before a lane change, for a gap
+                          // in the target lane
 };
 
 const char* StopReasonToString(StopReason reason);
@@ -30,6 +32,9 @@ const char* StopReasonToString(StopReason reason);
 bool StringToStopReason(std::string_view name, StopReason* reason);
 // Every reason's name, in code order.
 std::vector<std::string> StopReasonNames();
+// The stops for a tracked object (kObstacle, kLaneChange): they name the
+// track and its gap.
+bool StopReasonNamesTrack(StopReason reason);
 
 }  // namespace adse
 

@@ -117,6 +117,7 @@ class Stack final : public AdStack {
   std::unique_ptr<algo::TrafficLightPlanner> traffic_light_;
   std::optional<ObjectsMsg> stop_objects_;
   std::unique_ptr<algo::CrossingYielder> crossing_yield_;
+  std::unique_ptr<algo::LaneChangeGuard> lane_change_;
   std::optional<PoseMsg> smoother_pose_;
   std::unique_ptr<algo::TrajectoryFollower> follower_;
   std::optional<PoseMsg> follower_pose_;
@@ -561,6 +562,16 @@ void Stack::BuildPlanning(Graph* g) {
   yield_params.max_decel_mps2 = config_.Get("planning.max_decel_mps2");
   yield_params.max_accel_mps2 = config_.Get("planning.max_accel_mps2");
   crossing_yield_ = std::make_unique<algo::CrossingYielder>(yield_params);
+  // Autoware's lane change is a behavior_path_planner module; here it sits
+  // beside the crossing yield, which has the objects.
+  algo::LaneChangeParams lane_change_params;
+  lane_change_params.ego_front_m = stop_params.ego_front_m;
+  lane_change_params.ego_rear_m =
+      inputs_.vehicle_length_m / 2 - inputs_.wheelbase_m / 2;
+  lane_change_params.max_accel_mps2 = config_.Get("planning.max_accel_mps2");
+  lane_change_params.max_decel_mps2 = config_.Get("planning.max_decel_mps2");
+  lane_change_ = std::make_unique<algo::LaneChangeGuard>(
+      inputs_.route, inputs_.lane_changes, lane_change_params);
   structure_grid_.SetMap(inputs_.map_cloud);
   const int stop_node = g->AddNode("obstacle_stop_planner");
   g->Subscribe<ObjectsMsg>(
@@ -580,7 +591,10 @@ void Stack::BuildPlanning(Graph* g) {
             algo::InsertObstacleStop(&points, obstacles, stop_params);
         const algo::ObstacleStop crossing = crossing_yield_->Plan(
             &points, obstacles, in.ego_v_mps, ctx.now_s(), stop_params);
-        algo::ObstacleStop stop = algo::NearerStop(in_path, crossing);
+        const algo::ObstacleStop lane_change =
+            lane_change_->Plan(&points, obstacles, in.ego_v_mps, ctx.now_s());
+        algo::ObstacleStop stop =
+            algo::NearerStop(algo::NearerStop(in_path, crossing), lane_change);
         // Whether the map has structure there matters only for the object
         // stopped for.
         if (stop.obstacle_id >= 0) {
@@ -606,8 +620,9 @@ void Stack::BuildPlanning(Graph* g) {
         out.stop.obstacle_gap_m = decision.obstacle_gap_m;
         out.stop.static_structure = decision.static_structure;
         ctx.ReportWork(
-            {static_cast<double>(in_path.work_units + crossing.work_units), 0.0,
-             1});
+            {static_cast<double>(in_path.work_units + crossing.work_units +
+                                 lane_change.work_units),
+             0.0, 1});
         ctx.Publish(topics_.stop_reason, out.stop);
         ctx.Publish(trajectory_raw_, std::move(out));
       });

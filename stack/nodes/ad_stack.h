@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "stack/algorithms/lane_change.h"
 #include "stack/base/status.h"
 #include "stack/config/stack_config.h"
 #include "stack/geometry/geometry.h"
@@ -40,6 +41,9 @@ struct StackInputs {
   // the stack then subscribes to the signal detector and its velocity
   // planner stops for them. Without, the graph has neither.
   bool traffic_signals = false;
+  // Where the route changes lane (a lanelet route knows): the planner
+  // changes lane only when the target lane has a gap.
+  std::vector<algorithms::LaneChangeSection> lane_changes;
 };
 
 // Topic indices the harness talks to.

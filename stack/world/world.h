@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "stack/algorithms/lane_change.h"
 #include "stack/base/status.h"
 #include "stack/geometry/geometry.h"
 #include "stack/world/map_builder.h"
@@ -116,6 +117,8 @@ class World {
   // ('r', 'y', 'G', 'g', 'u', 'o', 's', ...), in the same order.
   const std::vector<RouteSignal>& route_signals() const;
   std::string RouteSignalStates() const;
+  // Where the road part changes lane, in route order (along road_path()).
+  const std::vector<algorithms::LaneChangeSection>& route_lane_changes() const;
 
   const geometry::Path2& ideal_path() const;
   const std::vector<std::string>& route_edges() const;

@@ -370,6 +370,17 @@ Status World::Impl::PlanRoute() {
   return Status::Ok();
 }
 
+double World::Impl::RoadS(double raw_s_m) const {
+  // Resample() put road point i at raw arc length L * i / n; a raw arc
+  // length maps to the road's between its neighbours.
+  const int n = static_cast<int>(road.points.size()) - 1;
+  if (n < 1) return 0.0;
+  const double f =
+      raw_length_m > 0 ? std::clamp(raw_s_m / raw_length_m, 0.0, 1.0) * n : 0.0;
+  const int i = std::min(static_cast<int>(std::floor(f)), n - 1);
+  return road.s_m[i] + (f - i) * (road.s_m[i + 1] - road.s_m[i]);
+}
+
 Status World::Impl::BuildIdealPath() {
   try {
     // Pick, from the goal backwards, a lane on each edge that connects to
@@ -447,6 +458,7 @@ Status World::Impl::BuildIdealPath() {
       }
     };
     crossings.clear();
+    lane_changes.clear();
     double width_sum = 0.0;
     for (size_t i = 0; i < n; ++i) {
       // Entry lane: the one the previous connection arrives on.
@@ -468,19 +480,31 @@ Status World::Impl::BuildIdealPath() {
           Slice(ToPoints(libsumo::Lane::getShape(exit_id)), s0, s1);
       if (entry != lane[i]) {
         // A lane change: blend from the entry lane into the exit lane over
-        // the middle of the edge.
+        // the middle of the edge (lane s here; the route's section below).
         geometry::Path2 from, to;
         from.points = ToPoints(libsumo::Lane::getShape(entry_id));
         from.UpdateArcLength();
         to.points = ToPoints(libsumo::Lane::getShape(exit_id));
         to.UpdateArcLength();
+        algorithms::LaneChangeSection blend;
+        blend.start_s_m = s0 + 0.25 * (s1 - s0);
+        blend.end_s_m = s0 + 0.75 * (s1 - s0);
         part.clear();
         for (double s = s0; s <= s1 + 1e-9; s += kResampleStepM) {
-          const double u = (s1 - s0) > 1e-6 ? (s - s0) / (s1 - s0) : 1.0;
-          const double alpha = std::clamp((u - 0.25) / 0.5, 0.0, 1.0);
-          const double w = alpha * alpha * (3 - 2 * alpha);  // smoothstep
+          const double w = blend.Weight(s);
           part.push_back((1 - w) * from.PointAt(s) + w * to.PointAt(s));
         }
+        // SUMO numbers a road's lanes from the right.
+        const double width = libsumo::Lane::getWidth(exit_id);
+        const double raw_at_s0 =
+            raw_s + (points.empty() || part.empty()
+                         ? 0.0
+                         : (part.front() - points.back()).norm());
+        blend.start_s_m += raw_at_s0 - s0;
+        blend.end_s_m += raw_at_s0 - s0;
+        blend.shift_m = (lane[i] - entry) * width;
+        blend.lane_width_m = width;
+        lane_changes.push_back(blend);
       }
       append(part);
       if (i + 1 < n) {
@@ -499,6 +523,10 @@ Status World::Impl::BuildIdealPath() {
 
     road = Resample(points, kResampleStepM);
     raw_length_m = raw_s;
+    for (algorithms::LaneChangeSection& c : lane_changes) {
+      c.start_s_m = RoadS(c.start_s_m);
+      c.end_s_m = RoadS(c.end_s_m);
+    }
     ideal = road;
     if (valet) {
       // The reference manoeuvre: the freespace planner's path from where the

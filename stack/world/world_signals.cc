@@ -35,20 +35,13 @@ Status World::Impl::FindRouteSignals() {
         }
       }
     }
-    // Resample() put road point i at raw arc length L * i / n; a raw arc
-    // length maps to the road's between its neighbours.
-    const int n = static_cast<int>(road.points.size()) - 1;
     for (const Crossing& c : crossings) {
       const auto it = controlled.find(
           c.via_lane.empty() ? std::make_pair(c.from_lane, "->" + c.to_lane)
                              : std::make_pair(c.from_lane, c.via_lane));
       if (it == controlled.end()) continue;
-      const double f = raw_length_m > 0
-                           ? std::clamp(c.raw_s_m / raw_length_m, 0.0, 1.0) * n
-                           : 0.0;
-      const int i = std::min(static_cast<int>(std::floor(f)), n - 1);
-      const double s = road.s_m[i] + (f - i) * (road.s_m[i + 1] - road.s_m[i]);
-      signals.push_back({it->second.first, it->second.second, s});
+      signals.push_back(
+          {it->second.first, it->second.second, RoadS(c.raw_s_m)});
     }
   } catch (const std::exception& e) {
     return Status::Internal(
@@ -59,6 +52,11 @@ Status World::Impl::FindRouteSignals() {
 
 const std::vector<RouteSignal>& World::route_signals() const {
   return impl_->signals;
+}
+
+const std::vector<algorithms::LaneChangeSection>& World::route_lane_changes()
+    const {
+  return impl_->lane_changes;
 }
 
 std::string World::RouteSignalStates() const {

@@ -70,6 +70,8 @@ struct World::Impl {
   };
   std::vector<Crossing> crossings;
   double raw_length_m = 0.0;  // of the joined lane pieces of the road part
+  // Where the road part changes lane (route s of the road part).
+  std::vector<algorithms::LaneChangeSection> lane_changes;
   std::vector<RouteSignal> signals;  // the crossings a traffic light controls
   geometry::Path2 ideal;
   // The ego on the road part: arc length reached so far and its distance
@@ -115,6 +117,8 @@ struct World::Impl {
                                             const std::string& from_field);
   Status PlanRoute();
   Status BuildIdealPath();
+  // The road part's arc length at `raw_s_m` along the joined lane pieces.
+  double RoadS(double raw_s_m) const;
   // The crossings' traffic lights (world_signals.cc).
   Status FindRouteSignals();
   Status BuildScene();

@@ -242,6 +242,26 @@ TEST(StallWatchTest,
   EXPECT_FALSE(by_wall.held_by_traffic());
 }
 
+TEST(StallWatchTest, ATargetLaneThatNeverHasAGapStallsTheCarAsTraffic) {
+  // 200 s waiting to change lane beside track 8: a road user, so the
+  // traffic bound (120 s), not the stall timeout (60 s), ends it.
+  runfile::RunData run = RunStanding({{0, 200}}, 200.0);
+  StopSample waiting = Obstacle(8, -2.5, false);
+  waiting.reason = StopReason::kLaneChange;
+  Publish(&run, 0, 200, waiting);
+  StallWatch watch(60.0, 120.0);
+  EXPECT_NEAR(StalledAt(run, &watch), 120.0, 0.11);
+  EXPECT_EQ(watch.reason(), StopReason::kLaneChange);
+  EXPECT_EQ(watch.track_id(), 8);
+  EXPECT_TRUE(watch.held_by_traffic());
+  // The summary names the track and its gap beside the car.
+  const StandingSummary summary = SummarizeStanding(run);
+  ASSERT_EQ(summary.by_reason.size(), 1u);
+  EXPECT_EQ(summary.by_reason[0].reason, StopReason::kLaneChange);
+  EXPECT_EQ(summary.by_reason[0].track_id, 8);
+  EXPECT_DOUBLE_EQ(summary.by_reason[0].obstacle_gap_m, -2.5);
+}
+
 TEST(StallWatchTest, TimeHeldByTrafficPausesTheCountWithoutResettingIt) {
   // 40 s lost, 20 s at a red light, 30 s lost: 70 s counted.
   runfile::RunData run = RunStanding({{0, 100}});

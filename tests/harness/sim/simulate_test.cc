@@ -309,6 +309,38 @@ TEST(SimulateTest, ACarBehindARoadUserThatNeverMovesOnEndsStalledByIt) {
   EXPECT_EQ(waits->termination_reason, "timeout");
 }
 
+TEST(SimulateTest, TheCarChangesLaneIntoAGapNotBesideAnOvertakingCar) {
+  // A two-lane road whose left turn leaves from the left lane; the car
+  // starts in the right one and must change lane. A flow to the same turn
+  // starts behind it, faster than the car's 30 km/h, and overtakes it in
+  // the left lane.
+  spec::Spec spec = SmallScenario();
+  spec.harness.early_stop = false;  // its nav-time bound is the small lot's
+  spec.world.map = {};
+  spec.world.map.net_path = std::string(ADSE_SOURCE_DIR) +
+                            "/tests/data/nets/two_lanes_left_turn.net.xml";
+  spec.world.traffic.parked_occupancy = 0.0;
+  spec.world.traffic.flows = {{"ab", "bc", 400.0}};
+  spec.task.start = world::Location::Xy(40.0, -4.8);
+  spec.task.goal = world::Location::Xy(401.6, 120.0);
+  Result<runfile::RunData> run = SimulatePoint(spec, SmallPoint(16, 2.1, 7));
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->termination_reason, "goal_reached");
+  EXPECT_EQ(run->metrics.at("collisions"), 0.0);
+  // The planner held its plan at the lane change for an overtaking car,
+  // naming it, while the car was still in its own lane.
+  int held = 0;
+  size_t e = 0;
+  for (const runfile::StopSample& stop : run->stop_reasons) {
+    if (stop.reason != StopReason::kLaneChange) continue;
+    ++held;
+    EXPECT_GE(stop.track_id, 0);
+    while (e + 1 < run->ego.size() && run->ego[e + 1].t_s <= stop.t_s) ++e;
+    EXPECT_NEAR(run->ego[e].y_m, -4.8, 0.3) << "at " << stop.t_s << " s";
+  }
+  EXPECT_GT(held, 0);
+}
+
 TEST(SimulateTest, PointOutsideTheSpaceIsRejected) {
   Result<runfile::RunData> run =
       SimulatePoint(SmallScenario(), SmallPoint(3, 2.1, 7));

@@ -446,10 +446,14 @@ TEST(PathPlanner, EmptyWithoutRoute) {
 
 TEST(StopReason, OneNamePerValueAndBack) {
   const std::vector<std::string> names = StopReasonNames();
-  ASSERT_EQ(names.size(), 6u);
+  ASSERT_EQ(names.size(), 7u);
   // The codes stored in run files never change; new ones come last.
   EXPECT_EQ(names[4], "no_trajectory");
   EXPECT_EQ(names[5], "red_light");
+  EXPECT_EQ(names[6], "lane_change");
+  EXPECT_TRUE(StopReasonNamesTrack(StopReason::kObstacle));
+  EXPECT_TRUE(StopReasonNamesTrack(StopReason::kLaneChange));
+  EXPECT_FALSE(StopReasonNamesTrack(StopReason::kRedLight));
   for (size_t i = 0; i < names.size(); ++i) {
     StopReason reason = StopReason::kNone;
     ASSERT_TRUE(StringToStopReason(names[i], &reason)) << names[i];

@@ -541,6 +541,36 @@ WorldSetup TwoAisleLot() {
   return setup;
 }
 
+TEST(WorldTest, ARouteThatChangesLaneSaysWhereAndByHowMuch) {
+  // A two-lane road whose left turn leaves from its left lane only; the
+  // car starts in the right lane.
+  const std::string net = std::string(ADSE_SOURCE_DIR) +
+                          "/tests/data/nets/two_lanes_left_turn.net.xml";
+  WorldSetup setup;
+  setup.world.map.net_path = net;
+  setup.task.start = Location::Xy(20, -4.8);   // right lane, eastbound
+  setup.task.goal = Location::Xy(401.6, 100);  // north, after the left turn
+  setup.cache_dir = CacheDir();
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  const auto& changes = (*world)->route_lane_changes();
+  ASSERT_EQ(changes.size(), 1u);
+  const algorithms::LaneChangeSection& change = changes.front();
+  EXPECT_NEAR(change.shift_m, 3.2, 1e-6);  // one lane to the left
+  EXPECT_NEAR(change.lane_width_m, 3.2, 1e-6);
+  // The middle half of what the route drives of the road: 20 to 400 m,
+  // less the junction's corner.
+  EXPECT_NEAR(change.start_s_m, 93.0, 3.0);
+  EXPECT_NEAR(change.end_s_m, 280.0, 5.0);
+  // The road part is in the right lane up to the section, in the left one
+  // from its end, and half way across at its middle.
+  const geometry::Path2& road = (*world)->road_path();
+  EXPECT_NEAR(road.PointAt(change.start_s_m).y(), -4.8, 0.05);
+  EXPECT_NEAR(road.PointAt(0.5 * (change.start_s_m + change.end_s_m)).y(), -3.2,
+              0.05);
+  EXPECT_NEAR(road.PointAt(change.end_s_m).y(), -1.6, 0.05);
+}
+
 TEST(WorldTest, WaypointsLeadTheRouteThroughTheAislesInOrder) {
   WorldSetup direct = TwoAisleLot();
   WorldSetup serpentine = TwoAisleLot();
