@@ -252,7 +252,14 @@ Result<std::vector<analysis::Remedy>> RemediesFromJson(
 
 std::string DescribeStanding(const analysis::StandingTime& t) {
   std::string what = StopReasonToString(t.reason);
-  if (StopReasonNamesTrack(t.reason)) {
+  if (t.reason == StopReason::kLaneChange) {
+    // The gap runs from the nearer bumper, ahead or behind; negative, the
+    // object is beside the car.
+    what += fmt::format(" (track {}, {} in the target lane)", t.track_id,
+                        t.obstacle_gap_m >= 0
+                            ? fmt::format("{:.1f} m away", t.obstacle_gap_m)
+                            : std::string("beside the car"));
+  } else if (StopReasonNamesTrack(t.reason)) {
     // A negative gap: the object's near edge is behind the front bumper
     // (it cut in beside the car).
     what += fmt::format(

@@ -178,6 +178,21 @@ TEST(RunReportTest, AnObjectBesideTheCarIsSaidToBeBesideIt) {
             "33.6 s");
 }
 
+TEST(RunReportTest, AWaitForALaneChangeNamesTheCarWithoutItsGap) {
+  analysis::StandingTime t;
+  t.reason = StopReason::kLaneChange;
+  t.standing_s = 19.1;
+  t.track_id = 122;
+  t.obstacle_gap_m = -4.2;
+  EXPECT_EQ(DescribeStanding(t),
+            "lane_change (track 122, beside the car in the target lane): "
+            "19.1 s");
+  // A car behind is not "ahead": the gap has no direction.
+  t.obstacle_gap_m = 20.0;
+  EXPECT_EQ(DescribeStanding(t),
+            "lane_change (track 122, 20.0 m away in the target lane): 19.1 s");
+}
+
 TEST(RunReportTest, AnOldRunFileSaysItHasNoStopReasons) {
   runfile::RunData run = StoodRun();
   run.stop_reasons.clear();
