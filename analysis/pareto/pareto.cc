@@ -19,6 +19,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // differ in the last bits; they still form one level.
 constexpr double kViolationRelTol = 1e-12;
 constexpr double kDesignPointTol = 1e-9;
+// Objective values equal to this many significant digits tie.
+constexpr int kTieDigits = 12;
 
 // The most common objective count (first seen wins ties); 0 if none.
 size_t ObjectiveCount(const std::vector<Evaluation>& evals) {
@@ -83,7 +85,11 @@ std::vector<pagmo::vector_double> Objectives(
     const std::vector<Evaluation>& evals, const std::vector<int>& subset) {
   std::vector<pagmo::vector_double> points;
   points.reserve(subset.size());
-  for (int i : subset) points.push_back(evals[i].objectives);
+  for (int i : subset) {
+    pagmo::vector_double f = evals[i].objectives;
+    for (double& v : f) v = TieKey(v);
+    points.push_back(std::move(f));
+  }
   return points;
 }
 
@@ -262,6 +268,14 @@ SearchQuality CompareImpl(const std::vector<Evaluation>& found,
 
 }  // namespace
 
+double TieKey(double value) {
+  if (!std::isfinite(value) || value == 0.0) return value;
+  const int digits = kTieDigits - 1 -
+                     static_cast<int>(std::floor(std::log10(std::abs(value))));
+  const double scale = std::pow(10.0, digits);
+  return std::round(value * scale) / scale;
+}
+
 bool SameDesignPoint(const std::map<std::string, double>& a,
                      const std::map<std::string, double>& b) {
   if (a.size() != b.size()) return false;
@@ -290,8 +304,10 @@ double PointsHypervolume(const std::vector<std::vector<double>>& points,
 bool Dominates(const std::vector<double>& a, const std::vector<double>& b) {
   bool better = false;
   for (size_t i = 0; i < a.size() && i < b.size(); ++i) {
-    if (a[i] > b[i]) return false;
-    if (a[i] < b[i]) better = true;
+    const double x = TieKey(a[i]);
+    const double y = TieKey(b[i]);
+    if (x > y) return false;
+    if (x < y) better = true;
   }
   return better;
 }
@@ -299,7 +315,7 @@ bool Dominates(const std::vector<double>& a, const std::vector<double>& b) {
 bool WeaklyDominates(const std::vector<double>& a,
                      const std::vector<double>& b) {
   for (size_t i = 0; i < a.size() && i < b.size(); ++i) {
-    if (a[i] > b[i]) return false;
+    if (TieKey(a[i]) > TieKey(b[i])) return false;
   }
   return true;
 }

@@ -10,7 +10,10 @@
 //    reference point. (±inf objectives are usable and compare as expected.)
 //  - `feasible` is authoritative; `violation` only orders infeasible
 //    evaluations (NaN or negative counts as +inf / 0).
-//  - Index lists are ascending; exact duplicates are all kept (neither
+//  - Objective values equal to 12 significant digits tie, in every
+//    dominance test here: float noise (7 x 1.8 against 6 x 2.1) never puts
+//    the slower of two equally priced computers on a front.
+//  - Index lists are ascending; duplicates are all kept (neither
 //    dominates the other).
 // Nothing here throws (pagmo's exceptions are caught inside).
 #ifndef ADSE_ANALYSIS_PARETO_PARETO_H_
@@ -60,6 +63,11 @@ double Hypervolume(const std::vector<Evaluation>& evals,
 // many times per round (pagmo's exact algorithms, no copies of maps).
 double PointsHypervolume(const std::vector<std::vector<double>>& points,
                          const std::vector<double>& reference);
+
+// The value an objective is compared by: rounded to 12 significant
+// digits, so that a cost expression's float noise (7 x 1.8 and 6 x 2.1
+// GHz-cores a last bit apart) is a tie. Non-finite values and 0 unchanged.
+double TieKey(double value);
 
 // Pareto dominance (minimisation) of two objective vectors of equal size:
 // `a` is no worse anywhere and better somewhere.

@@ -336,7 +336,7 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
      << " | feasible | picture |\n|---|---|";
   for (size_t i = 0; i < columns.size(); ++i) md << "---|";
   md << "---|---|\n";
-  for (int i : s.pareto_front) {
+  for (int i : CheapestFirst(rows, s.pareto_front)) {
     const EvaluationRow& row = rows[static_cast<size_t>(i)];
     md << "| " << row.index << " | "
        << spec::FormatPoint(spec.design_space, row.point) << " | ";

@@ -9,8 +9,10 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "analysis/metrics/run_metrics.h"
+#include "analysis/pareto/pareto.h"
 #include "analysis/pictures/pictures.h"
 #include "harness/campaign/replicas.h"
 #include "harness/spec/spec_parser.h"
@@ -117,7 +119,21 @@ bool SimpleBound(const std::string& constraint, const std::string& metric,
   return false;
 }
 
-double CostKey(double cost) { return std::round(cost * 1e9) / 1e9; }
+std::vector<int> CheapestFirst(const std::vector<EvaluationRow>& rows,
+                               std::vector<int> indices) {
+  // A missing value (a censored run's time) sorts last.
+  auto key = [&](int i) {
+    auto last = [](double v) {
+      return std::isnan(v) ? std::numeric_limits<double>::infinity() : v;
+    };
+    return std::make_tuple(
+        last(analysis::TieKey(RowMetric(rows[i], kCostMetric))),
+        last(RowMetric(rows[i], kTimeMetric)), i);
+  };
+  std::sort(indices.begin(), indices.end(),
+            [&](int a, int b) { return key(a) < key(b); });
+  return indices;
+}
 
 Headline ComputeHeadline(const spec::Spec& spec,
                          const std::vector<EvaluationRow>& rows) {
@@ -130,8 +146,10 @@ Headline ComputeHeadline(const spec::Spec& spec,
     }
   }
   // 3 x 1.2 (3.5999999999999996) and 2 x 1.8 cost the same, and the
-  // faster of them is the cheapest design.
-  auto cost = [&](int i) { return CostKey(RowMetric(rows[i], kCostMetric)); };
+  // faster of them is the cheapest design: costs compare as the front does.
+  auto cost = [&](int i) {
+    return analysis::TieKey(RowMetric(rows[i], kCostMetric));
+  };
   auto time = [&](int i) { return RowMetric(rows[i], kTimeMetric); };
   auto by_cost = [&](int a, int b) {
     return cost(a) != cost(b)   ? cost(a) < cost(b)
@@ -197,7 +215,7 @@ std::string HeadlineText(const spec::Spec& spec,
     objectives.push_back(o.metric);
   out << fmt::format("Pareto front over {} ({} of {} evaluations):\n",
                      fmt::join(objectives, ", "), h.front.size(), rows.size());
-  for (int i : h.front) {
+  for (int i : CheapestFirst(rows, h.front)) {
     const EvaluationRow& row = rows[i];
     out << fmt::format("  {:<36} cost {:>7}  nav {:>9}  ctrl {:>8}{}\n",
                        spec::FormatPoint(spec.design_space, row.point),

@@ -85,9 +85,10 @@ Status RenderStudyPicture(const spec::Spec& spec,
                           const std::string& title, const std::string& png_path,
                           Env* env = Env::Default());
 
-// A cost as the headline compares costs: to 1e-9, so that products of
-// design values that differ only in rounding (3 x 1.2, 2 x 1.8) tie.
-double CostKey(double cost);
+// `indices` (rows) cheapest first, then fastest, as every front is
+// listed for the user.
+std::vector<int> CheapestFirst(const std::vector<EvaluationRow>& rows,
+                               std::vector<int> indices);
 
 // A constraint of the form `metric OP number` or `number OP metric`
 // (OP one of < <= > >=) on `metric`: its bound. False for anything else.

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "analysis/pareto/pareto.h"
 #include "harness/campaign/headline.h"
 #include "harness/campaign/strategy_factory.h"
 #include "harness/spec/spec_parser.h"
@@ -113,14 +114,15 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
   const Headline answer = ComputeHeadline(spec, recording.rows);
   const double cheapest =
       answer.cheapest >= 0
-          ? CostKey(RowMetric(recording.rows[answer.cheapest], "hardware_cost"))
+          ? analysis::TieKey(
+                RowMetric(recording.rows[answer.cheapest], "hardware_cost"))
           : std::numeric_limits<double>::quiet_NaN();
   for (const EvaluationRow& row : result.evaluations) {
     run.proposals.push_back(row.point);
     run.found_cheapest_feasible =
         run.found_cheapest_feasible ||
         (row.status == runfile::kRunComplete && row.feasible &&
-         CostKey(RowMetric(row, "hardware_cost")) == cheapest);
+         analysis::TieKey(RowMetric(row, "hardware_cost")) == cheapest);
   }
   return run;
 }

@@ -59,6 +59,38 @@ TEST(ParetoFrontTest, SameValueInOneObjectiveKeepsOnlyTheBetterOther) {
   EXPECT_EQ(ParetoFront(evals), (std::vector<int>{1}));
 }
 
+TEST(ParetoFrontTest, CostsThatDifferOnlyInTheLastBitTie) {
+  // 7 cores x 1.8 GHz is 12.6 and 6 x 2.1 is 12.600000000000001: the same
+  // price, so only the faster computer is on the front, in 2-D (Kung's
+  // algorithm) and in 3-D (non-dominated sorting) alike.
+  const double seven_by_1_8 = 7 * 1.8;
+  const double six_by_2_1 = 6 * 2.1;
+  ASSERT_LT(seven_by_1_8, six_by_2_1);
+  EXPECT_EQ(
+      ParetoFront({Eval({seven_by_1_8, 173.2}), Eval({six_by_2_1, 163.1})}),
+      (std::vector<int>{1}));
+  EXPECT_EQ(ParetoFront({Eval({seven_by_1_8, 173.2, -28.4}),
+                         Eval({six_by_2_1, 163.1, -28.5})}),
+            (std::vector<int>{1}));
+  EXPECT_EQ(
+      ParetoRanks({Eval({seven_by_1_8, 173.2}), Eval({six_by_2_1, 163.1})}),
+      (std::vector<int>{1, 0}));
+  EXPECT_TRUE(analysis::Dominates({six_by_2_1, 163.1}, {seven_by_1_8, 173.2}));
+  EXPECT_TRUE(WeaklyDominates({six_by_2_1, 1.0}, {seven_by_1_8, 1.0}));
+}
+
+TEST(ParetoTieKeyTest, RoundsToTwelveSignificantDigits) {
+  EXPECT_EQ(TieKey(7 * 1.8), TieKey(6 * 2.1));
+  EXPECT_EQ(TieKey(3 * 1.2), TieKey(2 * 1.8));
+  EXPECT_EQ(TieKey(-7 * 1.8), TieKey(-6 * 2.1));
+  // A real difference, even in the 10th digit, stays one.
+  EXPECT_LT(TieKey(12.6), TieKey(12.600000001));
+  EXPECT_LT(TieKey(1e-7), TieKey(1.0000001e-7));
+  EXPECT_EQ(TieKey(0.0), 0.0);
+  EXPECT_EQ(TieKey(kInf), kInf);
+  EXPECT_TRUE(std::isnan(TieKey(kNaN)));
+}
+
 TEST(ParetoFrontTest, InfeasiblePointsNeverBeatFeasibleOnes) {
   // The infeasible (0, 0) would dominate everything.
   const std::vector<Evaluation> evals = {Eval({0, 0}, false, 5.0), Eval({1, 5}),

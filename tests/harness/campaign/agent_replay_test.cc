@@ -72,7 +72,9 @@ TEST(AgentReplayTest, OnTheRecordedRobotaxiCampaign) {
 }
 
 TEST(AgentReplayTest, OnTheReferenceStudyWhereStarvedRunsAreStoppedEarly) {
-  ExpectAgentOn("reference_study", {7, 0.98, 18});
+  // Its cheapest design (8 cores at 1.0 GHz) is found in no seed: the
+  // diagnosis sends the agent up the clock (README, "Strategies").
+  ExpectAgentOn("reference_study", {6, 0.96, 0});
 }
 
 TEST(AgentReplayTest, OnALandscapeThatSaturates) {
@@ -80,11 +82,11 @@ TEST(AgentReplayTest, OnALandscapeThatSaturates) {
 }
 
 TEST(AgentReplayTest, OnALandscapeCutByATimeBoundWithCensoredRuns) {
-  ExpectAgentOn("landscapes/constraint_cut", {6, 0.98, 17});
+  ExpectAgentOn("landscapes/constraint_cut", {7, 0.98, 15});
 }
 
 TEST(AgentReplayTest, OnANoisyLandscape) {
-  ExpectAgentOn("landscapes/noisy", {2, 0.9, 10});
+  ExpectAgentOn("landscapes/noisy", {3, 0.93, 12});
 }
 
 TEST(AgentReplayTest, OnALandscapePricedByAnotherCostExpression) {
