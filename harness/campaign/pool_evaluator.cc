@@ -137,6 +137,28 @@ std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
   row->content_key = p.key;
   row->source = source;
   row->attempts = p.attempt;
+  if (p.attempt == 0) {
+    // Taken over from an earlier sitting: what the run took then.
+    Result<RunCost> cost = ReadRunCost(folder_.CostPath(p.key));
+    if (cost.ok() && cost->content_key == p.key) {
+      row->attempts = cost->attempts;
+      row->wall_s = cost->wall_s;
+    }
+  }
+  return row;
+}
+
+std::optional<EvaluationRow> PoolEvaluator::LoadSimulated(const Pending& p,
+                                                          double wall_s) {
+  std::optional<EvaluationRow> row = LoadRun(p, "simulated");
+  if (!row) return row;
+  row->wall_s = wall_s;
+  // Bookkeeping only: losing it costs a resumed index the wall time.
+  if (Status s = WriteRunCost(folder_.CostPath(p.key),
+                              {p.key, p.attempt, wall_s}, folder_.env());
+      !s.ok()) {
+    std::fprintf(stderr, "warning: %s\n", s.message().c_str());
+  }
   return row;
 }
 
@@ -289,8 +311,7 @@ void PoolEvaluator::Finish(const pool::JobResult& result) {
   }
   std::string detail;
   if (result.outcome == pool::Outcome::kOk) {
-    if (auto row = LoadRun(p, "simulated")) {
-      row->wall_s = result.wall_s;
+    if (auto row = LoadSimulated(p, result.wall_s)) {
       if (options_.cache != nullptr) {
         // A cache that cannot be written costs reuse, not the result.
         if (Status s = options_.cache->Insert(p.key, folder_.RunPath(p.key));
@@ -368,8 +389,7 @@ std::vector<EvaluationRow> PoolEvaluator::Cancel() {
     // A run whose file landed just before the stop is kept, not redone.
     std::error_code ec;
     if (fs::exists(folder_.RunPath(it->second.key), ec)) {
-      if (auto row = LoadRun(it->second, "simulated")) {
-        row->wall_s = r.wall_s;
+      if (auto row = LoadSimulated(it->second, r.wall_s)) {
         Deliver(it->second, *std::move(row));
       }
     }

@@ -83,6 +83,9 @@ class PoolEvaluator : public Evaluator {
   // (then it is moved aside and the point simulated again).
   std::optional<EvaluationRow> LoadRun(const Pending& p,
                                        const std::string& source);
+  // LoadRun of a run a worker has just written, with what it took
+  // (attempts, wall time), which is also kept beside the run file.
+  std::optional<EvaluationRow> LoadSimulated(const Pending& p, double wall_s);
   EvaluationRow FailedRow(const Pending& p, const FailureRecord& record,
                           const std::string& source) const;
   void Dispatch();

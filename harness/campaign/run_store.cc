@@ -33,6 +33,9 @@ std::string CampaignFolder::ReportPath(const std::string& key) const {
 std::string CampaignFolder::FailurePath(const std::string& key) const {
   return root_ + "/runs/" + key + ".failed.json";
 }
+std::string CampaignFolder::CostPath(const std::string& key) const {
+  return root_ + "/runs/" + key + ".cost.json";
+}
 std::string CampaignFolder::LogPath(const std::string& key, int attempt) const {
   return fmt::format("{}/logs/{}.{}.log", root_, key, attempt);
 }
@@ -136,6 +139,33 @@ Result<FailureRecord> ReadFailureRecord(const std::string& path) {
     return Status::Corruption(path + ": " + e.what());
   }
   return r;
+}
+
+Status WriteRunCost(const std::string& path, const RunCost& cost, Env* env) {
+  const nlohmann::json j = {{"content_key", cost.content_key},
+                            {"attempts", cost.attempts},
+                            {"wall_s", cost.wall_s}};
+  return WriteFileAtomic(path, j.dump(2) + "\n", env);
+}
+
+Result<RunCost> ReadRunCost(const std::string& path) {
+  Result<std::string> text = ReadFile(path, 1 << 16);
+  if (!text.ok()) return text.status();
+  const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
+  if (!j.is_object() || !j.contains("content_key") ||
+      !j["content_key"].is_string() || !j.contains("attempts") ||
+      !j["attempts"].is_number_integer() || !j.contains("wall_s") ||
+      !j["wall_s"].is_number()) {
+    return Status::Corruption(
+        path +
+        ": expected a run's cost (JSON object with \"content_key\", "
+        "\"attempts\" and \"wall_s\")");
+  }
+  RunCost cost;
+  cost.content_key = j["content_key"].get<std::string>();
+  cost.attempts = j["attempts"].get<int>();
+  cost.wall_s = j["wall_s"].get<double>();
+  return cost;
 }
 
 Status CopyFileAtomic(const std::string& from, const std::string& to,

@@ -19,6 +19,7 @@ namespace adse::campaign {
 //   runs/<key>.report.json  its analysis (RunReport JSON), rebuilt from the
 //                           run file when missing
 //   runs/<key>.failed.json  a run that failed after its retries
+//   runs/<key>.cost.json    what a run that worked took: attempts, wall time
 //   logs/<key>.<attempt>.log  each worker attempt's stdout and stderr
 //   images/<key>/trajectory.png  the run's picture
 //   campaign.h5, report.md, summary.json, pareto.png   rebuilt views
@@ -36,6 +37,7 @@ class CampaignFolder {
   std::string RunPath(const std::string& key) const;
   std::string ReportPath(const std::string& key) const;
   std::string FailurePath(const std::string& key) const;
+  std::string CostPath(const std::string& key) const;
   std::string LogPath(const std::string& key, int attempt) const;
   // Folder of a run's pictures, and its trajectory picture in it.
   std::string ImageDir(const std::string& key) const;
@@ -82,6 +84,17 @@ struct FailureRecord {
 Status WriteFailureRecord(const std::string& path, const FailureRecord& record,
                           Env* env = Env::Default());
 Result<FailureRecord> ReadFailureRecord(const std::string& path);
+
+// What a run that worked took, kept as runs/<key>.cost.json, so that a
+// resumed campaign's index keeps it (the run file holds only the run).
+struct RunCost {
+  std::string content_key;
+  int attempts = 0;
+  double wall_s = 0.0;
+};
+Status WriteRunCost(const std::string& path, const RunCost& cost,
+                    Env* env = Env::Default());
+Result<RunCost> ReadRunCost(const std::string& path);
 
 // The shared evaluation cache: <dir>/<key>.h5, filled by every campaign
 // that does not opt out, read by all. Entries are immutable (a key fixes

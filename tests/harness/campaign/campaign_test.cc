@@ -145,6 +145,13 @@ TEST(CampaignTest,
               first->exploration.evaluations[i].content_key);
     EXPECT_EQ(second->exploration.evaluations[i].metrics,
               first->exploration.evaluations[i].metrics);
+    // What each run took survives the resume (runs/<key>.cost.json).
+    EXPECT_EQ(second->exploration.evaluations[i].source, "campaign");
+    EXPECT_GT(first->exploration.evaluations[i].wall_s, 0.0);
+    EXPECT_EQ(second->exploration.evaluations[i].wall_s,
+              first->exploration.evaluations[i].wall_s);
+    EXPECT_EQ(second->exploration.evaluations[i].attempts,
+              first->exploration.evaluations[i].attempts);
   }
 
   // Replay of the agent over this recording proposes exactly what a live

@@ -91,6 +91,26 @@ TEST(FailureRecordTest, RoundTripsAndRejectsDamage) {
   EXPECT_THAT(bad.status().message(), HasSubstr("bad.json"));
 }
 
+TEST(RunCostTest, RoundTripsAndRejectsDamage) {
+  const std::string dir = TempDir("cost");
+  ASSERT_TRUE(
+      WriteRunCost(dir + "/c.json", {std::string(64, 'b'), 2, 38.6}).ok());
+  Result<RunCost> back = ReadRunCost(dir + "/c.json");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->content_key, std::string(64, 'b'));
+  EXPECT_EQ(back->attempts, 2);
+  EXPECT_DOUBLE_EQ(back->wall_s, 38.6);
+  for (const char* damaged :
+       {"{\"content_key\": \"k\", \"attempts\": 1}", "[1, 2]", "not json",
+        "{\"content_key\": 3, \"attempts\": 1, \"wall_s\": 1}"}) {
+    ASSERT_TRUE(WriteFileAtomic(dir + "/bad.json", damaged).ok());
+    Result<RunCost> bad = ReadRunCost(dir + "/bad.json");
+    ASSERT_FALSE(bad.ok()) << damaged;
+    EXPECT_EQ(bad.status().code(), Status::Code::kCorruption);
+    EXPECT_THAT(bad.status().message(), HasSubstr("bad.json"));
+  }
+}
+
 TEST(RunCacheTest, InsertFindAndCopyOutLeaveNoTemporaries) {
   const std::string dir = TempDir("cache");
   ASSERT_TRUE(WriteFileAtomic(dir + "/run.h5", "payload").ok());
