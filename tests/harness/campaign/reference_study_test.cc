@@ -85,7 +85,7 @@ TEST(ReferenceStudyTest,
   const Headline answer = ComputeHeadline(Recorded().spec, Recorded().rows);
   ASSERT_GE(answer.cheapest, 0);
   EXPECT_EQ(answer.cheapest, At(8, 1.0, 7) - Recorded().rows.data());
-  // 7 x 1.8 is a last bit cheaper than 6 x 2.1 and 20 s slower: the same
+  // 7 x 1.8 is a last bit cheaper than 6 x 2.1 and 8 s slower: the same
   // price, so it is not on the front.
   const EvaluationRow* seven = At(7, 1.8, 7);
   const EvaluationRow* six = At(6, 2.1, 7);
