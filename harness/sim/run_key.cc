@@ -27,7 +27,8 @@ namespace {
 // perception places a scan by the pose at its stamp (it used the newest).
 // v10: the obstacle stop also sweeps the car's footprint along the path.
 // v11: the planner changes lane only when the target lane has a gap.
-constexpr char kKeyVersion[] = "adse-run-key-v11";
+// v12: a track born near a confirmed one starts at its velocity.
+constexpr char kKeyVersion[] = "adse-run-key-v12";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

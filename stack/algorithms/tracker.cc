@@ -53,6 +53,21 @@ void Tracker::Correct(Track* track, const Detection& detection) const {
   track->yaw_rad = detection.yaw_rad;
 }
 
+const Track* Tracker::NearestConfirmed(const Eigen::Vector2d& at,
+                                       size_t count) const {
+  const Track* nearest = nullptr;
+  if (params_.split_radius_m <= 0.0) return nearest;
+  double best2 = params_.split_radius_m * params_.split_radius_m;
+  for (size_t t = 0; t < count; ++t) {
+    const double d2 = (tracks_[t].position - at).squaredNorm();
+    if (tracks_[t].confirmed && d2 <= best2) {
+      best2 = d2;
+      nearest = &tracks_[t];
+    }
+  }
+  return nearest;
+}
+
 void Tracker::Update(double t_s, const std::vector<Detection>& detections) {
   double dt = has_time_ ? t_s - last_t_s_ : 0.0;
   dt = std::min(dt, params_.max_dt_s);
@@ -96,6 +111,7 @@ void Tracker::Update(double t_s, const std::vector<Detection>& detections) {
     return track.misses >= (track.confirmed ? params_.max_misses
                                             : params_.tentative_max_misses);
   });
+  const size_t existing = tracks_.size();
   for (size_t d = 0; d < detections.size(); ++d) {
     if (det_used[d]) continue;
     Track track;
@@ -106,6 +122,16 @@ void Tracker::Update(double t_s, const std::vector<Detection>& detections) {
     const double vn =
         params_.initial_velocity_std_mps * params_.initial_velocity_std_mps;
     track.covariance.diagonal() << pn, pn, vn, vn;
+    // A piece of a confirmed track's object moves as that track does. Born
+    // standing, such pieces of a car accelerating out of a turn outlived
+    // their parent with a third of its speed, and the crossing yield let
+    // the ego turn in front of the car (3 runs of the reference study).
+    if (const Track* parent =
+            NearestConfirmed(detections[d].center, existing)) {
+      track.velocity = parent->velocity;
+      track.covariance.bottomRightCorner<2, 2>() =
+          parent->covariance.bottomRightCorner<2, 2>();
+    }
     track.length_m = detections[d].length_m;
     track.width_m = detections[d].width_m;
     track.yaw_rad = detections[d].yaw_rad;

@@ -1,6 +1,7 @@
 // Multi-object tracker in the map frame: a constant-velocity Kalman filter
 // per track, greedy nearest-neighbour association inside a gate, birth
-// after N hits and deletion after M misses. Eigen and std types only.
+// after N hits (at the velocity of a confirmed track it splits from) and
+// deletion after M misses. Eigen and std types only.
 #ifndef ADSE_STACK_ALGORITHMS_TRACKER_H_
 #define ADSE_STACK_ALGORITHMS_TRACKER_H_
 
@@ -23,6 +24,10 @@ struct TrackerParams {
   double initial_velocity_std_mps = 8.0;  // a new track's speed is unknown
   double size_smoothing = 0.3;  // weight of a new box size (0..1, EMA)
   double max_dt_s = 2.0;        // longer gaps predict at most this far
+  // A detection born this near a confirmed track is a piece of that object
+  // (a turning car seen as two clusters, or a box whose centre jumped past
+  // the gate) and starts at its velocity, not standing. 0 never.
+  double split_radius_m = 4.0;
 };
 
 struct Track {
@@ -69,6 +74,9 @@ class Tracker {
  private:
   void Predict(Track* track, double dt_s) const;
   void Correct(Track* track, const Detection& detection) const;
+  // The confirmed track among the first `count` nearest to `at`, within
+  // split_radius_m, if any.
+  const Track* NearestConfirmed(const Eigen::Vector2d& at, size_t count) const;
 
   TrackerParams params_;
   std::vector<Track> tracks_;

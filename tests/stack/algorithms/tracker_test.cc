@@ -125,6 +125,56 @@ TEST(Tracker, GateSeparatesFarDetections) {
   EXPECT_EQ(tracker.last_work_units(), 1);
 }
 
+// A car doing 8 m/s whose box jumps 3 m (past the gate) as another part of
+// it comes into view: the new track is the same car and must not start
+// standing, or (from noisy boxes) it reports a fraction of the car's speed
+// for a second.
+TEST(Tracker, APieceBornNearAConfirmedTrackStartsAtItsVelocity) {
+  for (const double split_radius_m : {4.0, 0.0}) {
+    SCOPED_TRACE(split_radius_m);
+    TrackerParams params;
+    params.split_radius_m = split_radius_m;
+    Tracker tracker(params);
+    const double dt = 0.1;
+    for (int k = 0; k < 10; ++k) tracker.Update(k * dt, {At(0.8 * k, 0.0)});
+    ASSERT_EQ(tracker.ConfirmedTracks().size(), 1u);
+    const Track parent = tracker.ConfirmedTracks()[0];
+    ASSERT_NEAR(parent.velocity.x(), 8.0, 0.3);
+    tracker.Update(1.0, {At(11.0, 0.0)});  // 3 m beyond the prediction
+    ASSERT_EQ(tracker.tracks().size(), 2u);
+    const Track& piece = tracker.tracks()[1];
+    EXPECT_GT(piece.id, parent.id);
+    EXPECT_EQ(tracker.tracks()[0].misses, 1);
+    if (split_radius_m > 0.0) {
+      // Born moving, as sure of its speed as its parent.
+      EXPECT_EQ(piece.velocity, tracker.tracks()[0].velocity);
+      const Eigen::Matrix2d piece_var =
+          piece.covariance.bottomRightCorner(2, 2);
+      EXPECT_EQ(piece_var,
+                tracker.tracks()[0].covariance.bottomRightCorner(2, 2));
+    } else {
+      EXPECT_EQ(piece.velocity, Eigen::Vector2d::Zero());  // the old way
+    }
+    for (int k = 11; k < 13; ++k)
+      tracker.Update(k * dt, {At(0.8 * k + 3.0, 0.0)});
+    // The parent has missed three times and is gone; the piece goes on.
+    ASSERT_EQ(tracker.ConfirmedTracks().size(), 1u);
+    EXPECT_EQ(tracker.ConfirmedTracks()[0].id, piece.id);
+    EXPECT_NEAR(tracker.ConfirmedTracks()[0].velocity.x(), 8.0, 0.6);
+  }
+}
+
+// Far from every confirmed track a new object starts standing, uncertain.
+TEST(Tracker, ANewObjectFarFromEveryTrackStartsStanding) {
+  Tracker tracker;
+  for (int k = 0; k < 5; ++k) tracker.Update(0.1 * k, {At(0.8 * k, 0.0)});
+  tracker.Update(0.5, {At(4.0, 0.0), At(4.0, 4.5)});
+  ASSERT_EQ(tracker.tracks().size(), 2u);
+  const Track& born = tracker.tracks()[1];
+  EXPECT_EQ(born.velocity, Eigen::Vector2d::Zero());
+  EXPECT_NEAR(born.covariance(2, 2), 64.0, 1e-9);
+}
+
 TEST(Tracker, TracksPublishedLaterArePredictedToThatTime) {
   Tracker tracker;
   EXPECT_TRUE(tracker.ConfirmedTracksAt(1.0).empty());
