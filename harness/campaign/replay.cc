@@ -117,6 +117,17 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
           ? analysis::TieKey(
                 RowMetric(recording.rows[answer.cheapest], "hardware_cost"))
           : std::numeric_limits<double>::quiet_NaN();
+  for (const runfile::IterationRow& row : result.iterations) {
+    ReplayIteration iteration;
+    iteration.iteration = row.iteration;
+    iteration.rationale = row.rationale;
+    for (const EvaluationRow& evaluation : result.evaluations) {
+      if (evaluation.iteration == row.iteration) {
+        iteration.points.push_back(evaluation.point);
+      }
+    }
+    run.iterations.push_back(std::move(iteration));
+  }
   for (const EvaluationRow& row : result.evaluations) {
     run.proposals.push_back(row.point);
     run.found_cheapest_feasible =

@@ -42,6 +42,13 @@ class RecordingEvaluator : public Evaluator {
   int missing_ = 0;
 };
 
+// One round of a replay: what the strategy proposed and why.
+struct ReplayIteration {
+  int64_t iteration = 0;
+  std::string rationale;  // empty for strategies that give none
+  std::vector<spec::DesignPoint> points;
+};
+
 struct ReplayRun {
   std::string strategy;
   uint64_t seed = 0;
@@ -57,6 +64,7 @@ struct ReplayRun {
   // equally cheap); false when the recording has none.
   bool found_cheapest_feasible = false;
   std::vector<spec::DesignPoint> proposals;  // in order
+  std::vector<ReplayIteration> iterations;   // in order
 };
 
 // Replays `strategy` with exploration.seed = seed and the given budget

@@ -100,6 +100,7 @@ struct ExploreArgs {
   int budget = 0;                       // 0: the recording's scenario budget
   int seeds = 20;
   uint64_t first_seed = 1;
+  bool rationale = false;  // print every seed's proposals with their reasons
   bool json = false;
 };
 int RunExplore(const ExploreArgs& args);

@@ -75,6 +75,8 @@ int RunExplore(const ExploreArgs& args) {
         "(median eval) | cheapest feasible found | not recorded "
         "|\n|---|---|---|---|---|---|---|\n");
   }
+  // --rationale: every seed's rounds, printed after the table.
+  std::string rationales;
   for (const std::string& name : strategies) {
     std::vector<double> found, ratio, first;
     int front = 0, missing = 0, cheapest = 0;
@@ -95,13 +97,32 @@ int RunExplore(const ExploreArgs& args) {
       front = run->front_size;
       missing += run->missing;
       cheapest += run->found_cheapest_feasible;
+      const spec::DesignSpace& space = recording->spec.design_space;
       nlohmann::json proposals = nlohmann::json::array();
       for (const spec::DesignPoint& point : run->proposals) {
-        proposals.push_back(
-            spec::FormatPoint(recording->spec.design_space, point));
+        proposals.push_back(spec::FormatPoint(space, point));
+      }
+      nlohmann::json iterations = nlohmann::json::array();
+      if (args.rationale)
+        rationales += fmt::format("{} seed {}:\n", name, seed);
+      for (const campaign::ReplayIteration& iteration : run->iterations) {
+        std::vector<std::string> points;
+        for (const spec::DesignPoint& point : iteration.points) {
+          points.push_back(spec::FormatPoint(space, point));
+        }
+        if (args.rationale) {
+          rationales += fmt::format(
+              "  iteration {}: {}{}{}\n", iteration.iteration,
+              fmt::join(points, "; "),
+              iteration.rationale.empty() ? "" : " <- ", iteration.rationale);
+        }
+        iterations.push_back({{"iteration", iteration.iteration},
+                              {"points", points},
+                              {"rationale", iteration.rationale}});
       }
       runs.push_back({{"seed", seed},
                       {"proposals", proposals},
+                      {"iterations", iterations},
                       {"evaluations", run->evaluations},
                       {"true_pareto_found", run->true_pareto_found},
                       {"hypervolume_ratio", run->hypervolume_ratio},
@@ -136,6 +157,9 @@ int RunExplore(const ExploreArgs& args) {
                               .c_str(),
           cheapest, args.seeds, missing);
     }
+  }
+  if (!args.json && !rationales.empty()) {
+    std::printf("\n%s", rationales.c_str());
   }
   if (args.json) std::printf("%s\n", out.dump(2).c_str());
   return 0;

@@ -237,6 +237,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 100000));
   explore_cmd->add_option("--first-seed", explore.first_seed,
                           "First exploration seed");
+  explore_cmd->add_flag("--rationale", explore.rationale,
+                        "Also print, per seed, each iteration's proposals "
+                        "and the strategy's rationale for them");
   explore_cmd->add_flag("--json", explore.json, "Print the results as JSON");
 
   adse::cli::InterpretArgs interpret;

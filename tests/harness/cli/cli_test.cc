@@ -342,6 +342,51 @@ TEST(CliRunTest, ExploreReplayPrintsADistributionPerStrategy) {
       << bad.out;
 }
 
+TEST(CliRunTest, ExploreReplayWithRationaleShowsEachRoundAndWhy) {
+  const std::string replay =
+      "explore --replay " + std::string(ADSE_SOURCE_DIR) +
+      "/tests/data/landscapes/saturating --strategy agent,random --seeds 2 "
+      "--budget 4";
+  const CommandRun text = Adse(replay + " --rationale");
+  ASSERT_EQ(text.exit_code, 0) << text.out;
+  for (const char* seed :
+       {"agent seed 1:", "agent seed 2:", "random seed 1:", "random seed 2:"}) {
+    EXPECT_NE(text.out.find(seed), std::string::npos) << seed << text.out;
+  }
+  // The agent's first round has nothing to model; later ones explain the
+  // model's prediction. Random search says how it drew.
+  EXPECT_NE(text.out.find("  iteration 0: cores="), std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("<- No usable run to model yet"), std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("<- Last ("), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("<- random: 1 point(s) drawn uniformly"),
+            std::string::npos)
+      << text.out;
+
+  // The same rounds in JSON: one entry per round, its points in proposal
+  // order, together the run's proposals.
+  const CommandRun json = Adse(replay + " --json");
+  ASSERT_EQ(json.exit_code, 0) << json.out;
+  const nlohmann::json out = nlohmann::json::parse(json.out);
+  for (const char* name : {"agent", "random"}) {
+    SCOPED_TRACE(name);
+    const nlohmann::json& runs = out["strategies"][name]["runs"];
+    ASSERT_EQ(runs.size(), 2u);
+    for (const nlohmann::json& run : runs) {
+      nlohmann::json points = nlohmann::json::array();
+      for (const nlohmann::json& iteration : run["iterations"]) {
+        for (const nlohmann::json& point : iteration["points"]) {
+          points.push_back(point);
+        }
+        EXPECT_FALSE(iteration["rationale"].get<std::string>().empty());
+      }
+      EXPECT_EQ(points, run["proposals"]);
+      EXPECT_EQ(points.size(), 4u);
+    }
+  }
+}
+
 TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
   const CommandRun isolation =
       Adse("run " + Small() + " --isolation containers");
