@@ -88,7 +88,13 @@ std::string AgentStrategy::Predictions(const std::vector<double>& mean) const {
   for (size_t j = 0; j < spec_->objectives.size(); ++j) {
     const spec::Objective& objective = spec_->objectives[j];
     const double v = objective.minimize ? mean[j] : -mean[j];
-    predicted.push_back(fmt::format("{} {}", objective.metric, Num(v)));
+    // A mean over samples of which some never arrive (a rate model's
+    // progress at or below 0) is no number to print.
+    predicted.push_back(
+        std::isfinite(v)
+            ? fmt::format("{} {}", objective.metric, Num(v))
+            : fmt::format("{} unbounded in some of the model's samples",
+                          objective.metric));
   }
   return fmt::format("{}", fmt::join(predicted, ", "));
 }

@@ -364,6 +364,20 @@ TEST(CliRunTest, ExploreReplayWithRationaleShowsEachRoundAndWhy) {
             std::string::npos)
       << text.out;
 
+  // Where some of the model's samples never arrive (a 4-D space's coarse
+  // voxels on 3 cores), the rationale says so instead of printing "inf".
+  const CommandRun four_d =
+      Adse("explore --replay " + std::string(ADSE_SOURCE_DIR) +
+           "/tests/data/landscapes/four_d --strategy agent --seeds 1 "
+           "--first-seed 3 --rationale");
+  ASSERT_EQ(four_d.exit_code, 0) << four_d.out;
+  EXPECT_NE(four_d.out.find("nav_time_s unbounded in some of the model's "
+                            "samples"),
+            std::string::npos)
+      << four_d.out;
+  EXPECT_FALSE(std::regex_search(four_d.out, std::regex(R"(\binf\b)")))
+      << four_d.out;
+
   // The same rounds in JSON: one entry per round, its points in proposal
   // order, together the run's proposals.
   const CommandRun json = Adse(replay + " --json");
