@@ -301,13 +301,26 @@ double PointsHypervolume(const std::vector<std::vector<double>>& points,
   }
 }
 
+namespace {
+// Compares a and b as their TieKeys compare (-1, 0, 1; 0 also for NaN),
+// rounding only values close enough to tie: values that round to one key
+// lie within one unit of the 12th digit (under 1e-11 of either), and
+// TieKey keeps the order of any others. The agent compares in a hot loop.
+int CompareTied(double a, double b) {
+  if (!(std::abs(a - b) <= 1e-10 * std::max(std::abs(a), std::abs(b)))) {
+    return a < b ? -1 : a > b ? 1 : 0;  // far apart, infinite or NaN
+  }
+  const double x = TieKey(a), y = TieKey(b);
+  return x < y ? -1 : x > y ? 1 : 0;
+}
+}  // namespace
+
 bool Dominates(const std::vector<double>& a, const std::vector<double>& b) {
   bool better = false;
   for (size_t i = 0; i < a.size() && i < b.size(); ++i) {
-    const double x = TieKey(a[i]);
-    const double y = TieKey(b[i]);
-    if (x > y) return false;
-    if (x < y) better = true;
+    const int c = CompareTied(a[i], b[i]);
+    if (c > 0) return false;
+    if (c < 0) better = true;
   }
   return better;
 }
@@ -315,7 +328,7 @@ bool Dominates(const std::vector<double>& a, const std::vector<double>& b) {
 bool WeaklyDominates(const std::vector<double>& a,
                      const std::vector<double>& b) {
   for (size_t i = 0; i < a.size() && i < b.size(); ++i) {
-    if (TieKey(a[i]) > TieKey(b[i])) return false;
+    if (CompareTied(a[i], b[i]) > 0) return false;
   }
   return true;
 }

@@ -76,6 +76,7 @@ int RunExplore(const ExploreArgs& args) {
         "|\n|---|---|---|---|---|---|---|\n");
   }
   // --rationale: every seed's rounds, printed after the table.
+  const bool show_rationale = args.rationale && !args.json;
   std::string rationales;
   for (const std::string& name : strategies) {
     std::vector<double> found, ratio, first;
@@ -103,14 +104,15 @@ int RunExplore(const ExploreArgs& args) {
         proposals.push_back(spec::FormatPoint(space, point));
       }
       nlohmann::json iterations = nlohmann::json::array();
-      if (args.rationale)
+      if (show_rationale) {
         rationales += fmt::format("{} seed {}:\n", name, seed);
+      }
       for (const campaign::ReplayIteration& iteration : run->iterations) {
         std::vector<std::string> points;
         for (const spec::DesignPoint& point : iteration.points) {
           points.push_back(spec::FormatPoint(space, point));
         }
-        if (args.rationale) {
+        if (show_rationale) {
           rationales += fmt::format(
               "  iteration {}: {}{}{}\n", iteration.iteration,
               fmt::join(points, "; "),
@@ -158,9 +160,7 @@ int RunExplore(const ExploreArgs& args) {
           cheapest, args.seeds, missing);
     }
   }
-  if (!args.json && !rationales.empty()) {
-    std::printf("\n%s", rationales.c_str());
-  }
+  if (!rationales.empty()) std::printf("\n%s", rationales.c_str());
   if (args.json) std::printf("%s\n", out.dump(2).c_str());
   return 0;
 }
