@@ -22,9 +22,10 @@
 namespace adse::landscapes {
 namespace {
 
-// The reference study's route (scenarios/reference_study.yaml, README
-// "Reproducing the reference study"), which every landscape's scenario
-// keeps: the floor of the navigation time is this over the speed limit.
+// The reference study's route when the landscapes were made (README
+// "Reproducing the reference study"; it is 838 m since 2026-11-27), which
+// every landscape's scenario keeps: the floor of the navigation time is
+// this over the speed limit. Kept, so that the landscapes stay as recorded.
 constexpr double kRouteM = 661.0;
 // Fixed, so that the noisy landscape is the same on every machine; the
 // issue's number.

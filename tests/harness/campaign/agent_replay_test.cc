@@ -72,9 +72,10 @@ TEST(AgentReplayTest, OnTheRecordedRobotaxiCampaign) {
 }
 
 TEST(AgentReplayTest, OnTheReferenceStudyWhereStarvedRunsAreStoppedEarly) {
-  // Its cheapest design (8 cores at 1.0 GHz) is found in no seed: the
-  // diagnosis sends the agent up the clock (README, "Strategies").
-  ExpectAgentOn("reference_study", {6, 0.96, 0});
+  // Measured at run key v12 on the 838 m route: a median of 2 true
+  // Pareto points (the study's LLM agent found 6), the cheapest design (7
+  // cores at 1.2 GHz) in 11 of 20 seeds (README, "Strategies").
+  ExpectAgentOn("reference_study", {2, 0.95, 10});
 }
 
 TEST(AgentReplayTest, OnALandscapeThatSaturates) {
