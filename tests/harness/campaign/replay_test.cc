@@ -3,7 +3,7 @@
 // and the reference study's (tests/data/reference_study) for the built-in
 // agent there: the study's LLM agent found 6 true Pareto points with a
 // budget of 15 and its GA none; adse's agent finds 6 or the cheapest
-// design, and more than the GA.
+// design in most seeds, and more than the GA.
 #include "harness/campaign/replay.h"
 
 #include <gtest/gtest.h>
