@@ -153,10 +153,16 @@ bool StallWatch::Observe(double t_s, double v_mps,
   while (next_ < stops.size() && stops[next_].t_s <= t_s + 1e-9) ++next_;
   if (stall_timeout_s_ <= 0 && traffic_stall_timeout_s_ <= 0) return false;
   if (std::abs(v_mps) >= options_.standing_speed_mps) {
-    stood_s_ = traffic_s_ = 0.0;
-    stand_ = traffic_ = ReasonTally();
-    return false;
+    if (in_stand_) crept_m_ += std::abs(v_mps) * dt;
+    if (!in_stand_ || crept_m_ >= options_.stand_break_m) {
+      in_stand_ = false;
+      crept_m_ = stood_s_ = traffic_s_ = 0.0;
+      stand_ = traffic_ = ReasonTally();
+      return false;
+    }
+    // Creeping within the stand: counted as standing for its cause.
   }
+  in_stand_ = true;
   const runfile::StopSample* newest = next_ > 0 ? &stops[next_ - 1] : nullptr;
   const StopReason reason = HoldingReason(newest, t_s, options_);
   if (TrafficWillRelease(reason, newest)) {

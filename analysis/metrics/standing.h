@@ -22,6 +22,10 @@ struct StandingOptions {
   // A stop farther ahead than this does not hold a car standing now: the
   // plan lets it move, so something outside the planner holds it.
   double hold_distance_m = 2.0;
+  // StallWatch: a stand ends once the car has moved this far since it
+  // began; creeping a few centimetres behind a standing car (a blip over
+  // standing_speed_mps) does not start the count again.
+  double stand_break_m = 1.0;
 };
 
 // The time the car stood for one reason.
@@ -146,8 +150,10 @@ class StallWatch {
   double last_t_s_ = -1;  // the last observation; < 0 before the first
   double stood_s_ = 0.0;
   double traffic_s_ = 0.0;  // held by road users in the current stand
-  ReasonTally stand_;       // the counted time of the current stand
-  ReasonTally traffic_;     // the time road users held it in this stand
+  bool in_stand_ = false;
+  double crept_m_ = 0.0;  // moved since the current stand began
+  ReasonTally stand_;     // the counted time of the current stand
+  ReasonTally traffic_;   // the time road users held it in this stand
   StandingTime cause_;
   bool held_by_traffic_ = false;
 };

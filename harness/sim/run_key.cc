@@ -27,8 +27,10 @@ namespace {
 // perception places a scan by the pose at its stamp (it used the newest).
 // v10: the obstacle stop also sweeps the car's footprint along the path.
 // v11: the planner changes lane only when the target lane has a gap.
-// v12: a track born near a confirmed one starts at its velocity.
-constexpr char kKeyVersion[] = "adse-run-key-v12";
+// v12: a track born near a confirmed one starts at its velocity. v13: a
+// flow's car enters only when the ego is clear of where it would, and
+// SUMO's drivers brake for the ego in the lanes ahead of them.
+constexpr char kKeyVersion[] = "adse-run-key-v13";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

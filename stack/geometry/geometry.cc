@@ -16,6 +16,24 @@ size_t SegmentAt(const std::vector<double>& s_m, double s) {
   return std::min(i, s_m.size() - 2);
 }
 
+// Keeps the part of convex `polygon` where n·p <= c (Sutherland-Hodgman).
+std::vector<Eigen::Vector2d> ClipHalfPlane(
+    const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& n,
+    double c) {
+  std::vector<Eigen::Vector2d> out;
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector2d& a = polygon[i];
+    const Eigen::Vector2d& b = polygon[(i + 1) % polygon.size()];
+    const double da = n.dot(a) - c;
+    const double db = n.dot(b) - c;
+    if (da <= 0) out.push_back(a);
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
+      out.push_back(a + da / (da - db) * (b - a));
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 void Path2::UpdateArcLength() {
@@ -69,6 +87,37 @@ std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box) {
   // Front-right, front-left, rear-left, rear-right: counter-clockwise.
   return {box.center + hx - hy, box.center + hx + hy, box.center - hx + hy,
           box.center - hx - hy};
+}
+
+double DistanceAlongPathToBox(const std::vector<Eigen::Vector2d>& path,
+                              double half_width_m, const OrientedBox& box) {
+  const std::vector<Eigen::Vector2d> corners = BoxCorners(box);
+  double s0 = 0.0;
+  for (size_t i = 0; i + 1 < path.size(); ++i) {
+    const Eigen::Vector2d d = path[i + 1] - path[i];
+    const double length = d.norm();
+    if (length < 1e-9) continue;
+    const Eigen::Vector2d u = d / length;
+    const Eigen::Vector2d n(-u.y(), u.x());
+    // The box in the segment's frame: x along it from its start, y across.
+    std::vector<Eigen::Vector2d> local;
+    local.reserve(corners.size());
+    for (const Eigen::Vector2d& c : corners) {
+      const Eigen::Vector2d r = c - path[i];
+      local.emplace_back(u.dot(r), n.dot(r));
+    }
+    local = ClipHalfPlane(local, {-1, 0}, 0.0);
+    local = ClipHalfPlane(local, {1, 0}, length);
+    local = ClipHalfPlane(local, {0, -1}, half_width_m);
+    local = ClipHalfPlane(local, {0, 1}, half_width_m);
+    if (!local.empty()) {
+      double x = length;
+      for (const Eigen::Vector2d& p : local) x = std::min(x, p.x());
+      return s0 + x;
+    }
+    s0 += length;
+  }
+  return -1.0;
 }
 
 bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b) {

@@ -68,6 +68,15 @@ std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box);
 // True when two oriented boxes overlap (separating axis test).
 bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b);
 
+// How far along `path` the strip reaching `half_width_m` either side of it
+// first meets `box`: the smallest arc length of a point of the box inside
+// the strip (0 when the box covers the path's start), or -1 when the box
+// stays outside the strip. A car's corridor ahead, with the path starting
+// at its front bumper. Each segment's strip ends square, so a bend leaves
+// a sliver outside on its outer side and counts one twice on the inner.
+double DistanceAlongPathToBox(const std::vector<Eigen::Vector2d>& path,
+                              double half_width_m, const OrientedBox& box);
+
 // Even-odd rule: whether `p` lies inside the polygon closed back to its
 // first point. Points on the boundary may go either way.
 bool InsidePolygon(const std::vector<Eigen::Vector2d>& polygon,

@@ -1,4 +1,5 @@
-// The only place adse talks to libsumo. libsumo reports errors as
+// World itself (with world_route.cc, world_signals.cc and world_traffic.cc
+// the only places adse talks to libsumo). libsumo reports errors as
 // libsumo::TraCIException (or a bare "Process Error" whose cause goes to
 // SUMO's error log): both are caught here and turned into Status.
 #include "stack/world/world.h"
@@ -35,27 +36,18 @@ namespace adse::world {
 namespace {
 
 namespace fs = std::filesystem;
+using internal::kEgoId;
+using internal::kOffRoadSlackM;
 using internal::ToPoints;
 using internal::Vec2;
+using internal::YawToSumoAngle;
 
 std::atomic<bool> g_world_open{false};
 
-constexpr char kEgoId[] = "ego";
-// How far a start/goal may lie from a lane centre, beyond half its width.
-constexpr double kOffRoadSlackM = 1.5;
 // A car within the goal's tolerance projects at most that far before the
 // route's end; this much more for the projection on a bend.
 constexpr double kGoalSlackM = 1.0;
 constexpr double kValetSlackM = 8.0;
-
-double SumoAngleToYaw(double angle_deg) {
-  return (90.0 - angle_deg) * M_PI / 180.0;
-}
-double YawToSumoAngle(double yaw_rad) {
-  double a = 90.0 - yaw_rad * 180.0 / M_PI;
-  a = std::fmod(a, 360.0);
-  return a < 0 ? a + 360.0 : a;
-}
 
 // Runs `fn`, turning libsumo exceptions into Status.
 template <typename Fn>
@@ -202,60 +194,6 @@ Status World::Impl::BuildScene() {
   });
 }
 
-Status World::Impl::SetUpTraffic() {
-  traffic_random = std::make_unique<Random>(
-      Random::DeriveSeed(setup.world.traffic.seed, "traffic.flows"));
-  const auto& flows_in = setup.world.traffic.flows;
-  for (size_t i = 0; i < flows_in.size(); ++i) {
-    const Flow& flow = flows_in[i];
-    const std::string field = fmt::format("world.traffic.flows[{}]", i);
-    try {
-      const std::vector<std::string> edges = libsumo::Edge::getIDList();
-      for (const std::string* e : {&flow.from_edge, &flow.to_edge}) {
-        if (std::find(edges.begin(), edges.end(), *e) == edges.end()) {
-          return Status::InvalidArgument(
-              fmt::format("{}.{}: no edge '{}' in the network", field,
-                          e == &flow.from_edge ? "from" : "to", *e));
-        }
-      }
-      const libsumo::TraCIStage stage =
-          libsumo::Simulation::findRoute(flow.from_edge, flow.to_edge);
-      if (stage.edges.empty()) {
-        return Status::InvalidArgument(
-            fmt::format("{}: no route from '{}' to '{}'", field, flow.from_edge,
-                        flow.to_edge));
-      }
-      FlowState state;
-      state.route_id = fmt::format("adse_flow_{}", i);
-      libsumo::Route::add(state.route_id, stage.edges);
-      state.probability_per_step =
-          std::min(1.0, flow.vehicles_per_hour / 3600.0 * setup.world.step_s);
-      flows.push_back(state);
-    } catch (const std::exception& e) {
-      return Status::InvalidArgument(field + ": " + e.what());
-    }
-  }
-  const auto& stopped = setup.world.traffic.stopped_vehicles;
-  for (size_t i = 0; i < stopped.size(); ++i) {
-    const std::string field =
-        fmt::format("world.traffic.stopped_vehicles[{}]", i);
-    Result<RoadLocation> at = Resolve(stopped[i], field, kOffRoadSlackM);
-    if (!at.ok()) return at.status();
-    try {
-      // A one-edge route, inserted where it stands and held there.
-      const std::string id = fmt::format("stopped{}", i);
-      libsumo::Route::add("adse_" + id, {at->edge});
-      libsumo::Vehicle::add(id, "adse_" + id, "DEFAULT_VEHTYPE", "now",
-                            std::to_string(at->lane),
-                            fmt::format("{}", at->pos_m), "0");
-      libsumo::Vehicle::setSpeed(id, 0.0);
-    } catch (const std::exception& e) {
-      return Status::InvalidArgument(field + ": " + e.what());
-    }
-  }
-  return Status::Ok();
-}
-
 void World::Impl::PushEgo() {
   const geometry::OrientedBox body = ego->Body();
   const double yaw = ego->state().yaw_rad;
@@ -286,33 +224,6 @@ Status World::Impl::AddEgo() {
     libsumo::Vehicle::setSpeedMode(kEgoId, 0);
     libsumo::Vehicle::setLaneChangeMode(kEgoId, 0);
     PushEgo();
-  });
-}
-
-Status World::Impl::ReadOthers() {
-  return Guard("reading vehicles", [&] {
-    others.clear();
-    for (const std::string& id : libsumo::Vehicle::getIDList()) {
-      if (id == kEgoId) continue;
-      auto it = dims.find(id);
-      if (it == dims.end()) {
-        it = dims.emplace(id, Vec2(libsumo::Vehicle::getLength(id),
-                                   libsumo::Vehicle::getWidth(id)))
-                 .first;
-      }
-      const auto p = libsumo::Vehicle::getPosition(id);
-      const double yaw = SumoAngleToYaw(libsumo::Vehicle::getAngle(id));
-      OtherVehicle v;
-      v.id = id;
-      v.box.yaw_rad = yaw;
-      v.box.length_m = it->second.x();
-      v.box.width_m = it->second.y();
-      v.box.height_m = 1.5;
-      v.box.center = Vec2(p.x, p.y) -
-                     v.box.length_m / 2 * Vec2(std::cos(yaw), std::sin(yaw));
-      v.speed_mps = libsumo::Vehicle::getSpeed(id);
-      others.push_back(v);
-    }
   });
 }
 
@@ -402,19 +313,12 @@ Status World::Step(const ControlCommand& command) {
   w.ego->Step(command, dt);
   w.UpdateProgress();
   return Guard("world step", [&] {
-    for (size_t i = 0; i < w.flows.size(); ++i) {
-      Impl::FlowState& flow = w.flows[i];
-      if (w.traffic_random->Bernoulli(flow.probability_per_step)) {
-        libsumo::Vehicle::add(fmt::format("flow{}.{}", i, flow.spawned++),
-                              flow.route_id, "DEFAULT_VEHTYPE", "now", "best",
-                              "base", "max");
-      }
-    }
+    w.InsertFlows();
     w.PushEgo();
+    w.YieldToEgo();
     libsumo::Simulation::step();
     w.time_s += dt;
-    Status read = w.ReadOthers();
-    if (!read.ok()) throw std::runtime_error(read.message());
+    w.ReadOthers();
     const geometry::OrientedBox body = w.ego->Body();
     std::set<std::string> contact;
     w.new_contacts.clear();

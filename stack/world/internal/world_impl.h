@@ -6,6 +6,7 @@
 #include <libsumo/libsumo.h>
 
 #include <Eigen/Core>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <set>
@@ -23,6 +24,20 @@ namespace adse::world {
 namespace internal {
 
 using Vec2 = Eigen::Vector2d;
+
+// The ego's vehicle id in SUMO.
+inline constexpr char kEgoId[] = "ego";
+// How far a start/goal may lie from a lane centre, beyond half its width.
+inline constexpr double kOffRoadSlackM = 1.5;
+
+// SUMO's angles are compass degrees (0 north, clockwise).
+inline double SumoAngleToYaw(double angle_deg) {
+  return (90.0 - angle_deg) * M_PI / 180.0;
+}
+inline double YawToSumoAngle(double yaw_rad) {
+  const double a = std::fmod(90.0 - yaw_rad * 180.0 / M_PI, 360.0);
+  return a < 0 ? a + 360.0 : a;
+}
 
 // Spacing of the ideal path's points.
 inline constexpr double kResampleStepM = 0.5;
@@ -91,10 +106,16 @@ struct World::Impl {
 
   struct FlowState {
     std::string route_id;
+    std::vector<std::string> depart_lanes;  // the lanes of its first edge
     double probability_per_step = 0.0;
     int spawned = 0;
+    int pending = 0;  // drawn, waiting for the ego to clear the way in
   };
   std::vector<FlowState> flows;
+  std::set<std::string> held_still;  // traffic.stopped_vehicles
+  std::set<std::string> yielding;    // cars told to slow for the ego
+  std::map<std::string, std::vector<Eigen::Vector2d>>
+      lane_shapes;  // by lane id
   std::unique_ptr<Random> traffic_random;
   std::map<std::string, Eigen::Vector2d> dims;  // vehicle id -> (length, width)
 
@@ -122,14 +143,23 @@ struct World::Impl {
   // The crossings' traffic lights (world_signals.cc).
   Status FindRouteSignals();
   Status BuildScene();
+  // world_traffic.cc: the flows and standing cars; a flow's car enters
+  // only when the ego is clear of where it would enter; SUMO's drivers
+  // brake for the ego in their lane ahead (its moveToXY placement does not
+  // make SUMO's car-following and junction models see it everywhere).
   Status SetUpTraffic();
+  // Both throw libsumo's exceptions (World::Step guards).
+  void InsertFlows();
+  void YieldToEgo();
+  const std::vector<Eigen::Vector2d>& LaneShape(const std::string& lane_id);
   Status AddEgo();
   void PushEgo();
   // Projects the ego on the road part near its progress so far, as the
   // stack's path planner does: a route that comes back along the other
   // side of a street passes a lane width from where the car is.
   void UpdateProgress();
-  Status ReadOthers();
+  // Throws libsumo's exceptions (World::Step guards).
+  void ReadOthers();
 };
 
 }  // namespace adse::world

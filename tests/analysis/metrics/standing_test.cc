@@ -280,6 +280,26 @@ TEST(StallWatchTest, MovingStartsTheCountAgain) {
   EXPECT_EQ(StalledAt(run, &watch), -1);
 }
 
+TEST(StallWatchTest, CreepingACoupleOfCentimetresDoesNotStartTheCountAgain) {
+  // Behind a car that never moves on (the reference study's (14, 2.1,
+  // 14) crept 6 cm in 362 s): blips of 0.2 s at 0.15 m/s every 50 s.
+  runfile::RunData run = RunStanding({{0, 300}}, 300.0);
+  for (runfile::EgoSample& e : run.ego) {
+    if (std::fmod(e.t_s + 1e-6, 50.0) < 0.2) e.v_mps = 0.15;
+  }
+  Publish(&run, 0, 300, Obstacle(3, 4.0, false));
+  StallWatch watch(60.0, 120.0);
+  EXPECT_NEAR(StalledAt(run, &watch), 120.0, 0.11);
+  EXPECT_TRUE(watch.held_by_traffic());
+  // Creeping a metre ends the stand: 1 s at 1.2 m/s every 50 s.
+  for (runfile::EgoSample& e : run.ego) {
+    if (e.v_mps > 0) e.v_mps = 0;
+    if (std::fmod(e.t_s + 1e-6, 50.0) < 1.0) e.v_mps = 1.2;
+  }
+  StallWatch moved(60.0, 120.0);
+  EXPECT_EQ(StalledAt(run, &moved), -1);
+}
+
 TEST(StallWatchTest, APlannerThatNeverSpeaksStallsForNoTrajectory) {
   runfile::RunData run = RunStanding({{0, 100}});
   StallWatch watch(60.0);

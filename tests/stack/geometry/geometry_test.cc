@@ -131,6 +131,39 @@ TEST(MotionAfter, StraightLineAndQuarterCircle) {
   EXPECT_NEAR(right.y_m, -5.0, 1e-9);
 }
 
+TEST(DistanceAlongPathToBoxTest, StraightCorridorAheadAndBeside) {
+  const std::vector<Eigen::Vector2d> path = {{0, 0}, {30, 0}};
+  // In the lane ahead: its rear at 8 m.
+  EXPECT_NEAR(DistanceAlongPathToBox(path, 1.2, Box(10, 0, 0, 4, 2)), 8.0,
+              1e-9);
+  // In the next lane (3.2 m over): its near side 2.2 m from the path.
+  EXPECT_LT(DistanceAlongPathToBox(path, 1.2, Box(10, 3.2, 0, 4, 2)), 0);
+  // Standing across the lane, reaching 0.25 m past the path.
+  EXPECT_NEAR(DistanceAlongPathToBox(path, 1.2, Box(10, 2.0, M_PI / 2, 4.5, 2)),
+              9.0, 1e-9);
+  // Only a corner inside the strip: the nearest point of that part counts.
+  EXPECT_NEAR(DistanceAlongPathToBox(path, 1.2, Box(10, 2.3, M_PI / 4, 2, 2)),
+              10.0 - (1.2 - (2.3 - std::sqrt(2.0))), 1e-9);
+  // Beyond the path's end, behind its start, or covering the start.
+  EXPECT_LT(DistanceAlongPathToBox(path, 1.2, Box(33, 0, 0, 4, 2)), 0);
+  EXPECT_LT(DistanceAlongPathToBox(path, 1.2, Box(-3, 0, 0, 4, 2)), 0);
+  EXPECT_NEAR(DistanceAlongPathToBox(path, 1.2, Box(0.5, 0, 0, 4, 2)), 0.0,
+              1e-9);
+}
+
+TEST(DistanceAlongPathToBoxTest, FollowsABendAndSkipsDegenerateSegments) {
+  const std::vector<Eigen::Vector2d> path = {
+      {0, 0}, {10, 0}, {10, 0}, {10, 20}};
+  // Round the corner: 10 m to it, then the box's rear 12 - 2.25 m up.
+  EXPECT_NEAR(
+      DistanceAlongPathToBox(path, 1.0, Box(10, 12, M_PI / 2, 4.5, 1.8)), 19.75,
+      1e-9);
+  // Straight on past the corner is not on the path.
+  EXPECT_LT(DistanceAlongPathToBox(path, 1.0, Box(16, 0, 0, 4.5, 1.8)), 0);
+  EXPECT_LT(DistanceAlongPathToBox({}, 1.0, Box(0, 0, 0, 4.5, 1.8)), 0);
+  EXPECT_LT(DistanceAlongPathToBox({{1, 1}}, 1.0, Box(1, 1, 0, 4.5, 1.8)), 0);
+}
+
 TEST(InsidePolygon, ConvexConcaveAndDegenerate) {
   const std::vector<Eigen::Vector2d> square = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
   EXPECT_TRUE(InsidePolygon(square, {1, 1}));

@@ -86,7 +86,8 @@ TEST(WorldTest, GeneratedParkingLotLoadsAndIdealPathIsContinuous) {
   EXPECT_NEAR(w.lane_width_m(), 3.5, 0.01);
 }
 
-TEST(WorldTest, GridMapLoadsAndRoutes) {
+// A 3 x 3 grid of 100 m one-lane streets, from 10 m into A0B0 to C1C2.
+WorldSetup SmallGrid() {
   WorldSetup setup;
   setup.world.map.generator = "grid";
   setup.world.map.generator_params = {
@@ -94,6 +95,11 @@ TEST(WorldTest, GridMapLoadsAndRoutes) {
   setup.task.start = Location::OnEdge("A0B0", 10.0);
   setup.task.goal = Location::OnEdge("C1C2", 50.0);
   setup.cache_dir = CacheDir();
+  return setup;
+}
+
+TEST(WorldTest, GridMapLoadsAndRoutes) {
+  const WorldSetup setup = SmallGrid();
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   EXPECT_LT((*world)->ideal_path().MaxGap(), 0.51);
@@ -242,6 +248,32 @@ TEST(WorldTest, TrafficIsIdenticalForTheSameSeedAndDiffersForAnother) {
   const std::string c = TrafficFingerprint(12);
   EXPECT_EQ(a, b);
   EXPECT_NE(a, c);
+}
+
+// SUMO inserts a flow's car at the start of its first edge without seeing
+// the ego there (it did so onto the ego turning onto the edge); adse holds
+// the car back until the ego is clear of where it would enter.
+TEST(WorldTest, AFlowsCarEntersOnlyOnceTheEgoIsClearOfWhereItWouldEnter) {
+  WorldSetup setup = SmallGrid();
+  setup.world.traffic.flows = {{"A0B0", "B0B1", 3600.0}};
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  // The ego stands 10 m into the flow's first edge for 20 s: about 20 cars
+  // are drawn, none enters.
+  for (int i = 0; i < 400; ++i) {
+    ASSERT_TRUE((*world)->Step(ControlCommand{}).ok());
+    ASSERT_TRUE((*world)->others().empty())
+        << (*world)->others().front().id << " entered at " << (*world)->time_s()
+        << " s";
+  }
+  // Once it drives off they enter behind it, and none runs into it.
+  const IdealDriveReport report = DriveToTheGoal(**world, 30, 120);
+  EXPECT_EQ(report.collisions, 0);
+  int entered = 0;
+  for (const OtherVehicle& v : (*world)->others()) {
+    entered += v.id.rfind("flow0.", 0) == 0;
+  }
+  EXPECT_GE(entered, 3);
 }
 
 TEST(WorldTest, PerfectControllerReachesTheGoalWithoutCollisions) {

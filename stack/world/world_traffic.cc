@@ -1,0 +1,251 @@
+// The traffic around the ego: SUMO's flows and standing cars, and what
+// SUMO's drivers do about the ego. The ego is a SUMO vehicle placed by
+// moveToXY each step; SUMO matches it to a lane, but neither its insertion
+// nor its drivers see it everywhere: a flow's car is inserted where the ego
+// stands turning onto the edge, and a car stopped short of the ego standing
+// across its lane in a junction drives on once moveToXY matches the ego to
+// another internal lane (its leader is then a car far ahead). Here a car
+// enters only when the ego is clear of where it would, and a driver with
+// the ego in the lanes ahead slows to stop short of it, as a person would.
+#include <fmt/format.h>
+#include <libsumo/libsumo.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "stack/world/internal/world_impl.h"
+#include "stack/world/traffic_yield.h"
+
+namespace adse::world {
+namespace {
+
+using internal::InternalChain;
+using internal::kEgoId;
+using internal::kOffRoadSlackM;
+using internal::Slice;
+using internal::SumoAngleToYaw;
+using internal::ToPoints;
+using internal::Vec2;
+
+// A car entering with a flow is this long (SUMO's default type); it enters
+// with its rear at the lane's start ("base").
+constexpr double kEnteringLengthM = 5.0;
+// SUMO's default deceleration, m/s^2.
+constexpr double kDefaultDecelMps2 = 4.5;
+
+// Appends `piece` to `path`, skipping a repeat of its last point.
+void Append(const std::vector<Vec2>& piece, std::vector<Vec2>* path) {
+  for (const Vec2& p : piece) {
+    if (path->empty() || (p - path->back()).norm() > 1e-6) path->push_back(p);
+  }
+}
+
+}  // namespace
+
+Status World::Impl::SetUpTraffic() {
+  traffic_random = std::make_unique<Random>(
+      Random::DeriveSeed(setup.world.traffic.seed, "traffic.flows"));
+  const auto& flows_in = setup.world.traffic.flows;
+  for (size_t i = 0; i < flows_in.size(); ++i) {
+    const Flow& flow = flows_in[i];
+    const std::string field = fmt::format("world.traffic.flows[{}]", i);
+    try {
+      const std::vector<std::string> edges = libsumo::Edge::getIDList();
+      for (const std::string* e : {&flow.from_edge, &flow.to_edge}) {
+        if (std::find(edges.begin(), edges.end(), *e) == edges.end()) {
+          return Status::InvalidArgument(
+              fmt::format("{}.{}: no edge '{}' in the network", field,
+                          e == &flow.from_edge ? "from" : "to", *e));
+        }
+      }
+      const libsumo::TraCIStage stage =
+          libsumo::Simulation::findRoute(flow.from_edge, flow.to_edge);
+      if (stage.edges.empty()) {
+        return Status::InvalidArgument(
+            fmt::format("{}: no route from '{}' to '{}'", field, flow.from_edge,
+                        flow.to_edge));
+      }
+      FlowState state;
+      state.route_id = fmt::format("adse_flow_{}", i);
+      for (int k = 0; k < libsumo::Edge::getLaneNumber(flow.from_edge); ++k) {
+        state.depart_lanes.push_back(fmt::format("{}_{}", flow.from_edge, k));
+      }
+      libsumo::Route::add(state.route_id, stage.edges);
+      state.probability_per_step =
+          std::min(1.0, flow.vehicles_per_hour / 3600.0 * setup.world.step_s);
+      flows.push_back(state);
+    } catch (const std::exception& e) {
+      return Status::InvalidArgument(field + ": " + e.what());
+    }
+  }
+  const auto& stopped = setup.world.traffic.stopped_vehicles;
+  for (size_t i = 0; i < stopped.size(); ++i) {
+    const std::string field =
+        fmt::format("world.traffic.stopped_vehicles[{}]", i);
+    Result<RoadLocation> at = Resolve(stopped[i], field, kOffRoadSlackM);
+    if (!at.ok()) return at.status();
+    try {
+      // A one-edge route, inserted where it stands and held there.
+      const std::string id = fmt::format("stopped{}", i);
+      libsumo::Route::add("adse_" + id, {at->edge});
+      libsumo::Vehicle::add(id, "adse_" + id, "DEFAULT_VEHTYPE", "now",
+                            std::to_string(at->lane),
+                            fmt::format("{}", at->pos_m), "0");
+      libsumo::Vehicle::setSpeed(id, 0.0);
+      held_still.insert(id);
+    } catch (const std::exception& e) {
+      return Status::InvalidArgument(field + ": " + e.what());
+    }
+  }
+  return Status::Ok();
+}
+
+const std::vector<Vec2>& World::Impl::LaneShape(const std::string& lane_id) {
+  auto it = lane_shapes.find(lane_id);
+  if (it == lane_shapes.end()) {
+    it =
+        lane_shapes.emplace(lane_id, ToPoints(libsumo::Lane::getShape(lane_id)))
+            .first;
+  }
+  return it->second;
+}
+
+void World::Impl::InsertFlows() {
+  const geometry::OrientedBox body = ego->Body();
+  for (size_t i = 0; i < flows.size(); ++i) {
+    FlowState& flow = flows[i];
+    // One draw per flow and step, whether or not the car can enter now, so
+    // the traffic's random stream does not depend on the ego.
+    if (traffic_random->Bernoulli(flow.probability_per_step)) ++flow.pending;
+    if (flow.pending == 0) continue;
+    bool clear = true;
+    for (const std::string& lane : flow.depart_lanes) {
+      const std::vector<Vec2>& shape = LaneShape(lane);
+      const double reach =
+          kEnteringLengthM +
+          YieldLookaheadM(libsumo::Lane::getMaxSpeed(lane), kDefaultDecelMps2);
+      // The ego about to drive onto the edge counts as on it.
+      if (YieldSpeedMps(Slice(shape, 0, reach), libsumo::Lane::getWidth(lane),
+                        kDefaultDecelMps2, body, Vec2::Zero()) >= 0 ||
+          (!shape.empty() && (body.center - shape.front()).norm() <
+                                 body.length_m + kOffRoadSlackM)) {
+        clear = false;
+        break;
+      }
+    }
+    if (!clear) continue;
+    libsumo::Vehicle::add(fmt::format("flow{}.{}", i, flow.spawned++),
+                          flow.route_id, "DEFAULT_VEHTYPE", "now", "best",
+                          "base", "max");
+    --flow.pending;
+  }
+}
+
+void World::Impl::YieldToEgo() {
+  const geometry::OrientedBox body = ego->Body();
+  const VehicleState& state = ego->state();
+  const Vec2 ego_velocity =
+      state.v_mps * Vec2(std::cos(state.yaw_rad), std::sin(state.yaw_rad));
+  std::set<std::string> still_yielding;
+  for (const OtherVehicle& v : others) {
+    if (held_still.count(v.id)) continue;
+    const double decel = libsumo::Vehicle::getDecel(v.id);
+    const double lookahead = YieldLookaheadM(v.speed_mps, decel);
+    // Too far for any part of the ego to lie within its lookahead.
+    if ((v.box.center - body.center).norm() >
+        lookahead + v.box.length_m + body.length_m) {
+      continue;
+    }
+    const std::string lane = libsumo::Vehicle::getLaneID(v.id);
+    if (lane.empty()) continue;
+    // The lanes it drives next, from its front bumper: the rest of its
+    // lane, then through the next junction onto the next lane of its best
+    // continuation.
+    std::vector<Vec2> path;
+    const double pos = libsumo::Vehicle::getLanePosition(v.id);
+    Append(Slice(LaneShape(lane), pos, pos + lookahead), &path);
+    std::vector<std::string> next;
+    if (lane[0] == ':') {
+      std::string arrives_on;
+      next = InternalChain(lane, &arrives_on);
+      next.erase(next.begin());
+      if (!arrives_on.empty()) next.push_back(arrives_on);
+    } else {
+      for (const libsumo::TraCIBestLanesData& best :
+           libsumo::Vehicle::getBestLanes(v.id)) {
+        if (best.laneID != lane) continue;
+        const auto& c = best.continuationLanes;
+        const auto at = std::find(c.begin(), c.end(), lane);
+        if (at == c.end() || at + 1 == c.end()) break;
+        for (const libsumo::TraCIConnection& link :
+             libsumo::Lane::getLinks(lane)) {
+          if (link.approachedLane != *(at + 1)) continue;
+          if (!link.approachedInternal.empty()) {
+            next = InternalChain(link.approachedInternal, nullptr);
+          }
+          next.push_back(link.approachedLane);
+          break;
+        }
+        break;
+      }
+    }
+    for (const std::string& l : next) {
+      geometry::Path2 so_far;
+      so_far.points = path;
+      so_far.UpdateArcLength();
+      const double left = lookahead - so_far.length_m();
+      if (left <= 0) break;
+      Append(Slice(LaneShape(l), 0, left), &path);
+    }
+    const double safe =
+        YieldSpeedMps(path, v.box.width_m, decel, body, ego_velocity);
+    if (safe < 0) continue;
+    // Slower than it would drive anyway: a cap, never a push.
+    if (safe >= libsumo::Vehicle::getAllowedSpeed(v.id) *
+                    libsumo::Vehicle::getSpeedFactor(v.id)) {
+      continue;
+    }
+    libsumo::Vehicle::setSpeed(v.id, safe);
+    still_yielding.insert(v.id);
+  }
+  // Back to SUMO's own driving for those the ego no longer holds up.
+  for (const std::string& id : yielding) {
+    if (!still_yielding.count(id) &&
+        std::find_if(others.begin(), others.end(), [&](const OtherVehicle& v) {
+          return v.id == id;
+        }) != others.end()) {
+      libsumo::Vehicle::setSpeed(id, -1);
+    }
+  }
+  yielding = std::move(still_yielding);
+}
+
+void World::Impl::ReadOthers() {
+  others.clear();
+  for (const std::string& id : libsumo::Vehicle::getIDList()) {
+    if (id == kEgoId) continue;
+    auto it = dims.find(id);
+    if (it == dims.end()) {
+      it = dims.emplace(id, Vec2(libsumo::Vehicle::getLength(id),
+                                 libsumo::Vehicle::getWidth(id)))
+               .first;
+    }
+    const auto p = libsumo::Vehicle::getPosition(id);
+    const double yaw = SumoAngleToYaw(libsumo::Vehicle::getAngle(id));
+    OtherVehicle v;
+    v.id = id;
+    v.box.yaw_rad = yaw;
+    v.box.length_m = it->second.x();
+    v.box.width_m = it->second.y();
+    v.box.height_m = 1.5;
+    v.box.center = Vec2(p.x, p.y) -
+                   v.box.length_m / 2 * Vec2(std::cos(yaw), std::sin(yaw));
+    v.speed_mps = libsumo::Vehicle::getSpeed(id);
+    others.push_back(v);
+  }
+}
+
+}  // namespace adse::world
