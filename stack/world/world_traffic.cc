@@ -36,11 +36,23 @@ constexpr double kEnteringLengthM = 5.0;
 // SUMO's default deceleration, m/s^2.
 constexpr double kDefaultDecelMps2 = 4.5;
 
-// Appends `piece` to `path`, skipping a repeat of its last point.
-void Append(const std::vector<Vec2>& piece, std::vector<Vec2>* path) {
+// The ego's body this close to a flow's first lane's start counts as
+// about to drive onto it.
+constexpr double kAboutToEnterM = 1.5;
+
+// Appends `piece` to `path`, skipping a repeat of its last point; returns
+// the length added.
+double Append(const std::vector<Vec2>& piece, std::vector<Vec2>* path) {
+  double added = 0.0;
   for (const Vec2& p : piece) {
-    if (path->empty() || (p - path->back()).norm() > 1e-6) path->push_back(p);
+    if (!path->empty()) {
+      const double step = (p - path->back()).norm();
+      if (step <= 1e-6) continue;
+      added += step;
+    }
+    path->push_back(p);
   }
+  return added;
 }
 
 }  // namespace
@@ -131,7 +143,7 @@ void World::Impl::InsertFlows() {
       if (YieldSpeedMps(Slice(shape, 0, reach), libsumo::Lane::getWidth(lane),
                         kDefaultDecelMps2, body, Vec2::Zero()) >= 0 ||
           (!shape.empty() && (body.center - shape.front()).norm() <
-                                 body.length_m + kOffRoadSlackM)) {
+                                 body.length_m + kAboutToEnterM)) {
         clear = false;
         break;
       }
@@ -166,7 +178,8 @@ void World::Impl::YieldToEgo() {
     // continuation.
     std::vector<Vec2> path;
     const double pos = libsumo::Vehicle::getLanePosition(v.id);
-    Append(Slice(LaneShape(lane), pos, pos + lookahead), &path);
+    double length_m =
+        Append(Slice(LaneShape(lane), pos, pos + lookahead), &path);
     std::vector<std::string> next;
     if (lane[0] == ':') {
       std::string arrives_on;
@@ -193,12 +206,8 @@ void World::Impl::YieldToEgo() {
       }
     }
     for (const std::string& l : next) {
-      geometry::Path2 so_far;
-      so_far.points = path;
-      so_far.UpdateArcLength();
-      const double left = lookahead - so_far.length_m();
-      if (left <= 0) break;
-      Append(Slice(LaneShape(l), 0, left), &path);
+      if (length_m >= lookahead) break;
+      length_m += Append(Slice(LaneShape(l), 0, lookahead - length_m), &path);
     }
     const double safe =
         YieldSpeedMps(path, v.box.width_m, decel, body, ego_velocity);
