@@ -164,7 +164,7 @@ void World::Impl::YieldToEgo() {
   std::set<std::string> still_yielding;
   for (const OtherVehicle& v : others) {
     if (held_still.count(v.id)) continue;
-    const double decel = libsumo::Vehicle::getDecel(v.id);
+    const double decel = types.at(v.id).decel_mps2;
     const double lookahead = YieldLookaheadM(v.speed_mps, decel);
     // Too far for any part of the ego to lie within its lookahead.
     if ((v.box.center - body.center).norm() >
@@ -236,10 +236,12 @@ void World::Impl::ReadOthers() {
   others.clear();
   for (const std::string& id : libsumo::Vehicle::getIDList()) {
     if (id == kEgoId) continue;
-    auto it = dims.find(id);
-    if (it == dims.end()) {
-      it = dims.emplace(id, Vec2(libsumo::Vehicle::getLength(id),
-                                 libsumo::Vehicle::getWidth(id)))
+    auto it = types.find(id);
+    if (it == types.end()) {
+      it = types
+               .emplace(id, VehicleType{libsumo::Vehicle::getLength(id),
+                                        libsumo::Vehicle::getWidth(id),
+                                        libsumo::Vehicle::getDecel(id)})
                .first;
     }
     const auto p = libsumo::Vehicle::getPosition(id);
@@ -247,8 +249,8 @@ void World::Impl::ReadOthers() {
     OtherVehicle v;
     v.id = id;
     v.box.yaw_rad = yaw;
-    v.box.length_m = it->second.x();
-    v.box.width_m = it->second.y();
+    v.box.length_m = it->second.length_m;
+    v.box.width_m = it->second.width_m;
     v.box.height_m = 1.5;
     v.box.center = Vec2(p.x, p.y) -
                    v.box.length_m / 2 * Vec2(std::cos(yaw), std::sin(yaw));

@@ -117,7 +117,13 @@ struct World::Impl {
   std::map<std::string, std::vector<Eigen::Vector2d>>
       lane_shapes;  // by lane id
   std::unique_ptr<Random> traffic_random;
-  std::map<std::string, Eigen::Vector2d> dims;  // vehicle id -> (length, width)
+  // What SUMO's vehicles keep for life, asked once per vehicle.
+  struct VehicleType {
+    double length_m = 0.0;
+    double width_m = 0.0;
+    double decel_mps2 = 0.0;  // its comfortable deceleration
+  };
+  std::map<std::string, VehicleType> types;  // by vehicle id
 
   ~Impl() {
     if (sumo_running) {
