@@ -31,7 +31,7 @@ TEST(ReplayTest, TheRecordingHoldsTheWholeSpaceWithAFeasibleFront) {
 
 TEST(ReplayTest, AgentFindsTheCheapestDesignOrSixTrueParetoPointsInMostSeeds) {
   // The study's LLM agent found 6 true Pareto points in 15. On adse's
-  // recording (run key v12) the agent does that in the seeds that walk
+  // recording (run key v13) the agent does that in the seeds that walk
   // the 2.1 GHz column; most others find the cheapest design (7 cores at
   // 1.2 GHz) and fewer front points; seed 4 neither (7 of seeds 1-8 do;
   // README, "Reproducing the reference study").
