@@ -21,14 +21,14 @@
 
 #include "stack/runtime/graph.h"
 #include "stack/runtime/trace.h"
+#include "tests/stack/runtime/executor_test_util.h"
 
 namespace adse::stack {
 namespace {
 
-struct Msg {
-  Header header;
-  int value = 0;
-};
+using test::EventsOf;
+using test::Msg;
+using test::RecordsOf;
 
 // A flat cost of `cost_s` at 2 GHz for each named callback.
 std::shared_ptr<const CostProfile> FlatProfile(
@@ -64,20 +64,6 @@ double ProcessCpuSeconds() {
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return static_cast<double>(ts.tv_sec) +
          1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-std::vector<CallbackRecord> RecordsOf(const Trace& trace, int callback) {
-  std::vector<CallbackRecord> out;
-  for (const CallbackRecord& r : trace.callbacks) {
-    if (r.callback == callback) out.push_back(r);
-  }
-  return out;
-}
-
-size_t Count(const Trace& trace, TopicEvent::Kind kind, int topic) {
-  return static_cast<size_t>(std::count_if(
-      trace.topic_events.begin(), trace.topic_events.end(),
-      [&](const TopicEvent& e) { return e.kind == kind && e.topic == topic; }));
 }
 
 // A 100 Hz timer on node "a" publishes to "t"; "b" takes it and publishes
@@ -155,7 +141,8 @@ TEST(RealTimeExecutorTest, EveryCallbackKeepsItsThreadBusyForItsProfileCost) {
   // The timer fired every 10 ms of the 500 ms: each fire ran and published
   // once, or was skipped and counted as an overrun.
   const size_t fires = RecordsOf(exec->trace(), chain.timer).size();
-  EXPECT_EQ(fires, Count(exec->trace(), TopicEvent::kPublish, chain.t));
+  EXPECT_EQ(fires,
+            EventsOf(exec->trace(), TopicEvent::kPublish, chain.t).size());
   EXPECT_GE(
       fires + static_cast<size_t>(exec->trace().timer_overruns[chain.timer]),
       45u);
@@ -196,9 +183,12 @@ TEST(RealTimeExecutorTest, AFullKeepLastQueueDropsItsOldestMessage) {
   ASSERT_NE(exec, nullptr);
   ASSERT_TRUE(exec->AdvanceTo(0.4).ok());
   exec->Stop();
-  const size_t published = Count(exec->trace(), TopicEvent::kPublish, chain.t);
-  const size_t taken = Count(exec->trace(), TopicEvent::kTake, chain.t);
-  const size_t dropped = Count(exec->trace(), TopicEvent::kDrop, chain.t);
+  const size_t published =
+      EventsOf(exec->trace(), TopicEvent::kPublish, chain.t).size();
+  const size_t taken =
+      EventsOf(exec->trace(), TopicEvent::kTake, chain.t).size();
+  const size_t dropped =
+      EventsOf(exec->trace(), TopicEvent::kDrop, chain.t).size();
   EXPECT_GT(dropped, 0u);
   EXPECT_LE(taken, 15u) << "at most one per 30 ms of CPU";
   // Every message was taken, dropped, or is the one still queued.

@@ -6,10 +6,8 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
-#include <limits>
 #include <map>
 #include <memory>
-#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -18,63 +16,20 @@
 #include "stack/runtime/executor.h"
 #include "stack/runtime/graph.h"
 #include "stack/runtime/trace.h"
+#include "tests/stack/runtime/executor_test_util.h"
 
 namespace adse::stack {
 namespace {
 
+using test::Counted;
+using test::CreateVirtual;
+using test::EventsOf;
+using test::Msg;
+using test::Noop;
+using test::Publish;
+using test::RecordsOf;
+
 constexpr double kTol = 1e-9;
-
-struct Msg {
-  Header header;
-  int value = 0;
-};
-
-VirtualPlatformOptions Counted(int cores,
-                               std::map<std::string, CountedCost> costs) {
-  VirtualPlatformOptions o;
-  o.cores = cores;
-  o.freq_ghz = 2.0;
-  o.reference_ghz = 2.0;
-  o.cost_model = CostModelKind::kCounted;
-  o.counted = std::move(costs);
-  return o;
-}
-
-std::unique_ptr<Executor> Create(const Graph& graph,
-                                 const VirtualPlatformOptions& options) {
-  auto result = CreateVirtualExecutor(&graph, options);
-  EXPECT_TRUE(result.ok()) << result.status().ToString();
-  if (!result.ok()) return nullptr;
-  return std::move(result).value();
-}
-
-void Publish(Executor& ex, int topic, int value, double t) {
-  Msg m;
-  m.header.stamp_s = t;
-  m.value = value;
-  ex.PublishExternal(topic, std::make_shared<const Msg>(m), t, t);
-}
-
-std::vector<CallbackRecord> RecordsOf(const Trace& trace, int callback) {
-  std::vector<CallbackRecord> out;
-  for (const auto& r : trace.callbacks) {
-    if (r.callback == callback) out.push_back(r);
-  }
-  return out;
-}
-
-std::vector<TopicEvent> EventsOf(const Trace& trace, TopicEvent::Kind kind,
-                                 int topic) {
-  std::vector<TopicEvent> out;
-  for (const auto& e : trace.topic_events) {
-    if (e.kind == kind && e.topic == topic) out.push_back(e);
-  }
-  return out;
-}
-
-auto Noop() {
-  return [](const Msg&, CallbackContext&) {};
-}
 
 double ThreadCpu() {
   timespec ts{};
@@ -97,7 +52,8 @@ TEST(VirtualExecutorTest, QueueingOnOneCore) {
   const int in = g.AddTopic<Msg>("in");
   const int a = g.Subscribe<Msg>(g.AddNode("a"), in, "cb", 1, Noop());
   const int b = g.Subscribe<Msg>(g.AddNode("b"), in, "cb", 1, Noop());
-  auto ex = Create(g, Counted(1, {{"a/cb", {0.1, 0}}, {"b/cb", {0.2, 0}}}));
+  auto ex =
+      CreateVirtual(g, Counted(1, {{"a/cb", {0.1, 0}}, {"b/cb", {0.2, 0}}}));
   Publish(*ex, in, 0, 1.0);
   ASSERT_TRUE(ex->AdvanceTo(2.0).ok());
   const auto ra = RecordsOf(ex->trace(), a);
@@ -121,7 +77,8 @@ TEST(VirtualExecutorTest, TwoCoresRunInParallel) {
   const int in = g.AddTopic<Msg>("in");
   const int a = g.Subscribe<Msg>(g.AddNode("a"), in, "cb", 1, Noop());
   const int b = g.Subscribe<Msg>(g.AddNode("b"), in, "cb", 1, Noop());
-  auto ex = Create(g, Counted(2, {{"a/cb", {0.1, 0}}, {"b/cb", {0.2, 0}}}));
+  auto ex =
+      CreateVirtual(g, Counted(2, {{"a/cb", {0.1, 0}}, {"b/cb", {0.2, 0}}}));
   Publish(*ex, in, 0, 1.0);
   ASSERT_TRUE(ex->AdvanceTo(2.0).ok());
   const auto ra = RecordsOf(ex->trace(), a);
@@ -145,7 +102,7 @@ TEST(VirtualExecutorTest, NodeCallbacksAreMutuallyExclusive) {
   const int a = g.Subscribe<Msg>(node, in, "a", 1, Noop());
   const int b = g.Subscribe<Msg>(node, in, "b", 1, Noop());
   const int other = g.Subscribe<Msg>(g.AddNode("m"), in, "c", 1, Noop());
-  auto ex = Create(
+  auto ex = CreateVirtual(
       g, Counted(4, {{"n/a", {0.3, 0}}, {"n/b", {0.2, 0}}, {"m/c", {0.1, 0}}}));
   Publish(*ex, in, 0, 0.0);
   ASSERT_TRUE(ex->AdvanceTo(1.0).ok());
@@ -169,7 +126,8 @@ TEST(VirtualExecutorTest, EarliestReadyTimeGoesFirst) {
   g.Subscribe<Msg>(g.AddNode("busy"), busy_in, "cb", 1, Noop());
   const int late = g.Subscribe<Msg>(g.AddNode("late"), x, "cb", 1, Noop());
   const int early = g.Subscribe<Msg>(g.AddNode("early"), y, "cb", 1, Noop());
-  auto ex = Create(g, Counted(1, {{"busy/cb", {1.0, 0}}}));  // others 1e-4
+  auto ex =
+      CreateVirtual(g, Counted(1, {{"busy/cb", {1.0, 0}}}));  // others 1e-4
   Publish(*ex, busy_in, 0, 0.0);
   Publish(*ex, x, 0, 0.6);
   Publish(*ex, y, 0, 0.3);
@@ -192,7 +150,7 @@ TEST(VirtualExecutorTest, KeepLastOneDropsAndTakesNewest) {
   const int sub = g.Subscribe<Msg>(
       g.AddNode("slow"), in, "cb", 1,
       [&seen](const Msg& m, CallbackContext&) { seen.push_back(m.value); });
-  auto ex = Create(g, Counted(1, {{"slow/cb", {0.25, 0}}}));
+  auto ex = CreateVirtual(g, Counted(1, {{"slow/cb", {0.25, 0}}}));
   for (int k = 0; k < 100; ++k) Publish(*ex, in, k, k * 0.1);
   ASSERT_TRUE(ex->AdvanceTo(10.0).ok());
 
@@ -227,7 +185,7 @@ TEST(VirtualExecutorTest, KeepLastThreeDepth) {
   Graph g;
   const int in = g.AddTopic<Msg>("in");
   const int sub = g.Subscribe<Msg>(g.AddNode("s"), in, "cb", 3, Noop());
-  auto ex = Create(g, Counted(1, {{"s/cb", {1.0, 0}}}));
+  auto ex = CreateVirtual(g, Counted(1, {{"s/cb", {1.0, 0}}}));
   for (int k = 0; k < 6; ++k) Publish(*ex, in, k, k * 0.1);
   ASSERT_TRUE(ex->AdvanceTo(10.0).ok());
   const auto takes = EventsOf(ex->trace(), TopicEvent::kTake, in);
@@ -254,7 +212,7 @@ TEST(VirtualExecutorTest, CompletionBeforeArrivalAtEqualTimes) {
   Graph g;
   const int in = g.AddTopic<Msg>("in");
   g.Subscribe<Msg>(g.AddNode("s"), in, "cb", 1, Noop());
-  auto ex = Create(g, Counted(1, {{"s/cb", {0.5, 0}}}));
+  auto ex = CreateVirtual(g, Counted(1, {{"s/cb", {0.5, 0}}}));
   Publish(*ex, in, 0, 0.0);
   Publish(*ex, in, 1, 0.5);
   Publish(*ex, in, 2, 1.0);
@@ -270,7 +228,7 @@ TEST(VirtualExecutorTest, AdvanceToIsStrictlyBefore) {
   int calls = 0;
   g.Subscribe<Msg>(g.AddNode("s"), in, "cb", 1,
                    [&calls](const Msg&, CallbackContext&) { ++calls; });
-  auto ex = Create(g, Counted(1, {}));
+  auto ex = CreateVirtual(g, Counted(1, {}));
   Publish(*ex, in, 0, 1.0);
   ASSERT_TRUE(ex->AdvanceTo(1.0).ok());
   EXPECT_EQ(calls, 0);
@@ -291,7 +249,7 @@ TEST(VirtualExecutorTest, FrequencyAndCostScale) {
       VirtualPlatformOptions o = Counted(1, {{"s/cb", {0.1, 0}}});
       o.freq_ghz = freq;
       o.cost_scale = scale;
-      auto ex = Create(g, o);
+      auto ex = CreateVirtual(g, o);
       Publish(*ex, in, 0, 0.0);
       ASSERT_TRUE(ex->AdvanceTo(10.0).ok());
       const auto r = RecordsOf(ex->trace(), sub);
@@ -310,7 +268,7 @@ TEST(VirtualExecutorTest, CountedPerUnitCost) {
       g.AddNode("s"), in, "cb", 1, [](const Msg& m, CallbackContext& ctx) {
         ctx.ReportWork({.units = static_cast<double>(m.value)});
       });
-  auto ex = Create(g, Counted(1, {{"s/cb", {0.01, 0.002}}}));
+  auto ex = CreateVirtual(g, Counted(1, {{"s/cb", {0.01, 0.002}}}));
   Publish(*ex, in, 50, 0.0);
   ASSERT_TRUE(ex->AdvanceTo(1.0).ok());
   const auto r = RecordsOf(ex->trace(), sub);
@@ -326,7 +284,7 @@ TEST(VirtualExecutorTest, CountedCanRecordHostCpu) {
                            [](CallbackContext&) { BurnCpu(0.002); });
   VirtualPlatformOptions o = Counted(1, {{"n/t", {0.5, 0}}});
   o.record_host_cpu_when_counted = true;
-  auto ex = Create(g, o);
+  auto ex = CreateVirtual(g, o);
   ASSERT_TRUE(ex->AdvanceTo(1.0).ok());
   const auto r = RecordsOf(ex->trace(), t);
   ASSERT_EQ(r.size(), 1u);
@@ -340,7 +298,7 @@ TEST(VirtualExecutorTest, UnlistedCallbackCostsDefault) {
   const int sub = g.Subscribe<Msg>(g.AddNode("s"), in, "cb", 1, Noop());
   VirtualPlatformOptions o = Counted(1, {});
   o.default_counted = {0.07, 0.0};
-  auto ex = Create(g, o);
+  auto ex = CreateVirtual(g, o);
   Publish(*ex, in, 0, 0.0);
   ASSERT_TRUE(ex->AdvanceTo(1.0).ok());
   ASSERT_EQ(RecordsOf(ex->trace(), sub).size(), 1u);
@@ -351,7 +309,7 @@ TEST(VirtualExecutorTest, MinimumCostIsOneMicrosecond) {
   Graph g;
   const int in = g.AddTopic<Msg>("in");
   const int sub = g.Subscribe<Msg>(g.AddNode("s"), in, "cb", 1, Noop());
-  auto ex = Create(g, Counted(1, {{"s/cb", {0.0, 0.0}}}));
+  auto ex = CreateVirtual(g, Counted(1, {{"s/cb", {0.0, 0.0}}}));
   Publish(*ex, in, 0, 0.0);
   ASSERT_TRUE(ex->AdvanceTo(1.0).ok());
   const auto r = RecordsOf(ex->trace(), sub);
@@ -376,7 +334,7 @@ CallbackRecord RunAmdahl(int cores, int blockers, int max_threads) {
                                                .max_threads = max_threads});
                              });
   costs["par/t"] = {1.0, 0.0};
-  auto ex = Create(g, Counted(cores, costs));
+  auto ex = CreateVirtual(g, Counted(cores, costs));
   EXPECT_TRUE(ex->AdvanceTo(5.0).ok());
   const auto r = RecordsOf(ex->trace(), par);
   EXPECT_EQ(r.size(), 1u);
@@ -412,7 +370,8 @@ TEST(VirtualExecutorTest, ParallelCallbackHoldsAllItsCores) {
       });
   const int later = g.AddTimer(
       g.AddNode("later"), "t", 100.0, [](CallbackContext&) {}, 0.1);
-  auto ex = Create(g, Counted(2, {{"par/t", {1.0, 0}}, {"later/t", {0.1, 0}}}));
+  auto ex = CreateVirtual(
+      g, Counted(2, {{"par/t", {1.0, 0}}, {"later/t", {0.1, 0}}}));
   ASSERT_TRUE(ex->AdvanceTo(5.0).ok());
   const auto rp = RecordsOf(ex->trace(), par);
   const auto rl = RecordsOf(ex->trace(), later);
@@ -434,7 +393,7 @@ TEST(VirtualExecutorTest, TimerOverruns) {
         ++calls;
         now_seen.push_back(ctx.now_s());
       });
-  auto ex = Create(g, Counted(4, {{"n/t", {0.625, 0}}}));
+  auto ex = CreateVirtual(g, Counted(4, {{"n/t", {0.625, 0}}}));
   ASSERT_TRUE(ex->AdvanceTo(2.5).ok());
   // Fires at 0.5, 1.0, 1.25 (equal to an end: still waiting), 1.75, 2.25.
   EXPECT_EQ(ex->trace().timer_overruns[t], 5);
@@ -455,7 +414,7 @@ TEST(VirtualExecutorTest, RunningTimerFiringAgainWaits) {
   Graph g;
   const int t = g.AddTimer(
       g.AddNode("n"), "t", 1.0, [](CallbackContext&) {}, 0.5);
-  auto ex = Create(g, Counted(2, {{"n/t", {1.5, 0}}}));
+  auto ex = CreateVirtual(g, Counted(2, {{"n/t", {1.5, 0}}}));
   ASSERT_TRUE(ex->AdvanceTo(3.4).ok());
   EXPECT_EQ(ex->trace().timer_overruns[t], 0);
   const auto r = RecordsOf(ex->trace(), t);
@@ -486,7 +445,8 @@ TEST(VirtualExecutorTest, PublicationsReleasedAtEnd) {
   g.AddSink<Msg>(
       x, [&](const Msg& m, double t) { sink_calls.emplace_back(t, m.value); });
   const int down = g.Subscribe<Msg>(g.AddNode("down"), x, "cb", 1, Noop());
-  auto ex = Create(g, Counted(2, {{"up/t", {0.3, 0}}, {"down/cb", {0.1, 0}}}));
+  auto ex =
+      CreateVirtual(g, Counted(2, {{"up/t", {0.3, 0}}, {"down/cb", {0.1, 0}}}));
   ASSERT_TRUE(ex->AdvanceTo(0.45).ok());
   EXPECT_NEAR(now_in_callback, 0.2, kTol);
   EXPECT_TRUE(sink_calls.empty());  // held until 0.5
@@ -513,7 +473,7 @@ TEST(VirtualExecutorTest, SinksSeeExternalPublicationsAtArrival) {
   const int in = g.AddTopic<Msg>("in");
   std::vector<double> times;
   g.AddSink<Msg>(in, [&](const Msg&, double t) { times.push_back(t); });
-  auto ex = Create(g, Counted(1, {}));
+  auto ex = CreateVirtual(g, Counted(1, {}));
   Publish(*ex, in, 0, 0.25);
   Publish(*ex, in, 1, 0.75);
   ASSERT_TRUE(ex->AdvanceTo(0.5).ok());
@@ -541,9 +501,9 @@ TEST(VirtualExecutorTest, ChainLatencyIsSumOfCosts) {
   std::vector<std::pair<double, Msg>> outputs;
   g.AddSink<Msg>(out,
                  [&](const Msg& m, double t) { outputs.emplace_back(t, m); });
-  auto ex = Create(g, Counted(3, {{"a/cb", {0.05, 0}},
-                                  {"b/cb", {0.03, 0}},
-                                  {"c/cb", {0.07, 0}}}));
+  auto ex = CreateVirtual(g, Counted(3, {{"a/cb", {0.05, 0}},
+                                         {"b/cb", {0.03, 0}},
+                                         {"c/cb", {0.07, 0}}}));
   for (int k = 0; k < 20; ++k) Publish(*ex, t0, k, 1.0 + k * 0.1);
   ASSERT_TRUE(ex->AdvanceTo(10.0).ok());
   ASSERT_EQ(outputs.size(), 20u);
@@ -571,7 +531,7 @@ TEST(VirtualExecutorTest, MeasuredCostFollowsHostCpuTime) {
     o.reference_ghz = 2.0;
     o.freq_ghz = freq;
     o.cost_model = CostModelKind::kMeasured;
-    auto ex = Create(g, o);
+    auto ex = CreateVirtual(g, o);
     ASSERT_TRUE(ex->AdvanceTo(1.0).ok());
     const auto rs = RecordsOf(ex->trace(), small);
     const auto rb = RecordsOf(ex->trace(), big);
@@ -620,11 +580,12 @@ Trace RunMixedGraph() {
                ctx.Publish(cmd, m);
              });
   g.AddSink<Msg>(cmd, [](const Msg&, double) {});
-  auto ex = Create(g, Counted(kMixedCores, {{"filter/cb", {0.01, 0.0004}},
-                                            {"loc/ndt", {0.02, 0.001}},
-                                            {"loc/ekf", {0.004, 0}},
-                                            {"ctrl/pose", {0.001, 0}},
-                                            {"follow/t", {0.035, 0}}}));
+  auto ex =
+      CreateVirtual(g, Counted(kMixedCores, {{"filter/cb", {0.01, 0.0004}},
+                                             {"loc/ndt", {0.02, 0.001}},
+                                             {"loc/ekf", {0.004, 0}},
+                                             {"ctrl/pose", {0.001, 0}},
+                                             {"follow/t", {0.035, 0}}}));
   for (int step = 1; step <= 100; ++step) {
     const double t = step * 0.1;
     for (int j = 0; j < 3; ++j) {  // 30 Hz: faster than the filter keeps up
@@ -701,125 +662,6 @@ TEST(VirtualExecutorTest, CoresAreNeverOversubscribed) {
     }
     EXPECT_LE(busy, kMixedCores) << "at " << x.start_s;
   }
-}
-
-std::string OptionsError(VirtualPlatformOptions o) {
-  const Status s = ValidateVirtualPlatformOptions(o);
-  EXPECT_EQ(s.code(), Status::Code::kInvalidArgument);
-  Graph g;
-  EXPECT_FALSE(CreateVirtualExecutor(&g, o).ok());
-  return s.message();
-}
-
-TEST(VirtualExecutorTest, InvalidOptionsNameTheField) {
-  EXPECT_TRUE(ValidateVirtualPlatformOptions({}).ok());
-  VirtualPlatformOptions o;
-  o.cores = 0;
-  EXPECT_NE(OptionsError(o).find("cores"), std::string::npos);
-  o = {};
-  o.freq_ghz = -1.0;
-  EXPECT_NE(OptionsError(o).find("freq_ghz"), std::string::npos);
-  o = {};
-  o.reference_ghz = 0.0;
-  EXPECT_NE(OptionsError(o).find("reference_ghz"), std::string::npos);
-  o = {};
-  o.cost_scale = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_NE(OptionsError(o).find("cost_scale"), std::string::npos);
-  o = {};
-  o.counted["n/cb"] = {-1.0, 0.0};
-  EXPECT_NE(OptionsError(o).find("counted[n/cb].fixed_s"), std::string::npos);
-  o = {};
-  o.default_counted.per_unit_s = std::numeric_limits<double>::infinity();
-  EXPECT_NE(OptionsError(o).find("default_counted.per_unit_s"),
-            std::string::npos);
-}
-
-TEST(VirtualExecutorTest, InvalidGraphRejected) {
-  {
-    Graph g;
-    g.AddTimer(g.AddNode("n"), "t", 0.0, [](CallbackContext&) {});
-    auto r = CreateVirtualExecutor(&g, {});
-    ASSERT_FALSE(r.ok());
-    EXPECT_NE(r.status().message().find("n/t"), std::string::npos);
-    EXPECT_NE(r.status().message().find("period_s"), std::string::npos);
-  }
-  {
-    Graph g;
-    const int in = g.AddTopic<Msg>("in");
-    g.Subscribe<Msg>(g.AddNode("n"), in, "cb", 0, Noop());
-    auto r = CreateVirtualExecutor(&g, {});
-    ASSERT_FALSE(r.ok());
-    EXPECT_NE(r.status().message().find("queue_depth"), std::string::npos);
-  }
-  EXPECT_FALSE(CreateVirtualExecutor(nullptr, {}).ok());
-}
-
-TEST(VirtualExecutorTest, ExceptionInCallbackNamesIt) {
-  Graph g;
-  const int in = g.AddTopic<Msg>("in");
-  g.Subscribe<Msg>(
-      g.AddNode("planner"), in, "plan", 1,
-      [](const Msg&, CallbackContext&) { throw std::runtime_error("boom"); });
-  auto ex = Create(g, Counted(1, {}));
-  Publish(*ex, in, 0, 0.0);
-  const Status s = ex->AdvanceTo(1.0);
-  EXPECT_EQ(s.code(), Status::Code::kInternal);
-  EXPECT_NE(s.message().find("planner/plan"), std::string::npos);
-  EXPECT_NE(s.message().find("boom"), std::string::npos);
-  EXPECT_EQ(ex->AdvanceTo(2.0).code(), Status::Code::kInternal);  // sticky
-}
-
-TEST(VirtualExecutorTest, NonStandardExceptionInTimer) {
-  Graph g;
-  g.AddTimer(g.AddNode("n"), "t", 1.0, [](CallbackContext&) { throw 42; });
-  auto ex = Create(g, Counted(1, {}));
-  const Status s = ex->AdvanceTo(1.0);
-  EXPECT_EQ(s.code(), Status::Code::kInternal);
-  EXPECT_NE(s.message().find("n/t"), std::string::npos);
-}
-
-TEST(VirtualExecutorTest, ExceptionInSinkIsAnError) {
-  Graph g;
-  const int in = g.AddTopic<Msg>("in");
-  g.AddSink<Msg>(
-      in, [](const Msg&, double) { throw std::runtime_error("actuator"); });
-  auto ex = Create(g, Counted(1, {}));
-  Publish(*ex, in, 0, 0.0);
-  const Status s = ex->AdvanceTo(1.0);
-  EXPECT_EQ(s.code(), Status::Code::kInternal);
-  EXPECT_NE(s.message().find("in"), std::string::npos);
-  EXPECT_NE(s.message().find("actuator"), std::string::npos);
-}
-
-TEST(VirtualExecutorTest, PublishToUnknownTopicNamesCallback) {
-  Graph g;
-  g.AddTimer(g.AddNode("n"), "t", 1.0,
-             [](CallbackContext& ctx) { ctx.Publish(99, Msg{}); });
-  auto ex = Create(g, Counted(1, {}));
-  const Status s = ex->AdvanceTo(1.0);
-  EXPECT_EQ(s.code(), Status::Code::kInternal);
-  EXPECT_NE(s.message().find("n/t"), std::string::npos);
-}
-
-TEST(VirtualExecutorTest, ExternalPublicationInThePastIsAnError) {
-  Graph g;
-  const int in = g.AddTopic<Msg>("in");
-  auto ex = Create(g, Counted(1, {}));
-  ASSERT_TRUE(ex->AdvanceTo(1.0).ok());
-  Publish(*ex, in, 0, 1.0 - 1e-12);  // rounding: moved to now
-  ASSERT_TRUE(ex->AdvanceTo(1.5).ok());
-  EXPECT_EQ(EventsOf(ex->trace(), TopicEvent::kPublish, in).size(), 1u);
-  EXPECT_DOUBLE_EQ(ex->trace().topic_events[0].t_s, 1.0);
-  Publish(*ex, in, 1, 0.5);
-  EXPECT_EQ(ex->AdvanceTo(2.0).code(), Status::Code::kInvalidArgument);
-}
-
-TEST(VirtualExecutorTest, UnknownExternalTopicIsAnError) {
-  Graph g;
-  g.AddTopic<Msg>("in");
-  auto ex = Create(g, Counted(1, {}));
-  ex->PublishExternal(3, std::make_shared<const Msg>(), 0.0, 0.0);
-  EXPECT_EQ(ex->AdvanceTo(1.0).code(), Status::Code::kInvalidArgument);
 }
 
 }  // namespace
