@@ -97,7 +97,7 @@ TEST_F(CampaignFileTest, LlmExchangesRoundTripAndOlderIndexesHaveNone) {
     EXPECT_EQ(r.latency_s, w.latency_s);
     EXPECT_EQ(r.attempts, w.attempts);
   }
-  // The recorded robotaxi campaign predates the group.
+  // The recorded robotaxi campaign (exhaustive, no LLM) exchanged none.
   Result<CampaignIndex> old =
       ReadCampaignIndex(std::string(ADSE_SOURCE_DIR) +
                         "/tests/data/robotaxi_exhaustive/campaign.h5");
