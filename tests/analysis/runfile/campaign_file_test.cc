@@ -97,13 +97,23 @@ TEST_F(CampaignFileTest, LlmExchangesRoundTripAndOlderIndexesHaveNone) {
     EXPECT_EQ(r.latency_s, w.latency_s);
     EXPECT_EQ(r.attempts, w.attempts);
   }
+  // An index written before LLM exchanges were kept: no /llm_exchanges.
+  {
+    RawFile raw(path);
+    ASSERT_GE(raw.get(), 0);
+    ASSERT_GE(H5Ldelete(raw.get(), "/llm_exchanges", H5P_DEFAULT), 0);
+  }
+  back = ReadCampaignIndex(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_TRUE(back->llm_exchanges.empty());
+  EXPECT_EQ(back->evaluations.size(), index.evaluations.size());
   // The recorded robotaxi campaign (exhaustive, no LLM) exchanged none.
-  Result<CampaignIndex> old =
+  Result<CampaignIndex> recorded =
       ReadCampaignIndex(std::string(ADSE_SOURCE_DIR) +
                         "/tests/data/robotaxi_exhaustive/campaign.h5");
-  ASSERT_TRUE(old.ok()) << old.status().ToString();
-  EXPECT_TRUE(old->llm_exchanges.empty());
-  EXPECT_EQ(old->evaluations.size(), 280u);
+  ASSERT_TRUE(recorded.ok()) << recorded.status().ToString();
+  EXPECT_TRUE(recorded->llm_exchanges.empty());
+  EXPECT_EQ(recorded->evaluations.size(), 280u);
 }
 
 TEST_F(CampaignFileTest, ReplicasRoundTripAndOlderIndexesHaveNone) {
