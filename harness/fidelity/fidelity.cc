@@ -41,7 +41,11 @@ Comparison Compare(const std::string& name, double virtual_value,
   c.name = name;
   c.virtual_value = virtual_value;
   for (double v : realtime) {
-    if (!std::isnan(v)) c.realtime.push_back(v);
+    if (std::isnan(v)) {
+      ++c.runs_without;
+    } else {
+      c.realtime.push_back(v);
+    }
   }
   c.realtime_median = analysis::Percentile(c.realtime, 0.5);
   c.difference =
@@ -93,13 +97,17 @@ std::string Number(double v) {
 }  // namespace
 
 bool Comparison::met() const {
-  return tolerance && std::isfinite(difference) &&
+  return tolerance && runs_without == 0 && std::isfinite(difference) &&
          std::abs(difference) <= *tolerance;
 }
 
 PointFidelity CompareRuns(const runfile::RunData& virtual_run,
                           const std::vector<runfile::RunData>& realtime_runs) {
   PointFidelity f;
+  f.virtual_outcome = virtual_run.termination_reason;
+  for (const runfile::RunData& r : realtime_runs) {
+    f.realtime_outcomes.push_back(r.termination_reason);
+  }
   struct Quantity {
     const char* name;
     std::optional<double> tolerance;
@@ -141,12 +149,13 @@ PointFidelity CompareRuns(const runfile::RunData& virtual_run,
     rts.push_back(CallbackLatenciesMs(r));
     rts_unit.push_back(CallbackLatenciesMs(r, /*per_kunit=*/true));
   }
-  // The p50 (and `q`) of `name` in each real-time run that ran it.
+  // The p50 (and `q`) of `name` in each real-time run; NaN where it never
+  // ran.
   auto realtime_quantile = [](auto& runs, const std::string& name, double q) {
     std::vector<double> out;
     for (auto& run : runs) {
       auto it = run.find(name);
-      if (it != run.end()) out.push_back(Quantile(it->second, q));
+      out.push_back(it != run.end() ? Quantile(it->second, q) : kNaN);
     }
     return out;
   };
@@ -211,6 +220,17 @@ std::string FormatPointFidelity(const PointFidelity& f) {
   out << fmt::format(
       "{}: virtual vs real-time (median of {} run{}; {}; clock by {})\n",
       f.point, k, k == 1 ? "" : "s", f.confinement, f.clock_by);
+  // How the runs ended leads: a real-time run that ended otherwise than
+  // the virtual one is a disagreement no median shows.
+  std::string outcomes;
+  for (const std::string& o : f.realtime_outcomes) {
+    outcomes += (outcomes.empty() ? "" : ", ") + o;
+  }
+  const bool same =
+      std::all_of(f.realtime_outcomes.begin(), f.realtime_outcomes.end(),
+                  [&](const std::string& o) { return o == f.virtual_outcome; });
+  out << fmt::format("  ended: virtual {}; real-time {}{}\n", f.virtual_outcome,
+                     outcomes, same ? "" : "  (differ)");
   auto table = [&](const char* what, const std::vector<Comparison>& rows) {
     out << fmt::format("  {:<44} {:>10} {:>10} {:>22} {:>8}  {}\n", what,
                        "virtual", "real-time", "real-time runs", "diff",
@@ -221,6 +241,9 @@ std::string FormatPointFidelity(const PointFidelity& f) {
         runs = Number(*std::min_element(c.realtime.begin(), c.realtime.end()));
         runs += "–" +
                 Number(*std::max_element(c.realtime.begin(), c.realtime.end()));
+      }
+      if (c.runs_without > 0 && !c.realtime.empty()) {
+        runs = fmt::format("{} ({} without)", runs, c.runs_without);
       }
       const std::string diff =
           std::isfinite(c.difference)

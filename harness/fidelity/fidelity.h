@@ -30,6 +30,10 @@ struct Comparison {
   std::string name;
   double virtual_value = 0.0;
   std::vector<double> realtime;  // one per real-time run that had it
+  // Real-time runs that lacked it (a nav time of a run that did not reach
+  // the goal, a callback that never ran): the target is then missed, since
+  // the median of the others hides an outcome the model did not predict.
+  int runs_without = 0;
   double realtime_median = 0.0;
   // (median - virtual) / |virtual|; NaN when either is missing or virtual
   // is 0.
@@ -43,6 +47,10 @@ struct PointFidelity {
   std::string point;        // FormatPoint text
   std::string confinement;  // where the real-time runs ran
   std::string clock_by;     // what stood for the clock there
+  // How each run ended (termination_reason): the virtual run's, then one
+  // per real-time run.
+  std::string virtual_outcome;
+  std::vector<std::string> realtime_outcomes;
   // nav_time_s (only of runs that reached the goal) and ctrl_rate_hz
   // (targets 10 %), e2e_latency_p50_s,
   // dropped_messages, lidar_frames_dropped, and the sensing-to-control

@@ -429,6 +429,15 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
       << run.out;
   EXPECT_NE(run.out.find("ctrl_rate_hz"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("callback p50 latency"), std::string::npos);
+  // How each run ended leads (4 s: neither reaches the goal).
+  EXPECT_NE(run.out.find("  ended: virtual timeout; real-time timeout\n"),
+            std::string::npos)
+      << run.out;
+  std::ifstream json_in(out / "fidelity.json");
+  const nlohmann::json json = nlohmann::json::parse(json_in, nullptr, false);
+  ASSERT_FALSE(json.is_discarded());
+  EXPECT_EQ(json["points"][0]["ended"]["virtual"], "timeout");
+  EXPECT_EQ(json["points"][0]["ended"]["realtime"].size(), 1u);
   for (const char* name : {"fidelity.txt", "fidelity.json", "fidelity-1.png",
                            "runs/1-virtual.h5", "runs/1-realtime-1.h5"}) {
     EXPECT_TRUE(fs::is_regular_file(out / name)) << name;

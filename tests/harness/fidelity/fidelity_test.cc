@@ -1,6 +1,7 @@
 // The comparison `adse fidelity` prints, on runs built by hand: medians of
 // the real-time runs against the virtual run, the targets, nav times only
-// between runs that reached the goal, and callbacks under 1 ms left out.
+// between runs that reached the goal (a run that did not misses the target),
+// and callbacks under 1 ms left out.
 #include "harness/fidelity/fidelity.h"
 
 #include <gtest/gtest.h>
@@ -89,6 +90,43 @@ TEST(FidelityTest, NavTimesOfRunsThatTimedOutAreNotCompared) {
   EXPECT_TRUE(std::isnan(nav.difference));
   EXPECT_FALSE(nav.met());
   EXPECT_NEAR(Find(f.metrics, "ctrl_rate_hz").difference, -0.25, 1e-12);
+}
+
+TEST(FidelityTest, ARealTimeRunThatDidNotArriveMissesTheNavTimeTarget) {
+  // The virtual run and one real-time run arrive 3 % apart; the other
+  // real-time run stalls. The median of the one that arrived would meet
+  // the target and hide that.
+  runfile::RunData stalled = MadeRun(168.8, 4.9, 10.0, false);
+  stalled.termination_reason = "stalled: localization_lost";
+  const PointFidelity f = CompareRuns(MadeRun(115.0, 5.0, 10.0),
+                                      {MadeRun(112.0, 4.9, 10.0), stalled});
+  const Comparison& nav = Find(f.metrics, "nav_time_s");
+  EXPECT_EQ(nav.realtime.size(), 1u);
+  EXPECT_EQ(nav.runs_without, 1);
+  EXPECT_NEAR(nav.difference, -3.0 / 115.0, 1e-12);
+  EXPECT_FALSE(nav.met());
+  EXPECT_TRUE(Find(f.metrics, "ctrl_rate_hz").met());
+  EXPECT_EQ(f.virtual_outcome, "goal_reached");
+  ASSERT_EQ(f.realtime_outcomes.size(), 2u);
+  EXPECT_EQ(f.realtime_outcomes[1], "stalled: localization_lost");
+  const std::string table = FormatPointFidelity(f);
+  EXPECT_NE(table.find("ended: virtual goal_reached; real-time goal_reached, "
+                       "stalled: localization_lost  (differ)"),
+            std::string::npos)
+      << table;
+  EXPECT_NE(table.find("(1 without)"), std::string::npos) << table;
+}
+
+TEST(FidelityTest, ACallbackThatNeverRanInARealTimeRunMissesItsTarget) {
+  runfile::RunData idle = MadeRun(100.0, 30.0, 10.0);
+  std::erase_if(idle.trace.callbacks,
+                [](const stack::CallbackRecord& r) { return r.callback == 0; });
+  const PointFidelity f = CompareRuns(MadeRun(100.0, 30.0, 10.0),
+                                      {MadeRun(100.0, 30.0, 10.0), idle});
+  const Comparison& work = Find(f.callback_p50_ms, "a/work");
+  EXPECT_EQ(work.runs_without, 1);
+  EXPECT_NEAR(work.difference, 0.0, 1e-9);
+  EXPECT_FALSE(work.met());
 }
 
 TEST(FidelityTest, MoreWorkIsToldFromASlowerExecutorPerWorkUnit) {
