@@ -36,6 +36,10 @@ nlohmann::json ComparisonsJson(
          {"realtime_median", number(c.realtime_median)},
          {"realtime_runs", runs},
          {"realtime_runs_without", c.runs_without},
+         {"invocations", c.virtual_count > 0
+                             ? nlohmann::json{{"virtual", c.virtual_count},
+                                              {"realtime", c.realtime_counts}}
+                             : nlohmann::json()},
          {"difference", number(c.difference)},
          {"tolerance",
           c.tolerance ? nlohmann::json(*c.tolerance) : nlohmann::json()},

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "analysis/metrics/run_metrics.h"
 #include "harness/profile/profile_check.h"
@@ -163,8 +164,15 @@ PointFidelity CompareRuns(const runfile::RunData& virtual_run,
     const double p50 = Quantile(latencies, 0.5);
     if (!(p50 >= kMinCallbackMs)) continue;
     const double p99 = Quantile(latencies, 0.99);
-    f.callback_p50_ms.push_back(Compare(
-        name, p50, realtime_quantile(rts, name, 0.5), kCallbackTolerance));
+    Comparison c50 = Compare(name, p50, realtime_quantile(rts, name, 0.5),
+                             kCallbackTolerance);
+    c50.virtual_count = static_cast<int>(latencies.size());
+    for (const auto& run : rts) {
+      auto it = run.find(name);
+      c50.realtime_counts.push_back(
+          it == run.end() ? 0 : static_cast<int>(it->second.size()));
+    }
+    f.callback_p50_ms.push_back(std::move(c50));
     f.callback_p99_ms.push_back(
         Compare(name, p99, realtime_quantile(rts, name, 0.99), std::nullopt));
     auto unit = v_unit.find(name);
@@ -253,9 +261,14 @@ std::string FormatPointFidelity(const PointFidelity& f) {
           c.tolerance ? fmt::format("±{:.0f}% {}", 100.0 * *c.tolerance,
                                     c.met() ? "met" : "missed")
                       : std::string();
-      out << fmt::format("  {:<44} {:>10} {:>10} {:>22} {:>8}  {}\n", c.name,
+      std::string count;
+      if (c.virtual_count > 0) {
+        count = fmt::format("  n {} / {}", c.virtual_count,
+                            fmt::join(c.realtime_counts, ", "));
+      }
+      out << fmt::format("  {:<44} {:>10} {:>10} {:>22} {:>8}  {}{}\n", c.name,
                          Number(c.virtual_value), Number(c.realtime_median),
-                         runs, diff, target);
+                         runs, diff, target, count);
     }
   };
   table("run", f.metrics);

@@ -34,6 +34,12 @@ struct Comparison {
   // the goal, a callback that never ran): the target is then missed, since
   // the median of the others hides an outcome the model did not predict.
   int runs_without = 0;
+  // For a callback: its invocations in the virtual run and in each
+  // real-time run. A p50 of a few invocations (the scan chain on a starved
+  // core runs a handful of times) is a draw of the cost profile, not a
+  // measurement of the model.
+  int virtual_count = 0;
+  std::vector<int> realtime_counts;
   double realtime_median = 0.0;
   // (median - virtual) / |virtual|; NaN when either is missing or virtual
   // is 0.

@@ -75,10 +75,16 @@ TEST(FidelityTest, TheMedianRealTimeRunIsHeldAgainstTheVirtualOne) {
   EXPECT_NEAR(f.callback_p50_ms[0].difference, 0.25, 1e-9);
   EXPECT_FALSE(f.callback_p50_ms[0].met()) << "25 % is past the 20 % target";
   EXPECT_NEAR(f.callback_p99_ms[0].virtual_value, 10.0, 1e-9);
+  // How many invocations each p50 is of.
+  EXPECT_EQ(f.callback_p50_ms[0].virtual_count, 100);
+  EXPECT_EQ(f.callback_p50_ms[0].realtime_counts,
+            (std::vector<int>{100, 100, 100}));
 
   const std::string table = FormatPointFidelity(f);
   EXPECT_NE(table.find("±20% missed"), std::string::npos) << table;
   EXPECT_NE(table.find("±10% met"), std::string::npos) << table;
+  EXPECT_NE(table.find("±20% missed  n 100 / 100, 100, 100"), std::string::npos)
+      << table;
 }
 
 TEST(FidelityTest, NavTimesOfRunsThatTimedOutAreNotCompared) {
@@ -125,6 +131,7 @@ TEST(FidelityTest, ACallbackThatNeverRanInARealTimeRunMissesItsTarget) {
                                       {MadeRun(100.0, 30.0, 10.0), idle});
   const Comparison& work = Find(f.callback_p50_ms, "a/work");
   EXPECT_EQ(work.runs_without, 1);
+  EXPECT_EQ(work.realtime_counts, (std::vector<int>{100, 0}));
   EXPECT_NEAR(work.difference, 0.0, 1e-9);
   EXPECT_FALSE(work.met());
 }
