@@ -230,15 +230,12 @@ std::string FormatPointFidelity(const PointFidelity& f) {
       f.point, k, k == 1 ? "" : "s", f.confinement, f.clock_by);
   // How the runs ended leads: a real-time run that ended otherwise than
   // the virtual one is a disagreement no median shows.
-  std::string outcomes;
-  for (const std::string& o : f.realtime_outcomes) {
-    outcomes += (outcomes.empty() ? "" : ", ") + o;
-  }
   const bool same =
       std::all_of(f.realtime_outcomes.begin(), f.realtime_outcomes.end(),
                   [&](const std::string& o) { return o == f.virtual_outcome; });
   out << fmt::format("  ended: virtual {}; real-time {}{}\n", f.virtual_outcome,
-                     outcomes, same ? "" : "  (differ)");
+                     fmt::join(f.realtime_outcomes, ", "),
+                     same ? "" : "  (differ)");
   auto table = [&](const char* what, const std::vector<Comparison>& rows) {
     out << fmt::format("  {:<44} {:>10} {:>10} {:>22} {:>8}  {}\n", what,
                        "virtual", "real-time", "real-time runs", "diff",
