@@ -195,7 +195,8 @@ struct RunData {
   std::string status = kRunComplete;  // one of the statuses above
   // goal_reached | timeout | constraint_violated: <constraint> |
   // stalled: <stop reason> | error text;
-  // valet_parking also: no_path (the planner found no manoeuvre),
+  // no_path (the freespace planner found no manoeuvre: valet parking, or
+  // a three-point turn on the route); valet_parking also:
   // parked_out_of_tolerance (the manoeuvre ended outside the tolerances)
   std::string termination_reason;
   std::string scenario_name;

@@ -36,6 +36,16 @@ std::string PathCsv(const geometry::Path2& path) {
   return csv;
 }
 
+// ", turns round in 5 moves at 812 m": the route's three-point turns.
+std::string TurnaroundText(const std::vector<world::RouteTurnaround>& turns) {
+  std::string text;
+  for (const world::RouteTurnaround& t : turns) {
+    text += fmt::format(", turns round in {} moves at {:.0f} m",
+                        world::ManoeuvreMoves(t.reference), t.start_s_m);
+  }
+  return text;
+}
+
 }  // namespace
 
 int RunWorld(const WorldArgs& args) {
@@ -75,6 +85,15 @@ int RunWorld(const WorldArgs& args) {
   summary["parking_slots"] = w.scene().parking_slots().size();
   summary["parked_cars"] = parked;
   summary["traffic_seed"] = setup.world.traffic.seed;
+  // The three-point turns where the route turns around tighter than the
+  // car can.
+  nlohmann::json turns = nlohmann::json::array();
+  for (const world::RouteTurnaround& t : w.route_turnarounds()) {
+    turns.push_back({{"start_s_m", t.start_s_m},
+                     {"end_s_m", t.end_s_m},
+                     {"moves", world::ManoeuvreMoves(t.reference)}});
+  }
+  summary["turnarounds"] = turns;
 
   if (!args.follow_ideal) {
     std::printf(
@@ -82,10 +101,11 @@ int RunWorld(const WorldArgs& args) {
         args.json ? summary.dump(2).c_str()
                   : fmt::format(
                         "world of {}: route {} edges, ideal path {:.1f} m, "
-                        "{} obstacles, {} parked cars of {} slots",
+                        "{} obstacles, {} parked cars of {} slots{}",
                         spec->name, w.route_edges().size(),
                         w.ideal_path().length_m(), w.scene().obstacles().size(),
-                        parked, w.scene().parking_slots().size())
+                        parked, w.scene().parking_slots().size(),
+                        TurnaroundText(w.route_turnarounds()))
                         .c_str());
     return 0;
   }

@@ -154,6 +154,10 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   // detector reports them (runs without keep the graph they always had).
   inputs.traffic_signals = !w.route_signals().empty();
   inputs.lane_changes = w.route_lane_changes();
+  for (const world::RouteTurnaround& t : w.route_turnarounds()) {
+    inputs.turnarounds.push_back(
+        {t.start_s_m, t.end_s_m, t.goal, t.drivable, t.obstacles});
+  }
   if (w.parking_task()) {
     inputs.parking = true;
     inputs.parking_goal = w.parking_goal();
@@ -188,6 +192,9 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   if (topics.parking_path >= 0) {
     graph.AddSink<stack::ParkingPathMsg>(
         topics.parking_path, [&](const stack::ParkingPathMsg& m, double t_s) {
+          no_path = !m.found;
+          // A three-point turn's plan is no parking manoeuvre.
+          if (!w.parking_task()) return;
           if (run.parking.first_planned_at_s < 0) {
             run.parking.first_planned_at_s = t_s;
           } else if (m.found) {
@@ -256,17 +263,31 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     if (!loaded.ok()) return loaded.status().WithContext("platform.profile");
     profile_name = loaded->name;
     // The graph has the signal subscription only where the route has
-    // signals; say which profile covers it rather than just what is missing.
-    constexpr char kSignalCallback[] =
-        "behavior_velocity_planner/traffic_signal";
-    if (topics.traffic_signal >= 0 &&
-        loaded->costs.callbacks.count(kSignalCallback) == 0) {
-      return Status::InvalidArgument(fmt::format(
-          "platform.profile: the route has traffic signals, so the stack "
-          "subscribes to its signal detector ({}), which profile '{}' lacks; "
-          "name a profile that has it, such as "
-          "profiles/autoware-2022.12-i9-12900kf-signals.yaml",
-          kSignalCallback, profile_name));
+    // signals, and the freespace planner only where it turns round in
+    // several moves; say which profile covers them rather than just what
+    // is missing.
+    struct RouteCallback {
+      bool in_graph;
+      const char* callback;
+      const char* why;
+    };
+    for (const RouteCallback& c :
+         {RouteCallback{topics.traffic_signal >= 0,
+                        "behavior_velocity_planner/traffic_signal",
+                        "the route has traffic signals, so the stack "
+                        "subscribes to its signal detector"},
+          RouteCallback{!inputs.turnarounds.empty(),
+                        "behavior_path_planner/turnaround_done",
+                        "the route turns round in several moves (a "
+                        "three-point turn), so the stack runs its freespace "
+                        "planner"}}) {
+      if (c.in_graph && loaded->costs.callbacks.count(c.callback) == 0) {
+        return Status::InvalidArgument(fmt::format(
+            "platform.profile: {} ({}), which profile '{}' lacks; name a "
+            "profile that has it, such as "
+            "profiles/autoware-2022.12-i9-12900kf-signals.yaml",
+            c.why, c.callback, profile_name));
+      }
     }
     vp.profile =
         std::make_shared<const stack::CostProfile>(std::move(loaded->costs));

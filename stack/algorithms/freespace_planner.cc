@@ -162,7 +162,8 @@ FreespacePlanner::FreespacePlanner(const FreespacePlannerParams& params,
 
 Result<FreespacePath> FreespacePlanner::Plan(
     const Pose2& start, const Pose2& goal,
-    const std::vector<std::vector<Eigen::Vector2d>>& obstacles) {
+    const std::vector<std::vector<Eigen::Vector2d>>& obstacles,
+    const std::vector<std::vector<Eigen::Vector2d>>& drivable) {
   const FreespacePlannerParams& p = params_;
   stats_ = {};
   const Eigen::Vector2d s_xy(start.x_m, start.y_m), g_xy(goal.x_m, goal.y_m);
@@ -170,6 +171,22 @@ Result<FreespacePath> FreespacePlanner::Plan(
   OccupancyGrid grid(s_xy.cwiseMin(g_xy) - margin, s_xy.cwiseMax(g_xy) + margin,
                      p.grid_resolution_m);
   for (const auto& outline : obstacles) grid.AddObstacle(outline);
+  if (!drivable.empty()) {
+    // Where the car stands is drivable, however near the area's edge it
+    // has come: a lane's edge on a map is no kerb, and a car that brushed
+    // it in a tight turn must still be able to go on.
+    std::vector<std::vector<Eigen::Vector2d>> area = drivable;
+    const double grown = p.collision_margin_m + 2 * p.grid_resolution_m;
+    geometry::OrientedBox body;
+    body.yaw_rad = start.yaw_rad;
+    body.length_m = footprint_.front_m + footprint_.rear_m + 2 * grown;
+    body.width_m = footprint_.width_m + 2 * grown;
+    body.center = s_xy + 0.5 * (footprint_.front_m - footprint_.rear_m) *
+                             Eigen::Vector2d(std::cos(start.yaw_rad),
+                                             std::sin(start.yaw_rad));
+    area.push_back(geometry::BoxCorners(body));
+    grid.KeepInside(area);
+  }
   grid.ComputeDistances();
   stats_.work_units +=
       static_cast<int64_t>(grid.width_cells()) * grid.height_cells();

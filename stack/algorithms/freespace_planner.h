@@ -92,13 +92,15 @@ class FreespacePlanner {
                    const VehicleFootprint& footprint);
 
   // A path from `start` to `goal` (rear axle poses, map frame) among
-  // `obstacles` (outlines as OccupancyGrid::AddObstacle takes them).
+  // `obstacles` (outlines as OccupancyGrid::AddObstacle takes them),
+  // inside `drivable` when that is given (OccupancyGrid::KeepInside).
   // NotFound with the reason when there is none: the goal or start
   // footprint collides, the two are not connected for a car this wide, or
   // the search ran out of expansions.
   Result<FreespacePath> Plan(
       const geometry::Pose2& start, const geometry::Pose2& goal,
-      const std::vector<std::vector<Eigen::Vector2d>>& obstacles);
+      const std::vector<std::vector<Eigen::Vector2d>>& obstacles,
+      const std::vector<std::vector<Eigen::Vector2d>>& drivable = {});
 
   const FreespaceStats& last_stats() const { return stats_; }
   const FreespacePlannerParams& params() const { return params_; }

@@ -79,25 +79,38 @@ void OccupancyGrid::AddObstacle(const std::vector<Eigen::Vector2d>& outline) {
   }
   if (outline.size() == 1) Mark(outline.front());
   if (outline.size() < 3) return;
+  FillPolygon(outline, &cells_);
+}
+
+void OccupancyGrid::FillPolygon(const std::vector<Eigen::Vector2d>& polygon,
+                                std::vector<uint8_t>* cells) const {
   // The inside: cells whose centre the polygon holds.
-  Eigen::Vector2d lo = outline.front(), hi = outline.front();
-  for (const Eigen::Vector2d& p : outline) {
+  Eigen::Vector2d lo = polygon.front(), hi = polygon.front();
+  for (const Eigen::Vector2d& p : polygon) {
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
   int x0, y0, x1, y1;
   CellOf(lo, &x0, &y0);
   CellOf(hi, &x1, &y1);
-  x0 = std::max(x0, 0);
-  y0 = std::max(y0, 0);
-  x1 = std::min(x1, nx_ - 1);
-  y1 = std::min(y1, ny_ - 1);
-  for (int iy = y0; iy <= y1; ++iy) {
-    for (int ix = x0; ix <= x1; ++ix) {
-      if (geometry::InsidePolygon(outline, CellCentre(ix, iy))) {
-        cells_[iy * nx_ + ix] = 1;
+  for (int iy = std::max(y0, 0); iy <= std::min(y1, ny_ - 1); ++iy) {
+    for (int ix = std::max(x0, 0); ix <= std::min(x1, nx_ - 1); ++ix) {
+      if (geometry::InsidePolygon(polygon, CellCentre(ix, iy))) {
+        (*cells)[iy * nx_ + ix] = 1;
       }
     }
+  }
+}
+
+void OccupancyGrid::KeepInside(
+    const std::vector<std::vector<Eigen::Vector2d>>& areas) {
+  if (areas.empty()) return;
+  std::vector<uint8_t> inside(cells_.size(), 0);
+  for (const std::vector<Eigen::Vector2d>& area : areas) {
+    if (area.size() >= 3) FillPolygon(area, &inside);
+  }
+  for (size_t i = 0; i < cells_.size(); ++i) {
+    if (!inside[i]) cells_[i] = 1;
   }
 }
 

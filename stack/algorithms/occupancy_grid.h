@@ -41,6 +41,9 @@ class OccupancyGrid {
   // Marks every cell the outline touches: two points are a thin segment (a
   // wall), three or more a filled polygon closed back to its first point.
   void AddObstacle(const std::vector<Eigen::Vector2d>& outline);
+  // Marks every cell whose centre lies in none of `areas` (polygons): the
+  // car keeps to them, e.g. a road's lanes and junctions. Empty: no effect.
+  void KeepInside(const std::vector<std::vector<Eigen::Vector2d>>& areas);
 
   int width_cells() const { return nx_; }
   int height_cells() const { return ny_; }
@@ -88,6 +91,10 @@ class OccupancyGrid {
 
  private:
   void Mark(const Eigen::Vector2d& p);
+  // Sets to 1 the cells of `cells` (one per grid cell) whose centre
+  // `polygon` (3 or more points) holds.
+  void FillPolygon(const std::vector<Eigen::Vector2d>& polygon,
+                   std::vector<uint8_t>* cells) const;
   Eigen::Vector2d min_;
   double resolution_m_;
   double inverse_resolution_;

@@ -98,6 +98,20 @@ void PathPlanner::SetRoute(const geometry::Path2& route,
     goal_s_m_ = ProjectOnPath(route_, *goal, 0.0, route_.length_m(),
                               route_.length_m(), &lateral, &distance);
   }
+  route_goal_s_m_ = goal_s_m_;
+  held_at_end_ = false;
+}
+
+void PathPlanner::EndAt(double s_m) {
+  goal_s_m_ = std::clamp(s_m, 0.0, route_.length_m());
+  held_at_end_ = true;
+}
+
+void PathPlanner::ResumeAt(double s_m) {
+  last_s_m_ = std::clamp(s_m, 0.0, route_.length_m());
+  has_progress_ = true;
+  goal_s_m_ = route_goal_s_m_;
+  held_at_end_ = false;
 }
 
 double PathPlanner::CurvatureAt(double s) const {
@@ -140,6 +154,7 @@ PlannedPath PathPlanner::Plan(const geometry::Pose2& pose) {
   // Monotone progress: small backward jitter of the pose does not move the
   // path start back (a re-acquisition may).
   if (has_progress_ && !searched_globally) s = std::max(s, last_s_m_);
+  if (held_at_end_) s = std::min(s, goal_s_m_);
   last_s_m_ = s;
   has_progress_ = true;
   out.ego_s_m = s;

@@ -84,6 +84,13 @@ class PathPlanner {
                 std::optional<Eigen::Vector2d> goal = std::nullopt);
   bool has_route() const { return route_.points.size() >= 2; }
   double goal_s_m() const { return goal_s_m_; }
+  // Where the route turns round tighter than the car can: the path ends
+  // at `s_m` (as at a goal) and the progress stays short of it, whatever
+  // the car does beyond (a turn in several moves), until ResumeAt().
+  void EndAt(double s_m);
+  // The car has turned round: progress goes on from `s_m`, and the path
+  // ends at the route's goal again (or at the next EndAt()).
+  void ResumeAt(double s_m);
 
   // The path ahead of `pose` (rear axle, map frame), sampled every
   // spacing_m with the curvature at each point. Empty without a route.
@@ -99,6 +106,8 @@ class PathPlanner {
   PathPlannerParams params_;
   geometry::Path2 route_;
   double goal_s_m_ = 0.0;
+  double route_goal_s_m_ = 0.0;  // the goal's, as SetRoute() projected it
+  bool held_at_end_ = false;     // EndAt() holds the progress
   double last_s_m_ = 0.0;
   bool has_progress_ = false;
 };

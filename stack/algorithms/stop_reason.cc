@@ -15,6 +15,7 @@ const std::vector<Term<StopReason>>& StopReasonTerms() {
       {StopReason::kNoTrajectory, "no_trajectory"},
       {StopReason::kRedLight, "red_light"},
       {StopReason::kLaneChange, "lane_change"},
+      {StopReason::kTurnaround, "turnaround"},
   };
   return kTerms;
 }

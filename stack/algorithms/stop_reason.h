@@ -25,6 +25,9 @@ enum class StopReason : int8_t {
                           // read until it has waited that out)
   kLaneChange = 6,        // "lane_change": before a lane change, for a gap
                           // in the target lane
+  kTurnaround = 7,        // "turnaround": where the route turns round
+                          // tighter than the car can, for a turn in
+                          // several moves
 };
 
 const char* StopReasonToString(StopReason reason);

@@ -50,7 +50,7 @@ Status Stack::Build(Graph* g) {
   ADSE_RETURN_IF_ERROR(BuildLocalization(g));
   BuildPerception(g);
   BuildPlanning(g);
-  if (inputs_.parking) BuildParking(g);
+  if (inputs_.parking || !inputs_.turnarounds.empty()) BuildManoeuvres(g);
   BuildControl(g);
   return Status::Ok();
 }

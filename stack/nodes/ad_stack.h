@@ -44,6 +44,19 @@ struct StackInputs {
   // Where the route changes lane (a lanelet route knows): the planner
   // changes lane only when the target lane has a gap.
   std::vector<algorithms::LaneChangeSection> lane_changes;
+  // Where the route turns round tighter than the car can (a lanelet route
+  // knows its turns), in route order: the path ends at each one's
+  // start_s_m, the freespace planner takes the car round to its goal (rear
+  // axle) within `drivable` and clear of `obstacles`, and the path goes on
+  // from end_s_m (route s).
+  struct Turnaround {
+    double start_s_m = 0.0;
+    double end_s_m = 0.0;
+    geometry::Pose2 goal;
+    std::vector<std::vector<Eigen::Vector2d>> drivable;
+    std::vector<std::vector<Eigen::Vector2d>> obstacles;
+  };
+  std::vector<Turnaround> turnarounds;
 };
 
 // Topic indices the harness talks to.

@@ -13,6 +13,10 @@ namespace {
 
 // Braking asked for while there is no valid pose to steer by.
 constexpr double kNoPoseDecelMps2 = 3.0;
+// A three-point turn has ended within this of its goal on the lane (the
+// path takes the car on from there).
+constexpr double kTurnToleranceM = 1.0;
+constexpr double kTurnYawToleranceRad = 0.35;
 
 // Trajectory points as the planning and control algorithms take them; the
 // speed can be capped on the way.
@@ -66,7 +70,21 @@ void Stack::BuildPlanning(Graph* g) {
                         [this](const PathMsg& in, CallbackContext&) {
                           path_planner_->SetRoute(in.path,
                                                   in.path.points.back());
+                          EndRouteLeg();
                         });
+  if (!inputs_.turnarounds.empty()) {
+    // A route with three-point turns: the freespace planner says when the
+    // car has turned, and the path goes on from there.
+    turn_done_ = g->AddTopic<ParkingDoneMsg>("/planning/turnaround/completed");
+    g->Subscribe<ParkingDoneMsg>(
+        path_node, turn_done_, "turnaround_done", 1,
+        [this](const ParkingDoneMsg& in, CallbackContext&) {
+          if (in.turnaround != route_leg_) return;
+          path_planner_->ResumeAt(inputs_.turnarounds[route_leg_].end_s_m);
+          ++route_leg_;
+          EndRouteLeg();
+        });
+  }
   g->Subscribe<PoseMsg>(
       path_node, topics_.pose, "pose", 1,
       [this](const PoseMsg& in, CallbackContext&) { path_pose_ = in; });
@@ -81,6 +99,7 @@ void Stack::BuildPlanning(Graph* g) {
           const algo::PlannedPath path = path_planner_->Plan(path_pose_->pose);
           out.header.stamp_s = path_pose_->header.stamp_s;
           out.ends_at_goal = path.ends_at_goal;
+          out.route_leg = route_leg_;
           out.localization_lost = !path_pose_->valid;
           out.ego_v_mps = path_pose_->v_mps;
           out.points = ToMessage(path.points);
@@ -190,10 +209,15 @@ void Stack::BuildPlanning(Graph* g) {
             break;
           }
         }
-        const algo::StopDecision decision = algo::DecideStop(
+        algo::StopDecision decision = algo::DecideStop(
             &points, in.ends_at_goal, in.localization_lost, stop,
             in.signal_stop ? std::optional<double>(in.signal_stop_s_m)
                            : std::nullopt);
+        // The path of a leg that ends at a three-point turn ends there.
+        if (decision.reason == StopReason::kGoal &&
+            in.route_leg < static_cast<int>(inputs_.turnarounds.size())) {
+          decision.reason = StopReason::kTurnaround;
+        }
         TrajectoryMsg out = in;
         out.points = ToMessage(points);
         out.header.perception_stamp_s =
@@ -233,13 +257,22 @@ void Stack::BuildPlanning(Graph* g) {
       });
 }
 
-void Stack::BuildParking(Graph* g) {
+void Stack::EndRouteLeg() {
+  if (route_leg_ < static_cast<int>(inputs_.turnarounds.size())) {
+    path_planner_->EndAt(inputs_.turnarounds[route_leg_].start_s_m);
+  }
+}
+
+void Stack::BuildManoeuvres(Graph* g) {
   // Autoware's parking scenario: once the car stands at the end of its
   // road route (on the aisle beside the slot), the freespace planner plans
   // the manoeuvre into the slot from the localization pose; again from
   // where it stands whenever the car has left that path's course, or has
   // driven it to its end outside the goal's tolerances. It says when the
-  // car is parked (Autoware's is_completed).
+  // car is parked (Autoware's is_completed). A three-point turn on the
+  // route is planned and driven the same way, from where the route's leg
+  // ends to the turn's goal within the road's lanes and junctions; it
+  // says when the car has turned.
   topics_.parking_path =
       g->AddTopic<ParkingPathMsg>("/planning/scenario_planning/parking/path");
   topics_.parking_completed = g->AddTopic<ParkingDoneMsg>(
@@ -265,42 +298,64 @@ void Stack::BuildParking(Graph* g) {
   const int max_replans = static_cast<int>(config_.Get("parking.max_replans"));
   g->AddTimer(node, "plan", 1.0 / config_.Get("parking.rate_hz"),
               [this, course_out_m, max_replans](CallbackContext& ctx) {
-                PlanParking(ctx, course_out_m, max_replans);
+                PlanManoeuvre(ctx, course_out_m, max_replans);
               });
 }
 
-void Stack::PlanParking(CallbackContext& ctx, double course_out_m,
-                        int max_replans) {
+void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
+                          int max_replans) {
   if (parking_completed_ || !freespace_pose_ || !freespace_pose_->valid) return;
+  const int turns = static_cast<int>(inputs_.turnarounds.size());
+  if (manoeuvre_ == turns && !inputs_.parking) return;  // all turns made
+  // The manoeuvre now: the next three-point turn, then the parking.
+  const bool turning = manoeuvre_ < turns;
+  const StackInputs::Turnaround* turn =
+      turning ? &inputs_.turnarounds[manoeuvre_] : nullptr;
+  const geometry::Pose2& goal = turning ? turn->goal : inputs_.parking_goal;
   const geometry::Pose2& pose = freespace_pose_->pose;
   const Eigen::Vector2d at(pose.x_m, pose.y_m);
   const bool standing = std::abs(freespace_pose_->v_mps) < 0.1;
   const double stamp_s = freespace_pose_->header.stamp_s;
   auto complete = [&] {
-    parking_completed_ = true;
     ParkingDoneMsg done;
     done.header.stamp_s = stamp_s;
-    ctx.Publish(topics_.parking_completed, std::move(done));
+    if (!turning) {
+      parking_completed_ = true;
+      ctx.Publish(topics_.parking_completed, std::move(done));
+      return;
+    }
+    // Turned: the path goes on, and the next manoeuvre starts afresh.
+    done.turnaround = manoeuvre_++;
+    parking_planned_ = false;
+    path_driven_ = false;
+    freespace_replans_ = 0;
+    freespace_path_.clear();
+    ctx.Publish(turn_done_, std::move(done));
   };
   ParkingPathMsg out;
   out.header.stamp_s = stamp_s;
   bool correcting = false;
   if (!parking_planned_) {
-    // Handed over when standing within reach of the route's end.
-    const Eigen::Vector2d end = inputs_.route.points.back();
+    // Handed over when standing within reach of where the route's leg
+    // ends (the route's end, or the turn's start).
+    const Eigen::Vector2d end = turning ? inputs_.route.PointAt(turn->start_s_m)
+                                        : inputs_.route.points.back();
     if (!standing ||
         (at - end).norm() > std::max(3.0, inputs_.goal_tolerance_m))
       return;
     parking_planned_ = true;
   } else if (path_driven_) {
-    // At the path's end: parked if the stack's pose is within the goal's
-    // tolerances, or if no re-plan is left; otherwise a new path from
-    // here corrects it.
+    // At the path's end: parked (turned) if the stack's pose is within the
+    // goal's tolerances, or if no re-plan is left; otherwise a new path
+    // from here corrects it.
     path_driven_ = false;
-    if (geometry::WithinTolerance(pose, inputs_.parking_goal,
-                                  inputs_.goal_tolerance_m,
-                                  inputs_.goal_yaw_tolerance_rad) ||
-        freespace_replans_ == max_replans) {
+    const bool there =
+        turning
+            ? geometry::WithinTolerance(pose, goal, kTurnToleranceM,
+                                        kTurnYawToleranceRad)
+            : geometry::WithinTolerance(pose, goal, inputs_.goal_tolerance_m,
+                                        inputs_.goal_yaw_tolerance_rad);
+    if (there || freespace_replans_ == max_replans) {
       complete();
       return;
     }
@@ -325,12 +380,13 @@ void Stack::PlanParking(CallbackContext& ctx, double course_out_m,
     ++freespace_replans_;
   }
   const Result<algo::FreespacePath> path =
-      freespace_->Plan(pose, inputs_.parking_goal, inputs_.parking_obstacles);
+      turning ? freespace_->Plan(pose, goal, turn->obstacles, turn->drivable)
+              : freespace_->Plan(pose, goal, inputs_.parking_obstacles);
   ctx.ReportWork(
       {static_cast<double>(freespace_->last_stats().work_units), 0.0, 1});
   if (!path.ok() && correcting) {
-    // No way to the goal from where it stands: parked there, off the goal
-    // (the planner's failure would end the run as no_path).
+    // No way to the goal from where it stands: parked (turned) there, off
+    // the goal (the planner's failure would end the run as no_path).
     complete();
     return;
   }
@@ -380,7 +436,7 @@ void Stack::BuildControl(Graph* g) {
       [this](const TrajectoryMsg& in, CallbackContext&) {
         follower_trajectory_ = in;
       });
-  if (inputs_.parking) {
+  if (inputs_.parking || !inputs_.turnarounds.empty()) {
     algo::ParkingFollowerParams parking;
     parking.wheelbase_m = inputs_.wheelbase_m;
     parking.forward_speed_mps = config_.Get("parking.forward_speed_mps");
@@ -397,6 +453,16 @@ void Stack::BuildControl(Graph* g) {
           parking_follower_->SetPath(poses);
           parking_mode_ = true;
           path_end_reported_ = false;
+        });
+  }
+  if (!inputs_.turnarounds.empty()) {
+    // Turned: back to the path, once the planner's path of the next leg
+    // has come (an older one ends behind the car).
+    g->Subscribe<ParkingDoneMsg>(
+        node, turn_done_, "turnaround_done", 1,
+        [this](const ParkingDoneMsg& in, CallbackContext&) {
+          parking_mode_ = false;
+          follower_leg_ = in.turnaround + 1;
         });
   }
   const double max_travel_per_fix_m =
@@ -425,7 +491,8 @@ void Stack::BuildControl(Graph* g) {
                           : max_travel_per_fix_m / std::max(fix_age, 1e-3);
                   if (parking_mode_) return Park(ctx, dt, speed_cap, &out);
                   const std::vector<algo::PlannedPoint> points =
-                      follower_trajectory_
+                      follower_trajectory_ &&
+                              follower_trajectory_->route_leg == follower_leg_
                           ? ToPlanned(follower_trajectory_->points, speed_cap)
                           : std::vector<algo::PlannedPoint>{};
                   const algo::FollowerCommand c = follower_->Update(

@@ -124,6 +124,10 @@ struct TrajectoryMsg {
   bool signal_stop = false;
   double signal_stop_s_m = 0.0;
   StopReasonMsg stop;  // set by obstacle_stop_planner
+  // The part of the route it lies on: 0 up to the first three-point turn,
+  // k after the k-th. Its end is that turn's start when ends_at_goal is
+  // set and the route has more turns than this.
+  int route_leg = 0;
 };
 
 // The freespace planner's parking manoeuvre (or why there is none).
@@ -144,6 +148,7 @@ struct ParkingPathMsg {
 // The controller's parking mode reached the manoeuvre's end and holds.
 struct ParkingDoneMsg {
   Header header;
+  int turnaround = -1;  // the three-point turn completed; -1: the parking
 };
 
 struct ControlMsg {

@@ -57,8 +57,12 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
   IdealDriveReport report;
   // The road part (all of the ideal path but a valet task's manoeuvre) by
   // pure pursuit; then the manoeuvre, gears and all, with the stack's
-  // parking controller on the true pose.
+  // parking controller on the true pose. A three-point turn on the way is
+  // driven the same way from where the car stops for it.
   const geometry::Path2& path = world.road_path();
+  const std::vector<RouteTurnaround>& turns = world.route_turnarounds();
+  size_t next_turn = 0;       // the first turn not yet driven
+  geometry::Path2 turn_path;  // the turn being driven, for its error
   algorithms::ParkingFollowerParams parking_params;
   parking_params.wheelbase_m = world.ego_limits().wheelbase_m;
   algorithms::ParkingFollower parking(parking_params);
@@ -79,11 +83,13 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
                                  ego.v_mps, ego.steer_rad, ego.accel_mps2});
     const double s_progress = world.road_progress_m();
     const double off_road = world.road_offset_m();
-    // Lane driving: the ideal path is the road part, already measured.
+    // Lane driving: the ideal path is the road part, already measured;
+    // in a three-point turn, the turn's path.
     report.max_lateral_error_m =
         std::max(report.max_lateral_error_m,
                  world.parking_task() ? DistanceToPath(world.ideal_path(), pos)
-                                      : off_road);
+                 : !turn_path.points.empty() ? DistanceToPath(turn_path, pos)
+                                             : off_road);
     if (world.goal_reached() && std::abs(ego.v_mps) < 0.5) {
       report.reached_goal = true;
       break;
@@ -108,9 +114,28 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
       parking.SetPath(poses);
       parking_mode = true;
     }
+    if (!parking_mode && next_turn < turns.size() &&
+        s_progress >= turns[next_turn].start_s_m - 0.5 &&
+        std::abs(ego.v_mps) < 0.05) {
+      std::vector<algorithms::GearedPose> poses;
+      turn_path = geometry::Path2();
+      for (const ManoeuvrePose& p : turns[next_turn].reference) {
+        poses.push_back({p.pose, p.reverse});
+        turn_path.points.emplace_back(p.pose.x_m, p.pose.y_m);
+      }
+      turn_path.UpdateArcLength();
+      parking.SetPath(poses);
+      parking_mode = true;
+    }
     if (parking_mode) {
       const algorithms::ParkingCommand c =
           parking.Update({ego.x_m, ego.y_m, ego.yaw_rad}, ego.v_mps, dt);
+      if (c.finished && !turn_path.points.empty()) {
+        // Turned: on along the road part.
+        parking_mode = false;
+        turn_path = geometry::Path2();
+        ++next_turn;
+      }
       const auto t0 = Clock::now();
       ADSE_RETURN_IF_ERROR(world.Step({c.accel_mps2, c.steer_rad, c.reverse}));
       report.world_wall_s += Seconds(Clock::now() - t0);
@@ -150,7 +175,9 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
     // Where the car must stand: the goal, or a signal's stop line before
     // it. Signals: a perfect detector (the true state, no latency) and the
     // stack's own rule for when to stop.
-    double remaining = std::max(0.0, path.length_m() - s_progress);
+    const double stop_s =
+        next_turn < turns.size() ? turns[next_turn].start_s_m : path.length_m();
+    double remaining = std::max(0.0, stop_s - s_progress);
     if (options.obey_signals && !route_signals.empty()) {
       algorithms::SignalObservation seen;
       seen.stamp_s = world.time_s();

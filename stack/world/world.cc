@@ -48,6 +48,9 @@ std::atomic<bool> g_world_open{false};
 // route's end; this much more for the projection on a bend.
 constexpr double kGoalSlackM = 1.0;
 constexpr double kValetSlackM = 8.0;
+// A car within this of a three-point turn's end pose (and 0.5 rad of its
+// heading) has turned.
+constexpr double kTurnedSlackM = 2.0;
 
 // Runs `fn`, turning libsumo exceptions into Status.
 template <typename Fn>
@@ -366,6 +369,17 @@ bool EgoCausedContact(const VehicleState& ego,
 void World::Impl::UpdateProgress() {
   const VehicleState& s = ego->state();
   const algorithms::PathPlannerParams window;
+  // Turned round in a three-point turn, standing on the lane it leaves
+  // on: the progress resumes there (the turn itself is off the road part).
+  const Vec2 at(s.x_m, s.y_m);
+  for (const RouteTurnaround& turn : turnarounds) {
+    if (road_progress_m >= turn.start_s_m - kTurnedSlackM &&
+        road_progress_m < turn.end_s_m &&
+        (at - Vec2(turn.goal.x_m, turn.goal.y_m)).norm() < kTurnedSlackM &&
+        std::cos(s.yaw_rad - turn.goal.yaw_rad) > std::cos(0.5)) {
+      road_progress_m = turn.end_s_m;
+    }
+  }
   double lateral = 0.0;
   road_progress_m = std::max(
       road_progress_m,
@@ -406,6 +420,9 @@ double World::goal_yaw_error_rad() const {
 const geometry::Path2& World::road_path() const { return impl_->road; }
 double World::road_progress_m() const { return impl_->road_progress_m; }
 double World::road_offset_m() const { return impl_->road_offset_m; }
+const std::vector<RouteTurnaround>& World::route_turnarounds() const {
+  return impl_->turnarounds;
+}
 const std::vector<ManoeuvrePose>& World::reference_manoeuvre() const {
   return impl_->reference;
 }

@@ -63,6 +63,27 @@ struct RouteSignal {
   double stop_line_s_m = 0.0;  // along road_path()
 };
 
+// Where a lane-driving route turns around tighter than the car can (a
+// U-turn narrower than its turning circle, where no way round the block
+// leads on): the car stops on the lane it arrives on and turns in several
+// moves, forwards and in reverse, within the road's lanes and junctions,
+// onto the lane it leaves on.
+struct RouteTurnaround {
+  double start_s_m = 0.0;  // along road_path(): where the car stops to turn
+  double end_s_m = 0.0;    // along road_path(): where it drives on
+  geometry::Pose2 goal;    // rear axle on the departing lane, at end_s_m
+  // The lanes open to cars and the junctions about the turn, as polygons
+  // (where the manoeuvre keeps to), and the structure standing there.
+  std::vector<std::vector<Eigen::Vector2d>> drivable;
+  std::vector<std::vector<Eigen::Vector2d>> obstacles;
+  // The manoeuvre planned on the ground truth from the road part at
+  // start_s_m to `goal`.
+  std::vector<ManoeuvrePose> reference;
+};
+
+// The moves of a manoeuvre: its runs in one gear (a three-point turn has 3).
+int ManoeuvreMoves(const std::vector<ManoeuvrePose>& manoeuvre);
+
 // Errors from Open() start with the scenario field they concern
 // ("task.goal: ...", "world.map.net: ...") so callers can cite its line.
 class World {
@@ -95,8 +116,9 @@ class World {
   double distance_to_goal_m() const;
 
   // valet_parking only: the goal's slot, the rear-axle pose parked in it,
-  // the heading error now and the road part of the route (the whole ideal
-  // path for lane driving), which ends on the aisle beside the slot.
+  // the heading error now and the road part of the route (for lane
+  // driving the whole route, through its U-turns as SUMO draws them),
+  // which ends on the aisle beside the slot.
   bool parking_task() const;
   const ParkingSlot& goal_slot() const;
   const geometry::Pose2& parking_goal() const;
@@ -117,9 +139,14 @@ class World {
   // ('r', 'y', 'G', 'g', 'u', 'o', 's', ...), in the same order.
   const std::vector<RouteSignal>& route_signals() const;
   std::string RouteSignalStates() const;
+  // The three-point turns along the road part, in route order.
+  const std::vector<RouteTurnaround>& route_turnarounds() const;
   // Where the road part changes lane, in route order (along road_path()).
   const std::vector<algorithms::LaneChangeSection>& route_lane_changes() const;
 
+  // The path a perfect driver takes: the road part, with each three-point
+  // turn's stretch replaced by its manoeuvre and, for valet parking, the
+  // manoeuvre into the slot after it.
   const geometry::Path2& ideal_path() const;
   const std::vector<std::string>& route_edges() const;
   // Largest gap between consecutive lane pieces (lanes and junction lanes)

@@ -8,7 +8,6 @@
 #include <functional>
 #include <limits>
 #include <map>
-#include <optional>
 #include <queue>
 #include <set>
 #include <utility>
@@ -78,6 +77,15 @@ bool OpenToCars(const std::string& lane_id) {
          disallowed.end();
 }
 
+double UTurnWidthM(const std::string& from_lane, const std::string& to_lane) {
+  const std::vector<Vec2> from = ToPoints(libsumo::Lane::getShape(from_lane));
+  const std::vector<Vec2> to = ToPoints(libsumo::Lane::getShape(to_lane));
+  if (from.size() < 2 || to.empty()) return 0.0;
+  const Vec2 heading = (from.back() - from[from.size() - 2]).normalized();
+  const Vec2 d = to.front() - from.back();
+  return std::abs(heading.x() * d.y() - heading.y() * d.x());
+}
+
 }  // namespace internal
 
 using internal::InternalChain;
@@ -86,6 +94,7 @@ using internal::OpenToCars;
 using internal::Resample;
 using internal::Slice;
 using internal::ToPoints;
+using internal::UTurnWidthM;
 using internal::Vec2;
 
 Result<RoadLocation> World::Impl::Resolve(const Location& location,
@@ -174,46 +183,25 @@ namespace {
 // A path vertex turning by more than 150 degrees folds the path back.
 constexpr double kFoldCos = -0.866;
 
-// How far across the road a U-turn from `from_lane` to `to_lane` must
-// turn: the arrival lane's start off the departure lane's end, square to
-// its last heading.
-double UTurnWidthM(const std::string& from_lane, const std::string& to_lane) {
-  const std::vector<Vec2> from = ToPoints(libsumo::Lane::getShape(from_lane));
-  const std::vector<Vec2> to = ToPoints(libsumo::Lane::getShape(to_lane));
-  if (from.size() < 2 || to.empty()) return 0.0;
-  const Vec2 heading = (from.back() - from[from.size() - 2]).normalized();
-  const Vec2 d = to.front() - from.back();
-  return std::abs(heading.x() * d.y() - heading.y() * d.x());
-}
-
-// Where a route turns around tighter than the car can.
-struct TightUTurn {
-  std::string from_edge, to_edge;
-  double width_m = 0.0;  // across the road, lane centre to lane centre
-};
-
-// The edges a car may drive to from `edge`, with whether it can: through
-// any link but a U-turn, or a U-turn at least two turning radii wide (a
-// car that turns no tighter than `min_radius_m` needs that much road to
-// turn around without reversing). Only links between lanes open to
-// passenger cars.
-std::map<std::string, TightUTurn> Successors(const std::string& edge,
-                                             double min_radius_m,
-                                             std::set<std::string>* drivable) {
-  std::map<std::string, TightUTurn> tight;
+// The edges a car may drive to from `edge` (through any link but a
+// U-turn, or a U-turn at least two turning radii wide: a car that turns no
+// tighter than `min_radius_m` needs that much road to turn around without
+// reversing) into `drivable`; returns those reached only by a narrower
+// U-turn. Only links between lanes open to passenger cars.
+std::set<std::string> Successors(const std::string& edge, double min_radius_m,
+                                 std::set<std::string>* drivable) {
+  std::set<std::string> tight;
   for (int l = 0; l < libsumo::Edge::getLaneNumber(edge); ++l) {
     const std::string lane_id = edge + "_" + std::to_string(l);
     if (!OpenToCars(lane_id)) continue;
     for (const auto& link : libsumo::Lane::getLinks(lane_id)) {
       if (!OpenToCars(link.approachedLane)) continue;
       const std::string next = EdgeOfLane(link.approachedLane);
-      const bool turnaround = link.direction == "t";
-      const double width =
-          turnaround ? UTurnWidthM(lane_id, link.approachedLane) : 0.0;
-      if (!turnaround || width >= 2.0 * min_radius_m) {
+      if (link.direction != "t" ||
+          UTurnWidthM(lane_id, link.approachedLane) >= 2.0 * min_radius_m) {
         drivable->insert(next);
-      } else if (!tight.count(next) || width > tight[next].width_m) {
-        tight[next] = TightUTurn{edge, next, width};
+      } else {
+        tight.insert(next);
       }
     }
   }
@@ -221,17 +209,15 @@ std::map<std::string, TightUTurn> Successors(const std::string& edge,
   return tight;
 }
 
-// The first U-turn of `route` that the car cannot drive, if any.
-std::optional<TightUTurn> FirstTightUTurn(const std::vector<std::string>& route,
-                                          double min_radius_m) {
+// Whether `route` takes a U-turn the car cannot drive in one move.
+bool HasTightUTurn(const std::vector<std::string>& route, double min_radius_m) {
   for (size_t i = 0; i + 1 < route.size(); ++i) {
     std::set<std::string> drivable;
-    std::map<std::string, TightUTurn> tight =
-        Successors(route[i], min_radius_m, &drivable);
-    auto it = tight.find(route[i + 1]);
-    if (it != tight.end()) return it->second;
+    if (Successors(route[i], min_radius_m, &drivable).count(route[i + 1])) {
+      return true;
+    }
   }
-  return std::nullopt;
+  return false;
 }
 
 // The quickest route (travel time at the lanes' speed limits, as SUMO's
@@ -326,21 +312,14 @@ Result<std::vector<std::string>> World::Impl::RouteLeg(
     }
     // SUMO's router turns around wherever the net has a turnaround link;
     // a car cannot follow a U-turn narrower than its turning circle
-    // without reversing, so such a route goes round the block instead.
-    const double min_radius_m =
-        setup.ego.wheelbase_m / std::tan(setup.ego.max_steer_rad);
-    if (std::optional<TightUTurn> uturn = FirstTightUTurn(best, min_radius_m)) {
-      best = DrivableRoute(from.edge, to.edge, min_radius_m);
-      if (best.empty()) {
-        return Status::InvalidArgument(fmt::format(
-            "{}: unreachable from {} without a U-turn the car cannot drive: "
-            "SUMO's route turns around from edge '{}' to edge '{}', {:.1f} m "
-            "across, where turning without reversing needs {:.1f} m (twice "
-            "the car's {:.1f} m turning radius), and no route avoids such a "
-            "turn",
-            to_field, from_field, uturn->from_edge, uturn->to_edge,
-            uturn->width_m, 2.0 * min_radius_m, min_radius_m));
-      }
+    // without reversing, so such a route goes round the block instead
+    // where it can, and turns in several moves where it cannot (a
+    // cul-de-sac, a start heading into a dead end; PlanTurnarounds).
+    const double min_radius_m = MinTurningRadiusM();
+    if (HasTightUTurn(best, min_radius_m)) {
+      std::vector<std::string> round =
+          DrivableRoute(from.edge, to.edge, min_radius_m);
+      if (!round.empty()) best = std::move(round);
     }
     return best;
   } catch (const std::exception& e) {
@@ -510,7 +489,13 @@ Status World::Impl::BuildIdealPath() {
       if (i + 1 < n) {
         std::string to_lane = route[i + 1] + "_" + std::to_string(lane[i + 1]);
         if (!via[i].empty()) InternalChain(via[i], &to_lane);
-        crossings.push_back({exit_id, via[i], to_lane, raw_s});
+        bool tight = false;
+        for (const auto& link : libsumo::Lane::getLinks(exit_id)) {
+          if (link.approachedLane == to_lane && link.direction == "t") {
+            tight = UTurnWidthM(exit_id, to_lane) < 2.0 * MinTurningRadiusM();
+          }
+        }
+        crossings.push_back({exit_id, via[i], to_lane, raw_s, tight});
       }
       if (i + 1 < n && !via[i].empty()) {
         for (const std::string& internal : InternalChain(via[i], nullptr)) {
@@ -528,6 +513,7 @@ Status World::Impl::BuildIdealPath() {
       c.end_s_m = RoadS(c.end_s_m);
     }
     ideal = road;
+    ADSE_RETURN_IF_ERROR(PlanTurnarounds());
     if (valet) {
       // The reference manoeuvre: the freespace planner's path from where the
       // road part ends into the slot, on the ground-truth lot. When it finds

@@ -9,7 +9,9 @@ over all samples, and the number of places where the ideal path turns
 tighter than the car can (U-turns, hairpin corners): its heading changes
 faster than 1 / (the ego's minimum turning radius, 2.7 m wheelbase at
 0.6 rad steering: 3.9 m) over 4 m of path. There the car must leave the
-path, and does so beyond the junction's shape. Coordinates are SUMO net
+path, and does so beyond the junction's shape. A three-point turn's cusps
+(where the ideal path reverses, at a gear change) are no such place: the
+path is cut there and each piece counted alone. Coordinates are SUMO net
 coordinates, as adse's world uses them.
 """
 import csv
@@ -53,7 +55,22 @@ def inside(polygon, p):
 MIN_TURN_RADIUS_M = 2.7 / np.tan(0.6)
 
 
+def pieces_between_cusps(line):
+    # A cusp: the path goes back the way it came (over 150 degrees at one
+    # vertex), as a manoeuvre does at a gear change. Pieces share it.
+    moved = np.concatenate([[True], np.linalg.norm(np.diff(line, axis=0),
+                                                   axis=1) > 1e-9])
+    line = line[moved]
+    u = np.diff(line, axis=0)
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    cusps = list(np.nonzero((u[:-1] * u[1:]).sum(axis=1) < -0.866)[0] + 1)
+    bounds = [0] + cusps + [len(line) - 1]
+    return [line[a:b + 1] for a, b in zip(bounds[:-1], bounds[1:])]
+
+
 def tight_turns(line, window_m=4.0):
+    if len(line) < 3:
+        return 0
     step = np.linalg.norm(np.diff(line, axis=0), axis=1)
     s = np.concatenate([[0.0], np.cumsum(step)])[:-1]
     heading = np.unwrap(np.arctan2(np.diff(line[:, 1]), np.diff(line[:, 0])))
@@ -84,7 +101,8 @@ def main():
                           (boxes[:, 1] <= p[1]) & (p[1] <= boxes[:, 3]))[0]
         outside[i] = not any(inside(shapes[k], p) for k in near)
     print("%.2f %.2f %d" % (error[outside].max() if outside.any() else 0.0,
-                            error.max(), tight_turns(ideal)))
+                            error.max(),
+                            sum(tight_turns(p) for p in pieces_between_cusps(ideal))))
 
 
 if __name__ == "__main__":

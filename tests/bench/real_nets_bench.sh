@@ -4,14 +4,15 @@
 # for passenger cars, checked with sumolib), with seeded traffic flows and
 # the net's own traffic lights, each run once with `adse simulate` at a
 # generous point. adse routes them itself (round the block where SUMO's
-# route turns around tighter than the car can) and refuses a goal that
-# only such a U-turn reaches; those rows say "refused". Prints a markdown
-# table: net, route (SUMO's length and adse's), reached goal, nav
-# time, dominant stop reason, peak memory (/usr/bin/time -v), simulated
-# seconds per wall second, and how far `adse world --follow-ideal`'s
-# ground-truth controller strays from the ideal path outside junctions,
-# with the number of places the path turns tighter than the car can
-# (tests/bench/ideal_path_error.py).
+# route turns around tighter than the car can, else a turn in several
+# moves) and refuses a goal where not even that fits; those rows say
+# "refused". Prints a markdown table: net, route (SUMO's length and
+# adse's), reached goal, nav time, dominant stop reason, peak memory
+# (/usr/bin/time -v), simulated seconds per wall second, how far `adse
+# world --follow-ideal`'s ground-truth controller strays from the ideal
+# path outside junctions, with the number of places the path turns
+# tighter than the car can (tests/bench/ideal_path_error.py), and the
+# route's three-point turns with the moves of each.
 #   tests/bench/real_nets_bench.sh [routes-per-net] [net-name ...]
 # ROUTES_SEED (default 1) seeds the routes and flows; POINT (default
 # cores=16,freq_ghz=2.1) is the design point; KEEP=DIR keeps the scenarios,
@@ -113,8 +114,8 @@ PY
 echo "point: ${point}; routes per net: ${routes}; seed: ${seed}"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1 /proc/loadavg)"
 echo
-echo "| net | route | length m, SUMO's shortest / adse's | reached goal | ended | nav time s | dominant stop reason | stood s | collisions (caused by the ego) | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| net | route | length m, SUMO's shortest / adse's | reached goal | ended | nav time s | dominant stop reason | stood s | collisions (caused by the ego) | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's | three-point turns (moves) |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 reached=0
 total=0
 refused=0
@@ -127,19 +128,20 @@ for name in "${names[@]}"; do
   while read -r run length; do
     yaml="${out}/${run}.yaml"
     # adse's own route first: it goes round the block where SUMO's turns
-    # around tighter than the car can, and refuses a goal only such a
-    # U-turn reaches (a three-point turn it cannot drive).
+    # around tighter than the car can, turns in several moves where no
+    # such way leads on, and refuses a goal where not even that fits.
     if ! "${adse}" world "${yaml}" --no-scan --json -o "${out}/${run}-route" \
         >"${out}/${run}-route.json" 2>"${out}/${run}-route.log"; then
-      echo "| ${name} | ${run} | ${length} / - | refused | $(tail -n1 "${out}/${run}-route.log") | | | | | | | | |"
+      echo "| ${name} | ${run} | ${length} / - | refused | $(tail -n1 "${out}/${run}-route.log") | | | | | | | | | |"
       refused=$((refused + 1))
       continue
     fi
     length="${length} / $("${py}" -c 'import json,sys; print("%.0f" % json.load(open(sys.argv[1]))["ideal_path_length_m"])' "${out}/${run}-route.json")"
+    turnarounds="$("${py}" -c 'import json,sys; t = json.load(open(sys.argv[1]))["turnarounds"]; print("%d%s" % (len(t), " (%s)" % ", ".join(str(x["moves"]) for x in t) if t else ""))' "${out}/${run}-route.json")"
     if ! /usr/bin/time -v -o "${out}/${run}.time" "${adse}" simulate "${yaml}" \
         --point "${point}" --json -q -o "${out}/${run}.h5" \
         >"${out}/${run}.json" 2>"${out}/${run}.log"; then
-      echo "| ${name} | ${run} | ${length} | error | $(tail -n1 "${out}/${run}.log") | | | | | | | | |"
+      echo "| ${name} | ${run} | ${length} | error | $(tail -n1 "${out}/${run}.log") | | | | | | | | | |"
       total=$((total + 1))
       continue
     fi
@@ -172,10 +174,10 @@ print("| %s | %s | %s | %s | %s | %.1f | %s | %.1f | %d (%d) | %.0f | %.2f |" % 
     int(rss.group(1)) / 1024 if rss else float("nan"), t["simulated"] / t["wall"]))
 PY
 )"
-    echo "${line} ${ideal} |"
+    echo "${line} ${ideal} | ${turnarounds} |"
     total=$((total + 1))
     case "${line}" in *"| yes |"*) reached=$((reached + 1)) ;; esac
   done < <(make_scenarios "${name}" "${net}")
 done
 echo
-echo "reached the goal: ${reached} of ${total}; refused (only a U-turn too tight for the car reaches the goal): ${refused}"
+echo "reached the goal: ${reached} of ${total}; refused (only a U-turn reaches the goal, and no turn in several moves fits there): ${refused}"

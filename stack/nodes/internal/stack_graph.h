@@ -39,8 +39,14 @@ class Stack final : public AdStack {
   Status BuildLocalization(Graph* g);
   void BuildPerception(Graph* g);
   void BuildPlanning(Graph* g);
-  void BuildParking(Graph* g);
-  void PlanParking(CallbackContext& ctx, double course_out_m, int max_replans);
+  // The freespace planner's manoeuvres: the route's three-point turns and
+  // valet parking's way into the slot.
+  void BuildManoeuvres(Graph* g);
+  // The path planner's path ends where the route's leg does: at the next
+  // three-point turn, or the goal.
+  void EndRouteLeg();
+  void PlanManoeuvre(CallbackContext& ctx, double course_out_m,
+                     int max_replans);
   void BuildControl(Graph* g);
   // The controller's parking mode: one command along the manoeuvre, gear
   // and all, published.
@@ -71,6 +77,7 @@ class Stack final : public AdStack {
   PoseListener cluster_poses_;
   std::unique_ptr<algo::Tracker> tracker_;
   std::unique_ptr<algo::PathPlanner> path_planner_;
+  int route_leg_ = 0;  // three-point turns the path planner has seen made
   std::optional<PoseMsg> path_pose_;
   std::unique_ptr<algo::TrafficLightPlanner> traffic_light_;
   std::optional<ObjectsMsg> stop_objects_;
@@ -88,9 +95,12 @@ class Stack final : public AdStack {
   bool parking_planned_ = false;    // the planner has answered (path or not)
   bool path_driven_ = false;        // the controller says: driven to its end
   bool parking_completed_ = false;  // the planner has said: parked
+  int manoeuvre_ = 0;      // the freespace planner's: turns made so far
+  int turn_done_ = -1;     // topic: a three-point turn is made
   int parking_done_ = -1;  // topic: the controller drove its path's end
   std::unique_ptr<algo::ParkingFollower> parking_follower_;
   bool parking_mode_ = false;       // the follower drives the parking path
+  int follower_leg_ = 0;            // the route leg the controller follows
   bool path_end_reported_ = false;  // ... and has reported reaching its end
 };
 

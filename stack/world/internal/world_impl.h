@@ -54,6 +54,14 @@ inline std::vector<Vec2> ToPoints(const libsumo::TraCIPositionVector& shape) {
 std::vector<std::string> InternalChain(const std::string& via,
                                        std::string* arrives_on);
 
+// How far across the road a U-turn from `from_lane` to `to_lane` must
+// turn: the arrival lane's start off the departure lane's end, square to
+// its last heading.
+double UTurnWidthM(const std::string& from_lane, const std::string& to_lane);
+
+// Whether passenger cars may use the lane (not a sidewalk, bus lane, ...).
+bool OpenToCars(const std::string& lane_id);
+
 // Part of `shape` between arc lengths s0 and s1.
 std::vector<Vec2> Slice(const std::vector<Vec2>& shape, double s0, double s1);
 
@@ -82,12 +90,15 @@ struct World::Impl {
   struct Crossing {
     std::string from_lane, via_lane, to_lane;
     double raw_s_m = 0.0;
+    // A U-turn narrower than the car's turning circle: a three-point turn.
+    bool tight_uturn = false;
   };
   std::vector<Crossing> crossings;
   double raw_length_m = 0.0;  // of the joined lane pieces of the road part
   // Where the road part changes lane (route s of the road part).
   std::vector<algorithms::LaneChangeSection> lane_changes;
   std::vector<RouteSignal> signals;  // the crossings a traffic light controls
+  std::vector<RouteTurnaround> turnarounds;  // the tight U-turns' manoeuvres
   geometry::Path2 ideal;
   // The ego on the road part: arc length reached so far and its distance
   // from the road part there (UpdateProgress).
@@ -144,6 +155,13 @@ struct World::Impl {
                                             const std::string& from_field);
   Status PlanRoute();
   Status BuildIdealPath();
+  // The manoeuvre of each tight U-turn of the road part
+  // (world_turnaround.cc); an error naming task.goal where there is none.
+  Status PlanTurnarounds();
+  // The car's tightest turn (rear axle), from its wheelbase and steering.
+  double MinTurningRadiusM() const {
+    return setup.ego.wheelbase_m / std::tan(setup.ego.max_steer_rad);
+  }
   // The road part's arc length at `raw_s_m` along the joined lane pieces.
   double RoadS(double raw_s_m) const;
   // The crossings' traffic lights (world_signals.cc).

@@ -315,8 +315,8 @@ assert lanes["lane"].tolist() == [0] * 4 + [1] * 5 + [2] * 6
 stops = f["planning/stop_reasons"][:]
 assert h5py.check_enum_dtype(f["planning/stop_reasons"].dtype["reason"]) == \
     {"none": 0, "goal": 1, "obstacle": 2, "localization_lost": 3,
-     "no_trajectory": 4, "red_light": 5, "lane_change": 6}
-assert stops["reason"].tolist() == [0, 1, 2, 3, 4, 5, 6] * 2, stops["reason"]
+     "no_trajectory": 4, "red_light": 5, "lane_change": 6, "turnaround": 7}
+assert stops["reason"].tolist() == [0, 1, 2, 3, 4, 5, 6, 7] * 2, stops["reason"]
 assert f["scenario/yaml"].asstr()[()].startswith("name: cut_in")
 assert f["metrics"].attrs["min_ttc_s"] == 0.75
 try:

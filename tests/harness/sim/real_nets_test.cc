@@ -6,12 +6,15 @@
 // host.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <string>
 
 #include "analysis/metrics/standing.h"
 #include "harness/sim/simulator.h"
 #include "harness/spec/spec_parser.h"
+#include "stack/geometry/geometry.h"
 
 namespace adse::sim {
 namespace {
@@ -54,8 +57,9 @@ spec::Spec RealNetScenario(const std::string& name, const std::string& net,
 }
 
 // Simulates at 16 cores, 2.1 GHz and checks the goal was reached without
-// a collision and without standing long for anything but red lights.
-void DrivesToTheGoal(const spec::Spec& spec) {
+// a collision and without standing long for anything but red lights; the
+// run in `out` when given.
+void DrivesToTheGoal(const spec::Spec& spec, runfile::RunData* out = nullptr) {
   ASSERT_TRUE(std::filesystem::exists(spec.world.map.net_path))
       << "sumo-tools is not installed";
   Result<runfile::RunData> run =
@@ -73,6 +77,7 @@ void DrivesToTheGoal(const spec::Spec& spec) {
   EXPECT_TRUE(run->collisions.empty());
   EXPECT_TRUE(standing.has_reasons);
   EXPECT_LT(standing.standing_s - at_signals_s, 60.0) << why;
+  if (out != nullptr) *out = std::move(run).value();
 }
 
 // The DRT game's town (scenarios/osm_drt.yaml's route): before NDT scored
@@ -103,6 +108,46 @@ TEST(RealNetsTest, AcostaOneWayStreets) {
       "{edge: \"84\", pos_m: 10, lane: 0}",
       "{edge: \"113\", pos_m: 44.2, lane: 0}",
       "[{from: \"119\", to: \"15\", vehicles_per_hour: 300}]"));
+}
+
+// DRT's street -314415495#1 ends at a junction whose only way back is a
+// U-turn 3.2 m across (the car turns no tighter than 3.9 m): the car
+// stops short of it and turns round forwards and in reverse within the
+// lanes and the junction (the bench's DRT-1 turns there).
+TEST(RealNetsTest, DrtDeadEndTurnsRoundInSeveralMoves) {
+  const spec::Spec spec =
+      RealNetScenario("drt_turn", "/usr/share/sumo/tools/game/DRT/osm.net.xml",
+                      "{edge: \"-314415495#1\", pos_m: 10, lane: 1}",
+                      "{edge: \"314415495#1\", pos_m: 51, lane: 1}", "[]");
+  runfile::RunData run;
+  DrivesToTheGoal(spec, &run);
+  bool stopped_to_turn = false;
+  for (const runfile::StopSample& s : run.stop_reasons) {
+    stopped_to_turn |= s.reason == StopReason::kTurnaround;
+  }
+  EXPECT_TRUE(stopped_to_turn);
+  double reversed_m = 0.0;
+  for (size_t i = 1; i < run.ego.size(); ++i) {
+    if (run.ego[i - 1].v_mps < 0) {
+      reversed_m += std::hypot(run.ego[i].x_m - run.ego[i - 1].x_m,
+                               run.ego[i].y_m - run.ego[i - 1].y_m);
+    }
+  }
+  EXPECT_GT(reversed_m, 1.0);
+  // The ideal path takes the manoeuvre: the stack keeps near it.
+  double farthest_m = 0.0;
+  for (const runfile::EgoSample& e : run.ego) {
+    double nearest_m = INFINITY;
+    for (size_t i = 1; i < run.ideal_path.size(); ++i) {
+      const runfile::PathPoint& a = run.ideal_path[i - 1];
+      const runfile::PathPoint& b = run.ideal_path[i];
+      nearest_m = std::min(
+          nearest_m, geometry::DistanceToSegment({e.x_m, e.y_m}, {a.x_m, a.y_m},
+                                                 {b.x_m, b.y_m}));
+    }
+    farthest_m = std::max(farthest_m, nearest_m);
+  }
+  EXPECT_LT(farthest_m, 1.5);
 }
 
 }  // namespace

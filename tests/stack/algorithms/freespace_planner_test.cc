@@ -193,6 +193,109 @@ TEST(FreespacePlanner, FootprintCheckSeesAPoleUnderTheCar) {
   EXPECT_TRUE(grid.FootprintCollides({9.0, -5, 0}, fp, 0.0));
 }
 
+// A straight street along x, `width_m` across (two lanes), 80 m long: the
+// drivable area of a dead-end street's last stretch.
+std::vector<std::vector<Eigen::Vector2d>> Street(double width_m) {
+  return {{{-40, -width_m / 2},
+           {40, -width_m / 2},
+           {40, width_m / 2},
+           {-40, width_m / 2}}};
+}
+
+// The body's corners at every pose stay within the street (up to the
+// grid's cell, which the margin covers).
+void ExpectWithinStreet(const FreespacePath& path, double width_m) {
+  for (size_t i = 0; i < path.poses.size(); ++i) {
+    for (const Eigen::Vector2d& c :
+         geometry::BoxCorners(BodyAt(path.poses[i].pose, Footprint()))) {
+      ASSERT_LT(std::abs(c.y()), width_m / 2) << "pose " << i;
+    }
+  }
+}
+
+TEST(OccupancyGrid, KeepInsideMarksEverythingOutsideTheAreas) {
+  OccupancyGrid grid({-10, -10}, {10, 10}, 0.2);
+  grid.KeepInside({{{-5, -1}, {5, -1}, {5, 1}, {-5, 1}},
+                   {{-1, 0}, {1, 0}, {1, 6}, {-1, 6}}});
+  EXPECT_FALSE(grid.OccupiedAt({0, 0}));
+  EXPECT_FALSE(grid.OccupiedAt({4.9, 0.9}));
+  EXPECT_FALSE(grid.OccupiedAt({0, 5.5}));  // the second area
+  EXPECT_TRUE(grid.OccupiedAt({0, -1.5}));
+  EXPECT_TRUE(grid.OccupiedAt({3, 3}));
+  EXPECT_TRUE(grid.OccupiedAt({-9, 9}));
+  // No areas: no limit.
+  OccupancyGrid open({-10, -10}, {10, 10}, 0.2);
+  open.KeepInside({});
+  EXPECT_FALSE(open.OccupiedAt({-9, 9}));
+}
+
+TEST(FreespacePlanner, TurnsRoundAtASideStreetInSeveralMoves) {
+  // A two-lane street 6.4 m across with a side street of two lanes going
+  // off to the left at x = 0: the car (5 m planning radius) needs 10 m to
+  // turn in one move, and backs into the side street as a driver does.
+  const double width_m = 6.4;
+  std::vector<std::vector<Eigen::Vector2d>> area = Street(width_m);
+  area.push_back({{-3.2, 0}, {3.2, 0}, {3.2, 30}, {-3.2, 30}});
+  FreespacePlanner planner({}, Footprint());
+  const Pose2 start{-12, -1.6, 0};
+  const Pose2 goal{-12, 1.6, M_PI};
+  const Result<FreespacePath> path = planner.Plan(start, goal, {}, area);
+  ASSERT_TRUE(path.ok()) << path.status().ToString();
+  ExpectEndsAt(*path, goal);
+  EXPECT_GE(path->gear_changes, 1);
+  bool reverses = false;
+  for (const GearedPose& p : path->poses) {
+    reverses |= p.reverse;
+    // Every corner of the body on the street or in the side street.
+    for (const Eigen::Vector2d& c :
+         geometry::BoxCorners(BodyAt(p.pose, Footprint()))) {
+      const bool on_street = std::abs(c.y()) < width_m / 2;
+      const bool in_side_street = std::abs(c.x()) < 3.2 && c.y() > 0;
+      ASSERT_TRUE(on_street || in_side_street)
+          << "corner (" << c.x() << ", " << c.y() << ")";
+    }
+  }
+  EXPECT_TRUE(reverses);
+}
+
+TEST(FreespacePlanner, TurnsRoundOnAWideStreetInSeveralMoves) {
+  // 8 m across (two lanes and parking lanes), no side street.
+  const double width_m = 8.0;
+  FreespacePlanner planner({}, Footprint());
+  const Pose2 start{0, -2.0, 0};
+  const Pose2 goal{0, 2.0, M_PI};
+  const Result<FreespacePath> path =
+      planner.Plan(start, goal, {}, Street(width_m));
+  ASSERT_TRUE(path.ok()) << path.status().ToString();
+  ExpectEndsAt(*path, goal);
+  ExpectWithinStreet(*path, width_m);
+  EXPECT_GE(path->gear_changes, 2);  // a three-point turn at least
+}
+
+TEST(FreespacePlanner, NoTurnFitsInAStreetShorterAcrossThanTheCar) {
+  // 4.4 m across, the car 4.6 m long: it cannot stand across the street.
+  FreespacePlannerParams params;
+  params.max_expansions = 20000;
+  FreespacePlanner planner(params, Footprint());
+  const Result<FreespacePath> path =
+      planner.Plan({0, -1.1, 0}, {0, 1.1, M_PI}, {}, Street(4.4));
+  ASSERT_FALSE(path.ok());
+  EXPECT_EQ(path.status().code(), Status::Code::kNotFound);
+  EXPECT_NE(path.status().message().find("no path"), std::string::npos)
+      << path.status().message();
+}
+
+TEST(FreespacePlanner, WhereTheCarStandsIsDrivableAtTheAreasEdge) {
+  // The car has brushed the street's edge: its right side 0.1 m over it.
+  // It may still go on (the lane's edge on a map is no kerb).
+  FreespacePlanner planner({}, Footprint());
+  const Pose2 start{0, -2.3, 0};  // right side at -3.25, the edge at -3.2
+  const Result<FreespacePath> path =
+      planner.Plan(start, {20, -1.6, 0}, {}, Street(6.4));
+  ASSERT_TRUE(path.ok()) << path.status().ToString();
+  EXPECT_NEAR(path->poses.back().pose.x_m, 20.0, 1e-6);
+}
+
 TEST(FreespacePlanner, ParamsValidationNamesTheField) {
   FreespacePlannerParams p;
   p.yaw_bins = 3;

@@ -436,6 +436,34 @@ TEST(PathPlanner, ProjectionStaysOnItsLegOfAUTurn) {
   EXPECT_NEAR(planner.Plan(geometry::Pose2{10, 3.2, kPi}).ego_s_m, 93.0, 1e-9);
 }
 
+TEST(PathPlanner, ALegEndsAtItsTurnAndTheNextGoesOnFromTheTurnsEnd) {
+  // Out along y = 0 to a dead end, round in several moves, back along
+  // y = 3: the first leg ends at x = 90, short of the U-turn.
+  PathPlanner planner;
+  planner.SetRoute(Polyline({{0, 0}, {100, 0}, {100, 3}, {0, 3}}));
+  planner.EndAt(90.0);
+  const PlannedPath before = planner.Plan(geometry::Pose2{0, 0, 0});
+  EXPECT_FALSE(before.ends_at_goal);  // 90 m away, the horizon is 50 m
+  const PlannedPath at = planner.Plan(geometry::Pose2{45, 0, 0});
+  EXPECT_TRUE(at.ends_at_goal);
+  EXPECT_NEAR(at.points.back().s_m, 90.0, 1e-9);
+  EXPECT_NEAR(planner.Plan(geometry::Pose2{89.9, 0, 0}).ego_s_m, 89.9, 1e-9);
+  // Turning: wherever the car goes, the progress stays at the leg's end.
+  for (const geometry::Pose2& turning :
+       {geometry::Pose2{95, 1, 1.5}, geometry::Pose2{98, 2.5, 3.0},
+        geometry::Pose2{94, 3, kPi}}) {
+    EXPECT_NEAR(planner.Plan(turning).ego_s_m, 90.0, 1e-9);
+  }
+  // Turned, 10 m along the way back (s = 103 + 10): on to the route's end.
+  planner.ResumeAt(113.0);
+  const PlannedPath after = planner.Plan(geometry::Pose2{90, 3, kPi});
+  EXPECT_NEAR(after.ego_s_m, 113.0, 1e-9);
+  EXPECT_NEAR(after.points.back().s_m, 163.0, 1e-9);
+  EXPECT_FALSE(after.ends_at_goal);
+  EXPECT_NEAR(planner.Plan(geometry::Pose2{70, 3, kPi}).ego_s_m, 133.0, 1e-9);
+  EXPECT_TRUE(planner.Plan(geometry::Pose2{40, 3, kPi}).ends_at_goal);
+}
+
 TEST(PathPlanner, EmptyWithoutRoute) {
   PathPlanner planner;
   EXPECT_TRUE(planner.Plan(geometry::Pose2{}).points.empty());
@@ -446,11 +474,12 @@ TEST(PathPlanner, EmptyWithoutRoute) {
 
 TEST(StopReason, OneNamePerValueAndBack) {
   const std::vector<std::string> names = StopReasonNames();
-  ASSERT_EQ(names.size(), 7u);
+  ASSERT_EQ(names.size(), 8u);
   // The codes stored in run files never change; new ones come last.
   EXPECT_EQ(names[4], "no_trajectory");
   EXPECT_EQ(names[5], "red_light");
   EXPECT_EQ(names[6], "lane_change");
+  EXPECT_EQ(names[7], "turnaround");
   EXPECT_TRUE(StopReasonNamesTrack(StopReason::kObstacle));
   EXPECT_TRUE(StopReasonNamesTrack(StopReason::kLaneChange));
   EXPECT_FALSE(StopReasonNamesTrack(StopReason::kRedLight));

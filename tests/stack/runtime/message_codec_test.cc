@@ -87,7 +87,9 @@ TEST(MessageCodecTest, EveryMessageTypeOfTheStackComesBackFieldForField) {
   trajectory.stop.reason = StopReason::kObstacle;
   trajectory.stop.track_id = 7;
   trajectory.stop.static_structure = true;
+  trajectory.route_leg = 2;
   const TrajectoryMsg trajectory2 = RoundTrip(trajectory);
+  EXPECT_EQ(trajectory2.route_leg, 2);
   ASSERT_EQ(trajectory2.points.size(), 3u);
   EXPECT_EQ(trajectory2.points[2].curvature_1pm, -0.125);
   EXPECT_TRUE(trajectory2.signal_stop);
@@ -133,7 +135,9 @@ TEST(MessageCodecTest, EveryMessageTypeOfTheStackComesBackFieldForField) {
   EXPECT_EQ(RoundTrip(odometry).yaw_rate_rps, -0.0625);
   ParkingDoneMsg done;
   done.header.stamp_s = 3.0;
+  done.turnaround = 1;
   EXPECT_EQ(RoundTrip(done).header.stamp_s, 3.0);
+  EXPECT_EQ(RoundTrip(done).turnaround, 1);
 }
 
 TEST(MessageCodecTest, BytesCutShortOrLeftOverAreRefused) {
