@@ -154,10 +154,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   // detector reports them (runs without keep the graph they always had).
   inputs.traffic_signals = !w.route_signals().empty();
   inputs.lane_changes = w.route_lane_changes();
-  for (const world::RouteTurnaround& t : w.route_turnarounds()) {
-    inputs.turnarounds.push_back(
-        {t.start_s_m, t.end_s_m, t.goal, t.drivable, t.obstacles});
-  }
+  inputs.turnarounds.assign(w.route_turnarounds().begin(),
+                            w.route_turnarounds().end());
   if (w.parking_task()) {
     inputs.parking = true;
     inputs.parking_goal = w.parking_goal();

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "stack/algorithms/lane_change.h"
+#include "stack/algorithms/turnaround_section.h"
 #include "stack/base/status.h"
 #include "stack/config/stack_config.h"
 #include "stack/geometry/geometry.h"
@@ -46,17 +47,9 @@ struct StackInputs {
   std::vector<algorithms::LaneChangeSection> lane_changes;
   // Where the route turns round tighter than the car can (a lanelet route
   // knows its turns), in route order: the path ends at each one's
-  // start_s_m, the freespace planner takes the car round to its goal (rear
-  // axle) within `drivable` and clear of `obstacles`, and the path goes on
-  // from end_s_m (route s).
-  struct Turnaround {
-    double start_s_m = 0.0;
-    double end_s_m = 0.0;
-    geometry::Pose2 goal;
-    std::vector<std::vector<Eigen::Vector2d>> drivable;
-    std::vector<std::vector<Eigen::Vector2d>> obstacles;
-  };
-  std::vector<Turnaround> turnarounds;
+  // start_s_m, the freespace planner takes the car round to its goal, and
+  // the path goes on from end_s_m.
+  std::vector<algorithms::TurnaroundSection> turnarounds;
 };
 
 // Topic indices the harness talks to.

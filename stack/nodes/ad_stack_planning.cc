@@ -309,7 +309,7 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
   if (manoeuvre_ == turns && !inputs_.parking) return;  // all turns made
   // The manoeuvre now: the next three-point turn, then the parking.
   const bool turning = manoeuvre_ < turns;
-  const StackInputs::Turnaround* turn =
+  const algo::TurnaroundSection* turn =
       turning ? &inputs_.turnarounds[manoeuvre_] : nullptr;
   const geometry::Pose2& goal = turning ? turn->goal : inputs_.parking_goal;
   const geometry::Pose2& pose = freespace_pose_->pose;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "stack/algorithms/lane_change.h"
+#include "stack/algorithms/turnaround_section.h"
 #include "stack/base/status.h"
 #include "stack/geometry/geometry.h"
 #include "stack/world/map_builder.h"
@@ -63,21 +64,10 @@ struct RouteSignal {
   double stop_line_s_m = 0.0;  // along road_path()
 };
 
-// Where a lane-driving route turns around tighter than the car can (a
-// U-turn narrower than its turning circle, where no way round the block
-// leads on): the car stops on the lane it arrives on and turns in several
-// moves, forwards and in reverse, within the road's lanes and junctions,
-// onto the lane it leaves on.
-struct RouteTurnaround {
-  double start_s_m = 0.0;  // along road_path(): where the car stops to turn
-  double end_s_m = 0.0;    // along road_path(): where it drives on
-  geometry::Pose2 goal;    // rear axle on the departing lane, at end_s_m
-  // The lanes open to cars and the junctions about the turn, as polygons
-  // (where the manoeuvre keeps to), and the structure standing there.
-  std::vector<std::vector<Eigen::Vector2d>> drivable;
-  std::vector<std::vector<Eigen::Vector2d>> obstacles;
-  // The manoeuvre planned on the ground truth from the road part at
-  // start_s_m to `goal`.
+// Where a lane-driving route turns around tighter than the car can and no
+// way round the block leads on (s along road_path()), with the manoeuvre
+// planned on the ground truth from the road part at start_s_m to `goal`.
+struct RouteTurnaround : algorithms::TurnaroundSection {
   std::vector<ManoeuvrePose> reference;
 };
 

@@ -183,10 +183,17 @@ namespace {
 // A path vertex turning by more than 150 degrees folds the path back.
 constexpr double kFoldCos = -0.866;
 
+// Whether `link` from `from_lane` is a U-turn narrower than two turning
+// radii: a car that turns no tighter than `min_radius_m` needs that much
+// road to turn around without reversing.
+bool TooTightUTurn(const std::string& from_lane,
+                   const libsumo::TraCIConnection& link, double min_radius_m) {
+  return link.direction == "t" &&
+         UTurnWidthM(from_lane, link.approachedLane) < 2.0 * min_radius_m;
+}
+
 // The edges a car may drive to from `edge` (through any link but a
-// U-turn, or a U-turn at least two turning radii wide: a car that turns no
-// tighter than `min_radius_m` needs that much road to turn around without
-// reversing) into `drivable`; returns those reached only by a narrower
+// TooTightUTurn) into `drivable`; returns those reached only by such a
 // U-turn. Only links between lanes open to passenger cars.
 std::set<std::string> Successors(const std::string& edge, double min_radius_m,
                                  std::set<std::string>* drivable) {
@@ -197,11 +204,10 @@ std::set<std::string> Successors(const std::string& edge, double min_radius_m,
     for (const auto& link : libsumo::Lane::getLinks(lane_id)) {
       if (!OpenToCars(link.approachedLane)) continue;
       const std::string next = EdgeOfLane(link.approachedLane);
-      if (link.direction != "t" ||
-          UTurnWidthM(lane_id, link.approachedLane) >= 2.0 * min_radius_m) {
-        drivable->insert(next);
-      } else {
+      if (TooTightUTurn(lane_id, link, min_radius_m)) {
         tight.insert(next);
+      } else {
+        drivable->insert(next);
       }
     }
   }
@@ -491,9 +497,8 @@ Status World::Impl::BuildIdealPath() {
         if (!via[i].empty()) InternalChain(via[i], &to_lane);
         bool tight = false;
         for (const auto& link : libsumo::Lane::getLinks(exit_id)) {
-          if (link.approachedLane == to_lane && link.direction == "t") {
-            tight = UTurnWidthM(exit_id, to_lane) < 2.0 * MinTurningRadiusM();
-          }
+          tight |= link.approachedLane == to_lane &&
+                   TooTightUTurn(exit_id, link, MinTurningRadiusM());
         }
         crossings.push_back({exit_id, via[i], to_lane, raw_s, tight});
       }
