@@ -79,6 +79,33 @@ double Path2::MaxGap() const {
   return gap;
 }
 
+double Path2::DistanceTo(const Eigen::Vector2d& p, double s_lo, double s_hi,
+                         double* s_out) const {
+  if (points.size() == 1 || s_m.size() != points.size()) {
+    if (s_out) *s_out = 0.0;
+    return points.empty() ? INFINITY : (points.front() - p).norm();
+  }
+  // The first segment that ends at or after s_lo.
+  size_t i = std::lower_bound(s_m.begin(), s_m.end(), s_lo) - s_m.begin();
+  i = i > 0 ? i - 1 : 0;
+  double best = INFINITY;
+  double best_s = 0.0;
+  for (; i + 1 < points.size() && s_m[i] <= s_hi; ++i) {
+    const Eigen::Vector2d a = points[i];
+    const Eigen::Vector2d ab = points[i + 1] - a;
+    const double len2 = ab.squaredNorm();
+    const double u =
+        len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    const double d = (a + u * ab - p).norm();
+    if (d < best) {
+      best = d;
+      best_s = s_m[i] + u * (s_m[i + 1] - s_m[i]);
+    }
+  }
+  if (s_out) *s_out = best_s;
+  return best;
+}
+
 std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box) {
   const Eigen::Vector2d ax(std::cos(box.yaw_rad), std::sin(box.yaw_rad));
   const Eigen::Vector2d ay(-ax.y(), ax.x());

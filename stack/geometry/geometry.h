@@ -3,6 +3,7 @@
 #define ADSE_STACK_GEOMETRY_GEOMETRY_H_
 
 #include <Eigen/Core>
+#include <cmath>
 #include <vector>
 
 namespace adse::geometry {
@@ -37,6 +38,12 @@ struct Path2 {
   double HeadingAt(double s) const;
   // Largest distance between consecutive points.
   double MaxGap() const;
+  // Distance from p to the nearest point of the segments that reach into
+  // arc lengths [s_lo, s_hi] (the whole path by default; a window keeps a
+  // point on its own pass of a path that comes back near itself), and in
+  // *s_out that point's arc length. Infinity for an empty path.
+  double DistanceTo(const Eigen::Vector2d& p, double s_lo = 0.0,
+                    double s_hi = INFINITY, double* s_out = nullptr) const;
 };
 
 // Planar motion at constant speed and yaw rate (a sweeping LiDAR's carrier

@@ -1,6 +1,5 @@
 #include "stack/world/ideal_driver.h"
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -8,6 +7,7 @@
 
 #include "stack/algorithms/parking_control.h"
 #include "stack/algorithms/traffic_light.h"
+#include "stack/world/predictive_steering.h"
 #include "stack/world/traffic_signal_detector.h"
 
 namespace adse::world {
@@ -18,48 +18,21 @@ double Seconds(Clock::duration d) {
   return std::chrono::duration<double>(d).count();
 }
 
-// Curvature of the path around arc length s, from the heading change over
-// a window (robust to the 0.5 m sampling).
-double CurvatureAt(const geometry::Path2& path, double s) {
-  const double ds = 2.0;
-  double dh = path.HeadingAt(std::min(s + ds, path.length_m())) -
-              path.HeadingAt(std::max(s - ds, 0.0));
-  dh = std::atan2(std::sin(dh), std::cos(dh));
-  return std::abs(dh) / (2 * ds);
-}
-
 }  // namespace
-
-double DistanceToPath(const geometry::Path2& path, const Eigen::Vector2d& p,
-                      double* s_out) {
-  double best = std::numeric_limits<double>::infinity();
-  double best_s = 0.0;
-  for (size_t i = 0; i + 1 < path.points.size(); ++i) {
-    const Eigen::Vector2d a = path.points[i];
-    const Eigen::Vector2d ab = path.points[i + 1] - a;
-    const double len2 = ab.squaredNorm();
-    const double u =
-        len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    const double d = (a + u * ab - p).norm();
-    if (d < best) {
-      best = d;
-      best_s = path.s_m[i] + u * std::sqrt(len2);
-    }
-  }
-  if (path.points.size() == 1) best = (path.points[0] - p).norm();
-  if (s_out) *s_out = best_s;
-  return best;
-}
 
 Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
                                         const IdealDriverOptions& options,
                                         const ScanCallback& on_scan) {
   IdealDriveReport report;
   // The road part (all of the ideal path but a valet task's manoeuvre) by
-  // pure pursuit; then the manoeuvre, gears and all, with the stack's
+  // predictive steering; then the manoeuvre, gears and all, with the stack's
   // parking controller on the true pose. A three-point turn on the way is
   // driven the same way from where the car stops for it.
   const geometry::Path2& path = world.road_path();
+  // The speed limit, curves ahead (the stops come on top).
+  const SpeedProfile speed = CurveSpeedProfile(path, options.speed_limit_mps,
+                                               options.max_lateral_accel_mps2,
+                                               options.comfort_decel_mps2);
   const std::vector<RouteTurnaround>& turns = world.route_turnarounds();
   size_t next_turn = 0;       // the first turn not yet driven
   geometry::Path2 turn_path;  // the turn being driven, for its error
@@ -87,8 +60,8 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
     // in a three-point turn, the turn's path.
     report.max_lateral_error_m =
         std::max(report.max_lateral_error_m,
-                 world.parking_task() ? DistanceToPath(world.ideal_path(), pos)
-                 : !turn_path.points.empty() ? DistanceToPath(turn_path, pos)
+                 world.parking_task() ? world.ideal_path().DistanceTo(pos)
+                 : !turn_path.points.empty() ? turn_path.DistanceTo(pos)
                                              : off_road);
     if (world.goal_reached() && std::abs(ego.v_mps) < 0.5) {
       report.reached_goal = true;
@@ -141,37 +114,12 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
       report.world_wall_s += Seconds(Clock::now() - t0);
       continue;
     }
-    // Pure pursuit on the true pose.
-    // Shorter lookahead when slow (in curves) keeps corners from being cut.
-    const double lookahead =
-        std::clamp(options.lookahead_time_s * ego.v_mps,
-                   options.min_lookahead_m, options.lookahead_m);
-    // The target lies `lookahead` from the car, not from its projection:
-    // a car off the path (after a corner tighter than it can turn) then
-    // aims ahead and rejoins smoothly instead of steering across it.
-    double s_target = s_progress + lookahead;
-    while (s_target < path.length_m() &&
-           (path.PointAt(s_target) - pos).norm() < lookahead) {
-      s_target += 0.25;
-    }
-    const Eigen::Vector2d target = path.PointAt(s_target);
-    const Eigen::Vector2d local =
-        Eigen::Rotation2Dd(-ego.yaw_rad) * (target - pos);
-    const double ld2 = std::max(local.squaredNorm(), 1e-6);
-    const double curvature = 2.0 * local.y() / ld2;
+    // Steering that looks ahead through the car's own model.
     ControlCommand command;
-    command.steer_rad = std::atan(curvature * limits.wheelbase_m);
+    command.steer_rad =
+        PredictiveSteer(path, speed, s_progress, ego, limits, options.steering);
     // Speed: limit, curves ahead, and a stop at the goal.
-    double v_target = options.speed_limit_mps;
-    for (double ahead = 0.0; ahead <= 20.0; ahead += 2.0) {
-      const double k = CurvatureAt(path, s_progress + ahead);
-      if (k > 1e-4) {
-        const double v_curve = std::sqrt(options.max_lateral_accel_mps2 / k);
-        const double v_allowed = std::sqrt(
-            v_curve * v_curve + 2 * options.comfort_decel_mps2 * ahead);
-        v_target = std::min(v_target, v_allowed);
-      }
-    }
+    double v_target = speed.At(s_progress);
     // Where the car must stand: the goal, or a signal's stop line before
     // it. Signals: a perfect detector (the true state, no latency) and the
     // stack's own rule for when to stop.
@@ -203,7 +151,8 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
     }
     v_target = std::min(v_target,
                         std::sqrt(2 * options.comfort_decel_mps2 * remaining));
-    command.accel_mps2 = 1.5 * (v_target - ego.v_mps);
+    command.accel_mps2 =
+        options.steering.speed_gain_per_s * (v_target - ego.v_mps);
     // Near the stop, brake exactly as much as stopping on it needs; a
     // proportional controller alone lags and overshoots.
     if (remaining > 0.05) {

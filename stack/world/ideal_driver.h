@@ -1,6 +1,7 @@
-// Drives the ego along the ideal path with a ground-truth controller (pure
-// pursuit on the true pose, a curvature- and goal-aware speed profile). It
-// checks the world before, and independently of, the stack under test.
+// Drives the ego along the ideal path with a ground-truth controller
+// (predictive steering on the true pose, a curvature- and goal-aware speed
+// profile). It checks the world before, and independently of, the stack under
+// test.
 #ifndef ADSE_STACK_WORLD_IDEAL_DRIVER_H_
 #define ADSE_STACK_WORLD_IDEAL_DRIVER_H_
 
@@ -9,19 +10,14 @@
 
 #include "stack/base/status.h"
 #include "stack/world/lidar.h"
+#include "stack/world/predictive_steering.h"
 #include "stack/world/world.h"
 
 namespace adse::world {
 
 struct IdealDriverOptions {
   double speed_limit_mps = 30.0 / 3.6;
-  // Pure-pursuit lookahead: speed x lookahead_time_s within [min, max],
-  // taken from the car (not from its projection on the path). At 0.5 s
-  // the car swung ever wider about the path at 10 m/s after a corner on
-  // a real net (4 m off on DRT); 0.6 s held it within 0.2 m.
-  double lookahead_m = 8.0;
-  double min_lookahead_m = 2.0;  // short in slow corners: no corner cutting
-  double lookahead_time_s = 0.7;
+  PredictiveSteeringOptions steering;
   double max_lateral_accel_mps2 = 2.0;  // sets the speed in curves
   double comfort_decel_mps2 = 2.0;      // braking towards the goal
   double timeout_s = 600.0;
@@ -58,10 +54,6 @@ using ScanCallback =
 Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
                                         const IdealDriverOptions& options,
                                         const ScanCallback& on_scan = nullptr);
-
-// Distance from `p` to the polyline, and the arc length of the closest point.
-double DistanceToPath(const geometry::Path2& path, const Eigen::Vector2d& p,
-                      double* s_out = nullptr);
 
 }  // namespace adse::world
 

@@ -115,6 +115,28 @@ TEST(Path2Test, RepeatedPointsAndDegenerateInputs) {
   EXPECT_EQ(one.MaxGap(), 0.0);
 }
 
+TEST(Path2Test, DistanceToTheWholePathOrToAWindowOfIt) {
+  // Out 10 m along x and back 2 m to the left: a point between the legs
+  // is nearest the way back, unless the window holds only the way out.
+  Path2 p;
+  p.points = {{0, 0}, {10, 0}, {10, 2}, {0, 2}};
+  p.UpdateArcLength();
+  const Eigen::Vector2d q(4, 1.5);
+  double s = -1.0;
+  EXPECT_NEAR(p.DistanceTo(q, 0.0, INFINITY, &s), 0.5, 1e-12);
+  EXPECT_NEAR(s, 18.0, 1e-12);
+  EXPECT_NEAR(p.DistanceTo(q, 0.0, 9.0, &s), 1.5, 1e-12);
+  EXPECT_NEAR(s, 4.0, 1e-12);
+  EXPECT_NEAR(p.DistanceTo(q), 0.5, 1e-12);
+
+  Path2 empty;
+  EXPECT_TRUE(std::isinf(empty.DistanceTo(q)));
+  Path2 one;
+  one.points = {{4, 5.5}};
+  one.UpdateArcLength();
+  EXPECT_NEAR(one.DistanceTo(q), 4.0, 1e-12);
+}
+
 TEST(MotionAfter, StraightLineAndQuarterCircle) {
   const Pose2 straight = MotionAfter({10.0, 0.0}, 0.1);
   EXPECT_NEAR(straight.x_m, 1.0, 1e-12);

@@ -288,7 +288,7 @@ TEST(WorldTest, PerfectControllerReachesTheGoalWithoutCollisions) {
   EXPECT_TRUE(report->reached_goal);
   EXPECT_EQ(report->collisions, 0);
   // Within issue 17's 1 m, junctions (the lot's right-angle corners, which
-  // the 0.7 s lookahead cuts by about 0.4 m) included.
+  // no car with a turning circle takes on the polyline) included.
   EXPECT_LT(report->max_lateral_error_m, 0.5);
   // About 80 m at up to 8.3 m/s with slow corners.
   EXPECT_GT(report->time_s, 10.0);
