@@ -31,9 +31,10 @@ struct Rollout {
   double second_target_rad;  // held after
 };
 
-// How far a rollout strays from the path: the mean squared distance over
-// the steps, plus the squared distance and lever-weighted heading error
-// at its end.
+// How far a rollout strays from the path: its worst distance (squared,
+// weighted), the mean penalised distance over its steps, and the
+// penalised distance and heading error's chord at its end; plus the cost
+// of moving the target from the wheels' angle.
 double Cost(const geometry::Path2& path, const SpeedProfile& speed, double s0,
             const VehicleState& ego, const VehicleLimits& limits,
             const PredictiveSteeringOptions& options, double dt_s,
