@@ -43,6 +43,28 @@ WorldSetup SmallLot() {
   return setup;
 }
 
+// Nets that Debian's sumo-tools ships.
+constexpr char kDrtNet[] = "/usr/share/sumo/tools/game/DRT/osm.net.xml";
+constexpr char kAcostaNet[] =
+    "/usr/share/sumo/tools/sumolib/scenario/scenarios/RealWorld/acosta/"
+    "acosta_buslanes.net.xml";
+constexpr char kPasubioNet[] =
+    "/usr/share/sumo/tools/sumolib/scenario/scenarios/RealWorld/pasubio/"
+    "pasubio_buslanes.net.xml";
+
+// A route of the real-nets bench (tests/bench/real_nets_bench.sh) on
+// `net`, driven at the bench's 40 km/h.
+WorldSetup BenchRoute(const std::string& net, const Location& start,
+                      const Location& goal) {
+  WorldSetup setup;
+  setup.world.map.net_path = net;
+  setup.task.start = start;
+  setup.task.goal = goal;
+  setup.task.speed_limit_kmh = 40.0;
+  setup.cache_dir = CacheDir();
+  return setup;
+}
+
 // The ground-truth driver over the whole route without the LiDAR; expects
 // it to reach the goal.
 IdealDriveReport DriveToTheGoal(World& world, double speed_limit_kmh,
@@ -110,10 +132,10 @@ TEST(WorldTest, GridMapLoadsAndRoutes) {
 }
 
 TEST(WorldTest, RealOsmNetworkFromSumoToolsLoadsAndRoutes) {
-  const std::string net = "/usr/share/sumo/tools/game/DRT/osm.net.xml";
-  ASSERT_TRUE(std::filesystem::exists(net)) << "sumo-tools is not installed";
+  ASSERT_TRUE(std::filesystem::exists(kDrtNet))
+      << "sumo-tools is not installed";
   WorldSetup setup;
-  setup.world.map.net_path = net;
+  setup.world.map.net_path = kDrtNet;
   setup.task.start = Location::Xy(899.9, 400.8);
   setup.task.goal = Location::Xy(1100.0, 232.0);
   setup.cache_dir = CacheDir();
@@ -133,15 +155,11 @@ TEST(WorldTest, RealOsmNetworkFromSumoToolsLoadsAndRoutes) {
 // around at a junction, where the ideal driver swung 4.9 m wide; adse's
 // goes round the blocks (about 1.2 km) and the driver stays on it.
 TEST(WorldTest, OnARealTownTheRouteAvoidsAUTurnTheCarCannotDrive) {
-  const std::string net = "/usr/share/sumo/tools/game/DRT/osm.net.xml";
-  ASSERT_TRUE(std::filesystem::exists(net)) << "sumo-tools is not installed";
-  WorldSetup setup;
-  setup.world.map.net_path = net;
-  setup.task.start = Location::OnEdge("142575704#14", 10.0, 1);
-  setup.task.goal = Location::OnEdge("142575674#3", 20.1, 1);
-  setup.task.speed_limit_kmh = 40.0;
-  setup.cache_dir = CacheDir();
-  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_TRUE(std::filesystem::exists(kDrtNet))
+      << "sumo-tools is not installed";
+  Result<std::unique_ptr<World>> world =
+      World::Open(BenchRoute(kDrtNet, Location::OnEdge("142575704#14", 10.0, 1),
+                             Location::OnEdge("142575674#3", 20.1, 1)));
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   EXPECT_NEAR((*world)->ideal_path().length_m(), 1228.0, 20.0);
   const IdealDriveReport report = DriveToTheGoal(**world, 40.0, 400.0);
@@ -153,17 +171,11 @@ TEST(WorldTest, OnARealTownTheRouteAvoidsAUTurnTheCarCannotDrive) {
 // starts 9 m past its corner and folds back; the ideal path took the fold
 // and the ideal driver ended 9 m off it. The path drops the fold.
 TEST(WorldTest, OnARealTownALaneShapeThatFoldsBackIsDrivenAsTheCorner) {
-  const std::string net =
-      "/usr/share/sumo/tools/sumolib/scenario/scenarios/RealWorld/acosta/"
-      "acosta_buslanes.net.xml";
-  ASSERT_TRUE(std::filesystem::exists(net)) << "sumo-tools is not installed";
-  WorldSetup setup;
-  setup.world.map.net_path = net;
-  setup.task.start = Location::OnEdge("224[0]", 10.0, 0);
-  setup.task.goal = Location::OnEdge("2", 22.2, 0);
-  setup.task.speed_limit_kmh = 40.0;
-  setup.cache_dir = CacheDir();
-  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_TRUE(std::filesystem::exists(kAcostaNet))
+      << "sumo-tools is not installed";
+  Result<std::unique_ptr<World>> world =
+      World::Open(BenchRoute(kAcostaNet, Location::OnEdge("224[0]", 10.0, 0),
+                             Location::OnEdge("2", 22.2, 0)));
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   // Nowhere does the path turn back on itself.
   const geometry::Path2& path = (*world)->ideal_path();
@@ -183,17 +195,11 @@ TEST(WorldTest, OnARealTownALaneShapeThatFoldsBackIsDrivenAsTheCorner) {
 // rad/s) cannot take on the polyline. Pure pursuit, blind to the
 // steering's rate limit, swung wide and wove back: 5.88 m off the path.
 TEST(WorldTest, OnARealTownTheIdealDriverTakesSharpCornersWithoutSwingingWide) {
-  const std::string net =
-      "/usr/share/sumo/tools/sumolib/scenario/scenarios/RealWorld/pasubio/"
-      "pasubio_buslanes.net.xml";
-  ASSERT_TRUE(std::filesystem::exists(net)) << "sumo-tools is not installed";
-  WorldSetup setup;
-  setup.world.map.net_path = net;
-  setup.task.start = Location::OnEdge("22[0]", 10.0, 0);
-  setup.task.goal = Location::OnEdge("39[1][1][0]", 100.7, 0);
-  setup.task.speed_limit_kmh = 40.0;
-  setup.cache_dir = CacheDir();
-  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_TRUE(std::filesystem::exists(kPasubioNet))
+      << "sumo-tools is not installed";
+  Result<std::unique_ptr<World>> world =
+      World::Open(BenchRoute(kPasubioNet, Location::OnEdge("22[0]", 10.0, 0),
+                             Location::OnEdge("39[1][1][0]", 100.7, 0)));
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   const IdealDriveReport report = DriveToTheGoal(**world, 40.0, 900.0);
   // Junctions included: 1.63 m measured (0.87 m outside them, issue 17's
@@ -204,12 +210,10 @@ TEST(WorldTest, OnARealTownTheIdealDriverTakesSharpCornersWithoutSwingingWide) {
 TEST(WorldTest, AOneWayStreetOfABareNetHasPolesOnBothSides) {
   // Edge 69 of sumo-tools' acosta: a one-way, two-lane street. With poles
   // on its right side only, NDT saw too little structure and got lost.
-  const std::string net =
-      "/usr/share/sumo/tools/sumolib/scenario/scenarios/RealWorld/acosta/"
-      "acosta_buslanes.net.xml";
-  ASSERT_TRUE(std::filesystem::exists(net)) << "sumo-tools is not installed";
+  ASSERT_TRUE(std::filesystem::exists(kAcostaNet))
+      << "sumo-tools is not installed";
   WorldSetup setup;
-  setup.world.map.net_path = net;
+  setup.world.map.net_path = kAcostaNet;
   setup.task.start = Location::OnEdge("69", 10.0);
   setup.task.goal = Location::OnEdge("69", 160.0);
   setup.cache_dir = CacheDir();
