@@ -81,23 +81,18 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
     }
     if (!parking_mode && !world.reference_manoeuvre().empty() &&
         s_progress >= path.length_m() - 0.05 && std::abs(ego.v_mps) < 0.05) {
-      std::vector<algorithms::GearedPose> poses;
-      for (const ManoeuvrePose& p : world.reference_manoeuvre())
-        poses.push_back({p.pose, p.reverse});
-      parking.SetPath(poses);
+      parking.SetPath(world.reference_manoeuvre());
       parking_mode = true;
     }
     if (!parking_mode && next_turn < turns.size() &&
         s_progress >= turns[next_turn].start_s_m - 0.5 &&
         std::abs(ego.v_mps) < 0.05) {
-      std::vector<algorithms::GearedPose> poses;
       turn_path = geometry::Path2();
-      for (const ManoeuvrePose& p : turns[next_turn].reference) {
-        poses.push_back({p.pose, p.reverse});
+      for (const algorithms::GearedPose& p : turns[next_turn].reference) {
         turn_path.points.emplace_back(p.pose.x_m, p.pose.y_m);
       }
       turn_path.UpdateArcLength();
-      parking.SetPath(poses);
+      parking.SetPath(turns[next_turn].reference);
       parking_mode = true;
     }
     if (parking_mode) {

@@ -423,7 +423,7 @@ double World::road_offset_m() const { return impl_->road_offset_m; }
 const std::vector<RouteTurnaround>& World::route_turnarounds() const {
   return impl_->turnarounds;
 }
-const std::vector<ManoeuvrePose>& World::reference_manoeuvre() const {
+const std::vector<algorithms::GearedPose>& World::reference_manoeuvre() const {
   return impl_->reference;
 }
 const geometry::Path2& World::ideal_path() const { return impl_->ideal; }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "stack/algorithms/lane_change.h"
+#include "stack/algorithms/reeds_shepp.h"
 #include "stack/algorithms/turnaround_section.h"
 #include "stack/base/status.h"
 #include "stack/geometry/geometry.h"
@@ -34,12 +35,6 @@ struct RoadLocation {
   int lane = 0;
   double pos_m = 0.0;
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // on the lane centre
-};
-
-// A pose of the reference parking manoeuvre and the gear it is driven in.
-struct ManoeuvrePose {
-  geometry::Pose2 pose;  // rear axle
-  bool reverse = false;
 };
 
 struct OtherVehicle {
@@ -68,11 +63,11 @@ struct RouteSignal {
 // way round the block leads on (s along road_path()), with the manoeuvre
 // planned on the ground truth from the road part at start_s_m to `goal`.
 struct RouteTurnaround : algorithms::TurnaroundSection {
-  std::vector<ManoeuvrePose> reference;
+  std::vector<algorithms::GearedPose> reference;  // rear axle poses
 };
 
 // The moves of a manoeuvre: its runs in one gear (a three-point turn has 3).
-int ManoeuvreMoves(const std::vector<ManoeuvrePose>& manoeuvre);
+int ManoeuvreMoves(const std::vector<algorithms::GearedPose>& manoeuvre);
 
 // Errors from Open() start with the scenario field they concern
 // ("task.goal: ...", "world.map.net: ...") so callers can cite its line.
@@ -122,7 +117,7 @@ class World {
   // The reference manoeuvre from the road part's end into the slot (the
   // ideal path's last part), planned on the ground truth; empty when the
   // planner found none or for lane driving.
-  const std::vector<ManoeuvrePose>& reference_manoeuvre() const;
+  const std::vector<algorithms::GearedPose>& reference_manoeuvre() const;
 
   // The signalised links along the road part, in route order (empty on
   // maps without traffic lights), and SUMO's state letter of each now

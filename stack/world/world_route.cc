@@ -541,8 +541,8 @@ Status World::Impl::BuildIdealPath() {
               (point - ideal.points.back()).norm() > 1e-6) {
             ideal.points.push_back(point);
           }
-          reference.push_back({p.pose, p.reverse});
         }
+        reference = manoeuvre->poses;
       }
       ideal.UpdateArcLength();
       goal_xy = Vec2(parking_goal.x_m, parking_goal.y_m);

@@ -80,7 +80,7 @@ Polygons DrivableAround(const Vec2& at) {
 
 }  // namespace
 
-int ManoeuvreMoves(const std::vector<ManoeuvrePose>& manoeuvre) {
+int ManoeuvreMoves(const std::vector<algorithms::GearedPose>& manoeuvre) {
   int moves = manoeuvre.empty() ? 0 : 1;
   for (size_t i = 1; i < manoeuvre.size(); ++i) {
     moves += manoeuvre[i].reverse != manoeuvre[i - 1].reverse;
@@ -138,9 +138,7 @@ Status World::Impl::PlanTurnarounds() {
           internal::UTurnWidthM(crossing.from_lane, crossing.to_lane),
           MinTurningRadiusM(), manoeuvre.status().message()));
     }
-    for (const algorithms::GearedPose& p : manoeuvre->poses) {
-      turn.reference.push_back({p.pose, p.reverse});
-    }
+    turn.reference = manoeuvre->poses;
     turnarounds.push_back(std::move(turn));
   }
   if (turnarounds.empty()) return Status::Ok();
@@ -162,7 +160,7 @@ Status World::Impl::PlanTurnarounds() {
   double from_s = 0.0;
   for (const RouteTurnaround& turn : turnarounds) {
     add_road(from_s, turn.start_s_m);
-    for (const ManoeuvrePose& p : turn.reference) {
+    for (const algorithms::GearedPose& p : turn.reference) {
       add(Vec2(p.pose.x_m, p.pose.y_m));
     }
     from_s = turn.end_s_m;

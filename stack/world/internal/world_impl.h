@@ -78,10 +78,11 @@ struct World::Impl {
   Eigen::Vector2d goal_xy =
       Eigen::Vector2d::Zero();  // final target (rear axle when valet)
   bool valet = false;
-  ParkingSlot goal_slot;                 // valet: the slot parked in
-  geometry::Pose2 parking_goal;          // valet: rear axle parked
-  geometry::Path2 road;                  // the route's road part
-  std::vector<ManoeuvrePose> reference;  // valet: the reference manoeuvre
+  ParkingSlot goal_slot;         // valet: the slot parked in
+  geometry::Pose2 parking_goal;  // valet: rear axle parked
+  geometry::Path2 road;          // the route's road part
+  // valet: the reference manoeuvre
+  std::vector<algorithms::GearedPose> reference;
   std::vector<std::string> route;
   // Where the road part leaves each route edge but the last for the next:
   // the lane it leaves, the connection's first internal lane (empty on

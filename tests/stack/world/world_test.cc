@@ -787,7 +787,7 @@ TEST(WorldTest, PerfectDriverParksAlongTheReferenceManoeuvre) {
   EXPECT_LT(report->max_lateral_error_m, 0.5);
   // It drove in reverse at some point only if the manoeuvre asks for it.
   bool plan_reverses = false, drove_back = false;
-  for (const ManoeuvrePose& p : w.reference_manoeuvre())
+  for (const algorithms::GearedPose& p : w.reference_manoeuvre())
     plan_reverses = plan_reverses || p.reverse;
   for (const TrajectorySample& t : report->trajectory)
     drove_back = drove_back || t.v_mps < -0.1;
