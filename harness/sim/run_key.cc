@@ -83,6 +83,10 @@ Result<std::string> RunKey(const spec::Spec& spec,
   for (const auto& [name, value] : w.map.generator_params)
     h.Add(name).Add(value);
   ADSE_RETURN_IF_ERROR(AddFile(&h, "world.map.net", w.map.net_path));
+  // Since 2026-11-28 a lane position is scaled onto the lane's shape where
+  // a net gives the lane another length: keys of net files changed, those
+  // of generated maps (whose lanes' lengths are their shapes') did not.
+  if (!w.map.net_path.empty()) h.Add("lane-positions-on-shapes");
   ADSE_RETURN_IF_ERROR(AddFile(&h, "world.map.polygons", w.map.polygons_path));
   h.Add("traffic").Add(w.traffic.parked_occupancy);
   for (const world::Flow& f : w.traffic.flows) {

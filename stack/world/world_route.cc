@@ -52,6 +52,20 @@ std::vector<Vec2> Slice(const std::vector<Vec2>& shape, double s0, double s1) {
   return out;
 }
 
+double ShapeS(const std::vector<Vec2>& shape, double lane_length_m,
+              double pos_m) {
+  // Differences below this are the rounding of the net's coordinates.
+  constexpr double kRoundingM = 0.05;
+  double shape_m = 0.0;
+  for (size_t i = 1; i < shape.size(); ++i) {
+    shape_m += (shape[i] - shape[i - 1]).norm();
+  }
+  if (lane_length_m <= 0.0 || std::abs(shape_m - lane_length_m) <= kRoundingM) {
+    return pos_m;
+  }
+  return pos_m * shape_m / lane_length_m;
+}
+
 geometry::Path2 Resample(const std::vector<Vec2>& points, double step) {
   geometry::Path2 raw;
   for (const Vec2& p : points) {
@@ -92,6 +106,7 @@ using internal::InternalChain;
 using internal::kResampleStepM;
 using internal::OpenToCars;
 using internal::Resample;
+using internal::ShapeS;
 using internal::Slice;
 using internal::ToPoints;
 using internal::UTurnWidthM;
@@ -458,11 +473,13 @@ Status World::Impl::BuildIdealPath() {
       const std::string entry_id = route[i] + "_" + std::to_string(entry);
       const std::string exit_id = route[i] + "_" + std::to_string(lane[i]);
       const double length = libsumo::Lane::getLength(exit_id);
-      const double s0 = i == 0 ? start.pos_m : 0.0;
-      const double s1 = i == n - 1 ? goal.pos_m : length;
+      const std::vector<Vec2> exit_shape =
+          ToPoints(libsumo::Lane::getShape(exit_id));
+      const double s0 = i == 0 ? ShapeS(exit_shape, length, start.pos_m) : 0.0;
+      const double s1 =
+          ShapeS(exit_shape, length, i == n - 1 ? goal.pos_m : length);
       width_sum += libsumo::Lane::getWidth(exit_id);
-      std::vector<Vec2> part =
-          Slice(ToPoints(libsumo::Lane::getShape(exit_id)), s0, s1);
+      std::vector<Vec2> part = Slice(exit_shape, s0, s1);
       if (entry != lane[i]) {
         // A lane change: blend from the entry lane into the exit lane over
         // the middle of the edge (lane s here; the route's section below).

@@ -25,6 +25,7 @@ namespace {
 using internal::InternalChain;
 using internal::kEgoId;
 using internal::kOffRoadSlackM;
+using internal::ShapeS;
 using internal::Slice;
 using internal::SumoAngleToYaw;
 using internal::ToPoints;
@@ -177,7 +178,8 @@ void World::Impl::YieldToEgo() {
     // lane, then through the next junction onto the next lane of its best
     // continuation.
     std::vector<Vec2> path;
-    const double pos = libsumo::Vehicle::getLanePosition(v.id);
+    const double pos = ShapeS(LaneShape(lane), libsumo::Lane::getLength(lane),
+                              libsumo::Vehicle::getLanePosition(v.id));
     double length_m =
         Append(Slice(LaneShape(lane), pos, pos + lookahead), &path);
     std::vector<std::string> next;

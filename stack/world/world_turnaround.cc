@@ -106,7 +106,10 @@ Status World::Impl::PlanTurnarounds() {
     leave.UpdateArcLength();
     double along = std::min(kRejoinAlongM, leave.length_m());
     if (EdgeOfLane(crossing.to_lane) == goal.edge) {
-      along = std::min(along, goal.pos_m);
+      along = std::min(
+          along, internal::ShapeS(leave.points,
+                                  libsumo::Lane::getLength(crossing.to_lane),
+                                  goal.pos_m));
     }
     const Vec2 rejoin = leave.PointAt(along);
     turn.goal = {rejoin.x(), rejoin.y(), leave.HeadingAt(along)};

@@ -31,12 +31,19 @@ declare -A nets=(
   [acosta]="${tools}/sumolib/scenario/scenarios/RealWorld/acosta/acosta_buslanes.net.xml"
   [joined]="${tools}/sumolib/scenario/scenarios/RealWorld/joined/joined_buslanes.net.xml"
   [RiLSA1]="${tools}/sumolib/scenario/scenarios/RealWorld/RiLSA_example1/rilsa1.net.xml"
+  [RiLSA2]="${tools}/sumolib/scenario/scenarios/RealWorld/RiLSA_example2/rilsa2.net.xml"
   [RiLSA3]="${tools}/sumolib/scenario/scenarios/RealWorld/RiLSA_example3/rilsa3.net.xml"
+  [RiLSA4]="${tools}/sumolib/scenario/scenarios/RealWorld/RiLSA_example4/rilsa4.net.xml"
+  [bs3d]="${tools}/game/bs3d/bs.net.xml"
+  [grid6]="${tools}/game/grid6/grid6.net.xml"
+  [square]="${tools}/game/square/square.net.xml"
   [pasubio]="${tools}/sumolib/scenario/scenarios/RealWorld/pasubio/pasubio_buslanes.net.xml"
 )
-# kuehne (a 300 m square) has no shortest route of 500 m.
+# kuehne (a 300 m square) has no shortest route of 500 m; corridor,
+# highway, ramp and racing are a road or two, hiking footpaths.
 names=("$@")
-[ ${#names[@]} -eq 0 ] && names=(DRT A10KW pasubio acosta joined RiLSA1)
+[ ${#names[@]} -eq 0 ] &&
+  names=(DRT A10KW pasubio acosta joined RiLSA1 RiLSA2 RiLSA4 bs3d grid6 square)
 if [ -n "${KEEP:-}" ]; then
   out="${KEEP}"
   mkdir -p "${out}"

@@ -65,6 +65,15 @@ bool OpenToCars(const std::string& lane_id);
 // Part of `shape` between arc lengths s0 and s1.
 std::vector<Vec2> Slice(const std::vector<Vec2>& shape, double s0, double s1);
 
+// SUMO's position `pos_m` along a lane as arc length along its `shape`. A
+// lane's length (SUMO's positions) may differ from its shape's: a lane
+// of an edge with its own length (grid6's are 80 m on 94-112 m shapes),
+// the inner lane of a bend (all lanes of an edge share the edge's
+// length). SUMO scales positions onto the shape; so does this, where the
+// two differ by more than SUMO's rounding of both to 0.01 m.
+double ShapeS(const std::vector<Vec2>& shape, double lane_length_m,
+              double pos_m);
+
 // `points` without repeats, resampled every `step` metres.
 geometry::Path2 Resample(const std::vector<Vec2>& points, double step);
 
