@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "stack/world/world.h"
+#include "tests/stack/world/testing/real_nets.h"
 
 namespace adse::world {
 namespace {
@@ -111,8 +112,7 @@ TEST(TrafficSignalDetector, TheWorldFindsTheSignalOnARilsaRoute) {
   // 77 m to the stop line at the end of nm_1.
   setup.task.start = Location::OnEdge("nm", 10.0, 1);
   setup.task.goal = Location::OnEdge("ms", 60.0, 1);
-  const char* cache = std::getenv("ADSE_CACHE_DIR");
-  setup.cache_dir = cache ? cache : "/tmp/adse-test-cache";
+  setup.cache_dir = testing::CacheDir();
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   const std::vector<RouteSignal>& signals = (*world)->route_signals();
@@ -137,8 +137,7 @@ TEST(TrafficSignalDetector, AGeneratedLotHasNoSignals) {
   setup.world.map.generator_params = {{"rows", 2}, {"slots_per_row", 8}};
   setup.task.start = Location::Xy(8.0, -1.75);
   setup.task.goal = Location::Xy(10.0, 29.75);
-  const char* cache = std::getenv("ADSE_CACHE_DIR");
-  setup.cache_dir = cache ? cache : "/tmp/adse-test-cache";
+  setup.cache_dir = testing::CacheDir();
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   EXPECT_TRUE((*world)->route_signals().empty());

@@ -17,16 +17,17 @@
 #include "stack/world/ideal_driver.h"
 #include "stack/world/lidar.h"
 #include "stack/world/map_cloud.h"
+#include "tests/stack/world/testing/real_nets.h"
 
 namespace adse::world {
 namespace {
 
-std::string CacheDir() {
-  const char* dir = std::getenv("ADSE_CACHE_DIR");
-  return dir ? dir
-             : (std::filesystem::temp_directory_path() / "adse-test-cache")
-                   .string();
-}
+using testing::CacheDir;
+using testing::DriveToTheGoal;
+using testing::kAcostaNet;
+using testing::kDrtNet;
+using testing::kPasubioNet;
+using testing::OpenBenchRoute;
 
 // A small parking lot: one aisle between two rows, ring road around it.
 // Ring south lane (eastbound) at y = -1.75; north lane (westbound) at
@@ -41,43 +42,6 @@ WorldSetup SmallLot() {
   setup.task.goal = Location::Xy(10.0, 29.75);
   setup.cache_dir = CacheDir();
   return setup;
-}
-
-// Nets that Debian's sumo-tools ships.
-constexpr char kDrtNet[] = "/usr/share/sumo/tools/game/DRT/osm.net.xml";
-constexpr char kAcostaNet[] =
-    "/usr/share/sumo/tools/sumolib/scenario/scenarios/RealWorld/acosta/"
-    "acosta_buslanes.net.xml";
-constexpr char kPasubioNet[] =
-    "/usr/share/sumo/tools/sumolib/scenario/scenarios/RealWorld/pasubio/"
-    "pasubio_buslanes.net.xml";
-
-// A route of the real-nets bench (tests/bench/real_nets_bench.sh) on
-// `net`, driven at the bench's 40 km/h.
-WorldSetup BenchRoute(const std::string& net, const Location& start,
-                      const Location& goal) {
-  WorldSetup setup;
-  setup.world.map.net_path = net;
-  setup.task.start = start;
-  setup.task.goal = goal;
-  setup.task.speed_limit_kmh = 40.0;
-  setup.cache_dir = CacheDir();
-  return setup;
-}
-
-// The ground-truth driver over the whole route without the LiDAR; expects
-// it to reach the goal.
-IdealDriveReport DriveToTheGoal(World& world, double speed_limit_kmh,
-                                double timeout_s) {
-  IdealDriverOptions options;
-  options.scan = false;
-  options.speed_limit_mps = speed_limit_kmh / 3.6;
-  options.timeout_s = timeout_s;
-  Result<IdealDriveReport> report = DriveIdealPath(world, nullptr, options);
-  EXPECT_TRUE(report.ok()) << report.status().ToString();
-  if (!report.ok()) return {};
-  EXPECT_TRUE(report->reached_goal);
-  return *report;
 }
 
 TEST(WorldTest, GeneratedParkingLotLoadsAndIdealPathIsContinuous) {
@@ -155,11 +119,9 @@ TEST(WorldTest, RealOsmNetworkFromSumoToolsLoadsAndRoutes) {
 // around at a junction, where the ideal driver swung 4.9 m wide; adse's
 // goes round the blocks (about 1.2 km) and the driver stays on it.
 TEST(WorldTest, OnARealTownTheRouteAvoidsAUTurnTheCarCannotDrive) {
-  ASSERT_TRUE(std::filesystem::exists(kDrtNet))
-      << "sumo-tools is not installed";
   Result<std::unique_ptr<World>> world =
-      World::Open(BenchRoute(kDrtNet, Location::OnEdge("142575704#14", 10.0, 1),
-                             Location::OnEdge("142575674#3", 20.1, 1)));
+      OpenBenchRoute(kDrtNet, Location::OnEdge("142575704#14", 10.0, 1),
+                     Location::OnEdge("142575674#3", 20.1, 1));
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   EXPECT_NEAR((*world)->ideal_path().length_m(), 1228.0, 20.0);
   const IdealDriveReport report = DriveToTheGoal(**world, 40.0, 400.0);
@@ -171,11 +133,9 @@ TEST(WorldTest, OnARealTownTheRouteAvoidsAUTurnTheCarCannotDrive) {
 // starts 9 m past its corner and folds back; the ideal path took the fold
 // and the ideal driver ended 9 m off it. The path drops the fold.
 TEST(WorldTest, OnARealTownALaneShapeThatFoldsBackIsDrivenAsTheCorner) {
-  ASSERT_TRUE(std::filesystem::exists(kAcostaNet))
-      << "sumo-tools is not installed";
   Result<std::unique_ptr<World>> world =
-      World::Open(BenchRoute(kAcostaNet, Location::OnEdge("224[0]", 10.0, 0),
-                             Location::OnEdge("2", 22.2, 0)));
+      OpenBenchRoute(kAcostaNet, Location::OnEdge("224[0]", 10.0, 0),
+                     Location::OnEdge("2", 22.2, 0));
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   // Nowhere does the path turn back on itself.
   const geometry::Path2& path = (*world)->ideal_path();
@@ -195,11 +155,9 @@ TEST(WorldTest, OnARealTownALaneShapeThatFoldsBackIsDrivenAsTheCorner) {
 // rad/s) cannot take on the polyline. Pure pursuit, blind to the
 // steering's rate limit, swung wide and wove back: 5.88 m off the path.
 TEST(WorldTest, OnARealTownTheIdealDriverTakesSharpCornersWithoutSwingingWide) {
-  ASSERT_TRUE(std::filesystem::exists(kPasubioNet))
-      << "sumo-tools is not installed";
   Result<std::unique_ptr<World>> world =
-      World::Open(BenchRoute(kPasubioNet, Location::OnEdge("22[0]", 10.0, 0),
-                             Location::OnEdge("39[1][1][0]", 100.7, 0)));
+      OpenBenchRoute(kPasubioNet, Location::OnEdge("22[0]", 10.0, 0),
+                     Location::OnEdge("39[1][1][0]", 100.7, 0));
   ASSERT_TRUE(world.ok()) << world.status().ToString();
   const IdealDriveReport report = DriveToTheGoal(**world, 40.0, 900.0);
   // Junctions included: 1.63 m measured (0.87 m outside them, issue 17's
