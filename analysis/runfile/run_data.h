@@ -199,6 +199,9 @@ struct RunData {
   // a three-point turn on the route); valet_parking also:
   // parked_out_of_tolerance (the manoeuvre ended outside the tolerances)
   std::string termination_reason;
+  // What ended it, in words, where the reason alone does not say: for
+  // no_path, the freespace planner's failure. Empty otherwise.
+  std::string termination_detail;
   std::string scenario_name;
   std::string scenario_text;  // the scenario file, verbatim
   std::string scenario_hash;  // sha256 of scenario_text

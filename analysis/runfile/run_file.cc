@@ -36,6 +36,10 @@ Status WriteContents(hid_t file, const RunData& run) {
   if (!run.task_case.empty()) {
     ADSE_RETURN_IF_ERROR(WriteStringAttr(file, "task_case", run.task_case));
   }
+  if (!run.termination_detail.empty()) {
+    ADSE_RETURN_IF_ERROR(
+        WriteStringAttr(file, "termination_detail", run.termination_detail));
+  }
 
   {
     Result<Handle> group = CreateGroup(file, "scenario");

@@ -16,6 +16,14 @@ namespace {
 // Every failure is a Corruption whose message names the HDF5 object; the
 // caller prefixes the file name.
 
+// An attribute files written without it lack: `out` stays empty then.
+Status ReadOptionalStringAttr(hid_t loc, const std::string& name,
+                              std::string* out) {
+  Result<bool> has = HasAttr(loc, name);
+  if (!has.ok()) return has.status();
+  return *has ? Assign(ReadStringAttr(loc, name), out) : Status::Ok();
+}
+
 // Places index-table rows by their index, which must cover 0..n-1 once.
 Status ByIndex(const std::string& what, std::vector<IndexedName> rows,
                std::vector<std::string>* out) {
@@ -59,14 +67,10 @@ Status ReadContents(hid_t file, RunData* run) {
   ADSE_RETURN_IF_ERROR(Assign(internal::ReadU64Attr(file, "seed"), &run->seed));
   ADSE_RETURN_IF_ERROR(
       Assign(internal::ReadF64Attr(file, "lane_width_m"), &run->lane_width_m));
-  {
-    Result<bool> has_case = internal::HasAttr(file, "task_case");
-    if (!has_case.ok()) return has_case.status();
-    if (*has_case) {
-      ADSE_RETURN_IF_ERROR(
-          Assign(ReadStringAttr(file, "task_case"), &run->task_case));
-    }
-  }
+  ADSE_RETURN_IF_ERROR(
+      ReadOptionalStringAttr(file, "task_case", &run->task_case));
+  ADSE_RETURN_IF_ERROR(ReadOptionalStringAttr(file, "termination_detail",
+                                              &run->termination_detail));
 
   {
     Result<Handle> group = OpenGroup(file, "/scenario");

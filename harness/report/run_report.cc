@@ -33,6 +33,7 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
   r.status = run.status;
   r.censored = runfile::EndedEarly(run.status);
   r.termination_reason = run.termination_reason;
+  r.termination_detail = run.termination_detail;
   r.content_key = run.content_key;
   // Metrics are recomputed from the trace, never copied, so a changed
   // metric definition reaches old runs too; hardware_cost comes from the
@@ -140,6 +141,9 @@ nlohmann::json ToJson(const RunReport& r) {
   j["status"] = r.status;
   j["censored"] = r.censored;
   j["termination_reason"] = r.termination_reason;
+  if (!r.termination_detail.empty()) {
+    j["termination_detail"] = r.termination_detail;
+  }
   j["content_key"] = r.content_key;
   for (const auto& [name, value] : r.metrics)
     j["metrics"][name] = Number(value);
@@ -304,6 +308,9 @@ std::string FormatSummary(const RunReport& r) {
         "is a lower bound\n";
   } else {
     out += fmt::format("ended       {} ({})\n", r.termination_reason, r.status);
+    if (!r.termination_detail.empty()) {
+      out += fmt::format("            {}\n", r.termination_detail);
+    }
     if (r.censored) {
       out += fmt::format(
           "censored    early stop at {} s: the metrics below are measured up "

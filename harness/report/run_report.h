@@ -80,6 +80,7 @@ struct RunReport {
   // (metric `censored` = 1), nav_time_s only a lower bound.
   bool censored = false;
   std::string termination_reason;
+  std::string termination_detail;  // the run file's; empty for most reasons
   std::string content_key;
   std::map<std::string, double> metrics;  // run metrics + deviation metrics
   // Constraints as written in the scenario; `constraints_error` says why

@@ -87,6 +87,10 @@ Result<std::string> RunKey(const spec::Spec& spec,
   // a net gives the lane another length: keys of net files changed, those
   // of generated maps (whose lanes' lengths are their shapes') did not.
   if (!w.map.net_path.empty()) h.Add("lane-positions-on-shapes");
+  // Generated maps have one program per signal, which is never switched.
+  if (!w.map.net_path.empty()) {
+    h.Add("signal_program_switch_s").Add(w.traffic.signal_program_switch_s);
+  }
   ADSE_RETURN_IF_ERROR(AddFile(&h, "world.map.polygons", w.map.polygons_path));
   h.Add("traffic").Add(w.traffic.parked_occupancy);
   for (const world::Flow& f : w.traffic.flows) {

@@ -191,6 +191,9 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     graph.AddSink<stack::ParkingPathMsg>(
         topics.parking_path, [&](const stack::ParkingPathMsg& m, double t_s) {
           no_path = !m.found;
+          if (no_path) run.termination_detail = m.failure;
+          // A hold (a road user in the way) is no plan.
+          if (m.hold) return;
           // A three-point turn's plan is no parking manoeuvre.
           if (!w.parking_task()) return;
           if (run.parking.first_planned_at_s < 0) {
@@ -214,7 +217,6 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
             run.parking.planned_path.push_back(
                 {p.x_m, p.y_m, p.yaw_rad, p.reverse ? 1 : 0});
           }
-          no_path = !m.found;
         });
   }
   // ... and the planner's word that the car is parked (its is_completed):

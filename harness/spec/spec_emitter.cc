@@ -210,6 +210,8 @@ const std::vector<Field<TrafficOptions>>& TrafficFields() {
          out << YAML::EndSeq;
        }},
       Number("parked_occupancy", &TrafficOptions::parked_occupancy),
+      Number("signal_program_switch_s",
+             &TrafficOptions::signal_program_switch_s),
       {"parked_slots",
        [](YAML::Emitter& out, const TrafficOptions& t, const Spec&) {
          out << YAML::Flow << YAML::BeginSeq;

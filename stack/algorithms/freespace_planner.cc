@@ -176,15 +176,8 @@ Result<FreespacePath> FreespacePlanner::Plan(
     // has come: a lane's edge on a map is no kerb, and a car that brushed
     // it in a tight turn must still be able to go on.
     std::vector<std::vector<Eigen::Vector2d>> area = drivable;
-    const double grown = p.collision_margin_m + 2 * p.grid_resolution_m;
-    geometry::OrientedBox body;
-    body.yaw_rad = start.yaw_rad;
-    body.length_m = footprint_.front_m + footprint_.rear_m + 2 * grown;
-    body.width_m = footprint_.width_m + 2 * grown;
-    body.center = s_xy + 0.5 * (footprint_.front_m - footprint_.rear_m) *
-                             Eigen::Vector2d(std::cos(start.yaw_rad),
-                                             std::sin(start.yaw_rad));
-    area.push_back(geometry::BoxCorners(body));
+    area.push_back(geometry::BoxCorners(FootprintBox(
+        start, footprint_, p.collision_margin_m + 2 * p.grid_resolution_m)));
     grid.KeepInside(area);
   }
   grid.ComputeDistances();
@@ -380,6 +373,22 @@ Result<FreespacePath> FreespacePlanner::Plan(
     if (a.reverse != b.reverse) ++path.gear_changes;
   }
   return path;
+}
+
+int FirstBlockedPose(const std::vector<GearedPose>& path, size_t from,
+                     const std::vector<geometry::OrientedBox>& boxes,
+                     const VehicleFootprint& footprint, double margin_m) {
+  if (boxes.empty()) return -1;
+  for (size_t i = from; i < path.size(); ++i) {
+    // The cusp pose carries the old gear; the next one starts a new move.
+    if (i > from && path[i].reverse != path[i - 1].reverse) break;
+    const geometry::OrientedBox body =
+        FootprintBox(path[i].pose, footprint, margin_m);
+    for (const geometry::OrientedBox& box : boxes) {
+      if (geometry::BoxesOverlap(body, box)) return static_cast<int>(i);
+    }
+  }
+  return -1;
 }
 
 }  // namespace adse::algorithms

@@ -85,6 +85,16 @@ struct FreespaceStats {
   double collision_margin_m = 0.0;
 };
 
+// Where the car, driving `path` on from pose `from`, first comes within
+// `margin_m` of one of `boxes` (road users the car sees) before the move
+// under way ends (at the next gear change, or the path's end): that pose's
+// index, or -1 when the move is clear. Autoware's freespace planner checks
+// its trajectory against the costmap's objects the same way and plans
+// again when it collides.
+int FirstBlockedPose(const std::vector<GearedPose>& path, size_t from,
+                     const std::vector<geometry::OrientedBox>& boxes,
+                     const VehicleFootprint& footprint, double margin_m);
+
 class FreespacePlanner {
  public:
   // `params` must pass ValidateFreespacePlannerParams.

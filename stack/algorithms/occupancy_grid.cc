@@ -4,6 +4,20 @@
 #include <cmath>
 
 namespace adse::algorithms {
+
+geometry::OrientedBox FootprintBox(const geometry::Pose2& pose,
+                                   const VehicleFootprint& footprint,
+                                   double grown_m) {
+  geometry::OrientedBox body;
+  body.yaw_rad = pose.yaw_rad;
+  body.length_m = footprint.front_m + footprint.rear_m + 2 * grown_m;
+  body.width_m = footprint.width_m + 2 * grown_m;
+  body.center =
+      Eigen::Vector2d(pose.x_m, pose.y_m) +
+      0.5 * (footprint.front_m - footprint.rear_m) *
+          Eigen::Vector2d(std::cos(pose.yaw_rad), std::sin(pose.yaw_rad));
+  return body;
+}
 namespace {
 
 constexpr double kFar = 1e20;

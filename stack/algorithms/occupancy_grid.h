@@ -31,6 +31,12 @@ inline VehicleFootprint FootprintOfBody(double length_m, double wheelbase_m,
   return f;
 }
 
+// The body of a car whose rear axle stands at `pose`, grown by `grown_m`
+// on every side.
+geometry::OrientedBox FootprintBox(const geometry::Pose2& pose,
+                                   const VehicleFootprint& footprint,
+                                   double grown_m = 0.0);
+
 class OccupancyGrid {
  public:
   // A grid over the rectangle [min_corner, max_corner] with square cells of

@@ -17,6 +17,14 @@ constexpr double kNoPoseDecelMps2 = 3.0;
 // path takes the car on from there).
 constexpr double kTurnToleranceM = 1.0;
 constexpr double kTurnYawToleranceRad = 0.35;
+// The freespace planner minds the road users this close to the car.
+constexpr double kManoeuvreObjectRangeM = 30.0;
+// A move counts as blocked when a road user comes within this share of
+// the margin a plan keeps: a tracked box that wobbles by a few centimetres
+// does not make the planner plan again and again.
+constexpr double kBlockedMarginShare = 0.5;
+// How far on along its path (in poses) the car is looked for each time.
+constexpr size_t kProgressWindowPoses = 8;
 
 // Trajectory points as the planning and control algorithms take them; the
 // speed can be capped on the way.
@@ -294,6 +302,10 @@ void Stack::BuildManoeuvres(Graph* g) {
   g->Subscribe<ParkingDoneMsg>(
       node, parking_done_, "parking_done", 1,
       [this](const ParkingDoneMsg&, CallbackContext&) { path_driven_ = true; });
+  g->Subscribe<ObjectsMsg>(node, topics_.objects, "objects", 1,
+                           [this](const ObjectsMsg& in, CallbackContext&) {
+                             freespace_objects_ = in;
+                           });
   const double course_out_m = config_.Get("parking.course_out_m");
   const int max_replans = static_cast<int>(config_.Get("parking.max_replans"));
   g->AddTimer(node, "plan", 1.0 / config_.Get("parking.rate_hz"),
@@ -316,6 +328,28 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
   const Eigen::Vector2d at(pose.x_m, pose.y_m);
   const bool standing = std::abs(freespace_pose_->v_mps) < 0.1;
   const double stamp_s = freespace_pose_->header.stamp_s;
+  // The road users about the car, as its own outlines: the map's
+  // structure is among the manoeuvre's obstacles already.
+  std::vector<geometry::OrientedBox> others;
+  const std::vector<std::vector<Eigen::Vector2d>>& map_obstacles =
+      turning ? turn->obstacles : inputs_.parking_obstacles;
+  std::vector<std::vector<Eigen::Vector2d>> obstacles = map_obstacles;
+  if (freespace_objects_) {
+    for (const TrackedObject& o : freespace_objects_->objects) {
+      if ((o.position - at).norm() > kManoeuvreObjectRangeM ||
+          structure_grid_.IsStructure(o.position, o.length_m, o.width_m,
+                                      o.yaw_rad)) {
+        continue;
+      }
+      geometry::OrientedBox box;
+      box.center = o.position;
+      box.yaw_rad = o.yaw_rad;
+      box.length_m = o.length_m;
+      box.width_m = o.width_m;
+      others.push_back(box);
+      obstacles.push_back(geometry::BoxCorners(box));
+    }
+  }
   auto complete = [&] {
     ParkingDoneMsg done;
     done.header.stamp_s = stamp_s;
@@ -330,11 +364,13 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
     path_driven_ = false;
     freespace_replans_ = 0;
     freespace_path_.clear();
+    freespace_holding_ = false;
     ctx.Publish(turn_done_, std::move(done));
   };
   ParkingPathMsg out;
   out.header.stamp_s = stamp_s;
   bool correcting = false;
+  bool round_road_user = false;  // planning round a road user in the way
   if (!parking_planned_) {
     // Handed over when standing within reach of where the route's leg
     // ends (the route's end, or the turn's start).
@@ -362,28 +398,76 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
     ++freespace_replans_;
     correcting = true;
   } else {
+    // A road user in the way of the move under way: a path round it from
+    // here, or, while there is none, the car holds where it is (not
+    // counted against parking.max_replans).
+    if (!freespace_holding_ && !freespace_path_.empty()) {
+      const size_t end = std::min(freespace_path_.size(),
+                                  freespace_progress_ + kProgressWindowPoses);
+      double nearest_m = INFINITY;
+      for (size_t i = freespace_progress_; i < end; ++i) {
+        const geometry::Pose2& p = freespace_path_[i].pose;
+        const double d_m = (Eigen::Vector2d(p.x_m, p.y_m) - at).norm();
+        if (d_m < nearest_m) {
+          nearest_m = d_m;
+          freespace_progress_ = i;
+        }
+      }
+    }
+    round_road_user = freespace_holding_ ||
+                      (!freespace_path_.empty() &&
+                       algo::FirstBlockedPose(
+                           freespace_path_, freespace_progress_, others,
+                           freespace_->footprint(),
+                           kBlockedMarginShare *
+                               freespace_->params().collision_margin_m) >= 0);
     // Standing off the course of its path (where the controller holds
     // it), the car gets a new path from there.
-    if (freespace_path_.empty() || course_out_m <= 0 || !standing) return;
-    const double off_m = algo::DistanceFromPath(freespace_path_, at);
-    if (off_m <= course_out_m) return;
-    if (freespace_replans_ == max_replans) {
-      out.found = false;
-      out.failure = fmt::format(
-          "off the course of its path ({:.2f} m > parking.course_out_m) "
-          "after {} re-plans (parking.max_replans)",
-          off_m, max_replans);
-      freespace_path_.clear();
-      ctx.Publish(topics_.parking_path, std::move(out));
-      return;
+    if (!round_road_user) {
+      if (freespace_path_.empty() || course_out_m <= 0 || !standing) return;
+      const double off_m = algo::DistanceFromPath(freespace_path_, at);
+      if (off_m <= course_out_m) return;
+      if (freespace_replans_ == max_replans) {
+        out.found = false;
+        out.failure = fmt::format(
+            "off the course of its path ({:.2f} m > parking.course_out_m) "
+            "after {} re-plans (parking.max_replans)",
+            off_m, max_replans);
+        freespace_path_.clear();
+        ctx.Publish(topics_.parking_path, std::move(out));
+        return;
+      }
+      ++freespace_replans_;
     }
-    ++freespace_replans_;
   }
-  const Result<algo::FreespacePath> path =
-      turning ? freespace_->Plan(pose, goal, turn->obstacles, turn->drivable)
-              : freespace_->Plan(pose, goal, inputs_.parking_obstacles);
-  ctx.ReportWork(
-      {static_cast<double>(freespace_->last_stats().work_units), 0.0, 1});
+  auto plan = [&](const std::vector<std::vector<Eigen::Vector2d>>& among) {
+    Result<algo::FreespacePath> found =
+        turning ? freespace_->Plan(pose, goal, among, turn->drivable)
+                : freespace_->Plan(pose, goal, among);
+    ctx.ReportWork(
+        {static_cast<double>(freespace_->last_stats().work_units), 0.0, 1});
+    return found;
+  };
+  const Result<algo::FreespacePath> path = plan(obstacles);
+  out.expansions = freespace_->last_stats().expansions;
+  freespace_progress_ = 0;
+  if (!path.ok() && !round_road_user && !others.empty()) {
+    // Only road users in the way (a way leads on without them): they
+    // hold the car rather than end its run.
+    round_road_user = plan(map_obstacles).ok();
+  }
+  if (!path.ok() && round_road_user) {
+    // No way round yet: the car holds (told once) and the planner tries
+    // again at its next tick.
+    freespace_path_.clear();
+    if (freespace_holding_) return;
+    freespace_holding_ = true;
+    out.found = true;
+    out.hold = true;
+    ctx.Publish(topics_.parking_path, std::move(out));
+    return;
+  }
+  freespace_holding_ = false;
   if (!path.ok() && correcting) {
     // No way to the goal from where it stands: parked (turned) there, off
     // the goal (the planner's failure would end the run as no_path).
@@ -391,7 +475,6 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
     return;
   }
   out.found = path.ok();
-  out.expansions = freespace_->last_stats().expansions;
   if (path.ok()) {
     freespace_path_ = path->poses;
     for (const algo::GearedPose& p : path->poses) {
@@ -406,8 +489,13 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
 
 void Stack::Park(CallbackContext& ctx, double dt_s, double speed_cap_mps,
                  ControlMsg* out) {
-  const algo::ParkingCommand c = parking_follower_->Update(
+  algo::ParkingCommand c = parking_follower_->Update(
       follower_pose_->pose, follower_pose_->v_mps, dt_s, speed_cap_mps);
+  if (parking_hold_) {
+    // A road user in the way: brake to a stand in the gear it drives.
+    c.accel_mps2 = -parking_follower_->params().max_brake_mps2;
+    c.finished = false;
+  }
   out->accel_mps2 = c.accel_mps2;
   out->steer_rad = c.steer_rad;
   out->reverse = c.reverse;
@@ -447,6 +535,8 @@ void Stack::BuildControl(Graph* g) {
         node, topics_.parking_path, "parking_path", 1,
         [this](const ParkingPathMsg& in, CallbackContext&) {
           if (!in.found) return;
+          parking_hold_ = in.hold;
+          if (in.hold) return;
           std::vector<algo::GearedPose> poses;
           for (const ParkingPathPoint& p : in.poses)
             poses.push_back({{p.x_m, p.y_m, p.yaw_rad}, p.reverse});
@@ -462,6 +552,7 @@ void Stack::BuildControl(Graph* g) {
         node, turn_done_, "turnaround_done", 1,
         [this](const ParkingDoneMsg& in, CallbackContext&) {
           parking_mode_ = false;
+          parking_hold_ = false;
           follower_leg_ = in.turnaround + 1;
         });
   }

@@ -184,7 +184,7 @@ bool Io(IO& io, TrajectoryMsg& m) {
 }
 template <typename IO>
 bool Io(IO& io, ParkingPathMsg& m) {
-  return All(io, m.header, m.found, m.poses, m.failure, m.expansions);
+  return All(io, m.header, m.found, m.hold, m.poses, m.failure, m.expansions);
 }
 template <typename IO>
 bool Io(IO& io, ParkingDoneMsg& m) {

@@ -140,6 +140,9 @@ struct ParkingPathPoint {
 struct ParkingPathMsg {
   Header header;
   bool found = false;
+  // The move under way runs into a road user and no path leads round it
+  // yet: stand where you are until the next path (found, no poses).
+  bool hold = false;
   std::vector<ParkingPathPoint> poses;  // start to goal, when found
   std::string failure;                  // why not, when not found
   int64_t expansions = 0;               // search effort

@@ -303,6 +303,7 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
   impl->scene = std::move(parked).value();
   ADSE_RETURN_IF_ERROR(impl->BuildIdealPath());
   ADSE_RETURN_IF_ERROR(impl->FindRouteSignals());
+  ADSE_RETURN_IF_ERROR(impl->FindSwitchedSignals());
   ADSE_RETURN_IF_ERROR(impl->SetUpTraffic());
   ADSE_RETURN_IF_ERROR(impl->AddEgo());
   impl->UpdateProgress();
@@ -319,6 +320,7 @@ Status World::Step(const ControlCommand& command) {
     w.InsertFlows();
     w.PushEgo();
     w.YieldToEgo();
+    w.SwitchSignalPrograms();
     libsumo::Simulation::step();
     w.time_s += dt;
     w.ReadOthers();

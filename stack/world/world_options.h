@@ -75,6 +75,12 @@ struct TrafficOptions {
   // Road users that stand where they are placed for the whole run (a
   // broken-down car, a delivery van): SUMO vehicles held at speed 0.
   std::vector<Location> stopped_vehicles;
+  // A signal whose running program keeps links red through its whole
+  // cycle that another of its programs turns green (SUMO's game nets hold
+  // each direction green for 1,000-10,000 s until a player switches the
+  // program) goes on to its next program after this long, as a player
+  // would switch it; 0 keeps the net's programs as they are.
+  double signal_program_switch_s = 30.0;
 };
 
 struct WorldOptions {

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
+#include <set>
 #include <utility>
 
 #include "stack/world/internal/world_impl.h"
@@ -48,6 +50,71 @@ Status World::Impl::FindRouteSignals() {
         fmt::format("finding the route's traffic lights: {}", e.what()));
   }
   return Status::Ok();
+}
+
+namespace {
+
+// The link indices a program ever shows green ('G' or 'g').
+std::set<size_t> GreenLinks(const libsumo::TraCILogic& logic) {
+  std::set<size_t> green;
+  for (const std::shared_ptr<libsumo::TraCIPhase>& phase : logic.phases) {
+    for (size_t k = 0; k < phase->state.size(); ++k) {
+      if (phase->state[k] == 'G' || phase->state[k] == 'g') green.insert(k);
+    }
+  }
+  return green;
+}
+
+}  // namespace
+
+Status World::Impl::FindSwitchedSignals() {
+  switched_signals.clear();
+  const double period_s = setup.world.traffic.signal_program_switch_s;
+  if (period_s <= 0) return Status::Ok();
+  try {
+    for (const std::string& id : libsumo::TrafficLight::getIDList()) {
+      const std::vector<libsumo::TraCILogic> logics =
+          libsumo::TrafficLight::getAllProgramLogics(id);
+      if (logics.size() < 2) continue;
+      const std::string running = libsumo::TrafficLight::getProgram(id);
+      SwitchedSignal s{id, {}, 0};
+      std::set<size_t> running_green, other_green;
+      for (const libsumo::TraCILogic& logic : logics) {
+        if (logic.programID == running) {
+          s.current = s.programs.size();
+          running_green = GreenLinks(logic);
+        } else {
+          const std::set<size_t> green = GreenLinks(logic);
+          other_green.insert(green.begin(), green.end());
+        }
+        s.programs.push_back(logic.programID);
+      }
+      // Only a program that starves links another one serves waits for a
+      // player; a net's alternative day and night plans are left alone.
+      const bool starves =
+          std::any_of(other_green.begin(), other_green.end(),
+                      [&](size_t k) { return running_green.count(k) == 0; });
+      if (starves) switched_signals.push_back(std::move(s));
+    }
+  } catch (const std::exception& e) {
+    return Status::Internal(
+        fmt::format("reading the signals' programs: {}", e.what()));
+  }
+  next_program_switch_s = period_s;
+  return Status::Ok();
+}
+
+void World::Impl::SwitchSignalPrograms() {
+  if (switched_signals.empty() || time_s + 1e-9 < next_program_switch_s) {
+    return;
+  }
+  next_program_switch_s += setup.world.traffic.signal_program_switch_s;
+  for (SwitchedSignal& s : switched_signals) {
+    s.current = (s.current + 1) % s.programs.size();
+    // A program starts at its first phase: the games' yellow and all-red
+    // of the links the previous program served.
+    libsumo::TrafficLight::setProgram(s.id, s.programs[s.current]);
+  }
 }
 
 const std::vector<RouteSignal>& World::route_signals() const {

@@ -40,6 +40,13 @@ constexpr double kDefaultDecelMps2 = 4.5;
 // The ego's body this close to a flow's first lane's start counts as
 // about to drive onto it.
 constexpr double kAboutToEnterM = 1.5;
+// A turn's manoeuvre as the ego's body this often along it, m, grown by
+// this on every side.
+constexpr double kTurnSweepStepM = 1.0;
+constexpr double kTurnSweepMarginM = 1.5;
+// Drivers wait for a turn from when the ego is this far from its start
+// (it brakes there to stand), m.
+constexpr double kTurnApproachM = 15.0;
 
 // Appends `piece` to `path`, skipping a repeat of its last point; returns
 // the length added.
@@ -162,14 +169,54 @@ void World::Impl::YieldToEgo() {
   const VehicleState& state = ego->state();
   const Vec2 ego_velocity =
       state.v_mps * Vec2(std::cos(state.yaw_rad), std::sin(state.yaw_rad));
+  if (turn_sweeps.size() != turnarounds.size()) {
+    for (const RouteTurnaround& turn : turnarounds) {
+      std::vector<geometry::OrientedBox> sweep;
+      double since_m = INFINITY;
+      for (size_t i = 0; i < turn.reference.size(); ++i) {
+        const geometry::Pose2& p = turn.reference[i].pose;
+        if (i > 0) {
+          const geometry::Pose2& q = turn.reference[i - 1].pose;
+          since_m += std::hypot(p.x_m - q.x_m, p.y_m - q.y_m);
+        }
+        if (since_m < kTurnSweepStepM && i + 1 < turn.reference.size()) {
+          continue;
+        }
+        geometry::OrientedBox b = BodyAt(p, setup.ego);
+        // The stack plans its own manoeuvre, which strays from this one.
+        b.length_m += 2 * kTurnSweepMarginM;
+        b.width_m += 2 * kTurnSweepMarginM;
+        sweep.push_back(b);
+        since_m = 0.0;
+      }
+      turn_sweeps.push_back(std::move(sweep));
+    }
+  }
+  // Turning round in several moves (from its approach to the turn's end),
+  // the ego needs the space of its manoeuvre: drivers wait short of it, as
+  // they would for a car they see turning, unless already in it.
+  const std::vector<geometry::OrientedBox>* sweep = nullptr;
+  double sweep_reach_m = 0.0;
+  for (size_t k = 0; k < turnarounds.size(); ++k) {
+    if (road_progress_m >= turnarounds[k].start_s_m - kTurnApproachM &&
+        road_progress_m < turnarounds[k].end_s_m) {
+      sweep = &turn_sweeps[k];
+      for (const geometry::OrientedBox& b : *sweep) {
+        sweep_reach_m = std::max(sweep_reach_m,
+                                 (b.center - body.center).norm() + b.length_m);
+      }
+      break;
+    }
+  }
   std::set<std::string> still_yielding;
   for (const OtherVehicle& v : others) {
     if (held_still.count(v.id)) continue;
     const double decel = types.at(v.id).decel_mps2;
     const double lookahead = YieldLookaheadM(v.speed_mps, decel);
-    // Too far for any part of the ego to lie within its lookahead.
+    // Too far for any part of the ego (or its turn) to lie within its
+    // lookahead.
     if ((v.box.center - body.center).norm() >
-        lookahead + v.box.length_m + body.length_m) {
+        lookahead + v.box.length_m + std::max(body.length_m, sweep_reach_m)) {
       continue;
     }
     const std::string lane = libsumo::Vehicle::getLaneID(v.id);
@@ -211,8 +258,19 @@ void World::Impl::YieldToEgo() {
       if (length_m >= lookahead) break;
       length_m += Append(Slice(LaneShape(l), 0, lookahead - length_m), &path);
     }
-    const double safe =
-        YieldSpeedMps(path, v.box.width_m, decel, body, ego_velocity);
+    double safe = YieldSpeedMps(path, v.box.width_m, decel, body, ego_velocity);
+    const bool in_sweep = sweep != nullptr &&
+                          std::any_of(sweep->begin(), sweep->end(),
+                                      [&](const geometry::OrientedBox& b) {
+                                        return geometry::BoxesOverlap(v.box, b);
+                                      });
+    if (sweep != nullptr && !in_sweep) {
+      for (const geometry::OrientedBox& b : *sweep) {
+        const double wait =
+            YieldSpeedMps(path, v.box.width_m, decel, b, Vec2::Zero());
+        if (wait >= 0) safe = safe < 0 ? wait : std::min(safe, wait);
+      }
+    }
     if (safe < 0) continue;
     // Slower than it would drive anyway: a cap, never a push.
     if (safe >= libsumo::Vehicle::getAllowedSpeed(v.id) *

@@ -174,9 +174,12 @@ if s["by_reason"]:
             ", static structure" if top["static_structure"] else "", top["obstacle_gap_m"])
 else:
     why = "-"
+ended = d["termination_reason"]
+if d.get("termination_detail"):
+    ended += " (%s)" % d["termination_detail"]
 print("| %s | %s | %s | %s | %s | %.1f | %s | %.1f | %d (%d) | %.0f | %.2f |" % (
     sys.argv[3], sys.argv[4], sys.argv[5], "yes" if m["completed"] else "no",
-    d["termination_reason"], m["nav_time_s"], why, s["standing_s"], m["collisions"],
+    ended, m["nav_time_s"], why, s["standing_s"], m["collisions"],
     m["ego_collisions"],
     int(rss.group(1)) / 1024 if rss else float("nan"), t["simulated"] / t["wall"]))
 PY

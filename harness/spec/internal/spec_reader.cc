@@ -27,8 +27,12 @@ const std::vector<std::string> kWorldKeys = {"map", "traffic", "weather",
                                              "step_s"};
 const std::vector<std::string> kMapKeys = {"generate", "params", "net",
                                            "polygons"};
-const std::vector<std::string> kTrafficKeys = {
-    "seed", "flows", "parked_occupancy", "parked_slots", "stopped_vehicles"};
+const std::vector<std::string> kTrafficKeys = {"seed",
+                                               "flows",
+                                               "parked_occupancy",
+                                               "parked_slots",
+                                               "stopped_vehicles",
+                                               "signal_program_switch_s"};
 const std::vector<std::string> kFlowKeys = {"from", "to", "vehicles_per_hour"};
 const std::vector<std::string> kTaskKeys = {"kind",
                                             "start",
@@ -346,6 +350,9 @@ void SpecReader::ReadTraffic(const Val& v) {
   if (const Val* e = f.Get("seed")) ReadSeed(*e, &traffic.seed);
   if (const Val* e = f.Get("parked_occupancy")) {
     ReadNumber(*e, &traffic.parked_occupancy, Bounds::Closed(0, 1));
+  }
+  if (const Val* e = f.Get("signal_program_switch_s")) {
+    ReadNumber(*e, &traffic.signal_program_switch_s, Bounds::NonNegative());
   }
   if (const Val* e = f.Get("parked_slots")) {
     std::vector<Val> items;

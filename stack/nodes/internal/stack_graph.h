@@ -91,6 +91,10 @@ class Stack final : public AdStack {
   std::unique_ptr<algo::FreespacePlanner> freespace_;
   std::optional<PoseMsg> freespace_pose_;
   std::vector<algo::GearedPose> freespace_path_;  // the last plan found
+  // The road users the car sees, for the freespace planner.
+  std::optional<ObjectsMsg> freespace_objects_;
+  size_t freespace_progress_ = 0;   // the car's pose index on freespace_path_
+  bool freespace_holding_ = false;  // told the controller to hold
   int freespace_replans_ = 0;
   bool parking_planned_ = false;    // the planner has answered (path or not)
   bool path_driven_ = false;        // the controller says: driven to its end
@@ -100,6 +104,7 @@ class Stack final : public AdStack {
   int parking_done_ = -1;  // topic: the controller drove its path's end
   std::unique_ptr<algo::ParkingFollower> parking_follower_;
   bool parking_mode_ = false;       // the follower drives the parking path
+  bool parking_hold_ = false;       // ... and the planner said: hold
   int follower_leg_ = 0;            // the route leg the controller follows
   bool path_end_reported_ = false;  // ... and has reported reaching its end
 };

@@ -108,6 +108,15 @@ struct World::Impl {
   // Where the road part changes lane (route s of the road part).
   std::vector<algorithms::LaneChangeSection> lane_changes;
   std::vector<RouteSignal> signals;  // the crossings a traffic light controls
+  // Signals switched from program to program as a player would
+  // (traffic.signal_program_switch_s), in the net's order of programs.
+  struct SwitchedSignal {
+    std::string id;
+    std::vector<std::string> programs;
+    size_t current = 0;
+  };
+  std::vector<SwitchedSignal> switched_signals;
+  double next_program_switch_s = 0.0;
   std::vector<RouteTurnaround> turnarounds;  // the tight U-turns' manoeuvres
   geometry::Path2 ideal;
   // The ego on the road part: arc length reached so far and its distance
@@ -135,6 +144,9 @@ struct World::Impl {
   std::vector<FlowState> flows;
   std::set<std::string> held_still;  // traffic.stopped_vehicles
   std::set<std::string> yielding;    // cars told to slow for the ego
+  // Each turn's reference manoeuvre as the ego's body every metre or so:
+  // where SUMO's drivers wait while the ego turns (YieldToEgo).
+  std::vector<std::vector<geometry::OrientedBox>> turn_sweeps;
   std::map<std::string, std::vector<Eigen::Vector2d>>
       lane_shapes;  // by lane id
   std::unique_ptr<Random> traffic_random;
@@ -176,6 +188,10 @@ struct World::Impl {
   double RoadS(double raw_s_m) const;
   // The crossings' traffic lights (world_signals.cc).
   Status FindRouteSignals();
+  // The signals a player would switch (world_signals.cc).
+  Status FindSwitchedSignals();
+  // Throws libsumo's exceptions (World::Step guards).
+  void SwitchSignalPrograms();
   Status BuildScene();
   // world_traffic.cc: the flows and standing cars; a flow's car enters
   // only when the ego is clear of where it would enter; SUMO's drivers

@@ -30,7 +30,9 @@ using nlohmann::json;
 
 RunData MakeRun() {
   RunData run;
-  run.termination_reason = "timeout";
+  run.termination_reason = "no_path";
+  // Optional: written, so checked as documented.
+  run.termination_detail = "no path: the car does not fit at the goal";
   run.scenario_name = "follow";
   run.scenario_text = "name: follow\n";
   run.scenario_hash = Sha256Hex(run.scenario_text);

@@ -120,6 +120,26 @@ TEST_F(RunFileTest, FailedRunRoundTripsAndIsMarkedFailed) {
   EXPECT_TRUE(CheckRunFile(path, nullptr).ok());
 }
 
+TEST_F(RunFileTest, ANoPathRunKeepsThePlannersWordsAndOthersHaveNone) {
+  RunData run = MakeFullRun(30);
+  run.termination_reason = "no_path";
+  run.termination_detail =
+      "no path: the search ended after 20000 expansions without reaching the "
+      "goal";
+  const std::string path = Path("no_path.h5");
+  ASSERT_TRUE(WriteRunFile(path, run).ok());
+  Result<RunData> back = ReadRunFile(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->termination_detail, run.termination_detail);
+  EXPECT_EQ(Diff(run, *back), "");
+  // A run without it (as files written before it existed) reads empty.
+  run.termination_detail.clear();
+  ASSERT_TRUE(WriteRunFile(path, run).ok());
+  back = ReadRunFile(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->termination_detail, "");
+}
+
 TEST_F(RunFileTest, RejectsUnknownStatusAndWritesNothing) {
   RunData run;
   run.status = "done";

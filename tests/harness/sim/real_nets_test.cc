@@ -150,5 +150,42 @@ TEST(RealNetsTest, DrtDeadEndTurnsRoundInSeveralMoves) {
   EXPECT_LT(farthest_m, 1.5);
 }
 
+// The same dead end with cars following the ego in (900 vehicles/h, which
+// SUMO turns round there too): they wait short of the turn while the car
+// turns, as drivers who see it would; before, they pulled up 2 m from the
+// turning car and its next move backed into them.
+TEST(RealNetsTest, CarsComingUpBehindWaitShortOfATurnInSeveralMoves) {
+  const spec::Spec spec = RealNetScenario(
+      "drt_turn_traffic", "/usr/share/sumo/tools/game/DRT/osm.net.xml",
+      "{edge: \"-314415495#1\", pos_m: 10, lane: 1}",
+      "{edge: \"314415495#1\", pos_m: 51, lane: 1}",
+      "[{from: \"-314415495#1\", to: \"314415495#1\", vehicles_per_hour: "
+      "900}]");
+  runfile::RunData run;
+  DrivesToTheGoal(spec, &run);  // no collision among them
+  // The turn: from the first move in reverse to the last.
+  double first_s = INFINITY, last_s = -INFINITY;
+  for (const runfile::EgoSample& e : run.ego) {
+    if (e.v_mps < -0.05) {
+      first_s = std::min(first_s, e.t_s);
+      last_s = std::max(last_s, e.t_s);
+    }
+  }
+  ASSERT_LT(first_s, last_s);
+  double nearest_m = INFINITY;
+  bool waited = false;  // a car stood still near the turn meanwhile
+  size_t i = 0;
+  for (const runfile::VehicleSample& v : run.vehicles) {
+    if (v.t_s < first_s || v.t_s > last_s) continue;
+    while (i + 1 < run.ego.size() && run.ego[i].t_s < v.t_s) ++i;
+    const double d_m =
+        std::hypot(v.x_m - run.ego[i].x_m, v.y_m - run.ego[i].y_m);
+    nearest_m = std::min(nearest_m, d_m);
+    waited |= d_m < 30.0 && v.speed_mps < 0.01;
+  }
+  EXPECT_TRUE(waited);
+  EXPECT_GT(nearest_m, 8.0);
+}
+
 }  // namespace
 }  // namespace adse::sim

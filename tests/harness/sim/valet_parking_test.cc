@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <filesystem>
+#include <string>
 
 #include "analysis/runfile/run_file.h"
 #include "harness/sim/simulator.h"
@@ -99,6 +99,9 @@ TEST(ValetParkingTest, UnreachableSlotEndsTheRunWithNoPathNotATimeout) {
   Result<runfile::RunData> run = SimulatePoint(spec, kGenerous);
   ASSERT_TRUE(run.ok()) << run.status().ToString();
   EXPECT_EQ(run->termination_reason, "no_path");
+  // The planner's own words say why.
+  EXPECT_NE(run->termination_detail.find("no path"), std::string::npos)
+      << run->termination_detail;
   EXPECT_EQ(run->metrics.at("completed"), 0.0);
   EXPECT_EQ(run->metrics.at("parked"), 0.0);
   EXPECT_EQ(run->parking.path_found, 0);
@@ -185,6 +188,9 @@ TEST(ValetParkingTest, PastItsReplansAnOffCourseCarEndsTheRunWithNoPath) {
   Result<runfile::RunData> run = SimulatePoint(spec, kGenerous);
   ASSERT_TRUE(run.ok()) << run.status().ToString();
   EXPECT_EQ(run->termination_reason, "no_path");
+  EXPECT_NE(run->termination_detail.find("off the course of its path"),
+            std::string::npos)
+      << run->termination_detail;
   EXPECT_EQ(run->parking.replans, 0);
   EXPECT_EQ(run->parking.path_found, 0);
   EXPECT_EQ(run->metrics.at("parked"), 0.0);

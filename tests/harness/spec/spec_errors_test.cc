@@ -353,6 +353,11 @@ TEST(SpecErrorsTest, OtherBoundedNumbers) {
   ExpectError(text, "world.traffic.parked_occupancy", 3, "in [0, 1]");
   ExpectError(text, "world.traffic.flows[0].vehicles_per_hour", 3, "> 0");
   text = kHead;
+  text.replace(text.find("  map:"), 0,
+               "  traffic: {signal_program_switch_s: -5}\n");
+  ExpectError(text, "world.traffic.signal_program_switch_s", 3,
+              "a number >= 0");
+  text = kHead;
   text.replace(text.find("{x: 100, y: 0}"), 14,
                "{x: 100, y: 0, tolerance_m: 0}");
   ExpectError(text, "task.goal.tolerance_m", 6, "a number > 0");

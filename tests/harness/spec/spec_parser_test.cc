@@ -108,6 +108,8 @@ TEST(SpecParserTest, ReferenceExampleFillsEverySection) {
   EXPECT_EQ(spec.world.traffic.flows[0].from_edge, "E0");
   EXPECT_NEAR(spec.world.traffic.flows[0].vehicles_per_hour, 120, kTol);
   EXPECT_NEAR(spec.world.traffic.parked_occupancy, 0.6, kTol);
+  // Not given: a game's signal is switched as its player would.
+  EXPECT_NEAR(spec.world.traffic.signal_program_switch_s, 30.0, kTol);
   EXPECT_EQ(spec.world.weather, world::Weather::kClear);
   EXPECT_NEAR(spec.world.step_s, 0.05, kTol);
 

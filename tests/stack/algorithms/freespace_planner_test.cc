@@ -296,6 +296,65 @@ TEST(FreespacePlanner, WhereTheCarStandsIsDrivableAtTheAreasEdge) {
   EXPECT_NEAR(path->poses.back().pose.x_m, 20.0, 1e-6);
 }
 
+TEST(FreespacePlanner,
+     ACarStandingInTheMoveUnderWayBlocksItAndOneBeyondDoesNot) {
+  // A turn on the 8 m street; a car stands where the first move goes.
+  FreespacePlanner planner({}, Footprint());
+  const Pose2 start{0, -2.0, 0};
+  const Result<FreespacePath> path =
+      planner.Plan(start, {0, 2.0, M_PI}, {}, Street(8.0));
+  ASSERT_TRUE(path.ok()) << path.status().ToString();
+  size_t cusp = 0;  // the first move's last pose
+  while (cusp + 1 < path->poses.size() &&
+         path->poses[cusp + 1].reverse == path->poses[0].reverse) {
+    ++cusp;
+  }
+  ASSERT_LT(cusp + 1, path->poses.size());
+  const double margin_m = planner.params().collision_margin_m;
+  // A car 0.2 m beyond the body at the end of the first move.
+  const OrientedBox at_cusp = BodyAt(path->poses[cusp].pose, Footprint());
+  const Pose2& c = path->poses[cusp].pose;
+  OrientedBox ahead;
+  ahead.center = at_cusp.center +
+                 (at_cusp.length_m / 2 + 0.2 + 2.25) *
+                     Eigen::Vector2d(std::cos(c.yaw_rad), std::sin(c.yaw_rad));
+  ahead.yaw_rad = c.yaw_rad;
+  ahead.length_m = 4.5;
+  const int blocked =
+      FirstBlockedPose(path->poses, 0, {ahead}, Footprint(), margin_m);
+  EXPECT_GE(blocked, 0);
+  EXPECT_LE(blocked, static_cast<int>(cusp));
+  // Without the margin the body never reaches it.
+  EXPECT_EQ(FirstBlockedPose(path->poses, 0, {ahead}, Footprint(), 0.0), -1);
+  // From the next move on it is not in the way of the move under way
+  // (the car backs away from it).
+  EXPECT_EQ(
+      FirstBlockedPose(path->poses, cusp + 1, {ahead}, Footprint(), margin_m),
+      -1);
+  EXPECT_EQ(FirstBlockedPose(path->poses, 0, {}, Footprint(), margin_m), -1);
+}
+
+TEST(FreespacePlanner, APathPlannedWithACarAsAnObstacleKeepsClearOfIt) {
+  // The same turn with a car parked where the first move went: the planner
+  // given its outline finds another way, which it does not block.
+  FreespacePlanner planner({}, Footprint());
+  const Pose2 start{0, -2.0, 0};
+  const Pose2 goal{0, 2.0, M_PI};
+  OrientedBox parked;
+  parked.center = {8.0, 2.0};
+  parked.length_m = 4.5;
+  const Result<FreespacePath> path =
+      planner.Plan(start, goal, {geometry::BoxCorners(parked)}, Street(8.0));
+  ASSERT_TRUE(path.ok()) << path.status().ToString();
+  ExpectEndsAt(*path, goal);
+  for (size_t from = 0; from < path->poses.size(); ++from) {
+    ASSERT_EQ(FirstBlockedPose(path->poses, from, {parked}, Footprint(),
+                               0.5 * planner.params().collision_margin_m),
+              -1)
+        << "from pose " << from;
+  }
+}
+
 TEST(FreespacePlanner, ParamsValidationNamesTheField) {
   FreespacePlannerParams p;
   p.yaw_bins = 3;

@@ -109,10 +109,12 @@ TEST(MessageCodecTest, EveryMessageTypeOfTheStackComesBackFieldForField) {
 
   ParkingPathMsg parking;
   parking.found = true;
+  parking.hold = true;
   parking.poses = {{1.0, 2.0, 0.5, false}, {3.0, 4.0, 1.5, true}};
   parking.failure = "";
   parking.expansions = int64_t{1} << 40;
   const ParkingPathMsg parking2 = RoundTrip(parking);
+  EXPECT_TRUE(parking2.hold);
   ASSERT_EQ(parking2.poses.size(), 2u);
   EXPECT_TRUE(parking2.poses[1].reverse);
   EXPECT_EQ(parking2.poses[1].yaw_rad, 1.5);

@@ -52,6 +52,7 @@ inline std::string Diff(const RunData& a, const RunData& b) {
   };
   str("status", a.status, b.status);
   str("termination_reason", a.termination_reason, b.termination_reason);
+  str("termination_detail", a.termination_detail, b.termination_detail);
   str("scenario_name", a.scenario_name, b.scenario_name);
   str("scenario_text", a.scenario_text, b.scenario_text);
   str("scenario_hash", a.scenario_hash, b.scenario_hash);

@@ -76,10 +76,7 @@ inline Pose2 SlotGoal(bool nose_in) {
 inline const Pose2 kStart{1.5, kAisle / 2, 0.0};
 
 inline OrientedBox BodyAt(const Pose2& pose, const VehicleFootprint& fp) {
-  const double ahead = 0.5 * (fp.front_m - fp.rear_m);
-  return Box(pose.x_m + ahead * std::cos(pose.yaw_rad),
-             pose.y_m + ahead * std::sin(pose.yaw_rad), fp.front_m + fp.rear_m,
-             fp.width_m, pose.yaw_rad);
+  return FootprintBox(pose, fp);
 }
 
 }  // namespace adse::algorithms::testing

@@ -17,6 +17,7 @@
 namespace adse::world::testing {
 
 inline constexpr char kDrtNet[] = "/usr/share/sumo/tools/game/DRT/osm.net.xml";
+inline constexpr char kBs3dNet[] = "/usr/share/sumo/tools/game/bs3d/bs.net.xml";
 inline constexpr char kGrid6Net[] =
     "/usr/share/sumo/tools/game/grid6/grid6.net.xml";
 inline constexpr char kAcostaNet[] =
@@ -47,14 +48,22 @@ inline WorldSetup BenchRoute(const std::string& net, const Location& start,
   return setup;
 }
 
+// The world of `setup` on a sumo-tools net; NotFound when sumo-tools is not
+// installed.
+inline Result<std::unique_ptr<World>> OpenOnSumoToolsNet(
+    const WorldSetup& setup) {
+  const std::string& net = setup.world.map.net_path;
+  if (!std::filesystem::exists(net)) {
+    return Status::NotFound("sumo-tools is not installed: no " + net);
+  }
+  return World::Open(setup);
+}
+
 // The world of BenchRoute; NotFound when sumo-tools is not installed.
 inline Result<std::unique_ptr<World>> OpenBenchRoute(const std::string& net,
                                                      const Location& start,
                                                      const Location& goal) {
-  if (!std::filesystem::exists(net)) {
-    return Status::NotFound("sumo-tools is not installed: no " + net);
-  }
-  return World::Open(BenchRoute(net, start, goal));
+  return OpenOnSumoToolsNet(BenchRoute(net, start, goal));
 }
 
 // The ground-truth driver over the whole route without the LiDAR; expects
