@@ -333,7 +333,6 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
   std::vector<geometry::OrientedBox> others;
   const std::vector<std::vector<Eigen::Vector2d>>& map_obstacles =
       turning ? turn->obstacles : inputs_.parking_obstacles;
-  std::vector<std::vector<Eigen::Vector2d>> obstacles = map_obstacles;
   if (freespace_objects_) {
     for (const TrackedObject& o : freespace_objects_->objects) {
       if ((o.position - at).norm() > kManoeuvreObjectRangeM ||
@@ -347,7 +346,6 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
       box.length_m = o.length_m;
       box.width_m = o.width_m;
       others.push_back(box);
-      obstacles.push_back(geometry::BoxCorners(box));
     }
   }
   auto complete = [&] {
@@ -448,6 +446,11 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
         {static_cast<double>(freespace_->last_stats().work_units), 0.0, 1});
     return found;
   };
+  // Copied only when a plan is made, not at every tick.
+  std::vector<std::vector<Eigen::Vector2d>> obstacles = map_obstacles;
+  for (const geometry::OrientedBox& box : others) {
+    obstacles.push_back(geometry::BoxCorners(box));
+  }
   const Result<algo::FreespacePath> path = plan(obstacles);
   out.expansions = freespace_->last_stats().expansions;
   freespace_progress_ = 0;
