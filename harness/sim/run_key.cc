@@ -29,8 +29,11 @@ namespace {
 // v11: the planner changes lane only when the target lane has a gap.
 // v12: a track born near a confirmed one starts at its velocity. v13: a
 // flow's car enters only when the ego is clear of where it would, and
-// SUMO's drivers brake for the ego in the lanes ahead of them.
-constexpr char kKeyVersion[] = "adse-run-key-v13";
+// SUMO's drivers brake for the ego in the lanes ahead of them. v14:
+// drivers wait short of a turn in several moves, and those whose link
+// yields keep the ego's way through a junction free; a driver touching the
+// ego is left to SUMO.
+constexpr char kKeyVersion[] = "adse-run-key-v14";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

@@ -47,6 +47,21 @@ constexpr double kTurnSweepMarginM = 1.5;
 // Drivers wait for a turn from when the ego is this far from its start
 // (it brakes there to stand), m.
 constexpr double kTurnApproachM = 15.0;
+// The ego's way through a junction as its body this often, m, grown by
+// this on every side.
+constexpr double kClaimStepM = 1.0;
+constexpr double kClaimMarginM = 0.5;
+// Drivers whose link yields see the ego coming when its front is within
+// this of the junction, m, or this long at its speed, s (SUMO's minor
+// links wait for a foe arriving within a few seconds).
+constexpr double kClaimMinM = 5.0;
+constexpr double kClaimHorizonS = 4.0;
+// A driver held for the ego's claim while the ego has stood this long, s,
+// is let go: the ego waits for it (a driver held mid-turn stood in the
+// ego's way, and each waited for the other).
+constexpr double kClaimWaiveS = 2.0;
+// The ego counts as standing below this speed, m/s.
+constexpr double kStandingMps = 0.05;
 
 // Appends `piece` to `path`, skipping a repeat of its last point; returns
 // the length added.
@@ -164,6 +179,59 @@ void World::Impl::InsertFlows() {
   }
 }
 
+const World::Impl::JunctionClaim* World::Impl::ActiveJunctionClaim() {
+  const double front_m = (setup.ego.wheelbase_m + setup.ego.length_m) / 2;
+  const double rear_m = (setup.ego.length_m - setup.ego.wheelbase_m) / 2;
+  if (junction_claims.size() != crossings.size()) {
+    junction_claims.clear();
+    for (const Crossing& c : crossings) {
+      JunctionClaim claim;
+      if (!c.tight_uturn) {
+        double through_m = 0.0;
+        if (!c.via_lane.empty()) {
+          for (const std::string& l : InternalChain(c.via_lane, nullptr)) {
+            through_m += libsumo::Lane::getLength(l);
+          }
+        }
+        claim.from_edge = libsumo::Lane::getEdgeID(c.from_lane);
+        claim.entry_s_m = RoadS(c.raw_s_m);
+        const double exit_s = RoadS(c.raw_s_m + through_m);
+        claim.last_s_m = exit_s + rear_m;
+        for (double s = claim.entry_s_m - front_m; s <= claim.last_s_m;
+             s += kClaimStepM) {
+          const Vec2 p = road.PointAt(s);
+          geometry::OrientedBox b =
+              BodyAt({p.x(), p.y(), road.HeadingAt(s)}, setup.ego);
+          b.length_m += 2 * kClaimMarginM;
+          b.width_m += 2 * kClaimMarginM;
+          claim.bodies.push_back({s, b});
+        }
+      }
+      junction_claims.push_back(std::move(claim));
+    }
+  }
+  const double front_s = road_progress_m + front_m;
+  for (size_t k = 0; k < crossings.size(); ++k) {
+    const JunctionClaim& claim = junction_claims[k];
+    if (claim.bodies.empty() || road_progress_m > claim.last_s_m) continue;
+    const double gap_m = claim.entry_s_m - front_s;
+    if (gap_m <= 0) return &claim;  // in it: committed
+    if (gap_m > kClaimMinM + std::abs(ego->state().v_mps) * kClaimHorizonS) {
+      return nullptr;
+    }
+    const Crossing& c = crossings[k];
+    for (const libsumo::TraCIConnection& link :
+         libsumo::Lane::getLinks(c.from_lane)) {
+      const bool ours = c.via_lane.empty()
+                            ? link.approachedLane == c.to_lane
+                            : link.approachedInternal == c.via_lane;
+      if (ours) return link.hasPrio ? &claim : nullptr;
+    }
+    return nullptr;
+  }
+  return nullptr;
+}
+
 void World::Impl::YieldToEgo() {
   const geometry::OrientedBox body = ego->Body();
   const VehicleState& state = ego->state();
@@ -195,32 +263,57 @@ void World::Impl::YieldToEgo() {
   // Turning round in several moves (from its approach to the turn's end),
   // the ego needs the space of its manoeuvre: drivers wait short of it, as
   // they would for a car they see turning, unless already in it.
-  const std::vector<geometry::OrientedBox>* sweep = nullptr;
-  double sweep_reach_m = 0.0;
+  std::vector<const geometry::OrientedBox*> turn;
   for (size_t k = 0; k < turnarounds.size(); ++k) {
     if (road_progress_m >= turnarounds[k].start_s_m - kTurnApproachM &&
         road_progress_m < turnarounds[k].end_s_m) {
-      sweep = &turn_sweeps[k];
-      for (const geometry::OrientedBox& b : *sweep) {
-        sweep_reach_m = std::max(sweep_reach_m,
-                                 (b.center - body.center).norm() + b.length_m);
-      }
+      for (const geometry::OrientedBox& b : turn_sweeps[k]) turn.push_back(&b);
       break;
+    }
+  }
+  // Crossing a junction with the right of way, the ego's way through it
+  // is kept free by drivers whose link yields, as SUMO's junction model
+  // would if it saw the ego (a car standing in the junction turned across
+  // the ego's way out of a turn).
+  std::vector<const geometry::OrientedBox*> claim;
+  ego_standing_s = std::abs(state.v_mps) < kStandingMps
+                       ? ego_standing_s + setup.world.step_s
+                       : 0.0;
+  const JunctionClaim* junction = ActiveJunctionClaim();
+  if (junction != nullptr && junction != waived_for) {
+    waived_for = junction;
+    claim_waived.clear();
+  }
+  if (junction != nullptr) {
+    for (const auto& [s, b] : junction->bodies) {
+      if (s >= road_progress_m - kClaimStepM) claim.push_back(&b);
+    }
+  }
+  double reach_m = body.length_m;
+  for (const auto* way : {&turn, &claim}) {
+    for (const geometry::OrientedBox* b : *way) {
+      reach_m =
+          std::max(reach_m, (b->center - body.center).norm() + b->length_m);
     }
   }
   std::set<std::string> still_yielding;
   for (const OtherVehicle& v : others) {
-    if (held_still.count(v.id)) continue;
+    // A driver touching the ego is left to SUMO: held for the ego, a car
+    // that had run into the ego in its turn waited for it for ever while
+    // the ego waited for it.
+    if (held_still.count(v.id) || in_contact.count(v.id)) continue;
     const double decel = types.at(v.id).decel_mps2;
     const double lookahead = YieldLookaheadM(v.speed_mps, decel);
-    // Too far for any part of the ego (or its turn) to lie within its
-    // lookahead.
+    // Too far for any part of the ego (or the way it needs) to lie within
+    // its lookahead.
     if ((v.box.center - body.center).norm() >
-        lookahead + v.box.length_m + std::max(body.length_m, sweep_reach_m)) {
+        lookahead + v.box.length_m + reach_m) {
       continue;
     }
     const std::string lane = libsumo::Vehicle::getLaneID(v.id);
     if (lane.empty()) continue;
+    // Whether the link it drives next must yield (lower-case state).
+    bool minor_link = false;
     // The lanes it drives next, from its front bumper: the rest of its
     // lane, then through the next junction onto the next lane of its best
     // continuation.
@@ -235,6 +328,8 @@ void World::Impl::YieldToEgo() {
       next = InternalChain(lane, &arrives_on);
       next.erase(next.begin());
       if (!arrives_on.empty()) next.push_back(arrives_on);
+      const auto links = libsumo::Lane::getLinks(lane);
+      minor_link = !links.empty() && !links.front().hasPrio;
     } else {
       for (const libsumo::TraCIBestLanesData& best :
            libsumo::Vehicle::getBestLanes(v.id)) {
@@ -245,6 +340,7 @@ void World::Impl::YieldToEgo() {
         for (const libsumo::TraCIConnection& link :
              libsumo::Lane::getLinks(lane)) {
           if (link.approachedLane != *(at + 1)) continue;
+          minor_link = !link.hasPrio;
           if (!link.approachedInternal.empty()) {
             next = InternalChain(link.approachedInternal, nullptr);
           }
@@ -259,16 +355,31 @@ void World::Impl::YieldToEgo() {
       length_m += Append(Slice(LaneShape(l), 0, lookahead - length_m), &path);
     }
     double safe = YieldSpeedMps(path, v.box.width_m, decel, body, ego_velocity);
-    const bool in_sweep = sweep != nullptr &&
-                          std::any_of(sweep->begin(), sweep->end(),
-                                      [&](const geometry::OrientedBox& b) {
-                                        return geometry::BoxesOverlap(v.box, b);
-                                      });
-    if (sweep != nullptr && !in_sweep) {
-      for (const geometry::OrientedBox& b : *sweep) {
-        const double wait =
-            YieldSpeedMps(path, v.box.width_m, decel, b, Vec2::Zero());
-        if (wait >= 0) safe = safe < 0 ? wait : std::min(safe, wait);
+    // Waits short of `way`, unless already in it (it drives on to clear
+    // it).
+    const auto wait_short_of =
+        [&](const std::vector<const geometry::OrientedBox*>& way) {
+          if (std::any_of(way.begin(), way.end(),
+                          [&](const geometry::OrientedBox* b) {
+                            return geometry::BoxesOverlap(v.box, *b);
+                          })) {
+            return;
+          }
+          for (const geometry::OrientedBox* b : way) {
+            const double wait =
+                YieldSpeedMps(path, v.box.width_m, decel, *b, Vec2::Zero());
+            if (wait >= 0) safe = safe < 0 ? wait : std::min(safe, wait);
+          }
+        };
+    wait_short_of(turn);
+    // On the ego's own road it leads or follows the ego.
+    if (junction != nullptr && minor_link && !claim_waived.count(v.id) &&
+        libsumo::Lane::getEdgeID(lane) != junction->from_edge) {
+      const double unclaimed = safe;
+      wait_short_of(claim);
+      if (safe != unclaimed && ego_standing_s >= kClaimWaiveS) {
+        claim_waived.insert(v.id);
+        safe = unclaimed;
       }
     }
     if (safe < 0) continue;

@@ -147,6 +147,24 @@ struct World::Impl {
   // Each turn's reference manoeuvre as the ego's body every metre or so:
   // where SUMO's drivers wait while the ego turns (YieldToEgo).
   std::vector<std::vector<geometry::OrientedBox>> turn_sweeps;
+  // The ego's way through each crossing's junction as its body every metre
+  // or so, from its front at the junction to its rear out of it: where
+  // drivers whose link yields to the ego's wait (YieldToEgo). Empty for the
+  // tight U-turns (turn_sweeps).
+  struct JunctionClaim {
+    double entry_s_m = 0.0;  // road s where the junction starts
+    double last_s_m = 0.0;   // rear-axle road s of the last body
+    // The edge the ego arrives on: its drivers lead or follow the ego.
+    std::string from_edge;
+    std::vector<std::pair<double, geometry::OrientedBox>> bodies;  // by s
+  };
+  std::vector<JunctionClaim> junction_claims;
+  // Drivers no longer held for the junction claim `waived_for`: the ego
+  // stood while they waited for it (it waits for them, as their standing
+  // in its way says).
+  const JunctionClaim* waived_for = nullptr;
+  std::set<std::string> claim_waived;
+  double ego_standing_s = 0.0;  // how long the ego has stood still
   std::map<std::string, std::vector<Eigen::Vector2d>>
       lane_shapes;  // by lane id
   std::unique_ptr<Random> traffic_random;
@@ -201,6 +219,10 @@ struct World::Impl {
   // Both throw libsumo's exceptions (World::Step guards).
   void InsertFlows();
   void YieldToEgo();
+  // The junction the ego claims now (YieldToEgo), or null: the next one on
+  // its route, when its front is in it, or near it with a link that has
+  // the right of way (as SUMO's drivers would see an approaching car).
+  const JunctionClaim* ActiveJunctionClaim();
   const std::vector<Eigen::Vector2d>& LaneShape(const std::string& lane_id);
   Status AddEgo();
   void PushEgo();
