@@ -56,10 +56,9 @@ constexpr double kClaimMarginM = 0.5;
 // links wait for a foe arriving within a few seconds).
 constexpr double kClaimMinM = 5.0;
 constexpr double kClaimHorizonS = 4.0;
-// A driver held for the ego's claim while the ego has stood this long, s,
-// is let go: the ego waits for it (a driver held mid-turn stood in the
-// ego's way, and each waited for the other).
-constexpr double kClaimWaiveS = 2.0;
+// The ego's claim lapses while it has stood this long, s: a driver it
+// stopped for is not held for it in turn.
+constexpr double kClaimLapseS = 2.0;
 // The ego counts as standing below this speed, m/s.
 constexpr double kStandingMps = 0.05;
 
@@ -279,11 +278,8 @@ void World::Impl::YieldToEgo() {
   ego_standing_s = std::abs(state.v_mps) < kStandingMps
                        ? ego_standing_s + setup.world.step_s
                        : 0.0;
-  const JunctionClaim* junction = ActiveJunctionClaim();
-  if (junction != nullptr && junction != waived_for) {
-    waived_for = junction;
-    claim_waived.clear();
-  }
+  const JunctionClaim* junction =
+      ego_standing_s < kClaimLapseS ? ActiveJunctionClaim() : nullptr;
   if (junction != nullptr) {
     for (const auto& [s, b] : junction->bodies) {
       if (s >= road_progress_m - kClaimStepM) claim.push_back(&b);
@@ -373,14 +369,9 @@ void World::Impl::YieldToEgo() {
         };
     wait_short_of(turn);
     // On the ego's own road it leads or follows the ego.
-    if (junction != nullptr && minor_link && !claim_waived.count(v.id) &&
+    if (junction != nullptr && minor_link &&
         libsumo::Lane::getEdgeID(lane) != junction->from_edge) {
-      const double unclaimed = safe;
       wait_short_of(claim);
-      if (safe != unclaimed && ego_standing_s >= kClaimWaiveS) {
-        claim_waived.insert(v.id);
-        safe = unclaimed;
-      }
     }
     if (safe < 0) continue;
     // Slower than it would drive anyway: a cap, never a push.

@@ -159,11 +159,6 @@ struct World::Impl {
     std::vector<std::pair<double, geometry::OrientedBox>> bodies;  // by s
   };
   std::vector<JunctionClaim> junction_claims;
-  // Drivers no longer held for the junction claim `waived_for`: the ego
-  // stood while they waited for it (it waits for them, as their standing
-  // in its way says).
-  const JunctionClaim* waived_for = nullptr;
-  std::set<std::string> claim_waived;
   double ego_standing_s = 0.0;  // how long the ego has stood still
   std::map<std::string, std::vector<Eigen::Vector2d>>
       lane_shapes;  // by lane id
