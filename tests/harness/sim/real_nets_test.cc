@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "analysis/metrics/standing.h"
 #include "harness/sim/simulator.h"
@@ -78,6 +79,19 @@ void DrivesToTheGoal(const spec::Spec& spec, runfile::RunData* out = nullptr) {
   EXPECT_TRUE(standing.has_reasons);
   EXPECT_LT(standing.standing_s - at_signals_s, 60.0) << why;
   if (out != nullptr) *out = std::move(run).value();
+}
+
+// How far each of run.vehicles (in time order) is from the ego sampled at
+// or just after its time.
+std::vector<double> DistancesToEgoM(const runfile::RunData& run) {
+  std::vector<double> out;
+  out.reserve(run.vehicles.size());
+  size_t i = 0;
+  for (const runfile::VehicleSample& v : run.vehicles) {
+    while (i + 1 < run.ego.size() && run.ego[i].t_s < v.t_s) ++i;
+    out.push_back(std::hypot(v.x_m - run.ego[i].x_m, v.y_m - run.ego[i].y_m));
+  }
+  return out;
 }
 
 // The DRT game's town (scenarios/osm_drt.yaml's route): before NDT scored
@@ -174,12 +188,11 @@ TEST(RealNetsTest, CarsComingUpBehindWaitShortOfATurnInSeveralMoves) {
   ASSERT_LT(first_s, last_s);
   double nearest_m = INFINITY;
   bool waited = false;  // a car stood still near the turn meanwhile
-  size_t i = 0;
-  for (const runfile::VehicleSample& v : run.vehicles) {
+  const std::vector<double> distances_m = DistancesToEgoM(run);
+  for (size_t k = 0; k < run.vehicles.size(); ++k) {
+    const runfile::VehicleSample& v = run.vehicles[k];
     if (v.t_s < first_s || v.t_s > last_s) continue;
-    while (i + 1 < run.ego.size() && run.ego[i].t_s < v.t_s) ++i;
-    const double d_m =
-        std::hypot(v.x_m - run.ego[i].x_m, v.y_m - run.ego[i].y_m);
+    const double d_m = distances_m[k];
     nearest_m = std::min(nearest_m, d_m);
     waited |= d_m < 30.0 && v.speed_mps < 0.01;
   }
@@ -210,12 +223,11 @@ TEST(RealNetsTest, ADriverWhoseLinkYieldsWaitsForTheCarInTheJunction) {
       &run);  // no collision
   // The driver was there: it came within a car's length or two of the car.
   double nearest_m = INFINITY;
-  size_t i = 0;
-  for (const runfile::VehicleSample& v : run.vehicles) {
-    if (v.id != "flow0.0") continue;
-    while (i + 1 < run.ego.size() && run.ego[i].t_s < v.t_s) ++i;
-    nearest_m = std::min(
-        nearest_m, std::hypot(v.x_m - run.ego[i].x_m, v.y_m - run.ego[i].y_m));
+  const std::vector<double> distances_m = DistancesToEgoM(run);
+  for (size_t k = 0; k < run.vehicles.size(); ++k) {
+    if (run.vehicles[k].id == "flow0.0") {
+      nearest_m = std::min(nearest_m, distances_m[k]);
+    }
   }
   EXPECT_LT(nearest_m, 10.0);
 }
