@@ -32,8 +32,9 @@ namespace {
 // SUMO's drivers brake for the ego in the lanes ahead of them. v14:
 // drivers wait short of a turn in several moves, and those whose link
 // yields keep the ego's way through a junction free; a driver touching the
-// ego is left to SUMO.
-constexpr char kKeyVersion[] = "adse-run-key-v14";
+// ego is left to SUMO. v15: alongside the car, the obstacle stop counts
+// only what its body would touch driving off (not the path's corridor).
+constexpr char kKeyVersion[] = "adse-run-key-v15";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

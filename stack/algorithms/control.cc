@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 namespace adse::algorithms {
 namespace {
@@ -127,6 +128,27 @@ PurePursuitOutput PurePursuit::Compute(
   out.curvature_1pm = d2 > 1e-6 ? 2.0 * y_v / d2 : 0.0;
   out.steer_rad = std::clamp(std::atan(params_.wheelbase_m * out.curvature_1pm),
                              -params_.max_steer_rad, params_.max_steer_rad);
+  return out;
+}
+
+std::vector<geometry::Pose2> PurePursuit::Rollout(
+    const geometry::Pose2& pose, const std::vector<PlannedPoint>& trajectory,
+    double length_m, double step_m) const {
+  std::vector<geometry::Pose2> out = {pose};
+  if (trajectory.empty() || step_m <= 0.0) return out;
+  geometry::Pose2 p = pose;
+  for (double driven_m = 0.0; driven_m + step_m <= length_m + 1e-9;
+       driven_m += step_m) {
+    const PurePursuitOutput pp = Compute(p, 0.0, trajectory);
+    if (pp.past_end) break;
+    // One step along the arc the steering sets (midpoint heading).
+    const double turn = step_m * std::tan(pp.steer_rad) / params_.wheelbase_m;
+    const double mid = p.yaw_rad + 0.5 * turn;
+    p.x_m += step_m * std::cos(mid);
+    p.y_m += step_m * std::sin(mid);
+    p.yaw_rad = std::remainder(p.yaw_rad + turn, 2 * std::numbers::pi);
+    out.push_back(p);
+  }
   return out;
 }
 

@@ -37,6 +37,13 @@ class PurePursuit {
   // `pose` is the rear axle in the trajectory's frame.
   PurePursuitOutput Compute(const geometry::Pose2& pose, double v_mps,
                             const std::vector<PlannedPoint>& trajectory) const;
+  // The rear axle's poses, every step_m over length_m, as the car drives
+  // off from `pose` at a crawl following `trajectory` (a kinematic bicycle
+  // steered by Compute): its own way back onto a trajectory it stands
+  // off. Starts with `pose`; ends early past the trajectory's end.
+  std::vector<geometry::Pose2> Rollout(
+      const geometry::Pose2& pose, const std::vector<PlannedPoint>& trajectory,
+      double length_m, double step_m) const;
   const PurePursuitParams& params() const { return params_; }
 
  private:

@@ -287,46 +287,82 @@ BoxOnPath PlaceBox(const SearchPath& search, const Eigen::Vector2d& center,
   return out;
 }
 
-// The rear axle's first arc length along `pts` (from its start) at which
-// the car's footprint from the rear axle to the front bumper,
-// corridor_half_width_m either side, would touch `ob`; none when it never
-// does. (Behind the rear axle the car cannot stop for anything.)
-std::optional<double> FootprintTouchS(const std::vector<PlannedPoint>& pts,
-                                      const PlannerObstacle& ob,
-                                      const ObstacleStopParams& params) {
+geometry::OrientedBox BoxOf(const PlannerObstacle& ob) {
   geometry::OrientedBox box;
   box.center = ob.position;
   box.yaw_rad = ob.yaw_rad;
   box.length_m = ob.length_m;
   box.width_m = ob.width_m;
-  geometry::OrientedBox footprint;
-  footprint.length_m = params.ego_front_m;
-  footprint.width_m = 2 * params.corridor_half_width_m;
-  const double centre_ahead_m = 0.5 * params.ego_front_m;
+  return box;
+}
+
+// Whether the car's footprint from its rear axle at `rear` to the front
+// bumper, half_width_m either side, overlaps `box`.
+bool FootprintTouches(const geometry::Pose2& rear, double half_width_m,
+                      const geometry::OrientedBox& box, double ego_front_m) {
+  const Eigen::Vector2d at(rear.x_m, rear.y_m);
   // Nothing within reach of the footprint's far corner is skipped.
-  const double reach_m =
-      std::hypot(params.ego_front_m, params.corridor_half_width_m) +
-      0.5 * std::hypot(box.length_m, box.width_m);
+  const double reach_m = std::hypot(ego_front_m, half_width_m) +
+                         0.5 * std::hypot(box.length_m, box.width_m);
+  if ((at - box.center).norm() > reach_m) return false;
+  geometry::OrientedBox footprint;
+  footprint.length_m = ego_front_m;
+  footprint.width_m = 2 * half_width_m;
+  footprint.yaw_rad = rear.yaw_rad;
+  footprint.center =
+      at + 0.5 * ego_front_m *
+               Eigen::Vector2d(std::cos(rear.yaw_rad), std::sin(rear.yaw_rad));
+  return geometry::BoxesOverlap(footprint, box);
+}
+
+// The rear axle's first arc length along `pts`, from from_s_m on, at which
+// the footprint (FootprintTouches) would touch `box`; none when it never
+// does. (Behind the rear axle the car cannot stop for anything.)
+std::optional<double> FootprintTouchS(const std::vector<PlannedPoint>& pts,
+                                      const geometry::OrientedBox& box,
+                                      double half_width_m, double from_s_m,
+                                      const ObstacleStopParams& params) {
   const double step = std::max(params.footprint_step_m, 0.01);
   for (size_t i = 0; i < pts.size(); ++i) {
     const PlannedPoint& b = pts[i];
     const PlannedPoint& a = i == 0 ? b : pts[i - 1];
+    if (b.s_m < from_s_m) continue;
     const double seg = b.s_m - a.s_m;
     const int n = seg > step ? static_cast<int>(std::ceil(seg / step)) : 1;
     for (int k = i == 0 ? n : 1; k <= n; ++k) {
       const double w = static_cast<double>(k) / n;
+      if (a.s_m + w * seg < from_s_m) continue;
       const geometry::Pose2 rear = geometry::InterpolatePose(
           {a.x_m, a.y_m, a.yaw_rad}, {b.x_m, b.y_m, b.yaw_rad}, w);
-      const Eigen::Vector2d heading(std::cos(rear.yaw_rad),
-                                    std::sin(rear.yaw_rad));
-      const Eigen::Vector2d at(rear.x_m, rear.y_m);
-      if ((at - box.center).norm() > reach_m) continue;
-      footprint.yaw_rad = rear.yaw_rad;
-      footprint.center = at + centre_ahead_m * heading;
-      if (geometry::BoxesOverlap(footprint, box)) return a.s_m + w * seg;
+      if (FootprintTouches(rear, half_width_m, box, params.ego_front_m)) {
+        return a.s_m + w * seg;
+      }
     }
   }
   return std::nullopt;
+}
+
+// Where the footprint, body wide plus the drive-off clearance, would touch
+// `box` as the car drives off along `drive_off` (s0 when it would) and
+// then along `pts` from as far as it drove.
+std::optional<double> DriveOffTouchS(
+    const std::vector<PlannedPoint>& pts,
+    const std::vector<geometry::Pose2>& drive_off,
+    const geometry::OrientedBox& box, const ObstacleStopParams& params) {
+  const double half_width_m =
+      params.ego_half_width_m + params.drive_off_clearance_m;
+  double driven_m = 0.0;
+  for (size_t i = 0; i < drive_off.size(); ++i) {
+    if (FootprintTouches(drive_off[i], half_width_m, box, params.ego_front_m)) {
+      return pts.front().s_m;
+    }
+    if (i > 0) {
+      driven_m += std::hypot(drive_off[i].x_m - drive_off[i - 1].x_m,
+                             drive_off[i].y_m - drive_off[i - 1].y_m);
+    }
+  }
+  return FootprintTouchS(pts, box, half_width_m, pts.front().s_m + driven_m,
+                         params);
 }
 
 // Time to cover distance_m from speed v0_mps, speeding up at accel_mps2 up
@@ -377,6 +413,7 @@ void FinishStop(std::vector<PlannedPoint>* points, double stop_s,
 
 ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
                                 const std::vector<PlannerObstacle>& obstacles,
+                                const DriveOff& drive_off,
                                 const ObstacleStopParams& params) {
   ObstacleStop out;
   if (points == nullptr || points->empty()) return out;
@@ -385,6 +422,7 @@ ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
   const SearchPath search = MakeSearchPath(pts, params);
   double stop_s = std::numeric_limits<double>::infinity();
   double near_edge_s = 0.0;
+  std::optional<std::vector<geometry::Pose2>> driving_off;
   for (const PlannerObstacle& ob : obstacles) {
     if (!ob.position.allFinite()) continue;
     out.work_units += 1 + static_cast<int64_t>(pts.size());
@@ -392,14 +430,36 @@ ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
                                    ob.yaw_rad, params.corridor_half_width_m);
     double stop = std::numeric_limits<double>::infinity();
     double near_edge = 0.0;
-    if (box.in_corridor && box.s_m + box.half_along_m >= s0) {
+    // A road user that moves may be cutting in: the corridor from the
+    // rear axle on. One that stands, only ahead of the front bumper:
+    // alongside the car only what its body would touch driving off counts
+    // (below). On a curved path a car waiting beside the car projects into
+    // the corridor, though the car turns away from it, and the two stood
+    // for each other.
+    const bool standing = ob.velocity.allFinite() &&
+                          ob.velocity.norm() < params.standing_object_mps;
+    const double corridor_from_s =
+        standing ? s0 + params.ego_front_m + box.half_along_m
+                 : s0 - box.half_along_m;
+    if (box.in_corridor && box.s_m >= corridor_from_s) {
       near_edge = box.s_m - box.half_along_m;
       stop = near_edge - params.stop_margin_m - params.ego_front_m;
     }
     // Where the swept footprint touches it first, if earlier: the outside
-    // of a tight turn.
-    if (const std::optional<double> touch = FootprintTouchS(pts, ob, params);
-        touch && *touch - params.stop_margin_m < stop) {
+    // of a tight turn. A standing one within the corridor where the car
+    // stands holds it only if the body would come nearer than the
+    // clearance as the car drives off (away from it, the car may).
+    const geometry::OrientedBox ob_box = BoxOf(ob);
+    std::optional<double> touch =
+        FootprintTouchS(pts, ob_box, params.corridor_half_width_m, s0, params);
+    if (touch && *touch <= s0 && standing) {
+      if (!driving_off) {
+        driving_off = drive_off ? drive_off() : std::vector<geometry::Pose2>();
+        out.work_units += static_cast<int64_t>(driving_off->size());
+      }
+      touch = DriveOffTouchS(pts, *driving_off, ob_box, params);
+    }
+    if (touch && *touch - params.stop_margin_m < stop) {
       stop = *touch - params.stop_margin_m;
       near_edge = *touch + params.ego_front_m;
     }

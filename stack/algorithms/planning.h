@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -133,8 +134,19 @@ struct ObstacleStopParams {
   // axle, this wide, is also swept along the path: in a tight turn its
   // front corner swings out past a corridor around the rear axle's path.
   double corridor_half_width_m = 1.5;
-  double stop_margin_m = 5.0;  // gap left between ego front and obstacle
-  double ego_front_m = 3.8;    // rear axle to front bumper
+  double stop_margin_m = 5.0;      // gap left between ego front and obstacle
+  double ego_front_m = 3.8;        // rear axle to front bumper
+  double ego_half_width_m = 0.95;  // half the body's width
+  // What stands within the corridor where the car is already (a car
+  // waiting beside it in a turn) holds it only when the body would come
+  // nearer to it than this as the car drives off. A road user moving
+  // alongside (cutting in) counts whenever it is in the corridor.
+  double drive_off_clearance_m = 0.3;
+  double standing_object_mps = 0.5;  // slower than this, a track stands
+  // How far the car's own way back onto the path (its controller's, from
+  // where it stands off the path) is checked for that, in place of the
+  // path.
+  double drive_off_m = 8.0;
   // The footprint is placed along the path at most this far apart.
   double footprint_step_m = 0.25;
   // Obstacles are looked for from the ego's front bumper back to the rear
@@ -161,10 +173,16 @@ struct ObstacleStop {
 void InsertStopAt(std::vector<PlannedPoint>* points, double stop_s);
 
 // Finds the nearest obstacle whose box enters the corridor along `points`
-// (a path from the ego onwards), inserts a point exactly at the stop line
-// stop_margin_m before it, and sets 0 from there on.
+// (a path from the ego onwards) ahead of the car, or which the car's
+// footprint would touch, inserts a point exactly at the stop line
+// stop_margin_m before it, and sets 0 from there on. `drive_off` gives
+// the rear axle's poses as the car drives off from where it stands onto
+// the path (PurePursuit::Rollout over drive_off_m), asked for only when
+// something is within the corridor there already; may be empty.
+using DriveOff = std::function<std::vector<geometry::Pose2>()>;
 ObstacleStop InsertObstacleStop(std::vector<PlannedPoint>* points,
                                 const std::vector<PlannerObstacle>& obstacles,
+                                const DriveOff& drive_off,
                                 const ObstacleStopParams& params);
 
 // --- Crossing traffic: yield before a road user about to cross ----------

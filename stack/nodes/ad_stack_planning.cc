@@ -110,6 +110,7 @@ void Stack::BuildPlanning(Graph* g) {
           out.route_leg = route_leg_;
           out.localization_lost = !path_pose_->valid;
           out.ego_v_mps = path_pose_->v_mps;
+          out.ego_pose = path_pose_->pose;
           out.points = ToMessage(path.points);
           ctx.ReportWork({static_cast<double>(path.work_units), 0.0, 1});
         }
@@ -169,6 +170,7 @@ void Stack::BuildPlanning(Graph* g) {
   stop_params.stop_margin_m = config_.Get("planning.stop_margin_m");
   stop_params.ego_front_m =
       inputs_.wheelbase_m / 2 + inputs_.vehicle_length_m / 2;
+  stop_params.ego_half_width_m = inputs_.vehicle_width_m / 2;
   algo::CrossingYieldParams yield_params;
   yield_params.horizon_s = config_.Get("planning.yield_horizon_s");
   yield_params.max_decel_mps2 = config_.Get("planning.max_decel_mps2");
@@ -189,9 +191,12 @@ void Stack::BuildPlanning(Graph* g) {
   g->Subscribe<ObjectsMsg>(
       stop_node, topics_.objects, "objects", 1,
       [this](const ObjectsMsg& in, CallbackContext&) { stop_objects_ = in; });
+  // The way the controller would drive off from where the car stands.
+  const algo::PurePursuit pursuit(FollowerParams().pure_pursuit);
   g->Subscribe<TrajectoryMsg>(
       stop_node, path_limited_, "trajectory", 1,
-      [this, stop_params](const TrajectoryMsg& in, CallbackContext& ctx) {
+      [this, stop_params, pursuit](const TrajectoryMsg& in,
+                                   CallbackContext& ctx) {
         std::vector<algo::PlannerObstacle> obstacles;
         if (stop_objects_) {
           for (const TrackedObject& o : stop_objects_->objects) {
@@ -199,8 +204,14 @@ void Stack::BuildPlanning(Graph* g) {
           }
         }
         std::vector<algo::PlannedPoint> points = ToPlanned(in.points);
-        const algo::ObstacleStop in_path =
-            algo::InsertObstacleStop(&points, obstacles, stop_params);
+        const algo::ObstacleStop in_path = algo::InsertObstacleStop(
+            &points, obstacles,
+            [&] {
+              return pursuit.Rollout(in.ego_pose, points,
+                                     stop_params.drive_off_m,
+                                     stop_params.footprint_step_m);
+            },
+            stop_params);
         const algo::ObstacleStop crossing = crossing_yield_->Plan(
             &points, obstacles, in.ego_v_mps, ctx.now_s(), stop_params);
         const algo::ObstacleStop lane_change =
@@ -514,10 +525,14 @@ void Stack::Park(CallbackContext& ctx, double dt_s, double speed_cap_mps,
   ctx.Publish(topics_.control, std::move(*out));
 }
 
-void Stack::BuildControl(Graph* g) {
+algo::FollowerParams Stack::FollowerParams() const {
   algo::FollowerParams params;
   params.pure_pursuit.wheelbase_m = inputs_.wheelbase_m;
-  follower_ = std::make_unique<algo::TrajectoryFollower>(params);
+  return params;
+}
+
+void Stack::BuildControl(Graph* g) {
+  follower_ = std::make_unique<algo::TrajectoryFollower>(FollowerParams());
   const int node = g->AddNode("trajectory_follower");
   g->Subscribe<PoseMsg>(
       node, topics_.pose, "pose", 1,

@@ -179,7 +179,7 @@ bool Io(IO& io, PathMsg& m) {
 template <typename IO>
 bool Io(IO& io, TrajectoryMsg& m) {
   return All(io, m.header, m.points, m.ends_at_goal, m.localization_lost,
-             m.ego_v_mps, m.signal_stop, m.signal_stop_s_m, m.stop,
+             m.ego_v_mps, m.ego_pose, m.signal_stop, m.signal_stop_s_m, m.stop,
              m.route_leg);
 }
 template <typename IO>

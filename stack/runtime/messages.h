@@ -119,6 +119,7 @@ struct TrajectoryMsg {
   bool ends_at_goal = false;       // the path's last point is the goal
   bool localization_lost = false;  // planned from a pose marked invalid
   double ego_v_mps = 0.0;          // speed of the pose it was planned from
+  geometry::Pose2 ego_pose;        // that pose (rear axle, map frame)
   // A traffic signal set the speed to 0 from signal_stop_s_m on (rear
   // axle, route s; set by behavior_velocity_planner).
   bool signal_stop = false;

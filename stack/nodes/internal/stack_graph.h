@@ -47,6 +47,9 @@ class Stack final : public AdStack {
   void EndRouteLeg();
   void PlanManoeuvre(CallbackContext& ctx, double course_out_m,
                      int max_replans);
+  // The trajectory follower's parameters (the obstacle stop predicts how
+  // it drives off).
+  algo::FollowerParams FollowerParams() const;
   void BuildControl(Graph* g);
   // The controller's parking mode: one command along the manoeuvre, gear
   // and all, published.

@@ -84,6 +84,29 @@ TEST(PurePursuit, UTurnTrajectoryKeepsItsFirstLeg) {
   EXPECT_LT(out.steer_rad, 0.0);  // back down to the first leg
 }
 
+// Standing 1 m right of a straight trajectory, the car's way off turns it
+// left onto it: the lateral error shrinks, after 8 m (two lookaheads) it
+// is back within 0.2 m, and the poses are one step apart.
+TEST(PurePursuit, RolloutDrivesOffOntoTheTrajectory) {
+  const PurePursuit pp;
+  const std::vector<geometry::Pose2> way =
+      pp.Rollout(geometry::Pose2{0, -1.0, 0}, Line(0.0, 5.0, 30), 8.0, 0.25);
+  ASSERT_EQ(way.size(), 33u);
+  EXPECT_EQ(way.front().y_m, -1.0);
+  for (size_t i = 1; i < way.size(); ++i) {
+    EXPECT_NEAR(
+        std::hypot(way[i].x_m - way[i - 1].x_m, way[i].y_m - way[i - 1].y_m),
+        0.25, 1e-3);
+    EXPECT_GE(way[i].y_m, way[i - 1].y_m - 1e-9) << i;  // never away
+  }
+  EXPECT_GT(way.back().y_m, -0.2);
+  EXPECT_LT(way.back().y_m, 0.2);
+  // Past the trajectory's end it stops.
+  EXPECT_LT(pp.Rollout(geometry::Pose2{25, 0, 0}, Line(0.0, 5.0, 30), 8.0, 0.25)
+                .size(),
+            33u);
+}
+
 TEST(Pid, ReachesTargetOnAFirstOrderPlant) {
   PidParams params;
   Pid pid(params);

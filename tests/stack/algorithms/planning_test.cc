@@ -184,7 +184,7 @@ TEST(ObstacleStopPlanner, SeesWhatTheFrontCornerWouldSweepInATightTurn) {
   post.length_m = post.width_m = 0.5;
   std::vector<PlannedPoint> points =
       planner.Plan(geometry::Pose2{0.0, -12.0, kPi / 2}).points;
-  const ObstacleStop stop = InsertObstacleStop(&points, {post}, params);
+  const ObstacleStop stop = InsertObstacleStop(&points, {post}, {}, params);
   ASSERT_TRUE(stop.stop);
   EXPECT_EQ(stop.obstacle_id, 9);
   // The corner reaches it with the rear axle about 40 deg round the arc,
@@ -195,7 +195,68 @@ TEST(ObstacleStopPlanner, SeesWhatTheFrontCornerWouldSweepInATightTurn) {
   // 1.5 m further out the corner misses it.
   post.position = {-2.9 + 1.1, 7.1 + 1.1};
   points = planner.Plan(geometry::Pose2{0.0, -12.0, kPi / 2}).points;
-  EXPECT_FALSE(InsertObstacleStop(&points, {post}, params).stop);
+  EXPECT_FALSE(InsertObstacleStop(&points, {post}, {}, params).stop);
+}
+
+// A junction of A10KW's (x - 1500, y - 1950): the route comes west, turns
+// south round a sharp corner at (11.8, 7.5) and leaves east. The car, half
+// way round and 0.5 m inside the corner, stood for a SUMO car that had
+// stopped beside it 0.8 m off its right side, while the driver waited for
+// the car's body in its path: the corridor along the path, which swings
+// out to the corner, took the car beside it for one in its way. Driving
+// off, the car turns away from it.
+TEST(ObstacleStopPlanner, ACarWaitingBesideTheCarInItsTurnDoesNotHoldIt) {
+  PathPlanner planner;
+  planner.SetRoute(
+      Polyline({{23.76, 16.30}, {22.78, 16.30}, {21.87, 15.89}, {20.96, 15.48},
+                {20.05, 15.07}, {19.14, 14.66}, {18.23, 14.25}, {17.32, 13.84},
+                {16.41, 13.42}, {15.50, 13.01}, {14.74, 12.39}, {14.08, 11.65},
+                {13.47, 10.86}, {12.86, 10.07}, {12.25, 9.27},  {11.91, 8.35},
+                {11.78, 7.87},  {11.81, 7.45},  {12.22, 7.16},  {12.63, 6.88},
+                {13.62, 6.94},  {14.61, 7.02},  {15.60, 7.17},  {16.58, 7.38},
+                {17.56, 7.58},  {18.53, 7.78},  {19.51, 7.98},  {20.49, 8.13},
+                {21.49, 8.06},  {22.49, 8.00},  {23.48, 7.94},  {60.0, 7.0}}));
+  const geometry::Pose2 ego{12.54, 8.76, -1.70};
+  PlannerObstacle waiting = Car(3, 8.28, 9.13);
+  waiting.length_m = 4.9;
+  waiting.width_m = 1.8;
+  waiting.yaw_rad = -0.716;
+  const testing::ChainedPlan plan =
+      testing::PlanChain(&planner, ego, {waiting});
+  EXPECT_FALSE(plan.obstacle.stop) << "gap " << plan.obstacle.gap_m;
+  // Without the car's own way off, only the path's: it passes 0.1 m from
+  // the waiting car's corner.
+  std::vector<PlannedPoint> points = planner.Plan(ego).points;
+  EXPECT_TRUE(InsertObstacleStop(&points, {waiting}, {}, {}).stop);
+  // A car 1 m nearer, within the clearance of the car's way off, holds it
+  // where it stands.
+  waiting.position.x() += 1.0;
+  const testing::ChainedPlan held =
+      testing::PlanChain(&planner, ego, {waiting});
+  ASSERT_TRUE(held.obstacle.stop);
+  EXPECT_EQ(held.obstacle.obstacle_id, 3);
+  EXPECT_LE(held.obstacle.stop_s_m, held.points.front().s_m);
+}
+
+// Beside the car on a straight road, 1.4 m off its path (within the 1.5 m
+// corridor, clear of the body and the drive-off clearance): a car passing
+// there and edging in stops it, as it did before the drive-off check (on
+// joined, a flow's car overtaking at 14.7 m/s cut in, and the car, which
+// no longer counted it, ran into its rear); the same car standing there
+// does not.
+TEST(ObstacleStopPlanner,
+     ARoadUserMovingAlongsideStopsTheCarOneStandingThereDoesNot) {
+  PathPlanner planner;
+  planner.SetRoute(Straight(200, 5));
+  PlannerObstacle beside = Car(5, 22.0, 2.3);
+  beside.velocity = {14.0, -0.5};
+  const testing::ChainedPlan cutting_in =
+      testing::PlanChain(&planner, geometry::Pose2{20, 0, 0}, {beside});
+  ASSERT_TRUE(cutting_in.obstacle.stop);
+  EXPECT_EQ(cutting_in.obstacle.obstacle_id, 5);
+  beside.velocity = Eigen::Vector2d::Zero();
+  EXPECT_FALSE(testing::PlanChain(&planner, geometry::Pose2{20, 0, 0}, {beside})
+                   .obstacle.stop);
 }
 
 TEST(ObstacleStopPlanner, SeesAnObstacleJustPastThePathsEnd) {
@@ -469,7 +530,7 @@ TEST(PathPlanner, EmptyWithoutRoute) {
   EXPECT_TRUE(planner.Plan(geometry::Pose2{}).points.empty());
   std::vector<PlannedPoint> none;
   EXPECT_EQ(LimitVelocity(&none, true, {}), 0);
-  EXPECT_FALSE(InsertObstacleStop(&none, {Car(1, 0, 0)}, {}).stop);
+  EXPECT_FALSE(InsertObstacleStop(&none, {Car(1, 0, 0)}, {}, {}).stop);
 }
 
 TEST(StopReason, OneNamePerValueAndBack) {

@@ -88,8 +88,11 @@ TEST(MessageCodecTest, EveryMessageTypeOfTheStackComesBackFieldForField) {
   trajectory.stop.track_id = 7;
   trajectory.stop.static_structure = true;
   trajectory.route_leg = 2;
+  trajectory.ego_pose = {1.5, -2.0, 0.25};
   const TrajectoryMsg trajectory2 = RoundTrip(trajectory);
   EXPECT_EQ(trajectory2.route_leg, 2);
+  EXPECT_EQ(trajectory2.ego_pose.y_m, -2.0);
+  EXPECT_EQ(trajectory2.ego_pose.yaw_rad, 0.25);
   ASSERT_EQ(trajectory2.points.size(), 3u);
   EXPECT_EQ(trajectory2.points[2].curvature_1pm, -0.125);
   EXPECT_TRUE(trajectory2.signal_stop);

@@ -6,6 +6,7 @@
 
 #include <vector>
 
+#include "stack/algorithms/control.h"
 #include "stack/algorithms/planning.h"
 
 namespace adse::algorithms::testing {
@@ -24,7 +25,15 @@ inline ChainedPlan PlanChain(PathPlanner* planner, const geometry::Pose2& pose,
   out.path = planner->Plan(pose);
   out.points = out.path.points;
   LimitVelocity(&out.points, out.path.ends_at_goal, velocity);
-  out.obstacle = InsertObstacleStop(&out.points, obstacles, stop);
+  // The follower's way off from `pose`, as the stop planner's node gives it.
+  const PurePursuit pursuit;
+  out.obstacle = InsertObstacleStop(
+      &out.points, obstacles,
+      [&] {
+        return pursuit.Rollout(pose, out.points, stop.drive_off_m,
+                               stop.footprint_step_m);
+      },
+      stop);
   return out;
 }
 
