@@ -34,7 +34,9 @@ namespace {
 // yields keep the ego's way through a junction free; a driver touching the
 // ego is left to SUMO. v15: alongside the car, the obstacle stop counts
 // only what its body would touch driving off (not the path's corridor).
-constexpr char kKeyVersion[] = "adse-run-key-v15";
+// v16: a driver past its left turn's waiting point in a junction still
+// yields to the ego's way through it.
+constexpr char kKeyVersion[] = "adse-run-key-v16";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

@@ -231,6 +231,41 @@ const World::Impl::JunctionClaim* World::Impl::ActiveJunctionClaim() {
   return nullptr;
 }
 
+bool World::Impl::CameInYielding(const std::string& lane) {
+  if (!internal_ways_built) {
+    for (const std::string& from : libsumo::Lane::getIDList()) {
+      if (from.empty() || from[0] == ':') continue;
+      for (const libsumo::TraCIConnection& link :
+           libsumo::Lane::getLinks(from)) {
+        if (link.approachedInternal.empty()) continue;
+        const std::vector<std::string> chain =
+            InternalChain(link.approachedInternal, nullptr);
+        for (size_t i = 0; i < chain.size(); ++i) {
+          internal_ways.emplace(chain[i], InternalWay{from, chain[0], i});
+        }
+      }
+    }
+    internal_ways_built = true;
+  }
+  const auto way = internal_ways.find(lane);
+  if (way == internal_ways.end()) return false;
+  // The link from its lane into the junction (a signal's state changes
+  // it), then the internal junctions it has passed.
+  for (const libsumo::TraCIConnection& link :
+       libsumo::Lane::getLinks(way->second.approach_lane)) {
+    if (link.approachedInternal != way->second.first_internal) continue;
+    if (!link.hasPrio) return true;
+    break;
+  }
+  const std::vector<std::string> chain =
+      InternalChain(way->second.first_internal, nullptr);
+  for (size_t i = 0; i < way->second.index && i < chain.size(); ++i) {
+    const auto links = libsumo::Lane::getLinks(chain[i]);
+    if (!links.empty() && !links.front().hasPrio) return true;
+  }
+  return false;
+}
+
 void World::Impl::YieldToEgo() {
   const geometry::OrientedBox body = ego->Body();
   const VehicleState& state = ego->state();
@@ -324,8 +359,12 @@ void World::Impl::YieldToEgo() {
       next = InternalChain(lane, &arrives_on);
       next.erase(next.begin());
       if (!arrives_on.empty()) next.push_back(arrives_on);
+      // Its turn yields: at its waiting point in the junction or past it
+      // (on square's B1 a driver crept past it and, its next link having
+      // the right of way, turned into the car turning into the same lane).
       const auto links = libsumo::Lane::getLinks(lane);
-      minor_link = !links.empty() && !links.front().hasPrio;
+      minor_link =
+          (!links.empty() && !links.front().hasPrio) || CameInYielding(lane);
     } else {
       for (const libsumo::TraCIBestLanesData& best :
            libsumo::Vehicle::getBestLanes(v.id)) {

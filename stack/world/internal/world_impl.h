@@ -159,6 +159,16 @@ struct World::Impl {
     std::vector<std::pair<double, geometry::OrientedBox>> bodies;  // by s
   };
   std::vector<JunctionClaim> junction_claims;
+  // Each internal lane's way into its junction: the lane it comes from,
+  // the first internal lane of the connection and its place along it.
+  // Built on first use (CameInYielding).
+  struct InternalWay {
+    std::string approach_lane;
+    std::string first_internal;
+    size_t index = 0;
+  };
+  std::map<std::string, InternalWay> internal_ways;
+  bool internal_ways_built = false;
   double ego_standing_s = 0.0;  // how long the ego has stood still
   std::map<std::string, std::vector<Eigen::Vector2d>>
       lane_shapes;  // by lane id
@@ -218,6 +228,11 @@ struct World::Impl {
   // its route, when its front is in it, or near it with a link that has
   // the right of way (as SUMO's drivers would see an approaching car).
   const JunctionClaim* ActiveJunctionClaim();
+  // Whether a driver on internal lane `lane` came into its junction over a
+  // link that yields. The part of a left turn past its waiting point in
+  // the junction has a link of its own with the right of way, though the
+  // turn yields. Throws libsumo's exceptions.
+  bool CameInYielding(const std::string& lane);
   const std::vector<Eigen::Vector2d>& LaneShape(const std::string& lane_id);
   Status AddEgo();
   void PushEgo();

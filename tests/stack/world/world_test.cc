@@ -17,17 +17,21 @@
 #include "stack/world/ideal_driver.h"
 #include "stack/world/lidar.h"
 #include "stack/world/map_cloud.h"
+#include "stack/world/predictive_steering.h"
 #include "tests/stack/world/testing/real_nets.h"
 
 namespace adse::world {
 namespace {
 
+using testing::BenchRoute;
 using testing::CacheDir;
 using testing::DriveToTheGoal;
 using testing::kAcostaNet;
 using testing::kDrtNet;
 using testing::kPasubioNet;
+using testing::kSquareNet;
 using testing::OpenBenchRoute;
+using testing::OpenOnSumoToolsNet;
 
 // A small parking lot: one aisle between two rows, ring road around it.
 // Ring south lane (eastbound) at y = -1.75; north lane (westbound) at
@@ -259,6 +263,52 @@ TEST(WorldTest, AFlowsCarEntersOnlyOnceTheEgoIsClearOfWhereItWouldEnter) {
     entered += v.id.rfind("flow0.", 0) == 0;
   }
   EXPECT_GE(entered, 3);
+}
+
+// square's signalised junction B1: the car turns right from A1B1 into
+// B1B0 on green; a flow's drivers from right1B1 turn left into the same
+// lane, their link yielding ('g'). Such a driver waits at its turn's
+// waiting point in the junction; the next part of its turn has a link
+// with the right of way of its own ('M'). A driver that crept past the
+// waiting point was taken to have the right of way and turned in front
+// of the car (the bench's square-0 collision); it now waits for the car.
+TEST(WorldTest, ADriverPastItsLeftTurnsWaitingPointStillYieldsToTheCar) {
+  WorldSetup setup = BenchRoute(kSquareNet, Location::OnEdge("A1B1", 60.0),
+                                Location::OnEdge("B1B0", 40.0));
+  setup.world.traffic.seed = 1;
+  setup.world.traffic.flows = {{"right1B1", "B1B0", 1200.0}};
+  Result<std::unique_ptr<World>> world = OpenOnSumoToolsNet(setup);
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  World& w = **world;
+  // Standing until the signal's green (45 s into its cycle), then along
+  // the route at 1.5 m/s.
+  const SpeedProfile speed = CurveSpeedProfile(w.road_path(), 1.5, 1.5, 2.0);
+  // When the car and the first of the drivers came into B1B0 (beyond the
+  // junction's south edge, y = 292.8).
+  double ego_in_s = INFINITY;
+  double driver_in_s = INFINITY;
+  while (w.time_s() < 120.0 && w.road_progress_m() < 60.0) {
+    ControlCommand command;
+    command.steer_rad =
+        PredictiveSteer(w.road_path(), speed, w.road_progress_m(), w.ego(),
+                        w.ego_limits(), PredictiveSteeringOptions());
+    const double target_mps =
+        w.time_s() < 45.0 ? 0.0 : speed.At(w.road_progress_m());
+    command.accel_mps2 = w.ego().v_mps < target_mps ? 1.0 : -2.0;
+    ASSERT_TRUE(w.Step(command).ok());
+    if (w.ego().y_m < 292.8) ego_in_s = std::min(ego_in_s, w.time_s());
+    for (const OtherVehicle& v : w.others()) {
+      if (v.box.center.y() < 292.8 && std::abs(v.box.center.x() - 298.4) < 2) {
+        driver_in_s = std::min(driver_in_s, w.time_s());
+      }
+    }
+  }
+  ASSERT_LT(ego_in_s, 100.0);
+  // A driver came (one turned in front of the car without the fix, at
+  // 64.35 s against the car's 69.5 s) and waited for the car.
+  EXPECT_LT(driver_in_s, 100.0);
+  EXPECT_LT(ego_in_s, driver_in_s);
+  EXPECT_EQ(w.collisions(), 0);
 }
 
 TEST(WorldTest, PerfectControllerReachesTheGoalWithoutCollisions) {

@@ -23,6 +23,8 @@ inline constexpr char kGrid6Net[] =
 inline constexpr char kAcostaNet[] =
     "/usr/share/sumo/tools/sumolib/scenario/scenarios/RealWorld/acosta/"
     "acosta_buslanes.net.xml";
+inline constexpr char kSquareNet[] =
+    "/usr/share/sumo/tools/game/square/square.net.xml";
 inline constexpr char kPasubioNet[] =
     "/usr/share/sumo/tools/sumolib/scenario/scenarios/RealWorld/pasubio/"
     "pasubio_buslanes.net.xml";
