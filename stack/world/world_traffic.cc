@@ -241,7 +241,8 @@ bool World::Impl::CameInYielding(const std::string& lane) {
         const std::vector<std::string> chain =
             InternalChain(link.approachedInternal, nullptr);
         for (size_t i = 0; i < chain.size(); ++i) {
-          internal_ways.emplace(chain[i], InternalWay{from, chain[0], i});
+          internal_ways.emplace(
+              chain[i], InternalWay{from, {chain.begin(), chain.begin() + i}});
         }
       }
     }
@@ -249,18 +250,18 @@ bool World::Impl::CameInYielding(const std::string& lane) {
   }
   const auto way = internal_ways.find(lane);
   if (way == internal_ways.end()) return false;
+  const std::string& first =
+      way->second.before.empty() ? lane : way->second.before.front();
   // The link from its lane into the junction (a signal's state changes
   // it), then the internal junctions it has passed.
   for (const libsumo::TraCIConnection& link :
        libsumo::Lane::getLinks(way->second.approach_lane)) {
-    if (link.approachedInternal != way->second.first_internal) continue;
+    if (link.approachedInternal != first) continue;
     if (!link.hasPrio) return true;
     break;
   }
-  const std::vector<std::string> chain =
-      InternalChain(way->second.first_internal, nullptr);
-  for (size_t i = 0; i < way->second.index && i < chain.size(); ++i) {
-    const auto links = libsumo::Lane::getLinks(chain[i]);
+  for (const std::string& passed : way->second.before) {
+    const auto links = libsumo::Lane::getLinks(passed);
     if (!links.empty() && !links.front().hasPrio) return true;
   }
   return false;

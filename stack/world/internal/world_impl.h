@@ -159,13 +159,12 @@ struct World::Impl {
     std::vector<std::pair<double, geometry::OrientedBox>> bodies;  // by s
   };
   std::vector<JunctionClaim> junction_claims;
-  // Each internal lane's way into its junction: the lane it comes from,
-  // the first internal lane of the connection and its place along it.
-  // Built on first use (CameInYielding).
+  // Each internal lane's way into its junction: the lane it comes from and
+  // the internal lanes of the connection before it (the first one is the
+  // approach link's). Built on first use (CameInYielding).
   struct InternalWay {
     std::string approach_lane;
-    std::string first_internal;
-    size_t index = 0;
+    std::vector<std::string> before;
   };
   std::map<std::string, InternalWay> internal_ways;
   bool internal_ways_built = false;
