@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -135,6 +136,105 @@ TEST(RealNetsTest, AcostaOneWayStreets) {
       "{edge: \"113\", pos_m: 44.2, lane: 0}",
       "[{from: \"119\", to: \"15\", vehicles_per_hour: 300}]"));
 }
+
+// One short route on each of the bench's other nets (a stretch of one of
+// its routes: a signalised junction or two, 200-400 m, with the bench's
+// flows), so that every net it drives is driven in CI too.
+struct NetRoute {
+  const char* name;
+  const char* net;  // under /usr/share/sumo/tools
+  const char* start;
+  const char* goal;
+  const char* flows;
+  int traffic_seed;
+};
+
+const NetRoute kNetRoutes[] = {
+    {"pasubio",
+     "sumolib/scenario/scenarios/RealWorld/"
+     "pasubio/pasubio_buslanes.net.xml",
+     "{edge: \"14\", pos_m: 150, lane: 0}",
+     "{edge: \"17[0]\", pos_m: 60, lane: 0}",
+     "[{from: \"56[1][1]\", to: \"2[0]\", vehicles_per_hour: 300}, "
+     "{from: \"5[1][0]+66\", to: \"39[1][1][0]\", vehicles_per_hour: 300}, "
+     "{from: \"43\", to: \"5[1][0]+66\", vehicles_per_hour: 300}]",
+     2},
+    {"joined",
+     "sumolib/scenario/scenarios/RealWorld/"
+     "joined/joined_buslanes.net.xml",
+     "{edge: \"a80\", pos_m: 10, lane: 0}",
+     "{edge: \"a82\", pos_m: 50, lane: 0}",
+     "[{from: \"a75\", to: \"b16[0]\", vehicles_per_hour: 300}, "
+     "{from: \"b29[0]\", to: \"a35\", vehicles_per_hour: 300}, "
+     "{from: \"b1[0]\", to: \"b53a\", vehicles_per_hour: 300}]",
+     3},
+    {"RiLSA1",
+     "sumolib/scenario/scenarios/RealWorld/"
+     "RiLSA_example1/rilsa1.net.xml",
+     "{edge: \"sm\", pos_m: 380, lane: 0}",
+     "{edge: \"mw\", pos_m: 60, lane: 0}",
+     "[{from: \"wm\", to: \"ms\", vehicles_per_hour: 300}, "
+     "{from: \"em\", to: \"mn\", vehicles_per_hour: 300}, "
+     "{from: \"sm\", to: \"mw\", vehicles_per_hour: 300}]",
+     1},
+    {"RiLSA2",
+     "sumolib/scenario/scenarios/RealWorld/"
+     "RiLSA_example2/rilsa2.net.xml",
+     "{edge: \"sm\", pos_m: 300, lane: 0}",
+     "{edge: \"me\", pos_m: 60, lane: 0}",
+     "[{from: \"wm\", to: \"me\", vehicles_per_hour: 300}, "
+     "{from: \"em\", to: \"mw\", vehicles_per_hour: 300}, "
+     "{from: \"em\", to: \"ms\", vehicles_per_hour: 300}]",
+     3},
+    {"RiLSA4",
+     "sumolib/scenario/scenarios/RealWorld/"
+     "RiLSA_example4/rilsa4.net.xml",
+     "{edge: \"nm\", pos_m: 300, lane: 0}",
+     "{edge: \"me\", pos_m: 60, lane: 0}",
+     "[{from: \"em\", to: \"mw\", vehicles_per_hour: 300}, "
+     "{from: \"nm\", to: \"me\", vehicles_per_hour: 300}, "
+     "{from: \"em\", to: \"mn\", vehicles_per_hour: 300}]",
+     1},
+    {"bs3d", "game/bs3d/bs.net.xml",
+     "{edge: \"-38167741#5\", pos_m: 10, lane: 0}",
+     "{edge: \"33049438#1\", pos_m: 40, lane: 0}",
+     "[{from: \"166445405\", to: \"25068137\", vehicles_per_hour: 300}, "
+     "{from: \"23209601#0\", to: \"-33049407#6\", vehicles_per_hour: "
+     "300}, {from: \"5088373#0\", to: \"-165574143\", vehicles_per_hour: "
+     "300}]",
+     3},
+    {"grid6", "game/grid6/grid6.net.xml",
+     "{edge: \"0/0to0/1\", pos_m: 10, lane: 0}",
+     "{edge: \"1/1to1/0\", pos_m: 30, lane: 0}",
+     "[{from: \"top2to2/1\", to: \"0/1to1/1\", vehicles_per_hour: 300}, "
+     "{from: \"right0to2/0\", to: \"0/0to0/1\", vehicles_per_hour: 300}, "
+     "{from: \"gneE41\", to: \"0/0toleft0\", vehicles_per_hour: 300}]",
+     1},
+    {"square", "game/square/square.net.xml",
+     "{edge: \"bottom0A0\", pos_m: 100, lane: 0}",
+     "{edge: \"B1B0\", pos_m: 42.8, lane: 0}",
+     "[{from: \"right1B1\", to: \"bottom1B0\", vehicles_per_hour: 300}, "
+     "{from: \"left1A1\", to: \"B1right1\", vehicles_per_hour: 300}, "
+     "{from: \"right0B0\", to: \"B0A0\", vehicles_per_hour: 300}]",
+     1},
+};
+
+void PrintTo(const NetRoute& r, std::ostream* os) { *os << r.name; }
+
+class RealNetRouteTest : public ::testing::TestWithParam<NetRoute> {};
+
+TEST_P(RealNetRouteTest, AGenerousComputerReachesTheGoal) {
+  const NetRoute& r = GetParam();
+  DrivesToTheGoal(RealNetScenario(r.name,
+                                  std::string("/usr/share/sumo/tools/") + r.net,
+                                  r.start, r.goal, r.flows, r.traffic_seed));
+}
+
+INSTANTIATE_TEST_SUITE_P(RealNets, RealNetRouteTest,
+                         ::testing::ValuesIn(kNetRoutes),
+                         [](const ::testing::TestParamInfo<NetRoute>& info) {
+                           return std::string(info.param.name);
+                         });
 
 // DRT's street -314415495#1 ends at a junction whose only way back is a
 // U-turn 3.2 m across (the car turns no tighter than 3.9 m): the car
