@@ -22,10 +22,12 @@ namespace adse::sim {
 namespace {
 
 // A lane-driving scenario on `net` from `start` to `goal` (flow-map places)
-// with `flows` (a flow-sequence of flows) drawn from `traffic_seed`.
+// with `flows` (a flow-sequence of flows) drawn from `traffic_seed`, and
+// road users standing at `stopped` (a flow-sequence of places).
 spec::Spec RealNetScenario(const std::string& name, const std::string& net,
                            const std::string& start, const std::string& goal,
-                           const std::string& flows, int traffic_seed = 1) {
+                           const std::string& flows, int traffic_seed = 1,
+                           const std::string& stopped = "[]") {
   const std::string text =
       "adse: 1\n"
       "name: " +
@@ -37,6 +39,7 @@ spec::Spec RealNetScenario(const std::string& name, const std::string& net,
       "}\n"
       "  traffic: {seed: " +
       std::to_string(traffic_seed) + ", flows: " + flows +
+      ", stopped_vehicles: " + stopped +
       "}\n"
       "task:\n"
       "  start: " +
@@ -274,6 +277,34 @@ TEST(RealNetsTest, DrtDeadEndTurnsRoundInSeveralMoves) {
     farthest_m = std::max(farthest_m, nearest_m);
   }
   EXPECT_LT(farthest_m, 1.5);
+}
+
+// The same dead end with a car broken down on the lane the turn leaves
+// on, 12 m along: no manoeuvre gets past it, so the car holds where the
+// turn starts instead of driving into it, and the run ends stalled rather
+// than at its timeout. (The report names the turnaround, not the road
+// user it waits for: README, "Not done yet".)
+TEST(RealNetsTest, ACarStandingWhereTheTurnLeavesHoldsTheCarShortOfIt) {
+  const spec::Spec spec = RealNetScenario(
+      "drt_turn_blocked", "/usr/share/sumo/tools/game/DRT/osm.net.xml",
+      "{edge: \"-314415495#1\", pos_m: 10, lane: 1}",
+      "{edge: \"314415495#1\", pos_m: 51, lane: 1}", "[]", 1,
+      "[{edge: \"314415495#1\", pos_m: 12, lane: 1}]");
+  Result<runfile::RunData> run =
+      SimulatePoint(spec, {{"cores", 16}, {"freq_ghz", 2.1}});
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_TRUE(run->collisions.empty());
+  EXPECT_EQ(run->termination_reason.rfind("stalled", 0), 0u)
+      << run->termination_reason;
+  EXPECT_LT(run->metrics.at("nav_time_s"), 120.0);
+  // It never moved in reverse: no move of the turn was made.
+  double slowest_mps = INFINITY;
+  for (const runfile::EgoSample& e : run->ego) {
+    slowest_mps = std::min(slowest_mps, e.v_mps);
+  }
+  EXPECT_GT(slowest_mps, -0.05);
+  // The broken-down car stood by the turn (3.3 m off as the car passed).
+  EXPECT_LT(NearestToEgoM(*run, "stopped0"), 6.0);
 }
 
 // The same dead end with cars following the ego in (900 vehicles/h, which
