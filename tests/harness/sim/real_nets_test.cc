@@ -240,14 +240,22 @@ INSTANTIATE_TEST_SUITE_P(RealNets, RealNetRouteTest,
                          });
 
 // DRT's street -314415495#1 ends at a junction whose only way back is a
-// U-turn 3.2 m across (the car turns no tighter than 3.9 m): the car
-// stops short of it and turns round forwards and in reverse within the
-// lanes and the junction (the bench's DRT-1 turns there).
+// U-turn 3.2 m across (the car turns no tighter than 3.9 m): from 10 m
+// along it to 51 m along the way back, with `flows` and road users
+// standing at `stopped`.
+spec::Spec DrtDeadEnd(const std::string& name, const std::string& flows,
+                      const std::string& stopped = "[]") {
+  return RealNetScenario(name, "/usr/share/sumo/tools/game/DRT/osm.net.xml",
+                         "{edge: \"-314415495#1\", pos_m: 10, lane: 1}",
+                         "{edge: \"314415495#1\", pos_m: 51, lane: 1}", flows,
+                         1, stopped);
+}
+
+// The car stops short of the dead end and turns round forwards and in
+// reverse within the lanes and the junction (the bench's DRT-1 turns
+// there).
 TEST(RealNetsTest, DrtDeadEndTurnsRoundInSeveralMoves) {
-  const spec::Spec spec =
-      RealNetScenario("drt_turn", "/usr/share/sumo/tools/game/DRT/osm.net.xml",
-                      "{edge: \"-314415495#1\", pos_m: 10, lane: 1}",
-                      "{edge: \"314415495#1\", pos_m: 51, lane: 1}", "[]");
+  const spec::Spec spec = DrtDeadEnd("drt_turn", "[]");
   runfile::RunData run;
   DrivesToTheGoal(spec, &run);
   bool stopped_to_turn = false;
@@ -285,11 +293,9 @@ TEST(RealNetsTest, DrtDeadEndTurnsRoundInSeveralMoves) {
 // than at its timeout. (The report names the turnaround, not the road
 // user it waits for: README, "Not done yet".)
 TEST(RealNetsTest, ACarStandingWhereTheTurnLeavesHoldsTheCarShortOfIt) {
-  const spec::Spec spec = RealNetScenario(
-      "drt_turn_blocked", "/usr/share/sumo/tools/game/DRT/osm.net.xml",
-      "{edge: \"-314415495#1\", pos_m: 10, lane: 1}",
-      "{edge: \"314415495#1\", pos_m: 51, lane: 1}", "[]", 1,
-      "[{edge: \"314415495#1\", pos_m: 12, lane: 1}]");
+  const spec::Spec spec =
+      DrtDeadEnd("drt_turn_blocked", "[]",
+                 "[{edge: \"314415495#1\", pos_m: 12, lane: 1}]");
   Result<runfile::RunData> run =
       SimulatePoint(spec, {{"cores", 16}, {"freq_ghz", 2.1}});
   ASSERT_TRUE(run.ok()) << run.status().ToString();
@@ -312,10 +318,8 @@ TEST(RealNetsTest, ACarStandingWhereTheTurnLeavesHoldsTheCarShortOfIt) {
 // turns, as drivers who see it would; before, they pulled up 2 m from the
 // turning car and its next move backed into them.
 TEST(RealNetsTest, CarsComingUpBehindWaitShortOfATurnInSeveralMoves) {
-  const spec::Spec spec = RealNetScenario(
-      "drt_turn_traffic", "/usr/share/sumo/tools/game/DRT/osm.net.xml",
-      "{edge: \"-314415495#1\", pos_m: 10, lane: 1}",
-      "{edge: \"314415495#1\", pos_m: 51, lane: 1}",
+  const spec::Spec spec = DrtDeadEnd(
+      "drt_turn_traffic",
       "[{from: \"-314415495#1\", to: \"314415495#1\", vehicles_per_hour: "
       "900}]");
   runfile::RunData run;
