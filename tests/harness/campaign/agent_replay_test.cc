@@ -75,11 +75,11 @@ TEST(AgentReplayTest, OnTheRecordedRobotaxiCampaign) {
 }
 
 TEST(AgentReplayTest, OnTheReferenceStudyWhereStarvedRunsAreStoppedEarly) {
-  // Measured at run key v13 on the 838 m route: a median of 2 true
+  // Measured at run key v16 on the 838 m route: a median of 2 true
   // Pareto points (the study's LLM agent found 6), a median hypervolume
-  // ratio of 0.950, the cheapest design (7 cores at 1.2 GHz) in 11 of 20
+  // ratio of 0.949, the cheapest design (7 cores at 1.2 GHz) in 13 of 20
   // seeds (README, "Strategies").
-  ExpectAgentOn("reference_study", {2, 0.94, 10});
+  ExpectAgentOn("reference_study", {2, 0.94, 12});
 }
 
 TEST(AgentReplayTest, OnALandscapeThatSaturates) {
