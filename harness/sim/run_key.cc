@@ -35,8 +35,10 @@ namespace {
 // ego is left to SUMO. v15: alongside the car, the obstacle stop counts
 // only what its body would touch driving off (not the path's corridor).
 // v16: a driver past its left turn's waiting point in a junction still
-// yields to the ego's way through it.
-constexpr char kKeyVersion[] = "adse-run-key-v16";
+// yields to the ego's way through it. v17: a moving track's box is
+// measured as a view of part of its object, and the crossing yield sees a
+// car in a farther part of the path's corridor where it crosses nearer.
+constexpr char kKeyVersion[] = "adse-run-key-v17";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

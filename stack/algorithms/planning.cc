@@ -496,18 +496,26 @@ ObstacleStop InsertCrossingYield(std::vector<PlannedPoint>* points,
     if (speed < params.min_object_speed_mps || ob.age < params.min_track_age)
       continue;
     const double heading = std::atan2(ob.velocity.y(), ob.velocity.x());
-    // Its box along its straight-line prediction: when it first enters the
-    // corridor (not now: the stop planner has what is there now) and when
-    // it has left it again.
+    // Its box along its straight-line prediction: when it next enters the
+    // corridor and when it has left it again. Where it is in the corridor
+    // now is the stop planner's; a path that meets its way twice (a left
+    // turn onto a road and another off it) is crossed again nearer the
+    // ego once it has left that part (the ego drove on towards the nearer
+    // crossing, held only by the stop for the farther one).
     std::optional<BoxOnPath> entry;
     double t_in = 0.0, t_out = params.horizon_s;
+    bool in_corridor_now = false;
     for (int k = 0; k <= steps; ++k) {
       const double t = k * params.step_s;
       out.work_units += 1 + static_cast<int64_t>(pts.size());
       const BoxOnPath box =
           PlaceBox(search, ob.position + t * ob.velocity, ob.length_m,
                    ob.width_m, heading, stop_params.corridor_half_width_m);
-      if (k == 0 && box.in_corridor) break;
+      if (k == 0) in_corridor_now = box.in_corridor;
+      if (in_corridor_now) {
+        in_corridor_now = box.in_corridor;
+        continue;
+      }
       if (!entry && box.in_corridor) {
         entry = box;
         t_in = t;

@@ -2,9 +2,24 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
 #include <tuple>
 
 namespace adse::algorithms {
+namespace {
+
+// A box's length and width as extents along the unit vector u and across
+// it: a box nearer across u than along it is seen sideways. (Projecting
+// the box would widen it by the heading's noise.)
+Eigen::Vector2d ExtentsAlong(const Detection& box, const Eigen::Vector2d& u) {
+  const Eigen::Vector2d axis(std::cos(box.yaw_rad), std::sin(box.yaw_rad));
+  const bool sideways =
+      std::abs(axis.dot(u)) < std::abs(axis.x() * u.y() - axis.y() * u.x());
+  return sideways ? Eigen::Vector2d(box.width_m, box.length_m)
+                  : Eigen::Vector2d(box.length_m, box.width_m);
+}
+
+}  // namespace
 
 void Tracker::Reset() {
   tracks_.clear();
@@ -31,6 +46,32 @@ void Tracker::Predict(Track* track, double dt_s) const {
   track->covariance = f * track->covariance * f.transpose() + qm;
 }
 
+Eigen::Vector2d Tracker::MeasuredCenter(const Track& track,
+                                        const Detection& detection) const {
+  const double speed = track.velocity.norm();
+  if (params_.partial_view_min_speed_mps <= 0.0 ||
+      speed < params_.partial_view_min_speed_mps) {
+    return detection.center;
+  }
+  const Eigen::Vector2d u = track.velocity / speed;
+  const Eigen::Vector2d n(-u.y(), u.x());
+  const Eigen::Vector2d seen = ExtentsAlong(detection, u);
+  const double slack_along = std::max(0.0, track.extent_along_m - seen.x()) / 2;
+  const double slack_across =
+      std::max(0.0, track.extent_across_m - seen.y()) / 2;
+  const Eigen::Vector2d off = track.position - detection.center;
+  return detection.center +
+         std::clamp(off.dot(u), -slack_along, slack_along) * u +
+         std::clamp(off.dot(n), -slack_across, slack_across) * n;
+}
+
+void Tracker::GrowExtents(const Eigen::Vector2d& seen, Track* track) const {
+  track->extent_along_m = std::min(std::max(track->extent_along_m, seen.x()),
+                                   params_.max_extent_along_m);
+  track->extent_across_m = std::min(std::max(track->extent_across_m, seen.y()),
+                                    params_.max_extent_across_m);
+}
+
 void Tracker::Correct(Track* track, const Detection& detection) const {
   Eigen::Matrix<double, 2, 4> h = Eigen::Matrix<double, 2, 4>::Zero();
   h(0, 0) = h(1, 1) = 1.0;
@@ -41,7 +82,7 @@ void Tracker::Correct(Track* track, const Detection& detection) const {
   const Eigen::Matrix<double, 4, 2> k = p * h.transpose() * s.inverse();
   Eigen::Vector4d x;
   x << track->position, track->velocity;
-  x += k * (detection.center - track->position);
+  x += k * (MeasuredCenter(*track, detection) - track->position);
   track->position = x.head<2>();
   track->velocity = x.tail<2>();
   // Joseph form: stays symmetric positive definite under rounding.
@@ -51,6 +92,20 @@ void Tracker::Correct(Track* track, const Detection& detection) const {
   track->length_m = (1 - w) * track->length_m + w * detection.length_m;
   track->width_m = (1 - w) * track->width_m + w * detection.width_m;
   track->yaw_rad = detection.yaw_rad;
+  const double speed = track->velocity.norm();
+  const bool moving = params_.partial_view_min_speed_mps > 0.0 &&
+                      speed >= params_.partial_view_min_speed_mps;
+  const Eigen::Vector2d seen =
+      moving ? ExtentsAlong(detection, track->velocity / speed)
+             : Eigen::Vector2d(detection.length_m, detection.width_m);
+  GrowExtents(seen, track);
+  // A moving track's box is its object's, along its heading: a view of
+  // part of it would put the box's near edge beyond the object's.
+  if (moving) {
+    track->yaw_rad = std::atan2(track->velocity.y(), track->velocity.x());
+    track->length_m = std::max(track->length_m, track->extent_along_m);
+    track->width_m = std::max(track->width_m, track->extent_across_m);
+  }
 }
 
 const Track* Tracker::NearestConfirmed(const Eigen::Vector2d& at,
@@ -84,7 +139,8 @@ void Tracker::Update(double t_s, const std::vector<Detection>& detections) {
   for (size_t t = 0; t < tracks_.size(); ++t) {
     for (size_t d = 0; d < detections.size(); ++d) {
       const double d2 =
-          (detections[d].center - tracks_[t].position).squaredNorm();
+          (MeasuredCenter(tracks_[t], detections[d]) - tracks_[t].position)
+              .squaredNorm();
       if (d2 <= gate2) pairs.emplace_back(d2, t, d);
     }
   }
@@ -131,10 +187,13 @@ void Tracker::Update(double t_s, const std::vector<Detection>& detections) {
       track.velocity = parent->velocity;
       track.covariance.bottomRightCorner<2, 2>() =
           parent->covariance.bottomRightCorner<2, 2>();
+      track.extent_along_m = parent->extent_along_m;
+      track.extent_across_m = parent->extent_across_m;
     }
     track.length_m = detections[d].length_m;
     track.width_m = detections[d].width_m;
     track.yaw_rad = detections[d].yaw_rad;
+    GrowExtents({track.length_m, track.width_m}, &track);
     track.age = 1;
     track.hits = 1;
     track.last_seen_s = t_s;

@@ -428,6 +428,59 @@ TEST(CrossingYield, AYieldIsHeldUntilTheWayHasBeenClearForTheMargin) {
   for (const PlannedPoint& p : c.points) EXPECT_GT(p.v_mps, 0.0);
 }
 
+// A route that turns left onto a road (x = 44, northbound) and 16 m on
+// left off it again, across the southbound lane (x = 40.7) both times, as
+// the reference study's does from one aisle to the next. A southbound car
+// at 8 m/s stands in the path's corridor where the route leaves the road
+// (that is the stop planner's), and will cross where it joins, 2.4 s on,
+// while the ego, 16 m short, would be there too: it is yielded to. Before,
+// the yield skipped any car in the corridor now; held only by the stop for
+// the farther crossing, the ego drove on to the nearer one at 6 m/s and
+// then could not stop before it (a collision at (12, 1.8, 7), run key
+// v16 with the tracker of then).
+TEST(CrossingYield,
+     ACarInAFartherPartOfThePathIsYieldedToWhereItCrossesNearer) {
+  std::vector<Eigen::Vector2d> route;
+  for (double x = 0; x < 40; x += 1.0) route.emplace_back(x, 0);
+  for (int a = -90; a < 0; a += 10) {
+    const double th = a * kPi / 180;
+    route.emplace_back(40 + 4 * std::cos(th), 4 + 4 * std::sin(th));
+  }
+  for (double y = 4; y < 16; y += 1.0) route.emplace_back(44, y);
+  for (int a = 0; a < 90; a += 10) {
+    const double th = a * kPi / 180;
+    route.emplace_back(40 + 4 * std::cos(th), 16 + 4 * std::sin(th));
+  }
+  for (double x = 40; x >= 0; x -= 1.0) route.emplace_back(x, 20);
+  PathPlanner planner;
+  planner.SetRoute(Polyline(route));
+  std::vector<PlannedPoint> points =
+      planner.Plan(geometry::Pose2{20.0, 0.0, 0.0}).points;
+  PlannerObstacle car = Car(9, 40.7, 23.0);
+  car.velocity = {0.0, -8.0};
+  car.yaw_rad = -kPi / 2;
+  car.age = 10;
+  const ObstacleStopParams stop = CaseStop();
+  std::vector<PlannedPoint> in_path = points;
+  const ObstacleStop far = InsertObstacleStop(&in_path, {car}, {}, stop);
+  ASSERT_TRUE(far.stop);  // for where the route leaves the road
+  const ObstacleStop yield =
+      InsertCrossingYield(&points, {car}, 6.0, stop, CrossingYieldParams());
+  ASSERT_TRUE(yield.stop);
+  EXPECT_EQ(yield.obstacle_id, 9);
+  // Short of where the route joins the road (s 40-44), nearer than the
+  // stop for the farther crossing.
+  EXPECT_LT(yield.stop_s_m + stop.stop_margin_m + stop.ego_front_m, 42.0);
+  EXPECT_LT(yield.stop_s_m, far.stop_s_m - 20.0);
+  // Gone past where the route joins the road, it is not yielded to.
+  car.position = {40.7, -6.0};
+  std::vector<PlannedPoint> later =
+      planner.Plan(geometry::Pose2{20.0, 0.0, 0.0}).points;
+  EXPECT_FALSE(
+      InsertCrossingYield(&later, {car}, 6.0, stop, CrossingYieldParams())
+          .stop);
+}
+
 TEST(CrossingYield, TheNearerOfTwoStopsHoldsTheCar) {
   ObstacleStop far, near, none;
   far.stop = near.stop = true;

@@ -164,6 +164,64 @@ TEST(Tracker, APieceBornNearAConfirmedTrackStartsAtItsVelocity) {
   }
 }
 
+// A car at 7 m/s along x, seen whole for a second, then only its rear 1.2 m
+// (the rest hidden behind a parked car): the box's centre lags the car's
+// by 1.8 m. Measured as a view of part of the car, the track keeps its
+// speed and its place; taken at face value (the old way), it falls back.
+TEST(Tracker, AMovingCarSeenInPartKeepsItsSpeedAndPlace) {
+  for (const double min_speed_mps :
+       {TrackerParams().partial_view_min_speed_mps, 0.0}) {
+    SCOPED_TRACE(min_speed_mps);
+    TrackerParams params;
+    params.partial_view_min_speed_mps = min_speed_mps;
+    Tracker tracker(params);
+    const double dt = 0.1, speed = 7.0;
+    Random random(5);
+    for (int k = 0; k < 25; ++k) {
+      Detection seen = At(speed * k * dt + random.Normal(0, 0.05), 0.0);
+      seen.length_m = 4.8;
+      if (k >= 10) {
+        seen.length_m = 1.2;
+        seen.center.x() -= (4.8 - 1.2) / 2;
+      }
+      tracker.Update(k * dt, {seen});
+    }
+    ASSERT_EQ(tracker.ConfirmedTracks().size(), 1u);
+    const Track& car = tracker.ConfirmedTracks()[0];
+    const double lag_m = speed * 24 * dt - car.position.x();
+    if (min_speed_mps > 0.0) {
+      EXPECT_EQ(car.age, 25);  // one track all along
+      EXPECT_NEAR(car.velocity.x(), speed, 0.3);
+      EXPECT_NEAR(lag_m, 0.0, 0.3);
+      // Its box is the car's, along its heading.
+      EXPECT_NEAR(car.length_m, 4.8, 0.2);
+      EXPECT_NEAR(car.extent_along_m, 4.8, 0.2);
+      EXPECT_NEAR(car.yaw_rad, 0.0, 0.05);
+    } else {
+      EXPECT_GT(lag_m, 1.0);
+    }
+  }
+}
+
+// The far end of a car, 0.4 m of it, is seen 2.2 m from where the car's
+// centre is predicted (beyond the 2 m gate): still the same car.
+TEST(Tracker, AViewOfACarsFarEndIsStillThatCar) {
+  Tracker tracker;
+  for (int k = 0; k < 10; ++k) {
+    Detection seen = At(0.8 * k, 0.0);
+    seen.length_m = 4.8;
+    tracker.Update(0.1 * k, {seen});
+  }
+  ASSERT_EQ(tracker.ConfirmedTracks().size(), 1u);
+  const int id = tracker.ConfirmedTracks()[0].id;
+  Detection front = At(8.0 + 2.2, 0.0);
+  front.length_m = 0.4;
+  tracker.Update(1.0, {front});
+  ASSERT_EQ(tracker.tracks().size(), 1u);
+  EXPECT_EQ(tracker.tracks()[0].id, id);
+  EXPECT_EQ(tracker.tracks()[0].misses, 0);
+}
+
 // Far from every confirmed track a new object starts standing, uncertain.
 TEST(Tracker, ANewObjectFarFromEveryTrackStartsStanding) {
   Tracker tracker;
