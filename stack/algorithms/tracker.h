@@ -2,8 +2,8 @@
 // per track, greedy nearest-neighbour association inside a gate, birth
 // after N hits (at the velocity of a confirmed track it splits from) and
 // deletion after M misses. A box smaller than its track's object (a car
-// partly hidden, as Autoware's tracker anchors a shape) measures only
-// where the object's box may stand. Eigen and std types only.
+// partly hidden) measures only where the object's box may stand. Eigen and
+// std types only.
 #ifndef ADSE_STACK_ALGORITHMS_TRACKER_H_
 #define ADSE_STACK_ALGORITHMS_TRACKER_H_
 
