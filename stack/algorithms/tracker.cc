@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <tuple>
 
 namespace adse::algorithms {
@@ -46,14 +47,21 @@ void Tracker::Predict(Track* track, double dt_s) const {
   track->covariance = f * track->covariance * f.transpose() + qm;
 }
 
-Eigen::Vector2d Tracker::MeasuredCenter(const Track& track,
-                                        const Detection& detection) const {
+std::optional<Eigen::Vector2d> Tracker::MovingHeading(
+    const Track& track) const {
   const double speed = track.velocity.norm();
   if (params_.partial_view_min_speed_mps <= 0.0 ||
       speed < params_.partial_view_min_speed_mps) {
-    return detection.center;
+    return std::nullopt;
   }
-  const Eigen::Vector2d u = track.velocity / speed;
+  return Eigen::Vector2d(track.velocity / speed);
+}
+
+Eigen::Vector2d Tracker::MeasuredCenter(const Track& track,
+                                        const Detection& detection) const {
+  const std::optional<Eigen::Vector2d> heading = MovingHeading(track);
+  if (!heading) return detection.center;
+  const Eigen::Vector2d& u = *heading;
   const Eigen::Vector2d n(-u.y(), u.x());
   const Eigen::Vector2d seen = ExtentsAlong(detection, u);
   const double slack_along = std::max(0.0, track.extent_along_m - seen.x()) / 2;
@@ -92,16 +100,13 @@ void Tracker::Correct(Track* track, const Detection& detection) const {
   track->length_m = (1 - w) * track->length_m + w * detection.length_m;
   track->width_m = (1 - w) * track->width_m + w * detection.width_m;
   track->yaw_rad = detection.yaw_rad;
-  const double speed = track->velocity.norm();
-  const bool moving = params_.partial_view_min_speed_mps > 0.0 &&
-                      speed >= params_.partial_view_min_speed_mps;
-  const Eigen::Vector2d seen =
-      moving ? ExtentsAlong(detection, track->velocity / speed)
-             : Eigen::Vector2d(detection.length_m, detection.width_m);
-  GrowExtents(seen, track);
+  const std::optional<Eigen::Vector2d> heading = MovingHeading(*track);
+  GrowExtents(heading ? ExtentsAlong(detection, *heading)
+                      : Eigen::Vector2d(detection.length_m, detection.width_m),
+              track);
   // A moving track's box is its object's, along its heading: a view of
   // part of it would put the box's near edge beyond the object's.
-  if (moving) {
+  if (heading) {
     track->yaw_rad = std::atan2(track->velocity.y(), track->velocity.x());
     track->length_m = std::max(track->length_m, track->extent_along_m);
     track->width_m = std::max(track->width_m, track->extent_across_m);

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "stack/algorithms/clustering.h"
@@ -96,6 +97,8 @@ class Tracker {
  private:
   void Predict(Track* track, double dt_s) const;
   void Correct(Track* track, const Detection& detection) const;
+  // Its velocity's direction when faster than partial_view_min_speed_mps.
+  std::optional<Eigen::Vector2d> MovingHeading(const Track& track) const;
   // Widens the track's extents to `seen` (along, across), within the caps.
   void GrowExtents(const Eigen::Vector2d& seen, Track* track) const;
   // Where `detection` puts the track's centre: its box's centre, or for a
