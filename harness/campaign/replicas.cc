@@ -6,6 +6,8 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -116,7 +118,8 @@ void TakeIdentity(const EvaluationRow& first,
 // worse (a minimised objective, a constraint failing above a bound), -1
 // when smaller is, 0 when no objective or constraint says. Constraints are
 // probed at the metric's extremes (0 and 1 for a boolean), the other
-// metrics as in `sample`.
+// metrics as in `sample`; a bound that fails at both extremes (a count
+// that must be `== 0`) is probed again between zero and each extreme.
 int WorseDirection(const spec::Spec& spec, const std::string& metric,
                    const EvaluationRow& sample) {
   for (const spec::Objective& o : spec.objectives) {
@@ -126,12 +129,47 @@ int WorseDirection(const spec::Spec& spec, const std::string& metric,
   for (const spec::MetricInfo& m : spec::KnownMetrics()) {
     if (m.name == metric) boolean = m.boolean;
   }
-  for (const std::string& constraint : spec.constraints) {
-    const int side = FailingSide(spec, constraint, metric, sample,
-                                 boolean ? 0.0 : -1e12, boolean ? 1.0 : 1e12);
-    if (side != 0) return side;
+  const std::vector<std::pair<double, double>> probes =
+      boolean ? std::vector<std::pair<double, double>>{{0.0, 1.0}}
+              : std::vector<std::pair<double, double>>{
+                    {-1e12, 1e12}, {0.0, 1e12}, {-1e12, 0.0}};
+  for (const auto& [low, high] : probes) {
+    for (const std::string& constraint : spec.constraints) {
+      const int side = FailingSide(spec, constraint, metric, sample, low, high);
+      if (side != 0) return side;
+    }
   }
   return 0;
+}
+
+// How many of the spec's constraints `row` fails (one that cannot be
+// evaluated on it counts as failed).
+int FailedConstraints(const spec::Spec& spec, const EvaluationRow& row) {
+  int failed = 0;
+  for (const std::string& constraint : spec.constraints) {
+    Result<bool> holds =
+        spec::EvaluateConstraint(spec, constraint, row.metrics, row.point);
+    failed += !holds.ok() || !*holds;
+  }
+  return failed;
+}
+
+// The infeasible case that fails the most constraints, the first of equals:
+// the one whose reason explains the point's failures (a case that parked
+// but touched a car does not stand for one that also did not park).
+const EvaluationRow* MostFailing(const spec::Spec& spec,
+                                 const std::vector<EvaluationRow>& cases) {
+  const EvaluationRow* most = nullptr;
+  int most_failed = -1;
+  for (const EvaluationRow& c : cases) {
+    if (c.feasible) continue;
+    const int failed = FailedConstraints(spec, c);
+    if (failed > most_failed) {
+      most = &c;
+      most_failed = failed;
+    }
+  }
+  return most;
 }
 
 // The cases' rows (one per case, in case order) folded into the point's.
@@ -202,9 +240,7 @@ EvaluationRow AggregateCases(const spec::Spec& spec,
     const EvaluationRow* stopped = first(
         [](const EvaluationRow& c) { return !c.feasible && Censored(c); });
     representative =
-        censored && stopped != nullptr
-            ? stopped
-            : first([](const EvaluationRow& c) { return !c.feasible; });
+        censored && stopped != nullptr ? stopped : MostFailing(spec, cases);
   } else {
     for (const spec::Objective& o : spec.objectives) {
       const EvaluationRow* worst = nullptr;

@@ -201,7 +201,9 @@ void AgentStrategy::SetUpMetrics() {
     MetricModel model;
     model.name = metric;
     for (const spec::MetricInfo& info : spec::KnownMetrics()) {
-      if (info.name == metric) model.boolean_hint = info.boolean;
+      if (info.name != metric) continue;
+      model.boolean_hint = info.boolean;
+      model.count_hint = info.count;
     }
     model.rate_hint = metric == kNavTimeMetric;
     models_.push_back(model);

@@ -119,11 +119,14 @@ const std::vector<MetricInfo>& KnownMetrics() {
       {"hardware_cost", "value of the scenario's cost expression"},
       {"e2e_latency_p50_s", "median LiDAR-to-control latency, s"},
       {"e2e_latency_p99_s", "99th percentile LiDAR-to-control latency, s"},
-      {"dropped_messages", "messages dropped by keep-last queues, count"},
-      {"collisions", "collisions of the ego with vehicles or obstacles, count"},
+      {"dropped_messages", "messages dropped by keep-last queues, count", false,
+       true},
+      {"collisions", "collisions of the ego with vehicles or obstacles, count",
+       false, true},
       {"ego_collisions",
        "collisions the ego caused: at the contact it moved towards the other "
-       "vehicle at least as fast as that one moved towards it, count"},
+       "vehicle at least as fast as that one moved towards it, count",
+       false, true},
       // valet_parking runs only (analysis/metrics/parking_metrics.h).
       {"parked",
        "valet_parking: the run ended standing in the slot within the goal's "
@@ -141,7 +144,8 @@ const std::vector<MetricInfo>& KnownMetrics() {
       {"parking_replans",
        "valet_parking: paths found after the first, each planned where the "
        "car stood off the course of the one before or at its end outside "
-       "the goal's tolerances, count"},
+       "the goal's tolerances, count",
+       false, true},
       {"parking_path_deviation_m",
        "valet_parking: mean distance of the rear axle from the planned "
        "manoeuvre while driving it, m"},
@@ -150,9 +154,11 @@ const std::vector<MetricInfo>& KnownMetrics() {
        "or parked car, m"},
       {"obstacle_collisions",
        "valet_parking: contacts of the ego's body with walls, poles or "
-       "parked cars, count"},
+       "parked cars, count",
+       false, true},
       {"gear_changes",
-       "valet_parking: reversals of the direction of motion, count"},
+       "valet_parking: reversals of the direction of motion, count", false,
+       true},
       {"censored",
        "early stop ended the run (status infeasible): its other metrics are "
        "measured up to the stop (0 or 1)",

@@ -98,7 +98,8 @@ struct Objective {
 struct MetricInfo {
   std::string name;
   std::string doc;
-  bool boolean = false;
+  bool boolean = false;  // 0 or 1
+  bool count = false;    // a whole number of events, 0 or more
 };
 // Metrics a run reports (documented in scenarios/README.md).
 const std::vector<MetricInfo>& KnownMetrics();

@@ -422,6 +422,13 @@ double MetricModel::Bounded(double value) const {
 }
 
 double MetricModel::ToMetric(double t) const {
+  if (count_hint &&
+      (space_ == MetricSpace::kLog || space_ == MetricSpace::kLinear)) {
+    const double v = space_ == MetricSpace::kLog
+                         ? std::exp(std::clamp(t, -700.0, 700.0))
+                         : shift_ + scale_ * t;
+    return std::max(0.0, std::round(v));
+  }
   switch (space_) {
     case MetricSpace::kLog:
       return std::exp(std::clamp(t, -700.0, 700.0));

@@ -83,6 +83,9 @@ class MetricModel {
   int good_direction = 0;
   bool in_constraint = false;
   bool boolean_hint = false;  // documented as 0/1
+  // Documented as a count: a sample is rounded to a whole number of
+  // events, so that a bound such as `== 0` can hold on it.
+  bool count_hint = false;
   // A time to finish, which may also be modelled as its rate (1 / time,
   // falling to zero where a computer cannot keep up); the space whose
   // leave-one-out predictions fit the runs better is used.

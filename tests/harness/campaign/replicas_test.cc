@@ -268,6 +268,42 @@ TEST(CasesTest, OneInfeasibleCaseMakesThePointInfeasibleAndStandsForIt) {
   EXPECT_EQ(ReplicaSummary(broken), "2 cases, 1 failed");
 }
 
+TEST(CasesTest, TheCaseFailingMostConstraintsStandsForAnInfeasiblePoint) {
+  spec::Spec spec = Scenario();
+  spec.harness.replicas = 1;
+  // Case 0 is too slow; case 1 too slow and its control too: case 1's run
+  // explains both failures of the point.
+  EvaluationRow slow = CaseRun(0, 0, 70.0, 6.0, 0.2);
+  EvaluationRow starved = CaseRun(1, 0, 65.0, 0.5, 0.2);
+  starved.reason = "parked_out_of_tolerance";
+  const EvaluationRow row = AggregatePoint(spec, {slow, starved});
+  EXPECT_FALSE(row.feasible);
+  EXPECT_EQ(row.task_case, 1);
+  EXPECT_EQ(row.reason, "parked_out_of_tolerance");
+  EXPECT_DOUBLE_EQ(row.metrics.at("nav_time_s"), 70.0);
+  EXPECT_DOUBLE_EQ(row.metrics.at("ctrl_rate_hz"), 0.5);
+
+  // Equal failures: the first case.
+  const EvaluationRow equal =
+      AggregatePoint(spec, {slow, CaseRun(1, 0, 80.0, 6.0, 0.2)});
+  EXPECT_EQ(equal.task_case, 0);
+}
+
+TEST(CasesTest, ACountThatMustBeZeroIsFoldedToItsWorstNotItsMean) {
+  spec::Spec spec = Scenario();
+  spec.harness.replicas = 1;
+  spec.constraints.push_back("obstacle_collisions == 0");
+  EvaluationRow clean = CaseRun(0, 0, 40.0, 6.0, 0.2);
+  clean.metrics["obstacle_collisions"] = 0;
+  EvaluationRow touched = CaseRun(1, 0, 45.0, 6.0, 0.2);
+  touched.metrics["obstacle_collisions"] = 1;
+  touched.feasible = false;
+  const EvaluationRow row = AggregatePoint(spec, {clean, touched});
+  EXPECT_FALSE(row.feasible);
+  EXPECT_DOUBLE_EQ(row.metrics.at("obstacle_collisions"), 1.0);
+  EXPECT_EQ(row.task_case, 1);
+}
+
 TEST(CasesTest, EachCasesReplicasAreFoldedBeforeTheCases) {
   // Three replicas per case: medians 45 and 52, the point 52.
   const EvaluationRow row = AggregatePoint(

@@ -100,5 +100,32 @@ TEST(SurrogateTest, ABoundOnAFlagIsIgnoredRatherThanTakenForAValue) {
   EXPECT_EQ(model.space(), MetricSpace::kBoolean);
 }
 
+TEST(SurrogateTest, ACountIsSampledAsAWholeNumberSoThatABoundOfZeroCanHold) {
+  // Collisions folded over two cases and replicas: 0, a mean of 0.5, 2.
+  // Not 0/1, so modelled as a plain value; its samples must still be whole
+  // numbers, or `obstacle_collisions == 0` would never hold on one.
+  MetricModel model;
+  model.name = "obstacle_collisions";
+  model.count_hint = true;
+  model.good_direction = -1;
+  model.in_constraint = true;
+  model.Fit({{0.1}, {0.4}, {0.7}, {0.9}}, {2, 0.5, 0, 0}, {}, {1.0}, {0.25});
+  ASSERT_TRUE(model.fitted());
+  EXPECT_EQ(model.space(), MetricSpace::kLinear);
+  int zeros = 0;
+  for (double z = -2.0; z <= 2.0; z += 0.25) {
+    double mean = 0.0, sd = 0.0;
+    model.Predict({0.9}, &mean, &sd);
+    const double v = model.ToMetric(mean + z * sd);
+    EXPECT_EQ(v, std::round(v));
+    EXPECT_GE(v, 0.0);
+    zeros += v == 0.0;
+  }
+  EXPECT_GT(zeros, 8);  // where the runs had none, mostly none
+  double mean = 0.0, sd = 0.0;
+  model.Predict({0.1}, &mean, &sd);
+  EXPECT_GE(model.ToMetric(mean), 1.0);
+}
+
 }  // namespace
 }  // namespace adse::explore::internal
