@@ -88,24 +88,16 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
   for (double v : o.horizontal_lines) {
     if (std::isfinite(v)) ys.push_back(v);
   }
-  const Axis ax = MakeAxis(xs), ay = MakeAxis(ys);
-
-  const Style s = PlotStyle(o.width_px, o.height_px);
-  int baseline = 0;
-  const int text_h = TextSize("Ag", s, &baseline).height;
-  const int line_px = text_h + baseline + s.Px(8);
-  // Room on the left for the turned y label and tick labels, on top for
-  // the title and a note, below for tick labels and the x label.
-  const int left = s.Px(58) + line_px;
-  const int top = 2 * line_px + s.Px(6);
-  const int right = o.width_px - s.Px(24);
-  const int bottom = o.height_px - 2 * line_px - s.Px(8);
-  const cv::Rect area(left, top, right - left, bottom - top);
-  auto px = [&](double x, double y) {
-    return cv::Point2d(
-        area.x + (x - ax.min) / (ax.max - ax.min) * area.width,
-        area.y + area.height - (y - ay.min) / (ay.max - ay.min) * area.height);
-  };
+  // Two lines on top: the title and a note.
+  const PlotFrame frame =
+      MakePlotFrame(o.width_px, o.height_px, MakeAxis(xs), MakeAxis(ys), 2, 6);
+  const Style& s = frame.style;
+  const Axis &ax = frame.ax, &ay = frame.ay;
+  int baseline = frame.baseline;
+  const int text_h = frame.text_h, line_px = frame.line_px;
+  const int right = frame.right(), bottom = frame.bottom();
+  const cv::Rect& area = frame.area;
+  auto px = [&](double x, double y) { return frame.ToPx(x, y); };
   auto clipped = [&](const ParetoPlotPoint* p) {
     return p->nav_time_s > ay.max;
   };

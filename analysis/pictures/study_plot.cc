@@ -50,23 +50,16 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
   for (double v : o.cost_bounds) {
     if (std::isfinite(v)) ys.push_back(v);
   }
-  const Axis ax = MakeAxis(xs), ay = MakeAxis(ys);
-
-  const Style s = PlotStyle(o.width_px, o.height_px);
-  int baseline = 0;
-  const int text_h = TextSize("Ag", s, &baseline).height;
-  const int line_px = text_h + baseline + s.Px(8);
-  const int left = s.Px(58) + line_px;
-  const int top = line_px + s.Px(10);
-  const int right = o.width_px - s.Px(24);
-  const int bottom = o.height_px - 2 * line_px - s.Px(8);
-  const cv::Rect area(left, top, right - left, bottom - top);
-  auto px = [&](double time, double cost) {
-    return cv::Point2d(
-        area.x + (time - ax.min) / (ax.max - ax.min) * area.width,
-        area.y + area.height -
-            (cost - ay.min) / (ay.max - ay.min) * area.height);
-  };
+  // One line on top: the title.
+  const PlotFrame frame =
+      MakePlotFrame(o.width_px, o.height_px, MakeAxis(xs), MakeAxis(ys), 1, 10);
+  const Style& s = frame.style;
+  const Axis &ax = frame.ax, &ay = frame.ay;
+  int baseline = frame.baseline;
+  const int text_h = frame.text_h, line_px = frame.line_px;
+  const int right = frame.right();
+  const cv::Rect& area = frame.area;
+  auto px = [&](double time, double cost) { return frame.ToPx(time, cost); };
 
   cv::Mat img(o.height_px, o.width_px, CV_8UC3, Bgr(kBackgroundRgb));
   DrawAxes(&img, area, ax, ay, s);

@@ -4,11 +4,13 @@
 #include <cstdio>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "harness/cli/commands.h"
 #include "harness/explore/strategy.h"
 #include "harness/pool/worker_pool.h"
 #include "harness/spec/types.h"
+#include "stack/base/platform_limits.h"
 
 namespace {
 
@@ -429,7 +431,7 @@ int main(int argc, char** argv) {
       ->add_option("--cores", profile_check.cores,
                    "Cores of the reference machine (default 16, the "
                    "i9-12900KF's)")
-      ->check(CLI::Range(1, 1024));
+      ->check(CLI::Range(1, adse::kMaxPlatformCores));
   profile_check_cmd
       ->add_option("--lidar-hz", profile_check.lidar_hz,
                    "LiDAR rate of the reference run (default 10, as the "
@@ -466,9 +468,11 @@ int main(int argc, char** argv) {
                    "compared)")
       ->check(CLI::Range(1, 100));
   fidelity_cmd
-      ->add_option("--clock-by", fidelity.clock_by,
-                   "What stands for the clock in the real-time runs: padding "
-                   "or quota (default: the scenario's platform.clock_by)")
+      ->add_option(
+          "--clock-by", fidelity.clock_by,
+          fmt::format("What stands for the clock in the real-time runs: {} "
+                      "(default: the scenario's platform.clock_by)",
+                      fmt::join(adse::spec::ClockByNames(), ", ")))
       ->check(CLI::IsMember(adse::spec::ClockByNames()));
   fidelity_cmd->add_option(
       "-o,--out", fidelity.out,

@@ -1,9 +1,7 @@
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "harness/cli/cli_support.h"
@@ -19,12 +17,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Writes and flushes one file of the private folder (renamed into place
+// whole at the end).
 Status WriteText(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  out.close();
-  if (!out) return Status::IoError(path + ": write failed");
-  return Status::Ok();
+  ADSE_RETURN_IF_ERROR(Env::Default()->WriteFile(path, text));
+  return Env::Default()->SyncFile(path);
 }
 
 std::string PathCsv(const geometry::Path2& path) {
@@ -117,8 +114,7 @@ int RunWorld(const WorldArgs& args) {
           ? spec->output + "/world-check" +
                 (spec->task_case.empty() ? "" : "/" + spec->task_case)
           : args.out;
-  const std::string tmp =
-      out + ".tmp." + std::to_string(static_cast<long>(::getpid()));
+  const std::string tmp = TemporaryPathFor(out);
   std::error_code ec;
   fs::remove_all(tmp, ec);
   Status status = MakeDirs(tmp + "/scans");
@@ -194,12 +190,13 @@ int RunWorld(const WorldArgs& args) {
     if (!status.ok()) break;
   }
   if (status.ok()) {
+    const std::string parent = fs::path(out).parent_path().empty()
+                                   ? std::string(".")
+                                   : fs::path(out).parent_path().string();
     fs::remove_all(out, ec);
-    fs::create_directories(
-        fs::path(out).parent_path().empty() ? "." : fs::path(out).parent_path(),
-        ec);
-    fs::rename(tmp, out, ec);
-    if (ec) status = Status::IoError(out + ": " + ec.message());
+    status = MakeDirs(parent);
+    if (status.ok()) status = Env::Default()->RenameFile(tmp, out);
+    if (status.ok()) status = Env::Default()->SyncDir(parent);
   }
   if (!status.ok()) {
     fs::remove_all(tmp, ec);

@@ -5,9 +5,11 @@
 #include <filesystem>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "harness/spec/spec_parser.h"
+#include "stack/world/world_options.h"
 
 namespace adse::llm {
 namespace {
@@ -270,10 +272,11 @@ Result<Commands> ParseCommandAnswer(const std::string& answer,
   c.traffic_seed = w.at("traffic_seed").get<int64_t>();
   Result<std::string> weather = StringField(w, "weather", "\"world\"", true);
   if (!weather.ok()) return weather.status();
-  if (*weather != "clear" && *weather != "rain" && *weather != "fog") {
+  world::Weather parsed_weather;
+  if (!world::StringToWeather(*weather, &parsed_weather)) {
     return Status::InvalidArgument(
-        "\"world\".\"weather\" must be \"clear\", \"rain\" or "
-        "\"fog\", found " +
+        fmt::format("\"world\".\"weather\" must be one of \"{}\", found ",
+                    fmt::join(world::WeatherNames(), "\", \"")) +
         Excerpt(*weather, 60));
   }
   c.weather = *weather;

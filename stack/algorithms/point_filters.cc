@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "stack/base/random.h"
 
@@ -42,6 +43,24 @@ Points RemoveInsideBoxes(const Points& points,
     if (!inside) out.push_back(p);
   }
   return out;
+}
+
+void TwistHistory::Add(double stamp_s, const geometry::Twist2& twist) {
+  samples_.emplace_back(stamp_s, twist);
+  if (samples_.size() > capacity_) samples_.pop_front();
+}
+
+geometry::Twist2 TwistHistory::Nearest(double stamp_s) const {
+  geometry::Twist2 twist;
+  double best_s = std::numeric_limits<double>::infinity();
+  for (const auto& [sample_s, sample] : samples_) {
+    const double gap_s = std::abs(sample_s - stamp_s);
+    if (gap_s < best_s) {
+      best_s = gap_s;
+      twist = sample;
+    }
+  }
+  return twist;
 }
 
 Points CorrectDistortion(const Points& points, const geometry::Twist2& twist,

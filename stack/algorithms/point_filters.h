@@ -4,7 +4,10 @@
 #define ADSE_STACK_ALGORITHMS_POINT_FILTERS_H_
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
+#include <deque>
+#include <utility>
 #include <vector>
 
 #include "stack/geometry/geometry.h"
@@ -45,6 +48,26 @@ Points RemoveInsideBoxes(const Points& points,
 
 struct DistortionParams {
   double sweep_s = 0.1;  // one revolution, 1 / LiDAR rate
+  // Odometry samples the corrector keeps (2 s at 50 Hz): like Autoware's it
+  // queues the twists, deeper, so a busy node still takes every one.
+  size_t twist_history = 100;
+};
+
+// The corrector's recent odometry: the newest `capacity` twists by stamp.
+class TwistHistory {
+ public:
+  explicit TwistHistory(size_t capacity) : capacity_(capacity) {}
+
+  // Keeps `twist`, dropping the oldest sample past the capacity.
+  void Add(double stamp_s, const geometry::Twist2& twist);
+  // The twist of the sample stamped nearest `stamp_s` (the older of two
+  // equally near); standing still when none is kept.
+  geometry::Twist2 Nearest(double stamp_s) const;
+  size_t size() const { return samples_.size(); }
+
+ private:
+  size_t capacity_;
+  std::deque<std::pair<double, geometry::Twist2>> samples_;
 };
 
 // Undoes a spinning LiDAR's motion distortion: each point is moved from the

@@ -22,8 +22,6 @@ namespace {
 // speed-up on the virtual platform is this model, not a measurement.
 constexpr double kNdtParallelFraction = 0.85;
 constexpr double kClusteringParallelFraction = 0.6;
-// Odometry samples the distortion corrector keeps (2 s at 50 Hz).
-constexpr size_t kTwistHistory = 100;
 // Queue of a tf listener's pose subscription (tf2_ros's /tf QoS depth).
 constexpr int kTfListenerDepth = 100;
 
@@ -121,31 +119,24 @@ void Stack::BuildSensing(Graph* g) {
             });
 
   // Distortion corrector: the sweep's motion from the odometry sample
-  // nearest the sweep's middle. Like Autoware's, it queues the twists (a
-  // deeper queue, so a busy node still takes every sample in turn).
+  // nearest the sweep's middle.
   algo::DistortionParams distortion;
   distortion.sweep_s = 1.0 / lidar.rate_hz;
-  const int corrector = add_stage(
-      "distortion_corrector", "points", mirror_cropped, rectified,
-      [this, distortion](const PointCloudMsg& in) {
-        const double middle_s = in.header.stamp_s + distortion.sweep_s / 2;
-        geometry::Twist2 twist;
-        double best_s = INFINITY;
-        for (const OdometryMsg& o : corrector_twists_) {
-          const double gap_s = std::abs(o.header.stamp_s - middle_s);
-          if (gap_s < best_s) {
-            best_s = gap_s;
-            twist = {o.v_mps, o.yaw_rate_rps};
-          }
-        }
-        return algo::CorrectDistortion(in.points, twist, distortion);
+  corrector_twists_ = algo::TwistHistory(distortion.twist_history);
+  const int corrector =
+      add_stage("distortion_corrector", "points", mirror_cropped, rectified,
+                [this, distortion](const PointCloudMsg& in) {
+                  return algo::CorrectDistortion(
+                      in.points,
+                      corrector_twists_.Nearest(in.header.stamp_s +
+                                                distortion.sweep_s / 2),
+                      distortion);
+                });
+  g->Subscribe<OdometryMsg>(
+      corrector, topics_.odometry, "twist", 10,
+      [this](const OdometryMsg& in, CallbackContext&) {
+        corrector_twists_.Add(in.header.stamp_s, {in.v_mps, in.yaw_rate_rps});
       });
-  g->Subscribe<OdometryMsg>(corrector, topics_.odometry, "twist", 10,
-                            [this](const OdometryMsg& in, CallbackContext&) {
-                              corrector_twists_.push_back(in);
-                              if (corrector_twists_.size() > kTwistHistory)
-                                corrector_twists_.pop_front();
-                            });
 
   algo::RingOutlierParams ring;
   ring.beams = lidar.beams;

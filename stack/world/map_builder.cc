@@ -225,7 +225,7 @@ Status Generate(const MapOptions& options, const std::string& folder) {
 }  // namespace
 
 Result<MapArtifacts> PrepareMap(const MapOptions& options,
-                                const std::string& cache_dir) {
+                                const std::string& cache_dir, Env* env) {
   MapArtifacts out;
   ContentHasher hasher;
   if (options.generator.empty()) {
@@ -262,14 +262,16 @@ Result<MapArtifacts> PrepareMap(const MapOptions& options,
 
   // Build in a private folder and rename it into place: concurrent builders
   // of the same map race harmlessly and nobody sees a half-built map.
-  ADSE_RETURN_IF_ERROR(MakeDirs(cache_dir + "/maps"));
+  ADSE_RETURN_IF_ERROR(MakeDirs(cache_dir + "/maps", env));
   // Host and pid: builders on different nodes may share the cache (a
   // home folder on NFS) and pids repeat across hosts.
   const std::string tmp = TemporaryPathFor(out.cache_folder);
   fs::remove_all(tmp, ec);
-  ADSE_RETURN_IF_ERROR(MakeDirs(tmp));
+  ADSE_RETURN_IF_ERROR(MakeDirs(tmp, env));
   Status status = Generate(options, tmp);
-  if (status.ok()) status = WriteFileAtomic(tmp + "/DONE", out.key + "\n");
+  if (status.ok()) {
+    status = WriteFileAtomic(tmp + "/DONE", out.key + "\n", env);
+  }
   if (!status.ok()) {
     fs::remove_all(tmp, ec);
     return status.WithContext("generating map '" + options.generator + "'");
@@ -280,15 +282,19 @@ Result<MapArtifacts> PrepareMap(const MapOptions& options,
       !fs::exists(out.cache_folder + "/DONE", ec)) {
     fs::remove_all(out.cache_folder, ec);
   }
-  fs::rename(tmp, out.cache_folder, ec);
-  if (ec) {
+  Status moved = env->RenameFile(tmp, out.cache_folder);
+  if (moved.ok()) {
+    moved = env->SyncDir(cache_dir + "/maps");
+  } else {
     // Another process finished first; its copy is as good as ours.
     fs::remove_all(tmp, ec);
     if (!fs::exists(out.cache_folder + "/DONE", ec)) {
-      return Status::IoError("cannot move generated map into " +
-                             out.cache_folder);
+      return moved.WithContext("cannot move generated map into " +
+                               out.cache_folder);
     }
+    moved = Status::Ok();
   }
+  if (!moved.ok()) return moved;
   return out;
 }
 

@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "stack/base/env.h"
 #include "stack/base/status.h"
 #include "stack/world/world_options.h"
 
@@ -35,9 +36,11 @@ struct ParkingLotLayout {
 };
 
 // Generates (or finds in `cache_dir`) the map. Never starts SUMO; a net that
-// does not load is reported when the world opens it.
+// does not load is reported when the world opens it. The cache's folders,
+// marker and rename go through `env`.
 Result<MapArtifacts> PrepareMap(const MapOptions& options,
-                                const std::string& cache_dir);
+                                const std::string& cache_dir,
+                                Env* env = Env::Default());
 
 }  // namespace adse::world
 

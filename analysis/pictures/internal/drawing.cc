@@ -203,6 +203,23 @@ Style PlotStyle(int width_px, int height_px) {
                           kMinUi, kMaxUi)};
 }
 
+PlotFrame MakePlotFrame(int width_px, int height_px, const Axis& ax,
+                        const Axis& ay, int top_lines, double top_pad) {
+  PlotFrame f;
+  f.style = PlotStyle(width_px, height_px);
+  const Style& s = f.style;
+  f.text_h = TextSize("Ag", s, &f.baseline).height;
+  f.line_px = f.text_h + f.baseline + s.Px(8);
+  const int left = s.Px(58) + f.line_px;
+  const int top = top_lines * f.line_px + s.Px(top_pad);
+  const int right = width_px - s.Px(24);
+  const int bottom = height_px - 2 * f.line_px - s.Px(8);
+  f.area = cv::Rect(left, top, right - left, bottom - top);
+  f.ax = ax;
+  f.ay = ay;
+  return f;
+}
+
 void DrawAxes(cv::Mat* img, const cv::Rect& area, const Axis& ax,
               const Axis& ay, const Style& s) {
   const cv::Scalar grid(235, 235, 235);

@@ -102,6 +102,29 @@ void DrawAxes(cv::Mat* img, const cv::Rect& area, const Axis& ax,
 void DrawTurnedLabel(cv::Mat* img, const std::string& label,
                      const cv::Rect& area, const Style& s);
 
+// The layout of a plot of width x height px: its style, the height of a
+// line of text, and the data area, with room on the left for the turned y
+// label and tick labels, `top_lines` lines of text and `top_pad` (unscaled)
+// px on top, tick labels and the x label below.
+struct PlotFrame {
+  Style style;
+  int text_h = 0;    // height of a line's letters, px
+  int baseline = 0;  // depth below the baseline, px
+  int line_px = 0;   // one line of text with its spacing, px
+  cv::Rect area;
+  Axis ax, ay;
+  int right() const { return area.x + area.width; }
+  int bottom() const { return area.y + area.height; }
+  // Pixel position of data point (x, y).
+  cv::Point2d ToPx(double x, double y) const {
+    return cv::Point2d(
+        area.x + (x - ax.min) / (ax.max - ax.min) * area.width,
+        area.y + area.height - (y - ay.min) / (ay.max - ay.min) * area.height);
+  }
+};
+PlotFrame MakePlotFrame(int width_px, int height_px, const Axis& ax,
+                        const Axis& ay, int top_lines, double top_pad);
+
 // 1, 2 or 5 times a power of ten, nearest above `rough` (> 0).
 double NiceAbove(double rough);
 

@@ -66,7 +66,7 @@ class Stack final : public AdStack {
   // Node state. Callbacks of one node never overlap (the executor's
   // mutual exclusion), so none of this needs locking, but for the
   // PoseListeners, which a listener node fills for another.
-  std::deque<OdometryMsg> corrector_twists_;  // newest odometry samples
+  algo::TwistHistory corrector_twists_{0};  // newest odometry samples
   std::unique_ptr<algo::NdtMatcher> ndt_;
   PoseListener ndt_poses_;  // the EKF's, for the alignment's first guess
   algo::Ekf ekf_;

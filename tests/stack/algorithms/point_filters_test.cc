@@ -143,6 +143,22 @@ TEST(CorrectDistortion, UndoesASweepTakenWhileTurning) {
   EXPECT_EQ(CorrectDistortion(distorted, {}, params), distorted);
 }
 
+TEST(TwistHistory, GivesTheSampleNearestTheSweepsMiddleAndForgetsTheOldest) {
+  TwistHistory history(3);
+  EXPECT_EQ(history.Nearest(1.0).v_mps, 0.0);  // none yet: standing
+  history.Add(0.00, {1.0, 0.0});
+  history.Add(0.02, {2.0, 0.1});
+  history.Add(0.04, {3.0, 0.2});
+  EXPECT_EQ(history.Nearest(0.021).v_mps, 2.0);
+  EXPECT_EQ(history.Nearest(0.021).yaw_rate_rps, 0.1);
+  EXPECT_EQ(history.Nearest(0.03).v_mps, 2.0);  // equally near: the older
+  EXPECT_EQ(history.Nearest(-5.0).v_mps, 1.0);
+  history.Add(0.06, {4.0, 0.3});
+  EXPECT_EQ(history.size(), 3u);
+  EXPECT_EQ(history.Nearest(-5.0).v_mps, 2.0);  // 0.00 was dropped
+  EXPECT_EQ(history.Nearest(9.0).v_mps, 4.0);
+}
+
 TEST(RemoveRingOutliers, DropsIsolatedReturnsAndKeepsSurfaces) {
   RingOutlierParams params;  // 16 rings, -15..15 deg, sensor at 1.9 m
   Points points;

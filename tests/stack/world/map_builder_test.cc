@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "tests/stack/base/testing/fault_injection_env.h"
+
 namespace adse::world {
 namespace {
 
@@ -69,6 +71,45 @@ TEST(MapBuilderTest, LeftoverOfACrashedBuildIsReplaced) {
   Result<MapArtifacts> again = PrepareMap(Lot(2), cache);
   ASSERT_TRUE(again.ok()) << again.status().ToString();
   EXPECT_TRUE(fs::exists(again->net_path));
+}
+
+// No map folder left without its DONE marker, no temporary left behind,
+// the path and the reason told, and the next build succeeds.
+void ExpectFailedBuildLeavesNothing(const std::string& cache,
+                                    const Status& status,
+                                    const std::string& reason) {
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find(reason), std::string::npos)
+      << status.ToString();
+  EXPECT_NE(status.message().find(cache + "/maps/"), std::string::npos)
+      << status.ToString();
+  if (fs::exists(cache + "/maps")) {
+    for (const auto& entry : fs::directory_iterator(cache + "/maps")) {
+      ADD_FAILURE() << "left behind: " << entry.path();
+    }
+  }
+  Result<MapArtifacts> again = PrepareMap(Lot(2), cache);
+  ASSERT_TRUE(again.ok()) << again.status().ToString();
+  EXPECT_TRUE(fs::exists(again->cache_folder + "/DONE"));
+}
+
+TEST(MapBuilderTest, AFullDiskWhileMarkingTheMapDoneLeavesNoMap) {
+  const std::string cache = FreshCache("enospc");
+  testing::FaultInjectionEnv env;
+  env.Inject({testing::FaultOp::kWriteFile, "DONE", ENOSPC});
+  Result<MapArtifacts> map = PrepareMap(Lot(2), cache, &env);
+  ExpectFailedBuildLeavesNothing(cache, map.status(),
+                                 "No space left on device");
+}
+
+TEST(MapBuilderTest, AFailedRenameIntoTheCacheLeavesNoMap) {
+  const std::string cache = FreshCache("rename");
+  testing::FaultInjectionEnv env;
+  // The first rename under maps/ is the DONE marker's, the second the
+  // folder's into place.
+  env.Inject({testing::FaultOp::kRenameFile, "/maps/", EIO, 1});
+  Result<MapArtifacts> map = PrepareMap(Lot(2), cache, &env);
+  ExpectFailedBuildLeavesNothing(cache, map.status(), "Input/output error");
 }
 
 TEST(MapBuilderTest, GivenNetIsKeyedByItsContent) {
