@@ -85,8 +85,26 @@ Result<std::string> ReadControl(const std::string& path) {
 // 0 or the errno of the failure: callers turn EACCES/EBUSY into advice.
 int WriteControlErrno(const std::string& path, const std::string& value,
                       bool fake) {
-  const int flags = O_WRONLY | O_CLOEXEC | (fake ? O_CREAT | O_TRUNC : 0);
-  const int fd = ::open(path.c_str(), flags, 0644);
+  return WriteValueErrno(path, value, fake ? O_CREAT | O_TRUNC : 0);
+}
+
+Status ValidateCpuList(const std::vector<int>& cpus) {
+  if (cpus.empty()) {
+    return Status::InvalidArgument("cpus: at least one CPU is needed");
+  }
+  std::set<int> seen;
+  for (int cpu : cpus) {
+    if (cpu < 0 || !seen.insert(cpu).second) {
+      return Status::InvalidArgument(
+          fmt::format("cpus: {} is negative or listed twice", cpu));
+    }
+  }
+  return Status::Ok();
+}
+
+int WriteValueErrno(const std::string& path, const std::string& value,
+                    int extra_flags) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | extra_flags, 0644);
   if (fd < 0) return errno;
   ssize_t n;
   do {

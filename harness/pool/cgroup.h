@@ -38,10 +38,17 @@ bool Contains(const std::vector<std::string>& v, const std::string& s);
 bool Exists(const std::string& path);
 // The whole file, read to EOF (cgroupfs reports sizes of 0 or 4096).
 Result<std::string> ReadControl(const std::string& path);
+// Writes `value` to `path` opened O_WRONLY | `extra_flags`; 0 or the errno
+// of the failure (a short write is EIO).
+int WriteValueErrno(const std::string& path, const std::string& value,
+                    int extra_flags);
 // Writes `value`; 0 or the errno of the failure. `fake` (a test folder)
 // creates the file.
 int WriteControlErrno(const std::string& path, const std::string& value,
                       bool fake);
+// InvalidArgument ("cpus: ...") unless `cpus` lists at least one CPU, each
+// non-negative and once.
+Status ValidateCpuList(const std::vector<int>& cpus);
 // The same as Unavailable naming the version, value, file and error.
 Status WriteControl(int version, const std::string& path,
                     const std::string& value, bool fake);

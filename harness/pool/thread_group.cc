@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <set>
 
 #include <fmt/format.h>
 
@@ -41,16 +40,7 @@ const CgroupMount* FindV2(const std::vector<CgroupMount>& mounts) {
 }
 
 Status Validate(const ThreadGroupOptions& o) {
-  if (o.cpus.empty()) {
-    return Status::InvalidArgument("cpus: the group needs at least one CPU");
-  }
-  std::set<int> seen;
-  for (int cpu : o.cpus) {
-    if (cpu < 0 || !seen.insert(cpu).second) {
-      return Status::InvalidArgument(
-          fmt::format("cpus: {} is negative or listed twice", cpu));
-    }
-  }
+  ADSE_RETURN_IF_ERROR(internal::ValidateCpuList(o.cpus));
   if (!std::isfinite(o.cpu_quota) || o.cpu_quota < 0.0 ||
       o.cpu_quota > static_cast<double>(o.cpus.size())) {
     return Status::InvalidArgument(fmt::format(

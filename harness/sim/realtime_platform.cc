@@ -5,6 +5,7 @@
 
 #include <utility>
 
+#include "harness/pool/cpu_clock.h"
 #include "harness/pool/thread_group.h"
 #include "harness/pool/worker_pool.h"
 #include "harness/spec/types.h"
@@ -40,6 +41,18 @@ Result<std::unique_ptr<RealTimePlatform>> RealTimePlatform::Prepare(
     group.cpu_quota = options->cpu_share * platform.cores;
     clock += fmt::format(" (share {:.3f} of a {:.3g} GHz host CPU, from {})",
                          options->cpu_share, host_ghz, source);
+  }
+  if (platform.clock_by == spec::ClockBy::kCpufreq) {
+    // The host's own clock slows the real code; the padding then works to
+    // the profile cost at f on a CPU that truly runs at f.
+    pool::CpuClockOptions hold;
+    hold.cpus = placement->stack_cpus;
+    hold.freq_ghz = platform.freq_ghz;
+    Result<std::unique_ptr<pool::CpuClockGuard>> held =
+        pool::CpuClockGuard::Hold(hold);
+    if (!held.ok()) return held.status();
+    rt->clock_ = std::move(held).value();
+    clock += " (" + rt->clock_->Describe() + ")";
   }
   Result<std::unique_ptr<pool::ThreadGroup>> made =
       pool::ThreadGroup::Create(group);

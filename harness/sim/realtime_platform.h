@@ -1,6 +1,7 @@
 // What a run on the real-time platform (platform.kind: cgroup) holds while
 // it runs: a cgroup of N host CPUs for the stack's process (and a CPU quota
-// when a quota stands for the clock), the world's thread on the other CPUs,
+// when a quota stands for the clock, or those CPUs held at the point's
+// clock by cpufreq), the world's thread on the other CPUs,
 // and handlers that turn Ctrl-C and SIGTERM into an orderly end, so that the
 // group is removed on every exit path but SIGKILL (after which the next
 // run removes it).
@@ -18,6 +19,7 @@
 #include "stack/runtime/realtime_executor.h"
 
 namespace adse::pool {
+class CpuClockGuard;
 class ThreadGroup;
 }  // namespace adse::pool
 
@@ -30,8 +32,8 @@ class RealTimePlatform {
   // with the profile and clock filled in; Prepare adds host_cpus,
   // cpu_share and enter_thread. Unavailable naming what is missing: too
   // few host CPUs, no cgroup cpuset (or cpu, for a quota) controller, no
-  // permission; InvalidArgument when a quota cannot stand for the clock
-  // (faster than the host).
+  // permission, no cpufreq for clock_by: cpufreq; InvalidArgument when a
+  // quota or cpufreq cannot stand for the clock (beyond the host's).
   static Result<std::unique_ptr<RealTimePlatform>> Prepare(
       const spec::PlatformOptions& platform, stack::RealTimeOptions* options);
   ~RealTimePlatform();
@@ -43,6 +45,8 @@ class RealTimePlatform {
 
  private:
   RealTimePlatform() = default;
+  // Held before the group is made and put back after it is removed.
+  std::unique_ptr<pool::CpuClockGuard> clock_;
   std::unique_ptr<pool::ThreadGroup> group_;
   std::optional<AffinityGuard> world_affinity_;
   std::map<std::string, std::string> notes_;

@@ -156,6 +156,8 @@ Result<std::string> RunKey(const spec::Spec& spec,
     // Keys of padded runs stay as they were before quotas.
     if (p.clock_by == spec::ClockBy::kQuota) {
       h.Add("clock_by_quota").Add(p.host_ghz);
+    } else if (p.clock_by == spec::ClockBy::kCpufreq) {
+      h.Add("clock_by_cpufreq");
     }
   }
   if (p.cost_model == spec::CostModel::kCounted) {

@@ -59,7 +59,9 @@ enum class PlatformKind { kVirtual, kCgroup };
 // kPadding: each callback busy-works to its cost at the point's clock.
 // kQuota: threads get a CPU quota of f / host_ghz of each core (cpu.max),
 // and callbacks pad to their cost at f scaled by that share.
-enum class ClockBy { kPadding, kQuota };
+// kCpufreq: the stack's CPUs are held at f by cpufreq, and callbacks pad
+// as with kPadding.
+enum class ClockBy { kPadding, kQuota, kCpufreq };
 enum class CostModel { kMeasured, kCounted };
 
 struct PlatformOptions {

@@ -17,7 +17,9 @@ const std::vector<Term<PlatformKind>>& PlatformKindTerms() {
 
 const std::vector<Term<ClockBy>>& ClockByTerms() {
   static const std::vector<Term<ClockBy>> kTerms = {
-      {ClockBy::kPadding, "padding"}, {ClockBy::kQuota, "quota"}};
+      {ClockBy::kPadding, "padding"},
+      {ClockBy::kQuota, "quota"},
+      {ClockBy::kCpufreq, "cpufreq"}};
   return kTerms;
 }
 

@@ -25,7 +25,7 @@ std::vector<std::string> KnobRoleNames();
 // The role a parameter bound to `bind` has unless it says otherwise.
 KnobRole DefaultKnobRole(const std::string& bind);
 
-// platform.clock_by: padding, quota.
+// platform.clock_by: padding, quota, cpufreq.
 const char* ClockByToString(ClockBy clock_by);
 bool StringToClockBy(std::string_view name, ClockBy* clock_by);
 std::vector<std::string> ClockByNames();

@@ -658,10 +658,11 @@ void SpecReader::ReadPlatform(const Val& v) {
   }
   if (const Val* e = f.Get("clock_by")) {
     if (ReadEnum(*e, &p.clock_by, ClockByNames(), StringToClockBy) &&
-        p.clock_by == ClockBy::kQuota && p.kind != PlatformKind::kCgroup) {
+        p.clock_by != ClockBy::kPadding && p.kind != PlatformKind::kCgroup) {
       Error(e->mark, e->path, "kind: cgroup beside it",
             "kind: " + std::string(PlatformKindToString(p.kind)) +
-                " (only the real-time platform has CPU quotas)");
+                " (only the real-time platform has CPU quotas or host "
+                "clocks)");
     }
   }
   if (const Val* e = f.Get("host_ghz")) {
