@@ -202,7 +202,9 @@ Result<std::unique_ptr<CpuClockGuard>> CpuClockGuard::Hold(
   }
   guard->record_ = record;
   for (size_t i = 0; i < options.cpus.size(); ++i) {
-    // On failure the destructor puts back every CPU's limits.
+    // On failure the destructor puts back the CPUs touched so far (a
+    // refused write may have changed one limit of the pair).
+    guard->touched_ = i + 1;
     ADSE_RETURN_IF_ERROR(
         SetLimits(FreqDir(options.sysfs_cpu_root, options.cpus[i]), chosen[i],
                   chosen[i]));
@@ -219,7 +221,8 @@ CpuClockGuard::~CpuClockGuard() { Restore(); }
 
 void CpuClockGuard::Restore() {
   bool restored = true;
-  for (const Saved& s : saved_) {
+  for (size_t i = 0; i < touched_ && i < saved_.size(); ++i) {
+    const Saved& s = saved_[i];
     const Status status =
         SetLimits(FreqDir(root_, s.cpu), s.min_khz, s.max_khz);
     if (!status.ok()) {

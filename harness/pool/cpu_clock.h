@@ -13,6 +13,7 @@
 #ifndef ADSE_HARNESS_POOL_CPU_CLOCK_H_
 #define ADSE_HARNESS_POOL_CPU_CLOCK_H_
 
+#include <cstddef>
 #include <memory>
 #include <string>
 #include <vector>
@@ -65,6 +66,7 @@ class CpuClockGuard {
   std::string root_;
   std::string record_;  // <state_dir>/cpufreq-<pid>, empty: none written
   std::vector<Saved> saved_;
+  size_t touched_ = 0;  // the first CPUs of saved_ whose limits were written
   long held_khz_ = 0;
   std::string description_;
 };

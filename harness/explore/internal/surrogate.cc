@@ -422,24 +422,20 @@ double MetricModel::Bounded(double value) const {
 }
 
 double MetricModel::ToMetric(double t) const {
-  if (count_hint &&
-      (space_ == MetricSpace::kLog || space_ == MetricSpace::kLinear)) {
-    const double v = space_ == MetricSpace::kLog
-                         ? std::exp(std::clamp(t, -700.0, 700.0))
-                         : shift_ + scale_ * t;
-    return std::max(0.0, std::round(v));
-  }
+  double value = 0.0;
   switch (space_) {
     case MetricSpace::kLog:
-      return std::exp(std::clamp(t, -700.0, 700.0));
+      value = std::exp(std::clamp(t, -700.0, 700.0));
+      break;
     case MetricSpace::kBoolean:
       return t >= 0.5 ? 1.0 : 0.0;
     case MetricSpace::kReciprocal:
       return t > 0.0 ? scale_ / t : kInf;  // a rate of 0: never done
     case MetricSpace::kLinear:
+      value = shift_ + scale_ * t;
       break;
   }
-  return shift_ + scale_ * t;
+  return count_hint ? std::max(0.0, std::round(value)) : value;
 }
 
 Trend MetricModel::FitTrend(TrendShape shape,
