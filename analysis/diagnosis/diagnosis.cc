@@ -183,15 +183,21 @@ class TraceView {
 // The trace keeps only each execution's lowest core and core count. The
 // virtual executor gives a starting callback the lowest-numbered free cores,
 // so replaying starts in time order recovers the exact cores held; where the
-// replay disagrees with the recorded first_core (another platform), the
-// contiguous range first_core..first_core+cores-1 is assumed.
+// replay disagrees with the recorded first_core (the real-time platform,
+// processor sharing: first_core is the executor thread, and a team may
+// run on any core), the range first_core..first_core+cores-1 is assumed,
+// wrapped round the platform's cores. Executions there may overlap on a
+// core (the OS shares it), so a core's utilisation is capped at 1.
 std::vector<double> CoreUtilization(const runfile::RunData& run,
                                     const TraceView& view) {
   const auto& records = run.trace.callbacks;
-  int num_cores = ParseCores(run);
-  for (const auto& r : records) {
-    if (r.first_core >= 0 && r.cores > 0) {
-      num_cores = std::max(num_cores, r.first_core + r.cores);
+  const int platform_cores = ParseCores(run);
+  int num_cores = platform_cores;
+  if (platform_cores == 0) {  // unknown: as many as the records name
+    for (const auto& r : records) {
+      if (r.first_core >= 0 && r.cores > 0) {
+        num_cores = std::max(num_cores, r.first_core + r.cores);
+      }
     }
   }
   std::vector<double> busy_s(num_cores, 0.0);
@@ -207,7 +213,10 @@ std::vector<double> CoreUtilization(const runfile::RunData& run,
   std::vector<int> cores;
   for (size_t i : order) {
     const stack::CallbackRecord& r = records[i];
-    if (r.first_core < 0 || r.cores <= 0) continue;
+    if (r.first_core < 0 || r.first_core >= num_cores || r.cores <= 0 ||
+        r.cores > num_cores) {
+      continue;
+    }
     cores.clear();
     for (int c = 0; c < num_cores && static_cast<int>(cores.size()) < r.cores;
          ++c) {
@@ -217,7 +226,7 @@ std::vector<double> CoreUtilization(const runfile::RunData& run,
         cores.front() != r.first_core) {
       cores.clear();
       for (int c = r.first_core; c < r.first_core + r.cores; ++c) {
-        cores.push_back(c);
+        cores.push_back(c % num_cores);
       }
     }
     const double busy = view.Clip(r.start_s, r.end_s);
@@ -229,7 +238,7 @@ std::vector<double> CoreUtilization(const runfile::RunData& run,
   std::vector<double> utilization(num_cores, 0.0);
   if (view.window_s() > 0.0) {
     for (int c = 0; c < num_cores; ++c) {
-      utilization[c] = busy_s[c] / view.window_s();
+      utilization[c] = std::min(1.0, busy_s[c] / view.window_s());
     }
   }
   return utilization;

@@ -8,6 +8,34 @@
 #include "analysis/metrics/parking_metrics.h"
 
 namespace adse::analysis {
+namespace {
+
+// Core-seconds during which the executions of `records` that start by
+// `end_s` held more threads than `cores`: under processor sharing and in
+// real time threads beyond the cores wait for one, so those are not busy
+// cores. Run to completion never holds more (0 exactly).
+double OversubscribedCoreS(const std::vector<stack::CallbackRecord>& records,
+                           double end_s, int cores) {
+  std::vector<std::pair<double, int>> steps;  // (time, threads added)
+  for (const stack::CallbackRecord& r : records) {
+    if (r.start_s > end_s || r.cores <= 0) continue;
+    steps.push_back({r.start_s, r.cores});
+    steps.push_back({r.end_s, -r.cores});
+  }
+  // Ends before starts at equal times: a core freed is taken at once.
+  std::sort(steps.begin(), steps.end());
+  double excess_s = 0.0;
+  int threads = 0;
+  for (size_t i = 0; i < steps.size(); ++i) {
+    threads += steps[i].second;
+    if (threads > cores && i + 1 < steps.size()) {
+      excess_s += (threads - cores) * (steps[i + 1].first - steps[i].first);
+    }
+  }
+  return excess_s;
+}
+
+}  // namespace
 
 double Percentile(std::vector<double> values, double q) {
   if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -75,6 +103,10 @@ std::map<std::string, double> ComputeRunMetrics(
   double cores = 0.0;
   if (auto it = run.platform.find("cores"); it != run.platform.end()) {
     cores = std::atof(it->second.c_str());
+  }
+  if (cores >= 1) {
+    busy_core_s -= OversubscribedCoreS(run.trace.callbacks, end_s,
+                                       static_cast<int>(cores));
   }
   m["cpu_utilization"] =
       (cores > 0 && end_s > 0) ? busy_core_s / (cores * end_s) : 0.0;

@@ -30,7 +30,8 @@ inline constexpr char kCensoredMetric[] = "censored";
 // scan it derives from), dropped_messages (all topics), lidar_frames_dropped,
 // collisions, ego_collisions (those the ego caused, or not known not to
 // have), callbacks (executions), cpu_utilization (busy core-seconds /
-// cores x nav time).
+// cores x nav time; an execution holds `cores` threads from start to end,
+// and no more cores than the platform has are busy at once).
 std::map<std::string, double> ComputeRunMetrics(
     const runfile::RunData& run, const RunMetricsOptions& options = {});
 

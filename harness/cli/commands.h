@@ -181,7 +181,10 @@ struct FidelityArgs {
   std::vector<std::string> points;  // "cores=1,freq_ghz=2.1,..."
   int runs = 3;                     // real-time runs per point
   std::string clock_by;             // "padding"/"quota"; empty: the file's
-  std::string out;                  // folder; default <output>/fidelity
+  // The virtual platform's dispatches, each held against the same
+  // real-time runs; empty: the file's platform.dispatch.
+  std::vector<std::string> dispatch;
+  std::string out;  // folder; default <output>/fidelity
 };
 int RunFidelity(const FidelityArgs& args);
 

@@ -2,6 +2,7 @@
 // the virtual platform and K times on the real-time one, compared (harness/
 // fidelity). Exit 0 ok, 2 bad input (a point outside the space, a scenario
 // without a cost profile, more cores than the host gives), 1 otherwise.
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -76,6 +77,15 @@ int RunFidelity(const FidelityArgs& args) {
   }
   fidelity::FidelityOptions options;
   options.runs = args.runs;
+  for (const std::string& name : args.dispatch) {
+    spec::Dispatch d;
+    spec::StringToDispatch(name, &d);  // CLI11 checked the name
+    if (std::find(options.dispatches.begin(), options.dispatches.end(), d) ==
+        options.dispatches.end()) {
+      options.dispatches.push_back(d);
+    }
+  }
+  const bool several = options.dispatches.size() > 1;
   options.on_run = [](const std::string& point, const std::string& what) {
     std::fprintf(stderr, "%s: %s run ...\n", point.c_str(), what.c_str());
   };
@@ -84,66 +94,88 @@ int RunFidelity(const FidelityArgs& args) {
                       {"runs", args.runs},
                       {"points", nlohmann::json::array()}};
   if (!args.task_case.empty()) j["task_case"] = args.task_case;
+  std::vector<fidelity::PointFidelity> compared;
   for (size_t i = 0; i < points.size(); ++i) {
-    Result<fidelity::PointFidelity> f =
-        fidelity::ComparePoint(*spec, points[i], options);
-    if (!f.ok()) {
-      ReportError(*spec, f.status());
+    Result<fidelity::PointRuns> runs =
+        fidelity::RunPoint(*spec, points[i], options);
+    if (!runs.ok()) {
+      ReportError(*spec, runs.status());
       // What was compared so far stays on disk.
       if (!text.empty()) (void)WriteFileAtomic(dir + "/fidelity.txt", text);
-      return ExitCodeFor(f.status());
+      return ExitCodeFor(runs.status());
     }
-    const std::string table = fidelity::FormatPointFidelity(*f);
-    std::printf("%s\n", table.c_str());
-    text += table + "\n";
-    j["points"].push_back(
-        {{"point", f->point},
-         {"confinement", f->confinement},
-         {"clock_by", f->clock_by},
-         {"ended",
-          {{"virtual", f->virtual_outcome},
-           {"realtime", f->realtime_outcomes}}},
-         {"metrics", ComparisonsJson(f->metrics)},
-         {"callback_p50_ms", ComparisonsJson(f->callback_p50_ms)},
-         {"callback_p99_ms", ComparisonsJson(f->callback_p99_ms)},
-         {"callback_p50_ms_per_kunit",
-          ComparisonsJson(f->callback_p50_ms_per_kunit)}});
-    // Per point: the callbacks' p50, virtual above real-time.
-    std::vector<analysis::ComparisonRow> rows;
-    for (const fidelity::Comparison& c : f->callback_p50_ms) {
-      std::optional<double> real;
-      if (std::isfinite(c.realtime_median)) real = c.realtime_median;
-      rows.push_back({c.name, c.virtual_value, real});
-    }
-    if (!rows.empty()) {
-      analysis::ComparisonChartOptions o;
-      o.title = fmt::format(
-          "p50 callback latency at {}{}: virtual vs real time", f->point,
-          args.task_case.empty() ? "" : ", case " + args.task_case);
-      o.adse_name = "virtual platform";
-      o.reference_name =
-          args.runs == 1
-              ? std::string("real time (1 run)")
-              : fmt::format("real time (median of {} runs)", args.runs);
-      const std::string png = fmt::format("{}/fidelity-{}.png", dir, i + 1);
-      if (Status drawn = analysis::RenderComparisonChart(rows, o, png);
-          !drawn.ok()) {
-        std::fprintf(stderr, "error: %s\n", drawn.message().c_str());
-        return 1;
+    for (size_t d = 0; d < runs->dispatches.size(); ++d) {
+      const fidelity::PointFidelity f = fidelity::ComparePoint(*runs, d);
+      // With several dispatches each file names its own.
+      const std::string suffix = several ? "-" + f.dispatch : "";
+      const std::string table = fidelity::FormatPointFidelity(f);
+      std::printf("%s\n", table.c_str());
+      text += table + "\n";
+      j["points"].push_back(
+          {{"point", f.point},
+           {"dispatch", f.dispatch},
+           {"confinement", f.confinement},
+           {"clock_by", f.clock_by},
+           {"ended",
+            {{"virtual", f.virtual_outcome},
+             {"realtime", f.realtime_outcomes}}},
+           {"metrics", ComparisonsJson(f.metrics)},
+           {"callback_p50_ms", ComparisonsJson(f.callback_p50_ms)},
+           {"callback_p99_ms", ComparisonsJson(f.callback_p99_ms)},
+           {"callback_p50_ms_per_kunit",
+            ComparisonsJson(f.callback_p50_ms_per_kunit)}});
+      // Per point: the callbacks' p50, virtual above real-time.
+      std::vector<analysis::ComparisonRow> rows;
+      for (const fidelity::Comparison& c : f.callback_p50_ms) {
+        std::optional<double> real;
+        if (std::isfinite(c.realtime_median)) real = c.realtime_median;
+        rows.push_back({c.name, c.virtual_value, real});
       }
+      if (!rows.empty()) {
+        analysis::ComparisonChartOptions o;
+        o.title = fmt::format(
+            "p50 callback latency at {}{}: virtual vs real time", f.point,
+            args.task_case.empty() ? "" : ", case " + args.task_case);
+        o.adse_name = fmt::format("virtual platform ({})", f.dispatch);
+        o.reference_name =
+            args.runs == 1
+                ? std::string("real time (1 run)")
+                : fmt::format("real time (median of {} runs)", args.runs);
+        const std::string png =
+            fmt::format("{}/fidelity-{}{}.png", dir, i + 1, suffix);
+        if (Status drawn = analysis::RenderComparisonChart(rows, o, png);
+            !drawn.ok()) {
+          std::fprintf(stderr, "error: %s\n", drawn.message().c_str());
+          return 1;
+        }
+      }
+      compared.push_back(f);
     }
     // The runs themselves, for adse analyze and h5py.
-    for (size_t r = 0; r < f->runs.size(); ++r) {
-      const std::string path =
-          r == 0 ? fmt::format("{}/runs/{}-virtual.h5", dir, i + 1)
-                 : fmt::format("{}/runs/{}-realtime-{}.h5", dir, i + 1, r);
-      Status written = MakeDirs(dir + "/runs");
-      if (written.ok()) written = runfile::WriteRunFile(path, f->runs[r]);
-      if (!written.ok()) {
-        std::fprintf(stderr, "error: %s\n", written.message().c_str());
-        return 1;
-      }
+    Status written = MakeDirs(dir + "/runs");
+    for (size_t d = 0; d < runs->virtual_runs.size() && written.ok(); ++d) {
+      const std::string suffix =
+          several
+              ? fmt::format("-{}", spec::DispatchToString(runs->dispatches[d]))
+              : "";
+      written = runfile::WriteRunFile(
+          fmt::format("{}/runs/{}-virtual{}.h5", dir, i + 1, suffix),
+          runs->virtual_runs[d]);
     }
+    for (size_t r = 0; r < runs->realtime_runs.size() && written.ok(); ++r) {
+      written = runfile::WriteRunFile(
+          fmt::format("{}/runs/{}-realtime-{}.h5", dir, i + 1, r + 1),
+          runs->realtime_runs[r]);
+    }
+    if (!written.ok()) {
+      std::fprintf(stderr, "error: %s\n", written.message().c_str());
+      return 1;
+    }
+  }
+  if (points.size() > 1 || several) {
+    const std::string summary = fidelity::FormatDispatchSummary(compared);
+    std::printf("%s", summary.c_str());
+    text += summary;
   }
   Status saved = WriteFileAtomic(dir + "/fidelity.txt", text);
   if (saved.ok()) {

@@ -474,6 +474,16 @@ int main(int argc, char** argv) {
                       "(default: the scenario's platform.clock_by)",
                       fmt::join(adse::spec::ClockByNames(), ", ")))
       ->check(CLI::IsMember(adse::spec::ClockByNames()));
+  fidelity_cmd
+      ->add_option(
+          "--dispatch", fidelity.dispatch,
+          fmt::format("The virtual platform's dispatch, one or more of {} "
+                      "(comma-separated), each held against the same "
+                      "real-time runs (default: the scenario's "
+                      "platform.dispatch)",
+                      fmt::join(adse::spec::DispatchNames(), ", ")))
+      ->delimiter(',')
+      ->check(CLI::IsMember(adse::spec::DispatchNames()));
   fidelity_cmd->add_option(
       "-o,--out", fidelity.out,
       "Folder for fidelity.txt, fidelity.json and fidelity-N.png (default: "

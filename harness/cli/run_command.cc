@@ -12,6 +12,7 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "analysis/metrics/run_metrics.h"
@@ -21,6 +22,7 @@
 #include "harness/cli/commands.h"
 #include "harness/slurm/allocation.h"
 #include "harness/slurm/step_pool.h"
+#include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/files.h"
 
@@ -102,8 +104,8 @@ class Progress : public campaign::ExplorerListener {
                    : fmt::format(", nav {:.1f} s, ctrl {:.1f} Hz",
                                  campaign::RowMetric(row, "nav_time_s"),
                                  campaign::RowMetric(row, "ctrl_rate_hz")),
-          campaign::RowMetric(row, "hardware_cost"),
-          row.feasible ? "feasible" : "infeasible", row.source,
+          campaign::RowMetric(row, "hardware_cost"), Feasibility(row, censored),
+          row.source,
           row.source == "simulated" ? fmt::format(" {:.1f} s", row.wall_s)
                                     : "");
     }
@@ -112,6 +114,20 @@ class Progress : public campaign::ExplorerListener {
       std::fprintf(stderr, "%s\n", line.c_str());
     }
     Draw();
+  }
+
+  // "feasible", or "infeasible: " and the constraints it breaks, which a
+  // reason such as goal_reached does not say. A censored run's reason
+  // already names the bound that stopped it, and its withheld metrics
+  // would name every constraint.
+  std::string Feasibility(const campaign::EvaluationRow& row,
+                          bool censored) const {
+    if (row.feasible) return "feasible";
+    if (censored) return "infeasible";
+    const std::vector<std::string> broken =
+        spec::ViolatedConstraints(spec_, row.metrics, row.point);
+    if (broken.empty()) return "infeasible";
+    return fmt::format("infeasible: {}", fmt::join(broken, ", "));
   }
 
   void AttemptFailed(const campaign::EvalRequest& request, int attempt,

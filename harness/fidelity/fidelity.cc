@@ -14,6 +14,7 @@
 #include "harness/profile/profile_check.h"
 #include "harness/sim/simulator.h"
 #include "harness/spec/design_point.h"
+#include "harness/spec/types.h"
 
 namespace adse::fidelity {
 namespace {
@@ -185,9 +186,9 @@ PointFidelity CompareRuns(const runfile::RunData& virtual_run,
   return f;
 }
 
-Result<PointFidelity> ComparePoint(const spec::Spec& input,
-                                   const spec::DesignPoint& point,
-                                   const FidelityOptions& options) {
+Result<PointRuns> RunPoint(const spec::Spec& input,
+                           const spec::DesignPoint& point,
+                           const FidelityOptions& options) {
   if (options.runs < 1) {
     return Status::InvalidArgument(
         fmt::format("runs: expected at least 1, found {}", options.runs));
@@ -195,39 +196,59 @@ Result<PointFidelity> ComparePoint(const spec::Spec& input,
   ADSE_RETURN_IF_ERROR(input.design_space.Check(point));
   spec::Spec spec = input;
   spec.harness.early_stop = false;
-  const std::string text = spec::FormatPoint(spec.design_space, point);
+  PointRuns runs;
+  runs.point = spec::FormatPoint(spec.design_space, point);
+  runs.dispatches = options.dispatches;
+  if (runs.dispatches.empty()) runs.dispatches = {spec.platform.dispatch};
 
   spec.platform.kind = spec::PlatformKind::kVirtual;
-  if (options.on_run) options.on_run(text, "virtual");
-  Result<runfile::RunData> virtual_run = sim::SimulatePoint(spec, point);
-  if (!virtual_run.ok()) return virtual_run.status();
-
-  spec.platform.kind = spec::PlatformKind::kCgroup;
-  std::vector<runfile::RunData> realtime;
-  for (int k = 0; k < options.runs; ++k) {
+  for (spec::Dispatch dispatch : runs.dispatches) {
+    spec.platform.dispatch = dispatch;
     if (options.on_run) {
-      options.on_run(text, fmt::format("real-time {}/{}", k + 1, options.runs));
+      options.on_run(
+          runs.point,
+          runs.dispatches.size() == 1
+              ? std::string("virtual")
+              : fmt::format("virtual {}", spec::DispatchToString(dispatch)));
     }
     Result<runfile::RunData> run = sim::SimulatePoint(spec, point);
     if (!run.ok()) return run.status();
-    realtime.push_back(std::move(run).value());
+    runs.virtual_runs.push_back(std::move(run).value());
   }
-  PointFidelity f = CompareRuns(*virtual_run, realtime);
-  f.point = text;
-  const std::map<std::string, std::string>& notes = realtime.front().platform;
-  if (notes.count("confinement")) f.confinement = notes.at("confinement");
-  if (notes.count("clock_by")) f.clock_by = notes.at("clock_by");
-  f.runs.push_back(std::move(virtual_run).value());
-  for (runfile::RunData& r : realtime) f.runs.push_back(std::move(r));
+
+  spec.platform.kind = spec::PlatformKind::kCgroup;
+  spec.platform.dispatch = spec::Dispatch::kRunToCompletion;
+  for (int k = 0; k < options.runs; ++k) {
+    if (options.on_run) {
+      options.on_run(runs.point,
+                     fmt::format("real-time {}/{}", k + 1, options.runs));
+    }
+    Result<runfile::RunData> run = sim::SimulatePoint(spec, point);
+    if (!run.ok()) return run.status();
+    runs.realtime_runs.push_back(std::move(run).value());
+  }
+  return runs;
+}
+
+PointFidelity ComparePoint(const PointRuns& runs, size_t i) {
+  PointFidelity f = CompareRuns(runs.virtual_runs.at(i), runs.realtime_runs);
+  f.point = runs.point;
+  f.dispatch = spec::DispatchToString(runs.dispatches.at(i));
+  if (!runs.realtime_runs.empty()) {
+    const std::map<std::string, std::string>& notes =
+        runs.realtime_runs.front().platform;
+    if (notes.count("confinement")) f.confinement = notes.at("confinement");
+    if (notes.count("clock_by")) f.clock_by = notes.at("clock_by");
+  }
   return f;
 }
 
 std::string FormatPointFidelity(const PointFidelity& f) {
   std::ostringstream out;
-  const size_t k = f.runs.empty() ? 0 : f.runs.size() - 1;
+  const size_t k = f.realtime_outcomes.size();
   out << fmt::format(
-      "{}: virtual vs real-time (median of {} run{}; {}; clock by {})\n",
-      f.point, k, k == 1 ? "" : "s", f.confinement, f.clock_by);
+      "{}: virtual ({}) vs real-time (median of {} run{}; {}; clock by {})\n",
+      f.point, f.dispatch, k, k == 1 ? "" : "s", f.confinement, f.clock_by);
   // How the runs ended leads: a real-time run that ended otherwise than
   // the virtual one is a disagreement no median shows.
   const bool same =
@@ -273,6 +294,53 @@ std::string FormatPointFidelity(const PointFidelity& f) {
   table("callback p99 latency (ms)", f.callback_p99_ms);
   table("callback p50 latency per 1000 work units (ms)",
         f.callback_p50_ms_per_kunit);
+  return out.str();
+}
+
+std::string FormatDispatchSummary(const std::vector<PointFidelity>& points) {
+  struct Tally {
+    int points = 0, rate_met = 0, nav = 0, nav_met = 0;
+    int callbacks = 0, callbacks_met = 0;
+    std::vector<double> abs_p50;
+  };
+  std::vector<std::string> order;
+  std::map<std::string, Tally> by;
+  for (const PointFidelity& f : points) {
+    if (by.count(f.dispatch) == 0) order.push_back(f.dispatch);
+    Tally& t = by[f.dispatch];
+    ++t.points;
+    for (const Comparison& c : f.metrics) {
+      if (c.name == "ctrl_rate_hz") t.rate_met += c.met();
+      // Compared where some run arrived: a nav time no run has is no test.
+      if (c.name == "nav_time_s" &&
+          (std::isfinite(c.virtual_value) || !c.realtime.empty())) {
+        ++t.nav;
+        t.nav_met += c.met();
+      }
+    }
+    for (const Comparison& c : f.callback_p50_ms) {
+      ++t.callbacks;
+      t.callbacks_met += c.met();
+      if (std::isfinite(c.difference)) {
+        t.abs_p50.push_back(std::abs(c.difference));
+      }
+    }
+  }
+  std::ostringstream out;
+  out << fmt::format("{:<20} {:>16} {:>16} {:>20} {:>18}\n", "dispatch",
+                     "ctrl rate ±10%", "nav time ±10%", "callback p50 ±20%",
+                     "median |p50 diff|");
+  for (const std::string& d : order) {
+    Tally& t = by[d];
+    out << fmt::format(
+        "{:<20} {:>16} {:>16} {:>20} {:>18}\n", d,
+        fmt::format("{} of {}", t.rate_met, t.points),
+        fmt::format("{} of {}", t.nav_met, t.nav),
+        fmt::format("{} of {}", t.callbacks_met, t.callbacks),
+        t.abs_p50.empty()
+            ? std::string("—")
+            : fmt::format("{:.1f}%", 100.0 * Quantile(t.abs_p50, 0.5)));
+  }
   return out.str();
 }
 

@@ -20,7 +20,11 @@ namespace adse::fidelity {
 struct FidelityOptions {
   // Real-time runs per point (their median is compared), >= 1.
   int runs = 3;
-  // Told before each run: (point text, "virtual" | "real-time k/K").
+  // The virtual platform's dispatches to hold against the same real-time
+  // runs, one virtual run each; empty: the scenario's platform.dispatch.
+  std::vector<spec::Dispatch> dispatches;
+  // Told before each run: (point text, "virtual[ <dispatch>]" |
+  // "real-time k/K").
   std::function<void(const std::string&, const std::string&)> on_run;
 };
 
@@ -51,6 +55,7 @@ struct Comparison {
 
 struct PointFidelity {
   std::string point;        // FormatPoint text
+  std::string dispatch;     // the virtual run's platform.dispatch
   std::string confinement;  // where the real-time runs ran
   std::string clock_by;     // what stood for the clock there
   // How each run ended (termination_reason): the virtual run's, then one
@@ -72,17 +77,26 @@ struct PointFidelity {
   // latency only because one platform gave it more work; this tells the
   // executor model's error from that.
   std::vector<Comparison> callback_p50_ms_per_kunit;
-  // The runs themselves (the virtual one, then the real-time ones).
-  std::vector<runfile::RunData> runs;
+};
+
+// One point's runs: one virtual run per dispatch, and the real-time runs.
+struct PointRuns {
+  std::string point;  // FormatPoint text
+  std::vector<spec::Dispatch> dispatches;
+  std::vector<runfile::RunData> virtual_runs;  // one per dispatch
+  std::vector<runfile::RunData> realtime_runs;
 };
 
 // Runs `point` both ways. Early stop is off for these runs: a censored
 // time would compare nothing. Errors: the point's or the platform's
 // (InvalidArgument for a point outside the space or a scenario without a
 // cost profile, Unavailable when the host has too few CPUs).
-Result<PointFidelity> ComparePoint(const spec::Spec& spec,
-                                   const spec::DesignPoint& point,
-                                   const FidelityOptions& options);
+Result<PointRuns> RunPoint(const spec::Spec& spec,
+                           const spec::DesignPoint& point,
+                           const FidelityOptions& options);
+
+// The virtual run of `runs.dispatches[i]` held against the real-time runs.
+PointFidelity ComparePoint(const PointRuns& runs, size_t i);
 
 // The quantities of `virtual_run` and `realtime_runs` (exposed for tests).
 PointFidelity CompareRuns(const runfile::RunData& virtual_run,
@@ -90,6 +104,11 @@ PointFidelity CompareRuns(const runfile::RunData& virtual_run,
 
 // The table `adse fidelity` prints for one point.
 std::string FormatPointFidelity(const PointFidelity& fidelity);
+
+// How often each dispatch met the targets over `points` (each point's
+// comparisons for every dispatch): the control rate and nav time within
+// 10 %, the callback p50s within 20 %, and the median |p50 difference|.
+std::string FormatDispatchSummary(const std::vector<PointFidelity>& points);
 
 }  // namespace adse::fidelity
 

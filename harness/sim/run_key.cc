@@ -150,6 +150,11 @@ Result<std::string> RunKey(const spec::Spec& spec,
   h.Add("platform").Add(static_cast<long long>(p.kind)).Add(p.reference_ghz);
   h.Add(static_cast<long long>(p.cost_model)).Add(p.cost_scale);
   h.Add(static_cast<long long>(p.cores)).Add(p.freq_ghz);
+  // Keys of runs to completion stay as they were before processor sharing.
+  if (p.kind == spec::PlatformKind::kVirtual &&
+      p.dispatch == spec::Dispatch::kProcessorSharing) {
+    h.Add("dispatch_processor_sharing");
+  }
   // Keys of virtual runs stay as they were before the real-time platform.
   if (p.kind == spec::PlatformKind::kCgroup) {
     h.Add("time_dilation").Add(p.time_dilation);

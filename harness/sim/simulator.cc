@@ -255,6 +255,9 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   vp.freq_ghz = platform.freq_ghz;
   vp.reference_ghz = platform.reference_ghz;
   vp.cost_scale = platform.cost_scale;
+  vp.dispatch = platform.dispatch == spec::Dispatch::kProcessorSharing
+                    ? stack::DispatchKind::kProcessorSharing
+                    : stack::DispatchKind::kRunToCompletion;
   std::string profile_name;
   if (platform.cost_model == spec::CostModel::kCounted &&
       !platform.profile.empty()) {
@@ -540,6 +543,9 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
                   {"cost_model", spec::CostModelToString(platform.cost_model)},
                   {"cost_scale", fmt::format("{}", platform.cost_scale)}};
   if (!profile_name.empty()) run.platform["profile"] = profile_name;
+  if (platform.kind == spec::PlatformKind::kVirtual) {
+    run.platform["dispatch"] = spec::DispatchToString(platform.dispatch);
+  }
   for (const auto& [key, value] : platform_notes) run.platform[key] = value;
   if (platform.kind == spec::PlatformKind::kCgroup) {
     run.platform["world_lag_max_s"] = fmt::format("{:.4f}", world_lag_max_s);

@@ -174,15 +174,21 @@ Result<bool> EvaluateConstraint(const Spec& spec, const std::string& constraint,
   return std::isfinite(*value) && *value != 0.0;
 }
 
+std::vector<std::string> ViolatedConstraints(
+    const Spec& spec, const std::map<std::string, double>& metrics,
+    const DesignPoint& point) {
+  std::vector<std::string> violated;
+  for (const std::string& constraint : spec.constraints) {
+    Result<bool> holds = EvaluateConstraint(spec, constraint, metrics, point);
+    if (!holds.ok() || !*holds) violated.push_back(constraint);
+  }
+  return violated;
+}
+
 int ViolatedConstraintCount(const Spec& spec,
                             const std::map<std::string, double>& metrics,
                             const DesignPoint& point) {
-  int violated = 0;
-  for (const std::string& constraint : spec.constraints) {
-    Result<bool> holds = EvaluateConstraint(spec, constraint, metrics, point);
-    if (!holds.ok() || !*holds) ++violated;
-  }
-  return violated;
+  return static_cast<int>(ViolatedConstraints(spec, metrics, point).size());
 }
 
 Result<PointConfig> ApplyPoint(const Spec& spec, const DesignPoint& point) {

@@ -55,9 +55,13 @@ Result<bool> EvaluateConstraint(const Spec& spec, const std::string& constraint,
                                 const std::map<std::string, double>& metrics,
                                 const DesignPoint& point);
 
-// How many of the spec's constraints `metrics` and the point do not
-// satisfy; one that cannot be evaluated (a missing metric) counts as not
-// satisfied: nothing shows it holds.
+// The spec's constraints that `metrics` and the point do not satisfy, in
+// the spec's order; one that cannot be evaluated (a missing metric) counts
+// as not satisfied: nothing shows it holds.
+std::vector<std::string> ViolatedConstraints(
+    const Spec& spec, const std::map<std::string, double>& metrics,
+    const DesignPoint& point);
+// How many there are.
 int ViolatedConstraintCount(const Spec& spec,
                             const std::map<std::string, double>& metrics,
                             const DesignPoint& point);

@@ -62,6 +62,11 @@ enum class PlatformKind { kVirtual, kCgroup };
 // kCpufreq: the stack's CPUs are held at f by cpufreq, and callbacks pad
 // as with kPadding.
 enum class ClockBy { kPadding, kQuota, kCpufreq };
+// kind virtual: how its cores run the callbacks in progress
+// (stack::DispatchKind). kRunToCompletion: a callback holds its cores to its
+// end. kProcessorSharing: one executor thread per core, data-parallel
+// parts on a full team, the cores shared among all threads with work.
+enum class Dispatch { kRunToCompletion, kProcessorSharing };
 enum class CostModel { kMeasured, kCounted };
 
 struct PlatformOptions {
@@ -85,6 +90,8 @@ struct PlatformOptions {
   // clock and stretches every callback cost alike, so a small host can
   // hold a heavy stack.
   double time_dilation = 1.0;
+  // kind virtual: how its cores run the callbacks (see Dispatch).
+  Dispatch dispatch = Dispatch::kRunToCompletion;
   // kind cgroup: what stands for the point's clock (see ClockBy).
   ClockBy clock_by = ClockBy::kPadding;
   // clock_by quota: the host's clock in GHz; 0 reads it from /proc/cpuinfo.

@@ -311,6 +311,15 @@ const std::vector<Field<PlatformOptions>>& PlatformFields() {
       Integer("cores", &PlatformOptions::cores),
       Number("freq_ghz", &PlatformOptions::freq_ghz),
       Number("cost_scale", &PlatformOptions::cost_scale),
+      // Written when not the default, so that the normalised text of
+      // scenarios from before it stays as it was.
+      {"dispatch",
+       [](YAML::Emitter& out, const PlatformOptions& p, const Spec&) {
+         out << DispatchToString(p.dispatch);
+       },
+       [](const PlatformOptions& p) {
+         return p.dispatch != Dispatch::kRunToCompletion;
+       }},
       [] {
         // Only the real-time platform has a clock to slow.
         Field<PlatformOptions> f =

@@ -23,6 +23,13 @@ const std::vector<Term<ClockBy>>& ClockByTerms() {
   return kTerms;
 }
 
+const std::vector<Term<Dispatch>>& DispatchTerms() {
+  static const std::vector<Term<Dispatch>> kTerms = {
+      {Dispatch::kRunToCompletion, "run_to_completion"},
+      {Dispatch::kProcessorSharing, "processor_sharing"}};
+  return kTerms;
+}
+
 const std::vector<Term<CostModel>>& CostModelTerms() {
   static const std::vector<Term<CostModel>> kTerms = {
       {CostModel::kMeasured, "measured"}, {CostModel::kCounted, "counted"}};
@@ -76,6 +83,14 @@ bool StringToClockBy(std::string_view name, ClockBy* clock_by) {
   return ValueOf(ClockByTerms(), name, clock_by);
 }
 std::vector<std::string> ClockByNames() { return NamesOf(ClockByTerms()); }
+
+const char* DispatchToString(Dispatch dispatch) {
+  return NameOf(DispatchTerms(), dispatch);
+}
+bool StringToDispatch(std::string_view name, Dispatch* dispatch) {
+  return ValueOf(DispatchTerms(), name, dispatch);
+}
+std::vector<std::string> DispatchNames() { return NamesOf(DispatchTerms()); }
 
 const char* CostModelToString(CostModel model) {
   return NameOf(CostModelTerms(), model);

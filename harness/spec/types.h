@@ -30,6 +30,11 @@ const char* ClockByToString(ClockBy clock_by);
 bool StringToClockBy(std::string_view name, ClockBy* clock_by);
 std::vector<std::string> ClockByNames();
 
+// platform.dispatch: run_to_completion, processor_sharing.
+const char* DispatchToString(Dispatch dispatch);
+bool StringToDispatch(std::string_view name, Dispatch* dispatch);
+std::vector<std::string> DispatchNames();
+
 const char* CostModelToString(CostModel model);
 bool StringToCostModel(std::string_view name, CostModel* model);
 std::vector<std::string> CostModelNames();

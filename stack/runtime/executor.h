@@ -24,11 +24,26 @@ struct CountedCost {
 
 enum class CostModelKind { kMeasured, kCounted };
 
+// How the virtual platform's cores run the callbacks in progress.
+enum class DispatchKind {
+  // A callback holds its cores from start to end: one core, or a
+  // data-parallel callback as many free cores as it can use when it starts.
+  kRunToCompletion,
+  // Each of `cores` executor threads runs one callback; a data-parallel
+  // callback's parallel part runs on a team of min(max_threads, cores)
+  // threads whether or not cores are free (as an OpenMP team does), and the
+  // cores are shared equally among all threads that have work (as the OS's
+  // preemptive scheduler shares them), so everything in progress runs
+  // slower while threads outnumber cores.
+  kProcessorSharing,
+};
+
 struct VirtualPlatformOptions {
   int cores = 4;               // virtual cores
   double freq_ghz = 2.1;       // their frequency
   double reference_ghz = 2.1;  // frequency at which host costs count as-is
   CostModelKind cost_model = CostModelKind::kMeasured;
+  DispatchKind dispatch = DispatchKind::kRunToCompletion;
   // kCounted: cost per callback name ("<node>/<callback>"). A callback
   // without an entry costs `default_counted`.
   std::map<std::string, CountedCost> counted;

@@ -20,9 +20,10 @@
 //   exclusive callback group).
 // - Dispatch: while a core is free, start the ready callback (whose node is
 //   idle) with the earliest ready time, ties to the lower callback index.
-//   Non-preemptive. A subscription takes its OLDEST queued message (kTake).
-//   The real code runs at once; it sees now_s() = start; its publications are
-//   held until its end.
+//   Non-preemptive (kRunToCompletion; with kProcessorSharing "core" reads
+//   "executor thread", one per core, see below). A subscription takes its
+//   OLDEST queued message (kTake). The real code runs at once; it sees now_s()
+//   = start; its publications are held until its end.
 // - Cost: base = host thread CPU time (kMeasured) or fixed + per_unit * units
 //   (kCounted; host_cpu_s is then recorded as 0 unless
 //   record_host_cpu_when_counted); k = min(max_threads, free cores at start)
@@ -36,6 +37,14 @@
 //   cost the cores are freed, held publications are released in order
 //   (kPublish, per-topic seq from 0) and the CallbackRecord is appended
 //   (records are in completion order).
+// - kProcessorSharing: a started callback holds one executor thread; its
+//   cost is base * factor as above, of which the serial part (1 - p) runs on
+//   that thread and the parallel part p on k = min(max_threads, cores)
+//   threads, base * p * factor / k each, whether or not cores are free. The
+//   cores are shared equally among the threads with work
+//   (internal/processor_sharing.h), so the end is known only when it comes;
+//   CallbackRecord::cost_s is then end - start, cores k, first_core the
+//   executor thread. On one core both dispatches give the same trace.
 // - AdvanceTo(t) applies events strictly before t, then sets now = t.
 // - Errors (a callback or sink throws, a bad topic) are sticky: AdvanceTo
 //   returns the same Status from then on.
@@ -46,6 +55,7 @@
 #include <cstdint>
 #include <exception>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -57,6 +67,7 @@
 #include "stack/base/random.h"
 #include "stack/runtime/executor.h"
 #include "stack/runtime/internal/executor_parts.h"
+#include "stack/runtime/internal/processor_sharing.h"
 
 namespace adse::stack {
 namespace {
@@ -93,8 +104,10 @@ constexpr int kKindShift = 62;
 struct Event {
   double t;
   uint64_t key;   // kind << 62 | insertion sequence
-  int32_t index;  // completion, timer: callback; arrival: slot in arrivals_
+  int32_t index;  // completion, timer: callback; arrival: slot in arrivals_;
+                  // kSharedEnd: a part ends under processor sharing
 };
+constexpr int32_t kSharedEnd = -1;
 
 // std::push_heap builds a max-heap; this order puts the earliest on top.
 struct EventLater {
@@ -183,10 +196,12 @@ class VirtualExecutor final : public Executor {
   const Trace& trace() const override { return trace_; }
 
  private:
-  void PushEvent(double t, EventKind kind, int32_t index) {
-    heap_.push_back(
-        {t, (static_cast<uint64_t>(kind) << kKindShift) | next_seq_++, index});
+  uint64_t PushEvent(double t, EventKind kind, int32_t index) {
+    const uint64_t key =
+        (static_cast<uint64_t>(kind) << kKindShift) | next_seq_++;
+    heap_.push_back({t, key, index});
     std::push_heap(heap_.begin(), heap_.end(), EventLater());
+    return key;
   }
   Event PopEvent() {
     std::pop_heap(heap_.begin(), heap_.end(), EventLater());
@@ -205,6 +220,11 @@ class VirtualExecutor final : public Executor {
   void OnArrival(int32_t slot);
   void OnTimerFire(int c);
   void OnCompletion(int c);
+  // Processor sharing: the parts that end now; those that end a callback
+  // complete it. Events pushed before the sharing last changed are stale.
+  void OnSharedEnd(uint64_t key);
+  // Processor sharing: the event of the next part's end at the new rates.
+  void PushSharedEnd();
   // Publishes `message` on `topic` now: traces it, queues it for every
   // subscription and calls the sinks.
   void Deliver(int topic, const MessagePtr& message, double stamp_s,
@@ -244,7 +264,14 @@ class VirtualExecutor final : public Executor {
   std::vector<char> node_busy_;
   std::vector<int32_t> core_owner_;  // callback holding each core, or -1
   int free_cores_;
+  int cores_;
   std::shared_ptr<const CostProfile> profile_;  // keeps `profiled` valid
+  // kProcessorSharing only: the work in progress, whether it changed since
+  // its next end was pushed, and that event's key.
+  std::optional<internal::ProcessorSharing> sharing_;
+  bool sharing_changed_ = false;
+  uint64_t shared_end_key_ = 0;
+  std::vector<int> ended_;  // scratch for OnSharedEnd
 
   VirtualContext context_;
   Trace trace_;
@@ -260,6 +287,7 @@ VirtualExecutor::VirtualExecutor(const Graph* graph,
       measured_(options.cost_model == CostModelKind::kMeasured),
       read_clock_(measured_ || options.record_host_cpu_when_counted),
       free_cores_(options.cores),
+      cores_(options.cores),
       profile_(options.profile),
       context_(static_cast<int>(graph->topics().size())) {
   const auto& callbacks = graph->callbacks();
@@ -269,6 +297,9 @@ VirtualExecutor::VirtualExecutor(const Graph* graph,
   topic_seq_.assign(num_topics, 0);
   node_busy_.assign(graph->nodes().size(), 0);
   core_owner_.assign(options.cores, -1);
+  if (options.dispatch == DispatchKind::kProcessorSharing) {
+    sharing_.emplace(options.cores);
+  }
 
   states_.resize(callbacks.size());
   for (size_t c = 0; c < callbacks.size(); ++c) {
@@ -358,6 +389,7 @@ Status VirtualExecutor::AdvanceTo(double t_s) {
       ApplyEvent(PopEvent());
     }
     if (error_.ok()) Dispatch();
+    if (error_.ok() && sharing_changed_) PushSharedEnd();
   }
   in_advance_ = false;
   if (!error_.ok()) return error_;
@@ -368,7 +400,11 @@ Status VirtualExecutor::AdvanceTo(double t_s) {
 void VirtualExecutor::ApplyEvent(const Event& e) {
   switch (static_cast<EventKind>(e.key >> kKindShift)) {
     case kCompletion:
-      OnCompletion(e.index);
+      if (e.index == kSharedEnd) {
+        OnSharedEnd(e.key);
+      } else {
+        OnCompletion(e.index);
+      }
       break;
     case kArrival:
       OnArrival(e.index);
@@ -402,16 +438,39 @@ void VirtualExecutor::OnTimerFire(int c) {
   if (!st.running) MakeReady(c);
 }
 
+void VirtualExecutor::OnSharedEnd(uint64_t key) {
+  if (key != shared_end_key_) return;
+  ended_.clear();
+  sharing_->AdvanceTo(now_, &ended_);
+  sharing_changed_ = true;
+  for (size_t i = 0; i < ended_.size() && error_.ok(); ++i) {
+    OnCompletion(ended_[i]);
+  }
+}
+
+void VirtualExecutor::PushSharedEnd() {
+  sharing_changed_ = false;
+  if (sharing_->empty()) return;
+  shared_end_key_ = PushEvent(sharing_->NextEndS(), kCompletion, kSharedEnd);
+}
+
 void VirtualExecutor::OnCompletion(int c) {
   CallbackState& st = states_[c];
-  const CallbackRecord& rec = st.record;
-  for (int i = rec.first_core, left = rec.cores; left > 0; ++i) {
+  CallbackRecord& rec = st.record;
+  // Under processor sharing a callback holds one executor thread, and its
+  // end is now.
+  const int held = sharing_ ? 1 : rec.cores;
+  if (sharing_) {
+    rec.end_s = now_;
+    rec.cost_s = now_ - rec.start_s;
+  }
+  for (int i = rec.first_core, left = held; left > 0; ++i) {
     if (core_owner_[i] == c) {
       core_owner_[i] = -1;
       --left;
     }
   }
-  free_cores_ += rec.cores;
+  free_cores_ += held;
   node_busy_[st.spec->node] = 0;
   st.running = false;
   trace_.callbacks.push_back(rec);
@@ -564,25 +623,48 @@ void VirtualExecutor::Start(int c) {
   } else {
     base_s = st.counted.fixed_s + st.counted.per_unit_s * units;
   }
-  const int k = std::max(1, std::min(max_threads, free_cores_));
+  // Run to completion: k free cores, held to the end. Processor sharing:
+  // one executor thread, and a team of k whatever is free.
+  const int k =
+      std::max(1, std::min(max_threads, sharing_ ? cores_ : free_cores_));
+  const int held = sharing_ ? 1 : k;
   double cost_s = AmdahlS(base_s, p, k) * factor;
   if (!(cost_s >= kMinCostS)) cost_s = kMinCostS;  // also catches NaN
 
   int first_core = -1;
-  for (int i = 0, taken = 0; taken < k; ++i) {
+  for (int i = 0, taken = 0; taken < held; ++i) {
     if (core_owner_[i] >= 0) continue;
     core_owner_[i] = c;
     if (first_core < 0) first_core = i;
     ++taken;
   }
-  free_cores_ -= k;
+  free_cores_ -= held;
 
-  rec.end_s = now_ + cost_s;
-  rec.cost_s = cost_s;
   rec.host_cpu_s = host_cpu_s;
   rec.work_units = units;
   rec.cores = k;
   rec.first_core = first_core;
+  if (sharing_) {
+    // One team's thread does the serial part, then each its share; with no
+    // team the whole cost is serial, computed as above so that one core
+    // gives the same trace under both dispatches.
+    double serial_s = cost_s;
+    double share_s = 0.0;
+    if (k > 1) {
+      const double pc = std::clamp(p, 0.0, 1.0);
+      serial_s = base_s * (1.0 - pc) * factor;
+      share_s = base_s * pc * factor / k;
+      if (!(serial_s + share_s >= kMinCostS)) {  // also catches NaN
+        serial_s = kMinCostS;
+        share_s = 0.0;
+      }
+    }
+    sharing_->Add(c, now_, serial_s, share_s, k);
+    sharing_changed_ = true;
+    return;
+  }
+  rec.end_s = now_ + cost_s;
+  rec.cost_s = cost_s;
   PushEvent(rec.end_s, kCompletion, c);
 }
 
@@ -608,6 +690,10 @@ Status ValidateVirtualPlatformOptions(const VirtualPlatformOptions& options) {
   if (options.cost_model != CostModelKind::kMeasured &&
       options.cost_model != CostModelKind::kCounted) {
     return Status::InvalidArgument("cost_model: unknown kind");
+  }
+  if (options.dispatch != DispatchKind::kRunToCompletion &&
+      options.dispatch != DispatchKind::kProcessorSharing) {
+    return Status::InvalidArgument("dispatch: unknown kind");
   }
   if (options.profile != nullptr) {
     ADSE_RETURN_IF_ERROR(ValidateCostProfile(*options.profile));

@@ -54,7 +54,7 @@ const std::vector<std::string> kGoalKeys = {
 const std::vector<std::string> kPlatformKeys = {
     "kind",          "reference_ghz", "cost_model", "calibration",
     "profile",       "cores",         "freq_ghz",   "cost_scale",
-    "time_dilation", "clock_by",      "host_ghz"};
+    "time_dilation", "clock_by",      "host_ghz",   "dispatch"};
 
 }  // namespace
 
@@ -663,6 +663,16 @@ void SpecReader::ReadPlatform(const Val& v) {
             "kind: " + std::string(PlatformKindToString(p.kind)) +
                 " (only the real-time platform has CPU quotas or host "
                 "clocks)");
+    }
+  }
+  if (const Val* e = f.Get("dispatch")) {
+    if (ReadEnum(*e, &p.dispatch, DispatchNames(), StringToDispatch) &&
+        p.dispatch != Dispatch::kRunToCompletion &&
+        p.kind != PlatformKind::kVirtual) {
+      Error(e->mark, e->path, "kind: virtual beside it",
+            "kind: " + std::string(PlatformKindToString(p.kind)) +
+                " (on the real-time platform the host's scheduler "
+                "dispatches)");
     }
   }
   if (const Val* e = f.Get("host_ghz")) {

@@ -487,6 +487,14 @@ TEST(DiagnosisStatsTest, CallbackAndCoreUtilization) {
   const Diagnosis d2 = Diagnose(b.run());
   EXPECT_NEAR(d2.core_utilization[0], 0.3, 1e-12);
   EXPECT_NEAR(d2.core_utilization[3], 0.1, 1e-12);
+
+  // A team of two started from the last executor thread (processor
+  // sharing, real time) wraps round to core 0: no fifth core appears.
+  b.Record(c, 6.0, 6.0, 1.0, 2, 3);
+  const Diagnosis d3 = Diagnose(b.run());
+  ASSERT_EQ(d3.core_utilization.size(), 4u);
+  EXPECT_NEAR(d3.core_utilization[0], 0.4, 1e-12);
+  EXPECT_NEAR(d3.core_utilization[3], 0.2, 1e-12);
 }
 
 TEST(DiagnosisStatsTest, LatencyPercentiles) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 
 namespace adse::analysis {
 namespace {
@@ -54,6 +55,24 @@ TEST(RunMetricsTest, KnownRunGivesKnownMetrics) {
   EXPECT_NEAR(m.at("e2e_latency_p50_s"), 0.195, 0.011);
   EXPECT_NEAR(m.at("e2e_latency_p99_s"), 0.29, 0.002);
   EXPECT_NEAR(m.at("cpu_utilization"), 10.0 / 20.0, 1e-9);
+}
+
+// Processor sharing and real time: a team of two and another callback on
+// two cores hold three threads, but only two cores can be busy.
+TEST(RunMetricsTest, ThreadsBeyondThePlatformsCoresAreNotBusyCores) {
+  runfile::RunData run = TenSecondRun();
+  run.trace.callbacks.clear();
+  for (const auto& [start, end, cores] :
+       {std::tuple{0.0, 4.0, 2}, std::tuple{1.0, 3.0, 1}}) {
+    stack::CallbackRecord r;
+    r.start_s = start;
+    r.end_s = end;
+    r.cost_s = end - start;
+    r.cores = cores;
+    run.trace.callbacks.push_back(r);
+  }
+  // 2 x 4 + 1 x 2 thread-seconds, of which 1 x 2 beyond two cores.
+  EXPECT_NEAR(ComputeRunMetrics(run).at("cpu_utilization"), 8.0 / 20.0, 1e-12);
 }
 
 TEST(RunMetricsTest, TimeoutIsNotCompleted) {

@@ -424,7 +424,8 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
       "fidelity " + file +
       " --points cores=1,freq_ghz=2.1,lidar_hz=7 --runs 1 -o " + out.string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
-  EXPECT_NE(run.out.find("virtual vs real-time (median of 1 run; cgroup v"),
+  EXPECT_NE(run.out.find("virtual (run_to_completion) vs real-time (median "
+                         "of 1 run; cgroup v"),
             std::string::npos)
       << run.out;
   EXPECT_NE(run.out.find("ctrl_rate_hz"), std::string::npos) << run.out;
@@ -442,6 +443,42 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
                            "runs/1-virtual.h5", "runs/1-realtime-1.h5"}) {
     EXPECT_TRUE(fs::is_regular_file(out / name)) << name;
   }
+  // Both dispatches against the same real-time run: a table, a picture and
+  // a virtual run file each, and how often each met the targets.
+  const fs::path both = out / "both";
+  const CommandRun two =
+      Adse("fidelity " + file +
+           " --points cores=1,freq_ghz=2.1,lidar_hz=7 --runs 1 --dispatch "
+           "run_to_completion,processor_sharing -o " +
+           both.string());
+  ASSERT_EQ(two.exit_code, 0) << two.out;
+  EXPECT_NE(two.out.find("virtual (processor_sharing) vs real-time"),
+            std::string::npos)
+      << two.out;
+  EXPECT_NE(two.out.find("dispatch "), std::string::npos) << two.out;
+  EXPECT_NE(two.out.find("\nprocessor_sharing "), std::string::npos) << two.out;
+  std::ifstream both_in(both / "fidelity.json");
+  const nlohmann::json both_json =
+      nlohmann::json::parse(both_in, nullptr, false);
+  ASSERT_FALSE(both_json.is_discarded());
+  ASSERT_EQ(both_json["points"].size(), 2u);
+  EXPECT_EQ(both_json["points"][0]["dispatch"], "run_to_completion");
+  EXPECT_EQ(both_json["points"][1]["dispatch"], "processor_sharing");
+  // On one core the two dispatches are the same model.
+  EXPECT_EQ(both_json["points"][0]["metrics"],
+            both_json["points"][1]["metrics"]);
+  for (const char* name :
+       {"fidelity-1-run_to_completion.png", "fidelity-1-processor_sharing.png",
+        "runs/1-virtual-run_to_completion.h5",
+        "runs/1-virtual-processor_sharing.h5", "runs/1-realtime-1.h5"}) {
+    EXPECT_TRUE(fs::is_regular_file(both / name)) << name;
+  }
+  const CommandRun bad_dispatch =
+      Adse("fidelity " + file +
+           " --points cores=1,freq_ghz=2.1,lidar_hz=7 --dispatch shared");
+  EXPECT_EQ(bad_dispatch.exit_code, 2) << bad_dispatch.out;
+  EXPECT_NE(bad_dispatch.out.find("--dispatch"), std::string::npos)
+      << bad_dispatch.out;
   // A point outside the space, and no runs, are bad input.
   const CommandRun outside =
       Adse("fidelity " + file +
@@ -482,6 +519,34 @@ TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
   EXPECT_NE(status.out.find("\"done\": 2"), std::string::npos) << status.out;
   EXPECT_NE(status.out.find("\"pending\": 0"), std::string::npos) << status.out;
   EXPECT_NE(status.out.find("\"total\": 2"), std::string::npos) << status.out;
+}
+
+TEST(CliRunTest, AnInfeasiblePointsProgressLineNamesTheConstraintItBroke) {
+  std::ifstream in(Small());
+  std::string text((std::istreambuf_iterator<char>(in)),
+                   std::istreambuf_iterator<char>());
+  const std::string from =
+      "constraints: [nav_time_s <= 60, ctrl_rate_hz >= 1, completed]";
+  ASSERT_NE(text.find(from), std::string::npos);
+  // No run meets a 1 ms latency; no early stop ends a run for it either,
+  // so the run reaches the goal and is still infeasible.
+  text.replace(text.find(from), from.size(),
+               "constraints: [nav_time_s <= 60, e2e_latency_p50_s <= 0.001, "
+               "completed]");
+  // One point, generous enough to reach the goal.
+  const std::string cores = "values: [1, 4, 16]";
+  ASSERT_NE(text.find(cores), std::string::npos);
+  text.replace(text.find(cores), cores.size(), "values: [16]");
+  const std::string file = WriteScenario("latency_bound", text);
+  const fs::path out = fs::temp_directory_path() / "adse_cli_latency_bound";
+  fs::remove_all(out);
+  const CommandRun run =
+      Adse("run " + file + " --budget 1 --no-cache -o " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find(": goal_reached, nav "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("infeasible: e2e_latency_p50_s <= 0.001 (simulated"),
+            std::string::npos)
+      << run.out;
 }
 
 TEST(CliRunTest,

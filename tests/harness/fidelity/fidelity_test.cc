@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -134,6 +135,42 @@ TEST(FidelityTest, ACallbackThatNeverRanInARealTimeRunMissesItsTarget) {
   EXPECT_EQ(work.realtime_counts, (std::vector<int>{100, 0}));
   EXPECT_NEAR(work.difference, 0.0, 1e-9);
   EXPECT_FALSE(work.met());
+}
+
+// Two dispatches held against the same real-time runs at two points: the
+// summary counts each dispatch's met targets apart, and says where no run
+// arrived to compare a nav time.
+TEST(FidelityTest, TheSummaryCountsEachDispatchsMetTargets) {
+  const std::vector<runfile::RunData> realtime = {MadeRun(100.0, 30.0, 10.0),
+                                                  MadeRun(100.0, 30.0, 10.0)};
+  std::vector<PointFidelity> points;
+  for (const auto& [dispatch, work_ms] :
+       {std::pair{"run_to_completion", 7.0},
+        std::pair{"processor_sharing", 10.5}}) {
+    PointFidelity arrived =
+        CompareRuns(MadeRun(100.0, 30.0, work_ms), realtime);
+    arrived.dispatch = dispatch;
+    points.push_back(arrived);
+    PointFidelity timed_out = CompareRuns(MadeRun(30.0, 30.0, work_ms, false),
+                                          {MadeRun(30.0, 30.0, 10.0, false)});
+    timed_out.dispatch = dispatch;
+    points.push_back(timed_out);
+  }
+  const std::string summary = FormatDispatchSummary(points);
+  // Its rows with their spacing folded: dispatch, control rate, nav time
+  // (only where a run arrived), callback p50s, median |p50 difference|.
+  std::vector<std::string> rows;
+  std::istringstream lines(summary);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream words(line);
+    std::string row, word;
+    while (words >> word) row += (row.empty() ? "" : " ") + word;
+    rows.push_back(row);
+  }
+  ASSERT_EQ(rows.size(), 3u) << summary;
+  // 10 ms in real time: +42.9 % from 7 ms (missed), -4.8 % from 10.5 (met).
+  EXPECT_EQ(rows[1], "run_to_completion 2 of 2 1 of 1 0 of 2 42.9%");
+  EXPECT_EQ(rows[2], "processor_sharing 2 of 2 1 of 1 2 of 2 4.8%");
 }
 
 TEST(FidelityTest, MoreWorkIsToldFromASlowerExecutorPerWorkUnit) {

@@ -57,6 +57,9 @@ TEST(RunKeyTest, ChangesWithWhatChangesARun) {
   spec::Spec platform = base;
   platform.platform.cost_scale = 20;
   EXPECT_NE(key, Key(platform));
+  spec::Spec shared = base;
+  shared.platform.dispatch = spec::Dispatch::kProcessorSharing;
+  EXPECT_NE(key, Key(shared));
 }
 
 // Keys of maps without signals stay as they were before the ego obeyed

@@ -105,6 +105,26 @@ TEST(SpecErrorsTest, AClockQuotaNeedsTheRealTimePlatform) {
   EXPECT_DOUBLE_EQ(again->platform.host_ghz, 2.6);
 }
 
+TEST(SpecErrorsTest, ProcessorSharingIsTheVirtualPlatformsDispatch) {
+  ExpectError(std::string(kHead) +
+                  "platform: {kind: cgroup, dispatch: processor_sharing}\n",
+              "platform.dispatch", 9, "expected kind: virtual beside it");
+  ExpectError(std::string(kHead) + "platform: {dispatch: shared}\n",
+              "platform.dispatch", 9, "run_to_completion, processor_sharing");
+  Result<Spec> shared = ParseSpec(
+      std::string(kHead) + "platform: {dispatch: processor_sharing}\n",
+      "ok.yaml", "");
+  ASSERT_TRUE(shared.ok()) << shared.status().message();
+  EXPECT_EQ(shared->platform.dispatch, Dispatch::kProcessorSharing);
+  Result<Spec> again = ParseSpec(NormalizedYaml(*shared), "again.yaml", "/");
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  EXPECT_EQ(again->platform.dispatch, Dispatch::kProcessorSharing);
+  // The default is not written, so older normalised texts stay the same.
+  Result<Spec> plain = ParseSpec(kHead, "ok.yaml", "");
+  ASSERT_TRUE(plain.ok());
+  EXPECT_EQ(NormalizedYaml(*plain).find("dispatch"), std::string::npos);
+}
+
 TEST(SpecErrorsTest, WaypointsAreAListOfPlacesEachLocated) {
   std::string text = kHead;
   text.replace(text.find("  goal:"), 7, "  via: {x: 5, y: 0}\n  goal:");

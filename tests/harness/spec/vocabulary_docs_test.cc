@@ -62,6 +62,7 @@ TEST(VocabularyDocsTest, EveryChoiceIsDocumentedAsTheParserKnowsIt) {
       {"kind", PlatformKindNames()},
       {"cost_model", CostModelNames()},
       {"clock_by", ClockByNames()},
+      {"dispatch", DispatchNames()},
       {"strategy", StrategyNames()},
       {"backend", LlmBackendNames()},
       {"isolation", pool::IsolationNames()},

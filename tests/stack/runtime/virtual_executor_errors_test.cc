@@ -37,6 +37,9 @@ TEST(VirtualExecutorTest, InvalidOptionsNameTheField) {
   o.cores = 0;
   EXPECT_NE(OptionsError(o).find("cores"), std::string::npos);
   o = {};
+  o.dispatch = static_cast<DispatchKind>(7);
+  EXPECT_NE(OptionsError(o).find("dispatch"), std::string::npos);
+  o = {};
   o.freq_ghz = -1.0;
   EXPECT_NE(OptionsError(o).find("freq_ghz"), std::string::npos);
   o = {};

@@ -319,7 +319,9 @@ TEST(VirtualExecutorTest, MinimumCostIsOneMicrosecond) {
 
 // A data-parallel callback (p = 0.8, up to 4 threads) behind `blockers`
 // single-threaded callbacks that hold cores until t = 10.
-CallbackRecord RunAmdahl(int cores, int blockers, int max_threads) {
+CallbackRecord RunAmdahl(
+    int cores, int blockers, int max_threads,
+    DispatchKind dispatch = DispatchKind::kRunToCompletion) {
   Graph g;
   std::map<std::string, CountedCost> costs;
   for (int i = 0; i < blockers; ++i) {
@@ -334,7 +336,9 @@ CallbackRecord RunAmdahl(int cores, int blockers, int max_threads) {
                                                .max_threads = max_threads});
                              });
   costs["par/t"] = {1.0, 0.0};
-  auto ex = CreateVirtual(g, Counted(cores, costs));
+  VirtualPlatformOptions options = Counted(cores, costs);
+  options.dispatch = dispatch;
+  auto ex = CreateVirtual(g, options);
   EXPECT_TRUE(ex->AdvanceTo(5.0).ok());
   const auto r = RecordsOf(ex->trace(), par);
   EXPECT_EQ(r.size(), 1u);
@@ -361,8 +365,10 @@ TEST(VirtualExecutorTest, AmdahlLimitedByMaxThreads) {
   EXPECT_EQ(r.cores, 2);
 }
 
-// Parallel cores are held to the end: a callback ready meanwhile waits.
-TEST(VirtualExecutorTest, ParallelCallbackHoldsAllItsCores) {
+// A data-parallel callback (a team of up to two, cost 1 s) at t = 0 and a
+// 0.1 s callback ready at t = 0.1, on two cores: their records.
+std::pair<CallbackRecord, CallbackRecord> RunTeamAndLater(
+    DispatchKind dispatch) {
   Graph g;
   const int par =
       g.AddTimer(g.AddNode("par"), "t", 100.0, [](CallbackContext& ctx) {
@@ -370,16 +376,25 @@ TEST(VirtualExecutorTest, ParallelCallbackHoldsAllItsCores) {
       });
   const int later = g.AddTimer(
       g.AddNode("later"), "t", 100.0, [](CallbackContext&) {}, 0.1);
-  auto ex = CreateVirtual(
-      g, Counted(2, {{"par/t", {1.0, 0}}, {"later/t", {0.1, 0}}}));
-  ASSERT_TRUE(ex->AdvanceTo(5.0).ok());
+  VirtualPlatformOptions options =
+      Counted(2, {{"par/t", {1.0, 0}}, {"later/t", {0.1, 0}}});
+  options.dispatch = dispatch;
+  auto ex = CreateVirtual(g, options);
+  EXPECT_TRUE(ex->AdvanceTo(5.0).ok());
   const auto rp = RecordsOf(ex->trace(), par);
   const auto rl = RecordsOf(ex->trace(), later);
-  ASSERT_EQ(rp.size(), 1u);
-  ASSERT_EQ(rl.size(), 1u);
-  EXPECT_NEAR(rp[0].end_s, 0.5, kTol);
-  EXPECT_NEAR(rl[0].ready_s, 0.1, kTol);
-  EXPECT_NEAR(rl[0].start_s, 0.5, kTol);
+  EXPECT_EQ(rp.size(), 1u);
+  EXPECT_EQ(rl.size(), 1u);
+  if (rp.size() != 1 || rl.size() != 1) return {};
+  return {rp[0], rl[0]};
+}
+
+// Parallel cores are held to the end: a callback ready meanwhile waits.
+TEST(VirtualExecutorTest, ParallelCallbackHoldsAllItsCores) {
+  const auto [par, later] = RunTeamAndLater(DispatchKind::kRunToCompletion);
+  EXPECT_NEAR(par.end_s, 0.5, kTol);
+  EXPECT_NEAR(later.ready_s, 0.1, kTol);
+  EXPECT_NEAR(later.start_s, 0.5, kTol);
 }
 
 // A 0.625 s timer callback with a 0.25 s period: fires that find an earlier
@@ -548,7 +563,8 @@ TEST(VirtualExecutorTest, MeasuredCostFollowsHostCpuTime) {
 constexpr int kMixedCores = 3;
 
 // A graph with timers, drops, parallel work and a shared node.
-Trace RunMixedGraph() {
+Trace RunMixedGraph(int cores = kMixedCores,
+                    DispatchKind dispatch = DispatchKind::kRunToCompletion) {
   Graph g;
   const int lidar = g.AddTopic<Msg>("lidar");
   const int filtered = g.AddTopic<Msg>("filtered");
@@ -580,12 +596,14 @@ Trace RunMixedGraph() {
                ctx.Publish(cmd, m);
              });
   g.AddSink<Msg>(cmd, [](const Msg&, double) {});
-  auto ex =
-      CreateVirtual(g, Counted(kMixedCores, {{"filter/cb", {0.01, 0.0004}},
-                                             {"loc/ndt", {0.02, 0.001}},
-                                             {"loc/ekf", {0.004, 0}},
-                                             {"ctrl/pose", {0.001, 0}},
-                                             {"follow/t", {0.035, 0}}}));
+  VirtualPlatformOptions options =
+      Counted(cores, {{"filter/cb", {0.01, 0.0004}},
+                      {"loc/ndt", {0.02, 0.001}},
+                      {"loc/ekf", {0.004, 0}},
+                      {"ctrl/pose", {0.001, 0}},
+                      {"follow/t", {0.035, 0}}});
+  options.dispatch = dispatch;
+  auto ex = CreateVirtual(g, options);
   for (int step = 1; step <= 100; ++step) {
     const double t = step * 0.1;
     for (int j = 0; j < 3; ++j) {  // 30 Hz: faster than the filter keeps up
@@ -606,9 +624,10 @@ void ExpectBitEqual(T a, T b, const char* what, size_t i) {
   }
 }
 
-TEST(VirtualExecutorTest, CountedRunsAreBitIdentical) {
-  const Trace a = RunMixedGraph();
-  const Trace b = RunMixedGraph();
+// `cost_rounding`: cost_s may differ by rounding (one dispatch stores the
+// cost, the other end - start).
+void ExpectSameTrace(const Trace& a, const Trace& b,
+                     bool cost_rounding = false) {
   ASSERT_GT(a.callbacks.size(), 100u);
   ASSERT_EQ(a.callbacks.size(), b.callbacks.size());
   ASSERT_EQ(a.topic_events.size(), b.topic_events.size());
@@ -621,7 +640,11 @@ TEST(VirtualExecutorTest, CountedRunsAreBitIdentical) {
     ExpectBitEqual(x.ready_s, y.ready_s, "ready_s", i);
     ExpectBitEqual(x.start_s, y.start_s, "start_s", i);
     ExpectBitEqual(x.end_s, y.end_s, "end_s", i);
-    ExpectBitEqual(x.cost_s, y.cost_s, "cost_s", i);
+    if (cost_rounding) {
+      EXPECT_NEAR(x.cost_s, y.cost_s, 1e-15) << "cost_s #" << i;
+    } else {
+      ExpectBitEqual(x.cost_s, y.cost_s, "cost_s", i);
+    }
     ExpectBitEqual(x.host_cpu_s, y.host_cpu_s, "host_cpu_s", i);
     ExpectBitEqual(x.work_units, y.work_units, "work_units", i);
     ExpectBitEqual(x.cores, y.cores, "cores", i);
@@ -638,6 +661,11 @@ TEST(VirtualExecutorTest, CountedRunsAreBitIdentical) {
     ExpectBitEqual(x.seq, y.seq, "seq", i);
     ExpectBitEqual(x.stamp_s, y.stamp_s, "stamp_s", i);
   }
+}
+
+TEST(VirtualExecutorTest, CountedRunsAreBitIdentical) {
+  const Trace a = RunMixedGraph();
+  ExpectSameTrace(a, RunMixedGraph());
   // The graph is busy enough to exercise drops and parallel runs.
   int drops = 0;
   for (const auto& e : a.topic_events) drops += e.kind == TopicEvent::kDrop;
@@ -661,6 +689,73 @@ TEST(VirtualExecutorTest, CoresAreNeverOversubscribed) {
       EXPECT_NE(x.node, y.node) << "node overlap at " << x.start_s;
     }
     EXPECT_LE(busy, kMixedCores) << "at " << x.start_s;
+  }
+}
+
+// ---- Processor sharing -----------------------------------------------------
+
+// A team of two and a callback ready meanwhile: the latter starts at once
+// on the second executor thread, and the three threads share two cores.
+TEST(VirtualExecutorTest, ProcessorSharingSlowsWhatRunsBesideATeam) {
+  const auto [par, later] = RunTeamAndLater(DispatchKind::kProcessorSharing);
+  EXPECT_NEAR(later.start_s, 0.1, kTol);
+  EXPECT_NEAR(later.end_s, 0.25, kTol);  // 0.1 at 2/3 of a core
+  EXPECT_NEAR(later.cost_s, 0.15, kTol);
+  EXPECT_EQ(later.first_core, 1);
+  // 0.5 per thread: 0.1 alone, 0.1 shared, then the rest alone.
+  EXPECT_NEAR(par.end_s, 0.55, kTol);
+  EXPECT_EQ(par.cores, 2);
+  EXPECT_EQ(par.first_core, 0);
+}
+
+// The team is as large as the callback can use, busy cores or not (run to
+// completion takes the two free ones: 0.6, AmdahlOnTwoFreeCores).
+TEST(VirtualExecutorTest, ProcessorSharingTeamIgnoresBusyCores) {
+  const CallbackRecord r = RunAmdahl(4, 2, 4, DispatchKind::kProcessorSharing);
+  // Serial 0.2 on three busy threads of four cores; then four team threads
+  // and two blockers share four cores: 0.2 each at 2/3 is 0.3.
+  EXPECT_NEAR(r.cost_s, 0.5, kTol);
+  EXPECT_EQ(r.cores, 4);
+}
+
+TEST(VirtualExecutorTest, ProcessorSharingOnOneCoreIsRunToCompletion) {
+  ExpectSameTrace(RunMixedGraph(1, DispatchKind::kRunToCompletion),
+                  RunMixedGraph(1, DispatchKind::kProcessorSharing),
+                  /*cost_rounding=*/true);
+}
+
+TEST(VirtualExecutorTest, ProcessorSharingIsDeterministic) {
+  const Trace a = RunMixedGraph(kMixedCores, DispatchKind::kProcessorSharing);
+  ExpectSameTrace(a,
+                  RunMixedGraph(kMixedCores, DispatchKind::kProcessorSharing));
+  // It differs from run to completion where teams meet other work.
+  const Trace rtc = RunMixedGraph();
+  ASSERT_EQ(a.callbacks.size() > 0, true);
+  bool differs = a.callbacks.size() != rtc.callbacks.size();
+  for (size_t i = 0; !differs && i < a.callbacks.size(); ++i) {
+    differs = a.callbacks[i].end_s != rtc.callbacks[i].end_s;
+  }
+  EXPECT_TRUE(differs);
+}
+
+// Never more callbacks in progress than executor threads (= cores), nor
+// two of one node.
+TEST(VirtualExecutorTest, ProcessorSharingRunsOneCallbackPerThread) {
+  const Trace trace =
+      RunMixedGraph(kMixedCores, DispatchKind::kProcessorSharing);
+  for (size_t i = 0; i < trace.callbacks.size(); ++i) {
+    const auto& x = trace.callbacks[i];
+    EXPECT_GE(x.start_s, x.ready_s);
+    EXPECT_GE(x.end_s, x.start_s);
+    int running = 1;
+    for (size_t j = 0; j < trace.callbacks.size(); ++j) {
+      const auto& y = trace.callbacks[j];
+      if (i == j || y.start_s > x.start_s || y.end_s <= x.start_s) continue;
+      ++running;
+      EXPECT_NE(x.node, y.node) << "node overlap at " << x.start_s;
+      EXPECT_NE(x.first_core, y.first_core) << "thread shared at " << x.start_s;
+    }
+    EXPECT_LE(running, kMixedCores) << "at " << x.start_s;
   }
 }
 
