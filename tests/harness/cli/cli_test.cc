@@ -41,15 +41,26 @@ std::string WriteScenario(const std::string& name, const std::string& text) {
   return path.string();
 }
 
-std::string Variant(const std::string& name, const std::string& from,
-                    const std::string& to) {
-  std::ifstream in(Example());
-  std::string text((std::istreambuf_iterator<char>(in)),
-                   std::istreambuf_iterator<char>());
+// The text of the file at `path`.
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in) << path;
+  return std::string((std::istreambuf_iterator<char>(in)),
+                     std::istreambuf_iterator<char>());
+}
+
+// `text` with its first `from` replaced by `to`; a failure when it has none.
+std::string Replaced(std::string text, const std::string& from,
+                     const std::string& to) {
   const size_t at = text.find(from);
   EXPECT_NE(at, std::string::npos) << from;
   if (at != std::string::npos) text.replace(at, from.size(), to);
-  return WriteScenario(name, text);
+  return text;
+}
+
+std::string Variant(const std::string& name, const std::string& from,
+                    const std::string& to) {
+  return WriteScenario(name, Replaced(ReadText(Example()), from, to));
 }
 
 TEST(CliTest, ValidateReportsTheRobotaxiSpaceOf280Points) {
@@ -102,13 +113,9 @@ TEST(CliTest, UnknownFlowEdgeIsReportedAtItsLine) {
 // the profile beside it.
 std::string ValetVariant(const std::string& name, const std::string& from,
                          const std::string& to) {
-  std::ifstream in(std::string(ADSE_SOURCE_DIR) +
-                   "/scenarios/valet_parking.yaml");
-  std::string text((std::istreambuf_iterator<char>(in)),
-                   std::istreambuf_iterator<char>());
-  const size_t at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
+  const std::string text = Replaced(
+      ReadText(std::string(ADSE_SOURCE_DIR) + "/scenarios/valet_parking.yaml"),
+      from, to);
   const fs::path profile = fs::temp_directory_path() /
                            "profiles/autoware-2022.12-i9-12900kf-valet.yaml";
   fs::create_directories(profile.parent_path());
@@ -410,14 +417,10 @@ TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
 }
 
 TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
-  std::ifstream in(std::string(ADSE_SOURCE_DIR) +
-                   "/scenarios/fidelity_small.yaml");
-  std::string text((std::istreambuf_iterator<char>(in)),
-                   std::istreambuf_iterator<char>());
-  const std::string from = "timeout_s: 30";
-  ASSERT_NE(text.find(from), std::string::npos);
-  text.replace(text.find(from), from.size(), "timeout_s: 4");
-  const std::string file = WriteScenario("fidelity", text);
+  const std::string file = WriteScenario(
+      "fidelity", Replaced(ReadText(std::string(ADSE_SOURCE_DIR) +
+                                    "/scenarios/fidelity_small.yaml"),
+                           "timeout_s: 30", "timeout_s: 4"));
   const fs::path out = fs::temp_directory_path() / "adse_cli_fidelity";
   fs::remove_all(out);
   const CommandRun run = Adse(
@@ -493,11 +496,8 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
 }
 
 TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
-  std::ifstream in(Small());
-  std::string text((std::istreambuf_iterator<char>(in)),
-                   std::istreambuf_iterator<char>());
   const std::string file =
-      WriteScenario("replicas", text + "harness: {replicas: 2}\n");
+      WriteScenario("replicas", ReadText(Small()) + "harness: {replicas: 2}\n");
   const fs::path out = fs::temp_directory_path() / "adse_cli_replicas";
   fs::remove_all(out);
   const CommandRun run =
@@ -508,9 +508,7 @@ TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
     runs += e.path().extension() == ".h5";
   }
   EXPECT_EQ(runs, 2u) << "one run file per replica";
-  std::ifstream report(out / "report.md");
-  const std::string md((std::istreambuf_iterator<char>(report)),
-                       std::istreambuf_iterator<char>());
+  const std::string md = ReadText((out / "report.md").string());
   EXPECT_NE(md.find("## Replicas"), std::string::npos) << md;
   EXPECT_NE(md.find("| 2 runs |"), std::string::npos) << md;
   // adse status counts runs: both replicas are done, none pending.
@@ -522,22 +520,17 @@ TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
 }
 
 TEST(CliRunTest, AnInfeasiblePointsProgressLineNamesTheConstraintItBroke) {
-  std::ifstream in(Small());
-  std::string text((std::istreambuf_iterator<char>(in)),
-                   std::istreambuf_iterator<char>());
-  const std::string from =
-      "constraints: [nav_time_s <= 60, ctrl_rate_hz >= 1, completed]";
-  ASSERT_NE(text.find(from), std::string::npos);
   // No run meets a 1 ms latency; no early stop ends a run for it either,
-  // so the run reaches the goal and is still infeasible.
-  text.replace(text.find(from), from.size(),
-               "constraints: [nav_time_s <= 60, e2e_latency_p50_s <= 0.001, "
-               "completed]");
-  // One point, generous enough to reach the goal.
-  const std::string cores = "values: [1, 4, 16]";
-  ASSERT_NE(text.find(cores), std::string::npos);
-  text.replace(text.find(cores), cores.size(), "values: [16]");
-  const std::string file = WriteScenario("latency_bound", text);
+  // so the run reaches the goal and is still infeasible. One point,
+  // generous enough to reach the goal.
+  const std::string file = WriteScenario(
+      "latency_bound",
+      Replaced(Replaced(ReadText(Small()),
+                        "constraints: [nav_time_s <= 60, ctrl_rate_hz >= 1, "
+                        "completed]",
+                        "constraints: [nav_time_s <= 60, e2e_latency_p50_s <= "
+                        "0.001, completed]"),
+               "values: [1, 4, 16]", "values: [16]"));
   const fs::path out = fs::temp_directory_path() / "adse_cli_latency_bound";
   fs::remove_all(out);
   const CommandRun run =
@@ -551,13 +544,10 @@ TEST(CliRunTest, AnInfeasiblePointsProgressLineNamesTheConstraintItBroke) {
 
 TEST(CliRunTest,
      AnLlmCampaignWithItsServerDownSaysSoAndFinishesWithTheBuiltInAgent) {
-  std::ifstream in(Small());
-  std::string text((std::istreambuf_iterator<char>(in)),
-                   std::istreambuf_iterator<char>());
   // Port 9 (discard): nothing listens there.
   const std::string file = WriteScenario(
-      "llm_down",
-      text + "llm: {endpoint: \"http://127.0.0.1:9\", retries: 0}\n");
+      "llm_down", ReadText(Small()) +
+                      "llm: {endpoint: \"http://127.0.0.1:9\", retries: 0}\n");
   const std::string out =
       (fs::temp_directory_path() / "adse_cli_llm_down").string();
   fs::remove_all(out);
@@ -630,9 +620,7 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
 
 TEST(CliRunTest, AnalyzeOfACampaignWithCasesFoldsEveryCaseAsRunDid) {
   // The small scenario at one point, with two destinations.
-  std::ifstream in(Small());
-  std::string text((std::istreambuf_iterator<char>(in)),
-                   std::istreambuf_iterator<char>());
+  std::string text = ReadText(Small());
   const std::string goal = "  goal: {x: 10.0, y: 29.75}\n";
   const size_t at = text.find(goal);
   ASSERT_NE(at, std::string::npos);
@@ -773,14 +761,10 @@ TEST(CliProfileTest, ImportOfBadInputExitsWith2AndWritesNothing) {
       << missing.out;
   EXPECT_FALSE(fs::exists(out));
 
-  std::ifstream in(BundledMapping());
-  std::string text((std::istreambuf_iterator<char>(in)),
-                   std::istreambuf_iterator<char>());
-  const std::string from = "top/velodyne_convert_node/callback_0";
-  ASSERT_NE(text.find(from), std::string::npos);
-  text.replace(text.find(from), from.size(), "top/velodyne/callback_0");
   const fs::path mapping = fs::temp_directory_path() / "adse_cli_mapping.yaml";
-  std::ofstream(mapping) << text;
+  std::ofstream(mapping) << Replaced(ReadText(BundledMapping()),
+                                     "top/velodyne_convert_node/callback_0",
+                                     "top/velodyne/callback_0");
   const CommandRun unknown =
       Adse("profile import --caret " + TrimmedCaret() + " --map " +
            mapping.string() + " -o " + out.string());
