@@ -85,7 +85,12 @@ int RunFidelity(const FidelityArgs& args) {
       options.dispatches.push_back(d);
     }
   }
+  // With several dispatches each file names its own.
   const bool several = options.dispatches.size() > 1;
+  auto suffix = [several](spec::Dispatch d) {
+    return several ? fmt::format("-{}", spec::DispatchToString(d))
+                   : std::string();
+  };
   options.on_run = [](const std::string& point, const std::string& what) {
     std::fprintf(stderr, "%s: %s run ...\n", point.c_str(), what.c_str());
   };
@@ -106,8 +111,6 @@ int RunFidelity(const FidelityArgs& args) {
     }
     for (size_t d = 0; d < runs->dispatches.size(); ++d) {
       const fidelity::PointFidelity f = fidelity::ComparePoint(*runs, d);
-      // With several dispatches each file names its own.
-      const std::string suffix = several ? "-" + f.dispatch : "";
       const std::string table = fidelity::FormatPointFidelity(f);
       std::printf("%s\n", table.c_str());
       text += table + "\n";
@@ -141,8 +144,8 @@ int RunFidelity(const FidelityArgs& args) {
             args.runs == 1
                 ? std::string("real time (1 run)")
                 : fmt::format("real time (median of {} runs)", args.runs);
-        const std::string png =
-            fmt::format("{}/fidelity-{}{}.png", dir, i + 1, suffix);
+        const std::string png = fmt::format("{}/fidelity-{}{}.png", dir, i + 1,
+                                            suffix(runs->dispatches[d]));
         if (Status drawn = analysis::RenderComparisonChart(rows, o, png);
             !drawn.ok()) {
           std::fprintf(stderr, "error: %s\n", drawn.message().c_str());
@@ -154,13 +157,10 @@ int RunFidelity(const FidelityArgs& args) {
     // The runs themselves, for adse analyze and h5py.
     Status written = MakeDirs(dir + "/runs");
     for (size_t d = 0; d < runs->virtual_runs.size() && written.ok(); ++d) {
-      const std::string suffix =
-          several
-              ? fmt::format("-{}", spec::DispatchToString(runs->dispatches[d]))
-              : "";
-      written = runfile::WriteRunFile(
-          fmt::format("{}/runs/{}-virtual{}.h5", dir, i + 1, suffix),
-          runs->virtual_runs[d]);
+      written =
+          runfile::WriteRunFile(fmt::format("{}/runs/{}-virtual{}.h5", dir,
+                                            i + 1, suffix(runs->dispatches[d])),
+                                runs->virtual_runs[d]);
     }
     for (size_t r = 0; r < runs->realtime_runs.size() && written.ok(); ++r) {
       written = runfile::WriteRunFile(

@@ -30,33 +30,20 @@ void ProcessorSharing::Add(int id, double now_s, double serial_s,
 
 void ProcessorSharing::AdvanceTo(double now_s, std::vector<int>* ended) {
   Progress(now_s);
-  // A serial part that ends moves on to its parallel part, which changes
-  // the rate, so the check repeats until nothing more ends now.
-  bool changed = true;
-  while (changed) {
-    changed = false;
-    const double rate = Rate();
-    for (Job& job : jobs_) {
-      if (!PartEnded(job, rate)) continue;
-      if (!job.parallel && job.share_s > 0.0) {
-        job.parallel = true;
-        job.left_s = job.share_s;
-        job.share_s = 0.0;
-        changed = true;
-      } else {
-        job.left_s = -1.0;  // ended: taken out below
-      }
-    }
-  }
-  auto kept = jobs_.begin();
-  for (const Job& job : jobs_) {
-    if (job.left_s < 0.0) {
-      ended->push_back(job.id);
+  const double rate = Rate();
+  for (Job& job : jobs_) {
+    if (!PartEnded(job, rate)) continue;
+    if (!job.parallel && job.share_s > 0.0) {
+      // On to the parallel part, whose threads join from now.
+      job.parallel = true;
+      job.left_s = job.share_s;
+      job.share_s = 0.0;
     } else {
-      *kept++ = job;
+      ended->push_back(job.id);
+      job.id = -1;  // taken out below
     }
   }
-  jobs_.erase(kept, jobs_.end());
+  std::erase_if(jobs_, [](const Job& job) { return job.id < 0; });
 }
 
 double ProcessorSharing::NextEndS() const {

@@ -15,8 +15,9 @@ class ProcessorSharing {
   explicit ProcessorSharing(int cores) : cores_(cores) {}
 
   // Advances every job to `now_s` (>= the last time given), then adds job
-  // `id`: `serial_s` of CPU time on one thread, then `share_s` on each of
-  // `team` threads at once (a data-parallel part; share_s 0 or team 1: none).
+  // `id` (>= 0): `serial_s` of CPU time on one thread, then `share_s` on each
+  // of `team` threads at once (a data-parallel part; share_s 0 or team 1:
+  // none).
   void Add(int id, double now_s, double serial_s, double share_s, int team);
 
   // Advances every job to `now_s` and moves each whose serial part has
