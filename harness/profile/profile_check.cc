@@ -65,7 +65,28 @@ std::string Rows(const std::vector<CheckRow>& rows, const char* source_p95) {
   return out;
 }
 
+std::string UnitsRows(const std::vector<UnitsRow>& rows) {
+  std::string out = fmt::format("{:<40} {:>6} {:>10} {:>10} {:>8}\n", "", "n",
+                                "adse mean", "reference", "diff");
+  for (const UnitsRow& r : rows) {
+    const double d = r.adse_mean_units / r.reference_units - 1.0;
+    out += fmt::format(
+        "{:<40} {:>6} {:>10.1f} {:>10.1f} {:>8}{}\n", r.name, r.samples,
+        r.adse_mean_units, r.reference_units,
+        r.samples > 0 ? fmt::format("{:+.1f} %", 100.0 * d) : "-",
+        r.beyond_tolerance()
+            ? fmt::format("  beyond {:.0f} %", 100.0 * kUnitsTolerance)
+            : "");
+  }
+  return out;
+}
+
 }  // namespace
+
+bool UnitsRow::beyond_tolerance() const {
+  return samples > 0 && reference_units > 0.0 &&
+         std::abs(adse_mean_units / reference_units - 1.0) > kUnitsTolerance;
+}
 
 std::map<std::string, std::vector<double>> ChainLatencies(
     const runfile::RunData& run, const ChainTopics& topics) {
@@ -131,13 +152,16 @@ ProfileCheck CompareWithProfile(const runfile::RunData& run,
 
   // CARET's callback latency is start to end; so is adse's.
   std::map<std::string, std::vector<double>> latencies;
+  std::map<std::string, std::pair<int, double>> units;  // count, sum
   for (const stack::CallbackRecord& r : run.trace.callbacks) {
     if (r.callback < 0 ||
         r.callback >= static_cast<int>(run.callback_info.size())) {
       continue;
     }
-    latencies[run.callback_info[r.callback].name].push_back(r.end_s -
-                                                            r.start_s);
+    const std::string& name = run.callback_info[r.callback].name;
+    latencies[name].push_back(r.end_s - r.start_s);
+    units[name].first += 1;
+    units[name].second += r.work_units;
   }
   for (const auto& [name, cost] : profile.costs.callbacks) {
     CheckRow row;
@@ -147,6 +171,15 @@ ProfileCheck CompareWithProfile(const runfile::RunData& run,
     if (it != profile.provenance.end()) row.source_avg_ms = it->second.avg_ms;
     row.source_p95_ms = 1000.0 * stack::SampleCost(cost, 0.95);
     check.callbacks.push_back(std::move(row));
+    if (cost.reference_units > 0.0) {
+      UnitsRow u;
+      u.name = name;
+      u.reference_units = cost.reference_units;
+      const auto& [count, sum] = units[name];
+      u.samples = count;
+      u.adse_mean_units = count > 0 ? sum / count : 0.0;
+      check.units.push_back(std::move(u));
+    }
   }
   return check;
 }
@@ -157,7 +190,12 @@ std::string FormatProfileCheck(const ProfileCheck& check) {
          Rows(check.chains, "src p95") +
          "\ncallbacks (ms, start to end; src avg: the sources' measured "
          "mean, profile p95: the single-thread cost it draws from):\n" +
-         Rows(check.callbacks, "prof p95");
+         Rows(check.callbacks, "prof p95") +
+         "\nwork units per invocation (reference: the profile's "
+         "reference_units, the mean where they were measured; on that "
+         "scenario a row beyond 5 % means they must be measured again, "
+         "on another map its scans differ):\n" +
+         UnitsRows(check.units);
 }
 
 }  // namespace adse::profile

@@ -28,9 +28,30 @@ struct CheckRow {
   std::optional<double> tolerance;
 };
 
+// A callback whose cost scales with its work: the units it reported on
+// average beside the profile's reference_units, which by definition are
+// what a typical invocation reports on the scenario they were measured on
+// (robotaxi_small.yaml for the bundled profile). There, when the stack
+// changes how much work a scan takes (NDT's iterations fall with a better
+// initial guess), the two part and the profile charges that callback more
+// or less than its source measured; on another map the scans differ.
+struct UnitsRow {
+  std::string name;
+  int samples = 0;
+  double adse_mean_units = 0.0;
+  double reference_units = 0.0;
+
+  // Whether |adse_mean_units / reference_units - 1| is beyond kUnitsTolerance.
+  bool beyond_tolerance() const;
+};
+
+// How far a callback's mean units may lie from its reference_units.
+inline constexpr double kUnitsTolerance = 0.05;
+
 struct ProfileCheck {
   std::vector<CheckRow> chains;     // in ChainNames() order
   std::vector<CheckRow> callbacks;  // by name
+  std::vector<UnitsRow> units;      // by name, reference_units > 0 only
 };
 
 // Topics that delimit the chains in adse's stack (stack/nodes/ad_stack.cc).

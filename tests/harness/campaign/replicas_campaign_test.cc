@@ -207,10 +207,14 @@ TEST(ReplicasCampaignTest, APointWhoseReplicasDisagreeIsFlaggedUnstable) {
     nav.push_back(RowMetric(run, "nav_time_s"));
   }
   std::sort(nav.begin(), nav.end());
-  ASSERT_LT(nav[0], nav[1]) << "the fastest replica must differ";
+  ASSERT_LT(nav[0], nav[2]) << "the replicas' times must differ";
 
-  // A bound only the fastest replica meets.
-  const std::string bound = fmt::format("{:.6f}", 0.5 * (nav[0] + nav[1]));
+  // A bound the fastest replica meets and the slowest does not: one or two
+  // of the three (the two fastest may tie) meet it.
+  const double cut =
+      nav[0] < nav[1] ? 0.5 * (nav[0] + nav[1]) : 0.5 * (nav[1] + nav[2]);
+  const int meet = nav[0] < nav[1] ? 1 : 2;
+  const std::string bound = fmt::format("{:.6f}", cut);
   const spec::Spec strict =
       Scenario(dir, space, "[nav_time_s <= " + bound + ", completed]",
                "{replicas: 3, early_stop: false}");
@@ -220,12 +224,13 @@ TEST(ReplicasCampaignTest, APointWhoseReplicasDisagreeIsFlaggedUnstable) {
   EXPECT_EQ(judged->simulated, 0) << "every run comes from the cache";
   const EvaluationRow& point = judged->exploration.evaluations[0];
   EXPECT_TRUE(point.unstable);
-  EXPECT_FALSE(point.feasible) << "feasible in 1 of 3 runs";
-  EXPECT_EQ(ReplicaSummary(point), "unstable: feasible in 1 of 3 runs");
+  // Feasible when most runs are.
+  EXPECT_EQ(point.feasible, meet == 2) << "feasible in " << meet << " of 3";
+  const std::string summary =
+      fmt::format("unstable: feasible in {} of 3 runs", meet);
+  EXPECT_EQ(ReplicaSummary(point), summary);
   const std::string report = ReadFile(dir + "/strict/report.md").value();
-  EXPECT_NE(report.find("**unstable: feasible in 1 of 3 runs**"),
-            std::string::npos)
-      << report;
+  EXPECT_NE(report.find("**" + summary + "**"), std::string::npos) << report;
   Result<runfile::CampaignIndex> index =
       runfile::ReadCampaignIndex(dir + "/strict/campaign.h5");
   ASSERT_TRUE(index.ok());

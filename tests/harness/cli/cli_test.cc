@@ -805,6 +805,15 @@ TEST(CliProfileTest, CheckComparesTheChainsOnTheReferenceMachine) {
                             "+116\\.72 +[-+][0-9]+ %  within 15 %: ")))
       << check.out;
   EXPECT_NE(check.out.find("lidar_driver/points_raw"), std::string::npos);
+  // The bundled profile's reference_units were measured on this scenario:
+  // a change to the stack that moves them (NDT's iterations) must measure
+  // them again, or the profile charges off its source.
+  const size_t units = check.out.find("\nwork units per invocation");
+  ASSERT_NE(units, std::string::npos) << check.out;
+  EXPECT_NE(check.out.find("\nndt_scan_matcher/points ", units),
+            std::string::npos);
+  EXPECT_EQ(check.out.find("  beyond 5 %", units), std::string::npos)
+      << check.out;
 
   // A scenario with task.cases checks the case it is told to drive.
   const fs::path parked = fs::temp_directory_path() / "adse_cli_check_case";

@@ -88,5 +88,30 @@ TEST(ProfileCheckTest, TheTableSaysWhetherEachTargetIsMet) {
   EXPECT_NE(table.find("lidar_driver/points_raw"), std::string::npos);
 }
 
+TEST(ProfileCheckTest, WorkUnitsThatDriftFromTheReferenceAreFlagged) {
+  runfile::RunData run = TwoScans();
+  run.trace.callbacks[0].work_units = 900.0;
+  run.trace.callbacks[1].work_units = 1020.0;
+  Profile profile = SourceOf();
+  profile.costs.callbacks["lidar_driver/points_raw"].reference_units = 1000.0;
+  // A callback that does not scale with its work has no units row.
+  profile.costs.callbacks["ekf_localizer/publish"].quantiles = {{0.0, 0.001},
+                                                                {1.0, 0.002}};
+  ProfileCheck check = CompareWithProfile(run, profile);
+  ASSERT_EQ(check.units.size(), 1u);
+  EXPECT_EQ(check.units[0].samples, 2);
+  EXPECT_NEAR(check.units[0].adse_mean_units, 960.0, 1e-9);
+  EXPECT_FALSE(check.units[0].beyond_tolerance());  // -4 %, within 5 %
+  EXPECT_EQ(FormatProfileCheck(check).find("  beyond 5 %"), std::string::npos);
+
+  run.trace.callbacks[0].work_units = 680.0;  // mean 850: -15 %
+  check = CompareWithProfile(run, profile);
+  EXPECT_TRUE(check.units[0].beyond_tolerance());
+  const std::string table = FormatProfileCheck(check);
+  EXPECT_NE(table.find("850.0     1000.0  -15.0 %  beyond 5 %\n"),
+            std::string::npos)
+      << table;
+}
+
 }  // namespace
 }  // namespace adse::profile
