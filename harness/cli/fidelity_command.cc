@@ -4,6 +4,7 @@
 // without a cost profile, more cores than the host gives), 1 otherwise.
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,61 @@ nlohmann::json ComparisonsJson(
          {"met", c.tolerance ? nlohmann::json(c.met()) : nlohmann::json()}});
   }
   return out;
+}
+
+nlohmann::json PointJson(const fidelity::PointFidelity& f) {
+  return {{"point", f.point},
+          {"dispatch", f.dispatch},
+          {"confinement", f.confinement},
+          {"clock_by", f.clock_by},
+          {"ended",
+           {{"virtual", f.virtual_outcome}, {"realtime", f.realtime_outcomes}}},
+          {"metrics", ComparisonsJson(f.metrics)},
+          {"callback_p50_ms", ComparisonsJson(f.callback_p50_ms)},
+          {"callback_p99_ms", ComparisonsJson(f.callback_p99_ms)},
+          {"callback_p50_ms_per_kunit",
+           ComparisonsJson(f.callback_p50_ms_per_kunit)}};
+}
+
+// The point's callback p50s, virtual above real time, as a PNG at `png`
+// (nothing when no callback ran).
+Status DrawPoint(const fidelity::PointFidelity& f, const FidelityArgs& args,
+                 const std::string& png) {
+  std::vector<analysis::ComparisonRow> rows;
+  for (const fidelity::Comparison& c : f.callback_p50_ms) {
+    std::optional<double> real;
+    if (std::isfinite(c.realtime_median)) real = c.realtime_median;
+    rows.push_back({c.name, c.virtual_value, real});
+  }
+  if (rows.empty()) return Status::Ok();
+  analysis::ComparisonChartOptions o;
+  o.title =
+      fmt::format("p50 callback latency at {}{}: virtual vs real time", f.point,
+                  args.task_case.empty() ? "" : ", case " + args.task_case);
+  o.adse_name = fmt::format("virtual platform ({})", f.dispatch);
+  o.reference_name =
+      args.runs == 1 ? std::string("real time (1 run)")
+                     : fmt::format("real time (median of {} runs)", args.runs);
+  return analysis::RenderComparisonChart(rows, o, png);
+}
+
+// The point's runs themselves, for adse analyze and h5py: runs/N-virtual
+// (one per dispatch, `suffix` naming it) and runs/N-realtime-R.
+Status WritePointRuns(
+    const std::string& dir, size_t n, const fidelity::PointRuns& runs,
+    const std::function<std::string(spec::Dispatch)>& suffix) {
+  Status written = MakeDirs(dir + "/runs");
+  for (size_t d = 0; d < runs.virtual_runs.size() && written.ok(); ++d) {
+    written = runfile::WriteRunFile(fmt::format("{}/runs/{}-virtual{}.h5", dir,
+                                                n, suffix(runs.dispatches[d])),
+                                    runs.virtual_runs[d]);
+  }
+  for (size_t r = 0; r < runs.realtime_runs.size() && written.ok(); ++r) {
+    written = runfile::WriteRunFile(
+        fmt::format("{}/runs/{}-realtime-{}.h5", dir, n, r + 1),
+        runs.realtime_runs[r]);
+  }
+  return written;
 }
 
 }  // namespace
@@ -114,60 +170,17 @@ int RunFidelity(const FidelityArgs& args) {
       const std::string table = fidelity::FormatPointFidelity(f);
       std::printf("%s\n", table.c_str());
       text += table + "\n";
-      j["points"].push_back(
-          {{"point", f.point},
-           {"dispatch", f.dispatch},
-           {"confinement", f.confinement},
-           {"clock_by", f.clock_by},
-           {"ended",
-            {{"virtual", f.virtual_outcome},
-             {"realtime", f.realtime_outcomes}}},
-           {"metrics", ComparisonsJson(f.metrics)},
-           {"callback_p50_ms", ComparisonsJson(f.callback_p50_ms)},
-           {"callback_p99_ms", ComparisonsJson(f.callback_p99_ms)},
-           {"callback_p50_ms_per_kunit",
-            ComparisonsJson(f.callback_p50_ms_per_kunit)}});
-      // Per point: the callbacks' p50, virtual above real-time.
-      std::vector<analysis::ComparisonRow> rows;
-      for (const fidelity::Comparison& c : f.callback_p50_ms) {
-        std::optional<double> real;
-        if (std::isfinite(c.realtime_median)) real = c.realtime_median;
-        rows.push_back({c.name, c.virtual_value, real});
-      }
-      if (!rows.empty()) {
-        analysis::ComparisonChartOptions o;
-        o.title = fmt::format(
-            "p50 callback latency at {}{}: virtual vs real time", f.point,
-            args.task_case.empty() ? "" : ", case " + args.task_case);
-        o.adse_name = fmt::format("virtual platform ({})", f.dispatch);
-        o.reference_name =
-            args.runs == 1
-                ? std::string("real time (1 run)")
-                : fmt::format("real time (median of {} runs)", args.runs);
-        const std::string png = fmt::format("{}/fidelity-{}{}.png", dir, i + 1,
-                                            suffix(runs->dispatches[d]));
-        if (Status drawn = analysis::RenderComparisonChart(rows, o, png);
-            !drawn.ok()) {
-          std::fprintf(stderr, "error: %s\n", drawn.message().c_str());
-          return 1;
-        }
+      j["points"].push_back(PointJson(f));
+      const std::string png = fmt::format("{}/fidelity-{}{}.png", dir, i + 1,
+                                          suffix(runs->dispatches[d]));
+      if (Status drawn = DrawPoint(f, args, png); !drawn.ok()) {
+        std::fprintf(stderr, "error: %s\n", drawn.message().c_str());
+        return 1;
       }
       compared.push_back(f);
     }
-    // The runs themselves, for adse analyze and h5py.
-    Status written = MakeDirs(dir + "/runs");
-    for (size_t d = 0; d < runs->virtual_runs.size() && written.ok(); ++d) {
-      written =
-          runfile::WriteRunFile(fmt::format("{}/runs/{}-virtual{}.h5", dir,
-                                            i + 1, suffix(runs->dispatches[d])),
-                                runs->virtual_runs[d]);
-    }
-    for (size_t r = 0; r < runs->realtime_runs.size() && written.ok(); ++r) {
-      written = runfile::WriteRunFile(
-          fmt::format("{}/runs/{}-realtime-{}.h5", dir, i + 1, r + 1),
-          runs->realtime_runs[r]);
-    }
-    if (!written.ok()) {
+    if (Status written = WritePointRuns(dir, i + 1, *runs, suffix);
+        !written.ok()) {
       std::fprintf(stderr, "error: %s\n", written.message().c_str());
       return 1;
     }
