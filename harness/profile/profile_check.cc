@@ -191,10 +191,12 @@ std::string FormatProfileCheck(const ProfileCheck& check) {
          "\ncallbacks (ms, start to end; src avg: the sources' measured "
          "mean, profile p95: the single-thread cost it draws from):\n" +
          Rows(check.callbacks, "prof p95") +
-         "\nwork units per invocation (reference: the profile's "
-         "reference_units, the mean where they were measured; on that "
-         "scenario a row beyond 5 % means they must be measured again, "
-         "on another map its scans differ):\n" +
+         fmt::format(
+             "\nwork units per invocation (reference: the profile's "
+             "reference_units, the mean where they were measured; on that "
+             "scenario a row beyond {:.0f} % means they must be measured "
+             "again, on another map its scans differ):\n",
+             100.0 * kUnitsTolerance) +
          UnitsRows(check.units);
 }
 
