@@ -120,6 +120,15 @@ std::string Title(const runfile::RunData& run) {
             ? fmt::format(", nav >= {:.1f} s (stopped early)", it->second)
             : fmt::format(", nav {:.1f} s", it->second);
   }
+  // Contacts with traffic (valet parking's with the lot are drawn).
+  if (!run.collisions.empty()) {
+    const auto ego_caused = std::count_if(
+        run.collisions.begin(), run.collisions.end(),
+        [](const runfile::CollisionEvent& c) { return c.ego_caused == 1; });
+    outcome += fmt::format(", {} collision{} ({} caused by the ego)",
+                           run.collisions.size(),
+                           run.collisions.size() == 1 ? "" : "s", ego_caused);
+  }
   // The picture shows the last plan in colour; say when there were others.
   if (run.parking.replans > 0) {
     outcome += fmt::format(", re-planned {}x", run.parking.replans);
@@ -158,6 +167,39 @@ Rgb StandRgb(const analysis::Stand& stand) {
     default:
       return kStandOtherRgb;
   }
+}
+
+// Where a collision with traffic happened: between the ego's and the
+// other's recorded positions nearest its time (the ego's alone when the
+// other was not recorded).
+struct CollisionPlace {
+  double x_m = 0.0, y_m = 0.0, t_s = 0.0;
+  bool ego_caused = false;
+};
+std::vector<CollisionPlace> CollisionPlaces(const runfile::RunData& run) {
+  std::vector<CollisionPlace> out;
+  if (run.ego.empty()) return out;
+  for (const runfile::CollisionEvent& c : run.collisions) {
+    const auto ego = std::min_element(
+        run.ego.begin(), run.ego.end(), [&](const auto& a, const auto& b) {
+          return std::abs(a.t_s - c.t_s) < std::abs(b.t_s - c.t_s);
+        });
+    CollisionPlace place{ego->x_m, ego->y_m, c.t_s, c.ego_caused == 1};
+    const runfile::VehicleSample* other = nullptr;
+    for (const runfile::VehicleSample& v : run.vehicles) {
+      if (v.id == c.other_id &&
+          (other == nullptr ||
+           std::abs(v.t_s - c.t_s) < std::abs(other->t_s - c.t_s))) {
+        other = &v;
+      }
+    }
+    if (other != nullptr) {
+      place.x_m = 0.5 * (place.x_m + other->x_m);
+      place.y_m = 0.5 * (place.y_m + other->y_m);
+    }
+    out.push_back(place);
+  }
+  return out;
 }
 
 void DrawStandMarker(cv::Mat* img, cv::Point2d at, Rgb colour, const Style& s) {
@@ -350,6 +392,10 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   for (const analysis::Stand& stand : stands) {
     DrawStandMarker(&img, px(stand.x_m, stand.y_m), StandRgb(stand), s);
   }
+  const std::vector<CollisionPlace> collisions = CollisionPlaces(run);
+  for (const CollisionPlace& c : collisions) {
+    DrawContactMarker(&img, px(c.x_m, c.y_m), s);
+  }
   // Start and goal labelled first, so they get the first choice of place.
   std::vector<cv::Rect> labels;
   DrawGoalMarker(&img, goal, s);
@@ -358,6 +404,12 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
                   &labels);
   DrawMarkerLabel(&img, start, "start", s, Bgr(kStartRgb), map.map_top_px,
                   &labels);
+  for (const CollisionPlace& c : collisions) {
+    DrawMarkerLabel(&img, px(c.x_m, c.y_m),
+                    fmt::format("collision {:.0f} s{}", c.t_s,
+                                c.ego_caused ? " (ego's)" : ""),
+                    s, Bgr(kContactRgb), map.map_top_px, &labels);
+  }
   for (size_t k = 0; k < std::min(kLabelledStands, by_length.size()); ++k) {
     const analysis::Stand& stand = stands[by_length[k]];
     const std::string what =
@@ -439,6 +491,12 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
     legend.Add("stood >= 3 s", [&](cv::Point2d a, cv::Point2d b) {
       DrawStandMarker(&img, 0.5 * (a + b), StandRgb(stands.front()), s);
     });
+  }
+  if (!collisions.empty()) {
+    legend.Add(fmt::format("collision ({})", collisions.size()),
+               [&](cv::Point2d a, cv::Point2d b) {
+                 DrawContactMarker(&img, 0.5 * (a + b), s);
+               });
   }
   if (run.parking.present) {
     legend.Break();

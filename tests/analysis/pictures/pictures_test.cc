@@ -195,6 +195,26 @@ TEST_F(PictureTest, WhereTheCarStoodIsMarkedInTheColourOfWhatHeldIt) {
   EXPECT_EQ(CountColour(*plain, kStandRedLightRgb), 0);
 }
 
+TEST_F(PictureTest, ACollisionWithTrafficIsMarkedWhereItHappened) {
+  // At 5.0 s the ego is at (49, 1); a flow car recorded at (52, 3) then.
+  RunData run = SquareRun();
+  run.vehicles.push_back({5.0, "flow0.1", 52.0, 3.0, M_PI, 4, 4.5, 1.8});
+  run.collisions.push_back({5.0, "flow0.1", 1});
+  ASSERT_TRUE(RenderTrajectoryImage(run, Path("hit.png")).ok());
+  ASSERT_TRUE(RenderTrajectoryImage(SquareRun(), Path("plain.png")).ok());
+  Result<RgbImage> img = ReadImage(Path("hit.png"));
+  Result<RgbImage> plain = ReadImage(Path("plain.png"));
+  ASSERT_TRUE(img.ok() && plain.ok());
+  Result<WorldToImage> map = TrajectoryImageMapping(run);
+  ASSERT_TRUE(map.ok());
+  EXPECT_TRUE(
+      ColourNear(*img, map->Column(50.5), map->Row(2.0), kContactRgb, 1));
+  // The dot and the legend's sample (the label's text is anti-aliased);
+  // nothing without a collision.
+  EXPECT_GT(CountColour(*img, kContactRgb), 40);
+  EXPECT_EQ(CountColour(*plain, kContactRgb), 0);
+}
+
 TEST_F(PictureTest, AVehicleThatNeverMovedIsDrawnAsItsBody) {
   // A broken-down car at (50, 30), 4.5 m by 1.8 m along x, every sample
   // where the first was: no path, so its outline shows where it stood.
