@@ -4,9 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 
-#include "stack/algorithms/parking_control.h"
 #include "stack/algorithms/traffic_light.h"
+#include "stack/world/manoeuvre_tracker.h"
 #include "stack/world/predictive_steering.h"
 #include "stack/world/traffic_signal_detector.h"
 
@@ -25,8 +26,8 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
                                         const ScanCallback& on_scan) {
   IdealDriveReport report;
   // The road part (all of the ideal path but a valet task's manoeuvre) by
-  // predictive steering; then the manoeuvre, gears and all, with the stack's
-  // parking controller on the true pose. A three-point turn on the way is
+  // predictive steering; then the manoeuvre, gears and all, move by move
+  // on the true pose (ManoeuvreTracker). A three-point turn on the way is
   // driven the same way from where the car stops for it.
   const geometry::Path2& path = world.road_path();
   // The speed limit, curves ahead (the stops come on top).
@@ -36,10 +37,7 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
   const std::vector<RouteTurnaround>& turns = world.route_turnarounds();
   size_t next_turn = 0;       // the first turn not yet driven
   geometry::Path2 turn_path;  // the turn being driven, for its error
-  algorithms::ParkingFollowerParams parking_params;
-  parking_params.wheelbase_m = world.ego_limits().wheelbase_m;
-  algorithms::ParkingFollower parking(parking_params);
-  bool parking_mode = false;
+  std::optional<ManoeuvreTracker> manoeuvre;  // while driving one
   const double dt = world.step_s();
   const VehicleLimits& limits = world.ego_limits();
   const double scan_period = lidar ? 1.0 / lidar->params().rate_hz : 0.0;
@@ -79,12 +77,11 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
       if (on_scan) on_scan(cloud, pose);
       next_scan_t += scan_period;
     }
-    if (!parking_mode && !world.reference_manoeuvre().empty() &&
+    if (!manoeuvre && !world.reference_manoeuvre().empty() &&
         s_progress >= path.length_m() - 0.05 && std::abs(ego.v_mps) < 0.05) {
-      parking.SetPath(world.reference_manoeuvre());
-      parking_mode = true;
+      manoeuvre.emplace(world.reference_manoeuvre(), limits);
     }
-    if (!parking_mode && next_turn < turns.size() &&
+    if (!manoeuvre && next_turn < turns.size() &&
         s_progress >= turns[next_turn].start_s_m - 0.5 &&
         std::abs(ego.v_mps) < 0.05) {
       turn_path = geometry::Path2();
@@ -92,20 +89,18 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
         turn_path.points.emplace_back(p.pose.x_m, p.pose.y_m);
       }
       turn_path.UpdateArcLength();
-      parking.SetPath(turns[next_turn].reference);
-      parking_mode = true;
+      manoeuvre.emplace(turns[next_turn].reference, limits);
     }
-    if (parking_mode) {
-      const algorithms::ParkingCommand c =
-          parking.Update({ego.x_m, ego.y_m, ego.yaw_rad}, ego.v_mps, dt);
-      if (c.finished && !turn_path.points.empty()) {
+    if (manoeuvre) {
+      const ControlCommand c = manoeuvre->Update(ego);
+      if (manoeuvre->finished() && !turn_path.points.empty()) {
         // Turned: on along the road part.
-        parking_mode = false;
+        manoeuvre.reset();
         turn_path = geometry::Path2();
         ++next_turn;
       }
       const auto t0 = Clock::now();
-      ADSE_RETURN_IF_ERROR(world.Step({c.accel_mps2, c.steer_rad, c.reverse}));
+      ADSE_RETURN_IF_ERROR(world.Step(c));
       report.world_wall_s += Seconds(Clock::now() - t0);
       continue;
     }

@@ -40,7 +40,8 @@ ManoeuvreTracker::ManoeuvreTracker(
     }
     move.d_m.push_back(move.points.empty()
                            ? 0.0
-                           : move.d_m.back() + (xy - move.points.back()).norm());
+                           : move.d_m.back() +
+                                 (xy - move.points.back()).norm());
     move.heading_rad.push_back(
         move.heading_rad.empty()
             ? travel
@@ -48,9 +49,10 @@ ManoeuvreTracker::ManoeuvreTracker(
     move.points.push_back(xy);
   }
   // A move of one point (a gear change and no way in it) is no move.
-  moves_.erase(std::remove_if(moves_.begin(), moves_.end(),
-                              [](const Move& m) { return m.points.size() < 2; }),
-               moves_.end());
+  moves_.erase(
+      std::remove_if(moves_.begin(), moves_.end(),
+                     [](const Move& m) { return m.points.size() < 2; }),
+      moves_.end());
   for (Move& move : moves_) {
     for (size_t i = 0; i + 1 < move.points.size(); ++i) {
       move.curvature_1pm.push_back(
@@ -63,14 +65,13 @@ ManoeuvreTracker::ManoeuvreTracker(
 
 double ManoeuvreTracker::CurvatureAt(const Move& move, double d_m) const {
   const auto it = std::upper_bound(move.d_m.begin(), move.d_m.end(), d_m);
-  const size_t i = std::clamp<size_t>(
-      it == move.d_m.begin() ? 0 : it - move.d_m.begin() - 1, 0,
-      move.curvature_1pm.size() - 1);
+  const size_t i =
+      std::clamp<size_t>(it == move.d_m.begin() ? 0 : it - move.d_m.begin() - 1,
+                         0, move.curvature_1pm.size() - 1);
   return move.curvature_1pm[i];
 }
 
-double ManoeuvreTracker::FeedForwardSteer(const Move& move,
-                                          double d_m) const {
+double ManoeuvreTracker::FeedForwardSteer(const Move& move, double d_m) const {
   // The direction of travel turns by gear x tan(steer) / wheelbase per
   // metre driven.
   const double gear = move.reverse ? -1.0 : 1.0;
@@ -113,9 +114,9 @@ ControlCommand ManoeuvreTracker::Update(const VehicleState& ego) {
       d = move.d_m[i] + t * len;
       const Eigen::Vector2d u = ab / len;
       lateral = u.x() * (pos.y() - a.y()) - u.y() * (pos.x() - a.x());
-      heading = move.heading_rad[i] +
-                std::min(t, 1.0) *
-                    (move.heading_rad[i + 1] - move.heading_rad[i]);
+      heading =
+          move.heading_rad[i] +
+          std::min(t, 1.0) * (move.heading_rad[i + 1] - move.heading_rad[i]);
     }
   }
   const double remaining = move.d_m.back() - d;
@@ -144,29 +145,27 @@ ControlCommand ManoeuvreTracker::Update(const VehicleState& ego) {
   command.reverse = move.reverse;
   const double travel = ego.yaw_rad + (move.reverse ? M_PI : 0.0);
   const double heading_error = Wrap(travel - heading);
-  const double curvature =
-      CurvatureAt(move, d + speed * options_.preview_s) -
-      options_.lateral_gain_1pm2 * lateral -
-      options_.heading_gain_1pm * heading_error;
+  const double curvature = CurvatureAt(move, d + speed * options_.preview_s) -
+                           options_.lateral_gain_1pm2 * lateral -
+                           options_.heading_gain_1pm * heading_error;
   command.steer_rad =
       std::clamp(std::atan(gear * limits_.wheelbase_m * curvature),
                  -limits_.max_steer_rad, limits_.max_steer_rad);
 
   // Speed: the cruise speed, slow enough for the wheels to follow the
   // changes of curvature ahead, and a stop at the move's end.
-  double v_target = move.reverse ? options_.reverse_speed_mps
-                                 : options_.forward_speed_mps;
+  double v_target =
+      move.reverse ? options_.reverse_speed_mps : options_.forward_speed_mps;
   for (size_t i = index_; i <= last; ++i) {
     const double ahead = move.d_m[i] - d;
     if (ahead > options_.lookahead_m) break;
     const double change =
         std::abs(FeedForwardSteer(move, move.d_m[i]) - ego.steer_rad);
     if (change > kNegligibleSteerRad) {
-      v_target = std::min(
-          v_target,
-          std::max(options_.crawl_speed_mps,
-                   limits_.max_steer_rate_rad_per_s * std::max(0.0, ahead) /
-                       change));
+      v_target =
+          std::min(v_target, std::max(options_.crawl_speed_mps,
+                                      limits_.max_steer_rate_rad_per_s *
+                                          std::max(0.0, ahead) / change));
     }
   }
   v_target =

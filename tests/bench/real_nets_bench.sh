@@ -16,7 +16,9 @@
 #   tests/bench/real_nets_bench.sh [routes-per-net] [net-name ...]
 # ROUTES_SEED (default 1) seeds the routes and flows; POINT (default
 # cores=16,freq_ghz=2.1) is the design point; KEEP=DIR keeps the scenarios,
-# run files and logs in DIR.
+# run files and logs in DIR. IDEAL_ONLY=1 drives only the ground-truth
+# controller (no stack, a few seconds a route): the table then has the
+# route, whether and when that driver reached the goal, and its error.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 adse="${ADSE_BIN:-${root}/build/bin/adse}"
@@ -121,11 +123,19 @@ PY
 echo "point: ${point}; routes per net: ${routes}; seed: ${seed}"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1 /proc/loadavg)"
 echo
-echo "| net | route | length m, SUMO's shortest / adse's | reached goal | ended | nav time s | dominant stop reason | stood s | collisions (caused by the ego) | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's | three-point turns (moves) |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+ideal_only="${IDEAL_ONLY:-0}"
+if [ "${ideal_only}" = 1 ]; then
+  echo "| net | route | length m, SUMO's shortest / adse's | ideal driver reached goal | its time s | ideal driver off path m, outside junctions / all | turns tighter than the car's | three-point turns (moves) |"
+  echo "|---|---|---|---|---|---|---|---|"
+else
+  echo "| net | route | length m, SUMO's shortest / adse's | reached goal | ended | nav time s | dominant stop reason | stood s | collisions (caused by the ego) | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's | three-point turns (moves) |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+fi
 reached=0
 total=0
 refused=0
+within=0  # routes the ideal driver keeps within 1 m outside junctions
+ideal_total=0
 for name in "${names[@]}"; do
   net="${nets[${name}]:-}"
   if [ -z "${net}" ] || [ ! -f "${net}" ]; then
@@ -145,7 +155,8 @@ for name in "${names[@]}"; do
     fi
     length="${length} / $("${py}" -c 'import json,sys; print("%.0f" % json.load(open(sys.argv[1]))["ideal_path_length_m"])' "${out}/${run}-route.json")"
     turnarounds="$("${py}" -c 'import json,sys; t = json.load(open(sys.argv[1]))["turnarounds"]; print("%d%s" % (len(t), " (%s)" % ", ".join(str(x["moves"]) for x in t) if t else ""))' "${out}/${run}-route.json")"
-    if ! /usr/bin/time -v -o "${out}/${run}.time" "${adse}" simulate "${yaml}" \
+    if [ "${ideal_only}" != 1 ] &&
+      ! /usr/bin/time -v -o "${out}/${run}.time" "${adse}" simulate "${yaml}" \
         --point "${point}" --json -q -o "${out}/${run}.h5" \
         >"${out}/${run}.json" 2>"${out}/${run}.log"; then
       echo "| ${name} | ${run} | ${length} | error | $(tail -n1 "${out}/${run}.log") | | | | | | | | | |"
@@ -160,6 +171,22 @@ for name in "${names[@]}"; do
       read -r off all turns < <(PYTHONPATH="${tools}" "${py}" \
         "${root}/tests/bench/ideal_path_error.py" "${net}" "${out}/${run}-ideal")
       ideal="${off} / ${all} | ${turns}"
+      ideal_total=$((ideal_total + 1))
+      if "${py}" -c 'import sys; sys.exit(float(sys.argv[1]) > 1.0)' "${off}"; then
+        within=$((within + 1))
+      fi
+    fi
+    if [ "${ideal_only}" = 1 ]; then
+      summary="${out}/${run}-ideal/summary.json"
+      if [ -f "${summary}" ]; then
+        drove="$("${py}" -c 'import json,sys; d = json.load(open(sys.argv[1])); print("%s | %.1f" % ("yes" if d["reached_goal"] else "no", d["time_s"]))' "${summary}")"
+      else
+        drove="error: $(tail -n1 "${out}/${run}-ideal.log") | "
+      fi
+      echo "| ${name} | ${run} | ${length} | ${drove} | ${ideal} | ${turnarounds} |"
+      total=$((total + 1))
+      case "${drove}" in yes*) reached=$((reached + 1)) ;; esac
+      continue
     fi
     line="$("${py}" - "${out}/${run}.json" "${out}/${run}.time" "${name}" "${run}" "${length}" <<'PY'
 import json, re, sys
@@ -191,3 +218,4 @@ PY
 done
 echo
 echo "reached the goal: ${reached} of ${total}; refused (only a U-turn reaches the goal, and no turn in several moves fits there): ${refused}"
+echo "ideal driver within 1 m of the ideal path outside junctions: ${within} of ${ideal_total}"

@@ -34,10 +34,9 @@ Drive DriveThrough(const std::vector<GearedPose>& path) {
   const double dt = 0.05;
   for (int step = 0; step < 4000 && !tracker.finished(); ++step) {
     const VehicleState& ego = car.state();
-    drive.max_error_m =
-        std::max(drive.max_error_m,
-                 algorithms::DistanceFromPath(
-                     path, Eigen::Vector2d(ego.x_m, ego.y_m)));
+    drive.max_error_m = std::max(
+        drive.max_error_m,
+        algorithms::DistanceFromPath(path, Eigen::Vector2d(ego.x_m, ego.y_m)));
     car.Step(tracker.Update(ego), dt);
     drive.time_s += dt;
   }
