@@ -135,7 +135,16 @@ PoolEvaluatorOptions EvaluatorOptions(const spec::Spec& spec,
   PoolEvaluatorOptions evaluator_options;
   evaluator_options.worker_command = options.worker_command;
   if (evaluator_options.worker_command.empty()) {
-    evaluator_options.worker_command = {SelfExecutable(), "worker"};
+    // Local workers run the coordinator's own executable, through the
+    // link the kernel keeps to it: rebuilding adse during a campaign
+    // replaces the file, and each job started while the linker wrote it
+    // failed ("Permission denied"), or would run another adse than the
+    // campaign's. Steps on a Slurm allocation may run on other nodes:
+    // they get the path.
+    evaluator_options.worker_command = {
+        options.make_pool ? SelfExecutable()
+                          : fmt::format("/proc/{}/exe", ::getpid()),
+        "worker"};
   }
   std::error_code ec;
   evaluator_options.scenario_path =

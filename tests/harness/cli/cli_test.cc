@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -673,6 +674,41 @@ TEST(CliRunTest, AnalyzeWithAReferenceDrawsTheStudysFigureOrRefusesClearly) {
   EXPECT_EQ(file.exit_code, 2) << file.out;
   EXPECT_NE(file.out.find("not a campaign folder"), std::string::npos)
       << file.out;
+}
+
+TEST(CliRunTest, WorkersRunTheCampaignsOwnAdseWhenItsFileIsReplaced) {
+  // A copy of adse starts a two-point campaign, one worker; once it has
+  // started, its file is replaced by another program (as a rebuild does).
+  // The second point's worker still runs the campaign's adse; by the
+  // file's path it ran the other program and failed.
+  const fs::path dir = fs::temp_directory_path() / "adse_cli_replaced";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path copy = dir / "adse";
+  fs::copy_file(std::string(ADSE_BINARY_DIR) + "/bin/adse", copy);
+  const fs::path out = dir / "campaign";
+  const std::string script =
+      copy.string() + " run " + Small() +
+      " --strategy exhaustive --budget 2 --workers 1 --no-cache -o " +
+      out.string() + " > " + (dir / "run.log").string() +
+      " 2>&1 & pid=$!; "
+      "while [ ! -d " +
+      out.string() +
+      " ]; do sleep 0.05; done; "
+      "rm " +
+      copy.string() + "; printf '#!/bin/sh\\nexit 3\\n' > " + copy.string() +
+      "; chmod +x " + copy.string() + "; wait $pid";
+  const int status = std::system(script.c_str());
+  const std::string log = ReadText((dir / "run.log").string());
+  ASSERT_TRUE(WIFEXITED(status)) << log;
+  EXPECT_EQ(WEXITSTATUS(status), 0) << log;
+  size_t runs = 0;
+  for (const auto& e : fs::directory_iterator(out / "runs")) {
+    runs += e.path().extension() == ".h5";
+  }
+  EXPECT_EQ(runs, 2u) << log;
+  const CommandRun done = Adse("status " + out.string() + " --json");
+  EXPECT_NE(done.out.find("\"done\": 2"), std::string::npos) << done.out;
 }
 
 TEST(CliRunTest, WorkerRefusesAScenarioThatChangedUnderItsCampaign) {
