@@ -98,9 +98,10 @@ ControlCommand ManoeuvreTracker::Update(const VehicleState& ego) {
   // Where the car is along the move: the nearest interval from the last
   // one on; past the move's end the last interval extends.
   const size_t last = move.points.size() - 2;
+  const size_t from = index_;
   double best = INFINITY, d = 0.0, lateral = 0.0, heading = 0.0;
-  for (size_t i = index_; i <= last; ++i) {
-    if (move.d_m[i] > move.d_m[index_] + kSearchAheadM) break;
+  for (size_t i = from; i <= last; ++i) {
+    if (move.d_m[i] > move.d_m[from] + kSearchAheadM) break;
     const Eigen::Vector2d a = move.points[i];
     const Eigen::Vector2d ab = move.points[i + 1] - a;
     const double len = ab.norm();
@@ -110,7 +111,7 @@ ControlCommand ManoeuvreTracker::Update(const VehicleState& ego) {
     const double dist = (pos - closest).norm();
     if (dist < best) {
       best = dist;
-      index_ = std::max(index_, i);
+      index_ = i;
       d = move.d_m[i] + t * len;
       const Eigen::Vector2d u = ab / len;
       lateral = u.x() * (pos.y() - a.y()) - u.y() * (pos.x() - a.x());
