@@ -38,7 +38,9 @@ namespace {
 // yields to the ego's way through it. v17: a moving track's box is
 // measured as a view of part of its object, and the crossing yield sees a
 // car in a farther part of the path's corridor where it crosses nearer.
-constexpr char kKeyVersion[] = "adse-run-key-v17";
+// v18: a driver SUMO holds for the ego, the ego clear of its way, drives
+// on once both have stood 3 s.
+constexpr char kKeyVersion[] = "adse-run-key-v18";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

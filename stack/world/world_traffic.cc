@@ -61,6 +61,9 @@ constexpr double kClaimHorizonS = 4.0;
 constexpr double kClaimLapseS = 2.0;
 // The ego counts as standing below this speed, m/s.
 constexpr double kStandingMps = 0.05;
+// A driver SUMO holds for the ego, though the ego is clear of its way, is
+// let go once both have stood this long, s.
+constexpr double kMutualWaitS = 3.0;
 
 // Appends `piece` to `path`, skipping a repeat of its last point; returns
 // the length added.
@@ -413,7 +416,13 @@ void World::Impl::YieldToEgo() {
         libsumo::Lane::getEdgeID(lane) != junction->from_edge) {
       wait_short_of(claim);
     }
-    if (safe < 0) continue;
+    if (safe < 0) {
+      // Not while the ego turns in several moves: its next move is the
+      // freespace planner's, which the driver's corridor does not
+      // foresee, and it may back into a driver let go beside it.
+      if (turn.empty()) ReleaseFromEgo(v, lane, lookahead);
+      continue;
+    }
     // Slower than it would drive anyway: a cap, never a push.
     if (safe >= libsumo::Vehicle::getAllowedSpeed(v.id) *
                     libsumo::Vehicle::getSpeedFactor(v.id)) {
@@ -432,6 +441,41 @@ void World::Impl::YieldToEgo() {
     }
   }
   yielding = std::move(still_yielding);
+  // Those let past the ego see it again once off the lane they were held
+  // on.
+  for (auto it = ignoring_ego.begin(); it != ignoring_ego.end();) {
+    const bool present =
+        std::any_of(others.begin(), others.end(),
+                    [&](const OtherVehicle& v) { return v.id == it->first; });
+    if (present && libsumo::Vehicle::getLaneID(it->first) == it->second) {
+      ++it;
+      continue;
+    }
+    if (present) {
+      libsumo::Vehicle::setParameter(it->first, "junctionModel.ignoreIDs", "");
+    }
+    it = ignoring_ego.erase(it);
+  }
+}
+
+void World::Impl::ReleaseFromEgo(const OtherVehicle& v, const std::string& lane,
+                                 double lookahead_m) {
+  if (ignoring_ego.count(v.id)) return;
+  // moveToXY matches the ego to one of the junction's internal lanes, and
+  // SUMO's junction model then holds a driver whose lane crosses that one
+  // for the ego as its leader, though the ego's body is clear of the
+  // driver's way (safe < 0 above). On the reference study's lot such a
+  // driver stood with its front 0.4 m into the ego's left turn, and the
+  // two waited for each other until the stall timeout. Both standing, the
+  // driver drives on; this function's caller still caps its speed should
+  // the ego come into its way.
+  if (ego_standing_s < kMutualWaitS ||
+      libsumo::Vehicle::getWaitingTime(v.id) < kMutualWaitS) {
+    return;
+  }
+  if (libsumo::Vehicle::getLeader(v.id, lookahead_m).first != kEgoId) return;
+  libsumo::Vehicle::setParameter(v.id, "junctionModel.ignoreIDs", kEgoId);
+  ignoring_ego.emplace(v.id, lane);
 }
 
 void World::Impl::ReadOthers() {

@@ -144,6 +144,10 @@ struct World::Impl {
   std::vector<FlowState> flows;
   std::set<std::string> held_still;  // traffic.stopped_vehicles
   std::set<std::string> yielding;    // cars told to slow for the ego
+  // Drivers let past SUMO's junction logic's view of the ego (YieldToEgo),
+  // with the lane they were on then: the ego is theirs to see again once
+  // they have left it.
+  std::map<std::string, std::string> ignoring_ego;
   // Each turn's reference manoeuvre as the ego's body every metre or so:
   // where SUMO's drivers wait while the ego turns (YieldToEgo).
   std::vector<std::vector<geometry::OrientedBox>> turn_sweeps;
@@ -223,6 +227,11 @@ struct World::Impl {
   // Both throw libsumo's exceptions (World::Step guards).
   void InsertFlows();
   void YieldToEgo();
+  // Lets a driver that SUMO holds for the ego, the ego clear of its way
+  // (`lane`: where it is; `lookahead_m`: how far it looks), drive on once
+  // both have stood kMutualWaitS.
+  void ReleaseFromEgo(const OtherVehicle& v, const std::string& lane,
+                      double lookahead_m);
   // The junction the ego claims now (YieldToEgo), or null: the next one on
   // its route, when its front is in it, or near it with a link that has
   // the right of way (as SUMO's drivers would see an approaching car).

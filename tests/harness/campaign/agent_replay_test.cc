@@ -76,7 +76,7 @@ TEST(AgentReplayTest, OnTheRecordedRobotaxiCampaign) {
 }
 
 TEST(AgentReplayTest, OnTheReferenceStudyWhereStarvedRunsAreStoppedEarly) {
-  // Measured at run key v17 with the profile of 2026-12-01 on the 838 m
+  // Measured at run key v18 with the profile of 2026-12-01 on the 838 m
   // route: 7 of the 12 true Pareto points in every seed (the study's LLM
   // agent found 6), a median hypervolume ratio of 0.990, the cheapest
   // design (6 cores at 1.5 GHz) in 12 of 20 seeds (README, "Strategies").

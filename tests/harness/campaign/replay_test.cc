@@ -32,7 +32,7 @@ TEST(ReplayTest, TheRecordingHoldsTheWholeSpaceWithAFeasibleFront) {
 
 TEST(ReplayTest, AgentFindsTheCheapestDesignOrSixTrueParetoPointsInMostSeeds) {
   // The study's LLM agent found 6 true Pareto points in 15. On adse's
-  // recording (run key v17 with the profile of 2026-12-01) the agent finds
+  // recording (run key v18 with the profile of 2026-12-01) the agent finds
   // 7 of the front's 12 in every seed, and the cheapest design (6 cores
   // at 1.5 GHz) in 12 of 20 (README, "Reproducing the reference study").
   int either = 0;
