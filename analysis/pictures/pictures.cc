@@ -176,23 +176,31 @@ struct CollisionPlace {
   double x_m = 0.0, y_m = 0.0, t_s = 0.0;
   bool ego_caused = false;
 };
+
+// The sample of `samples` nearest `t_s` among those `keep` accepts; null
+// when there is none.
+template <typename Sample, typename Keep>
+const Sample* NearestInTime(const std::vector<Sample>& samples, double t_s,
+                            Keep keep) {
+  const Sample* best = nullptr;
+  for (const Sample& s : samples) {
+    if (keep(s) && (best == nullptr ||
+                    std::abs(s.t_s - t_s) < std::abs(best->t_s - t_s))) {
+      best = &s;
+    }
+  }
+  return best;
+}
+
 std::vector<CollisionPlace> CollisionPlaces(const runfile::RunData& run) {
   std::vector<CollisionPlace> out;
-  if (run.ego.empty()) return out;
   for (const runfile::CollisionEvent& c : run.collisions) {
-    const auto ego = std::min_element(
-        run.ego.begin(), run.ego.end(), [&](const auto& a, const auto& b) {
-          return std::abs(a.t_s - c.t_s) < std::abs(b.t_s - c.t_s);
-        });
+    const runfile::EgoSample* ego =
+        NearestInTime(run.ego, c.t_s, [](const auto&) { return true; });
+    if (ego == nullptr) return out;
     CollisionPlace place{ego->x_m, ego->y_m, c.t_s, c.ego_caused == 1};
-    const runfile::VehicleSample* other = nullptr;
-    for (const runfile::VehicleSample& v : run.vehicles) {
-      if (v.id == c.other_id &&
-          (other == nullptr ||
-           std::abs(v.t_s - c.t_s) < std::abs(other->t_s - c.t_s))) {
-        other = &v;
-      }
-    }
+    const runfile::VehicleSample* other = NearestInTime(
+        run.vehicles, c.t_s, [&](const auto& v) { return v.id == c.other_id; });
     if (other != nullptr) {
       place.x_m = 0.5 * (place.x_m + other->x_m);
       place.y_m = 0.5 * (place.y_m + other->y_m);

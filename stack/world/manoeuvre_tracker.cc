@@ -71,13 +71,13 @@ double ManoeuvreTracker::CurvatureAt(const Move& move, double d_m) const {
   return move.curvature_1pm[i];
 }
 
-double ManoeuvreTracker::FeedForwardSteer(const Move& move, double d_m) const {
+double ManoeuvreTracker::SteerFor(const Move& move,
+                                  double curvature_1pm) const {
   // The direction of travel turns by gear x tan(steer) / wheelbase per
   // metre driven.
   const double gear = move.reverse ? -1.0 : 1.0;
-  return std::clamp(
-      std::atan(gear * limits_.wheelbase_m * CurvatureAt(move, d_m)),
-      -limits_.max_steer_rad, limits_.max_steer_rad);
+  return std::clamp(std::atan(gear * limits_.wheelbase_m * curvature_1pm),
+                    -limits_.max_steer_rad, limits_.max_steer_rad);
 }
 
 ControlCommand ManoeuvreTracker::Update(const VehicleState& ego) {
@@ -90,7 +90,6 @@ ControlCommand ManoeuvreTracker::Update(const VehicleState& ego) {
   }
   const Move& move = moves_[current_];
   hold.reverse = move.reverse;
-  const double gear = move.reverse ? -1.0 : 1.0;
   const double speed = std::abs(ego.v_mps);
   const bool standing = speed < options_.standstill_mps;
   const Eigen::Vector2d pos(ego.x_m, ego.y_m);
@@ -135,7 +134,7 @@ ControlCommand ManoeuvreTracker::Update(const VehicleState& ego) {
   }
   // Standing at a move's start: the wheels first.
   if (standing && d < options_.arrive_tolerance_m) {
-    const double first = FeedForwardSteer(move, 0.0);
+    const double first = SteerFor(move, move.curvature_1pm.front());
     if (std::abs(ego.steer_rad - first) > options_.steer_settle_rad) {
       hold.steer_rad = first;
       return hold;
@@ -149,9 +148,7 @@ ControlCommand ManoeuvreTracker::Update(const VehicleState& ego) {
   const double curvature = CurvatureAt(move, d + speed * options_.preview_s) -
                            options_.lateral_gain_1pm2 * lateral -
                            options_.heading_gain_1pm * heading_error;
-  command.steer_rad =
-      std::clamp(std::atan(gear * limits_.wheelbase_m * curvature),
-                 -limits_.max_steer_rad, limits_.max_steer_rad);
+  command.steer_rad = SteerFor(move, curvature);
 
   // Speed: the cruise speed, slow enough for the wheels to follow the
   // changes of curvature ahead, and a stop at the move's end.
@@ -161,7 +158,7 @@ ControlCommand ManoeuvreTracker::Update(const VehicleState& ego) {
     const double ahead = move.d_m[i] - d;
     if (ahead > options_.lookahead_m) break;
     const double change =
-        std::abs(FeedForwardSteer(move, move.d_m[i]) - ego.steer_rad);
+        std::abs(SteerFor(move, move.curvature_1pm[i]) - ego.steer_rad);
     if (change > kNegligibleSteerRad) {
       v_target =
           std::min(v_target, std::max(options_.crawl_speed_mps,

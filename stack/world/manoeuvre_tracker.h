@@ -71,8 +71,9 @@ class ManoeuvreTracker {
     std::vector<double> curvature_1pm;
   };
   double CurvatureAt(const Move& move, double d_m) const;
-  // The steering angle that drives `move`'s curvature at `d_m`.
-  double FeedForwardSteer(const Move& move, double d_m) const;
+  // The steering angle that drives `move` at `curvature_1pm` (in its
+  // direction of travel), within the wheels' limits.
+  double SteerFor(const Move& move, double curvature_1pm) const;
 
   VehicleLimits limits_;
   ManoeuvreTrackerOptions options_;
