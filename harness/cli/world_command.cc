@@ -33,12 +33,15 @@ std::string PathCsv(const geometry::Path2& path) {
   return csv;
 }
 
-// ", turns round in 5 moves at 812 m": the route's three-point turns.
+// ", turns round in 5 moves at 812 m, takes a corner in 4 moves at 49 m":
+// the route's turns in several moves.
 std::string TurnaroundText(const std::vector<world::RouteTurnaround>& turns) {
   std::string text;
   for (const world::RouteTurnaround& t : turns) {
-    text += fmt::format(", turns round in {} moves at {:.0f} m",
-                        world::ManoeuvreMoves(t.reference), t.start_s_m);
+    const int moves = world::ManoeuvreMoves(t.reference);
+    text += fmt::format(", {} in {} move{} at {:.0f} m",
+                        t.corner ? "takes a corner" : "turns round", moves,
+                        moves == 1 ? "" : "s", t.start_s_m);
   }
   return text;
 }
@@ -82,13 +85,14 @@ int RunWorld(const WorldArgs& args) {
   summary["parking_slots"] = w.scene().parking_slots().size();
   summary["parked_cars"] = parked;
   summary["traffic_seed"] = setup.world.traffic.seed;
-  // The three-point turns where the route turns around tighter than the
-  // car can.
+  // The turns in several moves: where the route turns around tighter than
+  // the car can ("u_turn") or takes a corner it cannot follow ("corner").
   nlohmann::json turns = nlohmann::json::array();
   for (const world::RouteTurnaround& t : w.route_turnarounds()) {
     turns.push_back({{"start_s_m", t.start_s_m},
                      {"end_s_m", t.end_s_m},
-                     {"moves", world::ManoeuvreMoves(t.reference)}});
+                     {"moves", world::ManoeuvreMoves(t.reference)},
+                     {"kind", t.corner ? "corner" : "u_turn"}});
   }
   summary["turnarounds"] = turns;
 

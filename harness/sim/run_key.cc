@@ -39,8 +39,9 @@ namespace {
 // measured as a view of part of its object, and the crossing yield sees a
 // car in a farther part of the path's corridor where it crosses nearer.
 // v18: a driver SUMO holds for the ego, the ego clear of its way, drives
-// on once both have stood 3 s.
-constexpr char kKeyVersion[] = "adse-run-key-v18";
+// on once both have stood 3 s. v19: a corner the ideal driver cannot
+// follow within 1 m is turned as a manoeuvre, as a tight U-turn is.
+constexpr char kKeyVersion[] = "adse-run-key-v19";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

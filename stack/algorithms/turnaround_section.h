@@ -1,6 +1,7 @@
 // Where a route turns round tighter than the car can (a U-turn narrower
-// than its turning circle): what a lanelet route knows of such a turn, as
-// the world finds it and the stack drives it. Eigen and std types only.
+// than its turning circle), or takes a corner the car cannot follow on its
+// lanes: what a lanelet route knows of such a turn, as the world finds it
+// and the stack drives it. Eigen and std types only.
 #ifndef ADSE_STACK_ALGORITHMS_TURNAROUND_SECTION_H_
 #define ADSE_STACK_ALGORITHMS_TURNAROUND_SECTION_H_
 
@@ -22,6 +23,10 @@ struct TurnaroundSection {
   // (where the manoeuvre keeps to), and the structure standing there.
   std::vector<std::vector<Eigen::Vector2d>> drivable;
   std::vector<std::vector<Eigen::Vector2d>> obstacles;
+  // A corner sharper than the car can follow closely on its lanes, rather
+  // than a U-turn narrower than its turning circle: where no manoeuvre
+  // leads on from where the car stands, it may take the lanes instead.
+  bool corner = false;
 };
 
 }  // namespace adse::algorithms

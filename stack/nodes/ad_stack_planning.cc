@@ -88,7 +88,8 @@ void Stack::BuildPlanning(Graph* g) {
         path_node, turn_done_, "turnaround_done", 1,
         [this](const ParkingDoneMsg& in, CallbackContext&) {
           if (in.turnaround != route_leg_) return;
-          path_planner_->ResumeAt(inputs_.turnarounds[route_leg_].end_s_m);
+          const algo::TurnaroundSection& turn = inputs_.turnarounds[route_leg_];
+          path_planner_->ResumeAt(in.on_lanes ? turn.start_s_m : turn.end_s_m);
           ++route_leg_;
           EndRouteLeg();
         });
@@ -359,9 +360,10 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
       others.push_back(box);
     }
   }
-  auto complete = [&] {
+  auto complete = [&](bool on_lanes = false) {
     ParkingDoneMsg done;
     done.header.stamp_s = stamp_s;
+    done.on_lanes = on_lanes;
     if (!turning) {
       parking_completed_ = true;
       ctx.Publish(topics_.parking_completed, std::move(done));
@@ -380,6 +382,7 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
   out.header.stamp_s = stamp_s;
   bool correcting = false;
   bool round_road_user = false;  // planning round a road user in the way
+  const bool first_plan = !parking_planned_;
   if (!parking_planned_) {
     // Handed over when standing within reach of where the route's leg
     // ends (the route's end, or the turn's start).
@@ -482,6 +485,14 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
     return;
   }
   freespace_holding_ = false;
+  if (!path.ok() && turning && turn->corner && first_plan) {
+    // No manoeuvre round the corner from where the car stands (a little
+    // off the pose the world planned from; on pasubio's narrow streets
+    // that left it boxed in by the map's poles): on along the lanes, as
+    // before corners were turned, rather than end the run.
+    complete(/*on_lanes=*/true);
+    return;
+  }
   if (!path.ok() && correcting) {
     // No way to the goal from where it stands: parked (turned) there, off
     // the goal (the planner's failure would end the run as no_path).

@@ -153,6 +153,9 @@ struct ParkingPathMsg {
 struct ParkingDoneMsg {
   Header header;
   int turnaround = -1;  // the three-point turn completed; -1: the parking
+  // The turn (a corner's) is left to the lanes: no manoeuvre led on from
+  // where the car stood, and the path goes on from the turn's start.
+  bool on_lanes = false;
 };
 
 struct ControlMsg {

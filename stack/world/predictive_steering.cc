@@ -5,6 +5,8 @@
 #include <limits>
 #include <vector>
 
+#include "stack/algorithms/planning.h"
+
 namespace adse::world {
 namespace {
 
@@ -18,12 +20,14 @@ double Penalty(double d, double bound_m) {
 
 // Curvature of the path around arc length s, from the heading change over
 // 4 m (robust to polylines whose vertices carry all the turning).
-double CurvatureAt(const geometry::Path2& path, double s) {
+double SignedCurvatureAt(const geometry::Path2& path, double s) {
   const double ds = 2.0;
-  double dh = path.HeadingAt(std::min(s + ds, path.length_m())) -
-              path.HeadingAt(std::max(s - ds, 0.0));
-  dh = std::atan2(std::sin(dh), std::cos(dh));
-  return std::abs(dh) / (2 * ds);
+  const double dh = path.HeadingAt(std::min(s + ds, path.length_m())) -
+                    path.HeadingAt(std::max(s - ds, 0.0));
+  return std::atan2(std::sin(dh), std::cos(dh)) / (2 * ds);
+}
+double CurvatureAt(const geometry::Path2& path, double s) {
+  return std::abs(SignedCurvatureAt(path, s));
 }
 
 struct Rollout {
@@ -177,6 +181,50 @@ double PredictiveSteer(const geometry::Path2& path, const SpeedProfile& speed,
   refine(&Rollout::second_target_rad);
   refine(&Rollout::first_target_rad);
   return best.first_target_rad;
+}
+
+std::vector<RehearsalSample> RehearseFollowing(
+    const geometry::Path2& path, const SpeedProfile& speed, double s0_m,
+    double s1_m, double start_v_mps, const VehicleLimits& limits,
+    const PredictiveSteeringOptions& options, double dt_s) {
+  std::vector<RehearsalSample> samples;
+  if (path.points.size() < 2 || dt_s <= 0.0) return samples;
+  s0_m = std::clamp(s0_m, 0.0, path.length_m());
+  s1_m = std::clamp(s1_m, s0_m, path.length_m());
+  BicycleModel car(limits);
+  VehicleState start;
+  const Eigen::Vector2d p0 = path.PointAt(s0_m);
+  start.x_m = p0.x();
+  start.y_m = p0.y();
+  start.yaw_rad = path.HeadingAt(s0_m);
+  start.v_mps = start_v_mps;
+  start.steer_rad =
+      std::clamp(std::atan(limits.wheelbase_m * SignedCurvatureAt(path, s0_m)),
+                 -limits.max_steer_rad, limits.max_steer_rad);
+  car.Reset(start);
+  // Progress as the world measures it (World::road_progress_m).
+  const algorithms::PathPlannerParams window;
+  double s = s0_m;
+  // A car that falls behind a crawl (it never should) ends the rehearsal.
+  const int max_steps = static_cast<int>(std::ceil(
+                            (s1_m - s0_m) / (options.min_speed_mps * dt_s))) +
+                        static_cast<int>(std::ceil(10.0 / dt_s));
+  for (int k = 0; k < max_steps && s < s1_m; ++k) {
+    const VehicleState& ego = car.state();
+    ControlCommand command;
+    command.steer_rad = PredictiveSteer(path, speed, s, ego, limits, options);
+    command.accel_mps2 =
+        std::clamp(options.speed_gain_per_s * (speed.At(s) - ego.v_mps),
+                   -limits.max_decel_mps2, limits.max_accel_mps2);
+    car.Step(command, dt_s);
+    double lateral = 0.0, d = 0.0;
+    s = std::max(s, algorithms::ProjectOnPath(
+                        path, Eigen::Vector2d(car.state().x_m, car.state().y_m),
+                        s - window.projection_back_m,
+                        s + window.projection_ahead_m, s, &lateral, &d));
+    samples.push_back({s, d});
+  }
+  return samples;
 }
 
 }  // namespace adse::world

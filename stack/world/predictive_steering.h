@@ -66,6 +66,20 @@ double PredictiveSteer(const geometry::Path2& path, const SpeedProfile& speed,
                        const VehicleLimits& limits,
                        const PredictiveSteeringOptions& options);
 
+// The ground-truth driver's lane following rehearsed on the car's model
+// alone, no traffic and no stops: PredictiveSteer drives it from s0_m (on
+// the path, along it, at start_v_mps, its wheels at the path's curvature),
+// its speed following `speed`, until its progress passes s1_m, in steps of
+// dt_s. Returns its progress and distance from the path at each step.
+struct RehearsalSample {
+  double s_m = 0.0;
+  double distance_m = 0.0;
+};
+std::vector<RehearsalSample> RehearseFollowing(
+    const geometry::Path2& path, const SpeedProfile& speed, double s0_m,
+    double s1_m, double start_v_mps, const VehicleLimits& limits,
+    const PredictiveSteeringOptions& options, double dt_s);
+
 }  // namespace adse::world
 
 #endif  // ADSE_STACK_WORLD_PREDICTIVE_STEERING_H_

@@ -303,6 +303,7 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
   impl->scene = std::move(parked).value();
   ADSE_RETURN_IF_ERROR(impl->BuildIdealPath());
   ADSE_RETURN_IF_ERROR(impl->FindRouteSignals());
+  ADSE_RETURN_IF_ERROR(impl->PlanTurnarounds());
   ADSE_RETURN_IF_ERROR(impl->FindSwitchedSignals());
   ADSE_RETURN_IF_ERROR(impl->SetUpTraffic());
   ADSE_RETURN_IF_ERROR(impl->AddEgo());

@@ -534,8 +534,7 @@ Status World::Impl::BuildIdealPath() {
       c.start_s_m = RoadS(c.start_s_m);
       c.end_s_m = RoadS(c.end_s_m);
     }
-    ideal = road;
-    ADSE_RETURN_IF_ERROR(PlanTurnarounds());
+    ideal = road;  // PlanTurnarounds adds the manoeuvres
     if (valet) {
       // The reference manoeuvre: the freespace planner's path from where the
       // road part ends into the slot, on the ground-truth lot. When it finds

@@ -12,11 +12,13 @@
 # world --follow-ideal`'s ground-truth controller strays from the ideal
 # path outside junctions, with the number of places the path turns
 # tighter than the car can (tests/bench/ideal_path_error.py), and the
-# route's three-point turns with the moves of each.
+# route's turns in several moves with the moves of each (at U-turns and
+# at corners sharper than the car, "c").
 #   tests/bench/real_nets_bench.sh [routes-per-net] [net-name ...]
 # ROUTES_SEED (default 1) seeds the routes and flows; POINT (default
 # cores=16,freq_ghz=2.1) is the design point; KEEP=DIR keeps the scenarios,
-# run files and logs in DIR. IDEAL_ONLY=1 drives only the ground-truth
+# run files and logs in DIR. ONLY="A10KW-2 joined-0" runs only the routes
+# named (the others are drawn all the same, so the names stay). IDEAL_ONLY=1 drives only the ground-truth
 # controller (no stack, a few seconds a route): the table then has the
 # route, whether and when that driver reached the goal, and its error.
 set -euo pipefail
@@ -125,10 +127,10 @@ echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(c
 echo
 ideal_only="${IDEAL_ONLY:-0}"
 if [ "${ideal_only}" = 1 ]; then
-  echo "| net | route | length m, SUMO's shortest / adse's | ideal driver reached goal | its time s | ideal driver off path m, outside junctions / all | turns tighter than the car's | three-point turns (moves) |"
+  echo "| net | route | length m, SUMO's shortest / adse's | ideal driver reached goal | its time s | ideal driver off path m, outside junctions / all | turns tighter than the car's | manoeuvres (moves; c: at a corner) |"
   echo "|---|---|---|---|---|---|---|---|"
 else
-  echo "| net | route | length m, SUMO's shortest / adse's | reached goal | ended | nav time s | dominant stop reason | stood s | collisions (caused by the ego) | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's | three-point turns (moves) |"
+  echo "| net | route | length m, SUMO's shortest / adse's | reached goal | ended | nav time s | dominant stop reason | stood s | collisions (caused by the ego) | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's | manoeuvres (moves; c: at a corner) |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 fi
 reached=0
@@ -143,6 +145,9 @@ for name in "${names[@]}"; do
     exit 2
   fi
   while read -r run length; do
+    if [ -n "${ONLY:-}" ] && [[ " ${ONLY} " != *" ${run} "* ]]; then
+      continue
+    fi
     yaml="${out}/${run}.yaml"
     # adse's own route first: it goes round the block where SUMO's turns
     # around tighter than the car can, turns in several moves where no
@@ -154,7 +159,7 @@ for name in "${names[@]}"; do
       continue
     fi
     length="${length} / $("${py}" -c 'import json,sys; print("%.0f" % json.load(open(sys.argv[1]))["ideal_path_length_m"])' "${out}/${run}-route.json")"
-    turnarounds="$("${py}" -c 'import json,sys; t = json.load(open(sys.argv[1]))["turnarounds"]; print("%d%s" % (len(t), " (%s)" % ", ".join(str(x["moves"]) for x in t) if t else ""))' "${out}/${run}-route.json")"
+    turnarounds="$("${py}" -c 'import json,sys; t = json.load(open(sys.argv[1]))["turnarounds"]; print("%d%s" % (len(t), " (%s)" % ", ".join(("c " if x["kind"] == "corner" else "") + str(x["moves"]) for x in t) if t else ""))' "${out}/${run}-route.json")"
     if [ "${ideal_only}" != 1 ] &&
       ! /usr/bin/time -v -o "${out}/${run}.time" "${adse}" simulate "${yaml}" \
         --point "${point}" --json -q -o "${out}/${run}.h5" \

@@ -20,6 +20,10 @@
 #include "stack/world/vehicle_model.h"
 #include "stack/world/world.h"
 
+namespace adse::algorithms {
+class FreespacePlanner;
+}  // namespace adse::algorithms
+
 namespace adse::world {
 namespace internal {
 
@@ -203,9 +207,16 @@ struct World::Impl {
                                             const std::string& from_field);
   Status PlanRoute();
   Status BuildIdealPath();
-  // The manoeuvre of each tight U-turn of the road part
-  // (world_turnaround.cc); an error naming task.goal where there is none.
+  // The manoeuvre of each tight U-turn of the road part, and of each
+  // corner the car cannot follow closely (world_turnaround.cc); an error
+  // naming task.goal where a U-turn has none (a corner without one keeps
+  // its lanes). After FindRouteSignals: a signal's stop line stays on the
+  // lanes.
   Status PlanTurnarounds();
+  // The corners' manoeuvres, between the U-turns' (`turnarounds`), in
+  // route order.
+  std::vector<RouteTurnaround> SharpCorners(
+      algorithms::FreespacePlanner& planner) const;
   // The car's tightest turn (rear axle), from its wheelbase and steering.
   double MinTurningRadiusM() const {
     return setup.ego.wheelbase_m / std::tan(setup.ego.max_steer_rad);

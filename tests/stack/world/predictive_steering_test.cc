@@ -122,6 +122,40 @@ TEST(PredictiveSteeringTest, AHairpinSharperThanTheCarCanTurnIsLoopedAndLeft) {
   EXPECT_LT(drive.time_s, 27.0);
 }
 
+// The world rehearses the ideal driver through a route's bends to find
+// corners it cannot follow within 1 m (world_turnaround.cc): the
+// rehearsal is the drive above, step by step.
+TEST(PredictiveSteeringTest, ARehearsalStraysAsTheDriveDoes) {
+  for (const double degrees : {90.0, 150.0}) {
+    const geometry::Path2 road = Corner(degrees);
+    const Drive drive = DriveAlong(road, {}, 30 / 3.6);
+    const SpeedProfile speed = CurveSpeedProfile(road, 30 / 3.6, 2.0, 2.0);
+    const std::vector<RehearsalSample> samples =
+        RehearseFollowing(road, speed, 0.0, road.length_m() - 1.0, 0.0,
+                          VehicleLimits(), {}, 0.05);
+    ASSERT_FALSE(samples.empty());
+    double worst_m = 0.0, last_s = 0.0;
+    for (const RehearsalSample& sample : samples) {
+      EXPECT_GE(sample.s_m, last_s);  // progress never goes back
+      last_s = sample.s_m;
+      worst_m = std::max(worst_m, sample.distance_m);
+    }
+    EXPECT_GE(last_s, road.length_m() - 1.0) << degrees;
+    EXPECT_NEAR(worst_m, drive.max_error_m, 0.1) << degrees;
+  }
+  // It measures only what it drives: on the straight before the corner
+  // (to 15 m short of it, further than the driver looks ahead) the car
+  // keeps to the road.
+  const geometry::Path2 road = Corner(150);
+  const SpeedProfile speed = CurveSpeedProfile(road, 30 / 3.6, 2.0, 2.0);
+  double worst_m = 0.0;
+  for (const RehearsalSample& sample : RehearseFollowing(
+           road, speed, 0.0, 25.0, 0.0, VehicleLimits(), {}, 0.05)) {
+    worst_m = std::max(worst_m, sample.distance_m);
+  }
+  EXPECT_LT(worst_m, 0.05);
+}
+
 TEST(PredictiveSteeringTest, TheSpeedProfileSlowsForACornerAhead) {
   const geometry::Path2 road = Polyline({{0, 0}, {40, 0}, {40, 40}});
   const SpeedProfile speed = CurveSpeedProfile(road, 30 / 3.6, 2.0, 2.0);

@@ -26,6 +26,7 @@ namespace {
 using testing::BenchRoute;
 using testing::CacheDir;
 using testing::DriveToTheGoal;
+using testing::kA10kwNet;
 using testing::kAcostaNet;
 using testing::kDrtNet;
 using testing::kPasubioNet;
@@ -74,6 +75,8 @@ TEST(WorldTest, GeneratedParkingLotLoadsAndIdealPathIsContinuous) {
   EXPECT_GT(parked, 0);
   EXPECT_LT(parked, 16);
   EXPECT_NEAR(w.lane_width_m(), 3.5, 0.01);
+  // Its corners are ones the car follows within 1 m: no manoeuvres.
+  EXPECT_TRUE(w.route_turnarounds().empty());
 }
 
 // A 3 x 3 grid of 100 m one-lane streets, from 10 m into A0B0 to C1C2.
@@ -167,6 +170,29 @@ TEST(WorldTest, OnARealTownTheIdealDriverTakesSharpCornersWithoutSwingingWide) {
   // Junctions included: 1.63 m measured (0.87 m outside them, issue 17's
   // bound, by tests/bench/ideal_path_error.py).
   EXPECT_LT(report.max_lateral_error_m, 1.8);
+}
+
+// A10KW's junction 59909485: a left turn of 143 degrees between roads
+// that meet 4.6 m apart, which SUMO calls a left turn, not a U-turn. The
+// ideal driver, rehearsed along the lanes, strays 3.1 m there (the real-
+// nets bench's A10KW-2 measured 3.11 m before); the car turns in several
+// moves within the lanes and the junction instead, and the driver
+// follows that within issue 17's 1 m.
+TEST(WorldTest, OnARealTownACornerSharperThanTheCarIsTurnedInSeveralMoves) {
+  Result<std::unique_ptr<World>> world =
+      OpenBenchRoute(kA10kwNet, Location::OnEdge("225981818#2", 30.0, 0),
+                     Location::OnEdge("-256366931#3", 40.0, 0));
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  ASSERT_EQ((*world)->route_turnarounds().size(), 1u);
+  const RouteTurnaround& turn = (*world)->route_turnarounds()[0];
+  EXPECT_GE(ManoeuvreMoves(turn.reference), 2);
+  // It ends on the road part past the corner, heading along it.
+  const geometry::Path2& road = (*world)->road_path();
+  EXPECT_NEAR(turn.goal.yaw_rad, road.HeadingAt(turn.end_s_m), 1e-9);
+  EXPECT_LT(turn.end_s_m, road.length_m());
+  const IdealDriveReport report = DriveToTheGoal(**world, 40.0, 300.0);
+  EXPECT_EQ(report.collisions, 0);
+  EXPECT_LT(report.max_lateral_error_m, 1.0);
 }
 
 TEST(WorldTest, AOneWayStreetOfABareNetHasPolesOnBothSides) {
@@ -600,9 +626,17 @@ TEST(WorldTest, AGoalBehindTheStartIsReachedByATurnInSeveralMoves) {
   setup.cache_dir = CacheDir();
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_TRUE(world.ok()) << world.status().ToString();
-  ASSERT_EQ((*world)->route_turnarounds().size(), 1u);
-  const RouteTurnaround& turn = (*world)->route_turnarounds()[0];
+  const std::vector<RouteTurnaround>& turns = (*world)->route_turnarounds();
+  ASSERT_EQ(turns.size(), 2u);
+  const RouteTurnaround& turn = turns[0];
+  EXPECT_FALSE(turn.corner);
   EXPECT_GE(ManoeuvreMoves(turn.reference), 3);
+  // The bend back west comes 5 m past where the turn ends, too soon for
+  // the car, standing there, to follow the lanes round it within 1 m: a
+  // corner driven as a manoeuvre of its own, in one move.
+  EXPECT_TRUE(turns[1].corner);
+  EXPECT_NEAR(turns[1].start_s_m, turn.end_s_m, 1e-6);
+  EXPECT_EQ(ManoeuvreMoves(turns[1].reference), 1);
   // It ends on the lane back out of the stub, heading south.
   EXPECT_NEAR(turn.goal.x_m, 198.4, 1.0);
   EXPECT_NEAR(turn.goal.yaw_rad, -M_PI / 2, 0.05);

@@ -17,6 +17,8 @@
 namespace adse::world::testing {
 
 inline constexpr char kDrtNet[] = "/usr/share/sumo/tools/game/DRT/osm.net.xml";
+inline constexpr char kA10kwNet[] =
+    "/usr/share/sumo/tools/game/A10KW/osm.net.xml";
 inline constexpr char kBs3dNet[] = "/usr/share/sumo/tools/game/bs3d/bs.net.xml";
 inline constexpr char kGrid6Net[] =
     "/usr/share/sumo/tools/game/grid6/grid6.net.xml";
