@@ -266,8 +266,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     if (!loaded.ok()) return loaded.status().WithContext("platform.profile");
     profile_name = loaded->name;
     // The graph has the signal subscription only where the route has
-    // signals, and the freespace planner only where it turns round in
-    // several moves; say which profile covers them rather than just what
+    // signals, and the freespace planner only where it turns in several
+    // moves; say which profile covers them rather than just what
     // is missing.
     struct RouteCallback {
       bool in_graph;
@@ -281,9 +281,9 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
                         "subscribes to its signal detector"},
           RouteCallback{!inputs.turnarounds.empty(),
                         "behavior_path_planner/turnaround_done",
-                        "the route turns round in several moves (a "
-                        "three-point turn), so the stack runs its freespace "
-                        "planner"}}) {
+                        "the route turns in several moves (at a U-turn or "
+                        "a corner sharper than the car), so the stack runs "
+                        "its freespace planner"}}) {
       if (c.in_graph && loaded->costs.callbacks.count(c.callback) == 0) {
         return Status::InvalidArgument(fmt::format(
             "platform.profile: {} ({}), which profile '{}' lacks; name a "
