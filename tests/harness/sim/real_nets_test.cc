@@ -251,6 +251,34 @@ spec::Spec DrtDeadEnd(const std::string& name, const std::string& flows,
                          1, stopped);
 }
 
+// A route that turns in several moves runs the freespace planner, whose
+// callbacks the plain profile lacks: the run is refused, naming the
+// profile that has them, before anything is simulated.
+TEST(RealNetsTest, APlainProfileIsRefusedWhereTheRouteTurnsInSeveralMoves) {
+  spec::Spec spec = DrtDeadEnd("drt_turn_plain", "[]");
+  ASSERT_TRUE(std::filesystem::exists(spec.world.map.net_path))
+      << "sumo-tools is not installed";
+  spec.platform.profile =
+      std::string(ADSE_SOURCE_DIR) +
+      "/scenarios/profiles/autoware-2022.12-i9-12900kf.yaml";
+  Result<runfile::RunData> run =
+      SimulatePoint(spec, {{"cores", 16}, {"freq_ghz", 2.1}});
+  ASSERT_FALSE(run.ok());
+  EXPECT_EQ(run.status().code(), Status::Code::kInvalidArgument);
+  const std::string& message = run.status().message();
+  EXPECT_EQ(message.rfind("platform.profile: the route turns in several "
+                          "moves",
+                          0),
+            0u)
+      << message;
+  EXPECT_NE(message.find("behavior_path_planner/turnaround_done"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("autoware-2022.12-i9-12900kf-signals.yaml"),
+            std::string::npos)
+      << message;
+}
+
 // The car stops short of the dead end and turns round forwards and in
 // reverse within the lanes and the junction (the bench's DRT-1 turns
 // there).
