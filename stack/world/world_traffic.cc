@@ -401,27 +401,30 @@ void World::Impl::YieldToEgo() {
                                return geometry::BoxesOverlap(v.box, *b);
                              });
         };
-    // Waits short of `way`, unless already in it (it drives on to clear
-    // it).
+    // Waits short of `way` (it is not in it).
     const auto wait_short_of =
         [&](const std::vector<const geometry::OrientedBox*>& way) {
-          if (in_way(way)) return;
           for (const geometry::OrientedBox* b : way) {
             const double wait =
                 YieldSpeedMps(path, v.box.width_m, decel, *b, Vec2::Zero());
             if (wait >= 0) safe = safe < 0 ? wait : std::min(safe, wait);
           }
         };
-    wait_short_of(turn);
-    // In the turn's way with the car in its own, it keeps its place rather
-    // than creep after the car: the car's next move may back into the
-    // space the car has just left (at A10KW's sharpest corner a driver
-    // crept 0.8 m in 10 s, and the car, boxed in, stood until the stall
-    // timeout).
-    if (safe >= 0 && in_way(turn)) safe = 0.0;
-    // On the ego's own road it leads or follows the ego.
+    if (!in_way(turn)) {
+      wait_short_of(turn);
+    } else if (safe >= 0) {
+      // In the turn's way it drives on to clear it, but with the car in
+      // its own it keeps its place rather than creep after the car: the
+      // car's next move may back into the space the car has just left
+      // (at A10KW's sharpest corner a driver crept 0.8 m in 10 s, and the
+      // car, boxed in, stood until the stall timeout).
+      safe = 0.0;
+    }
+    // On the ego's own road it leads or follows the ego, unless already
+    // in the way it claims (it drives on to clear it).
     if (junction != nullptr && minor_link &&
-        libsumo::Lane::getEdgeID(lane) != junction->from_edge) {
+        libsumo::Lane::getEdgeID(lane) != junction->from_edge &&
+        !in_way(claim)) {
       wait_short_of(claim);
     }
     if (safe < 0) {

@@ -185,12 +185,11 @@ std::vector<RouteTurnaround> World::Impl::SharpCorners(
       if (!corners.empty() && turn.start_s_m < corners.back().end_s_m) {
         continue;
       }
-      const auto inside = [&](double s_m) {
-        return s_m >= turn.start_s_m && s_m <= turn.end_s_m;
-      };
-      if (std::any_of(
-              signals.begin(), signals.end(),
-              [&](const RouteSignal& x) { return inside(x.stop_line_s_m); }) ||
+      if (std::any_of(signals.begin(), signals.end(),
+                      [&](const RouteSignal& x) {
+                        return x.stop_line_s_m >= turn.start_s_m &&
+                               x.stop_line_s_m <= turn.end_s_m;
+                      }) ||
           std::any_of(lane_changes.begin(), lane_changes.end(),
                       [&](const algorithms::LaneChangeSection& c) {
                         return c.start_s_m <= turn.end_s_m &&
