@@ -40,8 +40,11 @@ namespace {
 // car in a farther part of the path's corridor where it crosses nearer.
 // v18: a driver SUMO holds for the ego, the ego clear of its way, drives
 // on once both have stood 3 s. v19: a corner the ideal driver cannot
-// follow within 1 m is turned as a manoeuvre, as a tight U-turn is.
-constexpr char kKeyVersion[] = "adse-run-key-v19";
+// follow within 1 m is turned as a manoeuvre, as a tight U-turn is. v20:
+// touching the scene's structure (a pole, a wall, a building, a parked
+// car) is a collision, and the car turns its wheels standing before each
+// move of a manoeuvre.
+constexpr char kKeyVersion[] = "adse-run-key-v20";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

@@ -44,15 +44,6 @@ double Seconds(Clock::duration d) {
   return std::chrono::duration<double>(d).count();
 }
 
-// 1 when the ego caused its new contact with vehicle `id`, 0 when that one
-// drove into it (world::EgoCausedContact); -1 when `id` is gone.
-int32_t EgoCaused(const world::World& w, const std::string& id) {
-  for (const world::OtherVehicle& v : w.others()) {
-    if (v.id == id) return world::EgoCausedContact(w.ego(), w.ego_body(), v);
-  }
-  return -1;
-}
-
 std::string HostDescription() {
   char name[256] = {0};
   ::gethostname(name, sizeof(name) - 1);
@@ -148,6 +139,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   inputs.goal_yaw_tolerance_rad =
       spec.task.goal_yaw_tolerance_deg * M_PI / 180.0;
   inputs.wheelbase_m = w.ego_limits().wheelbase_m;
+  inputs.max_steer_rate_rad_per_s = w.ego_limits().max_steer_rate_rad_per_s;
   inputs.vehicle_length_m = w.ego_limits().length_m;
   inputs.vehicle_width_m = w.ego_limits().width_m;
   // Signals on the route: the stack's map holds them, and the world's
@@ -469,8 +461,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     stats.world_s += Seconds(Clock::now() - t_world);
     if (!stepped.ok()) return stepped;
     record_ego();
-    for (const std::string& id : w.new_contacts())
-      run.collisions.push_back({w.time_s(), id, EgoCaused(w, id)});
+    for (const world::Contact& c : w.new_contacts())
+      run.collisions.push_back({w.time_s(), c.id, c.ego_caused ? 1 : 0});
     if (w.time_s() + 1e-9 >= next_vehicles) {
       for (const world::OtherVehicle& v : w.others()) {
         run.vehicles.push_back({w.time_s(), v.id, v.box.center.x(),

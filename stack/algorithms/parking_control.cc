@@ -29,6 +29,7 @@ void ParkingFollower::SetPath(const std::vector<GearedPose>& poses) {
   current_ = 0;
   finished_ = false;
   last_index_ = 0;
+  settling_ = true;
   pid_.Reset();
   for (size_t i = 0; i < poses.size(); ++i) {
     const Eigen::Vector2d p(poses[i].pose.x_m, poses[i].pose.y_m);
@@ -142,6 +143,7 @@ ParkingCommand ParkingFollower::Update(const geometry::Pose2& pose,
       // Shift at the cusp and drive the next segment.
       ++current_;
       last_index_ = 0;
+      settling_ = true;
       pid_.Reset();
       continue;
     }
@@ -194,6 +196,20 @@ ParkingCommand ParkingFollower::Update(const geometry::Pose2& pose,
   double steer = std::atan(p.wheelbase_m * curvature);
   if (seg.reverse) steer = -steer;
   out.steer_rad = std::clamp(steer, -p.max_steer_rad, p.max_steer_rad);
+
+  const double turn_rad = out.steer_rad - steer_estimate_rad_;
+  if (std::abs(v_mps) >= p.standstill_mps) settling_ = false;
+  if (settling_ && p.steer_rate_rad_per_s > 0 &&
+      std::abs(turn_rad) > p.steer_settled_rad) {
+    // Standing at the segment's start: turn the wheels first.
+    out.target_speed_mps = 0.0;
+    out.accel_mps2 = -p.stop_decel_mps2;
+    pid_.Reset();
+  }
+  const double step_rad = p.steer_rate_rad_per_s * dt_s;
+  steer_estimate_rad_ += p.steer_rate_rad_per_s > 0
+                             ? std::clamp(turn_rad, -step_rad, step_rad)
+                             : turn_rad;
   return out;
 }
 

@@ -34,6 +34,14 @@ struct ParkingFollowerParams {
   double course_out_m = 0.0;
   // Slower than this counts as standing: the gear may change.
   double standstill_mps = 0.05;
+  // How fast the wheels turn, rad/s: standing at a segment's start, the
+  // car waits until they have turned to its first steering command (as
+  // Autoware keeps a car stopped until its steering converges), or a short
+  // move between cusps, steered on the way, turns the car far less than
+  // planned. 0: no wait.
+  double steer_rate_rad_per_s = 0.0;
+  // The wheels count as turned within this of the command.
+  double steer_settled_rad = 0.02;
   PidParams pid;  // speed loop
 };
 
@@ -96,6 +104,11 @@ class ParkingFollower {
   int current_ = 0;
   bool finished_ = false;
   size_t last_index_ = 0;  // projection's segment start, never decreasing
+  // The wheel angle as the commands so far have turned it (at
+  // steer_rate_rad_per_s), and whether the car is still to move off on
+  // the current segment.
+  double steer_estimate_rad_ = 0.0;
+  bool settling_ = true;
 };
 
 }  // namespace adse::algorithms

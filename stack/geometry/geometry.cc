@@ -176,6 +176,50 @@ bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b) {
   return true;
 }
 
+bool BoxTouchesOutline(const OrientedBox& box,
+                       const std::vector<Eigen::Vector2d>& outline) {
+  if (outline.empty()) return false;
+  // In the box's frame the box is [-hx, hx] x [-hy, hy]; a segment meets
+  // it unless clipping it to that rectangle leaves nothing (Liang-Barsky).
+  const double c = std::cos(box.yaw_rad), s = std::sin(box.yaw_rad);
+  auto local = [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector2d d = p - box.center;
+    return Eigen::Vector2d(c * d.x() + s * d.y(), -s * d.x() + c * d.y());
+  };
+  const double hx = 0.5 * box.length_m, hy = 0.5 * box.width_m;
+  auto segment_meets = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    double t0 = 0.0, t1 = 1.0;
+    const Eigen::Vector2d d = b - a;
+    const double p[4] = {-d.x(), d.x(), -d.y(), d.y()};
+    const double q[4] = {a.x() + hx, hx - a.x(), a.y() + hy, hy - a.y()};
+    for (int i = 0; i < 4; ++i) {
+      if (p[i] == 0.0) {
+        if (q[i] < 0.0) return false;  // parallel and outside
+        continue;
+      }
+      const double t = q[i] / p[i];
+      if (p[i] < 0.0) {
+        t0 = std::max(t0, t);
+      } else {
+        t1 = std::min(t1, t);
+      }
+      if (t0 > t1) return false;
+    }
+    return true;
+  };
+  std::vector<Eigen::Vector2d> points;
+  points.reserve(outline.size());
+  for (const Eigen::Vector2d& p : outline) points.push_back(local(p));
+  const size_t n = points.size();
+  const size_t edges = n <= 2 ? n - 1 : n;
+  if (n == 1) return segment_meets(points[0], points[0]);
+  for (size_t i = 0; i < edges; ++i) {
+    if (segment_meets(points[i], points[(i + 1) % n])) return true;
+  }
+  // No edge meets the box: it overlaps only if it lies wholly inside.
+  return n >= 3 && InsidePolygon(outline, box.center);
+}
+
 Pose2 InterpolatePose(const Pose2& a, const Pose2& b, double w) {
   const double dyaw = std::remainder(b.yaw_rad - a.yaw_rad, 2 * M_PI);
   return {a.x_m + w * (b.x_m - a.x_m), a.y_m + w * (b.y_m - a.y_m),

@@ -75,6 +75,12 @@ std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box);
 // True when two oriented boxes overlap (separating axis test).
 bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b);
 
+// True when an oriented box and an outline overlap or touch: a polygon
+// closed back to its first point (3 or more points, inside counts), a
+// segment (2), a point (1).
+bool BoxTouchesOutline(const OrientedBox& box,
+                       const std::vector<Eigen::Vector2d>& outline);
+
 // How far along `path` the strip reaching `half_width_m` either side of it
 // first meets `box`: the smallest arc length of a point of the box inside
 // the strip (0 when the box covers the path's start), or -1 when the box

@@ -30,6 +30,7 @@ struct StackInputs {
   double goal_tolerance_m = 2.0;
   double goal_yaw_tolerance_rad = M_PI;  // valet_parking's heading tolerance
   double wheelbase_m = 2.7;
+  double max_steer_rate_rad_per_s = 0.8;  // how fast the wheels turn
   double vehicle_length_m = 4.6;
   double vehicle_width_m = 1.9;
   // valet_parking: the route ends on the aisle beside the slot; from there

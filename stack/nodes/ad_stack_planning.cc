@@ -559,6 +559,7 @@ void Stack::BuildControl(Graph* g) {
     parking.forward_speed_mps = config_.Get("parking.forward_speed_mps");
     parking.reverse_speed_mps = config_.Get("parking.reverse_speed_mps");
     parking.course_out_m = config_.Get("parking.course_out_m");
+    parking.steer_rate_rad_per_s = inputs_.max_steer_rate_rad_per_s;
     parking_follower_ = std::make_unique<algo::ParkingFollower>(parking);
     g->Subscribe<ParkingPathMsg>(
         node, topics_.parking_path, "parking_path", 1,

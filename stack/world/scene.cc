@@ -73,6 +73,20 @@ inline void IntersectFace(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 
 }  // namespace
 
+const char* ObstacleKindToString(ObstacleKind kind) {
+  switch (kind) {
+    case ObstacleKind::kWall:
+      return "wall";
+    case ObstacleKind::kPole:
+      return "pole";
+    case ObstacleKind::kParkedCar:
+      return "parked car";
+    case ObstacleKind::kBuilding:
+      return "building";
+  }
+  return "obstacle";
+}
+
 std::vector<std::array<Eigen::Vector2d, 2>> ObstacleEdges(
     const Obstacle& obstacle) {
   std::vector<std::array<Eigen::Vector2d, 2>> edges;

@@ -15,6 +15,9 @@ namespace adse::world {
 
 enum class ObstacleKind { kWall, kPole, kParkedCar, kBuilding };
 
+// "wall", "pole", "parked car", "building".
+const char* ObstacleKindToString(ObstacleKind kind);
+
 // A vertical prism: a closed footprint polygon extruded from z_min to z_max.
 // A wall is a thin footprint; a pole a small polygon around its centre.
 struct Obstacle {

@@ -301,6 +301,16 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
                      impl->valet ? impl->goal_slot.name : "");
   if (!parked.ok()) return parked.status();
   impl->scene = std::move(parked).value();
+  for (const Obstacle& o : impl->scene.obstacles()) {
+    Vec2 centre = Vec2::Zero();
+    for (const Vec2& p : o.footprint) centre += p;
+    if (!o.footprint.empty()) centre /= static_cast<double>(o.footprint.size());
+    double radius = 0.0;
+    for (const Vec2& p : o.footprint) {
+      radius = std::max(radius, (p - centre).norm());
+    }
+    impl->structure_bounds.emplace_back(centre, radius);
+  }
   ADSE_RETURN_IF_ERROR(impl->BuildIdealPath());
   ADSE_RETURN_IF_ERROR(impl->FindRouteSignals());
   ADSE_RETURN_IF_ERROR(impl->PlanTurnarounds());
@@ -328,13 +338,25 @@ Status World::Step(const ControlCommand& command) {
     const geometry::OrientedBox body = w.ego->Body();
     std::set<std::string> contact;
     w.new_contacts.clear();
+    auto touch = [&](Contact c) {
+      contact.insert(c.id);
+      if (w.in_contact.count(c.id)) return;
+      ++w.collisions;
+      w.new_contacts.push_back(std::move(c));
+    };
     for (const OtherVehicle& v : w.others) {
       if (geometry::BoxesOverlap(body, v.box)) {
-        contact.insert(v.id);
-        if (!w.in_contact.count(v.id)) {
-          ++w.collisions;
-          w.new_contacts.push_back(v.id);
-        }
+        touch({v.id, false, EgoCausedContact(w.ego->state(), body, v)});
+      }
+    }
+    const double reach_m = 0.5 * std::hypot(body.length_m, body.width_m);
+    const std::vector<Obstacle>& structure = w.scene.obstacles();
+    for (size_t i = 0; i < structure.size(); ++i) {
+      const auto& [centre, radius] = w.structure_bounds[i];
+      if ((centre - body.center).norm() > radius + reach_m) continue;
+      if (geometry::BoxTouchesOutline(body, structure[i].footprint)) {
+        touch({fmt::format("{} {}", ObstacleKindToString(structure[i].kind), i),
+               true, true});
       }
     }
     w.in_contact = std::move(contact);
@@ -348,7 +370,7 @@ const VehicleLimits& World::ego_limits() const { return impl_->setup.ego; }
 geometry::OrientedBox World::ego_body() const { return impl_->ego->Body(); }
 const std::vector<OtherVehicle>& World::others() const { return impl_->others; }
 int World::collisions() const { return impl_->collisions; }
-const std::vector<std::string>& World::new_contacts() const {
+const std::vector<Contact>& World::new_contacts() const {
   return impl_->new_contacts;
 }
 double World::distance_to_goal_m() const {

@@ -51,6 +51,15 @@ bool EgoCausedContact(const VehicleState& ego,
                       const geometry::OrientedBox& ego_body,
                       const OtherVehicle& other);
 
+// A contact of the ego's body that began in the last step: with another
+// vehicle (its SUMO id) or with the scene's structure ("pole 12": the
+// obstacle's kind and index), which the ego always causes.
+struct Contact {
+  std::string id;
+  bool structure = false;
+  bool ego_caused = true;  // see EgoCausedContact
+};
+
 // A link the route takes through a signalised junction: the traffic light
 // that controls it and the stop line at the end of the route's lane.
 struct RouteSignal {
@@ -88,11 +97,12 @@ class World {
   geometry::OrientedBox ego_body() const;
   // Other vehicles as of the last step.
   const std::vector<OtherVehicle>& others() const;
-  // Collision events so far (ego overlapping another vehicle, counted once
-  // per contact).
+  // Collision events so far (ego overlapping another vehicle or the
+  // scene's structure: a pole, a wall, a building, a parked car; counted
+  // once per contact).
   int collisions() const;
-  // Vehicles whose contact with the ego began in the last step.
-  const std::vector<std::string>& new_contacts() const;
+  // The contacts that began in the last step.
+  const std::vector<Contact>& new_contacts() const;
   // Lane driving: within goal_tolerance_m of the goal, at the end of the
   // route (see road_progress_m). valet_parking:
   // parked, i.e. standing with the body's centre within goal_tolerance_m of

@@ -197,6 +197,9 @@ namespace {
 
 // A path vertex turning by more than 150 degrees folds the path back.
 constexpr double kFoldCos = -0.866;
+// A folded stretch that runs past the next lane's start ends this far
+// short of it.
+constexpr double kFoldLeadM = 10.0;
 
 // Whether `link` from `from_lane` is a U-turn narrower than two turning
 // radii: a car that turns no tighter than `min_radius_m` needs that much
@@ -440,13 +443,29 @@ Status World::Impl::BuildIdealPath() {
         if (!points.empty() && (p - points.back()).norm() < 1e-6) continue;
         // OSM-derived lane shapes can fold back on themselves (acosta's
         // edge 224[1] starts 9 m past its corner and comes back): no car
-        // drives a vertex that reverses the path, so it is dropped.
+        // drives a vertex that reverses the path, so it is dropped. Where
+        // `p` lies beside the last stretch (a junction's lane starting
+        // well before the edge's shape ends, a little to its side), the
+        // stretch ends kFoldLeadM short of `p`, not at its start: joined
+        // from the start, pasubio's edge 30 drifted 2.2 m across its road
+        // over 90 m, into the roadside poles.
         while (points.size() >= 2) {
-          const Vec2 in = points.back() - points[points.size() - 2];
+          const Vec2 a = points[points.size() - 2];
+          const Vec2 in = points.back() - a;
           const Vec2 out = p - points.back();
           if (out.norm() < 1e-6 ||
               in.dot(out) > kFoldCos * in.norm() * out.norm()) {
             break;
+          }
+          const double along_m = (p - a).dot(in) / in.norm() - kFoldLeadM;
+          if (along_m > 1e-3) {
+            const Vec2 cut = a + in * (along_m / in.norm());
+            raw_s -= (points.back() - cut).norm();
+            for (Crossing& c : crossings) {
+              c.raw_s_m = std::min(c.raw_s_m, raw_s);
+            }
+            points.back() = cut;
+            continue;
           }
           raw_s -= in.norm();
           points.pop_back();

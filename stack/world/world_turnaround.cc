@@ -100,32 +100,40 @@ double DistanceToPolyline(const std::vector<Vec2>& line, const Vec2& p) {
   return best;
 }
 
-// The lanes open to cars and the junctions within kAreaRadiusM of `at`.
-Polygons DrivableAround(const Vec2& at) {
+// Within kAreaRadiusM of one of the points `around`.
+bool Near(const std::vector<Vec2>& shape, const std::vector<Vec2>& around) {
+  for (const Vec2& at : around) {
+    if (DistanceToPolyline(shape, at) <= kAreaRadiusM) return true;
+  }
+  return false;
+}
+
+// The lanes open to cars and the junctions near the points `around`.
+Polygons DrivableAround(const std::vector<Vec2>& around) {
   Polygons out;
   for (const std::string& lane : libsumo::Lane::getIDList()) {
     if (!OpenToCars(lane)) continue;
     const std::vector<Vec2> shape = ToPoints(libsumo::Lane::getShape(lane));
-    if (DistanceToPolyline(shape, at) > kAreaRadiusM) continue;
+    if (!Near(shape, around)) continue;
     AddLaneArea(shape, libsumo::Lane::getWidth(lane), &out);
   }
   for (const std::string& junction : libsumo::Junction::getIDList()) {
     const libsumo::TraCIPosition p = libsumo::Junction::getPosition(junction);
-    if ((Vec2(p.x, p.y) - at).norm() > kAreaRadiusM) continue;
+    if (!Near({Vec2(p.x, p.y)}, around)) continue;
     std::vector<Vec2> shape = ToPoints(libsumo::Junction::getShape(junction));
     if (shape.size() >= 3) out.push_back(std::move(shape));
   }
   return out;
 }
 
-// The ground truth about `at`: the lanes and junctions a manoeuvre there
-// keeps to, and the structure standing there.
-void SetAreaAbout(const Vec2& at, const Scene& scene, RouteTurnaround* turn) {
-  turn->drivable = DrivableAround(at);
+// The ground truth near the points `around` (a U-turn's place, or every
+// few metres of a corner's stretch, which may be long): the lanes and
+// junctions a manoeuvre there keeps to, and the structure standing there.
+void SetAreaAbout(const std::vector<Vec2>& around, const Scene& scene,
+                  RouteTurnaround* turn) {
+  turn->drivable = DrivableAround(around);
   for (std::vector<Vec2>& outline : ObstacleOutlines(scene)) {
-    if (DistanceToPolyline(outline, at) <= kAreaRadiusM) {
-      turn->obstacles.push_back(std::move(outline));
-    }
+    if (Near(outline, around)) turn->obstacles.push_back(std::move(outline));
   }
 }
 
@@ -201,7 +209,12 @@ std::vector<RouteTurnaround> World::Impl::SharpCorners(
       const Vec2 b = road.PointAt(turn.end_s_m);
       const geometry::Pose2 from{a.x(), a.y(), road.HeadingAt(turn.start_s_m)};
       turn.goal = {b.x(), b.y(), road.HeadingAt(turn.end_s_m)};
-      SetAreaAbout(road.PointAt(0.5 * (first + last)), scene, &turn);
+      std::vector<Vec2> stretch;
+      for (double s_m = turn.start_s_m; s_m < turn.end_s_m; s_m += 10.0) {
+        stretch.push_back(road.PointAt(s_m));
+      }
+      stretch.push_back(b);
+      SetAreaAbout(stretch, scene, &turn);
       Result<algorithms::FreespacePath> manoeuvre =
           planner.Plan(from, turn.goal, turn.obstacles, turn.drivable);
       if (!manoeuvre.ok()) continue;
@@ -247,7 +260,7 @@ Status World::Impl::PlanTurnarounds() {
                                road.HeadingAt(turn.start_s_m)};
     const std::vector<Vec2> arrive =
         ToPoints(libsumo::Lane::getShape(crossing.from_lane));
-    SetAreaAbout(arrive.empty() ? stop : arrive.back(), scene, &turn);
+    SetAreaAbout({arrive.empty() ? stop : arrive.back()}, scene, &turn);
     Result<algorithms::FreespacePath> manoeuvre =
         planner.Plan(from, turn.goal, turn.obstacles, turn.drivable);
     if (!manoeuvre.ok()) {

@@ -132,8 +132,11 @@ struct World::Impl {
   Scene scene;
   std::unique_ptr<BicycleModel> ego;
   std::vector<OtherVehicle> others;
+  // Per obstacle of the scene: the centre and radius of a circle round
+  // its outline, to skip the far ones in the contact test.
+  std::vector<std::pair<Eigen::Vector2d, double>> structure_bounds;
   std::set<std::string> in_contact;
-  std::vector<std::string> new_contacts;
+  std::vector<Contact> new_contacts;
   int collisions = 0;
   double time_s = 0.0;
   bool sumo_running = false;

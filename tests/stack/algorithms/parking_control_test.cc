@@ -171,6 +171,61 @@ TEST(ParkingFollower, OffItsCourseItBrakesAndHoldsUntilANewPath) {
   EXPECT_FALSE(lenient.Update({2.5, 5.0, 0}, 1.0, 0.05).course_out);
 }
 
+// A shuffle that turns the car on the spot: eight moves of 0.6 m at full
+// lock, forwards to the left and backwards to the right, each turning the
+// car 0.15 rad counter-clockwise, as the freespace planner plans in a tight
+// U-turn. Returns the heading at the end less the planned one.
+double ShuffleHeadingError(double steer_rate_rad_per_s, double* time_s) {
+  const world::VehicleLimits limits;
+  const double k = std::tan(limits.max_steer_rad) / limits.wheelbase_m;
+  std::vector<GearedPose> poses;
+  Pose2 p{0, 0, 0};
+  poses.push_back({p, false});
+  for (int move = 0; move < 8; ++move) {
+    const bool reverse = move % 2 == 1;
+    for (int i = 0; i < 6; ++i) {
+      const double ds = reverse ? -0.1 : 0.1;
+      p.x_m += ds * std::cos(p.yaw_rad);
+      p.y_m += ds * std::sin(p.yaw_rad);
+      p.yaw_rad += 0.1 * k;
+      poses.push_back({p, reverse});
+    }
+  }
+  ParkingFollowerParams params;
+  params.steer_rate_rad_per_s = steer_rate_rad_per_s;
+  ParkingFollower follower(params);
+  follower.SetPath(poses);
+  world::BicycleModel car{limits};
+  car.Reset(world::VehicleState{});
+  const double dt = 1.0 / 30.0;
+  *time_s = 0.0;
+  for (int i = 0; i < 30 * 120; ++i) {
+    const world::VehicleState& st = car.state();
+    const ParkingCommand c =
+        follower.Update({st.x_m, st.y_m, st.yaw_rad}, st.v_mps, dt);
+    if (c.finished) break;
+    car.Step({c.accel_mps2, c.steer_rad, c.reverse}, dt);
+    *time_s += dt;
+  }
+  return std::remainder(car.state().yaw_rad - p.yaw_rad, 2 * M_PI);
+}
+
+TEST(ParkingFollower, ShortMovesTurnTheCarAsPlannedWhenItSteersStanding) {
+  // The wheels swing lock to lock in 1.5 s; steered on the way, a 0.6 m
+  // move is half over before they reach the lock it was planned at.
+  double steered_standing_s = 0.0, steered_moving_s = 0.0;
+  const double standing = ShuffleHeadingError(
+      world::VehicleLimits{}.max_steer_rate_rad_per_s, &steered_standing_s);
+  const double moving = ShuffleHeadingError(0.0, &steered_moving_s);
+  // Steered on the way the shuffle loses 0.79 rad of its 1.22; steered
+  // standing, 0.31 (each move still ends within its 0.1 m tolerance,
+  // short of its end).
+  EXPECT_GT(std::abs(moving), 0.6);
+  EXPECT_LT(std::abs(standing), 0.5 * std::abs(moving));
+  // Each of the 7 shifts waits about a lock-to-lock swing, 1.5 s.
+  EXPECT_GT(steered_standing_s - steered_moving_s, 7 * 1.0);
+}
+
 TEST(DistanceFromPath, IsTheDistanceToTheNearestStretchOfThePolyline) {
   const std::vector<GearedPose> poses = {
       {{0, 0, 0}, false}, {{4, 0, 0}, false}, {{4, 3, 0}, true}};

@@ -72,6 +72,30 @@ Path2 LShape() {
   return p;
 }
 
+TEST(BoxTouchesOutlineTest, PolygonsSegmentsAndPoints) {
+  // A car-sized box at the origin, turned 90 degrees: 4.6 m along y.
+  const OrientedBox box{{0.0, 0.0}, M_PI / 2, 4.6, 1.9};
+  using V = Eigen::Vector2d;
+  auto square = [](double x, double y, double half) {
+    return std::vector<V>{{x - half, y - half},
+                          {x + half, y - half},
+                          {x + half, y + half},
+                          {x - half, y + half}};
+  };
+  // A pole by its side, one just clear of its nose, one touching it.
+  EXPECT_TRUE(BoxTouchesOutline(box, square(1.0, 1.0, 0.15)));
+  EXPECT_FALSE(BoxTouchesOutline(box, square(0.0, 2.5, 0.15)));
+  EXPECT_TRUE(BoxTouchesOutline(box, square(0.0, 2.4, 0.15)));
+  // A building round the whole car: no edge meets it, yet it is inside.
+  EXPECT_TRUE(BoxTouchesOutline(box, square(0.0, 0.0, 10.0)));
+  // A wall as a segment crossing it, passing it, and a point.
+  EXPECT_TRUE(BoxTouchesOutline(box, {V(-5.0, 0.5), V(5.0, 0.5)}));
+  EXPECT_FALSE(BoxTouchesOutline(box, {V(-5.0, 3.0), V(5.0, 3.0)}));
+  EXPECT_TRUE(BoxTouchesOutline(box, {V(0.5, -2.0)}));
+  EXPECT_FALSE(BoxTouchesOutline(box, {V(1.5, -2.0)}));
+  EXPECT_FALSE(BoxTouchesOutline(box, {}));
+}
+
 TEST(Path2Test, ArcLengthAndPointAtOnLShape) {
   const Path2 p = LShape();
   ASSERT_EQ(p.s_m.size(), 3u);

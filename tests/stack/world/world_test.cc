@@ -102,6 +102,27 @@ TEST(WorldTest, GridMapLoadsAndRoutes) {
   EXPECT_EQ((*world)->scene().obstacles().size(), 4u);  // city blocks
 }
 
+TEST(WorldTest, DrivingIntoACityBlockIsACollisionTheEgoCaused) {
+  Result<std::unique_ptr<World>> world = World::Open(SmallGrid());
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  World& w = **world;
+  // Off the road to the left, across the other lane, into the block.
+  std::vector<Contact> contacts;
+  for (int i = 0; i < 1200 && contacts.empty(); ++i) {
+    const double accel = w.ego().v_mps < 4.0 ? 1.0 : 0.0;
+    ASSERT_TRUE(w.Step({accel, w.time_s() < 1.5 ? 0.5 : 0.0, false}).ok());
+    contacts = w.new_contacts();
+  }
+  ASSERT_EQ(contacts.size(), 1u) << "never touched the block";
+  EXPECT_TRUE(contacts[0].structure);
+  EXPECT_TRUE(contacts[0].ego_caused);
+  EXPECT_FALSE(contacts[0].id.empty());
+  EXPECT_EQ(w.collisions(), 1);
+  // Pushing on into it is the same contact.
+  for (int i = 0; i < 20; ++i) ASSERT_TRUE(w.Step({1.0, 0.0, false}).ok());
+  EXPECT_EQ(w.collisions(), 1);
+}
+
 TEST(WorldTest, RealOsmNetworkFromSumoToolsLoadsAndRoutes) {
   ASSERT_TRUE(std::filesystem::exists(kDrtNet))
       << "sumo-tools is not installed";
