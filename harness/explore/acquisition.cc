@@ -85,7 +85,11 @@ bool AgentStrategy::SampleOutcome(
   for (size_t d = 0; d < knobs_.size(); ++d) {
     values[knobs_[d].parameter->name] = knobs_[d].parameter->values[c.genes[d]];
   }
-  for (const spec::Expression& constraint : constraints_) {
+  if (c.verdict == Verdict::kFails) return false;
+  for (size_t i = 0; i < constraints_.size(); ++i) {
+    const spec::Expression& constraint = constraints_[i];
+    // A run with less capacity already met the metric constraints.
+    if (c.verdict == Verdict::kHolds && metric_only_[i]) continue;
     // A constraint on a metric no run has shown yet cannot be predicted:
     // it is taken to hold until a run says otherwise.
     bool known = true;
@@ -124,6 +128,7 @@ std::string AgentStrategy::Choose(int n, std::vector<Genes>* chosen) {
     c.genes = pool[i];
     c.u = Coordinates(c.genes);
     c.cost = Cost(c.genes);
+    c.verdict = CapacityVerdict(c.genes);
     c.mean.assign(models_.size(), 0.0);
     c.sd.assign(models_.size(), 1.0);
     for (size_t m = 0; m < models_.size(); ++m) {
@@ -397,6 +402,7 @@ Candidate AgentStrategy::Predicted(const Genes& genes) const {
   c.genes = genes;
   c.u = Coordinates(genes);
   c.cost = Cost(genes);
+  c.verdict = CapacityVerdict(genes);
   c.mean.assign(models_.size(), 0.0);
   c.sd.assign(models_.size(), 1.0);
   for (size_t m = 0; m < models_.size(); ++m) {

@@ -138,6 +138,7 @@ void AgentStrategy::Remember(const Observation& observation) {
   record.feasible = observation.feasible && !observation.failed;
   record.objectives = Objectives(observation);
   if (observation.censored) record.censored = CensoredAt(observation);
+  record.metrics_fail = !record.failed && MetricsFail(observation);
   records_.push_back(std::move(record));
   ++fresh_;
 }
@@ -189,6 +190,7 @@ void AgentStrategy::SetUpKnobs() {
     // modifier more than an axis: its levels share much of their
     // behaviour, so they stay correlated in the GP.
     lengths_.push_back(values.size() <= 3 ? kFewValuesLength : kLength);
+    rate_raised_.push_back(false);
   }
 }
 
@@ -218,14 +220,17 @@ void AgentStrategy::SetUpMetrics() {
   for (const std::string& text : spec_->constraints) {
     Result<spec::Expression> expression = spec::Expression::Parse(text, names);
     if (!expression.ok()) continue;
+    bool metric_only = true;
     for (const std::string& variable : expression->variables()) {
-      if (variable == kCostMetric) continue;
-      if (std::find(parameter_names.begin(), parameter_names.end(), variable) !=
-          parameter_names.end()) {
+      if (variable == kCostMetric ||
+          std::find(parameter_names.begin(), parameter_names.end(), variable) !=
+              parameter_names.end()) {
+        metric_only = false;
         continue;
       }
       add(variable)->in_constraint = true;
     }
+    metric_only_.push_back(metric_only);
     constraints_.push_back(std::move(*expression));
     constraint_texts_.push_back(text);
   }
@@ -358,6 +363,58 @@ std::vector<int> AgentStrategy::RemedyDirections(const Record& record,
   return direction;
 }
 
+bool AgentStrategy::MetricsFail(const Observation& observation) const {
+  for (size_t i = 0; i < constraints_.size(); ++i) {
+    if (!metric_only_[i]) continue;
+    if (observation.censored &&
+        observation.violated_constraint == constraint_texts_[i]) {
+      return true;
+    }
+    bool measured = true;
+    for (const std::string& variable : constraints_[i].variables()) {
+      auto it = observation.metrics.find(variable);
+      measured = measured && it != observation.metrics.end() &&
+                 std::isfinite(it->second);
+    }
+    if (!measured) continue;
+    const double v = constraints_[i].Evaluate(observation.metrics);
+    if (!std::isfinite(v) || v == 0.0) return true;
+  }
+  return false;
+}
+
+int AgentStrategy::CompareCapacity(const Genes& a, const Genes& b) const {
+  int sign = 0;
+  for (size_t d = 0; d < knobs_.size(); ++d) {
+    if (a[d] == b[d]) continue;
+    const KnobRole role = knobs_[d].role;
+    int here = a[d] < b[d] ? -1 : +1;
+    if (role == KnobRole::kSensorRate && !rate_raised_[d]) {
+      here = -here;  // a faster sensor is more load
+    } else if (role != KnobRole::kCores && role != KnobRole::kFrequency) {
+      return 2;
+    }
+    if (sign != 0 && sign != here) return 2;
+    sign = here;
+  }
+  return sign;
+}
+
+Verdict AgentStrategy::CapacityVerdict(const Genes& genes) const {
+  Verdict verdict = Verdict::kUnknown;
+  for (const Record& record : records_) {
+    if (record.failed) continue;
+    const int order = CompareCapacity(genes, record.genes);
+    if (record.metrics_fail && (order == -1 || order == 0)) {
+      return Verdict::kFails;
+    }
+    if (record.feasible && (order == +1 || order == 0)) {
+      verdict = Verdict::kHolds;
+    }
+  }
+  return verdict;
+}
+
 std::optional<CensoredBound> AgentStrategy::CensoredAt(
     const Observation& observation) const {
   auto found = std::find(constraint_texts_.begin(), constraint_texts_.end(),
@@ -441,8 +498,10 @@ void AgentStrategy::FitModels() {
     const std::vector<int> direction = RemedyDirections(record, nullptr);
     for (size_t d = 0; d < knobs_.size(); ++d) votes[d] += direction[d];
   }
+  rate_raised_.assign(knobs_.size(), false);
   for (size_t d = 0; d < knobs_.size(); ++d) {
     const KnobRole role = knobs_[d].role;
+    rate_raised_[d] = role == KnobRole::kSensorRate && votes[d] > 0;
     if (role == KnobRole::kCores || role == KnobRole::kFrequency) {
       // Per unit of log capacity, cores and clock help alike: the prior is
       // an elasticity, so over the normalised knob it scales with the

@@ -95,7 +95,17 @@ struct Record {
   bool feasible = false;
   bool failed = false;
   std::optional<CensoredBound> censored;  // stopped early, bound known
+  // A constraint that reads only measured metrics failed here: with less
+  // capacity it fails too (see AgentStrategy::Capacity).
+  bool metrics_fail = false;
 };
+
+// What the runs say of a point by capacity alone: a point with no more
+// capacity than a run whose metric constraints failed fails them too; one
+// with no less than a feasible run's meets them. Capacity is ordered by
+// the knobs' roles: more cores and clock, a slower sensor, every other
+// knob equal.
+enum class Verdict { kUnknown, kFails, kHolds };
 
 struct Candidate {
   Genes genes;
@@ -108,6 +118,7 @@ struct Candidate {
   double p_front = 0.0;  // probability of joining the predicted front
   double factor = 1.0;   // diagnosis multiplier
   double runs = 1.0;     // probability that a run there does not fail
+  Verdict verdict = Verdict::kUnknown;
   double score = 0.0;
   std::string hint;  // the remedy it follows, if any
 };
@@ -146,6 +157,16 @@ class AgentStrategy : public Strategy {
   std::optional<CensoredBound> CensoredAt(const Observation& observation) const;
 
   void FitModels();
+
+  // Whether the metric constraints failed at a run (evaluated on what it
+  // measured, or named by its early stop).
+  bool MetricsFail(const Observation& observation) const;
+
+  // -1, 0 or +1: whether `a` has at most, the same or at least `b`'s
+  // capacity (see Verdict); 2 when neither.
+  int CompareCapacity(const Genes& a, const Genes& b) const;
+
+  Verdict CapacityVerdict(const Genes& genes) const;
 
   std::vector<Genes> Candidates(const std::vector<Genes>& chosen);
 
@@ -209,12 +230,17 @@ class AgentStrategy : public Strategy {
   Random random_;
   std::vector<Knob> knobs_;
   std::vector<double> lengths_;  // GP length scale per knob
+  // Per knob: a sensor rate the diagnosis asked to raise, so a faster
+  // sensor is not taken for more load (FitModels).
+  std::vector<bool> rate_raised_;
   std::vector<MetricModel> models_;
   bool any_failed_ = false;
   std::vector<spec::Expression> constraints_;
   std::vector<std::string> constraint_texts_;  // as the scenario writes them
-  std::vector<std::vector<double>> z_;         // [sample][model]
-  std::vector<int> objective_model_;           // per objective, index or -1
+  // Per constraint: it reads only measured metrics (no cost, no knob).
+  std::vector<bool> metric_only_;
+  std::vector<std::vector<double>> z_;  // [sample][model]
+  std::vector<int> objective_model_;    // per objective, index or -1
   std::optional<Genes> start_;
   int proposed_ = 0;
   int fresh_ = 0;  // runs told since the last Ask

@@ -316,6 +316,37 @@ TEST(AgentTest, StalledRunsTeachTheTimeBoundToo) {
   ExpectEndedEarlyRunsSendItToMoreCapacity(/*stalled=*/true);
 }
 
+TEST(AgentTest, ADesignWithLessCapacityThanAFailedRunIsNeverProposed) {
+  // The model's feasibility is monotone in capacity (more cores, a faster
+  // clock, a slower LiDAR), as the roles of the knobs declare: once a
+  // design fails its time bound, none with no more capacity is worth a run.
+  int infeasible_runs = 0;
+  for (uint64_t seed = 1; seed <= 5; ++seed) {
+    const spec::Spec spec =
+        MakeSpec("{budget: 20, seed: " + std::to_string(seed) + "}");
+    std::unique_ptr<Strategy> strategy = Create(spec);
+    ASSERT_NE(strategy, nullptr);
+    std::vector<spec::DesignPoint> failed;
+    const std::vector<spec::DesignPoint> points =
+        Drive(*strategy, 1, [&](const spec::DesignPoint& point) {
+          for (const spec::DesignPoint& f : failed) {
+            EXPECT_FALSE(point.at("cores") <= f.at("cores") &&
+                         point.at("freq_ghz") <= f.at("freq_ghz") &&
+                         point.at("lidar_hz") >= f.at("lidar_hz"))
+                << "seed " << seed << ": proposed "
+                << spec::FormatPoint(spec.design_space, point) << " after "
+                << spec::FormatPoint(spec.design_space, f) << " failed";
+          }
+          Observation o = Evaluate(point);
+          if (!o.feasible) failed.push_back(point);
+          return o;
+        });
+    EXPECT_EQ(points.size(), 20u);
+    infeasible_runs += static_cast<int>(failed.size());
+  }
+  EXPECT_GT(infeasible_runs, 0);  // the bound was met on the way
+}
+
 TEST(AgentTest, BatchesAreDistinctAndSpread) {
   const spec::Spec spec = MakeSpec("{budget: 24, seed: 7, batch: 4}");
   std::unique_ptr<Strategy> strategy = Create(spec);
