@@ -176,36 +176,45 @@ bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b) {
   return true;
 }
 
+bool ClipSegmentToRect(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,
+                       Eigen::Vector2d* a, Eigen::Vector2d* b) {
+  const Eigen::Vector2d d = *b - *a;
+  double t0 = 0.0, t1 = 1.0;
+  const double p[4] = {-d.x(), d.x(), -d.y(), d.y()};
+  const double q[4] = {a->x() - lo.x(), hi.x() - a->x(), a->y() - lo.y(),
+                       hi.y() - a->y()};
+  for (int i = 0; i < 4; ++i) {
+    if (p[i] == 0.0) {
+      if (q[i] < 0.0) return false;  // parallel and outside
+      continue;
+    }
+    const double t = q[i] / p[i];
+    if (p[i] < 0.0) {
+      t0 = std::max(t0, t);
+    } else {
+      t1 = std::min(t1, t);
+    }
+    if (t0 > t1) return false;
+  }
+  const Eigen::Vector2d start = *a;
+  *a = start + t0 * d;
+  *b = start + t1 * d;
+  return true;
+}
+
 bool BoxTouchesOutline(const OrientedBox& box,
                        const std::vector<Eigen::Vector2d>& outline) {
   if (outline.empty()) return false;
   // In the box's frame the box is [-hx, hx] x [-hy, hy]; a segment meets
-  // it unless clipping it to that rectangle leaves nothing (Liang-Barsky).
+  // it unless clipping it to that rectangle leaves nothing.
   const double c = std::cos(box.yaw_rad), s = std::sin(box.yaw_rad);
   auto local = [&](const Eigen::Vector2d& p) {
     const Eigen::Vector2d d = p - box.center;
     return Eigen::Vector2d(c * d.x() + s * d.y(), -s * d.x() + c * d.y());
   };
-  const double hx = 0.5 * box.length_m, hy = 0.5 * box.width_m;
-  auto segment_meets = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    double t0 = 0.0, t1 = 1.0;
-    const Eigen::Vector2d d = b - a;
-    const double p[4] = {-d.x(), d.x(), -d.y(), d.y()};
-    const double q[4] = {a.x() + hx, hx - a.x(), a.y() + hy, hy - a.y()};
-    for (int i = 0; i < 4; ++i) {
-      if (p[i] == 0.0) {
-        if (q[i] < 0.0) return false;  // parallel and outside
-        continue;
-      }
-      const double t = q[i] / p[i];
-      if (p[i] < 0.0) {
-        t0 = std::max(t0, t);
-      } else {
-        t1 = std::min(t1, t);
-      }
-      if (t0 > t1) return false;
-    }
-    return true;
+  const Eigen::Vector2d half(0.5 * box.length_m, 0.5 * box.width_m);
+  auto segment_meets = [&](Eigen::Vector2d a, Eigen::Vector2d b) {
+    return ClipSegmentToRect(-half, half, &a, &b);
   };
   std::vector<Eigen::Vector2d> points;
   points.reserve(outline.size());

@@ -75,6 +75,12 @@ std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box);
 // True when two oriented boxes overlap (separating axis test).
 bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b);
 
+// Clips segment a-b to the axis-aligned rectangle [lo, hi] (Liang-Barsky):
+// false when no part of it lies inside; else a and b become the ends of
+// the part inside.
+bool ClipSegmentToRect(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,
+                       Eigen::Vector2d* a, Eigen::Vector2d* b);
+
 // True when an oriented box and an outline overlap or touch: a polygon
 // closed back to its first point (3 or more points, inside counts), a
 // segment (2), a point (1).

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "stack/base/files.h"
+#include "stack/geometry/geometry.h"
 
 namespace adse::analysis::internal {
 
@@ -68,27 +69,14 @@ int DrawText(cv::Mat* img, const std::string& raw, int x, int y, Align align,
 
 // Liang-Barsky: clips segment a-b to `box`; false if nothing is inside.
 bool ClipSegment(const cv::Rect2d& box, cv::Point2d* a, cv::Point2d* b) {
-  const double dx = b->x - a->x, dy = b->y - a->y;
-  double t0 = 0.0, t1 = 1.0;
-  const double p[4] = {-dx, dx, -dy, dy};
-  const double q[4] = {a->x - box.x, box.x + box.width - a->x, a->y - box.y,
-                       box.y + box.height - a->y};
-  for (int i = 0; i < 4; ++i) {
-    if (p[i] == 0.0) {
-      if (q[i] < 0.0) return false;
-      continue;
-    }
-    const double t = q[i] / p[i];
-    if (p[i] < 0.0) {
-      t0 = std::max(t0, t);
-    } else {
-      t1 = std::min(t1, t);
-    }
-    if (t0 > t1) return false;
+  Eigen::Vector2d from(a->x, a->y), to(b->x, b->y);
+  if (!geometry::ClipSegmentToRect({box.x, box.y},
+                                   {box.x + box.width, box.y + box.height},
+                                   &from, &to)) {
+    return false;
   }
-  const cv::Point2d start = *a;
-  *a = start + t0 * cv::Point2d(dx, dy);
-  *b = start + t1 * cv::Point2d(dx, dy);
+  *a = {from.x(), from.y()};
+  *b = {to.x(), to.y()};
   return true;
 }
 
