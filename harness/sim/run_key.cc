@@ -43,8 +43,13 @@ namespace {
 // follow within 1 m is turned as a manoeuvre, as a tight U-turn is. v20:
 // touching the scene's structure (a pole, a wall, a building, a parked
 // car) is a collision, and the car turns its wheels standing before each
-// move of a manoeuvre.
-constexpr char kKeyVersion[] = "adse-run-key-v20";
+// move of a manoeuvre. v21: a car standing on the lane a turn goes onto
+// has turned (mid-manoeuvre too, and up to 5 m past its end), a turn in
+// several moves through a signal starts only when the signal lets the car
+// in, the world counts a turn made only once the car stands on that lane
+// (not when its moves back it past the turn's end), and drivers on the
+// ego's road wait 1.5 m farther short of its turn.
+constexpr char kKeyVersion[] = "adse-run-key-v21";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

@@ -1,5 +1,6 @@
 #include "stack/algorithms/traffic_light.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -30,7 +31,8 @@ void TrafficLightPlanner::NewSignal(const std::string& tls_id,
 
 SignalStop TrafficLightPlanner::Apply(double now_s, double stamp_s,
                                       double ego_v_mps,
-                                      std::vector<PlannedPoint>* points) {
+                                      std::vector<PlannedPoint>* points,
+                                      bool ends_for_turn) {
   SignalStop out;
   if (points == nullptr || points->empty()) return out;
   std::vector<PlannedPoint>& pts = *points;
@@ -63,7 +65,11 @@ SignalStop TrafficLightPlanner::Apply(double now_s, double stamp_s,
   const SignalState state = fresh ? latest_->state : SignalState::kUnknown;
   out.state = state;
   out.tls_id = tls_id_;
-  const double stop_s = line_s_m_ - params_.stop_margin_m - params_.ego_front_m;
+  double stop_s = line_s_m_ - params_.stop_margin_m - params_.ego_front_m;
+  if (ends_for_turn &&
+      line_s_m_ - pts.back().s_m <= params_.turn_line_reach_m) {
+    stop_s = std::min(stop_s, pts.back().s_m);
+  }
   const double to_stop_m = stop_s - s0;
   const double v = std::abs(ego_v_mps);
   if (v < params_.standing_speed_mps && to_stop_m < params_.at_line_m) {

@@ -41,6 +41,10 @@ struct TrafficLightParams {
                                     // junction, the signal no longer applies
   double standing_speed_mps = 0.1;  // slower than this: standing
   double at_line_m = 1.5;  // standing within this of the stop: at the line
+  // A path that ends for a turn in several moves (which the car starts
+  // standing) with a stop line at most this far past its end: the line is
+  // the turn's own, and the car waits for it at the path's end.
+  double turn_line_reach_m = 10.0;
 };
 
 struct SignalStop {
@@ -66,9 +70,12 @@ class TrafficLightPlanner {
   // pass, through the red that follows); unknown (an unreadable state or
   // an observation older than state_timeout_s) stops it at the line, then
   // lets it go after unknown_wait_s standing there; green, or no signal
-  // in range, does not stop it.
+  // in range, does not stop it. `ends_for_turn`: the path ends where the
+  // car stops to turn in several moves through the junction ahead, short
+  // of its line (see turn_line_reach_m).
   SignalStop Apply(double now_s, double stamp_s, double ego_v_mps,
-                   std::vector<PlannedPoint>* points);
+                   std::vector<PlannedPoint>* points,
+                   bool ends_for_turn = false);
 
  private:
   // Forgets what was decided for the previous signal.

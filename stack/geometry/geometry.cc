@@ -243,6 +243,21 @@ bool WithinTolerance(const Pose2& pose, const Pose2& goal, double tolerance_m,
          yaw_error <= yaw_tolerance_rad;
 }
 
+bool WithinToleranceOrAhead(const Pose2& pose, const Pose2& goal,
+                            double tolerance_m, double ahead_m,
+                            double yaw_tolerance_rad) {
+  const double dx = pose.x_m - goal.x_m;
+  const double dy = pose.y_m - goal.y_m;
+  const double c = std::cos(goal.yaw_rad);
+  const double s = std::sin(goal.yaw_rad);
+  const double along_m = dx * c + dy * s;
+  const double lateral_m = -dx * s + dy * c;
+  return along_m >= -tolerance_m && along_m <= ahead_m &&
+         std::abs(lateral_m) <= tolerance_m &&
+         std::abs(std::remainder(pose.yaw_rad - goal.yaw_rad, 2 * M_PI)) <=
+             yaw_tolerance_rad;
+}
+
 Pose2 MotionAfter(const Twist2& twist, double dt_s) {
   const double yaw = twist.yaw_rate_rps * dt_s;
   const double d = twist.v_mps * dt_s;

@@ -69,6 +69,15 @@ Pose2 InterpolatePose(const Pose2& a, const Pose2& b, double w);
 bool WithinTolerance(const Pose2& pose, const Pose2& goal, double tolerance_m,
                      double yaw_tolerance_rad);
 
+// Whether `pose` lies on the way on from `goal`: within `tolerance_m` of
+// the line through it along its heading, from `tolerance_m` before it to
+// `ahead_m` past it, and within `yaw_tolerance_rad` of its heading. A car
+// that has turned onto a lane a little past the pose it aimed for has
+// turned all the same.
+bool WithinToleranceOrAhead(const Pose2& pose, const Pose2& goal,
+                            double tolerance_m, double ahead_m,
+                            double yaw_tolerance_rad);
+
 // The four corners of a box, counter-clockwise.
 std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box);
 

@@ -17,6 +17,8 @@ constexpr double kNoPoseDecelMps2 = 3.0;
 // path takes the car on from there).
 constexpr double kTurnToleranceM = 1.0;
 constexpr double kTurnYawToleranceRad = 0.35;
+// ... or on its lane up to this far past it.
+constexpr double kTurnAheadM = 5.0;
 // The freespace planner minds the road users this close to the car.
 constexpr double kManoeuvreObjectRangeM = 30.0;
 // A move counts as blocked when a road user comes within this share of
@@ -25,6 +27,9 @@ constexpr double kManoeuvreObjectRangeM = 30.0;
 constexpr double kBlockedMarginShare = 0.5;
 // How far on along its path (in poses) the car is looked for each time.
 constexpr size_t kProgressWindowPoses = 8;
+// Slower than this the car stands (the planner hands a turn over to the
+// freespace planner only then).
+constexpr double kStandingMps = 0.1;
 
 // Trajectory points as the planning and control algorithms take them; the
 // speed can be capped on the way.
@@ -130,8 +135,14 @@ void Stack::BuildPlanning(Graph* g) {
         int64_t work = algo::LimitVelocity(&points, in.ends_at_goal, limits);
         TrajectoryMsg out = in;
         if (traffic_light_) {
-          const algo::SignalStop stop = traffic_light_->Apply(
-              ctx.now_s(), in.header.stamp_s, in.ego_v_mps, &points);
+          // A leg that ends at a turn in several moves ends short of the
+          // junction the turn goes through.
+          const bool ends_for_turn =
+              in.ends_at_goal &&
+              in.route_leg < static_cast<int>(inputs_.turnarounds.size());
+          const algo::SignalStop stop =
+              traffic_light_->Apply(ctx.now_s(), in.header.stamp_s,
+                                    in.ego_v_mps, &points, ends_for_turn);
           out.signal_stop = stop.stop;
           out.signal_stop_s_m = stop.stop_s_m;
           work += stop.work_units;
@@ -338,7 +349,7 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
   const geometry::Pose2& goal = turning ? turn->goal : inputs_.parking_goal;
   const geometry::Pose2& pose = freespace_pose_->pose;
   const Eigen::Vector2d at(pose.x_m, pose.y_m);
-  const bool standing = std::abs(freespace_pose_->v_mps) < 0.1;
+  const bool standing = std::abs(freespace_pose_->v_mps) < kStandingMps;
   const double stamp_s = freespace_pose_->header.stamp_s;
   // The road users about the car, as its own outlines: the map's
   // structure is among the manoeuvre's obstacles already.
@@ -383,6 +394,10 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
   bool correcting = false;
   bool round_road_user = false;  // planning round a road user in the way
   const bool first_plan = !parking_planned_;
+  const bool on_departing_lane =
+      turning &&
+      geometry::WithinToleranceOrAhead(pose, goal, kTurnToleranceM, kTurnAheadM,
+                                       kTurnYawToleranceRad);
   if (!parking_planned_) {
     // Handed over when standing within reach of where the route's leg
     // ends (the route's end, or the turn's start).
@@ -392,17 +407,24 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
         (at - end).norm() > std::max(3.0, inputs_.goal_tolerance_m))
       return;
     parking_planned_ = true;
+  } else if (turning && standing && on_departing_lane) {
+    // Standing on the lane it turns onto, at the path's end or before it
+    // (at a cusp, or held by a road user), it has turned. Moving on
+    // instead, it backed towards the cars that had queued on that lane
+    // behind its goal and stood held by them until the stall timeout (the
+    // bench's A10KW-0 of its third seed, 2.9 m past its goal, 0.7 m off
+    // its line).
+    complete();
+    return;
   } else if (path_driven_) {
     // At the path's end: parked (turned) if the stack's pose is within the
     // goal's tolerances, or if no re-plan is left; otherwise a new path
     // from here corrects it.
     path_driven_ = false;
-    const bool there =
-        turning
-            ? geometry::WithinTolerance(pose, goal, kTurnToleranceM,
-                                        kTurnYawToleranceRad)
-            : geometry::WithinTolerance(pose, goal, inputs_.goal_tolerance_m,
-                                        inputs_.goal_yaw_tolerance_rad);
+    const bool there = turning ? on_departing_lane
+                               : geometry::WithinTolerance(
+                                     pose, goal, inputs_.goal_tolerance_m,
+                                     inputs_.goal_yaw_tolerance_rad);
     if (there || freespace_replans_ == max_replans) {
       complete();
       return;
@@ -516,8 +538,19 @@ void Stack::Park(CallbackContext& ctx, double dt_s, double speed_cap_mps,
                  ControlMsg* out) {
   algo::ParkingCommand c = parking_follower_->Update(
       follower_pose_->pose, follower_pose_->v_mps, dt_s, speed_cap_mps);
-  if (parking_hold_) {
-    // A road user in the way: brake to a stand in the gear it drives.
+  // A turn in several moves starts only once its signal lets the car into
+  // the junction: until the car first moves, the planner's signal stop at
+  // the leg's end holds it (once in, it turns on whatever the signal
+  // shows, as a car in a junction clears it).
+  const bool turning =
+      follower_leg_ < static_cast<int>(inputs_.turnarounds.size());
+  if (std::abs(follower_pose_->v_mps) >= kStandingMps) turn_entered_ = true;
+  const bool signal_holds = turning && !turn_entered_ && follower_trajectory_ &&
+                            follower_trajectory_->route_leg == follower_leg_ &&
+                            follower_trajectory_->signal_stop;
+  if (parking_hold_ || signal_holds) {
+    // A road user in the way, or the signal: brake to a stand in the gear
+    // it drives.
     c.accel_mps2 = -parking_follower_->params().max_brake_mps2;
     c.finished = false;
   }
@@ -583,6 +616,7 @@ void Stack::BuildControl(Graph* g) {
         [this](const ParkingDoneMsg& in, CallbackContext&) {
           parking_mode_ = false;
           parking_hold_ = false;
+          turn_entered_ = false;
           follower_leg_ = in.turnaround + 1;
         });
   }

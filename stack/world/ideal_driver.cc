@@ -81,7 +81,39 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
         s_progress >= path.length_m() - 0.05 && std::abs(ego.v_mps) < 0.05) {
       manoeuvre.emplace(world.reference_manoeuvre(), limits);
     }
-    if (!manoeuvre && next_turn < turns.size() &&
+    // Where the car must stand: the goal, the start of a turn in several
+    // moves, or a signal's stop line before it (at a turn's start, a
+    // signal of the turn's junction holds the car there). Signals: a
+    // perfect detector (the true state, no latency) and the stack's own
+    // rule for when to stop.
+    const bool to_turn = next_turn < turns.size();
+    const double stop_s =
+        to_turn ? turns[next_turn].start_s_m : path.length_m();
+    std::optional<double> signal_stop_s;
+    if (!manoeuvre && options.obey_signals && !route_signals.empty()) {
+      algorithms::SignalObservation seen;
+      seen.stamp_s = world.time_s();
+      const int i = NextSignalAhead(route_signals, s_progress);
+      if (i >= 0) {
+        const std::string letters = world.RouteSignalStates();
+        seen.state = SignalStateOfLetter(
+            i < static_cast<int>(letters.size()) ? letters[i] : 'o');
+        seen.stop_line_distance_m = route_signals[i].stop_line_s_m - s_progress;
+        seen.tls_id = route_signals[i].tls_id;
+      }
+      signals.Observe(seen);
+      // The planner needs only the path's extent: from here to the stop.
+      std::vector<algorithms::PlannedPoint> ahead(2);
+      ahead[0].s_m = s_progress;
+      ahead[1].s_m = stop_s;
+      const algorithms::SignalStop stop = signals.Apply(
+          world.time_s(), world.time_s(), ego.v_mps, &ahead, to_turn);
+      if (stop.stop) {
+        signal_stop_s = stop.stop_s_m;
+        if (std::abs(ego.v_mps) < 0.1) report.red_light_wait_s += dt;
+      }
+    }
+    if (!manoeuvre && to_turn && !signal_stop_s &&
         s_progress >= turns[next_turn].start_s_m - 0.5 &&
         std::abs(ego.v_mps) < 0.05) {
       turn_path = geometry::Path2();
@@ -110,34 +142,9 @@ Result<IdealDriveReport> DriveIdealPath(World& world, LidarSimulator* lidar,
         PredictiveSteer(path, speed, s_progress, ego, limits, options.steering);
     // Speed: limit, curves ahead, and a stop at the goal.
     double v_target = speed.At(s_progress);
-    // Where the car must stand: the goal, or a signal's stop line before
-    // it. Signals: a perfect detector (the true state, no latency) and the
-    // stack's own rule for when to stop.
-    const double stop_s =
-        next_turn < turns.size() ? turns[next_turn].start_s_m : path.length_m();
     double remaining = std::max(0.0, stop_s - s_progress);
-    if (options.obey_signals && !route_signals.empty()) {
-      algorithms::SignalObservation seen;
-      seen.stamp_s = world.time_s();
-      const int i = NextSignalAhead(route_signals, s_progress);
-      if (i >= 0) {
-        const std::string letters = world.RouteSignalStates();
-        seen.state = SignalStateOfLetter(
-            i < static_cast<int>(letters.size()) ? letters[i] : 'o');
-        seen.stop_line_distance_m = route_signals[i].stop_line_s_m - s_progress;
-        seen.tls_id = route_signals[i].tls_id;
-      }
-      signals.Observe(seen);
-      // The planner needs only the path's extent: from here to the goal.
-      std::vector<algorithms::PlannedPoint> ahead(2);
-      ahead[0].s_m = s_progress;
-      ahead[1].s_m = path.length_m();
-      const algorithms::SignalStop stop =
-          signals.Apply(world.time_s(), world.time_s(), ego.v_mps, &ahead);
-      if (stop.stop) {
-        remaining = std::clamp(stop.stop_s_m - s_progress, 0.0, remaining);
-        if (std::abs(ego.v_mps) < 0.1) report.red_light_wait_s += dt;
-      }
+    if (signal_stop_s) {
+      remaining = std::clamp(*signal_stop_s - s_progress, 0.0, remaining);
     }
     v_target = std::min(v_target,
                         std::sqrt(2 * options.comfort_decel_mps2 * remaining));

@@ -48,9 +48,19 @@ std::atomic<bool> g_world_open{false};
 // route's end; this much more for the projection on a bend.
 constexpr double kGoalSlackM = 1.0;
 constexpr double kValetSlackM = 8.0;
-// A car within this of a three-point turn's end pose (and 0.5 rad of its
-// heading) has turned.
-constexpr double kTurnedSlackM = 2.0;
+// A car within this of a three-point turn's end pose, or of the lane on
+// from it up to kTurnedAheadM past it (and 0.5 rad of its heading), has
+// turned: a little looser than the stack's own test (1 m, 5 m, 0.35 rad),
+// which judges by its pose estimate. Not much looser: drivers are let on
+// once the car has turned, and with 2 m they came up behind a car the
+// stack had not yet turned (1.4 m off the lane's centre line) and held
+// its last move until the stall timeout.
+constexpr double kTurnedSlackM = 1.25;
+constexpr double kTurnedAheadM = 8.0;
+constexpr double kTurnedYawRad = 0.5;
+// From this far before a turn's start its manoeuvre may be under way (the
+// stack hands a turn to its freespace planner within 3 m of it).
+constexpr double kTurnBeginsM = 5.0;
 
 // Runs `fn`, turning libsumo exceptions into Status.
 template <typename Fn>
@@ -396,22 +406,31 @@ void World::Impl::UpdateProgress() {
   const algorithms::PathPlannerParams window;
   // Turned round in a three-point turn, standing on the lane it leaves
   // on: the progress resumes there (the turn itself is off the road part).
-  const Vec2 at(s.x_m, s.y_m);
+  // Until then the car's moves do not take the progress past the turn's
+  // end: a move backing it onto the lane it turns onto, still facing the
+  // other way, would end the turn for the drivers about it, who would come
+  // on into the space of its next move.
+  double turn_end_s = INFINITY;
+  const geometry::Pose2 pose{s.x_m, s.y_m, s.yaw_rad};
   for (const RouteTurnaround& turn : turnarounds) {
-    if (road_progress_m >= turn.start_s_m - kTurnedSlackM &&
-        road_progress_m < turn.end_s_m &&
-        (at - Vec2(turn.goal.x_m, turn.goal.y_m)).norm() < kTurnedSlackM &&
-        std::cos(s.yaw_rad - turn.goal.yaw_rad) > std::cos(0.5)) {
+    if (road_progress_m < turn.start_s_m - kTurnBeginsM ||
+        road_progress_m >= turn.end_s_m) {
+      continue;
+    }
+    if (geometry::WithinToleranceOrAhead(pose, turn.goal, kTurnedSlackM,
+                                         kTurnedAheadM, kTurnedYawRad)) {
       road_progress_m = turn.end_s_m;
+    } else {
+      turn_end_s = std::min(turn_end_s, turn.end_s_m);
     }
   }
   double lateral = 0.0;
-  road_progress_m = std::max(
-      road_progress_m,
-      algorithms::ProjectOnPath(road, Vec2(s.x_m, s.y_m),
-                                road_progress_m - window.projection_back_m,
-                                road_progress_m + window.projection_ahead_m,
-                                road_progress_m, &lateral, &road_offset_m));
+  const double projected = algorithms::ProjectOnPath(
+      road, Vec2(s.x_m, s.y_m), road_progress_m - window.projection_back_m,
+      road_progress_m + window.projection_ahead_m, road_progress_m, &lateral,
+      &road_offset_m);
+  road_progress_m =
+      std::max(road_progress_m, std::min(projected, turn_end_s - 1e-3));
 }
 
 bool World::goal_reached() const {

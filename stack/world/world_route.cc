@@ -461,15 +461,13 @@ Status World::Impl::BuildIdealPath() {
           if (along_m > 1e-3) {
             const Vec2 cut = a + in * (along_m / in.norm());
             raw_s -= (points.back() - cut).norm();
-            for (Crossing& c : crossings) {
-              c.raw_s_m = std::min(c.raw_s_m, raw_s);
-            }
             points.back() = cut;
-            continue;
+          } else {
+            raw_s -= in.norm();
+            points.pop_back();
           }
-          raw_s -= in.norm();
-          points.pop_back();
-          // A crossing recorded on the dropped part lies where it ends now.
+          // A crossing recorded on the cut or dropped part lies where the
+          // path ends now.
           for (Crossing& c : crossings) c.raw_s_m = std::min(c.raw_s_m, raw_s);
         }
         if (!points.empty()) raw_s += (p - points.back()).norm();

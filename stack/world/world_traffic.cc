@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "stack/world/internal/world_impl.h"
+#include "stack/world/roadside_poles.h"
 #include "stack/world/traffic_yield.h"
 
 namespace adse::world {
@@ -44,6 +45,14 @@ constexpr double kAboutToEnterM = 1.5;
 // this on every side.
 constexpr double kTurnSweepStepM = 1.0;
 constexpr double kTurnSweepMarginM = 1.5;
+// Drivers on the ego's own road (queued behind it, or coming on along the
+// lane it turns onto) wait this much farther back still: along the road
+// the stack's moves stray farther from the world's plan (on A10KW and
+// square 2-3 m past its longest reverse, which boxed the car in between a
+// queued driver and the road's end until the stall timeout). Across a
+// junction the margin stays as it is, so that a driver coming out of a
+// side road does not stop in the car's way on.
+constexpr double kTurnQueueExtraM = 1.5;
 // Drivers wait for a turn from when the ego is this far from its start
 // (it brakes there to stand), m.
 constexpr double kTurnApproachM = 15.0;
@@ -401,17 +410,24 @@ void World::Impl::YieldToEgo() {
                                return geometry::BoxesOverlap(v.box, *b);
                              });
         };
-    // Waits short of `way` (it is not in it).
+    // Waits short of `way` (it is not in it), grown by `extra_m`.
     const auto wait_short_of =
-        [&](const std::vector<const geometry::OrientedBox*>& way) {
+        [&](const std::vector<const geometry::OrientedBox*>& way,
+            double extra_m) {
           for (const geometry::OrientedBox* b : way) {
+            geometry::OrientedBox grown = *b;
+            grown.length_m += 2 * extra_m;
+            grown.width_m += 2 * extra_m;
             const double wait =
-                YieldSpeedMps(path, v.box.width_m, decel, *b, Vec2::Zero());
+                YieldSpeedMps(path, v.box.width_m, decel, grown, Vec2::Zero());
             if (wait >= 0) safe = safe < 0 ? wait : std::min(safe, wait);
           }
         };
     if (!in_way(turn)) {
-      wait_short_of(turn);
+      const bool on_ego_road =
+          lane[0] != ':' && std::find(route.begin(), route.end(),
+                                      EdgeOfLane(lane)) != route.end();
+      wait_short_of(turn, on_ego_road ? kTurnQueueExtraM : 0.0);
     } else if (safe >= 0) {
       // In the turn's way it drives on to clear it, but with the car in
       // its own it keeps its place rather than creep after the car: the
@@ -425,7 +441,7 @@ void World::Impl::YieldToEgo() {
     if (junction != nullptr && minor_link &&
         libsumo::Lane::getEdgeID(lane) != junction->from_edge &&
         !in_way(claim)) {
-      wait_short_of(claim);
+      wait_short_of(claim, 0.0);
     }
     if (safe < 0) {
       // Not while the ego turns in several moves: its next move is the

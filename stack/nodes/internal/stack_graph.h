@@ -109,6 +109,7 @@ class Stack final : public AdStack {
   bool parking_mode_ = false;       // the follower drives the parking path
   bool parking_hold_ = false;       // ... and the planner said: hold
   int follower_leg_ = 0;            // the route leg the controller follows
+  bool turn_entered_ = false;       // moved in the turn it drives
   bool path_end_reported_ = false;  // ... and has reported reaching its end
 };
 

@@ -4,6 +4,7 @@
 // subscription, so the run does not depend on the host.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -13,6 +14,7 @@
 #include "harness/spec/spec_parser.h"
 #include "stack/world/ideal_driver.h"
 #include "stack/world/world.h"
+#include "tests/harness/testing/net_scenario.h"
 
 namespace adse::sim {
 namespace {
@@ -25,30 +27,27 @@ constexpr char kRilsa[] =
 constexpr double kStopLineY = 511.35;
 constexpr double kGreenAtS = 45.0;
 
+// A lane-driving scenario on `net` from `start` to `goal` (flow-map
+// places), costs counted from `profile`.
+spec::Spec SignalScenario(
+    const std::string& name, const std::string& net, const std::string& start,
+    const std::string& goal, int timeout_s,
+    const std::string& profile = "autoware-2022.12-i9-12900kf-signals.yaml") {
+  adse::testing::NetScenario scenario;
+  scenario.name = name;
+  scenario.net = net;
+  scenario.start = start;
+  scenario.goal = goal;
+  scenario.timeout_s = timeout_s;
+  scenario.profile = profile;
+  return adse::testing::ParseNetScenario(scenario);
+}
+
 spec::Spec RilsaNorthToSouth(
     const std::string& profile = "autoware-2022.12-i9-12900kf-signals.yaml") {
-  const std::string text =
-      std::string("adse: 1\n") +
-      "name: rilsa-signal\n"
-      "world:\n"
-      "  map: {net: " +
-      kRilsa +
-      "}\n"
-      "  traffic: {seed: 1}\n"
-      "task:\n"
-      "  start: {edge: nm, pos_m: 10, lane: 1}\n"
-      "  goal: {edge: ms, pos_m: 60, lane: 1}\n"
-      "  speed_limit_kmh: 40\n"
-      "  timeout_s: 200\n"
-      "platform: {kind: virtual, cost_model: counted, profile: " +
-      ADSE_SOURCE_DIR + "/scenarios/profiles/" + profile +
-      "}\n"
-      "design_space:\n"
-      "  cores:    {bind: platform.cores,    range: [1, 16]}\n"
-      "  freq_ghz: {bind: platform.freq_ghz, values: [1.2, 2.1]}\n";
-  Result<spec::Spec> spec = spec::ParseSpec(text, "rilsa-signal.yaml", "");
-  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
-  return std::move(spec).value();
+  return SignalScenario("rilsa-signal", kRilsa,
+                        "{edge: nm, pos_m: 10, lane: 1}",
+                        "{edge: ms, pos_m: 60, lane: 1}", 200, profile);
 }
 
 TEST(TrafficLightsTest, TheEgoWaitsAtTheRedLightThenDrivesOnToTheGoal) {
@@ -152,6 +151,40 @@ TEST(TrafficLightsTest, TheIdealDriverWaitsAtTheRedLightAsTheStackDoes) {
   EXPECT_GT(waits->time_s, kGreenAtS);
   EXPECT_EQ(drives_through->red_light_wait_s, 0.0);
   EXPECT_LT(drives_through->time_s, waits->time_s - 20.0);
+}
+
+// tests/data/nets/dead_end_signal.net.xml: a 200 m road of two lanes each
+// way ending at a signal (red for the first 60 s, then green) whose only
+// link turns back, too tight for the car: the route from `ab` back along
+// `ba` turns there in several moves. Until run key v21 the car started
+// its moves on red (its first reverse at 23.3 s).
+TEST(TrafficLightsTest, ATurnInSeveralMovesThroughASignalStartsOnGreen) {
+  constexpr double kTurnGreenAtS = 60.0;
+  const spec::Spec spec = SignalScenario(
+      "dead_end_signal",
+      std::string(ADSE_SOURCE_DIR) + "/tests/data/nets/dead_end_signal.net.xml",
+      "{edge: ab, pos_m: 80, lane: 0}", "{edge: ba, pos_m: 150, lane: 0}", 300);
+  Result<runfile::RunData> run =
+      SimulatePoint(spec, {{"cores", 16}, {"freq_ghz", 2.1}});
+  ASSERT_TRUE(run.ok()) << run.status().ToString();
+  EXPECT_EQ(run->termination_reason, "goal_reached");
+  EXPECT_TRUE(run->collisions.empty());
+  // Until the green it neither backs up nor turns (heading east, +x).
+  bool turned = false;
+  for (const runfile::EgoSample& e : run->ego) {
+    if (e.t_s < kTurnGreenAtS) {
+      ASSERT_GT(e.v_mps, -0.05) << "at t = " << e.t_s;
+      ASSERT_LT(std::abs(e.yaw_rad), 0.2) << "at t = " << e.t_s;
+    } else {
+      turned |= std::abs(e.yaw_rad) > 3.0;
+    }
+  }
+  EXPECT_TRUE(turned);
+  // It stood for the red (it arrives at about 20 s), and says so.
+  const analysis::StandingSummary standing = analysis::SummarizeStanding(*run);
+  ASSERT_FALSE(standing.by_reason.empty());
+  EXPECT_EQ(standing.by_reason.front().reason, StopReason::kRedLight);
+  EXPECT_GT(standing.by_reason.front().standing_s, 30.0);
 }
 
 TEST(TrafficLightsTest, APlainProfileIsRefusedNamingTheOneWithTheSignals) {

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "stack/algorithms/planning.h"
@@ -178,6 +179,31 @@ TEST(TrafficLightPlanner, ANosePastTheLineIsInTheJunctionAndGoesOn) {
   std::vector<PlannedPoint> points = PathFrom(100.0, 5.0);
   EXPECT_FALSE(planner.Apply(0.0, 0.0, 5.0, &points).stop);
   for (const PlannedPoint& p : points) EXPECT_EQ(p.v_mps, 5.0);
+}
+
+TEST(TrafficLightPlanner, APathEndingForATurnInMovesWaitsAtItsEndForItsLine) {
+  // The path ends 8 m short of a red line, where the car stops to turn
+  // through that junction in several moves: it waits at the path's end.
+  std::vector<PlannedPoint> points = PathFrom(0.0, 8.0, 21);
+  TrafficLightPlanner turning;
+  turning.Observe(Seen(0.0, SignalState::kRed, 28.0));
+  const SignalStop stop = turning.Apply(0.0, 0.0, 8.0, &points, true);
+  ASSERT_TRUE(stop.stop);
+  EXPECT_NEAR(stop.stop_s_m, 20.0, 1e-9);
+  // Driving on along its lanes instead, the path reaches the line later.
+  TrafficLightPlanner driving;
+  driving.Observe(Seen(0.0, SignalState::kRed, 28.0));
+  points = PathFrom(0.0, 8.0, 21);
+  EXPECT_FALSE(driving.Apply(0.0, 0.0, 8.0, &points).stop);
+  // A line farther past the turn's start than turn_line_reach_m is
+  // another junction's, and green lets the car turn.
+  for (const auto& [state, line_m] : {std::pair(SignalState::kRed, 31.0),
+                                      std::pair(SignalState::kGreen, 28.0)}) {
+    TrafficLightPlanner planner;
+    planner.Observe(Seen(0.0, state, line_m));
+    points = PathFrom(0.0, 8.0, 21);
+    EXPECT_FALSE(planner.Apply(0.0, 0.0, 8.0, &points, true).stop) << line_m;
+  }
 }
 
 TEST(TrafficLightPlanner, AnotherSignalStartsAfresh) {

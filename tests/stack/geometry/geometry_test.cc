@@ -248,5 +248,22 @@ TEST(WithinToleranceTest, BothPositionAndHeadingWithinTheirTolerances) {
       WithinTolerance({0, 0, M_PI - 0.05}, {0, 0, -M_PI + 0.04}, 0.1, 0.1));
 }
 
+TEST(WithinToleranceOrAheadTest, AlongTheGoalsLineUpToAheadPastIt) {
+  // The goal heads along -y: "ahead" is smaller y, "lateral" is x.
+  const Pose2 goal{10, 5, -M_PI / 2};
+  const double heading = -M_PI / 2;
+  EXPECT_TRUE(WithinToleranceOrAhead({10.9, 1.0, heading}, goal, 1, 5, 0.3));
+  EXPECT_TRUE(WithinToleranceOrAhead({9.1, 5.9, heading}, goal, 1, 5, 0.3));
+  // Too far past, behind, or to the side; or heading elsewhere.
+  EXPECT_FALSE(WithinToleranceOrAhead({10, -0.1, heading}, goal, 1, 5, 0.3));
+  EXPECT_FALSE(WithinToleranceOrAhead({10, 6.1, heading}, goal, 1, 5, 0.3));
+  EXPECT_FALSE(WithinToleranceOrAhead({11.1, 3, heading}, goal, 1, 5, 0.3));
+  EXPECT_FALSE(
+      WithinToleranceOrAhead({10, 3, heading + 0.31}, goal, 1, 5, 0.3));
+  // Within the plain tolerance it is within this one.
+  EXPECT_TRUE(
+      WithinToleranceOrAhead({10.3, 5.39, heading + 0.29}, goal, 0.5, 0, 0.3));
+}
+
 }  // namespace
 }  // namespace adse::geometry
