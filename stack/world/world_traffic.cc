@@ -47,11 +47,11 @@ constexpr double kTurnSweepStepM = 1.0;
 constexpr double kTurnSweepMarginM = 1.5;
 // Drivers on the ego's own road (queued behind it, or coming on along the
 // lane it turns onto) wait this much farther back still: along the road
-// the stack's moves stray farther from the world's plan (on A10KW and
-// square 2-3 m past its longest reverse, which boxed the car in between a
-// queued driver and the road's end until the stall timeout). Across a
-// junction the margin stays as it is, so that a driver coming out of a
-// side road does not stop in the car's way on.
+// the stack's moves stray farther from the world's plan (on square's
+// dead end 1.6 m past its longest reverse; a driver queued there then
+// boxed the car in until the stall timeout). Across a junction the margin
+// stays as it is, so that a driver coming out of a side road does not
+// stop in the car's way on.
 constexpr double kTurnQueueExtraM = 1.5;
 // Drivers wait for a turn from when the ego is this far from its start
 // (it brakes there to stand), m.
