@@ -412,7 +412,7 @@ void Stack::PlanManoeuvre(CallbackContext& ctx, double course_out_m,
     // (at a cusp, or held by a road user), it has turned. Moving on
     // instead, it backed towards the cars that had queued on that lane
     // behind its goal and stood held by them until the stall timeout (the
-    // bench's A10KW-0 of its third seed, 2.9 m past its goal, 0.7 m off
+    // bench's A10KW-0 of its third seed, 3.1 m past its goal, 0.9 m off
     // its line).
     complete();
     return;
