@@ -33,15 +33,17 @@ std::string PathCsv(const geometry::Path2& path) {
   return csv;
 }
 
-// ", turns round in 5 moves at 812 m, takes a corner in 4 moves at 49 m":
+// ", turns round in 5 moves at 812 m, takes a corner in 4 moves at 49 m
+// (onto its shoulders)":
 // the route's turns in several moves.
 std::string TurnaroundText(const std::vector<world::RouteTurnaround>& turns) {
   std::string text;
   for (const world::RouteTurnaround& t : turns) {
     const int moves = world::ManoeuvreMoves(t.reference);
-    text += fmt::format(", {} in {} move{} at {:.0f} m",
+    text += fmt::format(", {} in {} move{} at {:.0f} m{}",
                         t.corner ? "takes a corner" : "turns round", moves,
-                        moves == 1 ? "" : "s", t.start_s_m);
+                        moves == 1 ? "" : "s", t.start_s_m,
+                        t.on_shoulders ? " (onto its shoulders)" : "");
   }
   return text;
 }
@@ -92,7 +94,8 @@ int RunWorld(const WorldArgs& args) {
     turns.push_back({{"start_s_m", t.start_s_m},
                      {"end_s_m", t.end_s_m},
                      {"moves", world::ManoeuvreMoves(t.reference)},
-                     {"kind", t.corner ? "corner" : "u_turn"}});
+                     {"kind", t.corner ? "corner" : "u_turn"},
+                     {"on_shoulders", t.on_shoulders}});
   }
   summary["turnarounds"] = turns;
 

@@ -48,8 +48,13 @@ namespace {
 // several moves through a signal starts only when the signal lets the car
 // in, the world counts a turn made only once the car stands on that lane
 // (not when its moves back it past the turn's end), and drivers on the
-// ego's road wait 1.5 m farther short of its turn.
-constexpr char kKeyVersion[] = "adse-run-key-v21";
+// ego's road wait 1.5 m farther short of its turn. v22: a contact is
+// blamed across the face the bodies met through, with each body's velocity
+// at the contact point (its turning included); a turn in several moves
+// that fits nowhere in the lanes and junctions may use their 1 m
+// shoulders; detections within a confirmed track's box that each show
+// part of its object are joined into one box first.
+constexpr char kKeyVersion[] = "adse-run-key-v22";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

@@ -20,6 +20,10 @@ Eigen::Vector2d ExtentsAlong(const Detection& box, const Eigen::Vector2d& u) {
                   : Eigen::Vector2d(box.length_m, box.width_m);
 }
 
+// A box shorter than this share of its track's length along the track's
+// heading is a view of part of the object.
+constexpr double kPartOfExtent = 0.6;
+
 }  // namespace
 
 void Tracker::Reset() {
@@ -113,6 +117,82 @@ void Tracker::Correct(Track* track, const Detection& detection) const {
   }
 }
 
+std::vector<Detection> Tracker::JoinViewsOfOneObject(
+    const std::vector<Detection>& detections) const {
+  if (params_.join_margin_m < 0.0 || detections.size() < 2) return detections;
+  std::vector<char> joined(detections.size(), 0);
+  std::vector<Detection> out;
+  for (const Track& track : tracks_) {  // by id: deterministic
+    if (!track.confirmed) continue;
+    const Eigen::Vector2d u = MovingHeading(track).value_or(
+        Eigen::Vector2d(std::cos(track.yaw_rad), std::sin(track.yaw_rad)));
+    const Eigen::Vector2d n(-u.y(), u.x());
+    // Along its heading, as far as the gate: its prediction may run ahead
+    // of an object braking.
+    const double half_along =
+        0.5 * std::max(track.extent_along_m, track.length_m) +
+        std::max(params_.join_margin_m, params_.gate_m);
+    const double half_across =
+        0.5 * std::max(track.extent_across_m, track.width_m) +
+        params_.join_margin_m;
+    // Parts only: a box as long as the object is a whole one (two cars
+    // passing each other are two objects).
+    const double part_below_m =
+        kPartOfExtent * std::max(track.extent_along_m, track.length_m);
+    std::vector<size_t> inside;
+    for (size_t d = 0; d < detections.size(); ++d) {
+      const Eigen::Vector2d off = detections[d].center - track.position;
+      if (!joined[d] && std::abs(off.dot(u)) <= half_along &&
+          std::abs(off.dot(n)) <= half_across &&
+          ExtentsAlong(detections[d], u).x() < part_below_m) {
+        inside.push_back(d);
+      }
+    }
+    if (inside.size() < 2) continue;
+    // Their corners' bounds along and across the track's heading.
+    double lo_u = INFINITY, hi_u = -INFINITY, lo_n = INFINITY, hi_n = -INFINITY;
+    Detection box;
+    box.z_min_m = INFINITY;
+    box.z_max_m = -INFINITY;
+    for (const size_t d : inside) {
+      const Detection& part = detections[d];
+      joined[d] = 1;
+      const Eigen::Vector2d a(std::cos(part.yaw_rad), std::sin(part.yaw_rad));
+      const Eigen::Vector2d b(-a.y(), a.x());
+      for (const double i : {-0.5, 0.5}) {
+        for (const double j : {-0.5, 0.5}) {
+          const Eigen::Vector2d c =
+              part.center + i * part.length_m * a + j * part.width_m * b;
+          lo_u = std::min(lo_u, c.dot(u));
+          hi_u = std::max(hi_u, c.dot(u));
+          lo_n = std::min(lo_n, c.dot(n));
+          hi_n = std::max(hi_n, c.dot(n));
+        }
+      }
+      box.z_min_m = std::min(box.z_min_m, part.z_min_m);
+      box.z_max_m = std::max(box.z_max_m, part.z_max_m);
+      box.point_count += part.point_count;
+    }
+    box.center = 0.5 * (lo_u + hi_u) * u + 0.5 * (lo_n + hi_n) * n;
+    // Length along the yaw, at least the width; yaw in (-pi/2, pi/2].
+    double yaw = std::atan2(u.y(), u.x());
+    box.length_m = hi_u - lo_u;
+    box.width_m = hi_n - lo_n;
+    if (box.length_m < box.width_m) {
+      std::swap(box.length_m, box.width_m);
+      yaw += M_PI / 2;
+    }
+    yaw = std::remainder(yaw, M_PI);
+    box.yaw_rad = yaw <= -M_PI / 2 ? yaw + M_PI : yaw;
+    out.push_back(box);
+  }
+  if (out.empty()) return detections;
+  for (size_t d = 0; d < detections.size(); ++d) {
+    if (!joined[d]) out.push_back(detections[d]);
+  }
+  return out;
+}
+
 const Track* Tracker::NearestConfirmed(const Eigen::Vector2d& at,
                                        size_t count) const {
   const Track* nearest = nullptr;
@@ -128,7 +208,7 @@ const Track* Tracker::NearestConfirmed(const Eigen::Vector2d& at,
   return nearest;
 }
 
-void Tracker::Update(double t_s, const std::vector<Detection>& detections) {
+void Tracker::Update(double t_s, const std::vector<Detection>& seen) {
   double dt = has_time_ ? t_s - last_t_s_ : 0.0;
   dt = std::min(dt, params_.max_dt_s);
   if (!has_time_ || t_s > last_t_s_) {
@@ -136,6 +216,7 @@ void Tracker::Update(double t_s, const std::vector<Detection>& detections) {
     has_time_ = true;
   }
   for (Track& track : tracks_) Predict(&track, dt);
+  const std::vector<Detection> detections = JoinViewsOfOneObject(seen);
 
   // Greedy global nearest neighbour: all gated pairs, closest first. Ties
   // break by track then detection index, so results are deterministic.

@@ -1,5 +1,6 @@
 // Multi-object tracker in the map frame: a constant-velocity Kalman filter
-// per track, greedy nearest-neighbour association inside a gate, birth
+// per track, detections within one track's box joined, greedy
+// nearest-neighbour association inside a gate, birth
 // after N hits (at the velocity of a confirmed track it splits from) and
 // deletion after M misses. A box smaller than its track's object (a car
 // partly hidden) measures only where the object's box may stand. Eigen and
@@ -38,6 +39,12 @@ struct TrackerParams {
   // 2-3.5 m behind the car's and its track took half its speed (2
   // collisions of the reference study at run key v16). 0 never.
   double partial_view_min_speed_mps = 2.0;
+  // Detections whose centres lie within a confirmed track's box (its
+  // largest extents about its prediction) grown by this are one view of
+  // its object and are joined into one box first, as Autoware's
+  // detection_by_tracker does: near, a LiDAR's rings cross a car's roof
+  // in thin arcs metres apart. Negative: never.
+  double join_margin_m = 0.3;
   // Extents beyond these are not kept as the object's: boxes that long or
   // wide are merged clusters or trucks, taken as seen.
   double max_extent_along_m = 6.0;
@@ -106,6 +113,10 @@ class Tracker {
   // track's extents around what was seen.
   Eigen::Vector2d MeasuredCenter(const Track& track,
                                  const Detection& detection) const;
+  // `detections` with those within one confirmed track's box joined into
+  // one box each (join_margin_m).
+  std::vector<Detection> JoinViewsOfOneObject(
+      const std::vector<Detection>& detections) const;
   // The confirmed track among the first `count` nearest to `at`, within
   // split_radius_m, if any.
   const Track* NearestConfirmed(const Eigen::Vector2d& at, size_t count) const;

@@ -1,7 +1,9 @@
 #include "stack/geometry/geometry.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 
 namespace adse::geometry {
 namespace {
@@ -147,33 +149,72 @@ double DistanceAlongPathToBox(const std::vector<Eigen::Vector2d>& path,
   return -1.0;
 }
 
+namespace {
+
+// A box's two face normals: along its heading and to its left.
+std::array<Eigen::Vector2d, 2> BoxAxes(const OrientedBox& box) {
+  return {Eigen::Vector2d(std::cos(box.yaw_rad), std::sin(box.yaw_rad)),
+          Eigen::Vector2d(-std::sin(box.yaw_rad), std::cos(box.yaw_rad))};
+}
+
+// How far the projections of two boxes onto `axis` (a unit vector)
+// overlap; negative when a gap separates them.
+double OverlapAlong(const OrientedBox& a, const OrientedBox& b,
+                    const Eigen::Vector2d& axis) {
+  auto reach = [&](const OrientedBox& box) {
+    const auto axes = BoxAxes(box);
+    return 0.5 * box.length_m * std::abs(axes[0].dot(axis)) +
+           0.5 * box.width_m * std::abs(axes[1].dot(axis));
+  };
+  return reach(a) + reach(b) - std::abs((b.center - a.center).dot(axis));
+}
+
+bool BoxContains(const OrientedBox& box, const Eigen::Vector2d& p) {
+  const auto axes = BoxAxes(box);
+  const Eigen::Vector2d d = p - box.center;
+  return std::abs(d.dot(axes[0])) <= 0.5 * box.length_m &&
+         std::abs(d.dot(axes[1])) <= 0.5 * box.width_m;
+}
+
+}  // namespace
+
 bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b) {
   // Two convex shapes are disjoint iff some edge normal separates them; a
   // box has two distinct normals. Boxes are closed sets, so touching boxes
   // overlap (a collision check should err towards "hit").
-  const Eigen::Vector2d a_axes[2] = {
-      {std::cos(a.yaw_rad), std::sin(a.yaw_rad)},
-      {-std::sin(a.yaw_rad), std::cos(a.yaw_rad)}};
-  const Eigen::Vector2d b_axes[2] = {
-      {std::cos(b.yaw_rad), std::sin(b.yaw_rad)},
-      {-std::sin(b.yaw_rad), std::cos(b.yaw_rad)}};
-  const double a_half[2] = {0.5 * a.length_m, 0.5 * a.width_m};
-  const double b_half[2] = {0.5 * b.length_m, 0.5 * b.width_m};
-  const Eigen::Vector2d d = b.center - a.center;
-  auto separated_along = [&](const Eigen::Vector2d& axis) {
-    const double ra = a_half[0] * std::abs(a_axes[0].dot(axis)) +
-                      a_half[1] * std::abs(a_axes[1].dot(axis));
-    const double rb = b_half[0] * std::abs(b_axes[0].dot(axis)) +
-                      b_half[1] * std::abs(b_axes[1].dot(axis));
-    return std::abs(d.dot(axis)) > ra + rb;
-  };
-  for (const auto& axis : a_axes) {
-    if (separated_along(axis)) return false;
-  }
-  for (const auto& axis : b_axes) {
-    if (separated_along(axis)) return false;
+  for (const OrientedBox* box : {&a, &b}) {
+    for (const Eigen::Vector2d& axis : BoxAxes(*box)) {
+      if (OverlapAlong(a, b, axis) < 0.0) return false;
+    }
   }
   return true;
+}
+
+BoxContact ContactOfBoxes(const OrientedBox& a, const OrientedBox& b) {
+  BoxContact contact;
+  contact.depth_m = std::numeric_limits<double>::infinity();
+  const Eigen::Vector2d d = b.center - a.center;
+  for (const OrientedBox* box : {&a, &b}) {
+    for (const Eigen::Vector2d& axis : BoxAxes(*box)) {
+      const double overlap = OverlapAlong(a, b, axis);
+      if (overlap < contact.depth_m) {
+        contact.depth_m = overlap;
+        contact.normal = d.dot(axis) < 0.0 ? Eigen::Vector2d(-axis) : axis;
+      }
+    }
+  }
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  int inside = 0;
+  for (const auto& [from, into] : {std::pair{&a, &b}, std::pair{&b, &a}}) {
+    for (const Eigen::Vector2d& corner : BoxCorners(*from)) {
+      if (!BoxContains(*into, corner)) continue;
+      sum += corner;
+      ++inside;
+    }
+  }
+  contact.point = inside > 0 ? Eigen::Vector2d(sum / inside)
+                             : Eigen::Vector2d(0.5 * (a.center + b.center));
+  return contact;
 }
 
 bool ClipSegmentToRect(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,

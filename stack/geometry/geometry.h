@@ -84,6 +84,18 @@ std::vector<Eigen::Vector2d> BoxCorners(const OrientedBox& box);
 // True when two oriented boxes overlap (separating axis test).
 bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b);
 
+// Where two oriented boxes meet.
+struct BoxContact {
+  // Of the boxes' four face normals, the one along which they overlap
+  // least (the face one came through), pointing from a towards b.
+  Eigen::Vector2d normal = Eigen::Vector2d::UnitX();
+  double depth_m = 0.0;  // their overlap along it (negative: that far apart)
+  // The corners of either box inside the other, averaged; halfway between
+  // the centres when none is (edges crossing with no corner in).
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();
+};
+BoxContact ContactOfBoxes(const OrientedBox& a, const OrientedBox& b);
+
 // Clips segment a-b to the axis-aligned rectangle [lo, hi] (Liang-Barsky):
 // false when no part of it lies inside; else a and b become the ends of
 // the part inside.

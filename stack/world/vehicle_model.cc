@@ -83,4 +83,8 @@ geometry::OrientedBox BicycleModel::Body() const {
   return BodyAt({state_.x_m, state_.y_m, state_.yaw_rad}, limits_);
 }
 
+double BicycleModel::yaw_rate_rps() const {
+  return state_.v_mps * std::tan(state_.steer_rad) / limits_.wheelbase_m;
+}
+
 }  // namespace adse::world

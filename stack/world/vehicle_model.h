@@ -55,6 +55,8 @@ class BicycleModel {
   const VehicleLimits& limits() const { return limits_; }
   // The body as a box (centre is half a wheelbase ahead of the rear axle).
   geometry::OrientedBox Body() const;
+  // How fast it turns now, about its rear axle (counter-clockwise positive).
+  double yaw_rate_rps() const;
 
  private:
   VehicleLimits limits_;

@@ -356,7 +356,9 @@ Status World::Step(const ControlCommand& command) {
     };
     for (const OtherVehicle& v : w.others) {
       if (geometry::BoxesOverlap(body, v.box)) {
-        touch({v.id, false, EgoCausedContact(w.ego->state(), body, v)});
+        touch(
+            {v.id, false,
+             EgoCausedContact(w.ego->state(), w.ego->yaw_rate_rps(), body, v)});
       }
     }
     const double reach_m = 0.5 * std::hypot(body.length_m, body.width_m);
@@ -387,18 +389,26 @@ double World::distance_to_goal_m() const {
   const VehicleState& s = impl_->ego->state();
   return (Vec2(s.x_m, s.y_m) - impl_->goal_xy).norm();
 }
-bool EgoCausedContact(const VehicleState& ego,
+bool EgoCausedContact(const VehicleState& ego, double ego_yaw_rate_rps,
                       const geometry::OrientedBox& ego_body,
                       const OtherVehicle& other) {
-  const Vec2 towards_other = other.box.center - ego_body.center;
-  const double d = towards_other.norm();
-  if (d < 1e-9) return true;
-  const Vec2 u = towards_other / d;
-  const Vec2 ego_v =
-      ego.v_mps * Vec2(std::cos(ego.yaw_rad), std::sin(ego.yaw_rad));
-  const Vec2 other_v = other.speed_mps * Vec2(std::cos(other.box.yaw_rad),
-                                              std::sin(other.box.yaw_rad));
-  return ego_v.dot(u) >= other_v.dot(-u);
+  const geometry::BoxContact contact =
+      geometry::ContactOfBoxes(ego_body, other.box);
+  // A rigid body's velocity at `p`: its reference point's, plus its
+  // turning about that point.
+  auto velocity_at = [&](const Vec2& reference, double speed_mps,
+                         double yaw_rad, double yaw_rate_rps) {
+    const Vec2 r = contact.point - reference;
+    return Vec2(speed_mps * std::cos(yaw_rad) - yaw_rate_rps * r.y(),
+                speed_mps * std::sin(yaw_rad) + yaw_rate_rps * r.x());
+  };
+  const Vec2 ego_v = velocity_at(Vec2(ego.x_m, ego.y_m), ego.v_mps, ego.yaw_rad,
+                                 ego_yaw_rate_rps);
+  const Vec2 heading(std::cos(other.box.yaw_rad), std::sin(other.box.yaw_rad));
+  const Vec2 other_v =
+      velocity_at(other.box.center + 0.5 * other.box.length_m * heading,
+                  other.speed_mps, other.box.yaw_rad, other.yaw_rate_rps);
+  return ego_v.dot(contact.normal) >= other_v.dot(-contact.normal);
 }
 
 void World::Impl::UpdateProgress() {

@@ -39,15 +39,21 @@ struct RoadLocation {
 
 struct OtherVehicle {
   std::string id;
-  geometry::OrientedBox box;
+  geometry::OrientedBox box;  // SUMO places it by its front bumper
   double speed_mps = 0.0;
+  double yaw_rate_rps = 0.0;  // since the step before (0 on its first)
 };
 
-// Whether the ego caused its contact with `other`: along the line between
-// their centres it moved towards the other at least as fast as the other
-// moved towards it. A car standing or braking that is driven into from
-// behind or the side did not; one that drives into a slower car did.
-bool EgoCausedContact(const VehicleState& ego,
+// Whether the ego caused its contact with `other`. At the point where the
+// two bodies meet, across the face one came through (the separating axis
+// of least overlap), the ego's body moved towards the other at least as
+// fast as the other's moved towards it. Each body's velocity there counts
+// its turning: the ego's about its rear axle (`ego_yaw_rate_rps`), the
+// other's about its front bumper. A car standing or braking that is
+// driven into from behind or the side did not cause it, nor one whose
+// side a car cutting in sweeps with its swinging rear; one that drives
+// into a slower car, or swings its own corner into a car beside it, did.
+bool EgoCausedContact(const VehicleState& ego, double ego_yaw_rate_rps,
                       const geometry::OrientedBox& ego_body,
                       const OtherVehicle& other);
 
@@ -73,6 +79,9 @@ struct RouteSignal {
 // planned on the ground truth from the road part at start_s_m to `goal`.
 struct RouteTurnaround : algorithms::TurnaroundSection {
   std::vector<algorithms::GearedPose> reference;  // rear axle poses
+  // No manoeuvre fitted in the lanes and junctions: `drivable` reaches
+  // past their edges onto the road's shoulders.
+  bool on_shoulders = false;
 };
 
 // The moves of a manoeuvre: its runs in one gear (a three-point turn has 3).

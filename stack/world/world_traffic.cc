@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -507,6 +508,7 @@ void World::Impl::ReleaseFromEgo(const OtherVehicle& v, const std::string& lane,
 
 void World::Impl::ReadOthers() {
   others.clear();
+  std::map<std::string, double> yaw_now;
   for (const std::string& id : libsumo::Vehicle::getIDList()) {
     if (id == kEgoId) continue;
     auto it = types.find(id);
@@ -528,8 +530,14 @@ void World::Impl::ReadOthers() {
     v.box.center = Vec2(p.x, p.y) -
                    v.box.length_m / 2 * Vec2(std::cos(yaw), std::sin(yaw));
     v.speed_mps = libsumo::Vehicle::getSpeed(id);
+    if (auto last = last_yaw_rad.find(id); last != last_yaw_rad.end()) {
+      v.yaw_rate_rps =
+          std::remainder(yaw - last->second, 2.0 * M_PI) / setup.world.step_s;
+    }
+    yaw_now.emplace(id, yaw);
     others.push_back(v);
   }
+  last_yaw_rad = std::move(yaw_now);
 }
 
 }  // namespace adse::world

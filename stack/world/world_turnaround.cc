@@ -108,14 +108,22 @@ bool Near(const std::vector<Vec2>& shape, const std::vector<Vec2>& around) {
   return false;
 }
 
-// The lanes open to cars and the junctions near the points `around`.
-Polygons DrivableAround(const std::vector<Vec2>& around) {
+// Where no manoeuvre keeps to the lanes and junctions (a corner or U-turn
+// where single lanes of 3.2 m meet at a sharp angle), it may use the
+// road's shoulders (a lanelet map's road_shoulder): this much beyond each
+// lane's edges, out to the line of the roadside poles, which it keeps
+// clear of as of all structure. The nets draw neither kerbs nor shoulders.
+constexpr double kShoulderM = 1.0;
+
+// The lanes open to cars, each with `shoulder_m` more on either side, and
+// the junctions near the points `around`.
+Polygons DrivableAround(const std::vector<Vec2>& around, double shoulder_m) {
   Polygons out;
   for (const std::string& lane : libsumo::Lane::getIDList()) {
     if (!OpenToCars(lane)) continue;
     const std::vector<Vec2> shape = ToPoints(libsumo::Lane::getShape(lane));
     if (!Near(shape, around)) continue;
-    AddLaneArea(shape, libsumo::Lane::getWidth(lane), &out);
+    AddLaneArea(shape, libsumo::Lane::getWidth(lane) + 2.0 * shoulder_m, &out);
   }
   for (const std::string& junction : libsumo::Junction::getIDList()) {
     const libsumo::TraCIPosition p = libsumo::Junction::getPosition(junction);
@@ -130,11 +138,32 @@ Polygons DrivableAround(const std::vector<Vec2>& around) {
 // few metres of a corner's stretch, which may be long): the lanes and
 // junctions a manoeuvre there keeps to, and the structure standing there.
 void SetAreaAbout(const std::vector<Vec2>& around, const Scene& scene,
-                  RouteTurnaround* turn) {
-  turn->drivable = DrivableAround(around);
+                  double shoulder_m, RouteTurnaround* turn) {
+  turn->drivable = DrivableAround(around, shoulder_m);
+  turn->obstacles.clear();
   for (std::vector<Vec2>& outline : ObstacleOutlines(scene)) {
     if (Near(outline, around)) turn->obstacles.push_back(std::move(outline));
   }
+}
+
+// The freespace planner's manoeuvre from `from` to `turn->goal` within the
+// lanes and junctions about `around`, or where none fits there, within
+// them and their shoulders. On success `turn` holds the area it was
+// planned in.
+Result<algorithms::FreespacePath> PlanWithinRoad(
+    algorithms::FreespacePlanner& planner, const geometry::Pose2& from,
+    const std::vector<Vec2>& around, const Scene& scene,
+    RouteTurnaround* turn) {
+  SetAreaAbout(around, scene, 0.0, turn);
+  Result<algorithms::FreespacePath> manoeuvre =
+      planner.Plan(from, turn->goal, turn->obstacles, turn->drivable);
+  if (manoeuvre.ok()) return manoeuvre;
+  SetAreaAbout(around, scene, kShoulderM, turn);
+  Result<algorithms::FreespacePath> wider =
+      planner.Plan(from, turn->goal, turn->obstacles, turn->drivable);
+  turn->on_shoulders = wider.ok();
+  // The lanes' own failure says more when the shoulders do not help.
+  return wider.ok() ? std::move(wider) : std::move(manoeuvre);
 }
 
 }  // namespace
@@ -214,9 +243,8 @@ std::vector<RouteTurnaround> World::Impl::SharpCorners(
         stretch.push_back(road.PointAt(s_m));
       }
       stretch.push_back(b);
-      SetAreaAbout(stretch, scene, &turn);
       Result<algorithms::FreespacePath> manoeuvre =
-          planner.Plan(from, turn.goal, turn.obstacles, turn.drivable);
+          PlanWithinRoad(planner, from, stretch, scene, &turn);
       if (!manoeuvre.ok()) continue;
       turn.reference = manoeuvre->poses;
       turn.corner = true;
@@ -260,15 +288,16 @@ Status World::Impl::PlanTurnarounds() {
                                road.HeadingAt(turn.start_s_m)};
     const std::vector<Vec2> arrive =
         ToPoints(libsumo::Lane::getShape(crossing.from_lane));
-    SetAreaAbout({arrive.empty() ? stop : arrive.back()}, scene, &turn);
-    Result<algorithms::FreespacePath> manoeuvre =
-        planner.Plan(from, turn.goal, turn.obstacles, turn.drivable);
+    Result<algorithms::FreespacePath> manoeuvre = PlanWithinRoad(
+        planner, from, {arrive.empty() ? stop : arrive.back()}, scene, &turn);
     if (!manoeuvre.ok()) {
       return Status::InvalidArgument(fmt::format(
           "task.goal: unreachable from task.start: the route turns around "
           "from lane '{}' to lane '{}', {:.1f} m across (the car turns no "
           "tighter than {:.1f} m), no way round the block leads on, and no "
-          "turn in several moves fits in the lanes and junctions there ({})",
+          "turn in several moves fits in the lanes, junctions and shoulders "
+          "there "
+          "({})",
           crossing.from_lane, crossing.to_lane,
           internal::UTurnWidthM(crossing.from_lane, crossing.to_lane),
           MinTurningRadiusM(), manoeuvre.status().message()));

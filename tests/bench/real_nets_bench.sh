@@ -13,7 +13,8 @@
 # path outside junctions, with the number of places the path turns
 # tighter than the car can (tests/bench/ideal_path_error.py), and the
 # route's turns in several moves with the moves of each (at U-turns and
-# at corners sharper than the car, "c").
+# at corners sharper than the car, "c"; "s" where the lanes left no room
+# and the manoeuvre uses the road's shoulders).
 #   tests/bench/real_nets_bench.sh [routes-per-net] [net-name ...]
 # ROUTES_SEED (default 1) seeds the routes and flows; POINT (default
 # cores=16,freq_ghz=2.1) is the design point; KEEP=DIR keeps the scenarios,
@@ -127,10 +128,10 @@ echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(c
 echo
 ideal_only="${IDEAL_ONLY:-0}"
 if [ "${ideal_only}" = 1 ]; then
-  echo "| net | route | length m, SUMO's shortest / adse's | ideal driver reached goal | its time s | ideal driver off path m, outside junctions / all | turns tighter than the car's | manoeuvres (moves; c: at a corner) |"
+  echo "| net | route | length m, SUMO's shortest / adse's | ideal driver reached goal | its time s | ideal driver off path m, outside junctions / all | turns tighter than the car's | manoeuvres (moves; c: at a corner, s: onto the shoulders) |"
   echo "|---|---|---|---|---|---|---|---|"
 else
-  echo "| net | route | length m, SUMO's shortest / adse's | reached goal | ended | nav time s | dominant stop reason | stood s | collisions (caused by the ego) | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's | manoeuvres (moves; c: at a corner) |"
+  echo "| net | route | length m, SUMO's shortest / adse's | reached goal | ended | nav time s | dominant stop reason | stood s | collisions (caused by the ego) | peak RSS MB | sim s / wall s | ideal driver off path m, outside junctions / all | turns tighter than the car's | manoeuvres (moves; c: at a corner, s: onto the shoulders) |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 fi
 reached=0
@@ -159,7 +160,7 @@ for name in "${names[@]}"; do
       continue
     fi
     length="${length} / $("${py}" -c 'import json,sys; print("%.0f" % json.load(open(sys.argv[1]))["ideal_path_length_m"])' "${out}/${run}-route.json")"
-    turnarounds="$("${py}" -c 'import json,sys; t = json.load(open(sys.argv[1]))["turnarounds"]; print("%d%s" % (len(t), " (%s)" % ", ".join(("c " if x["kind"] == "corner" else "") + str(x["moves"]) for x in t) if t else ""))' "${out}/${run}-route.json")"
+    turnarounds="$("${py}" -c 'import json,sys; t = json.load(open(sys.argv[1]))["turnarounds"]; print("%d%s" % (len(t), " (%s)" % ", ".join(("c " if x["kind"] == "corner" else "") + ("s " if x["on_shoulders"] else "") + str(x["moves"]) for x in t) if t else ""))' "${out}/${run}-route.json")"
     if [ "${ideal_only}" != 1 ] &&
       ! /usr/bin/time -v -o "${out}/${run}.time" "${adse}" simulate "${yaml}" \
         --point "${point}" --json -q -o "${out}/${run}.h5" \

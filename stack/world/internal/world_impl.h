@@ -190,6 +190,8 @@ struct World::Impl {
     double decel_mps2 = 0.0;  // its comfortable deceleration
   };
   std::map<std::string, VehicleType> types;  // by vehicle id
+  // Their headings at the last step, for their yaw rates.
+  std::map<std::string, double> last_yaw_rad;  // by vehicle id
 
   ~Impl() {
     if (sumo_running) {

@@ -65,6 +65,37 @@ TEST(BoxesOverlapTest, RotatedCasesNeedAllAxes) {
   EXPECT_TRUE(BoxesOverlap(Box(0, 0, 0.5, 10, 0.2), Box(0, 0, -0.5, 10, 0.2)));
 }
 
+TEST(ContactOfBoxesTest, TheFaceOfLeastOverlapAndTheCornersIn) {
+  // b overlaps a's front face by 0.2 m and its side by 1.5 m: it came
+  // through the front. One corner of each lies in the other.
+  const OrientedBox a = Box(0, 0, 0, 4, 2);
+  const OrientedBox b = Box(3.8, 0.5, 0, 4, 2);
+  BoxContact contact = ContactOfBoxes(a, b);
+  EXPECT_NEAR(contact.normal.x(), 1.0, 1e-12);
+  EXPECT_NEAR(contact.normal.y(), 0.0, 1e-12);
+  EXPECT_NEAR(contact.depth_m, 0.2, 1e-12);
+  // a's corner (2, 1) and b's corner (1.8, -0.5).
+  EXPECT_NEAR(contact.point.x(), 1.9, 1e-12);
+  EXPECT_NEAR(contact.point.y(), 0.25, 1e-12);
+  // Seen from b, the normal points back at a.
+  contact = ContactOfBoxes(b, a);
+  EXPECT_NEAR(contact.normal.x(), -1.0, 1e-12);
+  EXPECT_NEAR(contact.depth_m, 0.2, 1e-12);
+
+  // Rotated 90 degrees and beside a's left side, 0.1 m in: the normal is
+  // a's left, whichever box's axis gives it.
+  contact = ContactOfBoxes(a, Box(0.5, 1.9, M_PI / 2, 2, 4));
+  EXPECT_NEAR(contact.normal.x(), 0.0, 1e-12);
+  EXPECT_NEAR(contact.normal.y(), 1.0, 1e-12);
+  EXPECT_NEAR(contact.depth_m, 0.1, 1e-12);
+
+  // Apart: the depth is the gap, negative; no corner is in, so the point
+  // is halfway between the centres.
+  contact = ContactOfBoxes(a, Box(5.0, 0, 0, 4, 2));
+  EXPECT_NEAR(contact.depth_m, -1.0, 1e-12);
+  EXPECT_NEAR(contact.point.x(), 2.5, 1e-12);
+}
+
 Path2 LShape() {
   Path2 p;
   p.points = {{0, 0}, {10, 0}, {10, 5}};

@@ -216,6 +216,27 @@ TEST(WorldTest, OnARealTownACornerSharperThanTheCarIsTurnedInSeveralMoves) {
   EXPECT_LT(report.max_lateral_error_m, 1.0);
 }
 
+// acosta's edges 93 and 48: one-way streets of one 3.2 m lane that meet
+// at a 134 degree corner. No turn in several moves fits in the lanes and
+// the junction; the ideal driver kept its lanes there, strayed 2.79 m,
+// and the stack touched a roadside pole (the real-nets bench's acosta-1
+// of seed 4 at run key v21). On the streets' shoulders the car turns in
+// three moves.
+TEST(WorldTest, OnARealTownACornerOfSingleLanesIsTurnedOnTheirShoulders) {
+  Result<std::unique_ptr<World>> world =
+      OpenBenchRoute(kAcostaNet, Location::OnEdge("93", 10.0, 0),
+                     Location::OnEdge("48", 60.0, 0));
+  ASSERT_TRUE(world.ok()) << world.status().ToString();
+  ASSERT_EQ((*world)->route_turnarounds().size(), 1u);
+  const RouteTurnaround& turn = (*world)->route_turnarounds()[0];
+  EXPECT_TRUE(turn.corner);
+  EXPECT_TRUE(turn.on_shoulders);
+  EXPECT_GE(ManoeuvreMoves(turn.reference), 2);
+  const IdealDriveReport report = DriveToTheGoal(**world, 40.0, 300.0);
+  EXPECT_EQ(report.collisions, 0);
+  EXPECT_LT(report.max_lateral_error_m, 1.0);
+}
+
 TEST(WorldTest, AOneWayStreetOfABareNetHasPolesOnBothSides) {
   // Edge 69 of sumo-tools' acosta: a one-way, two-lane street. With poles
   // on its right side only, NDT saw too little structure and got lost.
@@ -475,21 +496,62 @@ TEST(WorldTest, AContactIsTheEgosWhenItClosedOnTheOtherAtLeastAsFast) {
   };
   // Standing, driven into from behind or the side: not the ego's.
   ego.v_mps = 0.0;
-  EXPECT_FALSE(EgoCausedContact(ego, body, other_at(-4, 0, 0, 10)));
-  EXPECT_FALSE(EgoCausedContact(ego, body, other_at(-2, -1.5, 0.2, 14)));
+  EXPECT_FALSE(EgoCausedContact(ego, 0.0, body, other_at(-4, 0, 0, 10)));
+  EXPECT_FALSE(EgoCausedContact(ego, 0.0, body, other_at(-2, -1.5, 0.2, 14)));
   // Braking at 2 m/s, passed by a car at 14 m/s that cuts in: not either.
   ego.v_mps = 2.0;
-  EXPECT_FALSE(EgoCausedContact(ego, body, other_at(-2, 2, -0.3, 14)));
+  EXPECT_FALSE(EgoCausedContact(ego, 0.0, body, other_at(-2, 2, -0.3, 14)));
   // Into a slower car ahead, or a standing one: the ego's.
   ego.v_mps = 8.0;
-  EXPECT_TRUE(EgoCausedContact(ego, body, other_at(4.5, 0, 0, 3)));
-  EXPECT_TRUE(EgoCausedContact(ego, body, other_at(4.5, 0.5, 0, 0)));
+  EXPECT_TRUE(EgoCausedContact(ego, 0.0, body, other_at(4.5, 0, 0, 3)));
+  EXPECT_TRUE(EgoCausedContact(ego, 0.0, body, other_at(4.5, 0.5, 0, 0)));
   // Backing into a standing car behind: the ego's.
   ego.v_mps = -1.0;
-  EXPECT_TRUE(EgoCausedContact(ego, body, other_at(-4.5, 0, 0, 0)));
+  EXPECT_TRUE(EgoCausedContact(ego, 0.0, body, other_at(-4.5, 0, 0, 0)));
   // Head on, both at 5 m/s: the ego closed as fast, so it counts.
   ego.v_mps = 5.0;
-  EXPECT_TRUE(EgoCausedContact(ego, body, other_at(4.5, 0, M_PI, 5)));
+  EXPECT_TRUE(EgoCausedContact(ego, 0.0, body, other_at(4.5, 0, M_PI, 5)));
+}
+
+TEST(WorldTest, ACarCuttingInWhoseRearSwingsIntoTheBrakingEgoCausedTheContact) {
+  // RiLSA2, route 0 of seed 3 at run key v20, 83.45 s: leaving the same
+  // green side by side, a flow's car from the lane on the ego's right
+  // swung into the ego's lane in the junction, 7 m/s and turning
+  // clockwise, while the ego braked through 1.6 m/s turning left, away
+  // from it. The two bodies along the line between their centres closed
+  // (the ego was behind it), which until v22 made it the ego's.
+  VehicleLimits car;
+  car.length_m = 4.6;
+  car.width_m = 1.9;
+  car.wheelbase_m = 2.7;
+  VehicleState ego;
+  ego.x_m = 502.216;
+  ego.y_m = 507.337;
+  ego.yaw_rad = -2.916;
+  ego.v_mps = 1.60;
+  ego.steer_rad = 0.306;
+  const double ego_yaw_rate = ego.v_mps * std::tan(ego.steer_rad) / 2.7;
+  const geometry::OrientedBox body =
+      BodyAt({ego.x_m, ego.y_m, ego.yaw_rad}, car);
+  OtherVehicle cutting_in;
+  cutting_in.box.center = Eigen::Vector2d(495.988, 508.010);
+  cutting_in.box.yaw_rad = -3.005;
+  cutting_in.box.length_m = 5.0;
+  cutting_in.box.width_m = 1.8;
+  cutting_in.speed_mps = 7.03;
+  cutting_in.yaw_rate_rps = -0.64;
+  ASSERT_TRUE(geometry::BoxesOverlap(body, cutting_in.box));
+  EXPECT_FALSE(EgoCausedContact(ego, ego_yaw_rate, body, cutting_in));
+
+  // The same ego swinging its front corner into a car standing beside
+  // it: the ego's.
+  OtherVehicle standing = cutting_in;
+  standing.speed_mps = 0.0;
+  standing.yaw_rate_rps = 0.0;
+  ego.v_mps = 3.0;
+  ego.steer_rad = -0.5;  // turning right, into it
+  EXPECT_TRUE(EgoCausedContact(ego, ego.v_mps * std::tan(ego.steer_rad) / 2.7,
+                               body, standing));
 }
 
 TEST(WorldTest, StartOffTheRoadIsRejected) {
@@ -687,18 +749,42 @@ TEST(WorldTest, AGoalBehindTheStartIsReachedByATurnInSeveralMoves) {
   }
 }
 
-TEST(WorldTest, AGoalOnlyAUTurnInAStreetTooNarrowForAnyTurnReachesIsRejected) {
-  // Two 2.2 m lanes: 4.4 m across, shorter than the 4.6 m car, and no
-  // side street.
+// A dead-end street of two lanes, `lane_width_m` each, with no side
+// street: only a U-turn leads to a goal on its far side.
+WorldSetup DeadEndStreet(const std::string& name, double lane_width_m) {
   WorldSetup setup;
-  setup.world.map.net_path =
-      TwoWayNet("narrow_dead_end",
-                R"(<node id="a" x="0" y="0"/><node id="b" x="200" y="0"/>)",
-                {{"a", "b"}}, 2.2);
-  setup.task.start = Location::Xy(20, -1.1);
-  setup.task.goal = Location::Xy(150, 1.1);
+  setup.world.map.net_path = TwoWayNet(
+      name, R"(<node id="a" x="0" y="0"/><node id="b" x="200" y="0"/>)",
+      {{"a", "b"}}, lane_width_m);
+  setup.task.start = Location::Xy(20, -0.5 * lane_width_m);
+  setup.task.goal = Location::Xy(150, 0.5 * lane_width_m);
   setup.cache_dir = CacheDir();
-  Result<std::unique_ptr<World>> world = World::Open(setup);
+  return setup;
+}
+
+TEST(WorldTest, AUTurnInAStreetNarrowerThanTheCarIsMadeOnItsShoulders) {
+  // Two 2.2 m lanes: 4.4 m across, shorter than the 4.6 m car. With 1 m
+  // of shoulder either side a turn in several moves fits.
+  Result<std::unique_ptr<World>> world =
+      World::Open(DeadEndStreet("narrow_dead_end", 2.2));
+  ASSERT_TRUE(world.ok()) << world.status().message();
+  const std::vector<RouteTurnaround>& turns = (*world)->route_turnarounds();
+  ASSERT_EQ(turns.size(), 1u);
+  EXPECT_FALSE(turns[0].corner);
+  EXPECT_TRUE(turns[0].on_shoulders);
+  EXPECT_GE(ManoeuvreMoves(turns[0].reference), 3);
+  // Its moves keep to the street and its shoulders: 2.2 + 1 m either side
+  // of the centre line, less the body's half width at most.
+  for (const algorithms::GearedPose& p : turns[0].reference) {
+    EXPECT_LT(std::abs(p.pose.y_m), 3.2) << "at x " << p.pose.x_m;
+  }
+}
+
+TEST(WorldTest, AGoalOnlyAUTurnInAStreetTooNarrowForAnyTurnReachesIsRejected) {
+  // Two 1.2 m lanes: 2.4 m across and 4.4 m with the shoulders, shorter
+  // than the 4.6 m car.
+  Result<std::unique_ptr<World>> world =
+      World::Open(DeadEndStreet("narrowest_dead_end", 1.2));
   ASSERT_FALSE(world.ok());
   const std::string& message = world.status().message();
   EXPECT_EQ(message.rfind("task.goal: unreachable from task.start", 0), 0u)
