@@ -296,8 +296,7 @@ Status World::Impl::PlanTurnarounds() {
           "from lane '{}' to lane '{}', {:.1f} m across (the car turns no "
           "tighter than {:.1f} m), no way round the block leads on, and no "
           "turn in several moves fits in the lanes, junctions and shoulders "
-          "there "
-          "({})",
+          "there ({})",
           crossing.from_lane, crossing.to_lane,
           internal::UTurnWidthM(crossing.from_lane, crossing.to_lane),
           MinTurningRadiusM(), manoeuvre.status().message()));
