@@ -151,29 +151,36 @@ double DistanceAlongPathToBox(const std::vector<Eigen::Vector2d>& path,
 
 namespace {
 
-// A box's two face normals: along its heading and to its left.
-std::array<Eigen::Vector2d, 2> BoxAxes(const OrientedBox& box) {
-  return {Eigen::Vector2d(std::cos(box.yaw_rad), std::sin(box.yaw_rad)),
-          Eigen::Vector2d(-std::sin(box.yaw_rad), std::cos(box.yaw_rad))};
+// A box as its centre, its two face normals (along its heading and to its
+// left) and its half extents along them, worked out once per box.
+struct BoxFrame {
+  Eigen::Vector2d center;
+  std::array<Eigen::Vector2d, 2> axes;
+  std::array<double, 2> half;
+};
+
+BoxFrame FrameOf(const OrientedBox& box) {
+  const double c = std::cos(box.yaw_rad), s = std::sin(box.yaw_rad);
+  return {box.center,
+          {Eigen::Vector2d(c, s), Eigen::Vector2d(-s, c)},
+          {0.5 * box.length_m, 0.5 * box.width_m}};
 }
 
 // How far the projections of two boxes onto `axis` (a unit vector)
 // overlap; negative when a gap separates them.
-double OverlapAlong(const OrientedBox& a, const OrientedBox& b,
+double OverlapAlong(const BoxFrame& a, const BoxFrame& b,
                     const Eigen::Vector2d& axis) {
-  auto reach = [&](const OrientedBox& box) {
-    const auto axes = BoxAxes(box);
-    return 0.5 * box.length_m * std::abs(axes[0].dot(axis)) +
-           0.5 * box.width_m * std::abs(axes[1].dot(axis));
+  auto reach = [&](const BoxFrame& box) {
+    return box.half[0] * std::abs(box.axes[0].dot(axis)) +
+           box.half[1] * std::abs(box.axes[1].dot(axis));
   };
   return reach(a) + reach(b) - std::abs((b.center - a.center).dot(axis));
 }
 
-bool BoxContains(const OrientedBox& box, const Eigen::Vector2d& p) {
-  const auto axes = BoxAxes(box);
+bool Contains(const BoxFrame& box, const Eigen::Vector2d& p) {
   const Eigen::Vector2d d = p - box.center;
-  return std::abs(d.dot(axes[0])) <= 0.5 * box.length_m &&
-         std::abs(d.dot(axes[1])) <= 0.5 * box.width_m;
+  return std::abs(d.dot(box.axes[0])) <= box.half[0] &&
+         std::abs(d.dot(box.axes[1])) <= box.half[1];
 }
 
 }  // namespace
@@ -182,9 +189,10 @@ bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b) {
   // Two convex shapes are disjoint iff some edge normal separates them; a
   // box has two distinct normals. Boxes are closed sets, so touching boxes
   // overlap (a collision check should err towards "hit").
-  for (const OrientedBox* box : {&a, &b}) {
-    for (const Eigen::Vector2d& axis : BoxAxes(*box)) {
-      if (OverlapAlong(a, b, axis) < 0.0) return false;
+  const BoxFrame fa = FrameOf(a), fb = FrameOf(b);
+  for (const BoxFrame* box : {&fa, &fb}) {
+    for (const Eigen::Vector2d& axis : box->axes) {
+      if (OverlapAlong(fa, fb, axis) < 0.0) return false;
     }
   }
   return true;
@@ -193,10 +201,11 @@ bool BoxesOverlap(const OrientedBox& a, const OrientedBox& b) {
 BoxContact ContactOfBoxes(const OrientedBox& a, const OrientedBox& b) {
   BoxContact contact;
   contact.depth_m = std::numeric_limits<double>::infinity();
+  const BoxFrame fa = FrameOf(a), fb = FrameOf(b);
   const Eigen::Vector2d d = b.center - a.center;
-  for (const OrientedBox* box : {&a, &b}) {
-    for (const Eigen::Vector2d& axis : BoxAxes(*box)) {
-      const double overlap = OverlapAlong(a, b, axis);
+  for (const BoxFrame* box : {&fa, &fb}) {
+    for (const Eigen::Vector2d& axis : box->axes) {
+      const double overlap = OverlapAlong(fa, fb, axis);
       if (overlap < contact.depth_m) {
         contact.depth_m = overlap;
         contact.normal = d.dot(axis) < 0.0 ? Eigen::Vector2d(-axis) : axis;
@@ -205,9 +214,9 @@ BoxContact ContactOfBoxes(const OrientedBox& a, const OrientedBox& b) {
   }
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
   int inside = 0;
-  for (const auto& [from, into] : {std::pair{&a, &b}, std::pair{&b, &a}}) {
+  for (const auto& [from, into] : {std::pair{&a, &fb}, std::pair{&b, &fa}}) {
     for (const Eigen::Vector2d& corner : BoxCorners(*from)) {
-      if (!BoxContains(*into, corner)) continue;
+      if (!Contains(*into, corner)) continue;
       sum += corner;
       ++inside;
     }
