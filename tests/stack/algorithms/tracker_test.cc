@@ -166,17 +166,17 @@ TEST(Tracker, APieceBornNearAConfirmedTrackStartsAtItsVelocity) {
   }
 }
 
-// A car drives up at 13 m/s behind the LiDAR and brakes at SUMO's
-// 4.5 m/s^2 to a stop 4 m from it. Near, the LiDAR's rings cross its roof
-// in two thin arcs, 0.95 m ahead of its centre and 1.9 m behind, each a
-// box 1.8 m across it and 0.2 m along (as at run key v21 on acosta, route
-// 1 of seed 4). Its tracks stand with it. There, a thin arc let the car's
-// centre lie anywhere within 2.4 m of it; the track's prediction always
-// lay so near one arc, so the arcs confirmed it without correcting it
-// and its speed froze at 6.4 m/s; the other arc, within 4 m of it, was
-// born a piece at that speed, as sure of it, and ran on through the
-// standing car in turn: for three minutes a phantom drove into the ego,
-// which stood for it.
+// A car drives up at 13 m/s and brakes at SUMO's 4.5 m/s^2 to a stop.
+// Near the LiDAR its rings cross the car's roof in two thin arcs, 0.95 m
+// ahead of its centre and 1.9 m behind, each a box 1.8 m across it and
+// 0.2 m along (as on acosta, route 1 of seed 4, with the tracker of run
+// key v21). Its tracks stand with it. There, one thin arc let the car's
+// centre lie anywhere within 2.4 m of it, so the track's prediction,
+// always that near one arc or the other, was confirmed and never
+// corrected, and its speed froze at 6.7 m/s; the other arc, within 4 m
+// of it, was born a piece at that speed, as sure of it, and ran on
+// through the standing car in turn: for minutes a phantom drove into the
+// ego, which stood for it.
 TEST(Tracker, TheTracksOfACarThatStopsSeenAsTwoArcsStandWithIt) {
   Tracker tracker;
   const double dt = 0.1, v0 = 13.0, decel = 4.5;
