@@ -6,6 +6,8 @@
 #include <optional>
 #include <tuple>
 
+#include "stack/geometry/geometry.h"
+
 namespace adse::algorithms {
 namespace {
 
@@ -157,17 +159,16 @@ std::vector<Detection> Tracker::JoinViewsOfOneObject(
     for (const size_t d : inside) {
       const Detection& part = detections[d];
       joined[d] = 1;
-      const Eigen::Vector2d a(std::cos(part.yaw_rad), std::sin(part.yaw_rad));
-      const Eigen::Vector2d b(-a.y(), a.x());
-      for (const double i : {-0.5, 0.5}) {
-        for (const double j : {-0.5, 0.5}) {
-          const Eigen::Vector2d c =
-              part.center + i * part.length_m * a + j * part.width_m * b;
-          lo_u = std::min(lo_u, c.dot(u));
-          hi_u = std::max(hi_u, c.dot(u));
-          lo_n = std::min(lo_n, c.dot(n));
-          hi_n = std::max(hi_n, c.dot(n));
-        }
+      geometry::OrientedBox part_box;
+      part_box.center = part.center;
+      part_box.yaw_rad = part.yaw_rad;
+      part_box.length_m = part.length_m;
+      part_box.width_m = part.width_m;
+      for (const Eigen::Vector2d& c : geometry::BoxCorners(part_box)) {
+        lo_u = std::min(lo_u, c.dot(u));
+        hi_u = std::max(hi_u, c.dot(u));
+        lo_n = std::min(lo_n, c.dot(n));
+        hi_n = std::max(hi_n, c.dot(n));
       }
       box.z_min_m = std::min(box.z_min_m, part.z_min_m);
       box.z_max_m = std::max(box.z_max_m, part.z_max_m);
