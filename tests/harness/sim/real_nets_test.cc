@@ -29,15 +29,13 @@ spec::Spec RealNetScenario(const std::string& name, const std::string& net,
                            const std::string& start, const std::string& goal,
                            const std::string& flows, int traffic_seed = 1,
                            const std::string& stopped = "[]") {
-  adse::testing::NetScenario scenario;
-  scenario.name = name;
-  scenario.net = net;
-  scenario.start = start;
-  scenario.goal = goal;
-  scenario.flows = flows;
-  scenario.traffic_seed = traffic_seed;
-  scenario.stopped = stopped;
-  return adse::testing::ParseNetScenario(scenario);
+  return adse::testing::ParseNetScenario({.name = name,
+                                          .net = net,
+                                          .start = start,
+                                          .goal = goal,
+                                          .flows = flows,
+                                          .traffic_seed = traffic_seed,
+                                          .stopped = stopped});
 }
 
 // Simulates at 16 cores, 2.1 GHz and checks the goal was reached without

@@ -33,14 +33,12 @@ spec::Spec SignalScenario(
     const std::string& name, const std::string& net, const std::string& start,
     const std::string& goal, int timeout_s,
     const std::string& profile = "autoware-2022.12-i9-12900kf-signals.yaml") {
-  adse::testing::NetScenario scenario;
-  scenario.name = name;
-  scenario.net = net;
-  scenario.start = start;
-  scenario.goal = goal;
-  scenario.timeout_s = timeout_s;
-  scenario.profile = profile;
-  return adse::testing::ParseNetScenario(scenario);
+  return adse::testing::ParseNetScenario({.name = name,
+                                          .net = net,
+                                          .start = start,
+                                          .goal = goal,
+                                          .timeout_s = timeout_s,
+                                          .profile = profile});
 }
 
 spec::Spec RilsaNorthToSouth(
