@@ -1,5 +1,6 @@
 #include "harness/campaign/replay.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <limits>
 
@@ -12,6 +13,37 @@
 
 namespace adse::campaign {
 namespace fs = std::filesystem;
+
+Status KeepObjectives(const std::vector<std::string>& metrics,
+                      Recording* recording) {
+  spec::Spec* spec = &recording->spec;
+  std::vector<std::string> have;
+  for (const spec::Objective& objective : spec->objectives) {
+    have.push_back(objective.metric);
+  }
+  for (const std::string& metric : metrics) {
+    if (std::find(have.begin(), have.end(), metric) == have.end()) {
+      return Status::InvalidArgument(
+          fmt::format("'{}' is not an objective of the recorded scenario "
+                      "(its objectives: {})",
+                      metric, fmt::join(have, ", ")));
+    }
+  }
+  std::vector<spec::Objective> kept;
+  for (const spec::Objective& objective : spec->objectives) {
+    if (std::find(metrics.begin(), metrics.end(), objective.metric) !=
+        metrics.end()) {
+      kept.push_back(objective);
+    }
+  }
+  if (kept.size() < 2) {
+    return Status::InvalidArgument(
+        "keep two objectives at least (a front of one objective is a "
+        "single point)");
+  }
+  spec->objectives = std::move(kept);
+  return Status::Ok();
+}
 
 Result<Recording> LoadRecording(const std::string& folder_or_file) {
   std::error_code ec;

@@ -25,6 +25,13 @@ struct Recording {
 // Reads <folder>/campaign.h5 (or a campaign.h5 path). Errors name the file.
 Result<Recording> LoadRecording(const std::string& folder_or_file);
 
+// Keeps only the scenario's objectives on these metrics, in its order, so
+// that strategies and the true front see those alone (`adse explore
+// --objectives`). Each must be one of its objectives, and two at least
+// must stay: a front of one objective is a single point.
+Status KeepObjectives(const std::vector<std::string>& metrics,
+                      Recording* recording);
+
 // Answers evaluations from a recording, one at a time.
 class RecordingEvaluator : public Evaluator {
  public:

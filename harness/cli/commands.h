@@ -98,6 +98,9 @@ struct ExploreArgs {
   std::string replay;                   // recorded campaign folder
   std::vector<std::string> strategies;  // default: the recorded strategy set
   int budget = 0;                       // 0: the recording's scenario budget
+  // Replay as if the scenario had only these of its objectives (metric
+  // names); empty: all of them.
+  std::vector<std::string> objectives;
   int seeds = 20;
   uint64_t first_seed = 1;
   bool rationale = false;  // print every seed's proposals with their reasons

@@ -43,6 +43,13 @@ int RunExplore(const ExploreArgs& args) {
                  recording.status().message().c_str());
     return ExitCodeFor(recording.status());
   }
+  if (!args.objectives.empty()) {
+    Status kept = campaign::KeepObjectives(args.objectives, &*recording);
+    if (!kept.ok()) {
+      std::fprintf(stderr, "error: --objectives: %s\n", kept.message().c_str());
+      return ExitCodeFor(kept);
+    }
+  }
   std::vector<std::string> strategies = args.strategies;
   if (strategies.empty()) strategies = explore::StrategyNames();
   const int budget =
@@ -51,7 +58,11 @@ int RunExplore(const ExploreArgs& args) {
                         {"recorded_evaluations", recording->rows.size()},
                         {"budget", budget},
                         {"seeds", args.seeds},
+                        {"objectives", nlohmann::json::array()},
                         {"strategies", nlohmann::json::object()}};
+  for (const spec::Objective& objective : recording->spec.objectives) {
+    out["objectives"].push_back(objective.metric);
+  }
   // The recording's own answer, from the same front as adse run's.
   const campaign::Headline answer =
       campaign::ComputeHeadline(recording->spec, recording->rows);

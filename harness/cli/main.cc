@@ -235,6 +235,13 @@ int main(int argc, char** argv) {
                    "Evaluations per replay (default: the "
                    "recorded scenario's budget)")
       ->check(CLI::PositiveNumber);
+  explore_cmd
+      ->add_option("--objectives", explore.objectives,
+                   "Replay with only these of the recorded scenario's "
+                   "objectives (metric names, comma-separated), e.g. "
+                   "hardware_cost,nav_time_s; the true front is then "
+                   "theirs too (default: all)")
+      ->delimiter(',');
   explore_cmd->add_option("--seeds", explore.seeds, "Seeds per strategy")
       ->check(CLI::Range(1, 100000));
   explore_cmd->add_option("--first-seed", explore.first_seed,

@@ -286,8 +286,9 @@ std::string AgentStrategy::Choose(int n, std::vector<Genes>* chosen) {
       max_gain = std::max(max_gain, c.gain);
     }
     // What the user asked for is the cheapest feasible design: while no run
-    // is feasible, and on every kCheapestEvery-th pick after, the pick goes
-    // to the cheapest design instead of the front's volume.
+    // is feasible, on every kCheapestEvery-th pick after and on the
+    // budget's last, the pick goes to the cheapest design instead of the
+    // front's volume.
     const int best_cheap = CheapestPick(candidates, *chosen);
     if (best_cheap >= 0) {
       const Candidate& pick = candidates[best_cheap];
@@ -361,7 +362,10 @@ int AgentStrategy::CheapestPick(const std::vector<Candidate>& candidates,
   }
   const int pick = proposed_ + static_cast<int>(chosen.size());
   const bool none_feasible = !std::isfinite(cheapest);
-  const bool cheapest_turn = pick % kCheapestEvery == kCheapestEvery - 1;
+  // The last run of the budget answers the question asked: no later run
+  // could use what a front point would teach.
+  const bool cheapest_turn =
+      pick % kCheapestEvery == kCheapestEvery - 1 || pick == budget_ - 1;
   if (!none_feasible && !cheapest_turn) return -1;
   int best = -1;
   double best_score = 0.0;
@@ -378,21 +382,20 @@ int AgentStrategy::CheapestPick(const std::vector<Candidate>& candidates,
       score = c.p_feasible >= 0.5 ? 2.0 - c.cost / (1.0 + std::abs(c.cost))
                                   : c.p_feasible;
     } else {
-      // Expected saving over the cheapest feasible run, relative; among
-      // equal savings, the one likelier on the front.
-      score = c.p_feasible * std::max(0.0, cheapest - c.cost) /
-                  std::max(std::abs(cheapest), 1e-12) +
-              kFrontTieBreak * c.p_front;
+      // Expected saving over the cheapest feasible run, relative, of a
+      // design cheaper by more than rounding and not too unlikely to
+      // be feasible: a small saving is still the answer, a long shot's
+      // large one seldom is. Among equal savings, the one likelier on the
+      // front.
+      const double saving =
+          (cheapest - c.cost) / std::max(std::abs(cheapest), 1e-12);
+      if (saving <= 1e-9 || c.p_feasible < kMinCheapestChance) continue;
+      score = c.p_feasible * saving + kFrontTieBreak * c.p_front;
     }
     if (score > best_score + 1e-12) {
       best_score = score;
       best = static_cast<int>(i);
     }
-  }
-  // A saving this unlikely is not worth a run the front could use (the
-  // tie-break alone never is).
-  if (!none_feasible && best_score < kMinCheapestSaving + kFrontTieBreak) {
-    return -1;
   }
   return best;
 }

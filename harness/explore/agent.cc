@@ -512,7 +512,7 @@ void AgentStrategy::FitModels() {
       // A faster sensor loads the whole chain behind it: it hurts, by
       // default a little; the diagnosis may say which way it goes here.
       prior[d] = votes[d] > 0   ? kRateVote
-                 : votes[d] < 0 ? -kRateVote
+                 : votes[d] < 0 ? -kVotedElasticity * knobs_[d].log_range
                                 : -kSensorElasticity * knobs_[d].log_range;
     }
   }
