@@ -38,7 +38,8 @@ constexpr double kVotedElasticity = 0.8;
 // ... and to a sensor-rate knob, which adds load rather than capacity.
 constexpr double kSensorElasticity = 0.5;
 // The prior slope a sensor rate gets when the diagnosis of an infeasible
-// run names it (sign from the remedy).
+// run asks to raise it (a consumer starved of data); asked to lower it, it
+// gets kVotedElasticity as a load, as a capacity knob voted for does.
 constexpr double kRateVote = 0.3;
 // Default GP length scales over normalised knobs: most knobs, and those
 // with at most 3 values.
