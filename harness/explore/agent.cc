@@ -47,6 +47,26 @@
 namespace adse::explore {
 namespace internal {
 
+int CompareCapacity(const std::vector<Knob>& knobs,
+                    const std::vector<bool>& rate_raised, const Genes& a,
+                    const Genes& b, bool coarser_is_capacity) {
+  int sign = 0;
+  for (size_t d = 0; d < knobs.size(); ++d) {
+    if (a[d] == b[d]) continue;
+    const KnobRole role = knobs[d].role;
+    int here = a[d] < b[d] ? -1 : +1;
+    if (role == KnobRole::kSensorRate && !rate_raised[d]) {
+      here = -here;  // a faster sensor is more load
+    } else if (role != KnobRole::kCores && role != KnobRole::kFrequency &&
+               !(role == KnobRole::kDownsample && coarser_is_capacity)) {
+      return 2;
+    }
+    if (sign != 0 && sign != here) return 2;
+    sign = here;
+  }
+  return sign;
+}
+
 AgentStrategy::AgentStrategy(const spec::Spec& spec)
     : spec_(&spec),
       grid_(spec.design_space),
@@ -138,7 +158,8 @@ void AgentStrategy::Remember(const Observation& observation) {
   record.feasible = observation.feasible && !observation.failed;
   record.objectives = Objectives(observation);
   if (observation.censored) record.censored = CensoredAt(observation);
-  record.metrics_fail = !record.failed && MetricsFail(observation);
+  record.metrics_fail = !record.failed && MetricsFail(observation, false);
+  record.load_fail = !record.failed && MetricsFail(observation, true);
   records_.push_back(std::move(record));
   ++fresh_;
 }
@@ -206,6 +227,7 @@ void AgentStrategy::SetUpMetrics() {
       if (info.name != metric) continue;
       model.boolean_hint = info.boolean;
       model.count_hint = info.count;
+      model.precision_hint = info.precision;
     }
     model.rate_hint = metric == kNavTimeMetric;
     models_.push_back(model);
@@ -221,6 +243,7 @@ void AgentStrategy::SetUpMetrics() {
     Result<spec::Expression> expression = spec::Expression::Parse(text, names);
     if (!expression.ok()) continue;
     bool metric_only = true;
+    bool reads_precision = false;
     for (const std::string& variable : expression->variables()) {
       if (variable == kCostMetric ||
           std::find(parameter_names.begin(), parameter_names.end(), variable) !=
@@ -228,9 +251,12 @@ void AgentStrategy::SetUpMetrics() {
         metric_only = false;
         continue;
       }
-      add(variable)->in_constraint = true;
+      MetricModel* model = add(variable);
+      model->in_constraint = true;
+      reads_precision = reads_precision || model->precision_hint;
     }
     metric_only_.push_back(metric_only);
+    reads_precision_.push_back(reads_precision);
     constraints_.push_back(std::move(*expression));
     constraint_texts_.push_back(text);
   }
@@ -363,9 +389,10 @@ std::vector<int> AgentStrategy::RemedyDirections(const Record& record,
   return direction;
 }
 
-bool AgentStrategy::MetricsFail(const Observation& observation) const {
+bool AgentStrategy::MetricsFail(const Observation& observation,
+                                bool load_only) const {
   for (size_t i = 0; i < constraints_.size(); ++i) {
-    if (!metric_only_[i]) continue;
+    if (!metric_only_[i] || (load_only && reads_precision_[i])) continue;
     if (observation.censored &&
         observation.violated_constraint == constraint_texts_[i]) {
       return true;
@@ -383,33 +410,19 @@ bool AgentStrategy::MetricsFail(const Observation& observation) const {
   return false;
 }
 
-int AgentStrategy::CompareCapacity(const Genes& a, const Genes& b) const {
-  int sign = 0;
-  for (size_t d = 0; d < knobs_.size(); ++d) {
-    if (a[d] == b[d]) continue;
-    const KnobRole role = knobs_[d].role;
-    int here = a[d] < b[d] ? -1 : +1;
-    if (role == KnobRole::kSensorRate && !rate_raised_[d]) {
-      here = -here;  // a faster sensor is more load
-    } else if (role != KnobRole::kCores && role != KnobRole::kFrequency) {
-      return 2;
-    }
-    if (sign != 0 && sign != here) return 2;
-    sign = here;
-  }
-  return sign;
-}
-
 Verdict AgentStrategy::CapacityVerdict(const Genes& genes) const {
   Verdict verdict = Verdict::kUnknown;
   for (const Record& record : records_) {
     if (record.failed) continue;
-    const int order = CompareCapacity(genes, record.genes);
-    if (record.metrics_fail && (order == -1 || order == 0)) {
-      return Verdict::kFails;
+    if (record.metrics_fail) {
+      const int order = CompareCapacity(knobs_, rate_raised_, genes,
+                                        record.genes, record.load_fail);
+      if (order == -1 || order == 0) return Verdict::kFails;
     }
-    if (record.feasible && (order == +1 || order == 0)) {
-      verdict = Verdict::kHolds;
+    if (record.feasible) {
+      const int order =
+          CompareCapacity(knobs_, rate_raised_, genes, record.genes, false);
+      if (order == +1 || order == 0) verdict = Verdict::kHolds;
     }
   }
   return verdict;
@@ -514,6 +527,10 @@ void AgentStrategy::FitModels() {
       prior[d] = votes[d] > 0   ? kRateVote
                  : votes[d] < 0 ? -kVotedElasticity * knobs_[d].log_range
                                 : -kSensorElasticity * knobs_[d].log_range;
+    } else if (role == KnobRole::kDownsample) {
+      // Coarser data is less work, as a slower sensor is; what it costs
+      // in precision is turned round per metric below.
+      prior[d] = kSensorElasticity * knobs_[d].log_range;
     }
   }
   const size_t first =
@@ -555,6 +572,11 @@ void AgentStrategy::FitModels() {
       sides.push_back(0);
     }
     std::vector<double> slope = prior;
+    if (model.precision_hint) {
+      for (size_t d = 0; d < knobs_.size(); ++d) {
+        if (knobs_[d].role == KnobRole::kDownsample) slope[d] = -slope[d];
+      }
+    }
     if (!model.in_constraint) {
       for (double& s : slope) s *= 0.4;
     }

@@ -87,6 +87,14 @@ std::string AgentStrategy::Predictions(const std::vector<double>& mean) const {
   std::vector<std::string> predicted;
   for (size_t j = 0; j < spec_->objectives.size(); ++j) {
     const spec::Objective& objective = spec_->objectives[j];
+    const int m = objective_model_[j];
+    if (objective.metric != kCostMetric && (m < 0 || !models_[m].fitted())) {
+      // No usable run has measured it (a run that timed out speaks only
+      // for the completion flag): there is no prediction to give.
+      predicted.push_back(fmt::format(
+          "{} not predicted yet (no run measured it)", objective.metric));
+      continue;
+    }
     const double v = objective.minimize ? mean[j] : -mean[j];
     // A mean over samples of which some never arrive (a rate model's
     // progress at or below 0) is no number to print.

@@ -112,9 +112,12 @@ const std::vector<MetricInfo>& KnownMetrics() {
        true},
       {"nav_time_s", "time from the start event to reaching the goal, s"},
       {"deviation_score",
-       "normalised distance between actual and ideal trajectory, in [0, 1]"},
-      {"max_deviation_m", "largest lateral error from the ideal path, m"},
-      {"zigzag_index", "jitter of the lateral error around its smooth fit"},
+       "normalised distance between actual and ideal trajectory, in [0, 1]",
+       /*boolean=*/false, /*count=*/false, /*precision=*/true},
+      {"max_deviation_m", "largest lateral error from the ideal path, m",
+       /*boolean=*/false, /*count=*/false, /*precision=*/true},
+      {"zigzag_index", "jitter of the lateral error around its smooth fit",
+       /*boolean=*/false, /*count=*/false, /*precision=*/true},
       {"ctrl_rate_hz", "control-command rate over the navigation, Hz"},
       {"hardware_cost", "value of the scenario's cost expression"},
       {"e2e_latency_p50_s", "median LiDAR-to-control latency, s"},
@@ -134,10 +137,12 @@ const std::vector<MetricInfo>& KnownMetrics() {
        true},
       {"parking_position_error_m",
        "valet_parking: parked body centre's distance from the slot's "
-       "target at the end, m"},
+       "target at the end, m",
+       /*boolean=*/false, /*count=*/false, /*precision=*/true},
       {"parking_yaw_error_deg",
        "valet_parking: heading error from the parked heading at the end, "
-       "degrees"},
+       "degrees",
+       /*boolean=*/false, /*count=*/false, /*precision=*/true},
       {"parking_time_s",
        "valet_parking: from the manoeuvre's first plan to the end of the "
        "run, s"},
@@ -148,7 +153,8 @@ const std::vector<MetricInfo>& KnownMetrics() {
        false, true},
       {"parking_path_deviation_m",
        "valet_parking: mean distance of the rear axle from the planned "
-       "manoeuvre while driving it, m"},
+       "manoeuvre while driving it, m",
+       /*boolean=*/false, /*count=*/false, /*precision=*/true},
       {"min_clearance_m",
        "valet_parking: smallest gap between the ego's body and a wall, pole "
        "or parked car, m"},

@@ -19,14 +19,17 @@ using DesignPoint = std::map<std::string, double>;
 
 // What a design parameter stands for, for strategies that reason about
 // capacity (the built-in agent's priors and the diagnosis' remedies):
-// none, cores, frequency, sensor_rate.
-enum class KnobRole { kNone, kCores, kFrequency, kSensorRate };
+// none, cores, frequency, sensor_rate (more of it is more load),
+// downsample (more of it is less load and less precision: a voxel or
+// azimuth step).
+enum class KnobRole { kNone, kCores, kFrequency, kSensorRate, kDownsample };
 
 struct DesignParameter {
   std::string name;  // key under design_space:
   std::string bind;  // "platform.cores", "stack.lidar.rate_hz", ...
   // `role:`; by default cores for platform.cores, frequency for
-  // platform.freq_ghz, sensor_rate for a sensor's rate knob, else none.
+  // platform.freq_ghz, sensor_rate for a sensor's rate knob, downsample for
+  // a stack knob that thins the data (KnobInfo::Load), else none.
   KnobRole role = KnobRole::kNone;
   // The allowed values, ascending and distinct. A `range: [lo, hi]` with an
   // optional `step` (default 1) is expanded here.
@@ -109,6 +112,10 @@ struct MetricInfo {
   std::string doc;
   bool boolean = false;  // 0 or 1
   bool count = false;    // a whole number of events, 0 or more
+  // How far the car strays from where it should be (lower is better): a
+  // knob that thins the stack's data (role downsample) makes it worse
+  // while it relieves the computer.
+  bool precision = false;
 };
 // Metrics a run reports (documented in scenarios/README.md).
 const std::vector<MetricInfo>& KnownMetrics();

@@ -41,7 +41,8 @@ const std::vector<Term<KnobRole>>& KnobRoleTerms() {
       {KnobRole::kNone, "none"},
       {KnobRole::kCores, "cores"},
       {KnobRole::kFrequency, "frequency"},
-      {KnobRole::kSensorRate, "sensor_rate"}};
+      {KnobRole::kSensorRate, "sensor_rate"},
+      {KnobRole::kDownsample, "downsample"}};
   return kTerms;
 }
 
@@ -61,7 +62,12 @@ KnobRole DefaultKnobRole(const std::string& bind) {
   const std::string prefix = "stack.";
   if (bind.compare(0, prefix.size(), prefix) == 0) {
     const KnobInfo* knob = FindStackKnob(bind.substr(prefix.size()));
-    if (knob != nullptr && knob->sensor_rate) return KnobRole::kSensorRate;
+    if (knob != nullptr && knob->load == KnobInfo::Load::kSensorRate) {
+      return KnobRole::kSensorRate;
+    }
+    if (knob != nullptr && knob->load == KnobInfo::Load::kDownsample) {
+      return KnobRole::kDownsample;
+    }
   }
   return KnobRole::kNone;
 }

@@ -18,7 +18,8 @@ const char* PlatformKindToString(PlatformKind kind);
 bool StringToPlatformKind(std::string_view name, PlatformKind* kind);
 std::vector<std::string> PlatformKindNames();
 
-// design_space.<name>.role: none, cores, frequency, sensor_rate.
+// design_space.<name>.role: none, cores, frequency, sensor_rate,
+// downsample.
 const char* KnobRoleToString(KnobRole role);
 bool StringToKnobRole(std::string_view name, KnobRole* role);
 std::vector<std::string> KnobRoleNames();

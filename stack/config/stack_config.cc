@@ -11,11 +11,12 @@ const std::vector<KnobInfo>& StackKnobs() {
     const world::LidarParams d;
     return std::vector<KnobInfo>{
         {"lidar.rate_hz", false, 0.5, 100.0, d.rate_hz,
-         "LiDAR scans per second, Hz", /*sensor_rate=*/true},
+         "LiDAR scans per second, Hz", KnobInfo::Load::kSensorRate},
         {"lidar.beams", true, 1, 128, static_cast<double>(d.beams),
          "vertical channels"},
         {"lidar.horizontal_resolution_deg", false, 0.05, 10.0,
-         d.horizontal_resolution_deg, "azimuth step, degrees"},
+         d.horizontal_resolution_deg, "azimuth step, degrees",
+         KnobInfo::Load::kDownsample},
         {"lidar.range_m", false, 1.0, 300.0, d.range_m,
          "maximum range in clear weather, m"},
         {"lidar.vertical_fov_up_deg", false, -30.0, 45.0, d.vertical_fov_up_deg,
@@ -28,10 +29,10 @@ const std::vector<KnobInfo>& StackKnobs() {
          "range noise in clear weather, m"},
         // Wheel odometry from the vehicle.
         {"odometry.rate_hz", false, 1.0, 200.0, 50.0,
-         "wheel odometry messages per second, Hz", /*sensor_rate=*/true},
+         "wheel odometry messages per second, Hz", KnobInfo::Load::kSensorRate},
         // Localization.
         {"localization.voxel_leaf_m", false, 0.1, 5.0, 1.0,
-         "voxel size of the scan given to NDT, m"},
+         "voxel size of the scan given to NDT, m", KnobInfo::Load::kDownsample},
         {"localization.ndt_resolution_m", false, 0.5, 10.0, 2.0,
          "NDT cell size, m"},
         {"localization.ndt_max_iterations", true, 1, 200, 30,
@@ -93,7 +94,8 @@ const std::vector<KnobInfo>& StackKnobs() {
         // Traffic signals (maps with signals on the route only): the
         // world's detector and the velocity planner's signal stage.
         {"traffic_light.detector_rate_hz", false, 0.5, 100.0, 10.0,
-         "signal detector observations per second, Hz", /*sensor_rate=*/true},
+         "signal detector observations per second, Hz",
+         KnobInfo::Load::kSensorRate},
         {"traffic_light.detector_range_m", false, 5.0, 500.0, 100.0,
          "farthest stop line (along the route) whose signal the detector "
          "reads, m"},

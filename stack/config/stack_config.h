@@ -22,9 +22,13 @@ struct KnobInfo {
   double max_value = 0.0;
   double default_value = 0.0;
   std::string doc;  // one line, with the unit
-  // A sensor's publishing rate: lowering it sheds load from the whole
-  // chain behind the sensor (a design space's default `role`).
-  bool sensor_rate = false;
+  // What the knob does to the stack's work (a design space's default
+  // `role`): kSensorRate, a sensor's publishing rate, whose lowering sheds
+  // load from the whole chain behind the sensor; kDownsample, a step or
+  // cell size that hands the stack fewer points, less work for less
+  // precision.
+  enum class Load { kOther, kSensorRate, kDownsample };
+  Load load = Load::kOther;
 };
 
 // Every knob the stack has, in a stable order.

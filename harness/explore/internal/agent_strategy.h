@@ -1,7 +1,8 @@
 // The built-in `agent` strategy's state, with its steps split by role:
 // agent.cc keeps the memory of told runs and fits the surrogates,
 // acquisition.cc scores candidates and chooses, rationale.cc says why.
-// Internal to harness/explore; only those files include it.
+// Internal to harness/explore; only those files (and their tests) include
+// it.
 #ifndef ADSE_HARNESS_EXPLORE_INTERNAL_AGENT_STRATEGY_H_
 #define ADSE_HARNESS_EXPLORE_INTERNAL_AGENT_STRATEGY_H_
 
@@ -35,7 +36,9 @@ constexpr size_t kMaxModelPoints = 160;
 // has asked for that knob.
 constexpr double kElasticity = 0.5;
 constexpr double kVotedElasticity = 0.8;
-// ... and to a sensor-rate knob, which adds load rather than capacity.
+// ... and to a sensor-rate knob, which adds load rather than capacity, or
+// a downsampling knob (a voxel size), which sheds it at the cost of
+// precision.
 constexpr double kSensorElasticity = 0.5;
 // The prior slope a sensor rate gets when the diagnosis of an infeasible
 // run asks to raise it (a consumer starved of data); asked to lower it, it
@@ -98,16 +101,31 @@ struct Record {
   bool failed = false;
   std::optional<CensoredBound> censored;  // stopped early, bound known
   // A constraint that reads only measured metrics failed here: with less
-  // capacity it fails too (see AgentStrategy::Capacity).
+  // capacity it fails too (see AgentStrategy::CapacityVerdict).
   bool metrics_fail = false;
+  // ... and one of them reads no precision metric: with finer data
+  // (downsample knobs) it fails too.
+  bool load_fail = false;
 };
 
 // What the runs say of a point by capacity alone: a point with no more
 // capacity than a run whose metric constraints failed fails them too; one
 // with no less than a feasible run's meets them. Capacity is ordered by
 // the knobs' roles: more cores and clock, a slower sensor, every other
-// knob equal.
+// knob equal. Coarser data (a downsample knob) counts as more capacity
+// only against a run that failed a constraint on no precision metric:
+// it costs precision, so it neither rescues a run that strayed nor keeps
+// a feasible one feasible.
 enum class Verdict { kUnknown, kFails, kHolds };
+
+// -1, 0 or +1: whether `a` has at most, the same or at least `b`'s
+// capacity by the knobs' roles (see Verdict); 2 when neither. A knob of no
+// capacity role must be equal; so must a sensor rate the diagnosis asked
+// to raise (`rate_raised`, per knob) and, unless `coarser_is_capacity`, a
+// downsample knob.
+int CompareCapacity(const std::vector<Knob>& knobs,
+                    const std::vector<bool>& rate_raised, const Genes& a,
+                    const Genes& b, bool coarser_is_capacity);
 
 struct Candidate {
   Genes genes;
@@ -161,12 +179,9 @@ class AgentStrategy : public Strategy {
   void FitModels();
 
   // Whether the metric constraints failed at a run (evaluated on what it
-  // measured, or named by its early stop).
-  bool MetricsFail(const Observation& observation) const;
-
-  // -1, 0 or +1: whether `a` has at most, the same or at least `b`'s
-  // capacity (see Verdict); 2 when neither.
-  int CompareCapacity(const Genes& a, const Genes& b) const;
+  // measured, or named by its early stop); with `load_only`, those of them
+  // that read no precision metric.
+  bool MetricsFail(const Observation& observation, bool load_only) const;
 
   Verdict CapacityVerdict(const Genes& genes) const;
 
@@ -241,6 +256,8 @@ class AgentStrategy : public Strategy {
   std::vector<std::string> constraint_texts_;  // as the scenario writes them
   // Per constraint: it reads only measured metrics (no cost, no knob).
   std::vector<bool> metric_only_;
+  // Per constraint: it reads a precision metric (spec::MetricInfo).
+  std::vector<bool> reads_precision_;
   std::vector<std::vector<double>> z_;  // [sample][model]
   std::vector<int> objective_model_;    // per objective, index or -1
   std::optional<Genes> start_;

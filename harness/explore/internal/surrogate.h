@@ -86,6 +86,9 @@ class MetricModel {
   // Documented as a count: a sample is rounded to a whole number of
   // events, so that a bound such as `== 0` can hold on it.
   bool count_hint = false;
+  // Documented as a precision metric (spec::MetricInfo::precision): a knob
+  // that thins the stack's data makes it worse, not better.
+  bool precision_hint = false;
   // A time to finish, which may also be modelled as its rate (1 / time,
   // falling to zero where a computer cannot keep up); the space whose
   // leave-one-out predictions fit the runs better is used.

@@ -123,7 +123,7 @@ TEST(AgentReplayTest, OnALandscapeWithAKnobThatDoesNothing) {
 }
 
 TEST(AgentReplayTest, OnAFourDimensionalLandscape) {
-  ExpectAgentOn("landscapes/four_d", {0, 0.9, 4});
+  ExpectAgentOn("landscapes/four_d", {3, 0.97, 18});
 }
 
 }  // namespace

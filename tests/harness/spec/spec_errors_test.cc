@@ -162,8 +162,8 @@ TEST(SpecErrorsTest, AnUnknownKnobRoleNamesTheRoles) {
   std::string text = kHead;
   text.replace(text.find("range: [1, 4]"), 13, "range: [1, 4], role: core");
   ExpectError(text, "design_space.cores.role", 8,
-              "none, cores, frequency, sensor_rate (what the knob stands "
-              "for), found 'core' (did you mean 'cores'?)");
+              "none, cores, frequency, sensor_rate, downsample (what the "
+              "knob stands for), found 'core' (did you mean 'cores'?)");
 }
 
 TEST(SpecErrorsTest, ValetGoalForms) {

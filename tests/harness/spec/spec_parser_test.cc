@@ -239,7 +239,10 @@ design_space:
   hz: {bind: stack.lidar.rate_hz, values: [7, 14]}
   odo: {bind: stack.odometry.rate_hz, values: [25, 50]}
   leaf: {bind: stack.localization.voxel_leaf_m, values: [1, 2]}
+  step: {bind: stack.lidar.horizontal_resolution_deg, values: [0.2, 0.4]}
+  iterations: {bind: stack.localization.ndt_max_iterations, values: [10, 30]}
   ctrl: {bind: stack.control.rate_hz, values: [10, 30], role: frequency}
+  thin: {bind: stack.perception.min_cluster_points, values: [5, 10], role: downsample}
 )");
   auto role = [&spec](const char* name) {
     return spec.design_space.Find(name)->role;
@@ -248,9 +251,14 @@ design_space:
   EXPECT_EQ(role("freq_ghz"), KnobRole::kFrequency);
   EXPECT_EQ(role("hz"), KnobRole::kSensorRate);
   EXPECT_EQ(role("odo"), KnobRole::kSensorRate);
-  // A node's timer rate is no sensor: no role unless declared.
-  EXPECT_EQ(role("leaf"), KnobRole::kNone);
+  // A voxel or azimuth step thins the data the stack works on.
+  EXPECT_EQ(role("leaf"), KnobRole::kDownsample);
+  EXPECT_EQ(role("step"), KnobRole::kDownsample);
+  // Any other knob has no role unless declared; a node's timer rate is no
+  // sensor.
+  EXPECT_EQ(role("iterations"), KnobRole::kNone);
   EXPECT_EQ(role("ctrl"), KnobRole::kFrequency);
+  EXPECT_EQ(role("thin"), KnobRole::kDownsample);
   // Only a declared role that differs from the default is written back.
   const std::string yaml = NormalizedYaml(spec);
   EXPECT_NE(yaml.find("role: frequency"), std::string::npos) << yaml;
@@ -258,6 +266,8 @@ design_space:
   Result<Spec> again = ParseSpec(yaml, "normalized.yaml", "");
   ASSERT_TRUE(again.ok()) << again.status().message();
   EXPECT_EQ(again->design_space.Find("ctrl")->role, KnobRole::kFrequency);
+  EXPECT_EQ(again->design_space.Find("thin")->role, KnobRole::kDownsample);
+  EXPECT_EQ(again->design_space.Find("leaf")->role, KnobRole::kDownsample);
 }
 
 TEST(SpecParserTest, NetAndPolygonPathsResolveFromTheFileFolder) {
