@@ -59,6 +59,11 @@ double AgentStrategy::Cost(const Genes& genes) const {
   return cost.ok() ? *cost : kNaN;
 }
 
+const MetricModel* AgentStrategy::FittedObjectiveModel(size_t j) const {
+  const int m = objective_model_[j];
+  return m >= 0 && models_[m].fitted() ? &models_[m] : nullptr;
+}
+
 bool AgentStrategy::SampleOutcome(
     const Candidate& c, int s, std::vector<double>* objectives,
     std::map<std::string, double>* scratch) const {
@@ -73,12 +78,11 @@ bool AgentStrategy::SampleOutcome(
   objectives->resize(spec_->objectives.size());
   for (size_t j = 0; j < spec_->objectives.size(); ++j) {
     const spec::Objective& objective = spec_->objectives[j];
-    const int m = objective_model_[j];
     double v = 0.0;
     if (objective.metric == kCostMetric) {
       v = c.cost;
-    } else if (m >= 0 && models_[m].fitted()) {
-      v = models_[m].Bounded(values[objective.metric]);
+    } else if (const MetricModel* model = FittedObjectiveModel(j)) {
+      v = model->Bounded(values[objective.metric]);
     }
     (*objectives)[j] = objective.minimize ? v : -v;
   }

@@ -159,7 +159,7 @@ void AgentStrategy::Remember(const Observation& observation) {
   record.objectives = Objectives(observation);
   if (observation.censored) record.censored = CensoredAt(observation);
   record.metrics_fail = !record.failed && MetricsFail(observation, false);
-  record.load_fail = !record.failed && MetricsFail(observation, true);
+  record.load_fail = record.metrics_fail && MetricsFail(observation, true);
   records_.push_back(std::move(record));
   ++fresh_;
 }

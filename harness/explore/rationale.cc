@@ -87,8 +87,7 @@ std::string AgentStrategy::Predictions(const std::vector<double>& mean) const {
   std::vector<std::string> predicted;
   for (size_t j = 0; j < spec_->objectives.size(); ++j) {
     const spec::Objective& objective = spec_->objectives[j];
-    const int m = objective_model_[j];
-    if (objective.metric != kCostMetric && (m < 0 || !models_[m].fitted())) {
+    if (objective.metric != kCostMetric && FittedObjectiveModel(j) == nullptr) {
       // No usable run has measured it (a run that timed out speaks only
       // for the completion flag): there is no prediction to give.
       predicted.push_back(fmt::format(

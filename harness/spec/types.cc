@@ -62,11 +62,13 @@ KnobRole DefaultKnobRole(const std::string& bind) {
   const std::string prefix = "stack.";
   if (bind.compare(0, prefix.size(), prefix) == 0) {
     const KnobInfo* knob = FindStackKnob(bind.substr(prefix.size()));
-    if (knob != nullptr && knob->load == KnobInfo::Load::kSensorRate) {
-      return KnobRole::kSensorRate;
-    }
-    if (knob != nullptr && knob->load == KnobInfo::Load::kDownsample) {
-      return KnobRole::kDownsample;
+    switch (knob != nullptr ? knob->load : KnobInfo::Load::kOther) {
+      case KnobInfo::Load::kSensorRate:
+        return KnobRole::kSensorRate;
+      case KnobInfo::Load::kDownsample:
+        return KnobRole::kDownsample;
+      case KnobInfo::Load::kOther:
+        break;
     }
   }
   return KnobRole::kNone;

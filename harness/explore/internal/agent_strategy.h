@@ -193,6 +193,10 @@ class AgentStrategy : public Strategy {
   bool SampleOutcome(const Candidate& c, int s, std::vector<double>* objectives,
                      std::map<std::string, double>* scratch) const;
 
+  // Objective j's model once it has runs to learn from, else nullptr (the
+  // cost has none: it comes from the cost expression).
+  const MetricModel* FittedObjectiveModel(size_t j) const;
+
   // The expected objectives at a candidate (sample means, minimisation).
   std::vector<double> MeanObjectives(const Candidate& c) const;
 
