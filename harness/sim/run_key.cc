@@ -53,8 +53,10 @@ namespace {
 // at the contact point (its turning included); a turn in several moves
 // that fits nowhere in the lanes and junctions may use their 1 m
 // shoulders; detections within a confirmed track's box that each show
-// part of its object are joined into one box first.
-constexpr char kKeyVersion[] = "adse-run-key-v22";
+// part of its object are joined into one box first. v23: the corner rule
+// rehearses the ideal driver as it drives, on from where the car stands,
+// and a stray soon after a corner's turn joins that turn.
+constexpr char kKeyVersion[] = "adse-run-key-v23";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {
