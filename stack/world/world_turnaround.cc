@@ -167,13 +167,13 @@ std::vector<RouteTurnaround> World::Impl::SharpCorners(
     gap_from = turn.end_s_m;
   }
   gaps.emplace_back(gap_from, road.length_m());
-  // A corner turned in moves from `first` to `last` (the stray's extent),
-  // or none where it must keep its lanes or no manoeuvre fits.
-  auto corner_turn = [&](double first, double last, double from_s,
-                         double gap_end) -> std::optional<RouteTurnaround> {
+  // A corner turned in moves from start_s to end_s along the road part, or
+  // none where it must keep its lanes or no manoeuvre fits.
+  auto corner_turn = [&](double start_s,
+                         double end_s) -> std::optional<RouteTurnaround> {
     RouteTurnaround turn;
-    turn.start_s_m = std::max(from_s, first - kCornerLeadM);
-    turn.end_s_m = std::min(gap_end, last + kCornerRejoinM);
+    turn.start_s_m = start_s;
+    turn.end_s_m = end_s;
     if (std::any_of(signals.begin(), signals.end(),
                     [&](const RouteSignal& x) {
                       return x.stop_line_s_m >= turn.start_s_m &&
@@ -229,17 +229,15 @@ std::vector<RouteTurnaround> World::Impl::SharpCorners(
         // A stray soon after the corner the car has just turned makes one
         // stretch with it, as strays in one rehearsal do: one manoeuvre,
         // not two back to back.
+        const double end_s = std::min(gap_end, last + kCornerRejoinM);
         const bool joins = from_s > gap_start &&
                            first - from_s < kCornerLeadM + kCornerRejoinM;
         std::optional<RouteTurnaround> turn;
-        if (joins) {
-          const double start_s = corners.back().start_s_m;
-          turn = corner_turn(start_s + kCornerLeadM, last, start_s, gap_end);
-        }
+        if (joins) turn = corner_turn(corners.back().start_s_m, end_s);
         if (turn) {
           corners.back() = std::move(*turn);
         } else {
-          turn = corner_turn(first, last, from_s, gap_end);
+          turn = corner_turn(std::max(from_s, first - kCornerLeadM), end_s);
           if (!turn) continue;
           corners.push_back(std::move(*turn));
         }
