@@ -169,8 +169,25 @@ std::string AgentStrategy::Choose(int n, std::vector<Genes>* chosen) {
         mean_objectives[i][j] += normalised[i][s][j] / kSamples;
       }
     }
-    candidates[i].p_feasible =
-        static_cast<double>(count) / kSamples * candidates[i].runs;
+    candidates[i].p_feasible = static_cast<double>(count) / kSamples;
+  }
+  // A design with no less capacity than another (by the knobs' roles) is
+  // no less likely to meet the constraints: far from the runs, a wide
+  // prediction would otherwise make an extreme corner with a faster
+  // sensor look likelier than the same computer with a slower one.
+  std::vector<double> envelope(candidates.size());
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    envelope[i] = candidates[i].p_feasible;
+    for (size_t j = 0; j < candidates.size(); ++j) {
+      if (candidates[j].p_feasible <= envelope[i]) continue;
+      const int order =
+          CompareCapacity(knobs_, rate_raised_, candidates[i].genes,
+                          candidates[j].genes, false);
+      if (order == 0 || order == 1) envelope[i] = candidates[j].p_feasible;
+    }
+  }
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    candidates[i].p_feasible = envelope[i] * candidates[i].runs;
   }
 
   // Objective scales: the range over feasible runs and the predictions
@@ -327,7 +344,12 @@ std::string AgentStrategy::Choose(int n, std::vector<Genes>* chosen) {
         const double d2 = Distance2(c.u, Coordinates(other));
         c.score *= 1.0 - std::exp(-d2 / (2.0 * 0.05 * 0.05));
       }
-      if (best < 0 || c.score > candidates[best].score) {
+      // Likely feasible designs first (kFrontMinChance), by score.
+      const bool safe = c.p_feasible >= kFrontMinChance;
+      const bool best_safe =
+          best >= 0 && candidates[best].p_feasible >= kFrontMinChance;
+      if (best < 0 || (safe && !best_safe) ||
+          (safe == best_safe && c.score > candidates[best].score)) {
         best = static_cast<int>(i);
       }
     }

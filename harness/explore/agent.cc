@@ -580,6 +580,10 @@ void AgentStrategy::FitModels() {
     if (!model.in_constraint) {
       for (double& s : slope) s *= 0.4;
     }
+    model.signed_slopes.assign(knobs_.size(), false);
+    for (size_t d = 0; d < knobs_.size(); ++d) {
+      model.signed_slopes[d] = knobs_[d].role != KnobRole::kNone;
+    }
     model.Fit(u, values, sides, slope, lengths_);
   }
   any_failed_ = false;

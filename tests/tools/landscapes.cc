@@ -235,12 +235,108 @@ std::vector<Definition> Definitions() {
   return defs;
 }
 
+// Landscapes no strategy was tuned on: other loads, grids, costs, bounds
+// and noise, written on demand (`make_landscapes --held-out`) and never
+// committed, so that what the agent is measured on there says how it does
+// on a study it has not seen (tests/bench/agent_held_out_bench.sh).
+std::vector<Definition> HeldOutDefinitions() {
+  std::vector<Definition> defs;
+
+  Definition heavy;
+  heavy.name = "heavy";
+  heavy.about =
+      "# A heavier stack (1.4 times the reference load, a LiDAR pipeline\n"
+      "# half as heavy again) on up to 32 cores and a finer clock grid:\n"
+      "# only larger computers drive within the bound.\n";
+  heavy.design_space =
+      "  cores:    {bind: platform.cores,      range: [1, 32]}\n"
+      "  freq_ghz: {bind: platform.freq_ghz,   values: [1.0, 1.3, 1.6, 1.9, "
+      "2.2, 2.5]}\n"
+      "  lidar_hz: {bind: stack.lidar.rate_hz, values: [7, 14]}\n";
+  heavy.constraints = kReferenceConstraints;
+  heavy.model.base_load = 7.0;
+  heavy.model.lidar_load = 3.0;
+  defs.push_back(heavy);
+
+  Definition serial;
+  serial.name = "serial";
+  serial.about =
+      "# A stack with a large serial part (10 %, Amdahl): cores stop\n"
+      "# helping early, so the front leans on the clock.\n";
+  serial.design_space = kReferenceSpace;
+  serial.constraints = kReferenceConstraints;
+  serial.model.serial_fraction = 0.10;
+  serial.model.base_load = 3.5;
+  defs.push_back(serial);
+
+  Definition noisy_cut;
+  noisy_cut.name = "noisy_cut";
+  noisy_cut.about =
+      "# The reference load with 8 % noise on the nav time under a 250 s\n"
+      "# bound on the 661 m route, runs past it stopped early.\n";
+  noisy_cut.design_space = kReferenceSpace;
+  noisy_cut.constraints = "[nav_time_s <= 250, ctrl_rate_hz >= 1, completed]";
+  noisy_cut.early_stop = true;
+  noisy_cut.model.nav_noise = 0.08;
+  defs.push_back(noisy_cut);
+
+  Definition cores_price;
+  cores_price.name = "cores_price";
+  cores_price.about =
+      "# Cores priced high and the clock low (a licence per core): the\n"
+      "# front runs up the clock before it adds cores.\n";
+  cores_price.design_space = kReferenceSpace;
+  cores_price.cost = "2 * cores + 4 * freq_ghz";
+  cores_price.constraints = kReferenceConstraints;
+  defs.push_back(cores_price);
+
+  Definition slow_clock;
+  slow_clock.name = "slow_clock";
+  slow_clock.about =
+      "# A light stack whose speed is held by single-thread latency: the\n"
+      "# floor of the nav time falls with the clock, not with cores.\n";
+  slow_clock.design_space = kReferenceSpace;
+  slow_clock.constraints = "[nav_time_s <= 300, ctrl_rate_hz >= 1, completed]";
+  slow_clock.model.base_load = 3.0;
+  slow_clock.model.lidar_load = 1.5;
+  slow_clock.model.latency_ghz = 2.5;
+  defs.push_back(slow_clock);
+
+  Definition lidar_heavy;
+  lidar_heavy.name = "lidar_heavy";
+  lidar_heavy.about =
+      "# A 4-D space where the LiDAR pipeline is most of the load, so the\n"
+      "# voxel size and the scan rate matter as much as the computer.\n";
+  lidar_heavy.design_space =
+      "  cores:    {bind: platform.cores,      range: [1, 16]}\n"
+      "  freq_ghz: {bind: platform.freq_ghz,   values: [1.0, 1.5, 2.0, "
+      "2.5]}\n"
+      "  lidar_hz: {bind: stack.lidar.rate_hz, values: [5, 10, 15]}\n"
+      "  voxel_leaf_m: {bind: stack.localization.voxel_leaf_m, values: [0.5, "
+      "1, 1.5, 2, 3]}\n";
+  lidar_heavy.constraints =
+      "[nav_time_s <= 350, ctrl_rate_hz >= 1, completed, max_deviation_m <= "
+      "0.6]";
+  lidar_heavy.model.base_load = 3.0;
+  lidar_heavy.model.lidar_load = 4.0;
+  defs.push_back(lidar_heavy);
+  return defs;
+}
+
+std::vector<Definition> DefinitionsOf(LandscapeFamily family) {
+  return family == LandscapeFamily::kHeldOut ? HeldOutDefinitions()
+                                             : Definitions();
+}
+
 // The reference study's scenario with the landscape's space, cost,
 // objectives, constraints, timeout and early stop: complete, so that adse
 // validates and could run it.
-std::string ScenarioText(const Definition& d) {
+std::string ScenarioText(const Definition& d, LandscapeFamily family) {
+  const std::string where = family == LandscapeFamily::kHeldOut
+                                ? "held out, never committed"
+                                : "tests/data/landscapes/" + d.name;
   return fmt::format(
-      R"(# Synthetic landscape '{name}' (tests/data/landscapes/{name}), written by
+      R"(# Synthetic landscape '{name}' ({where}), written by
 # make_landscapes (tests/tools/landscapes.cc): its rows come from a
 # closed-form model of the stack on the reference study's route, not from
 # simulation.
@@ -273,9 +369,10 @@ exploration: {{strategy: agent, budget: 15, batch: 1, seed: 1}}
 harness: {{early_stop: {early_stop}}}
 output: results/landscape-{name}
 )",
-      fmt::arg("name", d.name), fmt::arg("about", d.about),
-      fmt::arg("timeout", d.timeout_s), fmt::arg("space", d.design_space),
-      fmt::arg("cost", d.cost), fmt::arg("objectives", d.objectives),
+      fmt::arg("name", d.name), fmt::arg("where", where),
+      fmt::arg("about", d.about), fmt::arg("timeout", d.timeout_s),
+      fmt::arg("space", d.design_space), fmt::arg("cost", d.cost),
+      fmt::arg("objectives", d.objectives),
       fmt::arg("constraints", d.constraints),
       fmt::arg("early_stop", d.early_stop ? "true" : "false"));
 }
@@ -377,18 +474,16 @@ Result<runfile::EvaluationRow> Row(const Definition& d, const spec::Spec& spec,
 
 }  // namespace
 
-const std::vector<std::string>& LandscapeNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> out;
-    for (const Definition& d : Definitions()) out.push_back(d.name);
-    return out;
-  }();
-  return names;
+std::vector<std::string> LandscapeNames(LandscapeFamily family) {
+  std::vector<std::string> out;
+  for (const Definition& d : DefinitionsOf(family)) out.push_back(d.name);
+  return out;
 }
 
-Result<runfile::CampaignIndex> BuildLandscape(const std::string& name) {
+Result<runfile::CampaignIndex> BuildLandscape(const std::string& name,
+                                              LandscapeFamily family) {
   std::optional<Definition> found;
-  for (const Definition& d : Definitions()) {
+  for (const Definition& d : DefinitionsOf(family)) {
     if (d.name == name) found = d;
   }
   if (!found) {
@@ -396,7 +491,7 @@ Result<runfile::CampaignIndex> BuildLandscape(const std::string& name) {
   }
   const Definition& d = *found;
   runfile::CampaignIndex index;
-  index.scenario_text = ScenarioText(d);
+  index.scenario_text = ScenarioText(d, family);
   spec::ParseOptions parse;
   parse.check_files = false;  // as replay reads it
   Result<spec::Spec> spec =
@@ -433,9 +528,9 @@ Result<runfile::CampaignIndex> BuildLandscape(const std::string& name) {
   return index;
 }
 
-Status WriteLandscapes(const std::string& out_dir) {
-  for (const std::string& name : LandscapeNames()) {
-    Result<runfile::CampaignIndex> index = BuildLandscape(name);
+Status WriteLandscapes(const std::string& out_dir, LandscapeFamily family) {
+  for (const std::string& name : LandscapeNames(family)) {
+    Result<runfile::CampaignIndex> index = BuildLandscape(name, family);
     if (!index.ok()) return index.status();
     const std::string folder = out_dir + "/" + name;
     std::error_code ec;

@@ -18,20 +18,30 @@
 
 namespace adse::landscapes {
 
-// Every landscape's name, in the order WriteLandscapes writes them; each is
-// also its folder under tests/data/landscapes.
-const std::vector<std::string>& LandscapeNames();
+// The landscapes committed under tests/data/landscapes, which tests and
+// the README measure the strategies on, or a held-out family with other
+// loads, grids, costs and bounds that no strategy was tuned on, written
+// on demand and never committed.
+enum class LandscapeFamily { kCommitted, kHeldOut };
+
+// Every landscape's name in a family, in the order WriteLandscapes writes
+// them; each committed one is also its folder under tests/data/landscapes.
+std::vector<std::string> LandscapeNames(
+    LandscapeFamily family = LandscapeFamily::kCommitted);
 
 // One landscape's index: its scenario text and one row per design point in
 // lexicographic order (first parameter slowest), as an exhaustive campaign
 // of that scenario would hold them. InvalidArgument for an unknown name;
 // any other error is a bug in the landscape's definition (its scenario does
 // not parse, a constraint does not evaluate).
-Result<runfile::CampaignIndex> BuildLandscape(const std::string& name);
+Result<runfile::CampaignIndex> BuildLandscape(
+    const std::string& name,
+    LandscapeFamily family = LandscapeFamily::kCommitted);
 
-// Writes <out_dir>/<name>/campaign.h5 for every landscape, creating the
-// folders.
-Status WriteLandscapes(const std::string& out_dir);
+// Writes <out_dir>/<name>/campaign.h5 for every landscape of the family,
+// creating the folders.
+Status WriteLandscapes(const std::string& out_dir,
+                       LandscapeFamily family = LandscapeFamily::kCommitted);
 
 }  // namespace adse::landscapes
 

@@ -111,6 +111,9 @@ TEST(MakeLandscapesTest, TheCommittedLandscapesAreWhatTheGeneratorWrites) {
 
 TEST(MakeLandscapesTest, AnUnknownLandscapeIsAnError) {
   EXPECT_FALSE(BuildLandscape("everest").ok());
+  // Each family knows only its own.
+  EXPECT_FALSE(BuildLandscape("heavy", LandscapeFamily::kCommitted).ok());
+  EXPECT_FALSE(BuildLandscape("four_d", LandscapeFamily::kHeldOut).ok());
 }
 
 // The share of feasible points each landscape is built for.
@@ -305,6 +308,36 @@ TEST(MakeLandscapesTest, FourDimensionsWhereTheBestVoxelDependsOnTheComputer) {
                     RowMetric(row, "max_deviation_m") > 0.6;
   }
   EXPECT_GT(by_deviation, 0);
+}
+
+TEST(MakeLandscapesTest,
+     TheHeldOutFamilyIsAnotherSetOfStudiesThatWriteAndReplay) {
+  const std::vector<std::string> committed = LandscapeNames();
+  const std::vector<std::string> held_out =
+      LandscapeNames(LandscapeFamily::kHeldOut);
+  ASSERT_GE(held_out.size(), 6u);
+  const std::string dir = adse::testing::TestTempDir("held-out-landscapes");
+  const Status written = WriteLandscapes(dir, LandscapeFamily::kHeldOut);
+  ASSERT_TRUE(written.ok()) << written.message();
+  for (const std::string& name : held_out) {
+    SCOPED_TRACE(name);
+    EXPECT_EQ(std::count(committed.begin(), committed.end(), name), 0);
+    Result<campaign::Recording> recording =
+        campaign::LoadRecording(dir + "/" + name);
+    ASSERT_TRUE(recording.ok()) << recording.status().message();
+    Result<runfile::CampaignIndex> index =
+        runfile::ReadCampaignIndex(dir + "/" + name + "/campaign.h5");
+    ASSERT_TRUE(index.ok()) << index.status().message();
+    EXPECT_NE(index->scenario_text.find("held out"), std::string::npos);
+    int feasible = 0;
+    for (const EvaluationRow& row : recording->rows) feasible += row.feasible;
+    // Neither trivial nor hopeless: a strategy has a front to find.
+    const double share = static_cast<double>(feasible) / recording->rows.size();
+    EXPECT_GT(share, 0.3);
+    EXPECT_LT(share, 0.95);
+    EXPECT_GE(FeasibleFront(*recording).size(), 3u);
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -328,13 +328,14 @@ void MetricModel::FitIn(const std::vector<std::vector<double>>& u,
   if (space_ != MetricSpace::kBoolean && direction != 0) {
     preferred = direction < 0 ? TrendShape::kFloor : TrendShape::kCeiling;
   }
-  trend_ = FitTrend(preferred, u, t, sided, mu, slope_sd, sigma);
+  trend_ = FitTrend(preferred, u, t, sided, mu, signed_slopes, slope_sd, sigma);
   if (space_ != MetricSpace::kBoolean && values.size() >= dims + 3) {
     const double penalty = 0.5 * std::log(static_cast<double>(values.size()));
     for (TrendShape shape :
          {TrendShape::kLinear, TrendShape::kFloor, TrendShape::kCeiling}) {
       if (shape == preferred) continue;
-      Trend other = FitTrend(shape, u, t, sided, mu, slope_sd, sigma);
+      Trend other =
+          FitTrend(shape, u, t, sided, mu, signed_slopes, slope_sd, sigma);
       const double extra = shape == TrendShape::kLinear ? 0.0 : penalty;
       const double mine = trend_.shape == TrendShape::kLinear ? 0.0 : penalty;
       if (other.cost + extra < trend_.cost + mine) trend_ = other;
@@ -442,8 +443,9 @@ Trend MetricModel::FitTrend(TrendShape shape,
                             const std::vector<std::vector<double>>& u,
                             const std::vector<double>& t,
                             const std::vector<int>& sides,
-                            const std::vector<double>& mu, double slope_sd,
-                            double sigma) {
+                            const std::vector<double>& mu,
+                            const std::vector<bool>& signed_slopes,
+                            double slope_sd, double sigma) {
   const size_t dims = mu.size();
   Trend trend;
   trend.shape = shape;
@@ -485,6 +487,14 @@ Trend MetricModel::FitTrend(TrendShape shape,
   for (size_t i = 0; i < dims; ++i) slope_b(i) = mu[i];
   problem.AddResidualBlock(new ceres::NormalPrior(slope_a, slope_b), nullptr,
                            trend.b.data());
+  for (size_t i = 0; i < dims && i < signed_slopes.size(); ++i) {
+    if (!signed_slopes[i] || mu[i] == 0.0) continue;
+    if (mu[i] > 0.0) {
+      problem.SetParameterLowerBound(trend.b.data(), static_cast<int>(i), 0.0);
+    } else {
+      problem.SetParameterUpperBound(trend.b.data(), static_cast<int>(i), 0.0);
+    }
+  }
   if (shape != TrendShape::kLinear) {
     Eigen::MatrixXd fa = Eigen::MatrixXd::Identity(1, 1) / kSaturationSd;
     Eigen::VectorXd fb(1);

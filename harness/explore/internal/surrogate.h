@@ -93,6 +93,13 @@ class MetricModel {
   // falling to zero where a computer cannot keep up); the space whose
   // leave-one-out predictions fit the runs better is used.
   bool rate_hint = false;
+  // Per knob (may be empty: none): the prior slope's sign is certain, as
+  // a knob's role says which way it moves the metric (more cores never
+  // slow the stack, a faster sensor never lightens it), so the trend's
+  // slope is bounded to that side of zero. Without it a few runs that
+  // change several knobs at once can credit one knob with another's
+  // effect.
+  std::vector<bool> signed_slopes;
 
   bool fitted() const { return fitted_; }
   int points() const { return points_; }
@@ -138,7 +145,8 @@ class MetricModel {
                         const std::vector<std::vector<double>>& u,
                         const std::vector<double>& t,
                         const std::vector<int>& sides,
-                        const std::vector<double>& mu, double slope_sd,
+                        const std::vector<double>& mu,
+                        const std::vector<bool>& signed_slopes, double slope_sd,
                         double sigma);
 
   bool fitted_ = false;

@@ -52,6 +52,31 @@ TEST(SurrogateTest, RunsStoppedPastABoundArePredictedPastIt) {
   EXPECT_LT(Predicted(only, 1.0), Predicted(only, 0.1));
 }
 
+TEST(SurrogateTest, AKnobWhoseRoleFixesItsDirectionIsNotCreditedTheOther) {
+  // Two knobs: capacity (u0, helps) and a sensor rate (u1, a load). A slow
+  // first run with little capacity and the slow sensor, then two fast ones
+  // with much capacity and the fast sensor: the runs alone cannot tell the
+  // knobs apart, and a free trend credits part of the speed-up to the
+  // faster sensor. Its role says a faster sensor never lightens the stack.
+  const std::vector<std::vector<double>> u = {
+      {0.2, 0.0}, {1.0, 1.0}, {0.9, 1.0}};
+  const std::vector<double> nav = {800, 130, 150};
+  auto at = [](const MetricModel& model, std::vector<double> point) {
+    double mean = 0.0, sd = 0.0;
+    model.Predict(point, &mean, &sd);
+    return model.ToMetric(mean);
+  };
+  MetricModel model = NavTimeModel();
+  model.signed_slopes = {true, true};
+  model.Fit(u, nav, {}, {1.0, -0.35}, {0.25, 1.0});
+  ASSERT_TRUE(model.fitted());
+  // The same computer with the slower sensor is no slower, to within what
+  // the residual GP bends (its kernels are free: 5.5 % here), where a free
+  // trend makes it 30 % slower.
+  EXPECT_LE(at(model, {1.0, 0.0}), 1.1 * at(model, {1.0, 1.0}));
+  EXPECT_NEAR(at(model, {1.0, 1.0}), 130, 15);
+}
+
 TEST(SurrogateTest, ATimeThatBlowsUpWhereCapacityRunsOutIsModelledAsARate) {
   // 12 runs of a stack that needs capacity 0.2: the time is the route's
   // 100 s over the share of capacity left, which no trend in log time
