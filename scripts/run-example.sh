@@ -18,5 +18,5 @@ echo "== adse world $scenario --follow-ideal"
 build/bin/adse world "$scenario" --follow-ideal
 echo "== adse run $scenario"
 build/bin/adse run "$scenario"
-echo "== adse analyze results/robotaxi-parking-lot/runs (offline re-analysis)"
-build/bin/adse analyze results/robotaxi-parking-lot/runs | tail -n 2
+echo "== adse analyze results/robotaxi-parking-lot (offline re-analysis)"
+build/bin/adse analyze results/robotaxi-parking-lot | tail -n 2

@@ -172,6 +172,26 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
   return 0;
 }
 
+// A campaign's runs/ folder stands for its campaign: analyses live in
+// <campaign>/analysis, never among the run files. Any other folder is
+// itself.
+std::string CampaignOfRunsFolder(const std::string& target) {
+  std::error_code ec;
+  fs::path path = fs::absolute(target, ec).lexically_normal();
+  if (ec) return target;
+  if (path.filename().empty()) path = path.parent_path();
+  const fs::path campaign = path.parent_path();
+  if (path.filename() != "runs" || !fs::exists(campaign / "campaign.h5", ec)) {
+    return target;
+  }
+  std::fprintf(stderr,
+               "%s: the run files of the campaign %s, which is analysed "
+               "(into %s)\n",
+               target.c_str(), campaign.c_str(),
+               (campaign / "analysis").c_str());
+  return campaign.string();
+}
+
 // A folder: a campaign (its campaign.h5 names the runs and holds the
 // scenario) or loose run files of one scenario. Every run is analysed
 // again and the answer views are written by the code adse run uses, into
@@ -435,7 +455,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
     if (fs::is_directory(target, ec)) {
       exit_code =
           std::max(exit_code,
-                   AnalyzeFolder(target, options,
+                   AnalyzeFolder(CampaignOfRunsFolder(target), options,
                                  reference ? &*reference : nullptr, args.json));
       continue;
     }

@@ -652,6 +652,13 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
   EXPECT_EQ(diff.exit_code, 0) << diff.out;
   EXPECT_NE(diff.out.find("of 7 points changed"), std::string::npos)
       << diff.out;
+  // Its runs/ folder stands for the campaign: the same answer, written
+  // beside the others, nothing among the run files.
+  const CommandRun runs = Adse("analyze " + (out / "runs").string() + "/");
+  ASSERT_EQ(runs.exit_code, 0) << runs.out;
+  EXPECT_EQ(FrontSection(runs.out), FrontSection(run.out)) << runs.out;
+  EXPECT_TRUE(fs::exists(out / "analysis" / "v3" / "report.md"));
+  EXPECT_FALSE(fs::exists(out / "runs" / "analysis"));
 }
 
 TEST(CliRunTest, AnalyzeOfACampaignWithCasesFoldsEveryCaseAsRunDid) {
