@@ -580,9 +580,14 @@ void AgentStrategy::FitModels() {
     if (!model.in_constraint) {
       for (double& s : slope) s *= 0.4;
     }
+    // Capacity and load have a sure direction; a downsampling step does
+    // not: coarser data sheds load but localizes loosely, which can slow
+    // the car (the voxel size's best value depends on the computer).
     model.signed_slopes.assign(knobs_.size(), false);
     for (size_t d = 0; d < knobs_.size(); ++d) {
-      model.signed_slopes[d] = knobs_[d].role != KnobRole::kNone;
+      model.signed_slopes[d] = knobs_[d].role == KnobRole::kCores ||
+                               knobs_[d].role == KnobRole::kFrequency ||
+                               knobs_[d].role == KnobRole::kSensorRate;
     }
     model.Fit(u, values, sides, slope, lengths_);
   }
