@@ -338,7 +338,7 @@ TEST(CliRunTest, ExploreReplayPrintsADistributionPerStrategy) {
       << run.out;
   // The recording's own answer leads, from the same front as adse run's:
   // the true cheapest feasible design of the 280-point space.
-  EXPECT_NE(run.out.find("cheapest feasible   cores=5,freq_ghz=1.8,lidar_hz=7"
+  EXPECT_NE(run.out.find("cheapest feasible   cores=6,freq_ghz=1.5,lidar_hz=7"
                          "  cost 9,"),
             std::string::npos)
       << run.out;
