@@ -294,6 +294,25 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
       taken.emplace_back(x0 - w, y0 + marker, 2 * w, y1 - y0 - 2 * marker);
     }
   }
+  // The other designs' markers: a label goes over one (on white, hiding
+  // it) only when no place around its point is clear of them.
+  std::vector<cv::Rect> others;
+  for (const auto* p : shown) {
+    if (p->on_front) continue;
+    const cv::Point2d c = px(p->cost, clipped(p) ? ay.max : p->nav_time_s);
+    others.emplace_back(static_cast<int>(c.x) - radius - s.Px(2),
+                        static_cast<int>(c.y) - radius - s.Px(2),
+                        2 * (radius + s.Px(2)), 2 * (radius + s.Px(2)));
+  }
+  auto clear_of = [](const cv::Rect& box, const std::vector<cv::Rect>& rects,
+                     const cv::Rect& own_point) {
+    for (const cv::Rect& r : rects) {
+      // A point's own marker box is not in the way of its own label.
+      if ((r & own_point).area() > 0) continue;
+      if ((box & r).area() > 0) return false;
+    }
+    return true;
+  };
   size_t omitted = 0;
   for (const auto* p : front) {
     if (p->label.empty()) continue;
@@ -313,25 +332,23 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
                                     {cx - gap - size.width, cy + gap},
                                     {cx - size.width / 2, cy - gap - h},
                                     {cx - size.width / 2, cy + gap}};
+    const cv::Rect own_point(cx, cy, 1, 1);
     bool placed = false;
-    for (const cv::Point& corner : candidates) {
-      const cv::Rect box(corner.x - s.Px(2), corner.y - s.Px(1),
-                         size.width + s.Px(4), h + s.Px(2));
-      if ((box & area) != box) continue;
-      bool clear = true;
-      for (size_t k = 0; k < taken.size() && clear; ++k) {
-        // A point's own marker box is not in the way of its own label.
-        const bool own = (taken[k] & cv::Rect(cx, cy, 1, 1)).area() > 0;
-        clear = own || (box & taken[k]).area() == 0;
+    for (int pass = 0; pass < 2 && !placed; ++pass) {
+      for (const cv::Point& corner : candidates) {
+        const cv::Rect box(corner.x - s.Px(2), corner.y - s.Px(1),
+                           size.width + s.Px(4), h + s.Px(2));
+        if ((box & area) != box) continue;
+        if (!clear_of(box, taken, own_point)) continue;
+        if (pass == 0 && !clear_of(box, others, own_point)) continue;
+        // On white, so the dots of other designs under it do not garble it.
+        cv::rectangle(img, box, kWhite, cv::FILLED);
+        DrawText(&img, label, corner.x, corner.y + size.height, Align::kLeft, s,
+                 kDarkGrey, false);
+        taken.push_back(box);
+        placed = true;
+        break;
       }
-      if (!clear) continue;
-      // On white, so the dots of other designs under it do not garble it.
-      cv::rectangle(img, box, kWhite, cv::FILLED);
-      DrawText(&img, label, corner.x, corner.y + size.height, Align::kLeft, s,
-               kDarkGrey, false);
-      taken.push_back(box);
-      placed = true;
-      break;
     }
     if (!placed) ++omitted;
   }

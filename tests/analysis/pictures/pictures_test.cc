@@ -526,6 +526,24 @@ TEST_F(PictureTest, ParetoPlotKeepsTheFrontReadableBelowFarOutliers) {
   EXPECT_GT(CountColour(*img, kInfeasibleRgb), 5);
 }
 
+TEST_F(PictureTest, AFrontLabelGoesWhereItHidesNoOtherDesign) {
+  // A dominated design just above and right of a front point, where that
+  // point's label would go (its right is the staircase's): the label takes
+  // another place, and every pixel of the design's dot stays in sight.
+  std::vector<ParetoPlotPoint> points = {{5, 100, true, true, "5/1.5/7"},
+                                         {5.3, 103, true, false, ""},
+                                         {10, 50, true, true, "10/2.1/7"}};
+  ASSERT_TRUE(RenderParetoPlot(points, Path("labelled.png")).ok());
+  for (ParetoPlotPoint& p : points) p.label.clear();
+  ASSERT_TRUE(RenderParetoPlot(points, Path("unlabelled.png")).ok());
+  Result<RgbImage> labelled = ReadImage(Path("labelled.png"));
+  Result<RgbImage> unlabelled = ReadImage(Path("unlabelled.png"));
+  ASSERT_TRUE(labelled.ok() && unlabelled.ok());
+  EXPECT_GT(CountColour(*unlabelled, kFeasibleRgb), 40);
+  EXPECT_EQ(CountColour(*labelled, kFeasibleRgb),
+            CountColour(*unlabelled, kFeasibleRgb));
+}
+
 TEST_F(PictureTest, ParetoPlotEdgeCases) {
   // One point; equal values; non-finite points left out with a note.
   EXPECT_TRUE(
