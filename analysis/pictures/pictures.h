@@ -143,10 +143,11 @@ struct ParetoPlotOptions {
 // the front drawn as a staircase in x order (a min-min front promises
 // nothing between its points), highlighted points ringed, constraint lines
 // dashed, linear axes with ticks and labels, a legend, and the title. Front
-// labels are placed where they overlap nothing; a label without room is
-// left out and counted in a note, as are points with a non-finite
-// coordinate. InvalidArgument for bad options or no finite point; written
-// like RenderTrajectoryImage.
+// labels never overlap one another, the legend or the front, and hide
+// another design's marker only where no place around their point is free
+// of one; a label without room is left out and counted in a note, as are
+// points with a non-finite coordinate. InvalidArgument for bad options or no
+// finite point; written like RenderTrajectoryImage.
 Status RenderParetoPlot(const std::vector<ParetoPlotPoint>& points,
                         const std::string& png_path,
                         const ParetoPlotOptions& o = {});
