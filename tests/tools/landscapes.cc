@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <numeric>
 #include <optional>
 #include <set>
 #include <string>
@@ -13,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "analysis/metrics/run_metrics.h"
+#include "harness/campaign/evaluation.h"
 #include "harness/sim/early_stop.h"
 #include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
@@ -417,8 +419,11 @@ Result<std::optional<std::string>> EarlyStopped(const spec::Spec& spec,
   return std::optional<std::string>();
 }
 
+// One point's row, its noise (if the landscape has any) drawn from
+// `noise_seed`: kNoiseSeed for the landscape as written.
 Result<runfile::EvaluationRow> Row(const Definition& d, const spec::Spec& spec,
-                                   const spec::DesignPoint& point) {
+                                   const spec::DesignPoint& point,
+                                   uint64_t noise_seed) {
   Result<spec::PointConfig> config = spec::ApplyPoint(spec, point);
   if (!config.ok()) return config.status();
   Result<double> cost = spec::EvaluateCost(spec, point);
@@ -427,7 +432,7 @@ Result<runfile::EvaluationRow> Row(const Definition& d, const spec::Spec& spec,
 
   double noise_factor = 1.0;
   if (d.model.nav_noise > 0) {
-    Random random(Random::DeriveSeed(kNoiseSeed, d.name + "/" + where));
+    Random random(Random::DeriveSeed(noise_seed, d.name + "/" + where));
     noise_factor = std::exp(random.Normal(0.0, d.model.nav_noise));
   }
   const Drive drive = DriveModel(d.model, spec, *config, noise_factor);
@@ -472,6 +477,39 @@ Result<runfile::EvaluationRow> Row(const Definition& d, const spec::Spec& spec,
   return row;
 }
 
+Result<Definition> FindDefinition(const std::string& name,
+                                  LandscapeFamily family) {
+  for (const Definition& d : DefinitionsOf(family)) {
+    if (d.name == name) return d;
+  }
+  return Status::InvalidArgument("unknown landscape '" + name + "'");
+}
+
+Result<spec::Spec> ParseLandscape(const Definition& d, LandscapeFamily family) {
+  spec::ParseOptions parse;
+  parse.check_files = false;  // as replay reads it
+  return spec::ParseSpec(ScenarioText(d, family), d.name + ".yaml", "", parse);
+}
+
+// Every point's row in the exhaustive strategy's order, the noise drawn
+// from `noise_seed`.
+Result<std::vector<runfile::EvaluationRow>> Rows(const Definition& d,
+                                                 const spec::Spec& spec,
+                                                 uint64_t noise_seed) {
+  std::vector<runfile::EvaluationRow> rows;
+  for (const spec::DesignPoint& point : Grid(spec.design_space)) {
+    Result<runfile::EvaluationRow> row = Row(d, spec, point, noise_seed);
+    if (!row.ok()) {
+      return row.status().WithContext(
+          d.name + " at " + spec::FormatPoint(spec.design_space, point));
+    }
+    row->index = static_cast<int64_t>(rows.size());
+    row->iteration = row->index;
+    rows.push_back(std::move(row).value());
+  }
+  return rows;
+}
+
 }  // namespace
 
 std::vector<std::string> LandscapeNames(LandscapeFamily family) {
@@ -482,50 +520,95 @@ std::vector<std::string> LandscapeNames(LandscapeFamily family) {
 
 Result<runfile::CampaignIndex> BuildLandscape(const std::string& name,
                                               LandscapeFamily family) {
-  std::optional<Definition> found;
-  for (const Definition& d : DefinitionsOf(family)) {
-    if (d.name == name) found = d;
-  }
-  if (!found) {
-    return Status::InvalidArgument("unknown landscape '" + name + "'");
-  }
-  const Definition& d = *found;
-  runfile::CampaignIndex index;
-  index.scenario_text = ScenarioText(d, family);
-  spec::ParseOptions parse;
-  parse.check_files = false;  // as replay reads it
-  Result<spec::Spec> spec =
-      spec::ParseSpec(index.scenario_text, d.name + ".yaml", "", parse);
+  Result<Definition> d = FindDefinition(name, family);
+  if (!d.ok()) return d.status();
+  Result<spec::Spec> spec = ParseLandscape(*d, family);
   if (!spec.ok()) return spec.status();
+  Result<std::vector<runfile::EvaluationRow>> rows =
+      Rows(*d, *spec, kNoiseSeed);
+  if (!rows.ok()) return rows.status();
 
+  runfile::CampaignIndex index;
+  index.scenario_text = ScenarioText(*d, family);
   index.scenario_name = spec->name;
   index.strategy = "exhaustive";
   index.exploration_seed = spec->exploration.seed;
   index.isolation = "none: a synthetic landscape, nothing was simulated";
   index.adse_version = ADSE_VERSION;
   index.parameters = spec->design_space.Names();
+  index.budget = static_cast<int64_t>(rows->size());
   std::set<std::string> metrics;
-  const std::vector<spec::DesignPoint> grid = Grid(spec->design_space);
-  index.budget = static_cast<int64_t>(grid.size());
-  for (const spec::DesignPoint& point : grid) {
-    Result<runfile::EvaluationRow> row = Row(d, *spec, point);
-    if (!row.ok()) {
-      return row.status().WithContext(
-          d.name + " at " + spec::FormatPoint(spec->design_space, point));
-    }
-    row->index = static_cast<int64_t>(index.evaluations.size());
-    row->iteration = row->index;
-    for (const auto& [metric, value] : row->metrics) metrics.insert(metric);
+  for (const runfile::EvaluationRow& row : *rows) {
+    for (const auto& [metric, value] : row.metrics) metrics.insert(metric);
     index.iterations.push_back(
-        {row->iteration,
+        {row.iteration,
          "exhaustive",
          fmt::format("exhaustive: points {0}-{0} in lexicographic order of {1}",
-                     row->index + 1, grid.size()),
-         {row->content_key}});
-    index.evaluations.push_back(std::move(row).value());
+                     row.index + 1, rows->size()),
+         {row.content_key}});
   }
+  index.evaluations = std::move(rows).value();
   index.metrics.assign(metrics.begin(), metrics.end());
   return index;
+}
+
+Result<NoiseLimit> ComputeNoiseLimit(const std::string& name, int budget,
+                                     int draws, LandscapeFamily family) {
+  if (budget < 1) return Status::InvalidArgument("budget must be at least 1");
+  if (draws < 1) return Status::InvalidArgument("draws must be at least 1");
+  Result<Definition> d = FindDefinition(name, family);
+  if (!d.ok()) return d.status();
+  Result<spec::Spec> spec = ParseLandscape(*d, family);
+  if (!spec.ok()) return spec.status();
+  Result<std::vector<runfile::EvaluationRow>> committed =
+      Rows(*d, *spec, kNoiseSeed);
+  if (!committed.ok()) return committed.status();
+  const size_t n = committed->size();
+  std::vector<std::vector<runfile::EvaluationRow>> redrawn;
+  for (int k = 0; k < draws; ++k) {
+    Result<std::vector<runfile::EvaluationRow>> rows = Rows(
+        *d, *spec, Random::DeriveSeed(kNoiseSeed, fmt::format("redraw {}", k)));
+    if (!rows.ok()) return rows.status();
+    redrawn.push_back(std::move(rows).value());
+  }
+  // Per point, in how many redraws it is on the front, with the points in
+  // `seen` at their committed values.
+  auto on_front = [&](const std::vector<bool>& seen) {
+    std::vector<int> count(n, 0);
+    for (std::vector<runfile::EvaluationRow> rows : redrawn) {
+      for (size_t i = 0; i < n; ++i) {
+        if (seen[i]) rows[i] = (*committed)[i];
+      }
+      for (int i : campaign::ParetoFrontOf(*spec, rows)) ++count[i];
+    }
+    return count;
+  };
+
+  NoiseLimit limit;
+  const std::vector<int> truth = campaign::ParetoFrontOf(*spec, *committed);
+  limit.front_size = static_cast<int>(truth.size());
+  std::vector<int> count = on_front(std::vector<bool>(n, false));
+  limit.mean_front_size =
+      std::accumulate(count.begin(), count.end(), 0.0) / draws;
+  std::sort(count.rbegin(), count.rend());
+  for (size_t i = 0; i < n && i < static_cast<size_t>(budget); ++i) {
+    limit.best_fixed_expected += static_cast<double>(count[i]) / draws;
+  }
+  std::vector<bool> seen(n, false);
+  for (int pick = 0; pick < budget && pick < static_cast<int>(n); ++pick) {
+    const std::vector<int> chance = on_front(seen);
+    int best = -1;
+    for (size_t i = 0; i < n; ++i) {
+      if (!seen[i] && (best < 0 || chance[i] > chance[best])) {
+        best = static_cast<int>(i);
+      }
+    }
+    seen[best] = true;
+    if (std::find(truth.begin(), truth.end(), best) != truth.end()) {
+      ++limit.greedy_found;
+    }
+  }
+  return limit;
 }
 
 Status WriteLandscapes(const std::string& out_dir, LandscapeFamily family) {

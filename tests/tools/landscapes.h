@@ -43,6 +43,31 @@ Result<runfile::CampaignIndex> BuildLandscape(
 Status WriteLandscapes(const std::string& out_dir,
                        LandscapeFamily family = LandscapeFamily::kCommitted);
 
+// What a noisy landscape lets a search expect at a budget, whatever its
+// strategy. The landscape is rebuilt `draws` times from the same model
+// with fresh noise; a point's chance of being on the true front is the
+// share of redraws in which it is.
+struct NoiseLimit {
+  // True Pareto points of the landscape as written, and on average over
+  // the redraws.
+  int front_size = 0;
+  double mean_front_size = 0.0;
+  // The most true Pareto points `budget` points chosen in advance can
+  // expect: the sum of the `budget` largest chances.
+  double best_fixed_expected = 0.0;
+  // True Pareto points of the landscape as written found by a greedy
+  // oracle that knows the model and the law of its noise, and sees what
+  // each of its points measured: each pick is the point most often on the
+  // front over the redraws, with the points already picked held at their
+  // values.
+  int greedy_found = 0;
+};
+
+// InvalidArgument for an unknown name or a budget or draws below 1.
+Result<NoiseLimit> ComputeNoiseLimit(
+    const std::string& name, int budget, int draws,
+    LandscapeFamily family = LandscapeFamily::kCommitted);
+
 }  // namespace adse::landscapes
 
 #endif  // ADSE_TESTS_TOOLS_LANDSCAPES_H_

@@ -340,5 +340,42 @@ TEST(MakeLandscapesTest,
   std::filesystem::remove_all(dir);
 }
 
+// The target of 8 true Pareto points at budget 15 asks more of
+// `noisy` than its noise lets any search expect: the README says so with
+// these numbers.
+TEST(NoiseLimitTest, NoSearchCanExpectEightOfTheNoisyFrontWithinFifteenRuns) {
+  Result<NoiseLimit> limit = ComputeNoiseLimit("noisy", 15, 50);
+  ASSERT_TRUE(limit.ok()) << limit.status().message();
+  EXPECT_EQ(limit->front_size, 9);
+  EXPECT_NEAR(limit->mean_front_size, 9.0, 1.0);
+  EXPECT_GT(limit->best_fixed_expected, 5.0);
+  EXPECT_LT(limit->best_fixed_expected, 7.5);
+  EXPECT_GE(limit->greedy_found, 4);
+  EXPECT_LT(limit->greedy_found, 8);
+}
+
+TEST(NoiseLimitTest, WithoutNoiseTheOracleFindsTheWholeFront) {
+  Result<NoiseLimit> limit = ComputeNoiseLimit("constraint_cut", 15, 2);
+  ASSERT_TRUE(limit.ok()) << limit.status().message();
+  EXPECT_EQ(limit->front_size, 9);
+  EXPECT_DOUBLE_EQ(limit->mean_front_size, 9.0);
+  EXPECT_DOUBLE_EQ(limit->best_fixed_expected, 9.0);
+  EXPECT_EQ(limit->greedy_found, 9);
+  // A budget smaller than the front: every run on it.
+  Result<NoiseLimit> short_budget = ComputeNoiseLimit("constraint_cut", 4, 2);
+  ASSERT_TRUE(short_budget.ok()) << short_budget.status().message();
+  EXPECT_DOUBLE_EQ(short_budget->best_fixed_expected, 4.0);
+  EXPECT_EQ(short_budget->greedy_found, 4);
+}
+
+TEST(NoiseLimitTest, AnUnknownLandscapeOrAnEmptyBudgetIsAnError) {
+  EXPECT_EQ(ComputeNoiseLimit("nope", 15, 10).status().code(),
+            Status::Code::kInvalidArgument);
+  EXPECT_EQ(ComputeNoiseLimit("noisy", 0, 10).status().code(),
+            Status::Code::kInvalidArgument);
+  EXPECT_EQ(ComputeNoiseLimit("noisy", 15, 0).status().code(),
+            Status::Code::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace adse::landscapes
