@@ -85,8 +85,8 @@ std::string ReplicaSection(const spec::Spec& spec,
     if (!replicated(row)) continue;
     md << "| " << row.index << " | "
        << spec::FormatPoint(spec.design_space, row.point) << " | "
-       << (row.unstable ? "**" + ReplicaSummary(row) + "**"
-                        : ReplicaSummary(row));
+       << (row.unstable ? "**" + ReplicaSummary(spec, row) + "**"
+                        : ReplicaSummary(spec, row));
     for (const std::string& c : columns) {
       std::optional<MetricSpread> m = SpreadOf(spec, row, c);
       md << " | "
@@ -374,7 +374,7 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
         Number(RowMetric(row, "deviation_score")),
         row.replicas.size() > 1
             ? fmt::format("{} ({})", row.feasible ? "yes" : "no",
-                          ReplicaSummary(row))
+                          ReplicaSummary(spec, row))
             : std::string(row.feasible ? "yes" : "no"));
   }
 

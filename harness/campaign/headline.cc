@@ -68,14 +68,14 @@ std::string Facts(const spec::Spec& spec,
     if (per_case > 1) {
       sureness += fmt::format(", each the median of {} runs", per_case);
     }
-    if (row.unstable) sureness += ", " + ReplicaSummary(row);
+    if (row.unstable) sureness += ", " + Instability(spec, row);
   } else if (row.replicas.size() > 1) {
     sureness = fmt::format("median of {} runs", row.replicas.size());
     if (std::optional<MetricSpread> nav = SpreadOf(spec, row, kTimeMetric)) {
       sureness += fmt::format(", nav {}–{}", Value(nav->min, ""),
                               Value(nav->max, " s"));
     }
-    if (row.unstable) sureness += ", " + ReplicaSummary(row);
+    if (row.unstable) sureness += ", " + Instability(spec, row);
   } else {
     sureness = runs <= 1 ? std::string("1 run, no replicas")
                          : fmt::format("{} runs at this point", runs);

@@ -14,6 +14,7 @@
 #include "analysis/metrics/run_metrics.h"
 #include "analysis/runfile/run_data.h"
 #include "harness/spec/design_point.h"
+#include "harness/spec/spec.h"
 
 namespace adse::campaign {
 namespace {
@@ -372,29 +373,49 @@ std::optional<MetricSpread> SpreadOf(const spec::Spec& spec,
   return Spread(spec, row.replicas, metric);
 }
 
-std::string ReplicaSummary(const EvaluationRow& row) {
+std::string Instability(const spec::Spec& spec, const EvaluationRow& row) {
+  if (!row.unstable) return {};
+  // Per case: its runs, the complete ones and the feasible ones; a case
+  // is unstable when its complete runs disagree (AggregateReplicas).
+  struct Counts {
+    int runs = 0, complete = 0, feasible = 0;
+  };
+  std::map<int64_t, Counts> by_case;
+  for (const EvaluationRow& r : row.replicas) {
+    Counts& counts = by_case[r.task_case];
+    ++counts.runs;
+    counts.complete += Complete(r) ? 1 : 0;
+    counts.feasible += Complete(r) && r.feasible ? 1 : 0;
+  }
+  const bool several = by_case.size() > 1;
+  std::vector<std::string> parts;
+  for (const auto& [index, counts] : by_case) {
+    if (counts.feasible == 0 || counts.feasible == counts.complete) continue;
+    parts.push_back(
+        fmt::format("{}feasible in {} of {} runs",
+                    several ? spec::CaseName(spec, index) + " " : std::string(),
+                    counts.feasible, counts.runs));
+  }
+  if (parts.empty()) return "unstable";
+  return fmt::format("unstable: {}", fmt::join(parts, ", "));
+}
+
+std::string ReplicaSummary(const spec::Spec& spec, const EvaluationRow& row) {
   const size_t n = std::max<size_t>(1, row.replicas.size());
   if (n == 1) return "1 run";
+  size_t failed = 0;
+  for (const EvaluationRow& r : row.replicas) failed += !Complete(r);
   const int cases = CaseCountOf(row);
+  std::string text;
   if (cases > 1) {
-    std::string text = fmt::format("{} cases", cases);
+    text = fmt::format("{} cases", cases);
     if (n > static_cast<size_t>(cases)) {
       text += fmt::format(" x {} runs", n / static_cast<size_t>(cases));
     }
-    size_t failed = 0;
-    for (const EvaluationRow& r : row.replicas) failed += !Complete(r);
-    if (failed > 0) text += fmt::format(", {} failed", failed);
-    return text;
+    if (row.unstable) text += ", " + Instability(spec, row);
+  } else {
+    text = row.unstable ? Instability(spec, row) : fmt::format("{} runs", n);
   }
-  size_t feasible = 0, failed = 0;
-  for (const EvaluationRow& r : row.replicas) {
-    feasible += Complete(r) && r.feasible;
-    failed += !Complete(r);
-  }
-  std::string text =
-      row.unstable
-          ? fmt::format("unstable: feasible in {} of {} runs", feasible, n)
-          : fmt::format("{} runs", n);
   if (failed > 0) text += fmt::format(", {} failed", failed);
   return text;
 }

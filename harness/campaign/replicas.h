@@ -66,10 +66,16 @@ std::optional<MetricSpread> SpreadOf(const spec::Spec& spec,
                                      const EvaluationRow& row,
                                      const std::string& metric);
 
-// "feasible in 2 of 3 runs" for an unstable row, "3 runs" for a stable one,
-// "1 run" for a point run once; "2 cases" or "2 cases x 3 runs" for a
-// scenario with task.cases.
-std::string ReplicaSummary(const EvaluationRow& row);
+// "unstable: feasible in 2 of 3 runs" for an unstable row, "3 runs" for a
+// stable one, "1 run" for a point run once; "2 cases" or "2 cases x 3 runs"
+// for a scenario with task.cases, followed for an unstable row by the
+// cases whose runs disagree ("unstable: backing_in feasible in 2 of 3
+// runs"); ", 1 failed" when runs failed.
+std::string ReplicaSummary(const spec::Spec& spec, const EvaluationRow& row);
+
+// The instability alone: "" for a stable row, else "unstable: feasible in
+// 2 of 3 runs", naming each case whose runs disagree when there are cases.
+std::string Instability(const spec::Spec& spec, const EvaluationRow& row);
 
 }  // namespace adse::campaign
 

@@ -228,7 +228,7 @@ TEST(ReplicasCampaignTest, APointWhoseReplicasDisagreeIsFlaggedUnstable) {
   EXPECT_EQ(point.feasible, meet == 2) << "feasible in " << meet << " of 3";
   const std::string summary =
       fmt::format("unstable: feasible in {} of 3 runs", meet);
-  EXPECT_EQ(ReplicaSummary(point), summary);
+  EXPECT_EQ(ReplicaSummary(strict, point), summary);
   const std::string report = ReadFile(dir + "/strict/report.md").value();
   EXPECT_NE(report.find("**" + summary + "**"), std::string::npos) << report;
   Result<runfile::CampaignIndex> index =

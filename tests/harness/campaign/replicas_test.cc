@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "analysis/runfile/run_data.h"
+#include "harness/campaign/headline.h"
 #include "harness/spec/spec_parser.h"
 
 namespace adse::campaign {
@@ -83,7 +84,7 @@ TEST(ReplicasTest, OneRunIsItsOwnRow) {
   EXPECT_EQ(row.metrics, run.metrics);
   EXPECT_TRUE(row.replicas.empty());
   EXPECT_FALSE(row.unstable);
-  EXPECT_EQ(ReplicaSummary(row), "1 run");
+  EXPECT_EQ(ReplicaSummary(Scenario(), row), "1 run");
   EXPECT_FALSE(SpreadOf(Scenario(), row, "nav_time_s"));
 }
 
@@ -104,7 +105,7 @@ TEST(ReplicasTest, MetricsAreTheMedianAndTheRunsAreKept) {
   EXPECT_EQ(row.attempts, 3);
   EXPECT_DOUBLE_EQ(row.wall_s, 6.0);
   EXPECT_EQ(row.content_key, row.replicas[0].content_key);
-  EXPECT_EQ(ReplicaSummary(row), "3 runs");
+  EXPECT_EQ(ReplicaSummary(Scenario(), row), "3 runs");
 
   const std::optional<MetricSpread> nav =
       SpreadOf(Scenario(), row, "nav_time_s");
@@ -137,7 +138,8 @@ TEST(ReplicasTest, ARunStoppedEarlyRanksBeyondTheBoundItBroke) {
   EXPECT_TRUE(row.unstable);
   EXPECT_DOUBLE_EQ(row.metrics.at("censored"), 0.0);
   EXPECT_EQ(row.reason, "goal_reached");
-  EXPECT_EQ(ReplicaSummary(row), "unstable: feasible in 2 of 3 runs");
+  EXPECT_EQ(ReplicaSummary(Scenario(), row),
+            "unstable: feasible in 2 of 3 runs");
   const std::optional<MetricSpread> nav =
       SpreadOf(Scenario(), row, "nav_time_s");
   ASSERT_TRUE(nav);
@@ -185,7 +187,7 @@ TEST(ReplicasTest, FailedRunsCountAgainstFeasibilityButNotStability) {
   EXPECT_FALSE(row.unstable);
   EXPECT_DOUBLE_EQ(row.metrics.at("nav_time_s"), 45.0);
   EXPECT_EQ(row.content_key, row.replicas[1].content_key);
-  EXPECT_EQ(ReplicaSummary(row), "3 runs, 1 failed");
+  EXPECT_EQ(ReplicaSummary(Scenario(), row), "3 runs, 1 failed");
 
   const EvaluationRow half =
       AggregateReplicas(Scenario(), {Failed(0), Failed(1), Reached(2, 40.0)});
@@ -235,7 +237,7 @@ TEST(CasesTest, APointIsTheWorstOfItsCasesWithEveryRunKept) {
   EXPECT_EQ(row.replicas[1].task_case, 1);
   EXPECT_EQ(row.attempts, 2);
   EXPECT_EQ(CaseCountOf(row), 2);
-  EXPECT_EQ(ReplicaSummary(row), "2 cases");
+  EXPECT_EQ(ReplicaSummary(Scenario(), row), "2 cases");
   // A spread across cases would mix two tasks.
   EXPECT_FALSE(SpreadOf(spec, row, "nav_time_s"));
 }
@@ -265,7 +267,7 @@ TEST(CasesTest, OneInfeasibleCaseMakesThePointInfeasibleAndStandsForIt) {
   EXPECT_FALSE(broken.feasible);
   EXPECT_EQ(broken.reason, failed.reason);
   EXPECT_TRUE(broken.metrics.empty());
-  EXPECT_EQ(ReplicaSummary(broken), "2 cases, 1 failed");
+  EXPECT_EQ(ReplicaSummary(Scenario(), broken), "2 cases, 1 failed");
 }
 
 TEST(CasesTest, TheCaseFailingMostConstraintsStandsForAnInfeasiblePoint) {
@@ -316,7 +318,34 @@ TEST(CasesTest, EachCasesReplicasAreFoldedBeforeTheCases) {
   EXPECT_DOUBLE_EQ(row.metrics.at("max_deviation_m"), 0.2);
   EXPECT_TRUE(row.feasible);
   ASSERT_EQ(row.replicas.size(), 6u);
-  EXPECT_EQ(ReplicaSummary(row), "2 cases x 3 runs");
+  EXPECT_EQ(ReplicaSummary(Scenario(), row), "2 cases x 3 runs");
+}
+
+TEST(CasesTest, ACaseWhoseRunsDisagreeIsNamed) {
+  spec::Spec spec = Scenario();
+  spec.cases = {{"backing_in", spec.task}, {"nose_in", spec.task}};
+  // backing_in holds in all three runs, nose_in in two: 70 s breaks the
+  // 60 s bound.
+  const EvaluationRow row = AggregatePoint(
+      spec, {CaseRun(0, 0, 50.0, 4.0, 0.1), CaseRun(0, 1, 40.0, 6.0, 0.1),
+             CaseRun(0, 2, 45.0, 5.0, 0.1), CaseRun(1, 0, 52.0, 5.0, 0.3),
+             CaseRun(1, 1, 70.0, 5.0, 0.3), CaseRun(1, 2, 51.0, 5.0, 0.3)});
+  EXPECT_TRUE(row.feasible);
+  EXPECT_TRUE(row.unstable);
+  EXPECT_EQ(Instability(spec, row),
+            "unstable: nose_in feasible in 2 of 3 runs");
+  EXPECT_EQ(ReplicaSummary(spec, row),
+            "2 cases x 3 runs, unstable: nose_in feasible in 2 of 3 runs");
+  // The headline says how sure its design is once, case by case.
+  const std::string headline =
+      HeadlineText(spec, {row}, ComputeHeadline(spec, {row}));
+  EXPECT_NE(headline.find("(worst of 2 cases, each the median of 3 runs, "
+                          "unstable: nose_in feasible in 2 of 3 runs)"),
+            std::string::npos)
+      << headline;
+  const EvaluationRow stable = AggregatePoint(
+      spec, {CaseRun(0, 0, 50.0, 4.0, 0.1), CaseRun(1, 0, 52.0, 5.0, 0.3)});
+  EXPECT_EQ(Instability(spec, stable), "");
 }
 
 }  // namespace
