@@ -75,7 +75,7 @@ std::string Facts(const spec::Spec& spec,
       sureness += fmt::format(", nav {}–{}", Value(nav->min, ""),
                               Value(nav->max, " s"));
     }
-    if (row.unstable) sureness += ", " + Instability(spec, row);
+    if (row.unstable) sureness += ", " + ReplicaSummary(spec, row);
   } else {
     sureness = runs <= 1 ? std::string("1 run, no replicas")
                          : fmt::format("{} runs at this point", runs);
