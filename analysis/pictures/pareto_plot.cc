@@ -158,10 +158,19 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
       draw_cross(px(p->cost, p->nav_time_s), Bgr(kInfeasibleRgb));
     }
   }
+  // A feasible design whose runs disagree: a thin violet ring.
+  const int unstable_radius = radius + s.Px(3);
+  auto draw_unstable_ring = [&](cv::Point2d c) {
+    cv::circle(img, Fixed(c), unstable_radius * static_cast<int>(kShiftScale),
+               Bgr(kUnstableRgb), s.Px(1.5), cv::LINE_AA, kShift);
+  };
+  bool any_unstable = false;
   for (const auto* p : shown) {
     if (p->feasible && !p->on_front) {
       draw_dot(px(p->cost, p->nav_time_s), Bgr(kFeasibleRgb), radius);
+      if (p->unstable) draw_unstable_ring(px(p->cost, p->nav_time_s));
     }
+    any_unstable = any_unstable || (p->feasible && p->unstable);
   }
   std::vector<const ParetoPlotPoint*> front;
   for (const auto* p : shown) {
@@ -186,6 +195,7 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
     const cv::Point2d c = px(p->cost, p->nav_time_s);
     if (p->feasible) {
       draw_dot(c, Bgr(kFrontRgb), radius + s.Px(1));
+      if (p->unstable) draw_unstable_ring(c);
     } else {
       draw_cross(c, Bgr(kFrontRgb));
     }
@@ -221,6 +231,12 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
                              img, Fixed(c),
                              (radius + s.Px(5)) * static_cast<int>(kShiftScale),
                              kBlack, s.Px(1.5), cv::LINE_AA, kShift);
+                       }});
+  }
+  if (any_unstable) {
+    entries.push_back({"unstable (its runs disagree)", [&](cv::Point2d c) {
+                         draw_dot(c, Bgr(kFeasibleRgb), radius);
+                         draw_unstable_ring(c);
                        }});
   }
   if (any_censored) {
@@ -300,9 +316,10 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
   for (const auto* p : shown) {
     if (p->on_front) continue;
     const cv::Point2d c = px(p->cost, clipped(p) ? ay.max : p->nav_time_s);
-    others.emplace_back(static_cast<int>(c.x) - radius - s.Px(2),
-                        static_cast<int>(c.y) - radius - s.Px(2),
-                        2 * (radius + s.Px(2)), 2 * (radius + s.Px(2)));
+    const int half = p->feasible && p->unstable ? unstable_radius + s.Px(1)
+                                                : radius + s.Px(2);
+    others.emplace_back(static_cast<int>(c.x) - half,
+                        static_cast<int>(c.y) - half, 2 * half, 2 * half);
   }
   auto clear_of = [](const cv::Rect& box, const std::vector<cv::Rect>& rects,
                      const cv::Rect& own_point) {

@@ -32,6 +32,7 @@ inline constexpr Rgb kFeasibleRgb{40, 90, 200};
 inline constexpr Rgb kInfeasibleRgb{150, 150, 150};
 inline constexpr Rgb kFrontRgb{230, 90, 0};  // front points + line
 inline constexpr Rgb kConstraintRgb{190, 30, 60};
+inline constexpr Rgb kUnstableRgb{140, 60, 200};  // violet ring: runs disagree
 // The study's form: the campaign's points, the reference's, its front.
 inline constexpr Rgb kStudyPointRgb{215, 30, 30};  // red triangles
 inline constexpr Rgb kReferenceRgb{175, 175, 175};
@@ -125,6 +126,10 @@ struct ParetoPlotPoint {
   // nav_time_s is only a lower bound (early stop ended the run): drawn as
   // an arrow pointing up from it.
   bool censored = false;
+  // A feasible design whose runs (replicas) disagree on feasibility:
+  // ringed in violet, so the picture says how sure it is, as the headline
+  // does.
+  bool unstable = false;
 };
 
 struct ParetoPlotOptions {
@@ -141,7 +146,8 @@ struct ParetoPlotOptions {
 // Scatter of all points (feasible: filled circles; infeasible: grey
 // crosses; front points: in the front colour, a cross if infeasible) with
 // the front drawn as a staircase in x order (a min-min front promises
-// nothing between its points), highlighted points ringed, constraint lines
+// nothing between its points), highlighted points ringed, unstable feasible
+// points ringed in violet, constraint lines
 // dashed, linear axes with ticks and labels, a legend, and the title. Front
 // labels never overlap one another, the legend or the front, and hide
 // another design's marker only where no place around their point is free

@@ -328,6 +328,7 @@ std::vector<analysis::ParetoPlotPoint> PlotPoints(
     p.cost = RowMetric(rows[i], kCostMetric);
     p.nav_time_s = RowMetric(rows[i], kTimeMetric);
     p.feasible = rows[i].feasible;
+    p.unstable = rows[i].unstable;
     p.on_front = on_front[i];
     if (p.on_front) p.label = ShortPoint(spec, rows[i]);
     p.highlight = static_cast<int>(i) == h.cheapest;

@@ -544,6 +544,33 @@ TEST_F(PictureTest, AFrontLabelGoesWhereItHidesNoOtherDesign) {
             CountColour(*unlabelled, kFeasibleRgb));
 }
 
+TEST_F(PictureTest, EveryFeasibleDesignWhoseRunsDisagreeIsRingedAndNamed) {
+  // A front point and a dominated design, each stable or not: every
+  // unstable feasible design adds a violet ring, the first one also the
+  // legend's sample; an infeasible one gets none.
+  auto render = [&](bool front_unstable, bool other_unstable,
+                    bool infeasible_unstable, const std::string& name) {
+    std::vector<ParetoPlotPoint> points = {{5, 100, true, true, "5/1.5/7"},
+                                           {8, 110, true, false, ""},
+                                           {3, 120, false, false, ""},
+                                           {10, 50, true, true, "10/2.1/7"}};
+    points[0].unstable = front_unstable;
+    points[1].unstable = other_unstable;
+    points[2].unstable = infeasible_unstable;
+    EXPECT_TRUE(RenderParetoPlot(points, Path(name)).ok());
+    Result<RgbImage> img = ReadImage(Path(name));
+    EXPECT_TRUE(img.ok());
+    return img.ok() ? CountColour(*img, kUnstableRgb) : -1;
+  };
+  const int none = render(false, false, true, "stable.png");
+  const int one = render(true, false, false, "one.png");
+  const int two = render(true, true, false, "two.png");
+  EXPECT_EQ(none, 0);
+  EXPECT_GT(one, 20);
+  // The second ring adds about as much as the first ring less the legend's.
+  EXPECT_GT(two, one + 10);
+}
+
 TEST_F(PictureTest, ParetoPlotEdgeCases) {
   // One point; equal values; non-finite points left out with a note.
   EXPECT_TRUE(
