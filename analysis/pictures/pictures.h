@@ -146,14 +146,14 @@ struct ParetoPlotOptions {
 // Scatter of all points (feasible: filled circles; infeasible: grey
 // crosses; front points: in the front colour, a cross if infeasible) with
 // the front drawn as a staircase in x order (a min-min front promises
-// nothing between its points), highlighted points ringed, unstable feasible
-// points ringed in violet, constraint lines
-// dashed, linear axes with ticks and labels, a legend, and the title. Front
-// labels never overlap one another, the legend or the front, and hide
-// another design's marker only where no place around their point is free
-// of one; a label without room is left out and counted in a note, as are
-// points with a non-finite coordinate. InvalidArgument for bad options or no
-// finite point; written like RenderTrajectoryImage.
+// nothing between its points), highlighted points ringed in black and
+// unstable feasible ones in violet, constraint lines dashed, linear axes
+// with ticks and labels, a legend, and the title. Front labels never
+// overlap one another, the legend or the front, and hide another design's
+// marker only where no place around their point is free of one; a label
+// without room is left out and counted in a note, as are points with a
+// non-finite coordinate. InvalidArgument for bad options or no finite
+// point; written like RenderTrajectoryImage.
 Status RenderParetoPlot(const std::vector<ParetoPlotPoint>& points,
                         const std::string& png_path,
                         const ParetoPlotOptions& o = {});

@@ -567,7 +567,8 @@ TEST_F(PictureTest, EveryFeasibleDesignWhoseRunsDisagreeIsRingedAndNamed) {
   const int two = render(true, true, false, "two.png");
   EXPECT_EQ(none, 0);
   EXPECT_GT(one, 20);
-  // The second ring adds about as much as the first ring less the legend's.
+  // `one` is the front point's ring and the legend's sample; `two` adds
+  // the dominated design's ring.
   EXPECT_GT(two, one + 10);
 }
 
