@@ -510,6 +510,25 @@ Result<std::vector<runfile::EvaluationRow>> Rows(const Definition& d,
   return rows;
 }
 
+// A landscape's definition, its scenario and its rows as written.
+struct Built {
+  Definition definition;
+  spec::Spec spec;
+  std::vector<runfile::EvaluationRow> rows;
+};
+
+Result<Built> Build(const std::string& name, LandscapeFamily family) {
+  Result<Definition> d = FindDefinition(name, family);
+  if (!d.ok()) return d.status();
+  Result<spec::Spec> spec = ParseLandscape(*d, family);
+  if (!spec.ok()) return spec.status();
+  Result<std::vector<runfile::EvaluationRow>> rows =
+      Rows(*d, *spec, kNoiseSeed);
+  if (!rows.ok()) return rows.status();
+  return Built{std::move(d).value(), std::move(spec).value(),
+               std::move(rows).value()};
+}
+
 }  // namespace
 
 std::vector<std::string> LandscapeNames(LandscapeFamily family) {
@@ -520,16 +539,13 @@ std::vector<std::string> LandscapeNames(LandscapeFamily family) {
 
 Result<runfile::CampaignIndex> BuildLandscape(const std::string& name,
                                               LandscapeFamily family) {
-  Result<Definition> d = FindDefinition(name, family);
-  if (!d.ok()) return d.status();
-  Result<spec::Spec> spec = ParseLandscape(*d, family);
-  if (!spec.ok()) return spec.status();
-  Result<std::vector<runfile::EvaluationRow>> rows =
-      Rows(*d, *spec, kNoiseSeed);
-  if (!rows.ok()) return rows.status();
+  Result<Built> built = Build(name, family);
+  if (!built.ok()) return built.status();
+  const spec::Spec* spec = &built->spec;
+  std::vector<runfile::EvaluationRow>* rows = &built->rows;
 
   runfile::CampaignIndex index;
-  index.scenario_text = ScenarioText(*d, family);
+  index.scenario_text = ScenarioText(built->definition, family);
   index.scenario_name = spec->name;
   index.strategy = "exhaustive";
   index.exploration_seed = spec->exploration.seed;
@@ -547,7 +563,7 @@ Result<runfile::CampaignIndex> BuildLandscape(const std::string& name,
                      row.index + 1, rows->size()),
          {row.content_key}});
   }
-  index.evaluations = std::move(rows).value();
+  index.evaluations = std::move(*rows);
   index.metrics.assign(metrics.begin(), metrics.end());
   return index;
 }
@@ -556,13 +572,11 @@ Result<NoiseLimit> ComputeNoiseLimit(const std::string& name, int budget,
                                      int draws, LandscapeFamily family) {
   if (budget < 1) return Status::InvalidArgument("budget must be at least 1");
   if (draws < 1) return Status::InvalidArgument("draws must be at least 1");
-  Result<Definition> d = FindDefinition(name, family);
-  if (!d.ok()) return d.status();
-  Result<spec::Spec> spec = ParseLandscape(*d, family);
-  if (!spec.ok()) return spec.status();
-  Result<std::vector<runfile::EvaluationRow>> committed =
-      Rows(*d, *spec, kNoiseSeed);
-  if (!committed.ok()) return committed.status();
+  Result<Built> built = Build(name, family);
+  if (!built.ok()) return built.status();
+  const Definition* d = &built->definition;
+  const spec::Spec* spec = &built->spec;
+  const std::vector<runfile::EvaluationRow>* committed = &built->rows;
   const size_t n = committed->size();
   std::vector<std::vector<runfile::EvaluationRow>> redrawn;
   for (int k = 0; k < draws; ++k) {
