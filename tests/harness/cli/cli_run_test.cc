@@ -1,0 +1,408 @@
+// `adse run`, `adse explore --replay`, `adse analyze` of a campaign and
+// the worker, as a user runs them: progress, answers that agree, bad flags.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+
+#include "tests/harness/cli/example_files.h"
+#include "tests/harness/testing/adse_command.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using adse::testing::Adse;
+using adse::testing::CommandRun;
+using adse::testing::ReadText;
+using adse::testing::Replaced;
+using adse::testing::Small;
+using adse::testing::WriteScenario;
+
+TEST(CliRunTest, ExploreReplayPrintsADistributionPerStrategy) {
+  const CommandRun run =
+      Adse("explore --replay " + std::string(ADSE_SOURCE_DIR) +
+           "/tests/data/robotaxi_exhaustive --strategy agent,ga --seeds 3");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("280 recorded evaluations, budget 15, seeds 1..3"),
+            std::string::npos)
+      << run.out;
+  // The recording's own answer leads, from the same front as adse run's:
+  // the true cheapest feasible design of the 280-point space.
+  EXPECT_NE(run.out.find("cheapest feasible   cores=6,freq_ghz=1.5,lidar_hz=7"
+                         "  cost 9,"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("| agent |"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("| ga |"), std::string::npos) << run.out;
+  const CommandRun bad = Adse("explore --replay /nonexistent/campaign");
+  EXPECT_EQ(bad.exit_code, 2) << bad.out;
+  EXPECT_NE(bad.out.find("/nonexistent/campaign"), std::string::npos)
+      << bad.out;
+}
+
+TEST(CliRunTest, ExploreReplayWithTwoOfTheObjectivesScoresAgainstTheirFront) {
+  const std::string replay = "explore --replay " +
+                             std::string(ADSE_SOURCE_DIR) +
+                             "/tests/data/robotaxi_exhaustive --strategy "
+                             "random --seeds 1 --json";
+  const CommandRun all = Adse(replay);
+  ASSERT_EQ(all.exit_code, 0) << all.out;
+  const nlohmann::json four = nlohmann::json::parse(all.out);
+  EXPECT_EQ(four["objectives"].size(), 4u) << all.out;
+  const CommandRun two =
+      Adse(replay + " --objectives nav_time_s,hardware_cost");
+  ASSERT_EQ(two.exit_code, 0) << two.out;
+  const nlohmann::json out = nlohmann::json::parse(two.out);
+  // The scenario's order is kept; the true front is the 2-D one: 14 of
+  // the 280 points, against 69 over all four objectives.
+  EXPECT_EQ(out["objectives"],
+            nlohmann::json::array({"hardware_cost", "nav_time_s"}));
+  EXPECT_EQ(out["strategies"]["random"]["true_front_size"], 14) << two.out;
+  EXPECT_EQ(four["strategies"]["random"]["true_front_size"], 69) << all.out;
+
+  const CommandRun unknown = Adse(replay + " --objectives nav_time,cost");
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
+  EXPECT_NE(unknown.out.find("--objectives: 'nav_time' is not an objective "
+                             "of the recorded scenario (its objectives: "
+                             "hardware_cost, nav_time_s, deviation_score, "
+                             "ctrl_rate_hz)"),
+            std::string::npos)
+      << unknown.out;
+  const CommandRun one = Adse(replay + " --objectives nav_time_s");
+  EXPECT_EQ(one.exit_code, 2) << one.out;
+  EXPECT_NE(one.out.find("two objectives at least"), std::string::npos)
+      << one.out;
+}
+
+TEST(CliRunTest, ExploreReplayWithRationaleShowsEachRoundAndWhy) {
+  const std::string replay =
+      "explore --replay " + std::string(ADSE_SOURCE_DIR) +
+      "/tests/data/landscapes/saturating --strategy agent,random --seeds 2 "
+      "--budget 4";
+  const CommandRun text = Adse(replay + " --rationale");
+  ASSERT_EQ(text.exit_code, 0) << text.out;
+  for (const char* seed :
+       {"agent seed 1:", "agent seed 2:", "random seed 1:", "random seed 2:"}) {
+    EXPECT_NE(text.out.find(seed), std::string::npos) << seed << text.out;
+  }
+  // The agent's first round has nothing to model; later ones explain the
+  // model's prediction. Random search says how it drew.
+  EXPECT_NE(text.out.find("  iteration 0: cores="), std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("<- No usable run to model yet"), std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("<- Last ("), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("<- random: 1 point(s) drawn uniformly"),
+            std::string::npos)
+      << text.out;
+
+  // Where some of the model's samples never arrive (a 4-D space's coarse
+  // voxels on 3 cores at 2.1 GHz, in seed 1's twelfth round), the
+  // rationale says so instead of printing "inf".
+  const CommandRun four_d =
+      Adse("explore --replay " + std::string(ADSE_SOURCE_DIR) +
+           "/tests/data/landscapes/four_d --strategy agent --seeds 1 "
+           "--rationale");
+  ASSERT_EQ(four_d.exit_code, 0) << four_d.out;
+  EXPECT_NE(four_d.out.find("nav_time_s unbounded in some of the model's "
+                            "samples"),
+            std::string::npos)
+      << four_d.out;
+  EXPECT_FALSE(std::regex_search(four_d.out, std::regex(R"(\binf\b)")))
+      << four_d.out;
+
+  // The same rounds in JSON: one entry per round, its points in proposal
+  // order, together the run's proposals.
+  const CommandRun json = Adse(replay + " --json");
+  ASSERT_EQ(json.exit_code, 0) << json.out;
+  const nlohmann::json out = nlohmann::json::parse(json.out);
+  for (const char* name : {"agent", "random"}) {
+    SCOPED_TRACE(name);
+    const nlohmann::json& runs = out["strategies"][name]["runs"];
+    ASSERT_EQ(runs.size(), 2u);
+    for (const nlohmann::json& run : runs) {
+      nlohmann::json points = nlohmann::json::array();
+      for (const nlohmann::json& iteration : run["iterations"]) {
+        for (const nlohmann::json& point : iteration["points"]) {
+          points.push_back(point);
+        }
+        EXPECT_FALSE(iteration["rationale"].get<std::string>().empty());
+      }
+      EXPECT_EQ(points, run["proposals"]);
+      EXPECT_EQ(points.size(), 4u);
+    }
+  }
+}
+
+TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
+  const CommandRun isolation =
+      Adse("run " + Small() + " --isolation containers");
+  EXPECT_EQ(isolation.exit_code, 2) << isolation.out;
+  EXPECT_NE(isolation.out.find("--isolation"), std::string::npos)
+      << isolation.out;
+}
+
+TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
+  const std::string file =
+      WriteScenario("replicas", ReadText(Small()) + "harness: {replicas: 2}\n");
+  const fs::path out = fs::temp_directory_path() / "adse_cli_replicas";
+  fs::remove_all(out);
+  const CommandRun run =
+      Adse("run " + file + " --budget 1 --no-cache -o " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  size_t runs = 0;
+  for (const auto& e : fs::directory_iterator(out / "runs")) {
+    runs += e.path().extension() == ".h5";
+  }
+  EXPECT_EQ(runs, 2u) << "one run file per replica";
+  const std::string md = ReadText((out / "report.md").string());
+  EXPECT_NE(md.find("## Replicas"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 2 runs |"), std::string::npos) << md;
+  // adse status counts runs: both replicas are done, none pending.
+  const CommandRun status = Adse("status " + out.string() + " --json");
+  ASSERT_EQ(status.exit_code, 0) << status.out;
+  EXPECT_NE(status.out.find("\"done\": 2"), std::string::npos) << status.out;
+  EXPECT_NE(status.out.find("\"pending\": 0"), std::string::npos) << status.out;
+  EXPECT_NE(status.out.find("\"total\": 2"), std::string::npos) << status.out;
+}
+
+TEST(CliRunTest, AnInfeasiblePointsProgressLineNamesTheConstraintItBroke) {
+  // No run meets a 1 ms latency; no early stop ends a run for it either,
+  // so the run reaches the goal and is still infeasible. One point,
+  // generous enough to reach the goal.
+  const std::string file = WriteScenario(
+      "latency_bound",
+      Replaced(Replaced(ReadText(Small()),
+                        "constraints: [nav_time_s <= 60, ctrl_rate_hz >= 1, "
+                        "completed]",
+                        "constraints: [nav_time_s <= 60, e2e_latency_p50_s <= "
+                        "0.001, completed]"),
+               "values: [1, 4, 16]", "values: [16]"));
+  const fs::path out = fs::temp_directory_path() / "adse_cli_latency_bound";
+  fs::remove_all(out);
+  const CommandRun run =
+      Adse("run " + file + " --budget 1 --no-cache -o " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find(": goal_reached, nav "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("infeasible: e2e_latency_p50_s <= 0.001 (simulated"),
+            std::string::npos)
+      << run.out;
+}
+
+TEST(CliRunTest,
+     AnLlmCampaignWithItsServerDownSaysSoAndFinishesWithTheBuiltInAgent) {
+  // Port 9 (discard): nothing listens there.
+  const std::string file = WriteScenario(
+      "llm_down", ReadText(Small()) +
+                      "llm: {endpoint: \"http://127.0.0.1:9\", retries: 0}\n");
+  const std::string out =
+      (fs::temp_directory_path() / "adse_cli_llm_down").string();
+  fs::remove_all(out);
+  const CommandRun run =
+      Adse("run " + file + " --strategy llm --budget 1 -o " + out);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("fallback to the built-in agent"), std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("cannot reach http://127.0.0.1:9/api/chat"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("ollama serve"), std::string::npos) << run.out;
+  EXPECT_TRUE(fs::exists(out + "/llm/exchanges.jsonl"));
+}
+
+// The front as printed: the "Pareto front over" line and its indented rows.
+std::string FrontSection(const std::string& out) {
+  size_t at = out.find("Pareto front over");
+  if (at == std::string::npos) return "";
+  std::string section;
+  do {
+    const size_t end = out.find('\n', at);
+    section += out.substr(at, end - at) + "\n";
+    at = end + 1;
+  } while (at < out.size() && out.compare(at, 2, "  ") == 0);
+  return section;
+}
+
+TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
+  const fs::path out = fs::temp_directory_path() / "adse_cli_one_answer";
+  fs::remove_all(out);
+  const CommandRun run =
+      Adse("run " + Small() + " --budget 7 -q -o " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  ASSERT_NE(run.out.find("cheapest feasible"), std::string::npos) << run.out;
+  ASSERT_FALSE(FrontSection(run.out).empty()) << run.out;
+  // From "/", the scenario's relative paths do not resolve; the stored
+  // scenario still decides objectives and constraints.
+  const fs::path here = fs::current_path();
+  fs::current_path("/");
+  const CommandRun analyze = Adse("analyze " + out.string());
+  fs::current_path(here);
+  ASSERT_EQ(analyze.exit_code, 0) << analyze.out;
+  EXPECT_EQ(FrontSection(analyze.out), FrontSection(run.out)) << analyze.out;
+  const size_t cheapest = run.out.find("cheapest feasible");
+  const std::string cheapest_line =
+      run.out.substr(cheapest, run.out.find('\n', cheapest) - cheapest);
+  EXPECT_NE(analyze.out.find(cheapest_line), std::string::npos)
+      << cheapest_line << "\n"
+      << analyze.out;
+  // adse status tells the same answer, from the same front.
+  const CommandRun status = Adse("status " + out.string());
+  ASSERT_EQ(status.exit_code, 0) << status.out;
+  EXPECT_NE(status.out.find(cheapest_line), std::string::npos) << status.out;
+  EXPECT_EQ(FrontSection(status.out), FrontSection(run.out)) << status.out;
+  EXPECT_TRUE(fs::exists(out / "analysis" / "v1" / "pareto.png"));
+  EXPECT_TRUE(fs::exists(out / "analysis" / "v1" / "report.md"));
+  EXPECT_FALSE(fs::exists(out / "runs" / "analysis"));
+  ASSERT_EQ(Adse("analyze " + out.string() +
+                 " --threshold frequency_bound_fraction=0.8")
+                .exit_code,
+            0);
+  const CommandRun diff =
+      Adse("analyze --diff " + (out / "analysis" / "v1").string() + " " +
+           (out / "analysis" / "v2").string());
+  EXPECT_EQ(diff.exit_code, 0) << diff.out;
+  EXPECT_NE(diff.out.find("of 7 points changed"), std::string::npos)
+      << diff.out;
+  // Its runs/ folder stands for the campaign: the same answer, written
+  // beside the others, nothing among the run files.
+  const CommandRun runs = Adse("analyze " + (out / "runs").string() + "/");
+  ASSERT_EQ(runs.exit_code, 0) << runs.out;
+  EXPECT_EQ(FrontSection(runs.out), FrontSection(run.out)) << runs.out;
+  EXPECT_TRUE(fs::exists(out / "analysis" / "v3" / "report.md"));
+  EXPECT_FALSE(fs::exists(out / "runs" / "analysis"));
+}
+
+TEST(CliRunTest, AnalyzeOfACampaignWithCasesFoldsEveryCaseAsRunDid) {
+  // The small scenario at one point, with two destinations.
+  std::string text = ReadText(Small());
+  const std::string goal = "  goal: {x: 10.0, y: 29.75}\n";
+  const size_t at = text.find(goal);
+  ASSERT_NE(at, std::string::npos);
+  text.insert(at + goal.size(),
+              "  cases:\n"
+              "    - {name: across, goal: {x: 10.0, y: 29.75}}\n"
+              "    - {name: along, goal: {x: 40.0, y: -1.75}}\n");
+  const std::string scenario = WriteScenario("cases", text);
+  const fs::path out = fs::temp_directory_path() / "adse_cli_cases";
+  fs::remove_all(out);
+  const CommandRun run = Adse(
+      "run " + scenario +
+      " --budget 1 --strategy exhaustive -q --no-cache -o " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const CommandRun analyze = Adse("analyze " + out.string());
+  ASSERT_EQ(analyze.exit_code, 0) << analyze.out;
+  EXPECT_NE(analyze.out.find("2 runs analysed"), std::string::npos)
+      << analyze.out;
+  EXPECT_EQ(FrontSection(analyze.out), FrontSection(run.out)) << analyze.out;
+  EXPECT_NE(FrontSection(analyze.out).find("1 of 1 evaluations"),
+            std::string::npos)
+      << analyze.out;
+}
+
+TEST(CliRunTest, AnalyzeWithAReferenceDrawsTheStudysFigureOrRefusesClearly) {
+  const fs::path out = fs::temp_directory_path() / "adse_cli_study_figure";
+  fs::remove_all(out);
+  ASSERT_EQ(
+      Adse("run " + Small() + " --budget 3 -q -o " + out.string()).exit_code,
+      0);
+  const std::string recording =
+      std::string(ADSE_SOURCE_DIR) + "/tests/data/reference_study";
+  const CommandRun ok =
+      Adse("analyze " + out.string() + " --reference " + recording);
+  ASSERT_EQ(ok.exit_code, 0) << ok.out;
+  EXPECT_NE(ok.out.find("in the study's form over"), std::string::npos)
+      << ok.out;
+  EXPECT_TRUE(fs::exists(out / "analysis" / "v1" / "pareto.png"));
+  // A reference that is no campaign: exit 2, named, nothing written.
+  const CommandRun missing =
+      Adse("analyze " + out.string() + " --reference /nonexistent/ref");
+  EXPECT_EQ(missing.exit_code, 2) << missing.out;
+  EXPECT_NE(missing.out.find("--reference"), std::string::npos) << missing.out;
+  EXPECT_NE(missing.out.find("/nonexistent/ref"), std::string::npos)
+      << missing.out;
+  EXPECT_FALSE(fs::exists(out / "analysis" / "v2"));
+  // The figure is a campaign's: a run file with --reference is refused.
+  const CommandRun file = Adse("analyze " + (out / "campaign.h5").string() +
+                               " --reference " + recording);
+  EXPECT_EQ(file.exit_code, 2) << file.out;
+  EXPECT_NE(file.out.find("not a campaign folder"), std::string::npos)
+      << file.out;
+}
+
+TEST(CliRunTest, WorkersRunTheCampaignsOwnAdseWhenItsFileIsReplaced) {
+  // A copy of adse starts a two-point campaign, one worker; once it has
+  // started, its file is replaced by another program (as a rebuild does).
+  // The second point's worker still runs the campaign's adse; by the
+  // file's path it ran the other program and failed.
+  const fs::path dir = fs::temp_directory_path() / "adse_cli_replaced";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path copy = dir / "adse";
+  fs::copy_file(std::string(ADSE_BINARY_DIR) + "/bin/adse", copy);
+  const fs::path out = dir / "campaign";
+  const std::string script =
+      copy.string() + " run " + Small() +
+      " --strategy exhaustive --budget 2 --workers 1 --no-cache -o " +
+      out.string() + " > " + (dir / "run.log").string() +
+      " 2>&1 & pid=$!; "
+      "while [ ! -d " +
+      out.string() +
+      " ]; do sleep 0.05; done; "
+      "rm " +
+      copy.string() + "; printf '#!/bin/sh\\nexit 3\\n' > " + copy.string() +
+      "; chmod +x " + copy.string() + "; wait $pid";
+  const int status = std::system(script.c_str());
+  const std::string log = ReadText((dir / "run.log").string());
+  ASSERT_TRUE(WIFEXITED(status)) << log;
+  EXPECT_EQ(WEXITSTATUS(status), 0) << log;
+  size_t runs = 0;
+  for (const auto& e : fs::directory_iterator(out / "runs")) {
+    runs += e.path().extension() == ".h5";
+  }
+  EXPECT_EQ(runs, 2u) << log;
+  const CommandRun done = Adse("status " + out.string() + " --json");
+  EXPECT_NE(done.out.find("\"done\": 2"), std::string::npos) << done.out;
+}
+
+TEST(CliRunTest, WorkerRefusesAScenarioThatChangedUnderItsCampaign) {
+  const std::string out =
+      (fs::temp_directory_path() / "adse_cli_worker.h5").string();
+  const CommandRun run = Adse("worker " + Small() +
+                              " --point cores=4,freq_ghz=2.1,lidar_hz=14 -o " +
+                              out + " --expect-key " + std::string(64, '0'));
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("changed since the campaign started"),
+            std::string::npos)
+      << run.out;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(CliRunTest, WorkerLeavesItsAnalysisBesideTheRunFileWhenAsked) {
+  const fs::path dir = fs::temp_directory_path() / "adse_cli_worker_report";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string out = (dir / "run.h5").string();
+  const std::string report = (dir / "run.report.json").string();
+  const CommandRun run = Adse("worker " + Small() +
+                              " --point cores=4,freq_ghz=2.1,lidar_hz=14 -o " +
+                              out + " --report " + report);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  ASSERT_TRUE(fs::exists(out));
+  std::ifstream in(report);
+  ASSERT_TRUE(in) << "no " << report;
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  ASSERT_TRUE(j.is_object());
+  EXPECT_EQ(j.value("content_key", "").size(), 64u);
+  ASSERT_TRUE(j.contains("metrics"));
+  EXPECT_TRUE(j["metrics"].contains("nav_time_s"));
+  EXPECT_TRUE(j["metrics"].contains("deviation_score"));
+  EXPECT_TRUE(j.contains("findings"));
+}
+
+}  // namespace
