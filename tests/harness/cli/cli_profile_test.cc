@@ -9,6 +9,7 @@
 
 #include "tests/harness/cli/example_files.h"
 #include "tests/harness/testing/adse_command.h"
+#include "tests/harness/testing/small_scenario.h"
 
 namespace {
 
@@ -18,7 +19,7 @@ using adse::testing::Adse;
 using adse::testing::CommandRun;
 using adse::testing::ReadText;
 using adse::testing::Replaced;
-using adse::testing::Small;
+using adse::testing::SmallScenarioPath;
 using adse::testing::Variant;
 
 std::string TrimmedCaret() {
@@ -99,7 +100,7 @@ TEST(CliProfileTest, CheckComparesTheChainsOnTheReferenceMachine) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_profile_check";
   fs::remove_all(out);
   const CommandRun check =
-      Adse("profile check " + Small() + " -o " + out.string());
+      Adse("profile check " + SmallScenarioPath() + " -o " + out.string());
   ASSERT_EQ(check.exit_code, 0) << check.out;
   for (const char* file : {"run.h5", "check.txt", "check.png"}) {
     EXPECT_TRUE(fs::is_regular_file(out / file)) << file;

@@ -12,6 +12,7 @@
 
 #include "tests/harness/cli/example_files.h"
 #include "tests/harness/testing/adse_command.h"
+#include "tests/harness/testing/small_scenario.h"
 
 namespace {
 
@@ -21,7 +22,7 @@ using adse::testing::Adse;
 using adse::testing::CommandRun;
 using adse::testing::ReadText;
 using adse::testing::Replaced;
-using adse::testing::Small;
+using adse::testing::SmallScenarioPath;
 using adse::testing::WriteScenario;
 
 TEST(CliRunTest, ExploreReplayPrintsADistributionPerStrategy) {
@@ -142,15 +143,15 @@ TEST(CliRunTest, ExploreReplayWithRationaleShowsEachRoundAndWhy) {
 
 TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
   const CommandRun isolation =
-      Adse("run " + Small() + " --isolation containers");
+      Adse("run " + SmallScenarioPath() + " --isolation containers");
   EXPECT_EQ(isolation.exit_code, 2) << isolation.out;
   EXPECT_NE(isolation.out.find("--isolation"), std::string::npos)
       << isolation.out;
 }
 
 TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
-  const std::string file =
-      WriteScenario("replicas", ReadText(Small()) + "harness: {replicas: 2}\n");
+  const std::string file = WriteScenario(
+      "replicas", ReadText(SmallScenarioPath()) + "harness: {replicas: 2}\n");
   const fs::path out = fs::temp_directory_path() / "adse_cli_replicas";
   fs::remove_all(out);
   const CommandRun run =
@@ -178,7 +179,7 @@ TEST(CliRunTest, AnInfeasiblePointsProgressLineNamesTheConstraintItBroke) {
   // generous enough to reach the goal.
   const std::string file = WriteScenario(
       "latency_bound",
-      Replaced(Replaced(ReadText(Small()),
+      Replaced(Replaced(ReadText(SmallScenarioPath()),
                         "constraints: [nav_time_s <= 60, ctrl_rate_hz >= 1, "
                         "completed]",
                         "constraints: [nav_time_s <= 60, e2e_latency_p50_s <= "
@@ -199,7 +200,7 @@ TEST(CliRunTest,
      AnLlmCampaignWithItsServerDownSaysSoAndFinishesWithTheBuiltInAgent) {
   // Port 9 (discard): nothing listens there.
   const std::string file = WriteScenario(
-      "llm_down", ReadText(Small()) +
+      "llm_down", ReadText(SmallScenarioPath()) +
                       "llm: {endpoint: \"http://127.0.0.1:9\", retries: 0}\n");
   const std::string out =
       (fs::temp_directory_path() / "adse_cli_llm_down").string();
@@ -233,7 +234,7 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_one_answer";
   fs::remove_all(out);
   const CommandRun run =
-      Adse("run " + Small() + " --budget 7 -q -o " + out.string());
+      Adse("run " + SmallScenarioPath() + " --budget 7 -q -o " + out.string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
   ASSERT_NE(run.out.find("cheapest feasible"), std::string::npos) << run.out;
   ASSERT_FALSE(FrontSection(run.out).empty()) << run.out;
@@ -280,7 +281,7 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
 
 TEST(CliRunTest, AnalyzeOfACampaignWithCasesFoldsEveryCaseAsRunDid) {
   // The small scenario at one point, with two destinations.
-  std::string text = ReadText(Small());
+  std::string text = ReadText(SmallScenarioPath());
   const std::string goal = "  goal: {x: 10.0, y: 29.75}\n";
   const size_t at = text.find(goal);
   ASSERT_NE(at, std::string::npos);
@@ -309,7 +310,8 @@ TEST(CliRunTest, AnalyzeWithAReferenceDrawsTheStudysFigureOrRefusesClearly) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_study_figure";
   fs::remove_all(out);
   ASSERT_EQ(
-      Adse("run " + Small() + " --budget 3 -q -o " + out.string()).exit_code,
+      Adse("run " + SmallScenarioPath() + " --budget 3 -q -o " + out.string())
+          .exit_code,
       0);
   const std::string recording =
       std::string(ADSE_SOURCE_DIR) + "/tests/data/reference_study";
@@ -347,7 +349,7 @@ TEST(CliRunTest, WorkersRunTheCampaignsOwnAdseWhenItsFileIsReplaced) {
   fs::copy_file(std::string(ADSE_BINARY_DIR) + "/bin/adse", copy);
   const fs::path out = dir / "campaign";
   const std::string script =
-      copy.string() + " run " + Small() +
+      copy.string() + " run " + SmallScenarioPath() +
       " --strategy exhaustive --budget 2 --workers 1 --no-cache -o " +
       out.string() + " > " + (dir / "run.log").string() +
       " 2>&1 & pid=$!; "
@@ -373,7 +375,7 @@ TEST(CliRunTest, WorkersRunTheCampaignsOwnAdseWhenItsFileIsReplaced) {
 TEST(CliRunTest, WorkerRefusesAScenarioThatChangedUnderItsCampaign) {
   const std::string out =
       (fs::temp_directory_path() / "adse_cli_worker.h5").string();
-  const CommandRun run = Adse("worker " + Small() +
+  const CommandRun run = Adse("worker " + SmallScenarioPath() +
                               " --point cores=4,freq_ghz=2.1,lidar_hz=14 -o " +
                               out + " --expect-key " + std::string(64, '0'));
   EXPECT_EQ(run.exit_code, 2) << run.out;
@@ -389,7 +391,7 @@ TEST(CliRunTest, WorkerLeavesItsAnalysisBesideTheRunFileWhenAsked) {
   fs::create_directories(dir);
   const std::string out = (dir / "run.h5").string();
   const std::string report = (dir / "run.report.json").string();
-  const CommandRun run = Adse("worker " + Small() +
+  const CommandRun run = Adse("worker " + SmallScenarioPath() +
                               " --point cores=4,freq_ghz=2.1,lidar_hz=14 -o " +
                               out + " --report " + report);
   ASSERT_EQ(run.exit_code, 0) << run.out;

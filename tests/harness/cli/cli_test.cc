@@ -10,6 +10,7 @@
 
 #include "tests/harness/cli/example_files.h"
 #include "tests/harness/testing/adse_command.h"
+#include "tests/harness/testing/small_scenario.h"
 
 namespace {
 
@@ -20,7 +21,7 @@ using adse::testing::CommandRun;
 using adse::testing::Example;
 using adse::testing::ReadText;
 using adse::testing::Replaced;
-using adse::testing::Small;
+using adse::testing::SmallScenarioPath;
 using adse::testing::Variant;
 using adse::testing::WriteScenario;
 
@@ -184,7 +185,7 @@ TEST(CliTest, SimulateWritesARunFileThatPassesTheSchemaCheck) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_simulate.h5";
   fs::remove(out);
   const CommandRun run =
-      Adse("simulate " + Small() +
+      Adse("simulate " + SmallScenarioPath() +
            " --point cores=16,freq_ghz=2.1,lidar_hz=7 --json -q -o " +
            out.string() + " 2>/dev/null");
   ASSERT_EQ(run.exit_code, 0) << run.out;
@@ -200,13 +201,13 @@ TEST(CliTest, SimulateWritesARunFileThatPassesTheSchemaCheck) {
 }
 
 TEST(CliTest, SimulateRejectsAPointOutsideTheSpace) {
-  const CommandRun run =
-      Adse("simulate " + Small() + " --point cores=3,freq_ghz=2.1,lidar_hz=7");
+  const CommandRun run = Adse("simulate " + SmallScenarioPath() +
+                              " --point cores=3,freq_ghz=2.1,lidar_hz=7");
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_NE(run.out.find("cores"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("1, 4, 16"), std::string::npos) << run.out;
-  const CommandRun unknown =
-      Adse("simulate " + Small() + " --point cores=4,freq_ghz=2.1,lidar=7");
+  const CommandRun unknown = Adse("simulate " + SmallScenarioPath() +
+                                  " --point cores=4,freq_ghz=2.1,lidar=7");
   EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
   EXPECT_NE(unknown.out.find("lidar"), std::string::npos) << unknown.out;
 }
@@ -224,7 +225,7 @@ TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
   fs::remove_all(dir);
   fs::create_directories(dir / "runs");
   const CommandRun sim =
-      Adse("simulate " + Small() +
+      Adse("simulate " + SmallScenarioPath() +
            " --point cores=16,freq_ghz=2.1,lidar_hz=7 -q -o " +
            (dir / "runs" / "a.h5").string());
   ASSERT_EQ(sim.exit_code, 0) << sim.out;
@@ -270,7 +271,7 @@ TEST(CliTest, AnalyzeOneRunPrintsDeviationAndDiagnosis) {
   const fs::path run = fs::temp_directory_path() / "adse_cli_analyze_one.h5";
   fs::remove_all(fs::temp_directory_path() / "adse_cli_analyze_one.analysis");
   ASSERT_EQ(
-      Adse("simulate " + Small() +
+      Adse("simulate " + SmallScenarioPath() +
            " --point cores=1,freq_ghz=1.0,lidar_hz=14 -q -o " + run.string())
           .exit_code,
       0);

@@ -1,4 +1,4 @@
-// Scenario files for the end-to-end CLI tests: the bundled examples, and
+// Scenario files for the end-to-end CLI tests: the robotaxi example, and
 // copies of them with a line changed, written beside the calibration and
 // profile they name relative to themselves.
 #ifndef ADSE_TESTS_HARNESS_CLI_EXAMPLE_FILES_H_
@@ -15,10 +15,6 @@ namespace adse::testing {
 
 inline std::string Example() {
   return std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_parking_lot.yaml";
-}
-
-inline std::string Small() {
-  return std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_small.yaml";
 }
 
 // Writes scenario text to the temporary folder as adse_cli_<name>.yaml,
