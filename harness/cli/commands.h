@@ -187,7 +187,9 @@ struct FidelityArgs {
   // The virtual platform's dispatches, each held against the same
   // real-time runs; empty: the file's platform.dispatch.
   std::vector<std::string> dispatch;
-  std::string out;  // folder; default <output>/fidelity
+  std::string out;  // folder; default <output>/fidelity (or `compare`)
+  // An earlier call's folder: its runs/ compared again, no run made.
+  std::string compare;
 };
 int RunFidelity(const FidelityArgs& args);
 

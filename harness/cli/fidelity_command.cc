@@ -1,7 +1,9 @@
 // `adse fidelity <scenario> --points P1 P2 ... [--runs K]`: each point on
 // the virtual platform and K times on the real-time one, compared (harness/
-// fidelity). Exit 0 ok, 2 bad input (a point outside the space, a scenario
-// without a cost profile, more cores than the host gives), 1 otherwise.
+// fidelity); `adse fidelity --compare DIR` compares an earlier call's runs
+// again. Exit 0 ok, 2 bad input (a point outside the space, a scenario
+// without a cost profile, more cores than the host gives, a folder without
+// such runs), 1 otherwise.
 #include <algorithm>
 #include <cstdio>
 #include <functional>
@@ -40,7 +42,8 @@ nlohmann::json ComparisonsJson(
          {"realtime_runs_without", c.runs_without},
          {"invocations", c.virtual_count > 0
                              ? nlohmann::json{{"virtual", c.virtual_count},
-                                              {"realtime", c.realtime_counts}}
+                                              {"realtime", c.realtime_counts},
+                                              {"compared", c.compared_count}}
                              : nlohmann::json()},
          {"difference", number(c.difference)},
          {"tolerance",
@@ -66,8 +69,8 @@ nlohmann::json PointJson(const fidelity::PointFidelity& f) {
 
 // The point's callback p50s, virtual above real time, as a PNG at `png`
 // (nothing when no callback ran).
-Status DrawPoint(const fidelity::PointFidelity& f, const FidelityArgs& args,
-                 const std::string& png) {
+Status DrawPoint(const fidelity::PointFidelity& f, size_t realtime_runs,
+                 const std::string& task_case, const std::string& png) {
   std::vector<analysis::ComparisonRow> rows;
   for (const fidelity::Comparison& c : f.callback_p50_ms) {
     std::optional<double> real;
@@ -78,24 +81,72 @@ Status DrawPoint(const fidelity::PointFidelity& f, const FidelityArgs& args,
   analysis::ComparisonChartOptions o;
   o.title =
       fmt::format("p50 callback latency at {}{}: virtual vs real time", f.point,
-                  args.task_case.empty() ? "" : ", case " + args.task_case);
+                  task_case.empty() ? "" : ", case " + task_case);
   o.adse_name = fmt::format("virtual platform ({})", f.dispatch);
   o.reference_name =
-      args.runs == 1 ? std::string("real time (1 run)")
-                     : fmt::format("real time (median of {} runs)", args.runs);
+      realtime_runs == 1
+          ? std::string("real time (1 run)")
+          : fmt::format("real time (median of {} runs)", realtime_runs);
   return analysis::RenderComparisonChart(rows, o, png);
 }
 
+// With several dispatches each file names its own.
+std::string DispatchSuffix(const fidelity::PointRuns& runs, size_t d) {
+  return runs.dispatches.size() > 1
+             ? fmt::format("-{}", spec::DispatchToString(runs.dispatches[d]))
+             : std::string();
+}
+
+// The comparison as it grows, point by point: the text printed, the JSON,
+// and each dispatch's comparisons for the summary.
+struct Comparisons {
+  std::string dir;
+  std::string text;
+  nlohmann::json json;
+  std::vector<fidelity::PointFidelity> compared;
+  bool several_dispatches = false;
+
+  // Point `n`'s runs held against each other per dispatch: printed, kept,
+  // and drawn as fidelity-n[-dispatch].png.
+  Status Add(size_t n, const fidelity::PointRuns& runs,
+             const std::string& task_case) {
+    several_dispatches = several_dispatches || runs.dispatches.size() > 1;
+    for (size_t d = 0; d < runs.dispatches.size(); ++d) {
+      const fidelity::PointFidelity f = fidelity::ComparePoint(runs, d);
+      const std::string table = fidelity::FormatPointFidelity(f);
+      std::printf("%s\n", table.c_str());
+      text += table + "\n";
+      json["points"].push_back(PointJson(f));
+      ADSE_RETURN_IF_ERROR(DrawPoint(f, runs.realtime_runs.size(), task_case,
+                                     fmt::format("{}/fidelity-{}{}.png", dir, n,
+                                                 DispatchSuffix(runs, d))));
+      compared.push_back(f);
+    }
+    return Status::Ok();
+  }
+
+  // The summary (over more than one point or dispatch), then fidelity.txt
+  // and fidelity.json.
+  Status Finish(size_t points) {
+    if (points > 1 || several_dispatches) {
+      const std::string summary = fidelity::FormatDispatchSummary(compared);
+      std::printf("%s", summary.c_str());
+      text += summary;
+    }
+    ADSE_RETURN_IF_ERROR(WriteFileAtomic(dir + "/fidelity.txt", text));
+    return WriteFileAtomic(dir + "/fidelity.json", json.dump(1) + "\n");
+  }
+};
+
 // The point's runs themselves, for adse analyze and h5py: runs/N-virtual
 // (one per dispatch, `suffix` naming it) and runs/N-realtime-R.
-Status WritePointRuns(
-    const std::string& dir, size_t n, const fidelity::PointRuns& runs,
-    const std::function<std::string(spec::Dispatch)>& suffix) {
+Status WritePointRuns(const std::string& dir, size_t n,
+                      const fidelity::PointRuns& runs) {
   Status written = MakeDirs(dir + "/runs");
   for (size_t d = 0; d < runs.virtual_runs.size() && written.ok(); ++d) {
-    written = runfile::WriteRunFile(fmt::format("{}/runs/{}-virtual{}.h5", dir,
-                                                n, suffix(runs.dispatches[d])),
-                                    runs.virtual_runs[d]);
+    written = runfile::WriteRunFile(
+        fmt::format("{}/runs/{}-virtual{}.h5", dir, n, DispatchSuffix(runs, d)),
+        runs.virtual_runs[d]);
   }
   for (size_t r = 0; r < runs.realtime_runs.size() && written.ok(); ++r) {
     written = runfile::WriteRunFile(
@@ -105,9 +156,56 @@ Status WritePointRuns(
   return written;
 }
 
+// `adse fidelity --compare DIR`: the runs an earlier call wrote, compared
+// again (after a change to the comparison, or to read them with another
+// binary); the run files are left as they are.
+int CompareAgain(const FidelityArgs& args) {
+  Result<std::vector<fidelity::PointRuns>> runs =
+      fidelity::ReadPointRuns(args.compare);
+  if (!runs.ok()) {
+    std::fprintf(stderr, "error: --compare %s: %s\n", args.compare.c_str(),
+                 runs.status().message().c_str());
+    return ExitCodeFor(runs.status());
+  }
+  const runfile::RunData& first = runs->front().virtual_runs.front();
+  Comparisons c;
+  c.dir = args.out.empty() ? args.compare : args.out;
+  if (Status made = MakeDirs(c.dir); !made.ok()) {
+    std::fprintf(stderr, "error: %s\n", made.message().c_str());
+    return 1;
+  }
+  c.json = {{"scenario", first.scenario_name},
+            {"runs", runs->front().realtime_runs.size()},
+            {"points", nlohmann::json::array()}};
+  if (!first.task_case.empty()) c.json["task_case"] = first.task_case;
+  for (size_t i = 0; i < runs->size(); ++i) {
+    const fidelity::PointRuns& point = (*runs)[i];
+    if (Status added =
+            c.Add(i + 1, point, point.virtual_runs.front().task_case);
+        !added.ok()) {
+      std::fprintf(stderr, "error: %s\n", added.message().c_str());
+      return 1;
+    }
+  }
+  if (Status saved = c.Finish(runs->size()); !saved.ok()) {
+    std::fprintf(stderr, "error: %s\n", saved.message().c_str());
+    return 1;
+  }
+  std::printf("wrote %s/fidelity.txt, fidelity.json and fidelity-N.png\n",
+              c.dir.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int RunFidelity(const FidelityArgs& args) {
+  if (!args.compare.empty()) return CompareAgain(args);
+  if (args.scenario.empty() || args.points.empty()) {
+    std::fprintf(stderr,
+                 "error: adse fidelity: expected a scenario and --points, or "
+                 "--compare DIR\n");
+    return 2;
+  }
   std::optional<spec::Spec> spec =
       LoadCaseOrReport(args.scenario, args.task_case);
   if (!spec) return 2;
@@ -125,9 +223,9 @@ int RunFidelity(const FidelityArgs& args) {
     }
     points.push_back(*point);
   }
-  const std::string dir =
-      args.out.empty() ? spec->ResolvedOutput() + "/fidelity" : args.out;
-  if (Status made = MakeDirs(dir); !made.ok()) {
+  Comparisons c;
+  c.dir = args.out.empty() ? spec->ResolvedOutput() + "/fidelity" : args.out;
+  if (Status made = MakeDirs(c.dir); !made.ok()) {
     std::fprintf(stderr, "error: %s\n", made.message().c_str());
     return 1;
   }
@@ -141,66 +239,39 @@ int RunFidelity(const FidelityArgs& args) {
       options.dispatches.push_back(d);
     }
   }
-  // With several dispatches each file names its own.
-  const bool several = options.dispatches.size() > 1;
-  auto suffix = [several](spec::Dispatch d) {
-    return several ? fmt::format("-{}", spec::DispatchToString(d))
-                   : std::string();
-  };
   options.on_run = [](const std::string& point, const std::string& what) {
     std::fprintf(stderr, "%s: %s run ...\n", point.c_str(), what.c_str());
   };
-  std::string text;
-  nlohmann::json j = {{"scenario", spec->name},
-                      {"runs", args.runs},
-                      {"points", nlohmann::json::array()}};
-  if (!args.task_case.empty()) j["task_case"] = args.task_case;
-  std::vector<fidelity::PointFidelity> compared;
+  c.json = {{"scenario", spec->name},
+            {"runs", args.runs},
+            {"points", nlohmann::json::array()}};
+  if (!args.task_case.empty()) c.json["task_case"] = args.task_case;
   for (size_t i = 0; i < points.size(); ++i) {
     Result<fidelity::PointRuns> runs =
         fidelity::RunPoint(*spec, points[i], options);
     if (!runs.ok()) {
       ReportError(*spec, runs.status());
       // What was compared so far stays on disk.
-      if (!text.empty()) (void)WriteFileAtomic(dir + "/fidelity.txt", text);
+      if (!c.text.empty()) {
+        (void)WriteFileAtomic(c.dir + "/fidelity.txt", c.text);
+      }
       return ExitCodeFor(runs.status());
     }
-    for (size_t d = 0; d < runs->dispatches.size(); ++d) {
-      const fidelity::PointFidelity f = fidelity::ComparePoint(*runs, d);
-      const std::string table = fidelity::FormatPointFidelity(f);
-      std::printf("%s\n", table.c_str());
-      text += table + "\n";
-      j["points"].push_back(PointJson(f));
-      const std::string png = fmt::format("{}/fidelity-{}{}.png", dir, i + 1,
-                                          suffix(runs->dispatches[d]));
-      if (Status drawn = DrawPoint(f, args, png); !drawn.ok()) {
-        std::fprintf(stderr, "error: %s\n", drawn.message().c_str());
-        return 1;
-      }
-      compared.push_back(f);
-    }
-    if (Status written = WritePointRuns(dir, i + 1, *runs, suffix);
-        !written.ok()) {
-      std::fprintf(stderr, "error: %s\n", written.message().c_str());
+    // The runs first: a failed picture loses no run.
+    Status kept = WritePointRuns(c.dir, i + 1, *runs);
+    if (kept.ok()) kept = c.Add(i + 1, *runs, args.task_case);
+    if (!kept.ok()) {
+      std::fprintf(stderr, "error: %s\n", kept.message().c_str());
       return 1;
     }
   }
-  if (points.size() > 1 || several) {
-    const std::string summary = fidelity::FormatDispatchSummary(compared);
-    std::printf("%s", summary.c_str());
-    text += summary;
-  }
-  Status saved = WriteFileAtomic(dir + "/fidelity.txt", text);
-  if (saved.ok()) {
-    saved = WriteFileAtomic(dir + "/fidelity.json", j.dump(1) + "\n");
-  }
-  if (!saved.ok()) {
+  if (Status saved = c.Finish(points.size()); !saved.ok()) {
     std::fprintf(stderr, "error: %s\n", saved.message().c_str());
     return 1;
   }
   std::printf(
       "wrote %s/fidelity.txt, fidelity.json, fidelity-N.png and runs/\n",
-      dir.c_str());
+      c.dir.c_str());
   return 0;
 }
 

@@ -459,16 +459,15 @@ int main(int argc, char** argv) {
       "compare nav time, control rate, drops, the sensing-to-control chain "
       "and each callback's p50/p99 latency; writes fidelity.txt, "
       "fidelity.json and a picture per point");
-  fidelity_cmd
-      ->add_option("scenario", fidelity.scenario,
-                   "Scenario YAML file (cost_model: counted with a profile)")
-      ->required();
+  fidelity_cmd->add_option(
+      "scenario", fidelity.scenario,
+      "Scenario YAML file (cost_model: counted with a profile); required "
+      "unless --compare");
   AddCaseOption(fidelity_cmd, &fidelity.task_case);
-  fidelity_cmd
-      ->add_option("--points", fidelity.points,
-                   "Design points, e.g. cores=1,freq_ghz=2.1,lidar_hz=7; at "
-                   "most as many cores as this host gives the process")
-      ->required();
+  fidelity_cmd->add_option(
+      "--points", fidelity.points,
+      "Design points, e.g. cores=1,freq_ghz=2.1,lidar_hz=7; at most as many "
+      "cores as this host gives the process; required unless --compare");
   fidelity_cmd
       ->add_option("--runs", fidelity.runs,
                    "Real-time runs per point (default 3; their median is "
@@ -494,7 +493,16 @@ int main(int argc, char** argv) {
   fidelity_cmd->add_option(
       "-o,--out", fidelity.out,
       "Folder for fidelity.txt, fidelity.json and fidelity-N.png (default: "
-      "<output>/fidelity)");
+      "<output>/fidelity, or the --compare folder)");
+  CLI::Option* fidelity_compare = fidelity_cmd->add_option(
+      "--compare", fidelity.compare,
+      "Compare again the runs an earlier adse fidelity wrote to this folder "
+      "(its runs/), simulating nothing; writes fidelity.txt, fidelity.json "
+      "and the pictures there, or to -o");
+  for (const char* name : {"scenario", "--case", "--points", "--runs",
+                           "--clock-by", "--dispatch"}) {
+    fidelity_compare->excludes(name);
+  }
 
   try {
     app.parse(argc, argv);

@@ -2,18 +2,22 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <numeric>
+#include <regex>
 #include <sstream>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "analysis/metrics/run_metrics.h"
+#include "analysis/runfile/run_file.h"
 #include "harness/profile/profile_check.h"
 #include "harness/sim/simulator.h"
 #include "harness/spec/design_point.h"
+#include "harness/spec/spec_parser.h"
 #include "harness/spec/types.h"
 
 namespace adse::fidelity {
@@ -73,23 +77,50 @@ double SensingToControlMs(const runfile::RunData& run) {
          static_cast<double>(v.size());
 }
 
-// Per callback name: its execution latencies (start to end), ms; with
-// `per_kunit`, per 1000 of the work units each invocation reported (those
-// that reported none left out).
-std::map<std::string, std::vector<double>> CallbackLatenciesMs(
-    const runfile::RunData& run, bool per_kunit = false) {
-  std::map<std::string, std::vector<double>> out;
+// One invocation's execution latency (start to end, ms) and work units.
+struct Invocation {
+  double start_s;
+  double ms;
+  double work_units;
+};
+
+// Per callback name: its invocations in the order they started, which is
+// the order they drew their costs from the callback's seeded stream.
+std::map<std::string, std::vector<Invocation>> CallbackInvocations(
+    const runfile::RunData& run) {
+  std::map<std::string, std::vector<Invocation>> out;
   for (const stack::CallbackRecord& r : run.trace.callbacks) {
     if (r.callback < 0 ||
         r.callback >= static_cast<int>(run.callback_info.size())) {
       continue;
     }
-    if (per_kunit && !(r.work_units > 0.0)) continue;
-    const double ms = 1000.0 * (r.end_s - r.start_s);
     out[run.callback_info[r.callback].name].push_back(
-        per_kunit ? ms / (r.work_units / 1000.0) : ms);
+        {r.start_s, 1000.0 * (r.end_s - r.start_s), r.work_units});
+  }
+  for (auto& [name, invocations] : out) {
+    std::stable_sort(invocations.begin(), invocations.end(),
+                     [](const Invocation& a, const Invocation& b) {
+                       return a.start_s < b.start_s;
+                     });
   }
   return out;
+}
+
+// The `q` quantile of the first `n` invocations' latencies; with
+// `per_kunit`, per 1000 of the work units each reported (those that
+// reported none left out).
+double InvocationQuantile(const std::vector<Invocation>& invocations, size_t n,
+                          double q, bool per_kunit = false) {
+  std::vector<double> v;
+  for (size_t i = 0; i < n && i < invocations.size(); ++i) {
+    const Invocation& c = invocations[i];
+    if (!per_kunit) {
+      v.push_back(c.ms);
+    } else if (c.work_units > 0.0) {
+      v.push_back(c.ms / (c.work_units / 1000.0));
+    }
+  }
+  return Quantile(v, q);
 }
 
 std::string Number(double v) {
@@ -142,45 +173,57 @@ PointFidelity CompareRuns(const runfile::RunData& virtual_run,
                               SensingToControlMs(virtual_run), chain,
                               std::nullopt));
 
-  std::map<std::string, std::vector<double>> v =
-      CallbackLatenciesMs(virtual_run);
-  std::map<std::string, std::vector<double>> v_unit =
-      CallbackLatenciesMs(virtual_run, /*per_kunit=*/true);
-  std::vector<std::map<std::string, std::vector<double>>> rts, rts_unit;
+  // Both platforms draw a callback's i-th cost from the same seeded
+  // stream, so its latencies are compared over the invocations every run
+  // made (the first n of each): a run that made more invocations adds
+  // draws of a wide cost distribution, which move a p50 of a dozen
+  // invocations by a quarter with no difference in the executor.
+  const std::map<std::string, std::vector<Invocation>> v =
+      CallbackInvocations(virtual_run);
+  std::vector<std::map<std::string, std::vector<Invocation>>> rts;
   for (const runfile::RunData& r : realtime_runs) {
-    rts.push_back(CallbackLatenciesMs(r));
-    rts_unit.push_back(CallbackLatenciesMs(r, /*per_kunit=*/true));
+    rts.push_back(CallbackInvocations(r));
   }
-  // The p50 (and `q`) of `name` in each real-time run; NaN where it never
-  // ran.
-  auto realtime_quantile = [](auto& runs, const std::string& name, double q) {
-    std::vector<double> out;
-    for (auto& run : runs) {
-      auto it = run.find(name);
-      out.push_back(it != run.end() ? Quantile(it->second, q) : kNaN);
+  for (const auto& [name, invocations] : v) {
+    if (!(InvocationQuantile(invocations, invocations.size(), 0.5) >=
+          kMinCallbackMs)) {
+      continue;
     }
-    return out;
-  };
-  for (auto& [name, latencies] : v) {
-    const double p50 = Quantile(latencies, 0.5);
-    if (!(p50 >= kMinCallbackMs)) continue;
-    const double p99 = Quantile(latencies, 0.99);
-    Comparison c50 = Compare(name, p50, realtime_quantile(rts, name, 0.5),
-                             kCallbackTolerance);
-    c50.virtual_count = static_cast<int>(latencies.size());
+    size_t n = invocations.size();
+    std::vector<int> counts;
     for (const auto& run : rts) {
       auto it = run.find(name);
-      c50.realtime_counts.push_back(
-          it == run.end() ? 0 : static_cast<int>(it->second.size()));
+      counts.push_back(it == run.end() ? 0
+                                       : static_cast<int>(it->second.size()));
+      if (it != run.end()) n = std::min(n, it->second.size());
     }
-    f.callback_p50_ms.push_back(std::move(c50));
-    f.callback_p99_ms.push_back(
-        Compare(name, p99, realtime_quantile(rts, name, 0.99), std::nullopt));
-    auto unit = v_unit.find(name);
-    if (unit != v_unit.end()) {
-      f.callback_p50_ms_per_kunit.push_back(
-          Compare(name, Quantile(unit->second, 0.5),
-                  realtime_quantile(rts_unit, name, 0.5), std::nullopt));
+    // Each real-time run's quantile over the first n; NaN where it never
+    // ran.
+    auto realtime = [&](double q, bool per_kunit) {
+      std::vector<double> out;
+      for (const auto& run : rts) {
+        auto it = run.find(name);
+        out.push_back(it == run.end()
+                          ? kNaN
+                          : InvocationQuantile(it->second, n, q, per_kunit));
+      }
+      return out;
+    };
+    auto compare = [&](double q, bool per_kunit,
+                       std::optional<double> tolerance) {
+      Comparison c =
+          Compare(name, InvocationQuantile(invocations, n, q, per_kunit),
+                  realtime(q, per_kunit), tolerance);
+      c.virtual_count = static_cast<int>(invocations.size());
+      c.realtime_counts = counts;
+      c.compared_count = static_cast<int>(n);
+      return c;
+    };
+    f.callback_p50_ms.push_back(compare(0.5, false, kCallbackTolerance));
+    f.callback_p99_ms.push_back(compare(0.99, false, std::nullopt));
+    Comparison unit = compare(0.5, true, std::nullopt);
+    if (std::isfinite(unit.virtual_value)) {
+      f.callback_p50_ms_per_kunit.push_back(std::move(unit));
     }
   }
   return f;
@@ -228,6 +271,96 @@ Result<PointRuns> RunPoint(const spec::Spec& input,
     runs.realtime_runs.push_back(std::move(run).value());
   }
   return runs;
+}
+
+Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
+  const std::filesystem::path folder = std::filesystem::path(dir) / "runs";
+  std::error_code error;
+  if (!std::filesystem::is_directory(folder, error)) {
+    return Status::NotFound(
+        fmt::format("{}: no such folder (adse fidelity writes its runs there)",
+                    folder.string()));
+  }
+  // By N: the virtual runs' paths, then the real-time runs' by K.
+  struct Files {
+    std::vector<std::string> virtual_runs;
+    std::map<int, std::string> realtime_runs;
+  };
+  std::map<int, Files> by_point;
+  const std::regex name(R"((\d+)-(virtual(-[a-z_]+)?|realtime-(\d+))\.h5)");
+  for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+    const std::string file = entry.path().filename().string();
+    if (entry.path().extension() != ".h5") continue;
+    std::smatch m;
+    if (!std::regex_match(file, m, name)) {
+      return Status::InvalidArgument(fmt::format(
+          "{}: expected run files named N-virtual[-<dispatch>].h5 or "
+          "N-realtime-K.h5",
+          entry.path().string()));
+    }
+    Files& files = by_point[std::stoi(m[1].str())];
+    if (m[4].matched) {
+      files.realtime_runs[std::stoi(m[4].str())] = entry.path().string();
+    } else {
+      files.virtual_runs.push_back(entry.path().string());
+    }
+  }
+  if (error) {
+    return Status::IoError(
+        fmt::format("{}: {}", folder.string(), error.message()));
+  }
+  if (by_point.empty()) {
+    return Status::NotFound(
+        fmt::format("{}: holds no run of adse fidelity", folder.string()));
+  }
+  std::vector<PointRuns> out;
+  for (auto& [n, files] : by_point) {
+    if (files.virtual_runs.empty() || files.realtime_runs.empty()) {
+      return Status::InvalidArgument(fmt::format(
+          "{}: point {} has {} virtual and {} real-time run files; both are "
+          "needed",
+          folder.string(), n, files.virtual_runs.size(),
+          files.realtime_runs.size()));
+    }
+    PointRuns runs;
+    for (const std::string& path : files.virtual_runs) {
+      Result<runfile::RunData> run = runfile::ReadRunFile(path);
+      if (!run.ok()) return run.status();
+      spec::Dispatch dispatch;
+      const auto it = run->platform.find("dispatch");
+      if (it == run->platform.end() ||
+          !spec::StringToDispatch(it->second, &dispatch)) {
+        return Status::InvalidArgument(fmt::format(
+            "{}: platform.dispatch: expected one of the dispatches, found "
+            "'{}'",
+            path, it == run->platform.end() ? "" : it->second));
+      }
+      // In the vocabulary's order (run to completion first), whatever
+      // order the folder lists them in.
+      const auto at = std::upper_bound(runs.dispatches.begin(),
+                                       runs.dispatches.end(), dispatch);
+      runs.virtual_runs.insert(
+          runs.virtual_runs.begin() + (at - runs.dispatches.begin()),
+          std::move(run).value());
+      runs.dispatches.insert(at, dispatch);
+    }
+    for (const auto& [k, path] : files.realtime_runs) {
+      Result<runfile::RunData> run = runfile::ReadRunFile(path);
+      if (!run.ok()) return run.status();
+      runs.realtime_runs.push_back(std::move(run).value());
+    }
+    // The point as the scenario's space writes it.
+    const runfile::RunData& first = runs.virtual_runs.front();
+    spec::ParseOptions parse;
+    parse.check_files = false;  // only the space is read
+    Result<spec::Spec> stored = spec::ParseSpec(
+        first.scenario_text, files.virtual_runs.front() + ": scenario/yaml", "",
+        parse);
+    if (!stored.ok()) return stored.status();
+    runs.point = spec::FormatPoint(stored->design_space, first.design_point);
+    out.push_back(std::move(runs));
+  }
+  return out;
 }
 
 PointFidelity ComparePoint(const PointRuns& runs, size_t i) {
@@ -281,8 +414,9 @@ std::string FormatPointFidelity(const PointFidelity& f) {
                       : std::string();
       std::string count;
       if (c.virtual_count > 0) {
-        count = fmt::format("  n {} / {}", c.virtual_count,
-                            fmt::join(c.realtime_counts, ", "));
+        count =
+            fmt::format("  n {} / {}, first {} compared", c.virtual_count,
+                        fmt::join(c.realtime_counts, ", "), c.compared_count);
       }
       out << fmt::format("  {:<44} {:>10} {:>10} {:>22} {:>8}  {}{}\n", c.name,
                          Number(c.virtual_value), Number(c.realtime_median),

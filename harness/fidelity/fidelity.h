@@ -39,11 +39,14 @@ struct Comparison {
   // the median of the others hides an outcome the model did not predict.
   int runs_without = 0;
   // For a callback: its invocations in the virtual run and in each
-  // real-time run. A p50 of a few invocations (the scan chain on a starved
-  // core runs a handful of times) is a draw of the cost profile, not a
-  // measurement of the model.
+  // real-time run, and how many of them were compared: the first
+  // `compared_count` of every run (the fewest any run made), since the
+  // i-th invocation draws the same cost on both platforms. A p50 of a few
+  // invocations (the scan chain on a starved core runs a dozen times) is
+  // still a draw of the cost profile more than a measurement.
   int virtual_count = 0;
   std::vector<int> realtime_counts;
+  int compared_count = 0;
   double realtime_median = 0.0;
   // (median - virtual) / |virtual|; NaN when either is missing or virtual
   // is 0.
@@ -68,7 +71,8 @@ struct PointFidelity {
   // chain's mean.
   std::vector<Comparison> metrics;
   // Per callback of at least 1 ms on the virtual platform: the p50 of its
-  // execution latency, start to end (target 20 %), then its p99.
+  // execution latency, start to end (target 20 %), then its p99, each over
+  // the invocations every run made (`Comparison::compared_count`).
   std::vector<Comparison> callback_p50_ms;
   std::vector<Comparison> callback_p99_ms;
   // Per callback above that reports its work (points, iterations x
@@ -94,6 +98,15 @@ struct PointRuns {
 Result<PointRuns> RunPoint(const spec::Spec& spec,
                            const spec::DesignPoint& point,
                            const FidelityOptions& options);
+
+// The runs an earlier `adse fidelity` wrote to `<dir>/runs`
+// (N-virtual[-<dispatch>].h5, N-realtime-K.h5), one PointRuns per N in
+// N's order (its dispatches in Dispatch's order), to compare again
+// offline. Errors: NotFound when the folder holds no such run;
+// InvalidArgument naming the file for a name not of that form, a point
+// without a virtual or a real-time run, or a virtual run whose dispatch is
+// unknown; a run file's own error (Corruption).
+Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir);
 
 // The virtual run of `runs.dispatches[i]` held against the real-time runs.
 PointFidelity ComparePoint(const PointRuns& runs, size_t i);

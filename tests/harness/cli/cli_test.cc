@@ -341,6 +341,46 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
         "runs/1-virtual-processor_sharing.h5", "runs/1-realtime-1.h5"}) {
     EXPECT_TRUE(fs::is_regular_file(both / name)) << name;
   }
+  // Compared again from the run files alone: the same comparison, and the
+  // runs left as they were.
+  const fs::path again = both / "again";
+  const CommandRun compared =
+      Adse("fidelity --compare " + both.string() + " -o " + again.string());
+  ASSERT_EQ(compared.exit_code, 0) << compared.out;
+  std::ifstream again_in(again / "fidelity.json");
+  const nlohmann::json again_json =
+      nlohmann::json::parse(again_in, nullptr, false);
+  ASSERT_FALSE(again_json.is_discarded());
+  EXPECT_EQ(again_json["points"], both_json["points"]);
+  EXPECT_EQ(again_json["runs"], 1);
+  // Each callback says how many invocations it compared: the fewest any
+  // run made.
+  for (const nlohmann::json& c : again_json["points"][0]["callback_p50_ms"]) {
+    const nlohmann::json& n = c["invocations"];
+    EXPECT_EQ(n["compared"],
+              std::min(n["virtual"].get<int>(), n["realtime"][0].get<int>()))
+        << c["name"];
+  }
+  for (const char* name : {"fidelity.txt", "fidelity-1-run_to_completion.png",
+                           "fidelity-1-processor_sharing.png"}) {
+    EXPECT_TRUE(fs::is_regular_file(again / name)) << name;
+  }
+  EXPECT_FALSE(fs::exists(again / "runs"));
+  const CommandRun no_runs = Adse("fidelity --compare " + again.string());
+  EXPECT_EQ(no_runs.exit_code, 2) << no_runs.out;
+  EXPECT_NE(no_runs.out.find((again / "runs").string() + ": no such folder"),
+            std::string::npos)
+      << no_runs.out;
+  const CommandRun mixed =
+      Adse("fidelity " + file + " --compare " + both.string());
+  EXPECT_EQ(mixed.exit_code, 2) << mixed.out;
+  EXPECT_NE(mixed.out.find("excludes --compare"), std::string::npos)
+      << mixed.out;
+  const CommandRun neither = Adse("fidelity --points cores=1");
+  EXPECT_EQ(neither.exit_code, 2) << neither.out;
+  EXPECT_NE(neither.out.find("expected a scenario and --points, or --compare"),
+            std::string::npos)
+      << neither.out;
   const CommandRun bad_dispatch =
       Adse("fidelity " + file +
            " --points cores=1,freq_ghz=2.1,lidar_hz=7 --dispatch shared");

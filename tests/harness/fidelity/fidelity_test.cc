@@ -6,7 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -84,8 +87,66 @@ TEST(FidelityTest, TheMedianRealTimeRunIsHeldAgainstTheVirtualOne) {
   const std::string table = FormatPointFidelity(f);
   EXPECT_NE(table.find("±20% missed"), std::string::npos) << table;
   EXPECT_NE(table.find("±10% met"), std::string::npos) << table;
-  EXPECT_NE(table.find("±20% missed  n 100 / 100, 100, 100"), std::string::npos)
+  EXPECT_NE(
+      table.find("±20% missed  n 100 / 100, 100, 100, first 100 compared"),
+      std::string::npos)
       << table;
+}
+
+// "a/work" invoked `ms.size()` times, the i-th taking ms[i].
+runfile::RunData WithWork(const std::vector<double>& ms) {
+  runfile::RunData run = MadeRun(100.0, 30.0, 10.0);
+  std::erase_if(run.trace.callbacks,
+                [](const stack::CallbackRecord& r) { return r.callback == 0; });
+  for (size_t i = 0; i < ms.size(); ++i) {
+    stack::CallbackRecord work;
+    work.callback = 0;
+    work.start_s = static_cast<double>(i);
+    work.end_s = work.start_s + ms[i] / 1000.0;
+    work.work_units = 1000.0;
+    run.trace.callbacks.push_back(work);
+  }
+  return run;
+}
+
+TEST(FidelityTest, InvocationsOnlyTheRealTimeRunMadeAreNotCompared) {
+  // Both platforms draw the same costs in order: 10 and 20 ms alternating.
+  // The real-time run kept up better and made two more invocations, whose
+  // draws were 30 ms. Over all invocations its p50 would be 20 ms (+100 %);
+  // over the twelve both made, 10 ms as the virtual run's.
+  std::vector<double> draws;
+  for (int i = 0; i < 12; ++i) draws.push_back(i % 2 == 0 ? 10.0 : 20.0);
+  std::vector<double> more = draws;
+  more.insert(more.end(), {30.0, 30.0});
+  const PointFidelity f = CompareRuns(WithWork(draws), {WithWork(more)});
+  const Comparison& p50 = Find(f.callback_p50_ms, "a/work");
+  EXPECT_EQ(p50.virtual_count, 12);
+  EXPECT_EQ(p50.realtime_counts, (std::vector<int>{14}));
+  EXPECT_EQ(p50.compared_count, 12);
+  EXPECT_NEAR(p50.virtual_value, 10.0, 1e-9);
+  EXPECT_NEAR(p50.difference, 0.0, 1e-9);
+  EXPECT_TRUE(p50.met());
+  EXPECT_NEAR(Find(f.callback_p99_ms, "a/work").virtual_value, 20.0, 1e-9);
+  EXPECT_NEAR(Find(f.callback_p99_ms, "a/work").difference, 0.0, 1e-9);
+  EXPECT_NEAR(Find(f.callback_p50_ms_per_kunit, "a/work").difference, 0.0,
+              1e-9);
+  // Records out of start order (as a trace may hold them) are paired by
+  // when each invocation started.
+  runfile::RunData shuffled = WithWork(more);
+  std::reverse(shuffled.trace.callbacks.begin(),
+               shuffled.trace.callbacks.end());
+  EXPECT_NEAR(
+      Find(CompareRuns(WithWork(draws), {shuffled}).callback_p50_ms, "a/work")
+          .difference,
+      0.0, 1e-9);
+  // A real-time run slower on the invocations both made still misses.
+  std::vector<double> slower = more;
+  for (double& ms : slower) ms *= 1.3;
+  EXPECT_NEAR(
+      Find(CompareRuns(WithWork(draws), {WithWork(slower)}).callback_p50_ms,
+           "a/work")
+          .difference,
+      0.3, 1e-9);
 }
 
 TEST(FidelityTest, NavTimesOfRunsThatTimedOutAreNotCompared) {
@@ -195,6 +256,52 @@ TEST(FidelityTest, MoreWorkIsToldFromASlowerExecutorPerWorkUnit) {
   EXPECT_NEAR(unit.difference, 0.0, 1e-9);
   EXPECT_NE(FormatPointFidelity(f).find("per 1000 work units"),
             std::string::npos);
+}
+
+// `adse fidelity --compare`'s reading of a folder: what is not a folder of
+// its runs is an error naming the folder or file (the CLI test reads real
+// runs back).
+TEST(FidelityTest, AFolderWithoutFidelityRunsIsAnErrorNamingIt) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / "adse_fidelity_read_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  Result<std::vector<PointRuns>> none = ReadPointRuns(dir.string());
+  ASSERT_FALSE(none.ok());
+  EXPECT_EQ(none.status().code(), Status::Code::kNotFound);
+  EXPECT_NE(none.status().message().find((dir / "runs").string()),
+            std::string::npos)
+      << none.status().message();
+
+  std::filesystem::create_directories(dir / "runs");
+  EXPECT_EQ(ReadPointRuns(dir.string()).status().code(),
+            Status::Code::kNotFound);
+  auto touch = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / "runs" / name) << text;
+  };
+  touch("notes.txt", "not a run");  // other files are left alone
+  touch("1-virtual.h5", "not HDF5");
+  Result<std::vector<PointRuns>> lone = ReadPointRuns(dir.string());
+  ASSERT_FALSE(lone.ok());
+  EXPECT_NE(lone.status().message().find(
+                "point 1 has 1 virtual and 0 real-time run files"),
+            std::string::npos)
+      << lone.status().message();
+
+  touch("1-realtime-1.h5", "not HDF5");
+  Result<std::vector<PointRuns>> corrupt = ReadPointRuns(dir.string());
+  ASSERT_FALSE(corrupt.ok());
+  EXPECT_NE(corrupt.status().message().find("1-virtual.h5"), std::string::npos)
+      << corrupt.status().message();
+
+  touch("run.h5", "");
+  Result<std::vector<PointRuns>> named = ReadPointRuns(dir.string());
+  ASSERT_FALSE(named.ok());
+  EXPECT_EQ(named.status().code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(named.status().message().find("run.h5: expected run files named"),
+            std::string::npos)
+      << named.status().message();
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
