@@ -287,7 +287,8 @@ Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
     std::map<int, std::string> realtime_runs;
   };
   std::map<int, Files> by_point;
-  const std::regex name(R"((\d+)-(virtual(-[a-z_]+)?|realtime-(\d+))\.h5)");
+  const std::regex name(
+      R"((\d{1,6})-(virtual(-[a-z_]+)?|realtime-(\d{1,6}))\.h5)");
   for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
     const std::string file = entry.path().filename().string();
     if (entry.path().extension() != ".h5") continue;
@@ -323,6 +324,7 @@ Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
           files.realtime_runs.size()));
     }
     PointRuns runs;
+    std::string first_path;  // of the first dispatch's virtual run
     for (const std::string& path : files.virtual_runs) {
       Result<runfile::RunData> run = runfile::ReadRunFile(path);
       if (!run.ok()) return run.status();
@@ -339,6 +341,7 @@ Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
       // order the folder lists them in.
       const auto at = std::upper_bound(runs.dispatches.begin(),
                                        runs.dispatches.end(), dispatch);
+      if (at == runs.dispatches.begin()) first_path = path;
       runs.virtual_runs.insert(
           runs.virtual_runs.begin() + (at - runs.dispatches.begin()),
           std::move(run).value());
@@ -354,8 +357,7 @@ Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
     spec::ParseOptions parse;
     parse.check_files = false;  // only the space is read
     Result<spec::Spec> stored = spec::ParseSpec(
-        first.scenario_text, files.virtual_runs.front() + ": scenario/yaml", "",
-        parse);
+        first.scenario_text, first_path + ": scenario/yaml", "", parse);
     if (!stored.ok()) return stored.status();
     runs.point = spec::FormatPoint(stored->design_space, first.design_point);
     out.push_back(std::move(runs));

@@ -294,6 +294,10 @@ TEST(FidelityTest, AFolderWithoutFidelityRunsIsAnErrorNamingIt) {
   EXPECT_NE(corrupt.status().message().find("1-virtual.h5"), std::string::npos)
       << corrupt.status().message();
 
+  touch("99999999999-virtual.h5", "");
+  EXPECT_EQ(ReadPointRuns(dir.string()).status().code(),
+            Status::Code::kInvalidArgument);
+  std::filesystem::remove(dir / "runs" / "99999999999-virtual.h5");
   touch("run.h5", "");
   Result<std::vector<PointRuns>> named = ReadPointRuns(dir.string());
   ASSERT_FALSE(named.ok());
