@@ -12,19 +12,19 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 adse="${ADSE_BIN:-${root}/build/bin/adse}"
 repeats="${REPEATS:-5}"
 work="$(mktemp -d)"
-trap 'rm -rf "${work}"' EXIT
-py=/usr/bin/python3
+# The scenario variants sit beside the original so that its relative paths
+# (the cost profile) resolve.
+one_point_yaml="${root}/scenarios/.campaign_bench_one.$$.yaml"
+batch_yaml="${root}/scenarios/.campaign_bench_batch.$$.yaml"
+trap 'rm -rf "${work}" "${one_point_yaml}" "${batch_yaml}"' EXIT
 
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1 /proc/loadavg)"
 
-# Scenario variants next to the originals' calibration (relative path).
-mkdir -p "${work}/calibration"
-cp "${root}/scenarios/calibration/reference.json" "${work}/calibration/"
 sed -e 's/values: \[1, 4, 16\]/values: [4]/' -e 's/values: \[1.0, 2.1\]/values: [2.1]/' \
     -e 's/values: \[7, 14\]/values: [14]/' \
-    "${root}/scenarios/robotaxi_small.yaml" > "${work}/one_point.yaml"
+    "${root}/scenarios/robotaxi_small.yaml" > "${one_point_yaml}"
 sed -e 's/values: \[1, 4, 16\]/values: [4, 16]/' \
-    "${root}/scenarios/robotaxi_small.yaml" > "${work}/batch.yaml"
+    "${root}/scenarios/robotaxi_small.yaml" > "${batch_yaml}"
 
 now() { date +%s.%N; }
 median() { sort -g | awk '{a[NR]=$1} END {print (NR%2) ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2}'; }
@@ -40,18 +40,18 @@ sim_totals=(); run_totals=(); one_point=()
 for i in $(seq "${repeats}"); do
   t0=$(now)
   for p in ${points}; do
-    "${adse}" simulate "${work}/batch.yaml" --point "${p}" -o "${work}/sim.h5" -q > /dev/null
+    "${adse}" simulate "${batch_yaml}" --point "${p}" -o "${work}/sim.h5" -q > /dev/null
   done
   t1=$(now)
   rm -rf "${work}/camp"
-  "${adse}" run "${work}/batch.yaml" -o "${work}/camp" --strategy exhaustive --workers 1 \
+  "${adse}" run "${batch_yaml}" -o "${work}/camp" --strategy exhaustive --workers 1 \
     --no-cache --quiet > /dev/null
   t2=$(now)
   rm -rf "${work}/one"
-  "${adse}" run "${work}/one_point.yaml" -o "${work}/one" --strategy exhaustive --workers 1 \
+  "${adse}" run "${one_point_yaml}" -o "${work}/one" --strategy exhaustive --workers 1 \
     --no-cache --quiet > /dev/null
   t3=$(now)
-  "${adse}" simulate "${work}/one_point.yaml" --point cores=4,freq_ghz=2.1,lidar_hz=14 \
+  "${adse}" simulate "${one_point_yaml}" --point cores=4,freq_ghz=2.1,lidar_hz=14 \
     -o "${work}/sim.h5" -q > /dev/null
   t4=$(now)
   sim_totals+=("$(echo "${t1} - ${t0}" | bc)")
@@ -76,7 +76,7 @@ one=""
 for workers in 1 2; do
   rm -rf "${work}/batch-${workers}"
   t0=$(now)
-  "${adse}" run "${work}/batch.yaml" -o "${work}/batch-${workers}" --strategy exhaustive \
+  "${adse}" run "${batch_yaml}" -o "${work}/batch-${workers}" --strategy exhaustive \
     --workers "${workers}" --no-cache --quiet > /dev/null
   t1=$(now)
   wall=$(echo "${t1} - ${t0}" | bc)
