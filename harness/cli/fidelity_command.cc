@@ -6,7 +6,6 @@
 // such runs), 1 otherwise.
 #include <algorithm>
 #include <cstdio>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -138,8 +137,8 @@ struct Comparisons {
   }
 };
 
-// The point's runs themselves, for adse analyze and h5py: runs/N-virtual
-// (one per dispatch, `suffix` naming it) and runs/N-realtime-R.
+// The point's runs themselves, for adse analyze, h5py and --compare:
+// runs/N-virtual[-<dispatch>] (one per dispatch) and runs/N-realtime-R.
 Status WritePointRuns(const std::string& dir, size_t n,
                       const fidelity::PointRuns& runs) {
   Status written = MakeDirs(dir + "/runs");

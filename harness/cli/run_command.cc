@@ -106,7 +106,7 @@ class Progress : public campaign::ExplorerListener {
                                  campaign::RowMetric(row, "ctrl_rate_hz")),
           campaign::RowMetric(row, "hardware_cost"), Feasibility(row, censored),
           row.source,
-          row.source == "simulated" ? fmt::format(" {:.1f} s", row.wall_s)
+          row.source == "simulated" ? fmt::format(" in {:.1f} s", row.wall_s)
                                     : "");
     }
     if (!line.empty() && (failed || !quiet_)) {
