@@ -114,12 +114,25 @@ std::optional<Genes> UnseenSampler::Next(const std::set<Genes>& seen) {
   return std::nullopt;
 }
 
-analysis::Evaluation ParetoEvaluationOf(const spec::Spec& spec,
-                                        const Observation& observation) {
+namespace {
+
+// ConstraintViolation with the constraints already parsed.
+double ViolationOf(const spec::ConstraintChecker& checker,
+                   const Observation& observation) {
+  if (observation.failed) return std::numeric_limits<double>::infinity();
+  if (observation.feasible) return 0.0;
+  return std::max(checker.ViolatedCount(observation.metrics, observation.point),
+                  1);
+}
+
+// ParetoEvaluationOf with the constraints already parsed.
+analysis::Evaluation EvaluationOf(const spec::Spec& spec,
+                                  const spec::ConstraintChecker& checker,
+                                  const Observation& observation) {
   analysis::Evaluation input;
   input.point = observation.point;
   input.objectives = MinimizationObjectives(spec, observation);
-  input.violation = ConstraintViolation(spec, observation);
+  input.violation = ViolationOf(checker, observation);
   input.feasible = observation.feasible && !observation.failed;
   for (double& v : input.objectives) {
     // Unplaceable runs still take part, ranked behind every placed one.
@@ -133,12 +146,21 @@ analysis::Evaluation ParetoEvaluationOf(const spec::Spec& spec,
   return input;
 }
 
+}  // namespace
+
+analysis::Evaluation ParetoEvaluationOf(const spec::Spec& spec,
+                                        const Observation& observation) {
+  return EvaluationOf(spec, spec::ConstraintChecker(spec), observation);
+}
+
 std::vector<int> ParetoFrontOf(const spec::Spec& spec,
                                const std::vector<Observation>& observations) {
+  // Parsed once for all the rows.
+  const spec::ConstraintChecker checker(spec);
   std::vector<analysis::Evaluation> evals;
   evals.reserve(observations.size());
   for (const Observation& o : observations) {
-    evals.push_back(ParetoEvaluationOf(spec, o));
+    evals.push_back(EvaluationOf(spec, checker, o));
   }
   return analysis::ParetoFront(evals);
 }
@@ -161,11 +183,7 @@ std::vector<double> MinimizationObjectives(const spec::Spec& spec,
 
 double ConstraintViolation(const spec::Spec& spec,
                            const Observation& observation) {
-  if (observation.failed) return std::numeric_limits<double>::infinity();
-  if (observation.feasible) return 0.0;
-  return std::max(spec::ViolatedConstraintCount(spec, observation.metrics,
-                                                observation.point),
-                  1);
+  return ViolationOf(spec::ConstraintChecker(spec), observation);
 }
 
 const std::vector<std::string>& StrategyNames() {

@@ -156,6 +156,23 @@ Result<double> EvaluateCost(const Spec& spec, const DesignPoint& point) {
   return *value;
 }
 
+namespace {
+
+// Whether a parsed constraint holds for the metrics and the point.
+Result<bool> Holds(const Expression& e,
+                   const std::map<std::string, double>& metrics,
+                   const DesignPoint& point) {
+  std::map<std::string, double> vars = metrics;
+  for (const auto& [name, value] : point) vars[name] = value;
+  Result<double> value = e.TryEvaluate(vars);
+  if (!value.ok()) return value.status();
+  // NaN (a metric without a value, e.g. nav_time_s of a failed run) never
+  // satisfies a constraint.
+  return std::isfinite(*value) && *value != 0.0;
+}
+
+}  // namespace
+
 Result<bool> EvaluateConstraint(const Spec& spec, const std::string& constraint,
                                 const std::map<std::string, double>& metrics,
                                 const DesignPoint& point) {
@@ -165,30 +182,48 @@ Result<bool> EvaluateConstraint(const Spec& spec, const std::string& constraint,
     return Status::InvalidArgument("constraint '" + constraint +
                                    "': " + e.status().message());
   }
-  std::map<std::string, double> vars = metrics;
-  for (const auto& [name, value] : point) vars[name] = value;
-  Result<double> value = e->TryEvaluate(vars);
-  if (!value.ok()) return value.status();
-  // NaN (a metric without a value, e.g. nav_time_s of a failed run) never
-  // satisfies a constraint.
-  return std::isfinite(*value) && *value != 0.0;
+  return Holds(*e, metrics, point);
+}
+
+ConstraintChecker::ConstraintChecker(const Spec& spec)
+    : texts_(spec.constraints) {
+  const std::vector<std::string> names =
+      ConstraintVariableNames(spec.design_space);
+  for (const std::string& text : texts_) {
+    Result<Expression> e = Expression::Parse(text, names);
+    parsed_.push_back(e.ok() ? std::optional<Expression>(std::move(e).value())
+                             : std::nullopt);
+  }
+}
+
+std::vector<std::string> ConstraintChecker::Violated(
+    const std::map<std::string, double>& metrics,
+    const DesignPoint& point) const {
+  std::vector<std::string> violated;
+  for (size_t i = 0; i < texts_.size(); ++i) {
+    Result<bool> holds =
+        parsed_[i] ? Holds(*parsed_[i], metrics, point) : Result<bool>(false);
+    if (!holds.ok() || !*holds) violated.push_back(texts_[i]);
+  }
+  return violated;
+}
+
+int ConstraintChecker::ViolatedCount(
+    const std::map<std::string, double>& metrics,
+    const DesignPoint& point) const {
+  return static_cast<int>(Violated(metrics, point).size());
 }
 
 std::vector<std::string> ViolatedConstraints(
     const Spec& spec, const std::map<std::string, double>& metrics,
     const DesignPoint& point) {
-  std::vector<std::string> violated;
-  for (const std::string& constraint : spec.constraints) {
-    Result<bool> holds = EvaluateConstraint(spec, constraint, metrics, point);
-    if (!holds.ok() || !*holds) violated.push_back(constraint);
-  }
-  return violated;
+  return ConstraintChecker(spec).Violated(metrics, point);
 }
 
 int ViolatedConstraintCount(const Spec& spec,
                             const std::map<std::string, double>& metrics,
                             const DesignPoint& point) {
-  return static_cast<int>(ViolatedConstraints(spec, metrics, point).size());
+  return ConstraintChecker(spec).ViolatedCount(metrics, point);
 }
 
 Result<PointConfig> ApplyPoint(const Spec& spec, const DesignPoint& point) {

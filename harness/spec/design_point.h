@@ -5,10 +5,12 @@
 #define ADSE_HARNESS_SPEC_DESIGN_POINT_H_
 
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "harness/spec/expression.h"
 #include "harness/spec/spec.h"
 #include "stack/base/status.h"
 
@@ -65,6 +67,25 @@ std::vector<std::string> ViolatedConstraints(
 int ViolatedConstraintCount(const Spec& spec,
                             const std::map<std::string, double>& metrics,
                             const DesignPoint& point);
+
+// The spec's constraints parsed once, to check many rows: parsing is most
+// of a check (a front over a campaign's rows checks every infeasible one).
+// Not thread-safe on one object (muParser keeps state); copies are.
+class ConstraintChecker {
+ public:
+  explicit ConstraintChecker(const Spec& spec);
+  // As ViolatedConstraints, and ViolatedConstraintCount.
+  std::vector<std::string> Violated(
+      const std::map<std::string, double>& metrics,
+      const DesignPoint& point) const;
+  int ViolatedCount(const std::map<std::string, double>& metrics,
+                    const DesignPoint& point) const;
+
+ private:
+  std::vector<std::string> texts_;
+  // One per constraint; empty where it does not parse (never holds).
+  std::vector<std::optional<Expression>> parsed_;
+};
 
 // A design point applied to the spec: the platform and stack one run uses.
 struct PointConfig {

@@ -190,6 +190,28 @@ TEST(DesignPointTest, ConstraintsOverMetrics) {
   EXPECT_FALSE(EvaluateConstraint(spec, "collisions == 0", {}, point).ok());
 }
 
+TEST(DesignPointTest, AConstraintCheckerParsedOnceAgreesRowByRow) {
+  Spec spec = Reference();
+  const DesignPoint point = {{"cores", 4}, {"freq_ghz", 1.2}, {"lidar_hz", 14}};
+  const ConstraintChecker checker(spec);
+  const std::vector<std::map<std::string, double>> rows = {
+      {{"nav_time_s", 165}, {"ctrl_rate_hz", 7.8}, {"completed", 1}},
+      {{"nav_time_s", 1248}, {"ctrl_rate_hz", 7.8}, {"completed", 1}},
+      {{"nav_time_s", 1248}, {"ctrl_rate_hz", 0.91}, {"completed", 0}},
+      {{"nav_time_s", std::nan("")}, {"completed", 1}}};
+  const std::vector<int> expected = {0, 1, 3, 2};
+  for (size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(checker.Violated(rows[i], point),
+              ViolatedConstraints(spec, rows[i], point))
+        << i;
+    EXPECT_EQ(checker.ViolatedCount(rows[i], point), expected[i]) << i;
+  }
+  // A constraint that does not parse never holds.
+  spec.constraints.push_back("nav_time_s <=");
+  EXPECT_EQ(ConstraintChecker(spec).Violated(rows[0], point),
+            std::vector<std::string>{"nav_time_s <="});
+}
+
 TEST(DesignPointTest, ApplyPointSetsPlatformAndStack) {
   const Spec spec = Reference();
   Result<PointConfig> config =
