@@ -116,23 +116,24 @@ std::optional<Genes> UnseenSampler::Next(const std::set<Genes>& seen) {
 
 namespace {
 
-// ConstraintViolation with the constraints already parsed.
-double ViolationOf(const spec::ConstraintChecker& checker,
-                   const Observation& observation) {
+// How badly `observation` misses the constraints; `violated_count` counts
+// the ones that do not hold and is called only when the observation
+// itself does not settle it (parsing constraints is most of the cost).
+template <typename Count>
+double ViolationOf(const Observation& observation, Count violated_count) {
   if (observation.failed) return std::numeric_limits<double>::infinity();
   if (observation.feasible) return 0.0;
-  return std::max(checker.ViolatedCount(observation.metrics, observation.point),
-                  1);
+  return std::max(violated_count(), 1);
 }
 
-// ParetoEvaluationOf with the constraints already parsed.
+// ParetoEvaluationOf with its violation given.
 analysis::Evaluation EvaluationOf(const spec::Spec& spec,
-                                  const spec::ConstraintChecker& checker,
-                                  const Observation& observation) {
+                                  const Observation& observation,
+                                  double violation) {
   analysis::Evaluation input;
   input.point = observation.point;
   input.objectives = MinimizationObjectives(spec, observation);
-  input.violation = ViolationOf(checker, observation);
+  input.violation = violation;
   input.feasible = observation.feasible && !observation.failed;
   for (double& v : input.objectives) {
     // Unplaceable runs still take part, ranked behind every placed one.
@@ -150,7 +151,8 @@ analysis::Evaluation EvaluationOf(const spec::Spec& spec,
 
 analysis::Evaluation ParetoEvaluationOf(const spec::Spec& spec,
                                         const Observation& observation) {
-  return EvaluationOf(spec, spec::ConstraintChecker(spec), observation);
+  return EvaluationOf(spec, observation,
+                      ConstraintViolation(spec, observation));
 }
 
 std::vector<int> ParetoFrontOf(const spec::Spec& spec,
@@ -160,7 +162,9 @@ std::vector<int> ParetoFrontOf(const spec::Spec& spec,
   std::vector<analysis::Evaluation> evals;
   evals.reserve(observations.size());
   for (const Observation& o : observations) {
-    evals.push_back(EvaluationOf(spec, checker, o));
+    const double violation = ViolationOf(
+        o, [&] { return checker.ViolatedCount(o.metrics, o.point); });
+    evals.push_back(EvaluationOf(spec, o, violation));
   }
   return analysis::ParetoFront(evals);
 }
@@ -183,7 +187,10 @@ std::vector<double> MinimizationObjectives(const spec::Spec& spec,
 
 double ConstraintViolation(const spec::Spec& spec,
                            const Observation& observation) {
-  return ViolationOf(spec::ConstraintChecker(spec), observation);
+  return ViolationOf(observation, [&] {
+    return spec::ViolatedConstraintCount(spec, observation.metrics,
+                                         observation.point);
+  });
 }
 
 const std::vector<std::string>& StrategyNames() {
