@@ -183,6 +183,7 @@ struct FidelityArgs {
   std::string task_case;            // which of task.cases (when it has any)
   std::vector<std::string> points;  // "cores=1,freq_ghz=2.1,..."
   int runs = 3;                     // real-time runs per point
+  int perturbed_runs = 4;           // virtual runs with costs x (1 ± 1e-4 k)
   std::string clock_by;             // "padding"/"quota"; empty: the file's
   // The virtual platform's dispatches, each held against the same
   // real-time runs; empty: the file's platform.dispatch.

@@ -1,9 +1,9 @@
-// `adse fidelity <scenario> --points P1 P2 ... [--runs K]`: each point on
-// the virtual platform and K times on the real-time one, compared (harness/
-// fidelity); `adse fidelity --compare DIR` compares an earlier call's runs
-// again. Exit 0 ok, 2 bad input (a point outside the space, a scenario
-// without a cost profile, more cores than the host gives, a folder without
-// such runs), 1 otherwise.
+// `adse fidelity <scenario> --points P1 P2 ... [--runs K] [--perturbed-runs
+// P]`: each point on the virtual platform (1 + P times) and K times on the
+// real-time one, compared (harness/fidelity); `adse fidelity --compare DIR`
+// compares an earlier call's runs again. Exit 0 ok, 2 bad input (a point
+// outside the space, a scenario without a cost profile, more cores than the
+// host gives, a folder without such runs), 1 otherwise.
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -33,9 +33,13 @@ nlohmann::json ComparisonsJson(
   for (const fidelity::Comparison& c : comparisons) {
     nlohmann::json runs = nlohmann::json::array();
     for (double v : c.realtime) runs.push_back(number(v));
+    nlohmann::json virtual_runs = nlohmann::json::array();
+    for (double v : c.virtual_runs) virtual_runs.push_back(number(v));
     out.push_back(
         {{"name", c.name},
          {"virtual", number(c.virtual_value)},
+         {"virtual_runs", virtual_runs},
+         {"virtual_runs_without", c.virtual_runs_without},
          {"realtime_median", number(c.realtime_median)},
          {"realtime_runs", runs},
          {"realtime_runs_without", c.runs_without},
@@ -57,8 +61,11 @@ nlohmann::json PointJson(const fidelity::PointFidelity& f) {
           {"dispatch", f.dispatch},
           {"confinement", f.confinement},
           {"clock_by", f.clock_by},
+          {"perturbed_runs", f.perturbed_outcomes.size()},
           {"ended",
-           {{"virtual", f.virtual_outcome}, {"realtime", f.realtime_outcomes}}},
+           {{"virtual", f.virtual_outcome},
+            {"virtual_perturbed", f.perturbed_outcomes},
+            {"realtime", f.realtime_outcomes}}},
           {"metrics", ComparisonsJson(f.metrics)},
           {"callback_p50_ms", ComparisonsJson(f.callback_p50_ms)},
           {"callback_p99_ms", ComparisonsJson(f.callback_p99_ms)},
@@ -138,14 +145,21 @@ struct Comparisons {
 };
 
 // The point's runs themselves, for adse analyze, h5py and --compare:
-// runs/N-virtual[-<dispatch>] (one per dispatch) and runs/N-realtime-R.
+// runs/N-virtual[-<dispatch>] (one per dispatch), its perturbed runs
+// N-virtual[-<dispatch>]-pK, and runs/N-realtime-R.
 Status WritePointRuns(const std::string& dir, size_t n,
                       const fidelity::PointRuns& runs) {
   Status written = MakeDirs(dir + "/runs");
   for (size_t d = 0; d < runs.virtual_runs.size() && written.ok(); ++d) {
-    written = runfile::WriteRunFile(
-        fmt::format("{}/runs/{}-virtual{}.h5", dir, n, DispatchSuffix(runs, d)),
-        runs.virtual_runs[d]);
+    const std::string stem =
+        fmt::format("{}/runs/{}-virtual{}", dir, n, DispatchSuffix(runs, d));
+    written = runfile::WriteRunFile(stem + ".h5", runs.virtual_runs[d]);
+    for (size_t k = 0; d < runs.perturbed_runs.size() &&
+                       k < runs.perturbed_runs[d].size() && written.ok();
+         ++k) {
+      written = runfile::WriteRunFile(fmt::format("{}-p{}.h5", stem, k + 1),
+                                      runs.perturbed_runs[d][k]);
+    }
   }
   for (size_t r = 0; r < runs.realtime_runs.size() && written.ok(); ++r) {
     written = runfile::WriteRunFile(
@@ -230,6 +244,7 @@ int RunFidelity(const FidelityArgs& args) {
   }
   fidelity::FidelityOptions options;
   options.runs = args.runs;
+  options.perturbed_runs = args.perturbed_runs;
   for (const std::string& name : args.dispatch) {
     spec::Dispatch d;
     spec::StringToDispatch(name, &d);  // CLI11 checked the name

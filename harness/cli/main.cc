@@ -453,7 +453,9 @@ int main(int argc, char** argv) {
   CLI::App* fidelity_cmd = app.add_subcommand(
       "fidelity",
       "Hold the virtual platform against real execution: run each point on "
-      "the virtual platform and --runs times on the real-time one (the "
+      "the virtual platform (and --perturbed-runs more times with costs "
+      "moved by parts in ten thousand) and --runs times on the real-time one "
+      "(the "
       "stack in a process of its own on as many host CPUs as the point has "
       "cores), and "
       "compare nav time, control rate, drops, the sensing-to-control chain "
@@ -473,6 +475,15 @@ int main(int argc, char** argv) {
                    "Real-time runs per point (default 3; their median is "
                    "compared)")
       ->check(CLI::Range(1, 100));
+  fidelity_cmd
+      ->add_option(
+          "--perturbed-runs", fidelity.perturbed_runs,
+          "Virtual runs per point besides the scenario's own, with every "
+          "cost scaled by 1 + 1e-4, 1 - 1e-4, 1 + 2e-4, ... (default 4; a "
+          "starved closed loop answers so small a change with another "
+          "callback order, so one virtual run is one draw, as one real-time "
+          "run is; the run metrics' median over them is compared)")
+      ->check(CLI::Range(0, 100));
   fidelity_cmd
       ->add_option(
           "--clock-by", fidelity.clock_by,
@@ -500,7 +511,7 @@ int main(int argc, char** argv) {
       "(its runs/), simulating nothing; writes fidelity.txt, fidelity.json "
       "and the pictures there, or to -o");
   for (const char* name : {"scenario", "--case", "--points", "--runs",
-                           "--clock-by", "--dispatch"}) {
+                           "--perturbed-runs", "--clock-by", "--dispatch"}) {
     fidelity_compare->excludes(name);
   }
 

@@ -30,6 +30,8 @@ constexpr double kCallbackTolerance = 0.20;  // per-callback p50
 // Callbacks cheaper than this on the virtual platform are left out: their
 // latency is the executor's bookkeeping, not the model.
 constexpr double kMinCallbackMs = 1.0;
+// The step of the perturbed runs' cost factors (PerturbedCostScale).
+constexpr double kPerturbation = 1e-4;
 
 // Nearest-rank quantile of `v` (sorted in place).
 double Quantile(std::vector<double>& v, double q) {
@@ -40,24 +42,36 @@ double Quantile(std::vector<double>& v, double q) {
   return v[std::max<size_t>(rank, 1) - 1];
 }
 
-Comparison Compare(const std::string& name, double virtual_value,
+// The values that are not NaN into `present`; how many were, returned.
+int SplitMissing(const std::vector<double>& values,
+                 std::vector<double>* present) {
+  int missing = 0;
+  for (double v : values) {
+    if (std::isnan(v)) {
+      ++missing;
+    } else {
+      present->push_back(v);
+    }
+  }
+  return missing;
+}
+
+// `virtual_values`: one per virtual run, `realtime` one per real-time run,
+// NaN where a run lacked it.
+Comparison Compare(const std::string& name,
+                   const std::vector<double>& virtual_values,
                    const std::vector<double>& realtime,
                    std::optional<double> tolerance) {
   Comparison c;
   c.name = name;
-  c.virtual_value = virtual_value;
-  for (double v : realtime) {
-    if (std::isnan(v)) {
-      ++c.runs_without;
-    } else {
-      c.realtime.push_back(v);
-    }
-  }
+  c.virtual_runs_without = SplitMissing(virtual_values, &c.virtual_runs);
+  c.runs_without = SplitMissing(realtime, &c.realtime);
+  c.virtual_value = analysis::Percentile(c.virtual_runs, 0.5);
   c.realtime_median = analysis::Percentile(c.realtime, 0.5);
   c.difference =
-      std::isfinite(virtual_value) && virtual_value != 0.0 &&
+      std::isfinite(c.virtual_value) && c.virtual_value != 0.0 &&
               std::isfinite(c.realtime_median)
-          ? (c.realtime_median - virtual_value) / std::abs(virtual_value)
+          ? (c.realtime_median - c.virtual_value) / std::abs(c.virtual_value)
           : kNaN;
   c.tolerance = tolerance;
   return c;
@@ -129,18 +143,29 @@ std::string Number(double v) {
 
 }  // namespace
 
+double PerturbedCostScale(int k) {
+  const double step = kPerturbation * static_cast<double>((k + 1) / 2);
+  return k % 2 == 1 ? 1.0 + step : 1.0 - step;
+}
+
 bool Comparison::met() const {
-  return tolerance && runs_without == 0 && std::isfinite(difference) &&
-         std::abs(difference) <= *tolerance;
+  return tolerance && runs_without == 0 && virtual_runs_without == 0 &&
+         std::isfinite(difference) && std::abs(difference) <= *tolerance;
 }
 
 PointFidelity CompareRuns(const runfile::RunData& virtual_run,
-                          const std::vector<runfile::RunData>& realtime_runs) {
+                          const std::vector<runfile::RunData>& realtime_runs,
+                          const std::vector<runfile::RunData>& perturbed_runs) {
   PointFidelity f;
   f.virtual_outcome = virtual_run.termination_reason;
+  for (const runfile::RunData& r : perturbed_runs) {
+    f.perturbed_outcomes.push_back(r.termination_reason);
+  }
   for (const runfile::RunData& r : realtime_runs) {
     f.realtime_outcomes.push_back(r.termination_reason);
   }
+  std::vector<const runfile::RunData*> virtual_runs = {&virtual_run};
+  for (const runfile::RunData& r : perturbed_runs) virtual_runs.push_back(&r);
   struct Quantity {
     const char* name;
     std::optional<double> tolerance;
@@ -156,22 +181,23 @@ PointFidelity CompareRuns(const runfile::RunData& virtual_run,
                             Quantity{"dropped_messages", std::nullopt},
                             Quantity{"lidar_frames_dropped", std::nullopt}}) {
     const bool time = std::string(q.name) == "nav_time_s";
-    std::vector<double> rt;
-    for (const runfile::RunData& r : realtime_runs) {
-      rt.push_back(time && !reached(r) ? kNaN : Metric(r, q.name));
-    }
-    f.metrics.push_back(Compare(
-        q.name,
-        time && !reached(virtual_run) ? kNaN : Metric(virtual_run, q.name), rt,
-        q.tolerance));
+    auto value = [&](const runfile::RunData& r) {
+      return time && !reached(r) ? kNaN : Metric(r, q.name);
+    };
+    std::vector<double> v, rt;
+    for (const runfile::RunData* r : virtual_runs) v.push_back(value(*r));
+    for (const runfile::RunData& r : realtime_runs) rt.push_back(value(r));
+    f.metrics.push_back(Compare(q.name, v, rt, q.tolerance));
   }
-  std::vector<double> chain;
+  std::vector<double> v_chain, chain;
+  for (const runfile::RunData* r : virtual_runs) {
+    v_chain.push_back(SensingToControlMs(*r));
+  }
   for (const runfile::RunData& r : realtime_runs) {
     chain.push_back(SensingToControlMs(r));
   }
-  f.metrics.push_back(Compare("sensing_to_control_ms",
-                              SensingToControlMs(virtual_run), chain,
-                              std::nullopt));
+  f.metrics.push_back(
+      Compare("sensing_to_control_ms", v_chain, chain, std::nullopt));
 
   // Both platforms draw a callback's i-th cost from the same seeded
   // stream, so its latencies are compared over the invocations every run
@@ -212,7 +238,7 @@ PointFidelity CompareRuns(const runfile::RunData& virtual_run,
     auto compare = [&](double q, bool per_kunit,
                        std::optional<double> tolerance) {
       Comparison c =
-          Compare(name, InvocationQuantile(invocations, n, q, per_kunit),
+          Compare(name, {InvocationQuantile(invocations, n, q, per_kunit)},
                   realtime(q, per_kunit), tolerance);
       c.virtual_count = static_cast<int>(invocations.size());
       c.realtime_counts = counts;
@@ -236,6 +262,11 @@ Result<PointRuns> RunPoint(const spec::Spec& input,
     return Status::InvalidArgument(
         fmt::format("runs: expected at least 1, found {}", options.runs));
   }
+  if (options.perturbed_runs < 0) {
+    return Status::InvalidArgument(
+        fmt::format("perturbed_runs: expected at least 0, found {}",
+                    options.perturbed_runs));
+  }
   ADSE_RETURN_IF_ERROR(input.design_space.Check(point));
   spec::Spec spec = input;
   spec.harness.early_stop = false;
@@ -245,19 +276,30 @@ Result<PointRuns> RunPoint(const spec::Spec& input,
   if (runs.dispatches.empty()) runs.dispatches = {spec.platform.dispatch};
 
   spec.platform.kind = spec::PlatformKind::kVirtual;
+  const double cost_scale = spec.platform.cost_scale;
   for (spec::Dispatch dispatch : runs.dispatches) {
     spec.platform.dispatch = dispatch;
-    if (options.on_run) {
-      options.on_run(
-          runs.point,
-          runs.dispatches.size() == 1
-              ? std::string("virtual")
-              : fmt::format("virtual {}", spec::DispatchToString(dispatch)));
+    const std::string what =
+        runs.dispatches.size() == 1
+            ? std::string("virtual")
+            : fmt::format("virtual {}", spec::DispatchToString(dispatch));
+    runs.perturbed_runs.emplace_back();
+    for (int k = 0; k <= options.perturbed_runs; ++k) {
+      if (options.on_run) {
+        options.on_run(runs.point,
+                       k == 0 ? what
+                              : fmt::format("{} perturbed {}/{}", what, k,
+                                            options.perturbed_runs));
+      }
+      spec.platform.cost_scale =
+          k == 0 ? cost_scale : cost_scale * PerturbedCostScale(k);
+      Result<runfile::RunData> run = sim::SimulatePoint(spec, point);
+      if (!run.ok()) return run.status();
+      (k == 0 ? runs.virtual_runs : runs.perturbed_runs.back())
+          .push_back(std::move(run).value());
     }
-    Result<runfile::RunData> run = sim::SimulatePoint(spec, point);
-    if (!run.ok()) return run.status();
-    runs.virtual_runs.push_back(std::move(run).value());
   }
+  spec.platform.cost_scale = cost_scale;
 
   spec.platform.kind = spec::PlatformKind::kCgroup;
   spec.platform.dispatch = spec::Dispatch::kRunToCompletion;
@@ -273,6 +315,24 @@ Result<PointRuns> RunPoint(const spec::Spec& input,
   return runs;
 }
 
+namespace {
+
+// A virtual run file's platform.dispatch.
+Result<spec::Dispatch> DispatchOf(const runfile::RunData& run,
+                                  const std::string& path) {
+  spec::Dispatch dispatch;
+  const auto it = run.platform.find("dispatch");
+  if (it == run.platform.end() ||
+      !spec::StringToDispatch(it->second, &dispatch)) {
+    return Status::InvalidArgument(fmt::format(
+        "{}: platform.dispatch: expected one of the dispatches, found '{}'",
+        path, it == run.platform.end() ? "" : it->second));
+  }
+  return dispatch;
+}
+
+}  // namespace
+
 Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
   const std::filesystem::path folder = std::filesystem::path(dir) / "runs";
   std::error_code error;
@@ -284,24 +344,29 @@ Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
   // By N: the virtual runs' paths, then the real-time runs' by K.
   struct Files {
     std::vector<std::string> virtual_runs;
+    // By the name's dispatch part, then K.
+    std::map<std::string, std::map<int, std::string>> perturbed_runs;
     std::map<int, std::string> realtime_runs;
   };
   std::map<int, Files> by_point;
   const std::regex name(
-      R"((\d{1,6})-(virtual(-[a-z_]+)?|realtime-(\d{1,6}))\.h5)");
+      R"((\d{1,6})-(virtual(-[a-z_]+)?(-p(\d{1,6}))?|realtime-(\d{1,6}))\.h5)");
   for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
     const std::string file = entry.path().filename().string();
     if (entry.path().extension() != ".h5") continue;
     std::smatch m;
     if (!std::regex_match(file, m, name)) {
       return Status::InvalidArgument(fmt::format(
-          "{}: expected run files named N-virtual[-<dispatch>].h5 or "
+          "{}: expected run files named N-virtual[-<dispatch>][-pK].h5 or "
           "N-realtime-K.h5",
           entry.path().string()));
     }
     Files& files = by_point[std::stoi(m[1].str())];
-    if (m[4].matched) {
-      files.realtime_runs[std::stoi(m[4].str())] = entry.path().string();
+    if (m[6].matched) {
+      files.realtime_runs[std::stoi(m[6].str())] = entry.path().string();
+    } else if (m[5].matched) {
+      files.perturbed_runs[m[3].str()][std::stoi(m[5].str())] =
+          entry.path().string();
     } else {
       files.virtual_runs.push_back(entry.path().string());
     }
@@ -328,24 +393,36 @@ Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
     for (const std::string& path : files.virtual_runs) {
       Result<runfile::RunData> run = runfile::ReadRunFile(path);
       if (!run.ok()) return run.status();
-      spec::Dispatch dispatch;
-      const auto it = run->platform.find("dispatch");
-      if (it == run->platform.end() ||
-          !spec::StringToDispatch(it->second, &dispatch)) {
-        return Status::InvalidArgument(fmt::format(
-            "{}: platform.dispatch: expected one of the dispatches, found "
-            "'{}'",
-            path, it == run->platform.end() ? "" : it->second));
-      }
+      Result<spec::Dispatch> dispatch = DispatchOf(*run, path);
+      if (!dispatch.ok()) return dispatch.status();
       // In the vocabulary's order (run to completion first), whatever
       // order the folder lists them in.
       const auto at = std::upper_bound(runs.dispatches.begin(),
-                                       runs.dispatches.end(), dispatch);
+                                       runs.dispatches.end(), *dispatch);
       if (at == runs.dispatches.begin()) first_path = path;
       runs.virtual_runs.insert(
           runs.virtual_runs.begin() + (at - runs.dispatches.begin()),
           std::move(run).value());
-      runs.dispatches.insert(at, dispatch);
+      runs.dispatches.insert(at, *dispatch);
+    }
+    runs.perturbed_runs.resize(runs.dispatches.size());
+    for (const auto& [name_part, by_k] : files.perturbed_runs) {
+      for (const auto& [k, path] : by_k) {
+        Result<runfile::RunData> run = runfile::ReadRunFile(path);
+        if (!run.ok()) return run.status();
+        Result<spec::Dispatch> dispatch = DispatchOf(*run, path);
+        if (!dispatch.ok()) return dispatch.status();
+        const auto at = std::find(runs.dispatches.begin(),
+                                  runs.dispatches.end(), *dispatch);
+        if (at == runs.dispatches.end()) {
+          return Status::InvalidArgument(fmt::format(
+              "{}: a perturbed run of point {} with the {} dispatch, but no "
+              "virtual run of that dispatch beside it",
+              path, n, spec::DispatchToString(*dispatch)));
+        }
+        runs.perturbed_runs[at - runs.dispatches.begin()].push_back(
+            std::move(run).value());
+      }
     }
     for (const auto& [k, path] : files.realtime_runs) {
       Result<runfile::RunData> run = runfile::ReadRunFile(path);
@@ -366,7 +443,11 @@ Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
 }
 
 PointFidelity ComparePoint(const PointRuns& runs, size_t i) {
-  PointFidelity f = CompareRuns(runs.virtual_runs.at(i), runs.realtime_runs);
+  static const std::vector<runfile::RunData> kNone;
+  const std::vector<runfile::RunData>& perturbed =
+      i < runs.perturbed_runs.size() ? runs.perturbed_runs[i] : kNone;
+  PointFidelity f =
+      CompareRuns(runs.virtual_runs.at(i), runs.realtime_runs, perturbed);
   f.point = runs.point;
   f.dispatch = spec::DispatchToString(runs.dispatches.at(i));
   if (!runs.realtime_runs.empty()) {
@@ -381,31 +462,61 @@ PointFidelity ComparePoint(const PointRuns& runs, size_t i) {
 std::string FormatPointFidelity(const PointFidelity& f) {
   std::ostringstream out;
   const size_t k = f.realtime_outcomes.size();
+  const size_t p = f.perturbed_outcomes.size();
+  // The last perturbed run's factor is the farthest from 1.
+  const std::string perturbed =
+      p == 0 ? std::string()
+             : fmt::format(
+                   "; median of {} runs, costs x (1 ± {:g})", p + 1,
+                   std::abs(PerturbedCostScale(static_cast<int>(p)) - 1.0));
   out << fmt::format(
-      "{}: virtual ({}) vs real-time (median of {} run{}; {}; clock by {})\n",
-      f.point, f.dispatch, k, k == 1 ? "" : "s", f.confinement, f.clock_by);
-  // How the runs ended leads: a real-time run that ended otherwise than
-  // the virtual one is a disagreement no median shows.
-  const bool same =
-      std::all_of(f.realtime_outcomes.begin(), f.realtime_outcomes.end(),
-                  [&](const std::string& o) { return o == f.virtual_outcome; });
-  out << fmt::format("  ended: virtual {}; real-time {}{}\n", f.virtual_outcome,
-                     fmt::join(f.realtime_outcomes, ", "),
-                     same ? "" : "  (differ)");
+      "{}: virtual ({}{}) vs real-time (median of {} run{}; {}; clock by "
+      "{})\n",
+      f.point, f.dispatch, perturbed, k, k == 1 ? "" : "s", f.confinement,
+      f.clock_by);
+  // How the runs ended leads: a run that ended otherwise than the virtual
+  // one is a disagreement no median shows.
+  auto same_as_virtual = [&](const std::vector<std::string>& outcomes) {
+    return std::all_of(
+        outcomes.begin(), outcomes.end(),
+        [&](const std::string& o) { return o == f.virtual_outcome; });
+  };
+  out << fmt::format(
+      "  ended: virtual {}{}; real-time {}{}\n", f.virtual_outcome,
+      p == 0 ? std::string()
+             : fmt::format(" (perturbed: {})",
+                           fmt::join(f.perturbed_outcomes, ", ")),
+      fmt::join(f.realtime_outcomes, ", "),
+      same_as_virtual(f.realtime_outcomes) &&
+              same_as_virtual(f.perturbed_outcomes)
+          ? ""
+          : "  (differ)");
+  // "min–max" of a run's values, "(n without)" when some runs lacked it.
+  auto range = [](const std::vector<double>& values, int without) {
+    std::string text;
+    if (!values.empty()) {
+      text = Number(*std::min_element(values.begin(), values.end())) + "–" +
+             Number(*std::max_element(values.begin(), values.end()));
+    }
+    if (without > 0 && !values.empty()) {
+      text = fmt::format("{} ({} without)", text, without);
+    }
+    return text;
+  };
   auto table = [&](const char* what, const std::vector<Comparison>& rows) {
-    out << fmt::format("  {:<44} {:>10} {:>10} {:>22} {:>8}  {}\n", what,
-                       "virtual", "real-time", "real-time runs", "diff",
-                       "target");
+    // The virtual runs' column only when there were several.
+    auto column = [p](const std::string& text) {
+      return p == 0 ? std::string() : fmt::format(" {:>22}", text);
+    };
+    out << fmt::format("  {:<44}{} {:>10} {:>10} {:>22} {:>8}  {}\n", what,
+                       column("virtual runs"), "virtual", "real-time",
+                       "real-time runs", "diff", "target");
     for (const Comparison& c : rows) {
-      std::string runs;
-      if (!c.realtime.empty()) {
-        runs = Number(*std::min_element(c.realtime.begin(), c.realtime.end()));
-        runs += "–" +
-                Number(*std::max_element(c.realtime.begin(), c.realtime.end()));
-      }
-      if (c.runs_without > 0 && !c.realtime.empty()) {
-        runs = fmt::format("{} ({} without)", runs, c.runs_without);
-      }
+      const std::string virtual_runs =
+          column(c.virtual_runs.size() + c.virtual_runs_without > 1
+                     ? range(c.virtual_runs, c.virtual_runs_without)
+                     : std::string());
+      const std::string runs = range(c.realtime, c.runs_without);
       const std::string diff =
           std::isfinite(c.difference)
               ? fmt::format("{:+.1f}%", 100.0 * c.difference)
@@ -420,9 +531,9 @@ std::string FormatPointFidelity(const PointFidelity& f) {
             fmt::format("  n {} / {}, first {} compared", c.virtual_count,
                         fmt::join(c.realtime_counts, ", "), c.compared_count);
       }
-      out << fmt::format("  {:<44} {:>10} {:>10} {:>22} {:>8}  {}{}\n", c.name,
-                         Number(c.virtual_value), Number(c.realtime_median),
-                         runs, diff, target, count);
+      out << fmt::format("  {:<44}{} {:>10} {:>10} {:>22} {:>8}  {}{}\n",
+                         c.name, virtual_runs, Number(c.virtual_value),
+                         Number(c.realtime_median), runs, diff, target, count);
     }
   };
   table("run", f.metrics);

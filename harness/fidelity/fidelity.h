@@ -1,8 +1,9 @@
 // `adse fidelity`: the virtual platform held against real execution. Each
-// point runs once on the virtual platform (deterministic) and K times on
-// the real-time platform (noisy), with the same scenario and seed; the
-// comparison says, metric by metric and callback by callback, how far the
-// model is from what the host's scheduler did.
+// point runs on the virtual platform (deterministic: once as the scenario
+// says, and a few times with every cost moved by parts in ten thousand)
+// and K times on the real-time platform (noisy), with the same scenario
+// and seed; the comparison says, metric by metric and callback by
+// callback, how far the model is from what the host's scheduler did.
 #ifndef ADSE_HARNESS_FIDELITY_FIDELITY_H_
 #define ADSE_HARNESS_FIDELITY_FIDELITY_H_
 
@@ -23,20 +24,40 @@ struct FidelityOptions {
   // The virtual platform's dispatches to hold against the same real-time
   // runs, one virtual run each; empty: the scenario's platform.dispatch.
   std::vector<spec::Dispatch> dispatches;
+  // Virtual runs per dispatch besides the scenario's own, each with every
+  // cost scaled by PerturbedCostScale(k), k = 1..n, >= 0. On a starved
+  // core the closed loop answers so small a change (far below what a
+  // profile can measure) by running its callbacks in another order, and
+  // its control rate moves by a fifth or more: one virtual run is one draw
+  // of that loop, as one real-time run is. The run metrics are compared
+  // as the median of these runs and the scenario's own.
+  int perturbed_runs = 4;
   // Told before each run: (point text, "virtual[ <dispatch>]" |
   // "real-time k/K").
   std::function<void(const std::string&, const std::string&)> on_run;
 };
 
+// The cost factor of the k-th perturbed virtual run (k >= 1): 1 + 1e-4,
+// 1 - 1e-4, 1 + 2e-4, 1 - 2e-4, ...
+double PerturbedCostScale(int k);
+
 // One compared quantity: the virtual platform's value, the real-time
 // runs' values, and the relative difference of their median from it.
 struct Comparison {
   std::string name;
+  // A run metric: the median of the virtual runs that had it (the
+  // scenario's own and the perturbed ones); a callback's: of the
+  // scenario's own run.
   double virtual_value = 0.0;
+  // A run metric's value in each virtual run that had it, the scenario's
+  // own first (only it when no run was perturbed), and how many lacked it.
+  std::vector<double> virtual_runs;
+  int virtual_runs_without = 0;
   std::vector<double> realtime;  // one per real-time run that had it
   // Real-time runs that lacked it (a nav time of a run that did not reach
   // the goal, a callback that never ran): the target is then missed, since
-  // the median of the others hides an outcome the model did not predict.
+  // the median of the others hides an outcome the model did not predict;
+  // so it is when a virtual run lacked it.
   int runs_without = 0;
   // For a callback: its invocations in the virtual run and in each
   // real-time run, and how many of them were compared: the first
@@ -61,9 +82,10 @@ struct PointFidelity {
   std::string dispatch;     // the virtual run's platform.dispatch
   std::string confinement;  // where the real-time runs ran
   std::string clock_by;     // what stood for the clock there
-  // How each run ended (termination_reason): the virtual run's, then one
-  // per real-time run.
+  // How each run ended (termination_reason): the virtual run's, the
+  // perturbed virtual runs', then one per real-time run.
   std::string virtual_outcome;
+  std::vector<std::string> perturbed_outcomes;
   std::vector<std::string> realtime_outcomes;
   // nav_time_s (only of runs that reached the goal) and ctrl_rate_hz
   // (targets 10 %), e2e_latency_p50_s,
@@ -83,11 +105,14 @@ struct PointFidelity {
   std::vector<Comparison> callback_p50_ms_per_kunit;
 };
 
-// One point's runs: one virtual run per dispatch, and the real-time runs.
+// One point's runs: one virtual run per dispatch (and its perturbed
+// runs), and the real-time runs.
 struct PointRuns {
   std::string point;  // FormatPoint text
   std::vector<spec::Dispatch> dispatches;
   std::vector<runfile::RunData> virtual_runs;  // one per dispatch
+  // Per dispatch, the runs with perturbed costs (k = 1..n in order).
+  std::vector<std::vector<runfile::RunData>> perturbed_runs;
   std::vector<runfile::RunData> realtime_runs;
 };
 
@@ -100,20 +125,25 @@ Result<PointRuns> RunPoint(const spec::Spec& spec,
                            const FidelityOptions& options);
 
 // The runs an earlier `adse fidelity` wrote to `<dir>/runs`
-// (N-virtual[-<dispatch>].h5, N-realtime-K.h5), one PointRuns per N in
-// N's order (its dispatches in Dispatch's order), to compare again
-// offline. Errors: NotFound when the folder holds no such run;
-// InvalidArgument naming the file for a name not of that form, a point
-// without a virtual or a real-time run, or a virtual run whose dispatch is
-// unknown; a run file's own error (Corruption).
+// (N-virtual[-<dispatch>].h5, N-virtual[-<dispatch>]-pK.h5,
+// N-realtime-K.h5), one PointRuns per N in N's order (its dispatches in
+// Dispatch's order, perturbed runs by K), to compare again offline.
+// Errors: NotFound when the folder holds no such run; InvalidArgument
+// naming the file for a name not of that form, a point without a virtual
+// or a real-time run, a perturbed run without its virtual run, or a
+// virtual run whose dispatch is unknown; a run file's own error
+// (Corruption).
 Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir);
 
 // The virtual run of `runs.dispatches[i]` held against the real-time runs.
 PointFidelity ComparePoint(const PointRuns& runs, size_t i);
 
-// The quantities of `virtual_run` and `realtime_runs` (exposed for tests).
-PointFidelity CompareRuns(const runfile::RunData& virtual_run,
-                          const std::vector<runfile::RunData>& realtime_runs);
+// The quantities of `virtual_run` (with `perturbed_runs`, its runs with
+// perturbed costs) and `realtime_runs` (exposed for tests).
+PointFidelity CompareRuns(
+    const runfile::RunData& virtual_run,
+    const std::vector<runfile::RunData>& realtime_runs,
+    const std::vector<runfile::RunData>& perturbed_runs = {});
 
 // The table `adse fidelity` prints for one point.
 std::string FormatPointFidelity(const PointFidelity& fidelity);

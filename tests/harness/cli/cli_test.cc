@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 
+#include "analysis/runfile/run_file.h"
 #include "tests/harness/cli/example_files.h"
 #include "tests/harness/testing/adse_command.h"
 #include "tests/harness/testing/small_scenario.h"
@@ -292,35 +293,57 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
       "fidelity " + file +
       " --points cores=1,freq_ghz=2.1,lidar_hz=7 --runs 1 -o " + out.string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
-  EXPECT_NE(run.out.find("virtual (run_to_completion) vs real-time (median "
-                         "of 1 run; cgroup v"),
+  EXPECT_NE(run.out.find("virtual (run_to_completion; median of 5 runs, "
+                         "costs x (1 ± 0.0002)) vs real-time (median of 1 "
+                         "run; cgroup v"),
             std::string::npos)
       << run.out;
   EXPECT_NE(run.out.find("ctrl_rate_hz"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("callback p50 latency"), std::string::npos);
-  // How each run ended leads (4 s: neither reaches the goal).
-  EXPECT_NE(run.out.find("  ended: virtual timeout; real-time timeout\n"),
+  // How each run ended leads (4 s: none reaches the goal).
+  EXPECT_NE(run.out.find("  ended: virtual timeout (perturbed: timeout, "
+                         "timeout, timeout, timeout); real-time timeout\n"),
             std::string::npos)
       << run.out;
   std::ifstream json_in(out / "fidelity.json");
   const nlohmann::json json = nlohmann::json::parse(json_in, nullptr, false);
   ASSERT_FALSE(json.is_discarded());
   EXPECT_EQ(json["points"][0]["ended"]["virtual"], "timeout");
+  EXPECT_EQ(json["points"][0]["ended"]["virtual_perturbed"].size(), 4u);
   EXPECT_EQ(json["points"][0]["ended"]["realtime"].size(), 1u);
+  EXPECT_EQ(json["points"][0]["perturbed_runs"], 4);
+  for (const nlohmann::json& m : json["points"][0]["metrics"]) {
+    if (m["name"] == "ctrl_rate_hz") {
+      EXPECT_EQ(m["virtual_runs"].size(), 5u) << m;
+    }
+  }
   for (const char* name : {"fidelity.txt", "fidelity.json", "fidelity-1.png",
-                           "runs/1-virtual.h5", "runs/1-realtime-1.h5"}) {
+                           "runs/1-virtual.h5", "runs/1-virtual-p1.h5",
+                           "runs/1-virtual-p4.h5", "runs/1-realtime-1.h5"}) {
     EXPECT_TRUE(fs::is_regular_file(out / name)) << name;
+  }
+  // A perturbed run is the same point with its costs scaled.
+  for (const auto& [file, scale] :
+       {std::pair{"1-virtual.h5", "1"}, std::pair{"1-virtual-p2.h5", "0.9999"},
+        std::pair{"1-virtual-p3.h5", "1.0002"}}) {
+    adse::Result<adse::runfile::RunData> data =
+        adse::runfile::ReadRunFile((out / "runs" / file).string());
+    ASSERT_TRUE(data.ok()) << data.status().message();
+    EXPECT_EQ(data->platform.at("cost_scale"), scale) << file;
+    EXPECT_EQ(data->design_point.at("freq_ghz"), 2.1) << file;
   }
   // Both dispatches against the same real-time run: a table, a picture and
   // a virtual run file each, and how often each met the targets.
   const fs::path both = out / "both";
   const CommandRun two =
       Adse("fidelity " + file +
-           " --points cores=1,freq_ghz=2.1,lidar_hz=7 --runs 1 --dispatch "
+           " --points cores=1,freq_ghz=2.1,lidar_hz=7 --runs 1 "
+           "--perturbed-runs 1 --dispatch "
            "run_to_completion,processor_sharing -o " +
            both.string());
   ASSERT_EQ(two.exit_code, 0) << two.out;
-  EXPECT_NE(two.out.find("virtual (processor_sharing) vs real-time"),
+  EXPECT_NE(two.out.find("virtual (processor_sharing; median of 2 runs, "
+                         "costs x (1 ± 0.0001)) vs real-time"),
             std::string::npos)
       << two.out;
   EXPECT_NE(two.out.find("dispatch "), std::string::npos) << two.out;
@@ -338,7 +361,9 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
   for (const char* name :
        {"fidelity-1-run_to_completion.png", "fidelity-1-processor_sharing.png",
         "runs/1-virtual-run_to_completion.h5",
-        "runs/1-virtual-processor_sharing.h5", "runs/1-realtime-1.h5"}) {
+        "runs/1-virtual-run_to_completion-p1.h5",
+        "runs/1-virtual-processor_sharing.h5",
+        "runs/1-virtual-processor_sharing-p1.h5", "runs/1-realtime-1.h5"}) {
     EXPECT_TRUE(fs::is_regular_file(both / name)) << name;
   }
   // Compared again from the run files alone: the same comparison, and the

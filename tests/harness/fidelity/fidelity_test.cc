@@ -149,6 +149,59 @@ TEST(FidelityTest, InvocationsOnlyTheRealTimeRunMadeAreNotCompared) {
       0.3, 1e-9);
 }
 
+TEST(FidelityTest, PerturbedRunsMoveEveryCostByPartsInTenThousand) {
+  EXPECT_DOUBLE_EQ(PerturbedCostScale(1), 1.0001);
+  EXPECT_DOUBLE_EQ(PerturbedCostScale(2), 0.9999);
+  EXPECT_DOUBLE_EQ(PerturbedCostScale(3), 1.0002);
+  EXPECT_DOUBLE_EQ(PerturbedCostScale(4), 0.9998);
+}
+
+// A starved closed loop answers a tiny change of costs with another
+// callback order, so the run metrics are compared as the median of the
+// virtual runs; the callbacks (paired by invocation) only with the
+// scenario's own run.
+TEST(FidelityTest, TheVirtualRunsMedianIsHeldAgainstTheRealTimeRuns) {
+  const runfile::RunData own = MadeRun(100.0, 30.0, 10.0);
+  const std::vector<runfile::RunData> realtime = {MadeRun(101.0, 34.0, 10.0)};
+  const std::vector<runfile::RunData> perturbed = {
+      MadeRun(99.0, 33.0, 20.0), MadeRun(102.0, 34.0, 20.0),
+      MadeRun(98.0, 26.0, 20.0), MadeRun(100.0, 35.0, 20.0)};
+  const PointFidelity alone = CompareRuns(own, realtime);
+  EXPECT_FALSE(Find(alone.metrics, "ctrl_rate_hz").met()) << "+13 % of 30";
+  const PointFidelity f = CompareRuns(own, realtime, perturbed);
+  const Comparison& ctrl = Find(f.metrics, "ctrl_rate_hz");
+  EXPECT_EQ(ctrl.virtual_runs, (std::vector<double>{30, 33, 34, 26, 35}));
+  EXPECT_DOUBLE_EQ(ctrl.virtual_value, 33.0);
+  EXPECT_NEAR(ctrl.difference, 1.0 / 33.0, 1e-12);
+  EXPECT_TRUE(ctrl.met());
+  // The callbacks: the scenario's own run alone (10 ms, not 20).
+  EXPECT_NEAR(Find(f.callback_p50_ms, "a/work").virtual_value, 10.0, 1e-9);
+  EXPECT_EQ(Find(f.callback_p50_ms, "a/work").virtual_runs.size(), 1u);
+  const std::string table = FormatPointFidelity(f);
+  EXPECT_NE(table.find("virtual (; median of 5 runs, costs x (1 ± 0.0002)) "
+                       "vs real-time (median of 1 run"),
+            std::string::npos)
+      << table;
+  EXPECT_NE(table.find("virtual runs"), std::string::npos) << table;
+  EXPECT_NE(table.find("26–35"), std::string::npos) << table;
+  EXPECT_EQ(FormatPointFidelity(alone).find("virtual runs"), std::string::npos);
+
+  // A perturbed run that did not arrive: the nav time misses its target,
+  // and the runs' endings differ.
+  std::vector<runfile::RunData> one_late = perturbed;
+  one_late[2] = MadeRun(30.0, 26.0, 20.0, false);
+  const PointFidelity late = CompareRuns(own, realtime, one_late);
+  const Comparison& nav = Find(late.metrics, "nav_time_s");
+  EXPECT_EQ(nav.virtual_runs_without, 1);
+  EXPECT_FALSE(nav.met());
+  EXPECT_NE(FormatPointFidelity(late).find(
+                "ended: virtual goal_reached (perturbed: goal_reached, "
+                "goal_reached, timeout, goal_reached); real-time "
+                "goal_reached  (differ)"),
+            std::string::npos)
+      << FormatPointFidelity(late);
+}
+
 TEST(FidelityTest, NavTimesOfRunsThatTimedOutAreNotCompared) {
   const PointFidelity f = CompareRuns(MadeRun(30.0, 4.0, 10.0, false),
                                       {MadeRun(30.0, 3.0, 10.0, false)});
@@ -293,6 +346,16 @@ TEST(FidelityTest, AFolderWithoutFidelityRunsIsAnErrorNamingIt) {
   ASSERT_FALSE(corrupt.ok());
   EXPECT_NE(corrupt.status().message().find("1-virtual.h5"), std::string::npos)
       << corrupt.status().message();
+
+  // A perturbed virtual run's name is one of its runs' (read, and found
+  // damaged like the rest).
+  touch("1-virtual-p1.h5", "not HDF5");
+  Result<std::vector<PointRuns>> perturbed = ReadPointRuns(dir.string());
+  ASSERT_FALSE(perturbed.ok());
+  EXPECT_EQ(perturbed.status().message().find("expected run files named"),
+            std::string::npos)
+      << perturbed.status().message();
+  std::filesystem::remove(dir / "runs" / "1-virtual-p1.h5");
 
   touch("99999999999-virtual.h5", "");
   EXPECT_EQ(ReadPointRuns(dir.string()).status().code(),
