@@ -502,12 +502,14 @@ void AgentStrategy::FitModels() {
       }
     }
   }
-  // Prior slope sizes per knob: resources help; the diagnosis of any
-  // infeasible run strengthens the knob it names.
+  // Prior slope sizes per knob: resources help; the diagnoses of the runs
+  // strengthen the knobs they name on balance. A feasible run's counts
+  // too: the start's diagnosis already says which resource the stack is
+  // short of (README, "Diagnoses of feasible runs").
   std::vector<double> prior(knobs_.size(), 0.0);
   std::vector<int> votes(knobs_.size(), 0);
   for (const Record& record : records_) {
-    if (record.feasible || record.failed) continue;
+    if (record.failed) continue;
     const std::vector<int> direction = RemedyDirections(record, nullptr);
     for (size_t d = 0; d < knobs_.size(); ++d) votes[d] += direction[d];
   }

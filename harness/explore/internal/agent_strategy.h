@@ -35,17 +35,17 @@ constexpr size_t kNeighbourhoods = 48;
 // The surrogates learn from at most this many (most recent) runs.
 constexpr size_t kMaxModelPoints = 160;
 // Prior elasticity of a metric to a cores- or clock-like knob (how much
-// log metric per log knob), and after the diagnosis of an infeasible run
-// has asked for that knob.
+// log metric per log knob), and after the diagnosis of a run (feasible or
+// not) has asked for that knob on balance.
 constexpr double kElasticity = 0.5;
 constexpr double kVotedElasticity = 0.8;
 // ... and to a sensor-rate knob, which adds load rather than capacity, or
 // a downsampling knob (a voxel size), which sheds it at the cost of
 // precision.
 constexpr double kSensorElasticity = 0.5;
-// The prior slope a sensor rate gets when the diagnosis of an infeasible
-// run asks to raise it (a consumer starved of data); asked to lower it, it
-// gets kVotedElasticity as a load, as a capacity knob voted for does.
+// The prior slope a sensor rate gets when the runs' diagnoses ask to raise
+// it (a consumer starved of data); asked to lower it, it gets
+// kVotedElasticity as a load, as a capacity knob voted for does.
 constexpr double kRateVote = 0.3;
 // Default GP length scales over normalised knobs: most knobs, and those
 // with at most 3 values.

@@ -85,12 +85,13 @@ TEST(AgentReplayTest, OnTheRobotaxiCampaignWithTwoObjectives) {
   // Issue 16's targets are for two objectives: the same recording scored
   // on cost and nav time alone, whose front holds 14 of the 280 points.
   // Measured at v23: a median of 4 true Pareto points, a median
-  // hypervolume ratio of 0.940, the cheapest design in 20 of 20 seeds.
+  // hypervolume ratio of 0.963 (0.940 before the diagnoses of feasible
+  // runs counted in the priors), the cheapest design in 20 of 20 seeds.
   Recording recording =
       adse::testing::RecordingUnderTestData("robotaxi_exhaustive");
   ASSERT_TRUE(KeepObjectives({"hardware_cost", "nav_time_s"}, &recording).ok());
   ExpectAgentOn(recording, "robotaxi_exhaustive (cost, nav time)",
-                {3, 0.92, 19});
+                {3, 0.95, 19});
 }
 
 TEST(AgentReplayTest, OnTheReferenceStudyWhereStarvedRunsAreStoppedEarly) {
