@@ -33,7 +33,7 @@ struct FidelityOptions {
   // as the median of these runs and the scenario's own.
   int perturbed_runs = 4;
   // Told before each run: (point text, "virtual[ <dispatch>]" |
-  // "real-time k/K").
+  // "virtual[ <dispatch>] perturbed k/n" | "real-time k/K").
   std::function<void(const std::string&, const std::string&)> on_run;
 };
 
