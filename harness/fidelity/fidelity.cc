@@ -8,6 +8,7 @@
 #include <numeric>
 #include <regex>
 #include <sstream>
+#include <utility>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -317,18 +318,25 @@ Result<PointRuns> RunPoint(const spec::Spec& input,
 
 namespace {
 
-// A virtual run file's platform.dispatch.
-Result<spec::Dispatch> DispatchOf(const runfile::RunData& run,
-                                  const std::string& path) {
+// A virtual run file, and the dispatch its platform record names.
+struct VirtualRun {
+  runfile::RunData data;
   spec::Dispatch dispatch;
-  const auto it = run.platform.find("dispatch");
-  if (it == run.platform.end() ||
-      !spec::StringToDispatch(it->second, &dispatch)) {
+};
+
+Result<VirtualRun> ReadVirtualRun(const std::string& path) {
+  Result<runfile::RunData> run = runfile::ReadRunFile(path);
+  if (!run.ok()) return run.status();
+  VirtualRun out;
+  const auto it = run->platform.find("dispatch");
+  if (it == run->platform.end() ||
+      !spec::StringToDispatch(it->second, &out.dispatch)) {
     return Status::InvalidArgument(fmt::format(
         "{}: platform.dispatch: expected one of the dispatches, found '{}'",
-        path, it == run.platform.end() ? "" : it->second));
+        path, it == run->platform.end() ? "" : it->second));
   }
-  return dispatch;
+  out.data = std::move(run).value();
+  return out;
 }
 
 }  // namespace
@@ -344,8 +352,8 @@ Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
   // By N: the virtual runs' paths, then the real-time runs' by K.
   struct Files {
     std::vector<std::string> virtual_runs;
-    // By the name's dispatch part, then K.
-    std::map<std::string, std::map<int, std::string>> perturbed_runs;
+    // By the name's dispatch part and K.
+    std::map<std::pair<std::string, int>, std::string> perturbed_runs;
     std::map<int, std::string> realtime_runs;
   };
   std::map<int, Files> by_point;
@@ -365,7 +373,7 @@ Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
     if (m[6].matched) {
       files.realtime_runs[std::stoi(m[6].str())] = entry.path().string();
     } else if (m[5].matched) {
-      files.perturbed_runs[m[3].str()][std::stoi(m[5].str())] =
+      files.perturbed_runs[{m[3].str(), std::stoi(m[5].str())}] =
           entry.path().string();
     } else {
       files.virtual_runs.push_back(entry.path().string());
@@ -391,38 +399,32 @@ Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
     PointRuns runs;
     std::string first_path;  // of the first dispatch's virtual run
     for (const std::string& path : files.virtual_runs) {
-      Result<runfile::RunData> run = runfile::ReadRunFile(path);
+      Result<VirtualRun> run = ReadVirtualRun(path);
       if (!run.ok()) return run.status();
-      Result<spec::Dispatch> dispatch = DispatchOf(*run, path);
-      if (!dispatch.ok()) return dispatch.status();
       // In the vocabulary's order (run to completion first), whatever
       // order the folder lists them in.
       const auto at = std::upper_bound(runs.dispatches.begin(),
-                                       runs.dispatches.end(), *dispatch);
+                                       runs.dispatches.end(), run->dispatch);
       if (at == runs.dispatches.begin()) first_path = path;
       runs.virtual_runs.insert(
           runs.virtual_runs.begin() + (at - runs.dispatches.begin()),
-          std::move(run).value());
-      runs.dispatches.insert(at, *dispatch);
+          std::move(run->data));
+      runs.dispatches.insert(at, run->dispatch);
     }
     runs.perturbed_runs.resize(runs.dispatches.size());
-    for (const auto& [name_part, by_k] : files.perturbed_runs) {
-      for (const auto& [k, path] : by_k) {
-        Result<runfile::RunData> run = runfile::ReadRunFile(path);
-        if (!run.ok()) return run.status();
-        Result<spec::Dispatch> dispatch = DispatchOf(*run, path);
-        if (!dispatch.ok()) return dispatch.status();
-        const auto at = std::find(runs.dispatches.begin(),
-                                  runs.dispatches.end(), *dispatch);
-        if (at == runs.dispatches.end()) {
-          return Status::InvalidArgument(fmt::format(
-              "{}: a perturbed run of point {} with the {} dispatch, but no "
-              "virtual run of that dispatch beside it",
-              path, n, spec::DispatchToString(*dispatch)));
-        }
-        runs.perturbed_runs[at - runs.dispatches.begin()].push_back(
-            std::move(run).value());
+    for (const auto& [key, path] : files.perturbed_runs) {
+      Result<VirtualRun> run = ReadVirtualRun(path);
+      if (!run.ok()) return run.status();
+      const auto at = std::find(runs.dispatches.begin(), runs.dispatches.end(),
+                                run->dispatch);
+      if (at == runs.dispatches.end()) {
+        return Status::InvalidArgument(fmt::format(
+            "{}: a perturbed run of point {} with the {} dispatch, but no "
+            "virtual run of that dispatch beside it",
+            path, n, spec::DispatchToString(run->dispatch)));
       }
+      runs.perturbed_runs[at - runs.dispatches.begin()].push_back(
+          std::move(run->data));
     }
     for (const auto& [k, path] : files.realtime_runs) {
       Result<runfile::RunData> run = runfile::ReadRunFile(path);
