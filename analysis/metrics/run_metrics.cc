@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "analysis/metrics/parking_metrics.h"
+#include "stack/algorithms/stop_reason.h"
 
 namespace adse::analysis {
 namespace {
@@ -33,6 +34,23 @@ double OversubscribedCoreS(const std::vector<stack::CallbackRecord>& records,
     }
   }
   return excess_s;
+}
+
+// Seconds up to `end_s` that the planner's newest stop reason said
+// localization_lost: each stop sample holds until the next one (a starved
+// planner that publishes seldom still has no pose in between). NaN when
+// the run file has no stop reasons (written before they were recorded).
+double LocalizationLostS(const std::vector<runfile::StopSample>& stops,
+                         double end_s) {
+  if (stops.empty()) return std::numeric_limits<double>::quiet_NaN();
+  double lost_s = 0.0;
+  for (size_t i = 0; i < stops.size() && stops[i].t_s < end_s; ++i) {
+    if (stops[i].reason != StopReason::kLocalizationLost) continue;
+    const double until =
+        i + 1 < stops.size() ? std::min(stops[i + 1].t_s, end_s) : end_s;
+    lost_s += std::max(0.0, until - stops[i].t_s);
+  }
+  return lost_s;
 }
 
 }  // namespace
@@ -110,6 +128,7 @@ std::map<std::string, double> ComputeRunMetrics(
   }
   m["cpu_utilization"] =
       (cores > 0 && end_s > 0) ? busy_core_s / (cores * end_s) : 0.0;
+  m["localization_lost_s"] = LocalizationLostS(run.stop_reasons, end_s);
   AddParkingMetrics(run, &m);
   return m;
 }

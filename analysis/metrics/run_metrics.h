@@ -31,7 +31,9 @@ inline constexpr char kCensoredMetric[] = "censored";
 // collisions, ego_collisions (those the ego caused, or not known not to
 // have), callbacks (executions), cpu_utilization (busy core-seconds /
 // cores x nav time; an execution holds `cores` threads from start to end,
-// and no more cores than the platform has are busy at once).
+// and no more cores than the platform has are busy at once),
+// localization_lost_s (time the planner had no valid pose to drive by:
+// its newest stop reason localization_lost; NaN without stop reasons).
 std::map<std::string, double> ComputeRunMetrics(
     const runfile::RunData& run, const RunMetricsOptions& options = {});
 

@@ -180,7 +180,8 @@ PointFidelity CompareRuns(const runfile::RunData& virtual_run,
                             Quantity{"ctrl_rate_hz", kRunTolerance},
                             Quantity{"e2e_latency_p50_s", std::nullopt},
                             Quantity{"dropped_messages", std::nullopt},
-                            Quantity{"lidar_frames_dropped", std::nullopt}}) {
+                            Quantity{"lidar_frames_dropped", std::nullopt},
+                            Quantity{"localization_lost_s", std::nullopt}}) {
     const bool time = std::string(q.name) == "nav_time_s";
     auto value = [&](const runfile::RunData& r) {
       return time && !reached(r) ? kNaN : Metric(r, q.name);

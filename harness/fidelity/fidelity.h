@@ -88,8 +88,8 @@ struct PointFidelity {
   std::vector<std::string> perturbed_outcomes;
   std::vector<std::string> realtime_outcomes;
   // nav_time_s (only of runs that reached the goal) and ctrl_rate_hz
-  // (targets 10 %), e2e_latency_p50_s,
-  // dropped_messages, lidar_frames_dropped, and the sensing-to-control
+  // (targets 10 %), e2e_latency_p50_s, dropped_messages,
+  // lidar_frames_dropped, localization_lost_s, and the sensing-to-control
   // chain's mean.
   std::vector<Comparison> metrics;
   // Per callback of at least 1 ms on the virtual platform: the p50 of its

@@ -322,7 +322,8 @@ std::string FormatSummary(const RunReport& r) {
        {"completed", "nav_time_s", "ctrl_rate_hz", "hardware_cost",
         "deviation_score", "max_deviation_m", "offset_m", "zigzag_index",
         "e2e_latency_p50_s", "e2e_latency_p99_s", "dropped_messages",
-        "lidar_frames_dropped", "collisions", "cpu_utilization"}) {
+        "lidar_frames_dropped", "collisions", "cpu_utilization",
+        "localization_lost_s"}) {
     out += fmt::format("{:<20} {}\n", name, metric(name));
   }
   // valet_parking runs: the manoeuvre's own metrics.

@@ -130,6 +130,9 @@ const std::vector<MetricInfo>& KnownMetrics() {
        "collisions the ego caused: at the contact it moved towards the other "
        "vehicle at least as fast as that one moved towards it, count",
        false, true},
+      {"localization_lost_s",
+       "time the planner had no valid pose to drive by (its stop reason "
+       "localization_lost), s"},
       // valet_parking runs only (analysis/metrics/parking_metrics.h).
       {"parked",
        "valet_parking: the run ended standing in the slot within the goal's "

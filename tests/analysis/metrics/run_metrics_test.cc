@@ -75,6 +75,27 @@ TEST(RunMetricsTest, ThreadsBeyondThePlatformsCoresAreNotBusyCores) {
   EXPECT_NEAR(ComputeRunMetrics(run).at("cpu_utilization"), 8.0 / 20.0, 1e-12);
 }
 
+TEST(RunMetricsTest, LocalizationLostCountsTheTimeEachLostPlanHeldUpToTheEnd) {
+  runfile::RunData run = TenSecondRun();
+  EXPECT_TRUE(std::isnan(ComputeRunMetrics(run).at("localization_lost_s")));
+  auto stop = [](double t_s, StopReason reason) {
+    return runfile::StopSample{t_s, t_s - 0.1, reason, -1.0, -1, -1.0, 0};
+  };
+  // Lost from 2 to 3.5 s (three samples), found again, lost from 9.5 s to
+  // the run's end at 10 s; a sample after the end does not count.
+  run.stop_reasons = {stop(1.0, StopReason::kNone),
+                      stop(2.0, StopReason::kLocalizationLost),
+                      stop(2.5, StopReason::kLocalizationLost),
+                      stop(3.0, StopReason::kLocalizationLost),
+                      stop(3.5, StopReason::kGoal),
+                      stop(9.5, StopReason::kLocalizationLost),
+                      stop(10.5, StopReason::kLocalizationLost)};
+  EXPECT_NEAR(ComputeRunMetrics(run).at("localization_lost_s"), 1.5 + 0.5,
+              1e-9);
+  run.stop_reasons.resize(5);
+  EXPECT_NEAR(ComputeRunMetrics(run).at("localization_lost_s"), 1.5, 1e-9);
+}
+
 TEST(RunMetricsTest, TimeoutIsNotCompleted) {
   runfile::RunData run = TenSecondRun();
   run.termination_reason = "timeout";
