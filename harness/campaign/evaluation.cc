@@ -56,13 +56,10 @@ Result<EvaluationRow> RowFromJson(const nlohmann::json& j,
           f["rates_hz"]["deficit"].is_number()) {
         severity = f["rates_hz"]["deficit"].get<double>();
       }
-      // Strategies are told the typed remedies: a report without them
-      // (before report_version 2) is stale, and its run is analysed again.
+      // Strategies are told the typed remedies.
       if (!f.contains("remedies")) {
-        return Status::Corruption(fmt::format(
-            "{}: finding {} has no typed remedies (a report older than "
-            "report_version 2)",
-            path, i));
+        return Status::Corruption(
+            fmt::format("{}: finding {} has no typed remedies", path, i));
       }
       Result<std::vector<analysis::Remedy>> remedies =
           report::RemediesFromJson(f.at("remedies"));
@@ -96,6 +93,15 @@ Result<EvaluationRow> RowFromReportJson(const std::string& text,
   const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
   if (!j.is_object()) {
     return Status::Corruption(path + ": not a run report (invalid JSON)");
+  }
+  // A report is derived data: one an older adse wrote may lack what the
+  // rows now carry (a metric added since), so its run is analysed again.
+  const nlohmann::json& version = j.value("report_version", nlohmann::json());
+  if (!version.is_number_integer() ||
+      version.get<int>() < report::kReportVersion) {
+    return Status::Corruption(
+        fmt::format("{}: a report older than report_version {} ({})", path,
+                    report::kReportVersion, version.dump()));
   }
   return RowFromJson(j, path);
 }

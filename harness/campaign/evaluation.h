@@ -28,8 +28,9 @@ EvaluationRow RowFromReport(const report::RunReport& report);
 // The same row from a report's JSON (report::ToJson), as a worker writes it
 // next to its run file (runs/<key>.report.json): the coordinator then need
 // not analyse the run again. Corruption naming `path` when the text is not
-// such a report, when a finding has no typed remedies (a report older than
-// report_version 2) or names an unknown remedy kind (the message names it).
+// such a report, when it is older than report::kReportVersion (stale: the
+// run is analysed again), when a finding has no typed remedies or names an
+// unknown remedy kind (the message names it).
 Result<EvaluationRow> RowFromReportJson(const std::string& text,
                                         const std::string& path);
 

@@ -67,10 +67,14 @@ struct CallbackSummary {
   double utilization = 0.0;  // busy core-seconds per second
 };
 
+// What a report holds, by version: 2, findings carry typed `remedies`
+// beside the readable `remedy`; 3, `standing` says how long the car stood
+// and for which stop reason; 4, metrics carry `localization_lost_s`. A
+// campaign analyses a run again rather than read an older report.
+inline constexpr int kReportVersion = 4;
+
 struct RunReport {
-  // 2: findings carry typed `remedies` beside the readable `remedy`.
-  // 3: `standing` says how long the car stood and for which stop reason.
-  int report_version = 3;
+  int report_version = kReportVersion;
   std::string run_file;
   std::string scenario_name;
   std::map<std::string, double> point;

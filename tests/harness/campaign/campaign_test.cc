@@ -16,6 +16,8 @@
 #include <set>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "analysis/runfile/campaign_file.h"
 #include "analysis/runfile/run_file.h"
 #include "harness/campaign/evaluation.h"
@@ -152,6 +154,31 @@ TEST(CampaignTest,
               first->exploration.evaluations[i].wall_s);
     EXPECT_EQ(second->exploration.evaluations[i].attempts,
               first->exploration.evaluations[i].attempts);
+  }
+
+  // A report an older adse left (version 3, without localization_lost_s)
+  // is not taken: its run is analysed again and the report rewritten.
+  {
+    size_t i = 0;
+    while (!first->exploration.evaluations[i].feasible) ++i;  // not censored
+    const std::string key = first->exploration.evaluations[i].content_key;
+    const std::string report_path = out + "/runs/" + key + ".report.json";
+    nlohmann::json old = nlohmann::json::parse(ReadFile(report_path).value());
+    old["report_version"] = 3;
+    old["metrics"].erase("localization_lost_s");
+    ASSERT_TRUE(WriteFileAtomic(report_path, old.dump(1)).ok());
+    Result<CampaignSummary> third =
+        RunCampaign(spec, Options(out, "exhaustive", 12));
+    ASSERT_TRUE(third.ok()) << third.status().message();
+    EXPECT_EQ(third->simulated, 0);
+    EXPECT_EQ(third->exploration.evaluations[i].metrics,
+              first->exploration.evaluations[i].metrics);
+    EXPECT_EQ(
+        third->exploration.evaluations[i].metrics.count("localization_lost_s"),
+        1u);
+    const nlohmann::json rewritten =
+        nlohmann::json::parse(ReadFile(report_path).value());
+    EXPECT_EQ(rewritten["report_version"], report::kReportVersion);
   }
 
   // Replay of the agent over this recording proposes exactly what a live

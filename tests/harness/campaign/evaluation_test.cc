@@ -172,16 +172,39 @@ TEST(EvaluationTest, AReportWithAnUnknownRemedyKindIsRefusedNamingIt) {
       << row.status().message();
 }
 
-TEST(EvaluationTest, AReportWithoutTypedRemediesIsStale) {
+TEST(EvaluationTest, AReportWithoutTypedRemediesIsRefused) {
   nlohmann::json j = report::ToJson(ReportWithFindings());
   j["findings"][0].erase("remedies");
-  Result<EvaluationRow> row = RowFromReportJson(j.dump(), "old.report.json");
+  Result<EvaluationRow> row = RowFromReportJson(j.dump(), "x.report.json");
   ASSERT_FALSE(row.ok());
-  EXPECT_NE(row.status().message().find("report_version 2"), std::string::npos)
+  EXPECT_NE(row.status().message().find(
+                "x.report.json: finding 0 has no typed remedies"),
+            std::string::npos)
       << row.status().message();
-  // A healthy run's old report has no finding to miss them.
+  // A healthy run's report has no finding to miss them.
   j["findings"] = nlohmann::json::array();
-  EXPECT_TRUE(RowFromReportJson(j.dump(), "old.report.json").ok());
+  EXPECT_TRUE(RowFromReportJson(j.dump(), "x.report.json").ok());
+}
+
+// An older adse's report lacks what rows now carry (localization_lost_s
+// since version 4): the campaign analyses its run again instead.
+TEST(EvaluationTest, AReportOfAnOlderVersionIsStale) {
+  nlohmann::json j = report::ToJson(ReportWithFindings());
+  ASSERT_TRUE(RowFromReportJson(j.dump(), "new.report.json").ok());
+  for (const nlohmann::json& version :
+       {nlohmann::json(report::kReportVersion - 1), nlohmann::json("4"),
+        nlohmann::json()}) {
+    j["report_version"] = version;
+    Result<EvaluationRow> row = RowFromReportJson(j.dump(), "old.report.json");
+    ASSERT_FALSE(row.ok()) << version;
+    EXPECT_EQ(row.status().code(), Status::Code::kCorruption);
+    EXPECT_NE(row.status().message().find(
+                  "old.report.json: a report older than report_version 4"),
+              std::string::npos)
+        << row.status().message();
+  }
+  j.erase("report_version");
+  EXPECT_FALSE(RowFromReportJson(j.dump(), "old.report.json").ok());
 }
 
 TEST(EvaluationTest, AnIndexRowWithoutTypedRemediesKeepsItsText) {
