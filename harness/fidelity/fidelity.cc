@@ -325,8 +325,20 @@ struct VirtualRun {
   spec::Dispatch dispatch;
 };
 
-Result<VirtualRun> ReadVirtualRun(const std::string& path) {
+// A run file read back, its run metrics measured again from its data (as
+// `adse analyze` does): a comparison of older runs shows metrics added
+// since they were written.
+Result<runfile::RunData> ReadRun(const std::string& path) {
   Result<runfile::RunData> run = runfile::ReadRunFile(path);
+  if (!run.ok()) return run.status();
+  for (const auto& [name, value] : analysis::ComputeRunMetrics(*run)) {
+    run->metrics[name] = value;
+  }
+  return run;
+}
+
+Result<VirtualRun> ReadVirtualRun(const std::string& path) {
+  Result<runfile::RunData> run = ReadRun(path);
   if (!run.ok()) return run.status();
   VirtualRun out;
   const auto it = run->platform.find("dispatch");
@@ -428,7 +440,7 @@ Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
           std::move(run->data));
     }
     for (const auto& [k, path] : files.realtime_runs) {
-      Result<runfile::RunData> run = runfile::ReadRunFile(path);
+      Result<runfile::RunData> run = ReadRun(path);
       if (!run.ok()) return run.status();
       runs.realtime_runs.push_back(std::move(run).value());
     }

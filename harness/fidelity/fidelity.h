@@ -127,7 +127,8 @@ Result<PointRuns> RunPoint(const spec::Spec& spec,
 // The runs an earlier `adse fidelity` wrote to `<dir>/runs`
 // (N-virtual[-<dispatch>].h5, N-virtual[-<dispatch>]-pK.h5,
 // N-realtime-K.h5), one PointRuns per N in N's order (its dispatches in
-// Dispatch's order, perturbed runs by K), to compare again offline.
+// Dispatch's order, perturbed runs by K), to compare again offline; their
+// run metrics are measured again from their data (ComputeRunMetrics).
 // Errors: NotFound when the folder holds no such run; InvalidArgument
 // naming the file for a name not of that form, a point without a virtual
 // or a real-time run, a perturbed run without its virtual run, or a
