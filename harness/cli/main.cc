@@ -458,8 +458,9 @@ int main(int argc, char** argv) {
       "(the "
       "stack in a process of its own on as many host CPUs as the point has "
       "cores), and "
-      "compare nav time, control rate, drops, the sensing-to-control chain "
-      "and each callback's p50/p99 latency; writes fidelity.txt, "
+      "compare nav time, control rate, drops, the time without a pose, the "
+      "sensing-to-control chain and each callback's p50/p99 latency; writes "
+      "fidelity.txt, "
       "fidelity.json and a picture per point");
   fidelity_cmd->add_option(
       "scenario", fidelity.scenario,
