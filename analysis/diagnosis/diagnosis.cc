@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "analysis/diagnosis/internal/starved_input.h"
 #include "analysis/metrics/run_metrics.h"
 
 namespace adse::analysis {
@@ -49,6 +50,10 @@ constexpr OptionSpec kOptionSpecs[] = {
     {"remedy_exec_load", &DiagnosisOptions::remedy_exec_load, Range::kPositive},
     {"remedy_wait_ratio", &DiagnosisOptions::remedy_wait_ratio,
      Range::kPositive},
+    {"starved_input_min_s", &DiagnosisOptions::starved_input_min_s,
+     Range::kPositive},
+    {"starved_input_busy_share", &DiagnosisOptions::starved_input_busy_share,
+     Range::kFraction},
 };
 
 bool InRange(Range range, double v) {
@@ -171,6 +176,7 @@ class TraceView {
     static const std::string kNone;
     return ValidCallback(c) ? node_of_[c] : kNone;
   }
+  const std::vector<std::string>& node_of() const { return node_of_; }
 
  private:
   const runfile::RunData& run_;
@@ -675,6 +681,13 @@ Diagnosis Diagnose(const runfile::RunData& run,
         "{:.2f} Hz median of its other inputs (> {:.1f}%); {} -> {}",
         node, f.topics[0], slow_hz, 100.0 * deficit, median_hz,
         100.0 * options.frequency_bound_fraction, cause, f.remedy);
+    d.findings.push_back(std::move(f));
+  }
+
+  // ---- Starved input: a subscription its own node starves ----
+  for (Finding& f :
+       internal::FindStarvedInputs(run, view.start_s(), view.end_s(), options,
+                                   view.node_of(), d.topics)) {
     d.findings.push_back(std::move(f));
   }
 

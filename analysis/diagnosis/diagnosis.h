@@ -56,6 +56,13 @@ struct DiagnosisOptions {
   // needed, and the core-wait / execution ratio at which more cores are.
   double remedy_exec_load = 1.0;
   double remedy_wait_ratio = 1.0;
+  // Starved input: a subscription that took nothing for at least this long
+  // while its messages were dropped unread and its own node ran its other
+  // callbacks at least `starved_input_busy_share` of the time (see
+  // Finding). A starved computer leaves its nodes waiting for a core, not
+  // running, so this names a stack that starves itself.
+  double starved_input_min_s = 5.0;
+  double starved_input_busy_share = 0.9;
 };
 
 // Sets one option by its field name (for `--threshold NAME=VALUE`).
@@ -102,9 +109,10 @@ struct CallbackStats {
 };
 
 struct Finding {
-  std::string kind;  // "cpu_bound" | "frequency_bound"
+  std::string kind;  // "cpu_bound" | "frequency_bound" | "starved_input"
   // The node that cannot keep up (cpu_bound) / that is input-limited
-  // (frequency_bound).
+  // (frequency_bound) / whose callbacks starve one of its subscriptions
+  // (starved_input).
   std::string node;
   std::vector<std::string> topics;  // the topic fallen behind / slow input
   // Node(s) publishing topics[0] ("external" for a sensor).
@@ -117,7 +125,9 @@ struct Finding {
   // allowed_deficit, exec_load, core_wait_ratio. frequency_bound:
   // slowest_hz, others_median_hz, deficit, allowed_fraction,
   // "input_hz:<topic>" for every input considered, and origin_hz (the
-  // sensor's or timer's rate) when the origin has one.
+  // sensor's or timer's rate) when the origin has one. starved_input (not
+  // rates, despite the name): starved_s, from_s, node_busy_share, dropped,
+  // holder_timer_overruns (of the callback that held the node most).
   std::map<std::string, double> rates_hz;
   // What would relieve it, most important first. cpu_bound: higher_frequency
   // when exec_load >= remedy_exec_load, more_cores when core_wait_ratio >=
@@ -126,7 +136,7 @@ struct Finding {
   // the graph. frequency_bound: raise_publisher_rate of topics[0] (publisher
   // `upstream`, "unknown" if none), then by origin raise_sensor_rate of the
   // sensor topic | shorten_timer_period of the timer | relieve_node of the
-  // cpu_bound node.
+  // cpu_bound node. starved_input: own_callback_group of the subscription.
   std::vector<Remedy> remedies;
   // RemediesText(remedies), e.g. "higher frequency; lower sensor rate".
   std::string remedy;

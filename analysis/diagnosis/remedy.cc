@@ -17,6 +17,7 @@ const std::vector<Term<RemedyKind>>& RemedyKindTerms() {
       {RemedyKind::kRaiseSensorRate, "raise_sensor_rate"},
       {RemedyKind::kShortenTimerPeriod, "shorten_timer_period"},
       {RemedyKind::kRelieveNode, "relieve_node"},
+      {RemedyKind::kOwnCallbackGroup, "own_callback_group"},
   };
   return kTerms;
 }
@@ -73,6 +74,8 @@ std::string RemedyText(const Remedy& remedy) {
       return "shorten the period of " + remedy.target;
     case RemedyKind::kRelieveNode:
       return "relieve " + remedy.target + " (cpu_bound)";
+    case RemedyKind::kOwnCallbackGroup:
+      return "give " + remedy.target + " a callback group of its own";
   }
   return RemedyKindToString(remedy.kind);  // a value outside the enum
 }

@@ -36,6 +36,9 @@ enum class RemedyKind {
   kShortenTimerPeriod,
   // frequency_bound: the slow input's rate is set by a cpu_bound node.
   kRelieveNode,
+  // starved_input: the subscription's own node starves it; a callback
+  // group of its own lets it run beside the node's other callbacks.
+  kOwnCallbackGroup,
 };
 
 struct Remedy {
@@ -45,7 +48,8 @@ struct Remedy {
   //   lower_sensor_rate, raise_sensor_rate: a sensor topic (published from
   //     outside the graph), e.g. "/sensing/lidar/points_raw";
   //   raise_publisher_rate: the slow topic;
-  //   shorten_timer_period: the timer callback, "<node>/<callback>".
+  //   shorten_timer_period: the timer callback, "<node>/<callback>";
+  //   own_callback_group: the subscription, "<node>/<callback>".
   std::string target;
   // raise_publisher_rate only: the node(s) publishing `target`, sorted and
   // ", "-joined ("external" for a sensor, "unknown" when none was seen), as
@@ -69,7 +73,8 @@ std::vector<std::string> RemedyKindTokens();
 // The readable text of one remedy: "more cores", "higher frequency", "lower
 // sensor rate", "raise the rate of <topic>'s publisher (<publisher>)",
 // "raise the rate of sensor <topic>", "shorten the period of <timer>",
-// "relieve <node> (cpu_bound)".
+// "relieve <node> (cpu_bound)", "give <subscription> a callback group of
+// its own".
 std::string RemedyText(const Remedy& remedy);
 // The texts "; "-joined in order (most important first): Finding::remedy.
 std::string RemediesText(const std::vector<Remedy>& remedies);

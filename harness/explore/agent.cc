@@ -375,6 +375,7 @@ std::vector<int> AgentStrategy::RemedyDirections(const Record& record,
           case analysis::RemedyKind::kRaisePublisherRate:
           case analysis::RemedyKind::kShortenTimerPeriod:
           case analysis::RemedyKind::kRelieveNode:
+          case analysis::RemedyKind::kOwnCallbackGroup:
             break;  // no design knob stands for these
         }
         if (want != 0 && direction[d] == 0) direction[d] = want;

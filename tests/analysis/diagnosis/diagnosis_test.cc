@@ -456,6 +456,74 @@ TEST(DiagnosisFrequencyBoundTest, DrivingInputsOnlyIgnoresCachedState) {
   EXPECT_FALSE(SetOption(&o, "frequency_bound_driving_inputs_only", 0.5).ok());
 }
 
+// Node "planner": a 50 Hz pose it keeps (taken at once until `stall_s`),
+// and a 0.5 s planning timer whose runs cost 1 s from `stall_s` on, back
+// to back (`busy_share` of the time; 1: without a gap), to `end_s`; the
+// poses that come meanwhile are dropped unread.
+runfile::RunData PlannerRun(double stall_s, double end_s,
+                            double busy_share = 1.0) {
+  TraceBuilder b(end_s, /*cores=*/16);
+  const int pose = b.Topic("/pose");
+  const int sub = b.Subscription("planner", "pose", "/pose");
+  const int plan = b.Timer("planner", "plan", 0.5);
+  const int n = static_cast<int>(50.0 * end_s);
+  b.Publishes(pose, -1, 50.0, n);
+  b.Takes(pose, sub, 50.0, static_cast<int>(50.0 * stall_s), 0.0001);
+  for (int i = static_cast<int>(50.0 * stall_s); i < n; ++i) {
+    b.Event(TopicEvent::kDrop, pose, sub, i / 50.0);
+  }
+  int runs = 0;
+  for (double t = stall_s; t + 1.0 <= end_s + 1e-9; t += 1.0 / busy_share) {
+    b.Record(plan, t, t, 1.0);
+    ++runs;
+  }
+  b.run().trace.timer_overruns[plan] = runs;
+  return b.run();
+}
+
+TEST(DiagnosisStarvedInputTest, ATimerRunningBackToBackStarvesItsNodesInput) {
+  const Diagnosis d = Diagnose(PlannerRun(20.0, 60.0));
+  const Finding* f = FindKind(d, "starved_input");
+  ASSERT_NE(f, nullptr);
+  EXPECT_EQ(f->node, "planner");
+  EXPECT_EQ(f->topics, std::vector<std::string>{"/pose"});
+  EXPECT_EQ(f->upstream, "external");
+  EXPECT_NEAR(f->rates_hz.at("starved_s"), 40.0, 0.05);
+  EXPECT_NEAR(f->rates_hz.at("from_s"), 20.0, 0.05);
+  EXPECT_NEAR(f->rates_hz.at("node_busy_share"), 1.0, 0.01);
+  EXPECT_EQ(f->rates_hz.at("dropped"), 2000.0);
+  EXPECT_EQ(f->rates_hz.at("holder_timer_overruns"), 40.0);
+  EXPECT_NEAR(f->severity, 40.0 / 60.0, 0.01);
+  ASSERT_EQ(f->remedies.size(), 1u);
+  EXPECT_EQ(f->remedies[0],
+            (Remedy{RemedyKind::kOwnCallbackGroup, "planner/pose"}));
+  EXPECT_EQ(f->remedy, "give planner/pose a callback group of its own");
+  EXPECT_NE(f->message.find("planner/pose took no message of /pose for 40.0 "
+                            "s from 20.0 s while its node ran its other "
+                            "callbacks 100% of that time (mostly "
+                            "planner/plan, a timer that skipped 40 fires in "
+                            "the run, each due while the one before still "
+                            "waited)"),
+            std::string::npos)
+      << f->message;
+}
+
+// Waiting while the node is idle is waiting for a core: a starved
+// computer, which cpu_bound names, not a starved input.
+TEST(DiagnosisStarvedInputTest, AnInputWaitingWhileItsNodeIsIdleIsNotStarved) {
+  EXPECT_EQ(FindKind(Diagnose(PlannerRun(20.0, 60.0, /*busy_share=*/0.5)),
+                     "starved_input"),
+            nullptr);
+  // 4 s of planning back to back: under starved_input_min_s.
+  EXPECT_EQ(FindKind(Diagnose(PlannerRun(56.0, 60.0)), "starved_input"),
+            nullptr);
+  DiagnosisOptions shorter;
+  ASSERT_TRUE(SetOption(&shorter, "starved_input_min_s", 3.0).ok());
+  EXPECT_NE(
+      FindKind(Diagnose(PlannerRun(56.0, 60.0), shorter), "starved_input"),
+      nullptr);
+}
+
 TEST(DiagnosisStatsTest, CallbackAndCoreUtilization) {
   TraceBuilder b(10.0, 4);
   const int a = b.Timer("a", "tick", 1.0);

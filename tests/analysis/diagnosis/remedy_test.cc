@@ -11,7 +11,7 @@ namespace {
 
 TEST(RemedyTest, EveryKindRoundTripsThroughItsToken) {
   const std::vector<std::string> tokens = RemedyKindTokens();
-  ASSERT_EQ(tokens.size(), 7u);
+  ASSERT_EQ(tokens.size(), 8u);
   EXPECT_EQ(std::set<std::string>(tokens.begin(), tokens.end()).size(),
             tokens.size());
   for (size_t i = 0; i < tokens.size(); ++i) {
@@ -57,6 +57,8 @@ TEST(RemedyTest, TextIsTheDiagnosisWording) {
             "shorten the period of pub1/on_timer");
   EXPECT_EQ(RemedyText({RemedyKind::kRelieveNode, "slow"}),
             "relieve slow (cpu_bound)");
+  EXPECT_EQ(RemedyText({RemedyKind::kOwnCallbackGroup, "planner/pose"}),
+            "give planner/pose a callback group of its own");
   EXPECT_EQ(RemediesText({}), "");
 }
 

@@ -187,19 +187,20 @@ TEST(EvaluationTest, AReportWithoutTypedRemediesIsRefused) {
 }
 
 // An older adse's report lacks what rows now carry (localization_lost_s
-// since version 4): the campaign analyses its run again instead.
+// since version 4, starved_input findings since 5): the campaign analyses
+// its run again instead.
 TEST(EvaluationTest, AReportOfAnOlderVersionIsStale) {
   nlohmann::json j = report::ToJson(ReportWithFindings());
   ASSERT_TRUE(RowFromReportJson(j.dump(), "new.report.json").ok());
   for (const nlohmann::json& version :
-       {nlohmann::json(report::kReportVersion - 1), nlohmann::json("4"),
+       {nlohmann::json(report::kReportVersion - 1), nlohmann::json("5"),
         nlohmann::json()}) {
     j["report_version"] = version;
     Result<EvaluationRow> row = RowFromReportJson(j.dump(), "old.report.json");
     ASSERT_FALSE(row.ok()) << version;
     EXPECT_EQ(row.status().code(), Status::Code::kCorruption);
     EXPECT_NE(row.status().message().find(
-                  "old.report.json: a report older than report_version 4"),
+                  "old.report.json: a report older than report_version 5"),
               std::string::npos)
         << row.status().message();
   }
