@@ -135,10 +135,11 @@ std::vector<Finding> FindStarvedInputs(const runfile::RunData& run,
     f.remedies.push_back({RemedyKind::kOwnCallbackGroup, info.name});
     f.remedy = RemediesText(f.remedies);
     const std::string overrun_text =
-        overruns > 0 ? fmt::format(", a timer that skipped {} fires in the "
-                                   "run, each due while the one before "
-                                   "still waited",
-                                   overruns)
+        overruns > 0 ? fmt::format(
+                           ", a timer that skipped {} fires in the "
+                           "run, each due while the one before "
+                           "still waited",
+                           overruns)
                      : std::string();
     f.message = fmt::format(
         "{} took no message of {} for {:.1f} s from {:.1f} s while its node "
