@@ -94,8 +94,12 @@ std::vector<Finding> FindStarvedInputs(const runfile::RunData& run,
         busy[x.callback] += s;
         busy_s += s;
       }
+      // Some of the node's own work, whatever the share asked for: an idle
+      // node starves nothing.
       const double share = busy_s / (b - a);
-      if (share < options.starved_input_busy_share) continue;
+      if (!(busy_s > 0.0) || share < options.starved_input_busy_share) {
+        continue;
+      }
       best_s = b - a;
       best_from = a;
       best_share = share;

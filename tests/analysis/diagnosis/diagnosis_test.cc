@@ -522,6 +522,13 @@ TEST(DiagnosisStarvedInputTest, AnInputWaitingWhileItsNodeIsIdleIsNotStarved) {
   EXPECT_NE(
       FindKind(Diagnose(PlannerRun(56.0, 60.0), shorter), "starved_input"),
       nullptr);
+  // With no share asked for, a node that ran nothing still starves nothing.
+  runfile::RunData idle = PlannerRun(20.0, 60.0);
+  std::erase_if(idle.trace.callbacks, [](const stack::CallbackRecord& r) {
+    return r.start_s >= 20.0;
+  });
+  ASSERT_TRUE(SetOption(&shorter, "starved_input_busy_share", 0.0).ok());
+  EXPECT_EQ(FindKind(Diagnose(idle, shorter), "starved_input"), nullptr);
 }
 
 TEST(DiagnosisStatsTest, CallbackAndCoreUtilization) {
