@@ -96,7 +96,7 @@ Result<EvaluationRow> RowFromReportJson(const std::string& text,
   }
   // A report is derived data: one an older adse wrote may lack what the
   // rows now carry (a metric added since), so its run is analysed again.
-  const nlohmann::json& version = j.value("report_version", nlohmann::json());
+  const nlohmann::json version = j.value("report_version", nlohmann::json());
   if (!version.is_number_integer() ||
       version.get<int>() < report::kReportVersion) {
     return Status::Corruption(

@@ -87,7 +87,14 @@ std::vector<Finding> FindStarvedInputs(const runfile::RunData& run,
       if (drops < options.min_messages) continue;
       std::map<int, double> busy;
       double busy_s = 0.0;
-      for (const Execution& x : executions) {
+      // From the last execution starting before `a` (the only one that can
+      // reach into the stretch: they do not overlap).
+      auto from = std::lower_bound(
+          executions.begin(), executions.end(), a,
+          [](const Execution& x, double t) { return x.start_s < t; });
+      if (from != executions.begin()) --from;
+      for (auto x_it = from; x_it != executions.end(); ++x_it) {
+        const Execution& x = *x_it;
         if (x.start_s >= b) break;
         if (x.callback == c || x.end_s <= a) continue;
         const double s = std::min(x.end_s, b) - std::max(x.start_s, a);
