@@ -55,8 +55,11 @@ namespace {
 // shoulders; detections within a confirmed track's box that each show
 // part of its object are joined into one box first. v23: the corner rule
 // rehearses the ideal driver as it drives, on from where the car stands,
-// and a stray soon after a corner's turn joins that turn.
-constexpr char kKeyVersion[] = "adse-run-key-v23";
+// and a stray soon after a corner's turn joins that turn. v24: a
+// subscription waits from the oldest message it has not taken, however
+// often its keep-last queue turned over since, so an overrunning timer no
+// longer starves its node's subscriptions.
+constexpr char kKeyVersion[] = "adse-run-key-v24";
 
 Status AddFile(ContentHasher* h, const std::string& label,
                const std::string& path) {

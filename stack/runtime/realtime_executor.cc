@@ -65,6 +65,9 @@ struct CallbackState {
   bool is_timer = false;
   bool running = false;
   std::deque<QueuedMessage> queue;  // keep-last, oldest first
+  // Since when the queue has held a message not yet taken (see the
+  // virtual executor: a message pushed out leaves its wait to the next).
+  double waiting_since_s = 0.0;
   bool fire_pending = false;
   double fire_s = 0.0;
   int64_t next_fire = 0;
@@ -407,6 +410,7 @@ void RealTimeExecutor::Deliver(int topic, const MessagePtr& message,
       {TopicEvent::kPublish, topic, publisher, now, seq, stamp_s});
   for (int c : topic_subs_[topic]) {
     CallbackState& st = states_[c];
+    if (st.queue.empty()) st.waiting_since_s = now;
     if (static_cast<int>(st.queue.size()) == st.spec->queue_depth) {
       const QueuedMessage& old = st.queue.front();
       trace_.topic_events.push_back(
@@ -424,7 +428,7 @@ int RealTimeExecutor::Choose() const {
   for (size_t c = 0; c < states_.size(); ++c) {
     const CallbackState& st = states_[c];
     if (!Ready(st)) continue;
-    const double t = st.is_timer ? st.fire_s : st.queue.front().arrival_s;
+    const double t = st.is_timer ? st.fire_s : st.waiting_since_s;
     if (best < 0 || t < best_t) {
       best = static_cast<int>(c);
       best_t = t;
@@ -463,6 +467,7 @@ void RealTimeExecutor::RunOne(int c, int thread,
   } else {
     QueuedMessage q = std::move(st.queue.front());
     st.queue.pop_front();
+    if (!st.queue.empty()) st.waiting_since_s = st.queue.front().arrival_s;
     rec.ready_s = q.arrival_s;
     message = std::move(q.message);
     trace_.topic_events.push_back(

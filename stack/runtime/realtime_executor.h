@@ -63,8 +63,9 @@ Status ValidateRealTimeOptions(const RealTimeOptions& options);
 // - PublishExternal(t_s): delivered when the sim clock reaches t_s (at once
 //   when it has already passed: a world running late delivers late).
 // - Dispatch: any idle thread takes the ready callback (its node idle)
-//   with the earliest ready time; the OS preempts freely. A callback's
-//   publications are held to its end, as on the virtual platform.
+//   with the earliest ready time (a subscription's: the oldest message it
+//   has not taken, as on the virtual platform); the OS preempts freely. A
+//   callback's publications are held to its end, as on the virtual platform.
 // - Data-parallel callbacks: k = min(max_threads, cores) threads pad the
 //   parallel part together (the callback's thread and k - 1 helpers, in
 //   the same CPUs and group), each its 1/k share in thread CPU time after

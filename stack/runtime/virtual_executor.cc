@@ -11,10 +11,15 @@
 //   subscription keeps the last `queue_depth` messages; a full queue drops its
 //   oldest (kDrop). Sinks are called synchronously at publish time, free.
 // - Readiness: a subscription is ready when its queue is non-empty and it is
-//   not running; its ready time is the arrival time of the oldest queued
-//   message (the one it will take). A timer is ready when it fired and that
-//   fire has not started; a fire arriving while an earlier fire still waits
-//   is skipped and counted in Trace::timer_overruns (ROS 2 timers do not
+//   not running; its ready time is when its queue last went from empty to
+//   holding a message, or, after a take that left messages, the arrival of
+//   the oldest of them. A message the keep-last queue pushes out leaves its
+//   wait to the newer one: otherwise a busy node's overdue timer would
+//   always be older than a depth-1 subscription's newest message and
+//   starve it, which rclcpp's executor, serving every handle of one wait
+//   round before waiting again, does not. A timer is ready when it fired and
+//   that fire has not started; a fire arriving while an earlier fire still
+//   waits is skipped and counted in Trace::timer_overruns (ROS 2 timers do not
 //   queue missed periods). A running timer that fires waits for its end.
 // - Callbacks of one node exclude each other (ROS 2's default mutually
 //   exclusive callback group).
@@ -132,6 +137,10 @@ struct CallbackState {
   std::vector<QueuedMessage> ring;
   int head = 0;
   int size = 0;
+  // Since when the queue has held a message not yet taken: a message a
+  // newer one pushed out leaves its wait to it, as rclcpp's wait set keeps
+  // a subscription ready however often its queue turned over.
+  double waiting_since_s = 0.0;
   // Timers.
   bool fire_pending = false;
   double fire_s = 0.0;
@@ -237,7 +246,7 @@ class VirtualExecutor final : public Executor {
     ready_.push_back(c);
   }
   double ReadyTime(const CallbackState& st) const {
-    return st.is_timer ? st.fire_s : st.ring[st.head].arrival_s;
+    return st.is_timer ? st.fire_s : st.waiting_since_s;
   }
   void Dispatch();
   void Start(int c);
@@ -511,6 +520,7 @@ void VirtualExecutor::Enqueue(int c, const MessagePtr& message, uint64_t seq,
                               double stamp_s) {
   CallbackState& st = states_[c];
   const int depth = static_cast<int>(st.ring.size());
+  if (st.size == 0) st.waiting_since_s = now_;
   if (st.size == depth) {
     // Keep-last: the oldest message makes room.
     QueuedMessage& old = st.ring[st.head];
@@ -575,6 +585,7 @@ void VirtualExecutor::Start(int c) {
         {TopicEvent::kTake, spec.topic, c, now_, q.seq, q.stamp_s});
     st.head = st.head + 1 == static_cast<int>(st.ring.size()) ? 0 : st.head + 1;
     --st.size;
+    if (st.size > 0) st.waiting_since_s = st.ring[st.head].arrival_s;
   }
 
   context_.Begin(now_, &st.held);

@@ -1,10 +1,10 @@
 // The starved_input rule of the diagnosis: a subscription its own node
-// starves. Callbacks of one node exclude each other, and an executor that
-// starts the earliest ready callback (as rclcpp's takes timers first) runs
-// an overdue timer before a keep-last queue whose newest message came
-// after the timer's fire: a timer callback that outlasts its period then
-// runs back to back and the node's subscriptions never take a message,
-// however many cores are free.
+// starves. Callbacks of one node exclude each other, so callbacks ahead of
+// a subscription in its node's line that run for seconds keep it from its
+// messages however many cores are free. Runs of run key v23 and before
+// show it most: their executor counted a keep-last subscription's wait
+// from its newest message, so a timer that outlasted its period ran back
+// to back and the subscription never took a message again.
 #ifndef ADSE_ANALYSIS_DIAGNOSIS_INTERNAL_STARVED_INPUT_H_
 #define ADSE_ANALYSIS_DIAGNOSIS_INTERNAL_STARVED_INPUT_H_
 

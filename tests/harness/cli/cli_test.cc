@@ -379,11 +379,14 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
   EXPECT_EQ(again_json["points"], both_json["points"]);
   EXPECT_EQ(again_json["runs"], 1);
   // Each callback says how many invocations it compared: the fewest any
-  // run made.
+  // run that ran it made (a real-time run starved of a callback on a
+  // loaded host counts as without it).
   for (const nlohmann::json& c : again_json["points"][0]["callback_p50_ms"]) {
     const nlohmann::json& n = c["invocations"];
-    EXPECT_EQ(n["compared"],
-              std::min(n["virtual"].get<int>(), n["realtime"][0].get<int>()))
+    const int realtime = n["realtime"][0].get<int>();
+    EXPECT_EQ(n["compared"], realtime == 0
+                                 ? n["virtual"].get<int>()
+                                 : std::min(n["virtual"].get<int>(), realtime))
         << c["name"];
   }
   for (const char* name : {"fidelity.txt", "fidelity-1-run_to_completion.png",

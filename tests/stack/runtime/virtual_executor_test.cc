@@ -424,6 +424,39 @@ TEST(VirtualExecutorTest, TimerOverruns) {
   EXPECT_NEAR(now_seen[3], 1.875, kTol);
 }
 
+// A node whose timer overruns its period (a plan of 1.2 s every 0.5 s) still
+// takes its 50 Hz pose after each plan: the pose has waited since the first
+// message the plan kept it from, however often keep-last replaced it, so it
+// is older than the timer's next fire. Until run key v24 its ready time was
+// its newest message's arrival, always later than the overdue fire, and the
+// pose was never taken again (acosta-2 of seed 4's stall).
+TEST(VirtualExecutorTest, AnOverrunningTimerDoesNotStarveItsNodesSubscription) {
+  Graph g;
+  const int pose = g.AddTopic<Msg>("pose");
+  const int node = g.AddNode("planner");
+  const int plan = g.AddTimer(node, "plan", 0.5, [](CallbackContext&) {});
+  const int sub = g.Subscribe<Msg>(node, pose, "pose", 1, Noop());
+  auto ex = CreateVirtual(g, Counted(2, {{"planner/plan", {1.2, 0}},
+                                         {"planner/pose", {0.001, 0}}}));
+  for (int k = 1; k <= 500; ++k) Publish(*ex, pose, k, k * 0.02);
+  ASSERT_TRUE(ex->AdvanceTo(10.0).ok());
+  const auto plans = RecordsOf(ex->trace(), plan);
+  const auto takes = RecordsOf(ex->trace(), sub);
+  ASSERT_GE(plans.size(), 7u);
+  // After every plan but the last, the pose runs before the next plan.
+  for (size_t i = 0; i + 1 < plans.size(); ++i) {
+    const bool pose_between =
+        std::any_of(takes.begin(), takes.end(), [&](const CallbackRecord& r) {
+          return r.start_s >= plans[i].end_s - kTol &&
+                 r.end_s <= plans[i + 1].start_s + kTol;
+        });
+    EXPECT_TRUE(pose_between)
+        << "plan " << i << " ending at " << plans[i].end_s;
+  }
+  // The plan waits for the pose's 1 ms, so it starts 1.201 s apart.
+  EXPECT_NEAR(plans[2].start_s - plans[1].start_s, 1.201, kTol);
+}
+
 // A fire during a run waits for it and is not an overrun.
 TEST(VirtualExecutorTest, RunningTimerFiringAgainWaits) {
   Graph g;
