@@ -18,8 +18,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr char kExternal[] = "external";
-constexpr char kCpuBound[] = "cpu_bound";
-constexpr char kFrequencyBound[] = "frequency_bound";
 
 // ---- Options ---------------------------------------------------------------
 
@@ -380,6 +378,7 @@ Diagnosis Diagnose(const runfile::RunData& run,
   std::vector<bool> published_in_window(num_callbacks, false);
   // Per (topic, subscriber callback): takes and drops in the window.
   std::map<std::pair<int, int>, std::pair<int64_t, int64_t>> subs;
+  std::map<std::pair<int, int>, std::vector<double>> take_times;
   for (int c = 0; c < num_callbacks; ++c) {
     const runfile::NamedCallback& info = run.callback_info[c];
     if (info.kind == "subscription" && view.ValidTopic(info.topic)) {
@@ -408,7 +407,10 @@ Diagnosis Diagnose(const runfile::RunData& run,
     }
     if (!view.InWindow(e.t_s) || !view.ValidCallback(e.callback)) continue;
     auto& counts = subs[{e.topic, e.callback}];
-    if (e.kind == stack::TopicEvent::kTake) ++counts.first;
+    if (e.kind == stack::TopicEvent::kTake) {
+      ++counts.first;
+      take_times[{e.topic, e.callback}].push_back(e.t_s);
+    }
     if (e.kind == stack::TopicEvent::kDrop) ++counts.second;
   }
   d.topics.resize(num_topics);
@@ -425,6 +427,14 @@ Diagnosis Diagnose(const runfile::RunData& run,
     s.takes = counts.first;
     s.drops = counts.second;
     s.take_rate_hz = view.Rate(counts.first);
+    std::vector<double>& takes = take_times[key];
+    std::sort(takes.begin(), takes.end());
+    double last_s = view.start_s();
+    for (double t : takes) {
+      s.longest_gap_s = std::max(s.longest_gap_s, t - last_s);
+      last_s = t;
+    }
+    s.longest_gap_s = std::max(s.longest_gap_s, view.end_s() - last_s);
     d.topics[key.first].subscribers.push_back(std::move(s));
   }
 
@@ -502,7 +512,7 @@ Diagnosis Diagnose(const runfile::RunData& run,
     if (!(deficit > allowed)) continue;
 
     Finding f;
-    f.kind = kCpuBound;
+    f.kind = FindingKindToString(FindingKind::kCpuBound);
     f.node = view.NodeOfCallback(callback);
     f.topics = {run.topic_names[topic]};
     f.upstream = d.topics[topic].publisher;
@@ -638,7 +648,7 @@ Diagnosis Diagnose(const runfile::RunData& run,
     if (!(deficit > options.frequency_bound_fraction)) continue;
 
     Finding f;
-    f.kind = kFrequencyBound;
+    f.kind = FindingKindToString(FindingKind::kFrequencyBound);
     f.node = node;
     f.topics = {run.topic_names[slowest]};
     f.upstream = d.topics[slowest].publisher;

@@ -80,6 +80,10 @@ struct SubscriberStats {
   double take_rate_hz = 0.0;
   int64_t takes = 0;
   int64_t drops = 0;
+  // The window's longest stretch without a take (from its start, between
+  // takes, to its end): a node that starves one of its own subscriptions
+  // shows it here, not in the take rate.
+  double longest_gap_s = 0.0;
 };
 
 struct TopicStats {
@@ -109,7 +113,7 @@ struct CallbackStats {
 };
 
 struct Finding {
-  std::string kind;  // "cpu_bound" | "frequency_bound" | "starved_input"
+  std::string kind;  // a FindingKindToString token (remedy.h)
   // The node that cannot keep up (cpu_bound) / that is input-limited
   // (frequency_bound) / whose callbacks starve one of its subscriptions
   // (starved_input).

@@ -22,7 +22,41 @@ const std::vector<Term<RemedyKind>>& RemedyKindTerms() {
   return kTerms;
 }
 
+const std::vector<Term<FindingKind>>& FindingKindTerms() {
+  static const std::vector<Term<FindingKind>> kTerms = {
+      {FindingKind::kCpuBound, "cpu_bound"},
+      {FindingKind::kFrequencyBound, "frequency_bound"},
+      {FindingKind::kStarvedInput, "starved_input"},
+  };
+  return kTerms;
+}
+
+// "a, b, c" of a vocabulary's tokens, for errors.
+std::string Joined(const std::vector<std::string>& tokens) {
+  std::string out;
+  for (const std::string& token : tokens) {
+    out += (out.empty() ? "" : ", ") + token;
+  }
+  return out;
+}
+
 }  // namespace
+
+const char* FindingKindToString(FindingKind kind) {
+  return NameOf(FindingKindTerms(), kind);
+}
+
+Result<FindingKind> StringToFindingKind(const std::string& token) {
+  FindingKind kind = FindingKind::kCpuBound;
+  if (ValueOf(FindingKindTerms(), token, &kind)) return kind;
+  return Status::InvalidArgument(
+      "unknown bottleneck kind '" + token +
+      "'; valid kinds: " + Joined(FindingKindTokens()));
+}
+
+std::vector<std::string> FindingKindTokens() {
+  return NamesOf(FindingKindTerms());
+}
 
 bool operator==(const Remedy& a, const Remedy& b) {
   return a.kind == b.kind && a.target == b.target && a.publisher == b.publisher;
@@ -43,12 +77,9 @@ const char* RemedyKindToString(RemedyKind kind) {
 Result<RemedyKind> StringToRemedyKind(const std::string& token) {
   RemedyKind kind = RemedyKind::kMoreCores;
   if (ValueOf(RemedyKindTerms(), token, &kind)) return kind;
-  std::string valid;
-  for (const std::string& name : RemedyKindTokens()) {
-    valid += (valid.empty() ? "" : ", ") + name;
-  }
-  return Status::InvalidArgument("unknown remedy kind '" + token +
-                                 "'; valid kinds: " + valid);
+  return Status::InvalidArgument(
+      "unknown remedy kind '" + token +
+      "'; valid kinds: " + Joined(RemedyKindTokens()));
 }
 
 std::vector<std::string> RemedyKindTokens() {

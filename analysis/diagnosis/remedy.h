@@ -16,6 +16,27 @@
 
 namespace adse::analysis {
 
+// What a finding of the diagnosis says is wrong (Finding::kind, the
+// explore module's BottleneckHint::kind, the LLM text agent's answers
+// carry its token). A new kind needs its token in remedy.cc's
+// FindingKindTerms.
+enum class FindingKind {
+  // A node cannot keep up with its input.
+  kCpuBound,
+  // A node's input arrives too slowly although the node keeps up.
+  kFrequencyBound,
+  // A subscription goes untaken for seconds while its own node's other
+  // callbacks keep the node busy.
+  kStarvedInput,
+};
+
+// The snake_case token of a kind ("cpu_bound"), as stored in JSON.
+const char* FindingKindToString(FindingKind kind);
+// The kind of a token; InvalidArgument naming the token and the valid ones.
+Result<FindingKind> StringToFindingKind(const std::string& token);
+// Every token, in enum order.
+std::vector<std::string> FindingKindTokens();
+
 // One per thing the diagnosis proposes. A new kind needs its token in
 // remedy.cc's RemedyKindTerms (the single list of the vocabulary) and its
 // text in RemedyText.

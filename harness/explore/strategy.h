@@ -35,7 +35,7 @@ namespace adse::explore {
 
 // A bottleneck found in a run (a summary of analysis/diagnosis's Finding).
 struct BottleneckHint {
-  std::string kind;       // "cpu_bound" | "frequency_bound" | "starved_input"
+  std::string kind;       // analysis::FindingKindToString's token
   std::string node;       // the node that cannot keep up / is input-limited
   std::string remedy;     // readable text of `remedies`, for prompts
   double severity = 0.0;  // relative deficit

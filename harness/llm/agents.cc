@@ -8,6 +8,7 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
+#include "analysis/diagnosis/remedy.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/world/world_options.h"
 
@@ -371,11 +372,12 @@ Result<TextReading> ParseTextReading(const std::string& answer) {
     if (!node.ok()) return node.status();
     Result<std::string> kind = StringField(b, "kind", "a bottleneck", true);
     if (!kind.ok()) return kind.status();
-    if (*kind != "cpu_bound" && *kind != "frequency_bound") {
+    // The diagnosis' own vocabulary: a kind it can find, the agent can name.
+    if (!analysis::StringToFindingKind(*kind).ok()) {
       return Status::InvalidArgument(
-          "a bottleneck's \"kind\" must be \"cpu_bound\" or "
-          "\"frequency_bound\", found " +
-          Excerpt(*kind, 60));
+          "a bottleneck's \"kind\" must be one of " +
+          fmt::format("{}", fmt::join(analysis::FindingKindTokens(), ", ")) +
+          ", found " + Excerpt(*kind, 60));
     }
     Result<std::string> remedy =
         StringField(b, "remedy", "a bottleneck", false);
@@ -472,12 +474,15 @@ Result<std::string> TraceSummaryFromReport(const std::string& report_json) {
     return v.contains(key) && v.at(key).is_number() ? v.at(key).get<double>()
                                                     : std::nan("");
   };
-  std::string out = "topics (publisher, publish Hz, slowest take Hz, drops):";
+  std::string out =
+      "topics (publisher, publish Hz, slowest take Hz, drops, longest "
+      "stretch a subscriber took nothing):";
   for (const json& t : j["trace"].value("topics", json::array())) {
-    out += fmt::format(
-        "\n  {} ({}): {:.3g} Hz, {:.3g} Hz, {} drops", t.value("name", "?"),
-        t.value("publisher", "?"), num(t, "publish_rate_hz"),
-        num(t, "slowest_take_rate_hz"), t.value("drops", int64_t{0}));
+    out +=
+        fmt::format("\n  {} ({}): {:.3g} Hz, {:.3g} Hz, {} drops, {:.3g} s",
+                    t.value("name", "?"), t.value("publisher", "?"),
+                    num(t, "publish_rate_hz"), num(t, "slowest_take_rate_hz"),
+                    t.value("drops", int64_t{0}), num(t, "longest_take_gap_s"));
   }
   out += "\ncallbacks (latency p50 / p99 ms, utilisation):";
   for (const json& c : j["trace"].value("callbacks", json::array())) {

@@ -90,6 +90,8 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
           i == 0 ? sub.take_rate_hz
                  : std::min(summary.slowest_take_rate_hz, sub.take_rate_hz);
       summary.drops += sub.drops;
+      summary.longest_take_gap_s =
+          std::max(summary.longest_take_gap_s, sub.longest_gap_s);
     }
     r.topics.push_back(summary);
   }
@@ -190,7 +192,8 @@ nlohmann::json ToJson(const RunReport& r) {
          {"publisher", t.publisher},
          {"publish_rate_hz", Number(t.publish_rate_hz)},
          {"slowest_take_rate_hz", Number(t.slowest_take_rate_hz)},
-         {"drops", t.drops}});
+         {"drops", t.drops},
+         {"longest_take_gap_s", Number(t.longest_take_gap_s)}});
   }
   j["trace"]["callbacks"] = nlohmann::json::array();
   for (const CallbackSummary& c : r.callbacks) {

@@ -59,6 +59,9 @@ struct TopicSummary {
   double publish_rate_hz = 0.0;
   double slowest_take_rate_hz = 0.0;  // over its subscribers; 0 when none
   int64_t drops = 0;                  // over its subscribers
+  // The longest stretch one of its subscribers went without a take
+  // (analysis::SubscriberStats::longest_gap_s); 0 when none.
+  double longest_take_gap_s = 0.0;
 };
 struct CallbackSummary {
   std::string name;  // "<node>/<callback>"
@@ -70,9 +73,9 @@ struct CallbackSummary {
 // What a report holds, by version: 2, findings carry typed `remedies`
 // beside the readable `remedy`; 3, `standing` says how long the car stood
 // and for which stop reason; 4, metrics carry `localization_lost_s`; 5,
-// findings may be `starved_input`. A campaign analyses a run again rather
-// than read an older report.
-inline constexpr int kReportVersion = 5;
+// findings may be `starved_input`; 6, topics carry `longest_take_gap_s`.
+// A campaign analyses a run again rather than read an older report.
+inline constexpr int kReportVersion = 6;
 
 struct RunReport {
   int report_version = kReportVersion;

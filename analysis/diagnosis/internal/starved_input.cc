@@ -9,8 +9,6 @@
 namespace adse::analysis::internal {
 namespace {
 
-constexpr char kStarvedInput[] = "starved_input";
-
 // Takes and drops of one subscription, in time order.
 struct QueueEvents {
   std::vector<double> takes_s;
@@ -131,7 +129,7 @@ std::vector<Finding> FindStarvedInputs(const runfile::RunData& run,
             ? run.trace.timer_overruns[holder]
             : 0;
     Finding f;
-    f.kind = kStarvedInput;
+    f.kind = FindingKindToString(FindingKind::kStarvedInput);
     f.node = node_of[c];
     f.topics = {run.topic_names[info.topic]};
     if (info.topic < static_cast<int>(topics.size())) {

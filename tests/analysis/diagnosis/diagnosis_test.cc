@@ -135,6 +135,9 @@ TEST(DiagnosisCpuBoundTest, TopicTakenAtItsRateHasNoFinding) {
   EXPECT_EQ(d.topics[0].subscribers[0].callback, "filter/on_in");
   EXPECT_NEAR(d.topics[0].subscribers[0].take_rate_hz, 10.0, 1e-9);
   EXPECT_EQ(d.topics[0].subscribers[0].drops, 0);
+  // Taken every 0.1 s from 0 s: the longest stretch without a take is the
+  // last, from the 100th take (at 9.9 s) to the window's end.
+  EXPECT_NEAR(d.topics[0].subscribers[0].longest_gap_s, 0.1, 1e-9);
 }
 
 TEST(DiagnosisCpuBoundTest, SlowSubscriberIsCpuBoundWithEvidence) {
@@ -490,6 +493,11 @@ TEST(DiagnosisStarvedInputTest, ATimerRunningBackToBackStarvesItsNodesInput) {
   EXPECT_EQ(f->upstream, "external");
   EXPECT_NEAR(f->rates_hz.at("starved_s"), 40.0, 0.05);
   EXPECT_NEAR(f->rates_hz.at("from_s"), 20.0, 0.05);
+  // The topic's statistics show the stretch too (the LLM text agent reads
+  // them): from the last take, at 19.98 s, to the end.
+  ASSERT_EQ(d.topics.size(), 1u);
+  ASSERT_EQ(d.topics[0].subscribers.size(), 1u);
+  EXPECT_NEAR(d.topics[0].subscribers[0].longest_gap_s, 40.02, 1e-6);
   EXPECT_NEAR(f->rates_hz.at("node_busy_share"), 1.0, 0.01);
   EXPECT_EQ(f->rates_hz.at("dropped"), 2000.0);
   EXPECT_EQ(f->rates_hz.at("holder_timer_overruns"), 40.0);

@@ -40,6 +40,27 @@ TEST(RemedyTest, AnUnknownTokenIsRefusedByName) {
   }
 }
 
+TEST(RemedyTest, EveryFindingKindRoundTripsAndAnUnknownOneIsNamed) {
+  const std::vector<std::string> tokens = FindingKindTokens();
+  ASSERT_EQ(tokens, (std::vector<std::string>{"cpu_bound", "frequency_bound",
+                                              "starved_input"}));
+  for (size_t i = 0; i < tokens.size(); ++i) {
+    const FindingKind kind = static_cast<FindingKind>(i);
+    EXPECT_EQ(FindingKindToString(kind), tokens[i]);
+    Result<FindingKind> back = StringToFindingKind(tokens[i]);
+    ASSERT_TRUE(back.ok()) << back.status().ToString();
+    EXPECT_EQ(*back, kind);
+  }
+  Result<FindingKind> unknown = StringToFindingKind("memory_bound");
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_EQ(unknown.status().code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(unknown.status().message().find(
+                "'memory_bound'; valid kinds: cpu_bound, frequency_bound, "
+                "starved_input"),
+            std::string::npos)
+      << unknown.status().message();
+}
+
 TEST(RemedyTest, TextIsTheDiagnosisWording) {
   const std::vector<Remedy> cpu_bound = {
       {RemedyKind::kMoreCores, "lidar_driver"},

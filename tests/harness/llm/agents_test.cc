@@ -152,10 +152,29 @@ TEST(DecipherTest, TextReadingIsComparedByNodeAndKind) {
               ::testing::UnorderedElementsAre(
                   "missed cpu_bound euclidean_cluster",
                   "named frequency_bound planner (not found)"));
-  EXPECT_FALSE(ParseTextReading(
-                   R"js({"bottlenecks": [{"node": "a", "kind": "slow"}]})js")
-                   .ok());
+  const Result<TextReading> slow = ParseTextReading(
+      R"js({"bottlenecks": [{"node": "a", "kind": "slow"}]})js");
+  ASSERT_FALSE(slow.ok());
+  EXPECT_NE(slow.status().message().find(
+                "one of cpu_bound, frequency_bound, starved_input, found"),
+            std::string::npos)
+      << slow.status().message();
   EXPECT_FALSE(ParseTextReading(R"js({"summary": "fine"})js").ok());
+}
+
+TEST(DecipherTest, ATextReadingCanNameAStarvedInputAsTheDiagnosisDoes) {
+  // Every kind the diagnosis finds is one the text agent may name: a run
+  // whose planner starves its own subscription is not a disagreement
+  // when the agent says so.
+  Result<TextReading> r = ParseTextReading(
+      R"js({"bottlenecks": [{"node": "freespace_planner",
+                             "kind": "starved_input",
+                             "remedy": "own callback group"}],
+            "summary": "the planner's timer starves its pose input"})js");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  const std::vector<explore::BottleneckHint> found = {
+      {"starved_input", "freespace_planner", "give it a callback group", 0.5}};
+  EXPECT_TRUE(CompareTextReading(*r, found).empty());
 }
 
 TEST(DecipherTest, VisionReadingIsComparedWithTheMetrics) {
@@ -178,11 +197,13 @@ TEST(DecipherTest, TraceSummaryReadsTheReportsTrace) {
   Result<std::string> s = TraceSummaryFromReport(R"js({
     "metrics": {"ctrl_rate_hz": 9.5, "e2e_latency_p50_s": 0.12, "e2e_latency_p99_s": 0.3},
     "trace": {"topics": [{"name": "/points", "publisher": "external", "publish_rate_hz": 14,
-                          "slowest_take_rate_hz": 3.5, "drops": 120}],
+                          "slowest_take_rate_hz": 3.5, "drops": 120,
+                          "longest_take_gap_s": 61.04}],
               "callbacks": [{"name": "ndt/on_points", "latency_p50_s": 0.25,
                              "latency_p99_s": 0.4, "utilization": 0.98}]}})js");
   ASSERT_TRUE(s.ok());
-  EXPECT_THAT(*s, HasSubstr("/points (external): 14 Hz, 3.5 Hz, 120 drops"));
+  EXPECT_THAT(*s,
+              HasSubstr("/points (external): 14 Hz, 3.5 Hz, 120 drops, 61 s"));
   EXPECT_THAT(*s, HasSubstr("ndt/on_points: 250 / 400 ms, 0.98"));
   EXPECT_THAT(*s, HasSubstr("control rate 9.5 Hz"));
   EXPECT_EQ(TraceSummaryFromReport("{}").status().code(),

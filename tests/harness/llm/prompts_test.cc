@@ -53,12 +53,12 @@ TEST(PromptSetTest, TheCatalogueNamesSevenTemplates) {
                                             "interpret", "correction"));
 }
 
-TEST(PromptSetTest, LoadsTheBundledPromptsAllAtVersionOne) {
+TEST(PromptSetTest, LoadsTheBundledPromptsAtTheirVersions) {
   Result<PromptSet> set = PromptSet::Load("");
   ASSERT_TRUE(set.ok()) << set.status().ToString();
   EXPECT_EQ(set->folder(), DefaultPromptsDir());
   EXPECT_EQ(set->Versions(),
-            "dse_system v1, dse_step v1, command v1, decipher_text v1, "
+            "dse_system v1, dse_step v1, command v1, decipher_text v2, "
             "decipher_vision v1, interpret v1, correction v1");
 
   Result<PromptSet> named = PromptSet::Load(DefaultPromptsDir());

@@ -136,7 +136,7 @@ TEST(RunReportTest, NamesTheDominantStopReasonAndHowLongTheCarStood) {
                         "static structure, 3.3 m ahead): 40.0 s\n"));
   EXPECT_THAT(text, ::testing::HasSubstr("also localization_lost: 10.0 s\n"));
   const nlohmann::json j = ToJson(*r);
-  EXPECT_EQ(j["report_version"], 5);
+  EXPECT_EQ(j["report_version"], 6);
   EXPECT_EQ(j["standing"]["standing_s"], 50.0);
   ASSERT_EQ(j["standing"]["by_reason"].size(), 2u);
   const nlohmann::json& dominant = j["standing"]["by_reason"][0];
