@@ -31,13 +31,19 @@ const std::vector<Term<FindingKind>>& FindingKindTerms() {
   return kTerms;
 }
 
-// "a, b, c" of a vocabulary's tokens, for errors.
-std::string Joined(const std::vector<std::string>& tokens) {
-  std::string out;
-  for (const std::string& token : tokens) {
-    out += (out.empty() ? "" : ", ") + token;
+// The value of `token` in a vocabulary; InvalidArgument naming the token,
+// what it should be (`what`) and every valid token.
+template <typename E>
+Result<E> Parsed(const std::vector<Term<E>>& terms, const std::string& token,
+                 const char* what) {
+  E value = terms.front().value;
+  if (ValueOf(terms, token, &value)) return value;
+  std::string valid;
+  for (const std::string& name : NamesOf(terms)) {
+    valid += (valid.empty() ? "" : ", ") + name;
   }
-  return out;
+  return Status::InvalidArgument("unknown " + std::string(what) + " '" + token +
+                                 "'; valid kinds: " + valid);
 }
 
 }  // namespace
@@ -47,11 +53,7 @@ const char* FindingKindToString(FindingKind kind) {
 }
 
 Result<FindingKind> StringToFindingKind(const std::string& token) {
-  FindingKind kind = FindingKind::kCpuBound;
-  if (ValueOf(FindingKindTerms(), token, &kind)) return kind;
-  return Status::InvalidArgument(
-      "unknown bottleneck kind '" + token +
-      "'; valid kinds: " + Joined(FindingKindTokens()));
+  return Parsed(FindingKindTerms(), token, "bottleneck kind");
 }
 
 std::vector<std::string> FindingKindTokens() {
@@ -75,11 +77,7 @@ const char* RemedyKindToString(RemedyKind kind) {
 }
 
 Result<RemedyKind> StringToRemedyKind(const std::string& token) {
-  RemedyKind kind = RemedyKind::kMoreCores;
-  if (ValueOf(RemedyKindTerms(), token, &kind)) return kind;
-  return Status::InvalidArgument(
-      "unknown remedy kind '" + token +
-      "'; valid kinds: " + Joined(RemedyKindTokens()));
+  return Parsed(RemedyKindTerms(), token, "remedy kind");
 }
 
 std::vector<std::string> RemedyKindTokens() {
