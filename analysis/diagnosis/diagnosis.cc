@@ -381,7 +381,8 @@ Diagnosis Diagnose(const runfile::RunData& run,
   std::map<std::pair<int, int>, std::vector<double>> take_times;
   for (int c = 0; c < num_callbacks; ++c) {
     const runfile::NamedCallback& info = run.callback_info[c];
-    if (info.kind == "subscription" && view.ValidTopic(info.topic)) {
+    if (info.kind == runfile::CallbackKind::kSubscription &&
+        view.ValidTopic(info.topic)) {
       subs[{info.topic, c}];
     }
   }
@@ -495,7 +496,8 @@ Diagnosis Diagnose(const runfile::RunData& run,
   std::set<std::string> cpu_bound_nodes;
   for (const auto& [key, counts] : subs) {
     const auto [topic, callback] = key;
-    if (run.callback_info[callback].kind != "subscription" ||
+    if (run.callback_info[callback].kind !=
+            runfile::CallbackKind::kSubscription ||
         run.callback_info[callback].topic != topic || !enough(topic)) {
       continue;
     }
@@ -512,7 +514,7 @@ Diagnosis Diagnose(const runfile::RunData& run,
     if (!(deficit > allowed)) continue;
 
     Finding f;
-    f.kind = FindingKindToString(FindingKind::kCpuBound);
+    f.kind = FindingKind::kCpuBound;
     f.node = view.NodeOfCallback(callback);
     f.topics = {run.topic_names[topic]};
     f.upstream = d.topics[topic].publisher;
@@ -610,7 +612,7 @@ Diagnosis Diagnose(const runfile::RunData& run,
       if (cpu_bound_nodes.count(view.NodeOfCallback(p)) > 0) {
         return Origin{"cpu_bound", view.NodeOfCallback(p), 0.0};
       }
-      if (info.kind == "timer") {
+      if (info.kind == runfile::CallbackKind::kTimer) {
         return Origin{"timer", info.name,
                       info.period_s > 0.0 ? 1.0 / info.period_s : 0.0};
       }
@@ -626,8 +628,9 @@ Diagnosis Diagnose(const runfile::RunData& run,
   std::map<std::string, std::set<int>> inputs;
   for (int c = 0; c < num_callbacks; ++c) {
     const runfile::NamedCallback& info = run.callback_info[c];
-    if (info.kind == "subscription" && view.ValidTopic(info.topic) &&
-        enough(info.topic) && (!driving_only || published_in_window[c])) {
+    if (info.kind == runfile::CallbackKind::kSubscription &&
+        view.ValidTopic(info.topic) && enough(info.topic) &&
+        (!driving_only || published_in_window[c])) {
       inputs[view.NodeOfCallback(c)].insert(info.topic);
     }
   }
@@ -648,7 +651,7 @@ Diagnosis Diagnose(const runfile::RunData& run,
     if (!(deficit > options.frequency_bound_fraction)) continue;
 
     Finding f;
-    f.kind = FindingKindToString(FindingKind::kFrequencyBound);
+    f.kind = FindingKind::kFrequencyBound;
     f.node = node;
     f.topics = {run.topic_names[slowest]};
     f.upstream = d.topics[slowest].publisher;

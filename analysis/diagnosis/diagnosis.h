@@ -113,7 +113,7 @@ struct CallbackStats {
 };
 
 struct Finding {
-  std::string kind;  // a FindingKindToString token (remedy.h)
+  FindingKind kind = FindingKind::kCpuBound;
   // The node that cannot keep up (cpu_bound) / that is input-limited
   // (frequency_bound) / whose callbacks starve one of its subscriptions
   // (starved_input).

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "stack/algorithms/signal_state.h"
@@ -145,10 +146,23 @@ struct ParkingRecord {
   std::vector<EarlierPlanRow> earlier_plans;
 };
 
+// What makes a callback ready. A new kind needs its token in run_file.cc's
+// CallbackKindTerms.
+enum class CallbackKind {
+  kSubscription,  // a message on `topic`
+  kTimer,         // its period
+};
+// The token of a kind ("timer"), as /trace/callback_info stores it.
+const char* CallbackKindToString(CallbackKind kind);
+// False when `name` is no kind's token; `kind` is then unchanged.
+bool StringToCallbackKind(std::string_view name, CallbackKind* kind);
+// Every token, in enum order.
+std::vector<std::string> CallbackKindNames();
+
 struct NamedCallback {
   std::string name;  // "<node>/<callback>"
   int32_t node = -1;
-  std::string kind;  // "subscription" | "timer"
+  CallbackKind kind = CallbackKind::kSubscription;
   int32_t topic = -1;
   double period_s = 0.0;
 };

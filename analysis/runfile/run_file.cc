@@ -9,6 +9,7 @@
 
 #include "analysis/runfile/run_file_tables.h"
 #include "stack/base/hash.h"
+#include "stack/base/vocabulary.h"
 
 namespace adse::runfile {
 namespace internal {
@@ -94,12 +95,8 @@ Status WriteContents(hid_t file, const RunData& run) {
     std::vector<CallbackInfoRow> info(run.callback_info.size());
     for (size_t i = 0; i < info.size(); ++i) {
       const NamedCallback& cb = run.callback_info[i];
-      info[i] = {static_cast<int32_t>(i),
-                 cb.name,
-                 cb.node,
-                 cb.kind,
-                 cb.topic,
-                 cb.period_s};
+      info[i] = {static_cast<int32_t>(i),       cb.name,  cb.node,
+                 CallbackKindToString(cb.kind), cb.topic, cb.period_s};
     }
     ADSE_RETURN_IF_ERROR(
         WriteTable(group->get(), "callback_info", info, CallbackInfoColumns()));
@@ -200,6 +197,16 @@ Status Validate(const RunData& run) {
           std::to_string(static_cast<int>(run.stop_reasons[i].reason)));
     }
   }
+  for (size_t i = 0; i < run.callback_info.size(); ++i) {
+    CallbackKind named = CallbackKind::kSubscription;
+    const CallbackKind kind = run.callback_info[i].kind;
+    if (!StringToCallbackKind(CallbackKindToString(kind), &named) ||
+        named != kind) {
+      return Status::InvalidArgument("callback " + std::to_string(i) +
+                                     " has unknown kind code " +
+                                     std::to_string(static_cast<int>(kind)));
+    }
+  }
   for (size_t i = 0; i < run.signals.size(); ++i) {
     const int code = static_cast<int>(run.signals[i].state);
     if (code < static_cast<int>(kSignalStates[0]) ||
@@ -229,6 +236,26 @@ Status WriteRunFileImpl(const std::string& path, const RunData& run, Env* env) {
 
 }  // namespace
 }  // namespace internal
+
+namespace {
+const std::vector<Term<CallbackKind>>& CallbackKindTerms() {
+  static const std::vector<Term<CallbackKind>> kTerms = {
+      {CallbackKind::kSubscription, "subscription"},
+      {CallbackKind::kTimer, "timer"},
+  };
+  return kTerms;
+}
+}  // namespace
+
+const char* CallbackKindToString(CallbackKind kind) {
+  return NameOf(CallbackKindTerms(), kind);
+}
+bool StringToCallbackKind(std::string_view name, CallbackKind* kind) {
+  return ValueOf(CallbackKindTerms(), name, kind);
+}
+std::vector<std::string> CallbackKindNames() {
+  return NamesOf(CallbackKindTerms());
+}
 
 Status WriteRunFile(const std::string& path, const RunData& run, Env* env) {
   try {

@@ -31,9 +31,9 @@ inline constexpr size_t kKindBytes = 32;  // callback kind
 // the old file or the whole new one and a crash never leaves a file that
 // looks complete.
 // The root attribute `status` is written last. InvalidArgument if
-// run.status is no run status (run_data.h), a topic event has an unknown
-// kind or a non-empty scenario_hash is not the sha256 of scenario_text; IoError
-// if the file cannot be written (no temporary is left).
+// run.status is no run status (run_data.h), a topic event or callback has
+// an unknown kind or a non-empty scenario_hash is not the sha256 of
+// scenario_text; IoError if the file cannot be written (no temporary is left).
 Status WriteRunFile(const std::string& path, const RunData& run,
                     Env* env = Env::Default());
 

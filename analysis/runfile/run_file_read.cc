@@ -5,6 +5,8 @@
 #include <utility>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "analysis/runfile/run_file.h"
 #include "analysis/runfile/run_file_tables.h"
 #include "stack/base/hash.h"
@@ -207,9 +209,16 @@ Status ReadContents(hid_t file, RunData* run) {
             std::to_string(row.index));
       }
       seen[row.index] = true;
-      run->callback_info[row.index] = {std::move(row.name), row.node,
-                                       std::move(row.kind), row.topic,
-                                       row.period_s};
+      CallbackKind kind = CallbackKind::kSubscription;
+      if (!StringToCallbackKind(row.kind, &kind)) {
+        return Status::Corruption(fmt::format(
+            "/trace/callback_info: callback {} ({}) has unknown kind '{}'; "
+            "valid kinds: {}",
+            row.index, row.name, row.kind,
+            fmt::join(CallbackKindNames(), ", ")));
+      }
+      run->callback_info[row.index] = {std::move(row.name), row.node, kind,
+                                       row.topic, row.period_s};
     }
 
     ADSE_RETURN_IF_ERROR(

@@ -256,7 +256,7 @@ std::string LlmMarkdown(const LlmRecords& llm) {
   for (const auto& [agent, n] : asked) {
     md << fmt::format("| {} | {} | {} |\n", agent, n, failed[agent]);
   }
-  std::map<std::string, int> kinds;
+  std::map<llm::LlmEventKind, int> kinds;
   for (const llm::LlmEvent& e : llm.events) ++kinds[e.kind];
   md << fmt::format(
       "\nEvents: {} answers rejected (each got one corrective follow-up), {} "
@@ -264,13 +264,14 @@ std::string LlmMarkdown(const LlmRecords& llm) {
       "proposed by the built-in agent instead, {} disagreements with the "
       "deterministic "
       "analysis (the deterministic values were used), {} errors{}.\n\n",
-      kinds["rejected"], kinds["fallback"], kinds["disagreement"],
-      kinds["error"], kinds["converged"] ? ", convergence declared" : "");
+      kinds[llm::LlmEventKind::kRejected], kinds[llm::LlmEventKind::kFallback],
+      kinds[llm::LlmEventKind::kDisagreement], kinds[llm::LlmEventKind::kError],
+      kinds[llm::LlmEventKind::kConverged] ? ", convergence declared" : "");
   if (!llm.events.empty()) {
     md << "| iteration | agent | event | detail |\n|---|---|---|---|\n";
     for (const llm::LlmEvent& e : llm.events) {
-      md << fmt::format("| {} | {} | {} | {} |\n", e.iteration, e.agent, e.kind,
-                        Cell(e.detail));
+      md << fmt::format("| {} | {} | {} | {} |\n", e.iteration, e.agent,
+                        llm::LlmEventKindToString(e.kind), Cell(e.detail));
     }
   }
   return md.str();
@@ -519,9 +520,9 @@ Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
   if (llm) {
     int fallbacks = 0, rejected = 0, disagreements = 0;
     for (const llm::LlmEvent& e : llm->events) {
-      fallbacks += e.kind == "fallback";
-      rejected += e.kind == "rejected";
-      disagreements += e.kind == "disagreement";
+      fallbacks += e.kind == llm::LlmEventKind::kFallback;
+      rejected += e.kind == llm::LlmEventKind::kRejected;
+      disagreements += e.kind == llm::LlmEventKind::kDisagreement;
     }
     j["llm"] = {
         {"exchanges", llm->exchanges.size()},

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "analysis/diagnosis/remedy.h"
 #include "analysis/metrics/run_metrics.h"
 #include "analysis/runfile/run_data.h"
 #include "harness/spec/design_point.h"
@@ -56,7 +57,13 @@ Result<EvaluationRow> RowFromJson(const nlohmann::json& j,
           f["rates_hz"]["deficit"].is_number()) {
         severity = f["rates_hz"]["deficit"].get<double>();
       }
-      // Strategies are told the typed remedies.
+      // Strategies are told the typed kind and remedies.
+      Result<analysis::FindingKind> kind =
+          analysis::StringToFindingKind(f.value("kind", ""));
+      if (!kind.ok()) {
+        return Status::Corruption(fmt::format("{}: finding {}: {}", path, i,
+                                              kind.status().message()));
+      }
       if (!f.contains("remedies")) {
         return Status::Corruption(
             fmt::format("{}: finding {} has no typed remedies", path, i));
@@ -68,7 +75,7 @@ Result<EvaluationRow> RowFromJson(const nlohmann::json& j,
             "{}: finding {} ({} {}): {}", path, i, f.value("kind", "?"),
             f.value("node", "?"), remedies.status().message()));
       }
-      bottlenecks.push_back({{"kind", f.value("kind", "")},
+      bottlenecks.push_back({{"kind", analysis::FindingKindToString(*kind)},
                              {"node", f.value("node", "")},
                              {"remedy", f.value("remedy", "")},
                              {"remedies", report::RemediesToJson(*remedies)},
@@ -143,8 +150,13 @@ explore::Observation ObservationFromRow(const EvaluationRow& row) {
   if (j.is_array()) {
     for (const nlohmann::json& b : j) {
       if (!b.is_object()) continue;
+      // A kind outside the vocabulary (a row damaged or written by hand)
+      // leaves the hint out, as unreadable JSON leaves them all out.
+      Result<analysis::FindingKind> kind =
+          analysis::StringToFindingKind(b.value("kind", ""));
+      if (!kind.ok()) continue;
       explore::BottleneckHint hint;
-      hint.kind = b.value("kind", "");
+      hint.kind = *kind;
       hint.node = b.value("node", "");
       hint.remedy = b.value("remedy", "");
       hint.severity = b.value("severity", 0.0);

@@ -382,7 +382,8 @@ std::vector<int> AgentStrategy::RemedyDirections(const Record& record,
       }
     }
     if (parts.size() < 2 && !hint.node.empty()) {
-      parts.push_back(fmt::format("{} {} -> {}", hint.node, hint.kind,
+      parts.push_back(fmt::format("{} {} -> {}", hint.node,
+                                  analysis::FindingKindToString(hint.kind),
                                   hint.remedy.empty() ? "?" : hint.remedy));
     }
   }

@@ -35,7 +35,7 @@ namespace adse::explore {
 
 // A bottleneck found in a run (a summary of analysis/diagnosis's Finding).
 struct BottleneckHint {
-  std::string kind;       // analysis::FindingKindToString's token
+  analysis::FindingKind kind = analysis::FindingKind::kCpuBound;
   std::string node;       // the node that cannot keep up / is input-limited
   std::string remedy;     // readable text of `remedies`, for prompts
   double severity = 0.0;  // relative deficit

@@ -373,7 +373,8 @@ Result<TextReading> ParseTextReading(const std::string& answer) {
     Result<std::string> kind = StringField(b, "kind", "a bottleneck", true);
     if (!kind.ok()) return kind.status();
     // The diagnosis' own vocabulary: a kind it can find, the agent can name.
-    if (!analysis::StringToFindingKind(*kind).ok()) {
+    Result<analysis::FindingKind> typed = analysis::StringToFindingKind(*kind);
+    if (!typed.ok()) {
       return Status::InvalidArgument(
           "a bottleneck's \"kind\" must be one of " +
           fmt::format("{}", fmt::join(analysis::FindingKindTokens(), ", ")) +
@@ -383,7 +384,7 @@ Result<TextReading> ParseTextReading(const std::string& answer) {
         StringField(b, "remedy", "a bottleneck", false);
     if (!remedy.ok()) return remedy.status();
     claim.node = SanitizeText(*node, 100);
-    claim.kind = *kind;
+    claim.kind = *typed;
     claim.remedy = SanitizeText(*remedy, 200);
     r.bottlenecks.push_back(std::move(claim));
   }
@@ -396,17 +397,21 @@ Result<TextReading> ParseTextReading(const std::string& answer) {
 std::vector<std::string> CompareTextReading(
     const TextReading& reading,
     const std::vector<explore::BottleneckHint>& deterministic) {
-  std::set<std::pair<std::string, std::string>> claimed, found;
+  std::set<std::pair<std::string, analysis::FindingKind>> claimed, found;
   for (const auto& c : reading.bottlenecks) claimed.insert({c.node, c.kind});
   for (const auto& h : deterministic) found.insert({h.node, h.kind});
   std::vector<std::string> out;
   for (const auto& [node, kind] : found) {
-    if (!claimed.count({node, kind}))
-      out.push_back("missed " + kind + " " + node);
+    if (!claimed.count({node, kind})) {
+      out.push_back(fmt::format("missed {} {}",
+                                analysis::FindingKindToString(kind), node));
+    }
   }
   for (const auto& [node, kind] : claimed) {
-    if (!found.count({node, kind}))
-      out.push_back("named " + kind + " " + node + " (not found)");
+    if (!found.count({node, kind})) {
+      out.push_back(fmt::format("named {} {} (not found)",
+                                analysis::FindingKindToString(kind), node));
+    }
   }
   return out;
 }

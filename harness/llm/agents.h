@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/diagnosis/remedy.h"
 #include "harness/explore/strategy.h"
 #include "harness/llm/chat.h"
 #include "harness/llm/prompts.h"
@@ -66,7 +67,9 @@ std::vector<std::string> CompareCommands(const Commands& agent,
 // -------------------------------------------------------
 struct TextReading {
   struct Claim {
-    std::string node, kind, remedy;
+    std::string node;
+    analysis::FindingKind kind = analysis::FindingKind::kCpuBound;
+    std::string remedy;
   };
   std::vector<Claim> bottlenecks;
   std::string summary;

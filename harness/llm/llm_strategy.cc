@@ -3,17 +3,20 @@
 #include <functional>
 #include <optional>
 #include <set>
+#include <stdexcept>
 #include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "analysis/diagnosis/remedy.h"
 #include "harness/llm/agents.h"
 #include "harness/llm/jsonl_log.h"
 #include "harness/llm/memory.h"
 #include "harness/llm/prompts.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/files.h"
+#include "stack/base/vocabulary.h"
 
 namespace adse::llm {
 namespace {
@@ -71,7 +74,8 @@ std::string DiagnosisText(const std::vector<explore::BottleneckHint>& hints) {
   std::string out;
   for (const explore::BottleneckHint& h : hints) {
     out += fmt::format("{}{} {} (deficit {:.0f} %, remedy: {})",
-                       out.empty() ? "" : "; ", h.kind, h.node,
+                       out.empty() ? "" : "; ",
+                       analysis::FindingKindToString(h.kind), h.node,
                        100.0 * h.severity, h.remedy);
   }
   return out;
@@ -131,7 +135,7 @@ class LlmStrategy : public explore::Strategy {
       converged_ = true;
       rationale_ =
           "the DSE agent declared convergence: " + answer.value->rationale;
-      Event("dse", "converged", answer.value->rationale);
+      Event("dse", LlmEventKind::kConverged, answer.value->rationale);
       return {};
     }
     if (answer.value) {
@@ -139,7 +143,7 @@ class LlmStrategy : public explore::Strategy {
       rationale_ = answer.value->rationale;
     } else {
       Event(
-          "dse", "fallback",
+          "dse", LlmEventKind::kFallback,
           "the built-in agent proposes this iteration's point: " + answer.why);
       const std::vector<spec::DesignPoint> fallback = fallback_->Ask(1);
       if (fallback.empty()) return {};
@@ -260,7 +264,7 @@ class LlmStrategy : public explore::Strategy {
         "keys.");
     if (!failure_.ok()) return;
     if (!commands.value) {
-      Event("command", "error",
+      Event("command", LlmEventKind::kError,
             "the command agent " + commands.why +
                 "; the commands derived from the point are used");
       return;
@@ -268,7 +272,7 @@ class LlmStrategy : public explore::Strategy {
     const std::vector<std::string> diffs =
         CompareCommands(*commands.value, derived);
     if (!diffs.empty()) {
-      Event("command", "disagreement",
+      Event("command", LlmEventKind::kDisagreement,
             Join(diffs) + "; the commands derived from the point are used");
     }
   }
@@ -294,14 +298,14 @@ class LlmStrategy : public explore::Strategy {
         const std::vector<std::string> diffs =
             CompareTextReading(*reading.value, o.bottlenecks);
         if (!diffs.empty()) {
-          Event("text", "disagreement",
+          Event("text", LlmEventKind::kDisagreement,
                 Join(diffs) + "; the deterministic diagnosis is kept");
           *report += "\ntext agent (disagrees, not used): " + Join(diffs);
         } else if (!reading.value->summary.empty()) {
           *report += "\ntext agent (agrees): " + reading.value->summary;
         }
       } else {
-        Event("text", "error", "the text agent " + reading.why);
+        Event("text", LlmEventKind::kError, "the text agent " + reading.why);
       }
     }
 
@@ -326,14 +330,15 @@ class LlmStrategy : public explore::Strategy {
       const std::vector<std::string> diffs =
           CompareVisionReading(*reading.value, truth);
       if (!diffs.empty()) {
-        Event("vision", "disagreement", Join(diffs) + "; the metrics are kept");
+        Event("vision", LlmEventKind::kDisagreement,
+              Join(diffs) + "; the metrics are kept");
         *report += "\nvision agent (disagrees with the metrics, not used): " +
                    Join(diffs);
       } else if (!reading.value->notes.empty()) {
         *report += "\nvision agent (agrees): " + reading.value->notes;
       }
     } else {
-      Event("vision", "error", "the vision agent " + reading.why);
+      Event("vision", LlmEventKind::kError, "the vision agent " + reading.why);
     }
   }
 
@@ -362,11 +367,12 @@ class LlmStrategy : public explore::Strategy {
           return parsed.status();
         },
         expected);
-    for (const std::string& why : turn.rejected) Event(agent, "rejected", why);
+    for (const std::string& why : turn.rejected)
+      Event(agent, LlmEventKind::kRejected, why);
     if (turn.ok) return out;
     if (turn.error.code() == Status::Code::kNotFound && failure_.ok()) {
       failure_ = turn.error;
-      Event(agent, "error", turn.error.message());
+      Event(agent, LlmEventKind::kError, turn.error.message());
     }
     out.why =
         turn.error.ok()
@@ -375,11 +381,11 @@ class LlmStrategy : public explore::Strategy {
     return out;
   }
 
-  void Event(const std::string& agent, const std::string& kind,
+  void Event(const std::string& agent, LlmEventKind kind,
              const std::string& detail) {
     const json j = {{"iteration", iteration_},
                     {"agent", agent},
-                    {"kind", kind},
+                    {"kind", LlmEventKindToString(kind)},
                     {"detail", SanitizeText(detail, 1000)}};
     Record(events_log_, j.dump(-1, ' ', false, json::error_handler_t::replace));
   }
@@ -468,6 +474,29 @@ Result<std::unique_ptr<explore::Strategy>> NewLlmStrategy(
       std::move(*events), std::move(*system)));
 }
 
+namespace {
+const std::vector<Term<LlmEventKind>>& LlmEventKindTerms() {
+  static const std::vector<Term<LlmEventKind>> kTerms = {
+      {LlmEventKind::kRejected, "rejected"},
+      {LlmEventKind::kFallback, "fallback"},
+      {LlmEventKind::kDisagreement, "disagreement"},
+      {LlmEventKind::kConverged, "converged"},
+      {LlmEventKind::kError, "error"},
+  };
+  return kTerms;
+}
+}  // namespace
+
+const char* LlmEventKindToString(LlmEventKind kind) {
+  return NameOf(LlmEventKindTerms(), kind);
+}
+bool StringToLlmEventKind(std::string_view name, LlmEventKind* kind) {
+  return ValueOf(LlmEventKindTerms(), name, kind);
+}
+std::vector<std::string> LlmEventKindNames() {
+  return NamesOf(LlmEventKindTerms());
+}
+
 std::string EventsPath(const std::string& campaign_folder) {
   return campaign_folder + "/llm/events.jsonl";
 }
@@ -477,9 +506,15 @@ Result<std::vector<LlmEvent>> LoadEvents(const std::string& path) {
   ADSE_RETURN_IF_ERROR(
       ReadJsonLines(path, "an llm event", [&](const std::string& line) {
         const json j = json::parse(line);
+        const std::string token = j.at("kind").get<std::string>();
+        LlmEventKind kind = LlmEventKind::kRejected;
+        if (!StringToLlmEventKind(token, &kind)) {
+          throw std::invalid_argument(
+              fmt::format("unknown event kind '{}'; valid kinds: {}", token,
+                          fmt::join(LlmEventKindNames(), ", ")));
+        }
         events.push_back({j.at("iteration").get<int64_t>(),
-                          j.at("agent").get<std::string>(),
-                          j.at("kind").get<std::string>(),
+                          j.at("agent").get<std::string>(), kind,
                           j.at("detail").get<std::string>()});
       }));
   return events;

@@ -14,6 +14,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "harness/explore/strategy.h"
@@ -50,12 +51,36 @@ struct LlmStrategyOptions {
 Result<std::unique_ptr<explore::Strategy>> NewLlmStrategy(
     const spec::Spec& spec, LlmStrategyOptions options);
 
-// What happened in the agents' rounds, for reports: one event per
-// rejected answer, fallback, disagreement or convergence.
+// What happened in one of the agents' rounds. A new kind needs its token in
+// llm_strategy.cc's LlmEventKindTerms.
+enum class LlmEventKind {
+  // An answer that did not parse or validate (it got a corrective
+  // follow-up).
+  kRejected,
+  // The DSE agent's answers could not be used: the built-in agent proposed
+  // the iteration's point.
+  kFallback,
+  // An agent's reading differed from the deterministic analysis, whose
+  // values were used.
+  kDisagreement,
+  // The DSE agent declared convergence.
+  kConverged,
+  // The model could not be asked.
+  kError,
+};
+
+// The token of a kind ("fallback"), as stored in llm/events.jsonl.
+const char* LlmEventKindToString(LlmEventKind kind);
+// False when `name` is no kind's token; `kind` is then unchanged.
+bool StringToLlmEventKind(std::string_view name, LlmEventKind* kind);
+// Every token, in enum order.
+std::vector<std::string> LlmEventKindNames();
+
+// What happened in the agents' rounds, for reports.
 struct LlmEvent {
   int64_t iteration = 0;
   std::string agent;  // dse|command|text|vision
-  std::string kind;   // rejected|fallback|disagreement|converged|error
+  LlmEventKind kind = LlmEventKind::kRejected;
   std::string detail;
 };
 std::string EventsPath(const std::string& campaign_folder);

@@ -163,7 +163,7 @@ nlohmann::json ToJson(const RunReport& r) {
   if (!r.deviation_error.empty()) j["deviation"]["error"] = r.deviation_error;
   j["findings"] = nlohmann::json::array();
   for (const FindingSummary& f : r.findings) {
-    j["findings"].push_back({{"kind", f.kind},
+    j["findings"].push_back({{"kind", analysis::FindingKindToString(f.kind)},
                              {"node", f.node},
                              {"topics", f.topics},
                              {"rates_hz", f.rates_hz},
@@ -368,8 +368,9 @@ std::string FormatSummary(const RunReport& r) {
   out += fmt::format("feasible    {}\n", r.feasible ? "yes" : "no");
   if (r.findings.empty()) out += "diagnosis   no bottleneck found\n";
   for (const FindingSummary& f : r.findings) {
-    out += fmt::format("diagnosis   {}: {} (remedy: {})\n", f.kind, f.message,
-                       f.remedy);
+    out +=
+        fmt::format("diagnosis   {}: {} (remedy: {})\n",
+                    analysis::FindingKindToString(f.kind), f.message, f.remedy);
   }
   return out;
 }

@@ -41,7 +41,8 @@ struct ConstraintStatus {
 };
 
 struct FindingSummary {
-  std::string kind, node;
+  analysis::FindingKind kind = analysis::FindingKind::kCpuBound;
+  std::string node;
   std::string remedy;  // the readable text of `remedies`
   std::string message;
   std::vector<std::string> topics;

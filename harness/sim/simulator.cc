@@ -560,10 +560,11 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   for (const stack::TopicSpec& t : graph.topics())
     run.topic_names.push_back(t.name);
   for (const stack::CallbackSpec& c : graph.callbacks()) {
-    run.callback_info.push_back(
-        {c.name, c.node,
-         c.kind == stack::CallbackSpec::Kind::kTimer ? "timer" : "subscription",
-         c.topic, c.period_s});
+    run.callback_info.push_back({c.name, c.node,
+                                 c.kind == stack::CallbackSpec::Kind::kTimer
+                                     ? runfile::CallbackKind::kTimer
+                                     : runfile::CallbackKind::kSubscription,
+                                 c.topic, c.period_s});
   }
   executor.Stop();
   if (stack_process != nullptr) {

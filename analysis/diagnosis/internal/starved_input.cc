@@ -39,7 +39,7 @@ std::vector<Finding> FindStarvedInputs(const runfile::RunData& run,
   std::map<int, QueueEvents> queues;  // by subscription callback
   for (int c = 0; c < num_callbacks; ++c) {
     const runfile::NamedCallback& info = run.callback_info[c];
-    if (info.kind == "subscription" && info.topic >= 0 &&
+    if (info.kind == runfile::CallbackKind::kSubscription && info.topic >= 0 &&
         info.topic < num_topics) {
       queues[c];
     }
@@ -129,7 +129,7 @@ std::vector<Finding> FindStarvedInputs(const runfile::RunData& run,
             ? run.trace.timer_overruns[holder]
             : 0;
     Finding f;
-    f.kind = FindingKindToString(FindingKind::kStarvedInput);
+    f.kind = FindingKind::kStarvedInput;
     f.node = node_of[c];
     f.topics = {run.topic_names[info.topic]};
     if (info.topic < static_cast<int>(topics.size())) {

@@ -39,7 +39,7 @@ class TraceBuilder {
     runfile::NamedCallback info;
     info.name = node + "/" + cb;
     info.node = Node(node);
-    info.kind = "subscription";
+    info.kind = runfile::CallbackKind::kSubscription;
     info.topic = Topic(topic);
     run_.callback_info.push_back(info);
     run_.trace.timer_overruns.push_back(0);
@@ -49,7 +49,7 @@ class TraceBuilder {
     runfile::NamedCallback info;
     info.name = node + "/" + cb;
     info.node = Node(node);
-    info.kind = "timer";
+    info.kind = runfile::CallbackKind::kTimer;
     info.period_s = period_s;
     run_.callback_info.push_back(info);
     run_.trace.timer_overruns.push_back(0);
@@ -103,7 +103,7 @@ class TraceBuilder {
   runfile::RunData run_;
 };
 
-const Finding* FindKind(const Diagnosis& d, const std::string& kind) {
+const Finding* FindKind(const Diagnosis& d, FindingKind kind) {
   for (const Finding& f : d.findings) {
     if (f.kind == kind) return &f;
   }
@@ -145,7 +145,7 @@ TEST(DiagnosisCpuBoundTest, SlowSubscriberIsCpuBoundWithEvidence) {
   const Diagnosis d = Diagnose(SensorRun(4.0, 40, 0.2));
   ASSERT_EQ(d.findings.size(), 1u);
   const Finding& f = d.findings[0];
-  EXPECT_EQ(f.kind, "cpu_bound");
+  EXPECT_EQ(f.kind, FindingKind::kCpuBound);
   EXPECT_EQ(f.node, "filter");
   EXPECT_EQ(f.topics, std::vector<std::string>{"/in"});
   EXPECT_EQ(f.upstream, "external");
@@ -204,7 +204,7 @@ TEST(DiagnosisCpuBoundTest, WaitingForItsOwnNodeIsNotCoreWait) {
     b.Record(sub, i, i + 0.95, 0.01);
   }
   const Diagnosis d = Diagnose(b.run());
-  const Finding* f = FindKind(d, "cpu_bound");
+  const Finding* f = FindKind(d, FindingKind::kCpuBound);
   ASSERT_NE(f, nullptr);
   EXPECT_EQ(f->node, "planner");
   EXPECT_NEAR(f->rates_hz.at("core_wait_ratio"), 0.0, 1e-9);
@@ -277,14 +277,15 @@ runfile::RunData StateInputRun(double pose_take_hz) {
 
 TEST(DiagnosisCpuBoundTest, StateInputNeedsOneMessagePerOutputOfItsNode) {
   // 15 of 50 poses a second are more than one per output at 10 Hz.
-  EXPECT_EQ(FindKind(Diagnose(StateInputRun(15.0)), "cpu_bound"), nullptr);
+  EXPECT_EQ(FindKind(Diagnose(StateInputRun(15.0)), FindingKind::kCpuBound),
+            nullptr);
 
   // As the rule is stated, against the publish rate: 70 % behind.
   DiagnosisOptions every_message;
   ASSERT_TRUE(
       SetOption(&every_message, "cpu_bound_state_inputs_per_output", 0).ok());
   const Diagnosis d = Diagnose(StateInputRun(15.0), every_message);
-  const Finding* f = FindKind(d, "cpu_bound");
+  const Finding* f = FindKind(d, FindingKind::kCpuBound);
   ASSERT_NE(f, nullptr);
   EXPECT_EQ(f->topics, std::vector<std::string>{"/pose"});
   EXPECT_NEAR(f->rates_hz.at("deficit"), 0.7, 1e-9);
@@ -294,7 +295,7 @@ TEST(DiagnosisCpuBoundTest, StateInputNeedsOneMessagePerOutputOfItsNode) {
 TEST(DiagnosisCpuBoundTest, StateInputTakenLessThanItsNodeOutputsIsFlagged) {
   // 5 poses a second for 10 outputs: half of them use a stale pose.
   const Diagnosis d = Diagnose(StateInputRun(5.0));
-  const Finding* found = FindKind(d, "cpu_bound");
+  const Finding* found = FindKind(d, FindingKind::kCpuBound);
   ASSERT_NE(found, nullptr);
   const Finding& f = *found;
   EXPECT_EQ(f.node, "filter");
@@ -328,7 +329,7 @@ TEST(DiagnosisFrequencyBoundTest, SlowInputIsNamedWithItsPublisher) {
   const Diagnosis d = Diagnose(FusionRun({20.0, 10.0}));
   ASSERT_EQ(d.findings.size(), 1u);
   const Finding& f = d.findings[0];
-  EXPECT_EQ(f.kind, "frequency_bound");
+  EXPECT_EQ(f.kind, FindingKind::kFrequencyBound);
   EXPECT_EQ(f.node, "fusion");
   EXPECT_EQ(f.topics, std::vector<std::string>{"/in1"});
   EXPECT_EQ(f.upstream, "pub1");
@@ -385,9 +386,9 @@ TEST(DiagnosisFrequencyBoundTest, UpstreamCpuBoundIsNamedAsTheCause) {
   const Diagnosis d = Diagnose(b.run());
   ASSERT_EQ(d.findings.size(), 2u);
   // Equal severity (0.5): cpu_bound sorts before frequency_bound.
-  EXPECT_EQ(d.findings[0].kind, "cpu_bound");
+  EXPECT_EQ(d.findings[0].kind, FindingKind::kCpuBound);
   EXPECT_EQ(d.findings[0].node, "slow");
-  EXPECT_EQ(d.findings[1].kind, "frequency_bound");
+  EXPECT_EQ(d.findings[1].kind, FindingKind::kFrequencyBound);
   EXPECT_EQ(d.findings[1].node, "fusion");
   EXPECT_EQ(d.findings[1].upstream, "slow");
   EXPECT_EQ(d.findings[1].origin, "cpu_bound:slow");
@@ -436,7 +437,7 @@ TEST(DiagnosisFrequencyBoundTest, OriginIsTracedUpstreamToTheSensor) {
   const Diagnosis d = Diagnose(PipelineRun());
   ASSERT_EQ(d.findings.size(), 1u);
   const Finding& f = d.findings[0];
-  EXPECT_EQ(f.kind, "frequency_bound");
+  EXPECT_EQ(f.kind, FindingKind::kFrequencyBound);
   EXPECT_EQ(f.node, "planner");
   EXPECT_EQ(f.topics[0], "/objects");
   EXPECT_EQ(f.upstream, "cluster");
@@ -486,7 +487,7 @@ runfile::RunData PlannerRun(double stall_s, double end_s,
 
 TEST(DiagnosisStarvedInputTest, ATimerRunningBackToBackStarvesItsNodesInput) {
   const Diagnosis d = Diagnose(PlannerRun(20.0, 60.0));
-  const Finding* f = FindKind(d, "starved_input");
+  const Finding* f = FindKind(d, FindingKind::kStarvedInput);
   ASSERT_NE(f, nullptr);
   EXPECT_EQ(f->node, "planner");
   EXPECT_EQ(f->topics, std::vector<std::string>{"/pose"});
@@ -520,23 +521,25 @@ TEST(DiagnosisStarvedInputTest, ATimerRunningBackToBackStarvesItsNodesInput) {
 // computer, which cpu_bound names, not a starved input.
 TEST(DiagnosisStarvedInputTest, AnInputWaitingWhileItsNodeIsIdleIsNotStarved) {
   EXPECT_EQ(FindKind(Diagnose(PlannerRun(20.0, 60.0, /*busy_share=*/0.5)),
-                     "starved_input"),
+                     FindingKind::kStarvedInput),
             nullptr);
   // 4 s of planning back to back: under starved_input_min_s.
-  EXPECT_EQ(FindKind(Diagnose(PlannerRun(56.0, 60.0)), "starved_input"),
-            nullptr);
+  EXPECT_EQ(
+      FindKind(Diagnose(PlannerRun(56.0, 60.0)), FindingKind::kStarvedInput),
+      nullptr);
   DiagnosisOptions shorter;
   ASSERT_TRUE(SetOption(&shorter, "starved_input_min_s", 3.0).ok());
-  EXPECT_NE(
-      FindKind(Diagnose(PlannerRun(56.0, 60.0), shorter), "starved_input"),
-      nullptr);
+  EXPECT_NE(FindKind(Diagnose(PlannerRun(56.0, 60.0), shorter),
+                     FindingKind::kStarvedInput),
+            nullptr);
   // With no share asked for, a node that ran nothing still starves nothing.
   runfile::RunData idle = PlannerRun(20.0, 60.0);
   std::erase_if(idle.trace.callbacks, [](const stack::CallbackRecord& r) {
     return r.start_s >= 20.0;
   });
   ASSERT_TRUE(SetOption(&shorter, "starved_input_busy_share", 0.0).ok());
-  EXPECT_EQ(FindKind(Diagnose(idle, shorter), "starved_input"), nullptr);
+  EXPECT_EQ(FindKind(Diagnose(idle, shorter), FindingKind::kStarvedInput),
+            nullptr);
 }
 
 TEST(DiagnosisStatsTest, CallbackAndCoreUtilization) {
@@ -715,7 +718,8 @@ TEST(DiagnosisRobustnessTest, MalformedAndEmptyRunsDoNotThrow) {
   b.Record(sub, 0.0, 0.0, 0.01);
   b.run().trace.callbacks.back().callback = 99;
   b.run().trace.callbacks.back().first_core = -1;
-  b.run().callback_info.push_back({"orphan/cb", 17, "subscription", 55, 0.0});
+  b.run().callback_info.push_back(
+      {"orphan/cb", 17, runfile::CallbackKind::kSubscription, 55, 0.0});
   b.run().platform["cores"] = "lots";
   const Diagnosis d = Diagnose(b.run());
   EXPECT_EQ(d.callbacks.size(), 2u);

@@ -45,7 +45,8 @@ RunData MakeRun() {
   run.lanes = {{0, 0, 0}, {0, 50, 0}, {1, 50, 3.5}, {1, 0, 3.5}};
   run.node_names = {"planner"};
   run.topic_names = {"/pose"};
-  run.callback_info = {{"planner/on_pose", 0, "subscription", 0, 0.0}};
+  run.callback_info = {
+      {"planner/on_pose", 0, runfile::CallbackKind::kSubscription, 0, 0.0}};
   run.trace.callbacks.resize(3);
   run.trace.topic_events.resize(5);
   run.trace.timer_overruns = {0};

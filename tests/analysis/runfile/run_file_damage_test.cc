@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -138,6 +139,49 @@ TEST(RunFileDamageTest, ADamagedGlobalHeapIsRefusedBeforeHdf5ReadsIt) {
     ASSERT_EQ(problems.size(), 1u);
     EXPECT_NE(problems[0].find("damaged HDF5 global heap"), std::string::npos);
   }
+}
+
+TEST_F(RunFileTest, ACallbackOfUnknownKindIsCorruptionNamingIt) {
+  const std::string path = Path("run.h5");
+  ASSERT_TRUE(WriteRunFile(path, MakeFullRun(10)).ok());
+  {
+    // Rewrite the `kind` member of the table's rows alone, as h5py would.
+    RawHdf5 raw(path, H5F_ACC_RDWR);
+    const hid_t table =
+        H5Dopen2(raw.file(), "/trace/callback_info", H5P_DEFAULT);
+    ASSERT_GE(table, 0);
+    const hid_t space = H5Dget_space(table);
+    const hssize_t n = H5Sget_simple_extent_npoints(space);
+    ASSERT_GE(n, 2);
+    const hid_t row = H5Dget_type(table);
+    const hid_t text =  // the file's own string type (width, charset)
+        H5Tget_member_type(row, H5Tget_member_index(row, "kind"));
+    const size_t width = H5Tget_size(text);
+    const hid_t member = H5Tcreate(H5T_COMPOUND, width);
+    H5Tinsert(member, "kind", 0, text);
+    std::vector<char> kinds(static_cast<size_t>(n) * width, '\0');
+    ASSERT_GE(
+        H5Dread(table, member, H5S_ALL, H5S_ALL, H5P_DEFAULT, kinds.data()), 0);
+    std::fill(kinds.begin() + width, kinds.begin() + 2 * width, '\0');
+    const std::string bad = "interrupt";
+    std::copy(bad.begin(), bad.end(), kinds.begin() + width);
+    EXPECT_GE(
+        H5Dwrite(table, member, H5S_ALL, H5S_ALL, H5P_DEFAULT, kinds.data()),
+        0);
+    H5Tclose(member);
+    H5Tclose(text);
+    H5Tclose(row);
+    H5Sclose(space);
+    H5Dclose(table);
+  }
+  Result<RunData> back = ReadRunFile(path);
+  ASSERT_FALSE(back.ok());
+  EXPECT_EQ(back.status().code(), Status::Code::kCorruption);
+  EXPECT_NE(back.status().message().find(
+                "/trace/callback_info: callback 1 (localizer/on_points) has "
+                "unknown kind 'interrupt'; valid kinds: subscription, timer"),
+            std::string::npos)
+      << back.status().message();
 }
 
 TEST_F(RunFileTest, FileWithoutStatusNeverLooksComplete) {

@@ -157,6 +157,18 @@ TEST_F(RunFileTest, RejectsUnknownTopicEventKind) {
   EXPECT_TRUE(Listing().empty());
 }
 
+TEST_F(RunFileTest, RejectsUnknownCallbackKind) {
+  RunData run;
+  run.callback_info.resize(2);
+  run.callback_info[1].kind = static_cast<CallbackKind>(7);
+  const Status status = WriteRunFile(Path("bad.h5"), run);
+  EXPECT_EQ(status.code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(status.message().find("callback 1 has unknown kind code 7"),
+            std::string::npos)
+      << status.message();
+  EXPECT_TRUE(Listing().empty());
+}
+
 TEST_F(RunFileTest, RejectsAScenarioHashThatDoesNotMatchTheText) {
   RunData run;
   run.scenario_text = "name: a\n";

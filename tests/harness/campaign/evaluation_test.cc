@@ -90,7 +90,7 @@ using analysis::RemedyKind;
 report::RunReport ReportWithFindings() {
   report::RunReport r = Report(2, 50.0, false);
   report::FindingSummary cpu;
-  cpu.kind = "cpu_bound";
+  cpu.kind = analysis::FindingKind::kCpuBound;
   cpu.node = "lidar_driver";
   cpu.topics = {"/sensing/lidar/points_raw"};
   cpu.rates_hz = {{"deficit", 0.4}};
@@ -98,7 +98,7 @@ report::RunReport ReportWithFindings() {
                   {RemedyKind::kLowerSensorRate, "/sensing/lidar/points_raw"}};
   cpu.remedy = analysis::RemediesText(cpu.remedies);
   report::FindingSummary frequency;
-  frequency.kind = "frequency_bound";
+  frequency.kind = analysis::FindingKind::kFrequencyBound;
   frequency.node = "planner";
   frequency.topics = {"/objects"};
   frequency.rates_hz = {{"deficit", 0.3}};
@@ -172,6 +172,21 @@ TEST(EvaluationTest, AReportWithAnUnknownRemedyKindIsRefusedNamingIt) {
       << row.status().message();
 }
 
+TEST(EvaluationTest, AReportWhoseFindingHasAnUnknownKindIsRefused) {
+  nlohmann::json j = report::ToJson(ReportWithFindings());
+  j["findings"][1]["kind"] = "memory_bound";
+  Result<EvaluationRow> row = RowFromReportJson(j.dump(), "x.report.json");
+  ASSERT_FALSE(row.ok());
+  EXPECT_EQ(row.status().code(), Status::Code::kCorruption);
+  EXPECT_NE(row.status().message().find(
+                "x.report.json: finding 1: unknown bottleneck kind "
+                "'memory_bound'; valid kinds: cpu_bound"),
+            std::string::npos)
+      << row.status().message();
+  j["findings"][1].erase("kind");
+  EXPECT_FALSE(RowFromReportJson(j.dump(), "x.report.json").ok());
+}
+
 TEST(EvaluationTest, AReportWithoutTypedRemediesIsRefused) {
   nlohmann::json j = report::ToJson(ReportWithFindings());
   j["findings"][0].erase("remedies");
@@ -222,6 +237,17 @@ TEST(EvaluationTest, AnIndexRowWithoutTypedRemediesKeepsItsText) {
     EXPECT_EQ(hint.remedy, "more cores");
     EXPECT_TRUE(hint.remedies.empty()) << hint.node;
   }
+}
+
+TEST(EvaluationTest, AnIndexRowsHintOfAnUnknownKindIsLeftOut) {
+  EvaluationRow row = RowFromReport(Report(2, 50.0, false));
+  row.bottlenecks_json =
+      R"([{"kind":"memory_bound","node":"a","remedy":"more memory"},)"
+      R"({"kind":"frequency_bound","node":"b","remedy":"more cores"}])";
+  const explore::Observation o = ObservationFromRow(row);
+  ASSERT_EQ(o.bottlenecks.size(), 1u);
+  EXPECT_EQ(o.bottlenecks[0].node, "b");
+  EXPECT_EQ(o.bottlenecks[0].kind, analysis::FindingKind::kFrequencyBound);
 }
 
 // tests/data/migrate_remedies.py gave the recordings their typed remedies:

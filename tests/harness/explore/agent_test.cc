@@ -61,7 +61,7 @@ Observation Evaluate(const spec::DesignPoint& point) {
   if (!o.feasible) {
     const bool frequency = 10.0 / freq > 7.0;
     BottleneckHint hint;
-    hint.kind = "cpu_bound";
+    hint.kind = analysis::FindingKind::kCpuBound;
     hint.node = "ndt_scan_matcher";
     hint.severity = 0.3;
     if (frequency) {

@@ -28,8 +28,9 @@ runfile::RunData MadeRun(double nav_time_s, double ctrl_rate_hz, double work_ms,
                  {"e2e_latency_p50_s", 0.3},
                  {"dropped_messages", 10},
                  {"lidar_frames_dropped", 2}};
-  run.callback_info = {{"a/work", 0, "subscription", 0, 0.0},
-                       {"a/tick", 0, "timer", -1, 0.01}};
+  run.callback_info = {
+      {"a/work", 0, runfile::CallbackKind::kSubscription, 0, 0.0},
+      {"a/tick", 0, runfile::CallbackKind::kTimer, -1, 0.01}};
   for (int i = 0; i < 100; ++i) {
     stack::CallbackRecord work;
     work.callback = 0;

@@ -146,8 +146,10 @@ TEST(DecipherTest, TextReadingIsComparedByNodeAndKind) {
           "summary": "NDT falls behind"})js");
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   const std::vector<explore::BottleneckHint> found = {
-      {"cpu_bound", "ndt_scan_matcher", "higher frequency", 0.6},
-      {"cpu_bound", "euclidean_cluster", "more cores", 0.3}};
+      {analysis::FindingKind::kCpuBound, "ndt_scan_matcher", "higher frequency",
+       0.6},
+      {analysis::FindingKind::kCpuBound, "euclidean_cluster", "more cores",
+       0.3}};
   EXPECT_THAT(CompareTextReading(*r, found),
               ::testing::UnorderedElementsAre(
                   "missed cpu_bound euclidean_cluster",
@@ -173,7 +175,8 @@ TEST(DecipherTest, ATextReadingCanNameAStarvedInputAsTheDiagnosisDoes) {
             "summary": "the planner's timer starves its pose input"})js");
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   const std::vector<explore::BottleneckHint> found = {
-      {"starved_input", "freespace_planner", "give it a callback group", 0.5}};
+      {analysis::FindingKind::kStarvedInput, "freespace_planner",
+       "give it a callback group", 0.5}};
   EXPECT_TRUE(CompareTextReading(*r, found).empty());
 }
 

@@ -120,11 +120,11 @@ spec::Spec LlmScenario(const std::string& dir, const std::string& url,
 
 // The first event of an agent and kind.
 std::string Detail(const std::vector<LlmEvent>& events,
-                   const std::string& agent, const std::string& kind) {
+                   const std::string& agent, LlmEventKind kind) {
   for (const LlmEvent& e : events) {
     if (e.agent == agent && e.kind == kind) return e.detail;
   }
-  return "(no " + agent + " " + kind + " event)";
+  return "(no " + agent + " " + LlmEventKindToString(kind) + " event)";
 }
 
 campaign::CampaignOptions Options(const std::string& out, int budget) {
@@ -149,7 +149,7 @@ std::vector<LlmEvent> Events(const std::string& out) {
 }
 
 int Count(const std::vector<LlmEvent>& events, const std::string& agent,
-          const std::string& kind) {
+          LlmEventKind kind) {
   int n = 0;
   for (const LlmEvent& e : events) n += e.agent == agent && e.kind == kind;
   return n;
@@ -299,9 +299,10 @@ TEST(LlmCampaignTest,
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   EXPECT_EQ(Points(*s), std::vector<spec::DesignPoint>{kP1});
   const std::vector<LlmEvent> events = Events(out);
-  EXPECT_EQ(Count(events, "dse", "rejected"), 1);
-  EXPECT_EQ(Count(events, "dse", "fallback"), 0);
-  EXPECT_THAT(Detail(events, "dse", "rejected"), HasSubstr("not valid JSON"));
+  EXPECT_EQ(Count(events, "dse", LlmEventKind::kRejected), 1);
+  EXPECT_EQ(Count(events, "dse", LlmEventKind::kFallback), 0);
+  EXPECT_THAT(Detail(events, "dse", LlmEventKind::kRejected),
+              HasSubstr("not valid JSON"));
   // The follow-up showed the model its answer and what was wrong.
   const std::vector<ExchangeRecord> x = Exchanges(out);
   ASSERT_GE(x.size(), 2u);
@@ -330,8 +331,8 @@ TEST(LlmCampaignTest,
   EXPECT_NE(s->exploration.evaluations[0].point.at("cores"), 3);
   EXPECT_EQ(s->exploration.evaluations[1].point, kP3);
   const std::vector<LlmEvent> events = Events(out);
-  EXPECT_EQ(Count(events, "dse", "rejected"), 2);
-  EXPECT_EQ(Count(events, "dse", "fallback"), 1);
+  EXPECT_EQ(Count(events, "dse", LlmEventKind::kRejected), 2);
+  EXPECT_EQ(Count(events, "dse", LlmEventKind::kFallback), 1);
   ASSERT_EQ(s->exploration.iterations.size(), 2u);
   EXPECT_THAT(s->exploration.iterations[0].rationale,
               HasSubstr("fallback to the built-in agent"));
@@ -355,8 +356,8 @@ TEST(LlmCampaignTest, ARepeatedPointIsRefusedAndCorrected) {
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   EXPECT_EQ(Points(*s), (std::vector<spec::DesignPoint>{kP1, kP2}));
   const std::vector<LlmEvent> events = Events(out);
-  ASSERT_EQ(Count(events, "dse", "rejected"), 1);
-  EXPECT_THAT(Detail(events, "dse", "rejected"),
+  ASSERT_EQ(Count(events, "dse", LlmEventKind::kRejected), 1);
+  EXPECT_THAT(Detail(events, "dse", LlmEventKind::kRejected),
               HasSubstr("was evaluated already"));
 }
 
@@ -399,9 +400,9 @@ TEST(LlmCampaignTest, ShellTextAndPathsOutsideTheOutputFolderChangeNothing) {
   EXPECT_FALSE(fs::exists(evil));
   EXPECT_FALSE(fs::exists(evil + ".h5"));
   const std::vector<LlmEvent> events = Events(out);
-  EXPECT_EQ(Count(events, "dse", "rejected"), 1);
-  EXPECT_EQ(Count(events, "command", "rejected"), 2);
-  EXPECT_EQ(Count(events, "command", "error"), 1);
+  EXPECT_EQ(Count(events, "dse", LlmEventKind::kRejected), 1);
+  EXPECT_EQ(Count(events, "command", LlmEventKind::kRejected), 2);
+  EXPECT_EQ(Count(events, "command", LlmEventKind::kError), 1);
   // The rationale is kept as text only, control characters removed.
   EXPECT_THAT(s->exploration.iterations[0].rationale, HasSubstr("$(touch"));
 }
@@ -424,8 +425,8 @@ TEST(LlmCampaignTest,
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   EXPECT_EQ(s->exploration.evaluations.size(), 1u);
   const std::vector<LlmEvent> events = Events(out);
-  ASSERT_EQ(Count(events, "dse", "fallback"), 1);
-  EXPECT_THAT(Detail(events, "dse", "fallback"),
+  ASSERT_EQ(Count(events, "dse", LlmEventKind::kFallback), 1);
+  EXPECT_THAT(Detail(events, "dse", LlmEventKind::kFallback),
               HasSubstr("did not answer within 0.5 s"));
   const std::vector<ExchangeRecord> x = Exchanges(out);
   ASSERT_FALSE(x.empty());
@@ -452,7 +453,7 @@ TEST(LlmCampaignTest, AServerErrorThenSuccessIsRetriedOverTheOpenAiApi) {
   EXPECT_TRUE(x[0].ok);
   EXPECT_EQ(x[0].attempts, 2);
   EXPECT_EQ(x[0].backend, "openai");
-  EXPECT_EQ(Count(Events(out), "dse", "fallback"), 0);
+  EXPECT_EQ(Count(Events(out), "dse", LlmEventKind::kFallback), 0);
   bool image_part = false;
   for (const ReceivedRequest& r : (*server)->requests()) {
     EXPECT_EQ(r.path, "/v1/chat/completions");
@@ -477,8 +478,8 @@ TEST(LlmCampaignTest, ATenMegabyteAnswerIsRefusedAndTheAgentTakesOver) {
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   EXPECT_EQ(s->exploration.evaluations.size(), 1u);
   const std::vector<LlmEvent> events = Events(out);
-  ASSERT_EQ(Count(events, "dse", "fallback"), 1);
-  EXPECT_THAT(Detail(events, "dse", "fallback"),
+  ASSERT_EQ(Count(events, "dse", LlmEventKind::kFallback), 1);
+  EXPECT_THAT(Detail(events, "dse", LlmEventKind::kFallback),
               HasSubstr("larger than 4 MiB"));
   // The record holds the refusal, not the 10 MB.
   EXPECT_LT(fs::file_size(ExchangesPath(out)), 200u * 1024);
@@ -503,10 +504,10 @@ TEST(LlmCampaignTest,
   ASSERT_EQ(s->exploration.evaluations.size(), 1u);
   EXPECT_TRUE(s->exploration.evaluations[0].feasible);
   const std::vector<LlmEvent> events = Events(out);
-  ASSERT_EQ(Count(events, "vision", "disagreement"), 1);
-  EXPECT_THAT(Detail(events, "vision", "disagreement"),
+  ASSERT_EQ(Count(events, "vision", LlmEventKind::kDisagreement), 1);
+  EXPECT_THAT(Detail(events, "vision", LlmEventKind::kDisagreement),
               HasSubstr("reached goal: no (metrics: yes)"));
-  EXPECT_THAT(Detail(events, "vision", "disagreement"),
+  EXPECT_THAT(Detail(events, "vision", LlmEventKind::kDisagreement),
               HasSubstr("the metrics are kept"));
 }
 
@@ -519,10 +520,11 @@ TEST(LlmCampaignTest, AnUnreachableServerIsNamedAndTheAgentCarriesTheCampaign) {
   ASSERT_TRUE(s.ok()) << s.status().ToString();
   EXPECT_EQ(s->exploration.evaluations.size(), 1u);
   const std::vector<LlmEvent> events = Events(out);
-  ASSERT_EQ(Count(events, "dse", "fallback"), 1);
-  EXPECT_THAT(Detail(events, "dse", "fallback"),
+  ASSERT_EQ(Count(events, "dse", LlmEventKind::kFallback), 1);
+  EXPECT_THAT(Detail(events, "dse", LlmEventKind::kFallback),
               HasSubstr("http://127.0.0.1:9"));
-  EXPECT_THAT(Detail(events, "dse", "fallback"), HasSubstr("ollama serve"));
+  EXPECT_THAT(Detail(events, "dse", LlmEventKind::kFallback),
+              HasSubstr("ollama serve"));
 }
 
 }  // namespace

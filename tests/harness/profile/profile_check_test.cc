@@ -18,7 +18,8 @@ runfile::RunData TwoScans() {
   runfile::RunData run;
   run.topic_names = {"/sensing/lidar/points_raw", "/sensing/lidar/points",
                      "/localization/ndt_pose", "/localization/pose"};
-  run.callback_info.push_back({"lidar_driver/points_raw", 0, "subscription"});
+  run.callback_info.push_back(
+      {"lidar_driver/points_raw", 0, runfile::CallbackKind::kSubscription});
   auto& events = run.trace.topic_events;
   // Scan stamped 1.0: raw at 1.00, processed at 1.08, its NDT pose taken
   // by the EKF at 1.13, fused poses at 1.12 (too early) and 1.14.

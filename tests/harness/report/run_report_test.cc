@@ -31,7 +31,7 @@ RunReport Analyse(double cores, double ghz, double hz) {
 
 bool HasCpuBoundAt(const RunReport& r, const std::vector<std::string>& nodes) {
   for (const FindingSummary& f : r.findings) {
-    if (f.kind != "cpu_bound") continue;
+    if (f.kind != analysis::FindingKind::kCpuBound) continue;
     for (const std::string& n : nodes) {
       if (f.node == n) return true;
     }
@@ -56,7 +56,7 @@ TEST(RunReportTest,
     // The typed remedies are what the text says, about this finding.
     ASSERT_FALSE(f.remedies.empty()) << f.node;
     EXPECT_EQ(analysis::RemediesText(f.remedies), f.remedy);
-    if (f.kind == "cpu_bound") {
+    if (f.kind == analysis::FindingKind::kCpuBound) {
       EXPECT_EQ(f.remedies[0].target, f.node);
     }
   }
@@ -81,7 +81,7 @@ TEST(RunReportTest,
   // a 40 ms scan skips some of the 50 Hz poses it keeps last-1, but it
   // takes a fresh one for each of its outputs, which is all it needs.
   for (const FindingSummary& f : r.findings) {
-    EXPECT_NE(f.kind, "cpu_bound") << ToJson(r).dump(2);
+    EXPECT_NE(f.kind, analysis::FindingKind::kCpuBound) << ToJson(r).dump(2);
   }
   EXPECT_TRUE(r.feasible) << ToJson(r).dump(2);
   EXPECT_TRUE(r.deviation_complete);

@@ -135,7 +135,8 @@ inline std::string Diff(const RunData& a, const RunData& b) {
       const std::string at = "callback_info[" + std::to_string(i) + "].";
       str("callback_info name", x.name, y.name);
       integer(at + "node", x.node, y.node);
-      str("callback_info kind", x.kind, y.kind);
+      str("callback_info kind", CallbackKindToString(x.kind),
+          CallbackKindToString(y.kind));
       integer(at + "topic", x.topic, y.topic);
       num(at + "period_s", x.period_s, y.period_s);
     }
@@ -317,10 +318,11 @@ inline RunData MakeFullRun(size_t events = 5000) {
   run.collisions = {{7.25, "veh1"}, {8.5, "pedestrian 2"}};
   run.node_names = {"lidar_driver", "localizer", "planner", "controller"};
   run.topic_names = {"/points", "/pose", "/trajectory", "/cmd"};
-  run.callback_info = {{"lidar_driver/tick", 0, "timer", -1, 0.1},
-                       {"localizer/on_points", 1, "subscription", 0, 0.0},
-                       {"planner/on_pose", 2, "subscription", 1, 0.0},
-                       {"controller/tick", 3, "timer", -1, 0.02}};
+  run.callback_info = {
+      {"lidar_driver/tick", 0, runfile::CallbackKind::kTimer, -1, 0.1},
+      {"localizer/on_points", 1, runfile::CallbackKind::kSubscription, 0, 0.0},
+      {"planner/on_pose", 2, runfile::CallbackKind::kSubscription, 1, 0.0},
+      {"controller/tick", 3, runfile::CallbackKind::kTimer, -1, 0.02}};
   for (int i = 0; i < 200; ++i) {
     CallbackRecord r;
     r.callback = i % 4;
