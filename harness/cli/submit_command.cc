@@ -35,7 +35,7 @@ int RunSubmit(const SubmitArgs& args) {
   if (args.json) {
     nlohmann::json scripts = nlohmann::json::array();
     for (const slurm::SubmittedScript& s : r.scripts) {
-      scripts.push_back({{"kind", s.kind},
+      scripts.push_back({{"kind", slurm::JobKindToString(s.kind)},
                          {"path", s.path},
                          {"job_id", s.job_id},
                          {"text", s.text}});
@@ -66,7 +66,7 @@ int RunSubmit(const SubmitArgs& args) {
       std::printf(
           "# ---- %s script (dry run: not written, not submitted) "
           "----\n%s\n",
-          s.kind.c_str(), s.text.c_str());
+          slurm::JobKindToString(s.kind), s.text.c_str());
     }
   }
   if (r.adaptive) {
@@ -83,8 +83,8 @@ int RunSubmit(const SubmitArgs& args) {
   }
   if (!args.dry_run) {
     for (const slurm::SubmittedScript& s : r.scripts) {
-      std::printf("%s job %s (%s)\n", s.kind.c_str(), s.job_id.c_str(),
-                  s.path.c_str());
+      std::printf("%s job %s (%s)\n", slurm::JobKindToString(s.kind),
+                  s.job_id.c_str(), s.path.c_str());
     }
     std::printf("follow it with: adse status %s\n", r.output_dir.c_str());
   }

@@ -7,10 +7,30 @@
 #include <nlohmann/json.hpp>
 
 #include "stack/base/files.h"
+#include "stack/base/vocabulary.h"
 
 namespace adse::slurm {
 namespace fs = std::filesystem;
 using nlohmann::json;
+
+namespace {
+const std::vector<Term<JobKind>>& JobKindTerms() {
+  static const std::vector<Term<JobKind>> kTerms = {
+      {JobKind::kCoordinator, "coordinator"},
+      {JobKind::kArray, "array"},
+      {JobKind::kIndex, "index"},
+  };
+  return kTerms;
+}
+}  // namespace
+
+const char* JobKindToString(JobKind kind) {
+  return NameOf(JobKindTerms(), kind);
+}
+bool StringToJobKind(std::string_view name, JobKind* kind) {
+  return ValueOf(JobKindTerms(), name, kind);
+}
+std::vector<std::string> JobKindNames() { return NamesOf(JobKindTerms()); }
 
 namespace {
 
@@ -143,7 +163,12 @@ Result<JobLog> ReadJobLog(const std::string& campaign_dir) {
       SubmittedJob job;
       job.submission = e.value("submission", 0);
       job.time = e.value("time", "");
-      job.kind = e.value("kind", "");
+      const std::string kind = e.at("kind").get<std::string>();
+      if (!StringToJobKind(kind, &job.kind)) {
+        return Status::Corruption(fmt::format(
+            "{}: job {}: unknown kind '{}'; valid kinds: {}", path,
+            log.jobs.size(), kind, fmt::join(JobKindNames(), ", ")));
+      }
       job.job_id = e.value("job_id", "");
       job.script = e.value("script", "");
       job.shards = e.value("shards", std::vector<int>{});
@@ -160,7 +185,7 @@ Status WriteJobLog(const std::string& campaign_dir, const JobLog& log) {
   for (const SubmittedJob& job : log.jobs) {
     jobs.push_back({{"submission", job.submission},
                     {"time", job.time},
-                    {"kind", job.kind},
+                    {"kind", JobKindToString(job.kind)},
                     {"job_id", job.job_id},
                     {"script", job.script},
                     {"shards", job.shards}});

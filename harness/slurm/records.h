@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -54,13 +55,28 @@ Status WriteSweepPlan(const std::string& campaign_dir, const SweepPlan& plan);
 // it cannot be read as one.
 Result<SweepPlan> ReadSweepPlan(const std::string& campaign_dir);
 
+// What a submitted job does. A new kind needs its token in records.cc's
+// JobKindTerms.
+enum class JobKind {
+  kCoordinator,  // an adaptive campaign's coordinator, one allocation
+  kArray,        // a static sweep's shards, one array task each
+  kIndex,        // indexes the sweep's runs once the array has ended
+};
+// The token of a kind ("array"), as slurm/jobs.json and the JSON output
+// store it and the scripts' file names carry it.
+const char* JobKindToString(JobKind kind);
+// False when `name` is no kind's token; `kind` is then unchanged.
+bool StringToJobKind(std::string_view name, JobKind* kind);
+// Every token, in enum order.
+std::vector<std::string> JobKindNames();
+
 struct SubmittedJob {
   int submission = 0;  // 1 for the first adse submit, 2 for the next, ...
   std::string time;    // UTC, ISO 8601
-  std::string kind;    // "coordinator", "array" or "index"
+  JobKind kind = JobKind::kCoordinator;
   std::string job_id;
   std::string script;       // path relative to the campaign folder
-  std::vector<int> shards;  // array tasks submitted (kind "array")
+  std::vector<int> shards;  // array tasks submitted (JobKind::kArray)
 };
 
 struct JobLog {

@@ -60,6 +60,18 @@ std::string Summarise(const std::vector<JobState>& tasks) {
 
 }  // namespace
 
+const char* CampaignKindToString(CampaignKind kind) {
+  switch (kind) {
+    case CampaignKind::kLocal:
+      return "local";
+    case CampaignKind::kCoordinator:
+      return "coordinator";
+    case CampaignKind::kSweep:
+      return "sweep";
+  }
+  return "unknown";
+}
+
 Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
   std::error_code ec;
   const std::string folder =
@@ -83,9 +95,10 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
   st.scenario = log->scenario;
   st.strategy = log->strategy;
   st.total = log->budget;
-  st.kind = log->jobs.empty() ? "local" : "coordinator";
+  st.kind =
+      log->jobs.empty() ? CampaignKind::kLocal : CampaignKind::kCoordinator;
   if (plan.ok()) {
-    st.kind = "sweep";
+    st.kind = CampaignKind::kSweep;
     st.scenario = plan->scenario;
     st.strategy = plan->strategy;
     st.total = static_cast<int>(plan->points.size());
@@ -204,11 +217,11 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
 std::string FormatStatus(const CampaignStatus& st) {
   std::string out;
   const std::string what =
-      st.kind == "sweep" ? fmt::format(
-                               "a static sweep ({}) of {} points "
-                               "as a Slurm job array",
-                               st.strategy, st.total)
-      : st.kind == "coordinator"
+      st.kind == CampaignKind::kSweep ? fmt::format(
+                                            "a static sweep ({}) of {} points "
+                                            "as a Slurm job array",
+                                            st.strategy, st.total)
+      : st.kind == CampaignKind::kCoordinator
           ? fmt::format(
                 "strategy {} with a "
                 "coordinator on Slurm",
@@ -235,8 +248,9 @@ std::string FormatStatus(const CampaignStatus& st) {
       if (!j.job.shards.empty()) {
         shards = fmt::format(", {} shard(s)", j.job.shards.size());
       }
-      out += fmt::format("  {} job {} ({}{}): {}\n", j.job.kind, j.job.job_id,
-                         j.job.script, shards, j.summary);
+      out +=
+          fmt::format("  {} job {} ({}{}): {}\n", JobKindToString(j.job.kind),
+                      j.job.job_id, j.job.script, shards, j.summary);
     }
   }
   if (!st.lock_holder.empty()) {
@@ -274,7 +288,7 @@ std::string StatusJson(const CampaignStatus& st) {
     }
     jobs.push_back({{"submission", j.job.submission},
                     {"time", j.job.time},
-                    {"kind", j.job.kind},
+                    {"kind", JobKindToString(j.job.kind)},
                     {"job_id", j.job.job_id},
                     {"script", j.job.script},
                     {"shards", j.job.shards},
@@ -286,7 +300,7 @@ std::string StatusJson(const CampaignStatus& st) {
       {"folder", st.folder},
       {"scenario", st.scenario},
       {"strategy", st.strategy},
-      {"kind", st.kind},
+      {"kind", CampaignKindToString(st.kind)},
       {"total", st.total},
       {"counts",
        {{"done", st.done},

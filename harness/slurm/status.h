@@ -31,12 +31,20 @@ struct JobStatus {
   std::vector<JobState> tasks;
 };
 
+// How a campaign runs, as `adse status` tells it.
+enum class CampaignKind {
+  kLocal,        // `adse run` on this machine
+  kCoordinator,  // an adaptive campaign whose coordinator runs on Slurm
+  kSweep,        // a static sweep as a Slurm job array
+};
+// The token of a kind ("sweep"), as `adse status --json` writes it.
+const char* CampaignKindToString(CampaignKind kind);
+
 struct CampaignStatus {
   std::string folder;
   std::string scenario;
   std::string strategy;
-  // "sweep" (job array), "coordinator" (adaptive, on Slurm) or "local".
-  std::string kind;
+  CampaignKind kind = CampaignKind::kLocal;
   int total = 0;  // planned points, or the budget; 0 when unknown
   int done = 0, failed = 0, running = 0, pending = 0;
   std::vector<RunningStep> running_steps;

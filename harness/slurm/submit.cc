@@ -104,9 +104,9 @@ std::vector<std::string> Header(const Context& c,
   return description;
 }
 
-std::string ScriptPath(const Context& c, const std::string& kind) {
+std::string ScriptPath(const Context& c, JobKind kind) {
   return fmt::format("{}/{:03d}-{}.sbatch", SlurmDir(c.folder), c.submission,
-                     kind);
+                     JobKindToString(kind));
 }
 
 std::string TimeDirectives(const spec::Spec& spec) {
@@ -471,19 +471,19 @@ Result<SubmitResult> Submit(const spec::Spec& input,
           tasks, spec.exploration.strategy, round_size));
     }
     SubmittedScript script;
-    script.kind = "coordinator";
+    script.kind = JobKind::kCoordinator;
     script.text = RenderScript(CoordinatorScript(c, tasks, tasks, slurm.nodes));
     if (!options.dry_run) {
       ADSE_RETURN_IF_ERROR(campaign::CampaignFolder(c.folder).Create());
       ADSE_RETURN_IF_ERROR(MakeDirs(SlurmDir(c.folder) + "/logs"));
-      script.path = ScriptPath(c, "coordinator");
+      script.path = ScriptPath(c, JobKind::kCoordinator);
       ADSE_RETURN_IF_ERROR(SubmitScript(&script));
       log.scenario = c.scenario;
       log.strategy = spec.exploration.strategy;
       log.budget = spec.exploration.budget;
       log.jobs.push_back({c.submission,
                           c.time,
-                          "coordinator",
+                          JobKind::kCoordinator,
                           script.job_id,
                           Relative(script.path, c.folder),
                           {}});
@@ -582,9 +582,9 @@ Result<SubmitResult> Submit(const spec::Spec& input,
   }
 
   SubmittedScript array;
-  array.kind = "array";
+  array.kind = JobKind::kArray;
   SubmittedScript index;
-  index.kind = "index";
+  index.kind = JobKind::kIndex;
   if (options.dry_run) {
     if (!result.submitted_shards.empty()) {
       array.text = RenderScript(ArrayScript(c, plan, result.submitted_shards));
@@ -604,16 +604,16 @@ Result<SubmitResult> Submit(const spec::Spec& input,
   log.budget = spec.exploration.budget;
   if (!result.submitted_shards.empty()) {
     array.text = RenderScript(ArrayScript(c, plan, result.submitted_shards));
-    array.path = ScriptPath(c, "array");
+    array.path = ScriptPath(c, JobKind::kArray);
     ADSE_RETURN_IF_ERROR(SubmitScript(&array));
-    log.jobs.push_back({c.submission, c.time, "array", array.job_id,
+    log.jobs.push_back({c.submission, c.time, JobKind::kArray, array.job_id,
                         Relative(array.path, c.folder),
                         result.submitted_shards});
     ADSE_RETURN_IF_ERROR(WriteJobLog(c.folder, log));
     result.scripts.push_back(array);
   }
   index.text = RenderScript(IndexScript(c, array.job_id));
-  index.path = ScriptPath(c, "index");
+  index.path = ScriptPath(c, JobKind::kIndex);
   if (Status s = SubmitScript(&index); !s.ok()) {
     if (array.job_id.empty()) return s;
     return Status::IoError(fmt::format(
@@ -623,7 +623,7 @@ Result<SubmitResult> Submit(const spec::Spec& input,
   }
   log.jobs.push_back({c.submission,
                       c.time,
-                      "index",
+                      JobKind::kIndex,
                       index.job_id,
                       Relative(index.path, c.folder),
                       {}});

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/slurm/records.h"
 #include "harness/spec/spec.h"
 #include "stack/base/status.h"
 
@@ -47,7 +48,7 @@ struct SubmitOptions {
 };
 
 struct SubmittedScript {
-  std::string kind;  // "coordinator", "array" or "index"
+  JobKind kind = JobKind::kCoordinator;
   std::string path;  // where it was written; empty in a dry run
   std::string text;
   std::string job_id;  // empty in a dry run

@@ -15,9 +15,9 @@ using ::testing::HasSubstr;
 
 TEST(LlmStrategyTest, EveryEventKindRoundTripsAndAnUnknownOneIsNot) {
   const std::vector<std::string> names = LlmEventKindNames();
-  ASSERT_EQ(names, (std::vector<std::string>{"rejected", "fallback",
-                                             "disagreement", "converged",
-                                             "error"}));
+  ASSERT_EQ(names,
+            (std::vector<std::string>{"rejected", "fallback", "disagreement",
+                                      "converged", "error"}));
   for (size_t i = 0; i < names.size(); ++i) {
     const LlmEventKind kind = static_cast<LlmEventKind>(i);
     EXPECT_EQ(LlmEventKindToString(kind), names[i]);
@@ -49,11 +49,10 @@ TEST(LlmStrategyTest, EventsAreReadBackTypedAndAnUnknownKindNamesItsLine) {
   EXPECT_EQ((*events)[1].agent, "text");
 
   adse::testing::WriteRaw(
-      path,
-      R"({"iteration":2,"agent":"dse","kind":"fallback","detail":"d"})"
-      "\n"
-      R"({"iteration":3,"agent":"dse","kind":"fell_back","detail":"d"})"
-      "\n");
+      path, R"({"iteration":2,"agent":"dse","kind":"fallback","detail":"d"})"
+            "\n"
+            R"({"iteration":3,"agent":"dse","kind":"fell_back","detail":"d"})"
+            "\n");
   events = LoadEvents(path);
   ASSERT_FALSE(events.ok());
   EXPECT_EQ(events.status().code(), Status::Code::kCorruption);
