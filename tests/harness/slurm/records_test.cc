@@ -22,9 +22,10 @@ TEST(RecordsTest, EveryJobKindRoundTripsThroughTheJobLog) {
   log.scenario = "s.yaml";
   log.strategy = "exhaustive";
   log.budget = 4;
-  log.jobs = {{1, "2026-12-05T07:00:00Z", JobKind::kArray, "11", "a", {0, 1}},
-              {1, "2026-12-05T07:00:00Z", JobKind::kIndex, "12", "b", {}},
-              {2, "2026-12-05T08:00:00Z", JobKind::kCoordinator, "13", "c", {}}};
+  log.jobs = {
+      {1, "2026-12-05T07:00:00Z", JobKind::kArray, "11", "a", {0, 1}},
+      {1, "2026-12-05T07:00:00Z", JobKind::kIndex, "12", "b", {}},
+      {2, "2026-12-05T08:00:00Z", JobKind::kCoordinator, "13", "c", {}}};
   ASSERT_TRUE(WriteJobLog(dir, log).ok());
   Result<JobLog> back = ReadJobLog(dir);
   ASSERT_TRUE(back.ok()) << back.status().ToString();
@@ -54,8 +55,8 @@ TEST(RecordsTest, AJobOfAnUnknownKindIsRefusedNamingTheFileAndTheJob) {
               HasSubstr(path + ": job 1: unknown kind 'reindex'; valid "
                                "kinds: coordinator, array, index"));
 
-  adse::testing::WriteRaw(
-      path, R"({"jobs": [{"submission": 1, "job_id": "11"}]})");
+  adse::testing::WriteRaw(path,
+                          R"({"jobs": [{"submission": 1, "job_id": "11"}]})");
   back = ReadJobLog(dir);
   ASSERT_FALSE(back.ok());
   EXPECT_EQ(back.status().code(), Status::Code::kCorruption);
