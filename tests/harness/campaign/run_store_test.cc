@@ -8,9 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <chrono>
 #include <filesystem>
-#include <thread>
 
 #include "stack/base/files.h"
 
@@ -44,21 +42,27 @@ TEST(CampaignLockTest, ASecondHolderIsRefusedWithTheFirstOnesPid) {
 
 TEST(CampaignLockTest, AHolderKilledOutrightLeavesNoStaleLock) {
   const std::string dir = TempDir("killed");
+  // The child says over a pipe when it holds the lock. (Polling for it
+  // with Acquire raced: a probe that took the lock for an instant made
+  // the child's own Acquire fail.)
+  int said[2];
+  ASSERT_EQ(::pipe(said), 0);
   const pid_t child = ::fork();
   ASSERT_GE(child, 0);
   if (child == 0) {
+    ::close(said[0]);
     Result<CampaignLock> lock = CampaignLock::Acquire(dir);
-    if (!lock.ok()) ::_exit(1);
+    const char held = lock.ok() ? 1 : 0;
+    if (::write(said[1], &held, 1) != 1 || !lock.ok()) ::_exit(1);
     ::pause();
     ::_exit(0);
   }
-  // Wait until the child holds it.
-  bool held = false;
-  for (int i = 0; i < 200 && !held; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    held = !CampaignLock::Acquire(dir).ok();
-  }
-  ASSERT_TRUE(held) << "the child never took the lock";
+  ::close(said[1]);
+  char held = 0;  // stays 0 if the child dies before it says
+  ASSERT_EQ(::read(said[0], &held, 1), 1) << "the child said nothing";
+  ::close(said[0]);
+  ASSERT_EQ(held, 1) << "the child could not take the lock";
+  EXPECT_FALSE(CampaignLock::Acquire(dir).ok());
   ::kill(child, SIGKILL);
   int status = 0;
   ::waitpid(child, &status, 0);
