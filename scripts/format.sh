@@ -5,9 +5,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mode="${1:-fix}"
-mapfile -t files < <(git ls-files '*.cc' '*.h')
+# Tracked files and new ones not yet added (not those .gitignore keeps out),
+# so a file formats before its first commit, as CI's clone will check it.
+mapfile -t files < <(git ls-files --cached --others --exclude-standard \
+  '*.cc' '*.h' | sort -u)
 if [ ${#files[@]} -eq 0 ]; then
-  echo "format: no C++ files tracked" >&2
+  echo "format: no C++ files found" >&2
   exit 1
 fi
 case "$mode" in
