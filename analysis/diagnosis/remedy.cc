@@ -38,12 +38,8 @@ Result<E> Parsed(const std::vector<Term<E>>& terms, const std::string& token,
                  const char* what) {
   E value = terms.front().value;
   if (ValueOf(terms, token, &value)) return value;
-  std::string valid;
-  for (const std::string& name : NamesOf(terms)) {
-    valid += (valid.empty() ? "" : ", ") + name;
-  }
-  return Status::InvalidArgument("unknown " + std::string(what) + " '" + token +
-                                 "'; valid kinds: " + valid);
+  return Status::InvalidArgument(
+      UnknownTermMessage(what, token, NamesOf(terms)));
 }
 
 }  // namespace

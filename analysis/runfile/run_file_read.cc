@@ -10,6 +10,7 @@
 #include "analysis/runfile/run_file.h"
 #include "analysis/runfile/run_file_tables.h"
 #include "stack/base/hash.h"
+#include "stack/base/vocabulary.h"
 
 namespace adse::runfile {
 namespace internal {
@@ -212,10 +213,9 @@ Status ReadContents(hid_t file, RunData* run) {
       CallbackKind kind = CallbackKind::kSubscription;
       if (!StringToCallbackKind(row.kind, &kind)) {
         return Status::Corruption(fmt::format(
-            "/trace/callback_info: callback {} ({}) has unknown kind '{}'; "
-            "valid kinds: {}",
-            row.index, row.name, row.kind,
-            fmt::join(CallbackKindNames(), ", ")));
+            "/trace/callback_info: callback {} ({}) has {}", row.index,
+            row.name,
+            UnknownTermMessage("kind", row.kind, CallbackKindNames())));
       }
       run->callback_info[row.index] = {std::move(row.name), row.node, kind,
                                        row.topic, row.period_s};

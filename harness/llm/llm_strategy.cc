@@ -510,8 +510,7 @@ Result<std::vector<LlmEvent>> LoadEvents(const std::string& path) {
         LlmEventKind kind = LlmEventKind::kRejected;
         if (!StringToLlmEventKind(token, &kind)) {
           throw std::invalid_argument(
-              fmt::format("unknown event kind '{}'; valid kinds: {}", token,
-                          fmt::join(LlmEventKindNames(), ", ")));
+              UnknownTermMessage("event kind", token, LlmEventKindNames()));
         }
         events.push_back({j.at("iteration").get<int64_t>(),
                           j.at("agent").get<std::string>(), kind,

@@ -165,9 +165,9 @@ Result<JobLog> ReadJobLog(const std::string& campaign_dir) {
       job.time = e.value("time", "");
       const std::string kind = e.at("kind").get<std::string>();
       if (!StringToJobKind(kind, &job.kind)) {
-        return Status::Corruption(fmt::format(
-            "{}: job {}: unknown kind '{}'; valid kinds: {}", path,
-            log.jobs.size(), kind, fmt::join(JobKindNames(), ", ")));
+        return Status::Corruption(
+            fmt::format("{}: job {}: {}", path, log.jobs.size(),
+                        UnknownTermMessage("kind", kind, JobKindNames())));
       }
       job.job_id = e.value("job_id", "");
       job.script = e.value("script", "");

@@ -47,6 +47,20 @@ std::vector<std::string> NamesOf(const std::vector<Term<E>>& terms) {
   return names;
 }
 
+// What a reader says of a token missing from its vocabulary: "unknown
+// <what> '<token>'; valid kinds: a, b, c" (the caller adds where it was).
+inline std::string UnknownTermMessage(std::string_view what,
+                                      std::string_view token,
+                                      const std::vector<std::string>& valid) {
+  std::string message = "unknown ";
+  message.append(what).append(" '").append(token).append("'; valid kinds: ");
+  for (size_t i = 0; i < valid.size(); ++i) {
+    if (i > 0) message += ", ";
+    message += valid[i];
+  }
+  return message;
+}
+
 }  // namespace adse
 
 #endif  // ADSE_STACK_BASE_VOCABULARY_H_
