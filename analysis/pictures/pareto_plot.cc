@@ -330,11 +330,36 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
     }
     return true;
   };
-  size_t omitted = 0;
+  // Front designs drawn on one marker (equal cost and time, e.g. 4 cores
+  // at 3 GHz and 6 at 2 GHz) share one label, so that no design on the
+  // front hides under another's: the first two named, the rest counted.
+  struct MarkerLabel {
+    cv::Point centre;
+    std::string text;
+    int designs = 1;
+  };
+  std::vector<MarkerLabel> marker_labels;
   for (const auto* p : front) {
     if (p->label.empty()) continue;
     const cv::Point2d c = px(p->cost, p->nav_time_s);
-    const std::string label = Ascii(p->label);
+    const cv::Point centre(static_cast<int>(std::lround(c.x)),
+                           static_cast<int>(std::lround(c.y)));
+    auto same =
+        std::find_if(marker_labels.begin(), marker_labels.end(),
+                     [&](const MarkerLabel& m) { return m.centre == centre; });
+    if (same == marker_labels.end()) {
+      marker_labels.push_back({centre, Ascii(p->label)});
+    } else if (++same->designs == 2) {
+      same->text += ", " + Ascii(p->label);
+    }
+  }
+  for (MarkerLabel& m : marker_labels) {
+    if (m.designs > 2) m.text += fmt::format(" +{} more", m.designs - 2);
+  }
+  size_t omitted = 0;
+  for (const MarkerLabel& m : marker_labels) {
+    const cv::Point2d c(m.centre.x, m.centre.y);
+    const std::string& label = m.text;
     const cv::Size size = TextSize(label, s, &baseline);
     const int h = size.height + baseline;
     const int gap = s.Px(8);

@@ -148,7 +148,9 @@ struct ParetoPlotOptions {
 // the front drawn as a staircase in x order (a min-min front promises
 // nothing between its points), highlighted points ringed in black and
 // unstable feasible ones in violet, constraint lines dashed, linear axes
-// with ticks and labels, a legend, and the title. Front labels never
+// with ticks and labels, a legend, and the title. Front designs on one
+// marker (equal cost and time) share one label, the first two named and
+// the rest counted. Front labels never
 // overlap one another, the legend or the front, and hide another design's
 // marker only where no place around their point is free of one; a label
 // without room is left out and counted in a note, as are points with a

@@ -459,7 +459,10 @@ nlohmann::json AnswerJson(const spec::Spec& spec,
   auto row_or_null = [&](int i) {
     return i < 0 ? nlohmann::json() : RowJson(spec, rows[i]);
   };
+  nlohmann::json ties = nlohmann::json::array();
+  for (int i : headline.cheapest_ties) ties.push_back(RowJson(spec, rows[i]));
   return {{"cheapest_feasible", row_or_null(headline.cheapest)},
+          {"tied_with_cheapest", ties},
           {"fastest_feasible", row_or_null(headline.fastest)},
           {"knee", row_or_null(headline.knee)},
           {"cost_time_front", headline.cost_time_front}};

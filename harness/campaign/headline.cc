@@ -92,9 +92,14 @@ struct Line {
   int runs;
 };
 
-std::vector<Line> Lines(const Headline& h) {
-  std::vector<Line> lines = {{"cheapest feasible", h.cheapest, h.cheapest_runs},
-                             {"fastest feasible", h.fastest, h.fastest_runs}};
+std::vector<Line> Lines(const std::vector<EvaluationRow>& rows,
+                        const Headline& h) {
+  std::vector<Line> lines = {
+      {"cheapest feasible", h.cheapest, h.cheapest_runs}};
+  for (int i : h.cheapest_ties) {
+    lines.push_back({"tied with cheapest", i, RunsAt(rows, i)});
+  }
+  lines.push_back({"fastest feasible", h.fastest, h.fastest_runs});
   if (h.knee >= 0) lines.push_back({"knee of cost-time", h.knee, h.knee_runs});
   return lines;
 }
@@ -164,12 +169,21 @@ Headline ComputeHeadline(const spec::Spec& spec,
         return time(a) != time(b) ? time(a) < time(b) : by_cost(a, b);
       });
   // Sorted by cost, a row is on the 2-D front when it is strictly faster
-  // than every cheaper-or-equal row before it.
+  // than every cheaper-or-equal row before it, or ties the last one in
+  // both (4 cores at 3 GHz and 6 at 2 GHz: two answers, as on the n-D
+  // front, neither hidden under the other).
   double best_time = std::numeric_limits<double>::infinity();
   for (int i : feasible) {
-    if (time(i) < best_time) {
+    const double t = analysis::TieKey(time(i));
+    const bool ties_last = !h.cost_time_front.empty() &&
+                           cost(i) == cost(h.cost_time_front.back()) &&
+                           t == best_time;
+    if (t < best_time || ties_last) {
+      if (ties_last && h.cost_time_front.size() == 1 + h.cheapest_ties.size()) {
+        h.cheapest_ties.push_back(i);
+      }
       h.cost_time_front.push_back(i);
-      best_time = time(i);
+      best_time = t;
     }
   }
   const std::vector<int>& f = h.cost_time_front;
@@ -203,7 +217,7 @@ std::string HeadlineText(const spec::Spec& spec,
         "constraint ({})\n",
         rows.size(), fmt::join(spec.constraints, ", "));
   }
-  for (const Line& line : Lines(h)) {
+  for (const Line& line : Lines(rows, h)) {
     if (line.row < 0) continue;
     out << fmt::format(
         "{:<19} {}  {}\n", line.what,
@@ -261,7 +275,7 @@ std::string HeadlineMarkdown(const spec::Spec& spec,
         "constraint.\n\n",
         rows.size());
   }
-  for (const Line& line : Lines(h)) {
+  for (const Line& line : Lines(rows, h)) {
     if (line.row < 0) continue;
     const EvaluationRow& row = rows[line.row];
     std::string what = line.what;

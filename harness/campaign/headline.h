@@ -35,6 +35,10 @@ struct Headline {
   // Equal to `front` for the usual two objectives; with more objectives it
   // is the 2-D view, and the n-D front is listed separately.
   std::vector<int> cost_time_front;
+  // Other feasible rows of the cheapest's cost and nav time (TieKey): other
+  // computers that answer the question as well, e.g. 6 cores at 2 GHz
+  // beside 4 at 3 GHz.
+  std::vector<int> cheapest_ties;
   // Rows at the same design point as each of cheapest/fastest/knee
   // (replicas); 1 when the point ran once.
   int cheapest_runs = 0, fastest_runs = 0, knee_runs = 0;

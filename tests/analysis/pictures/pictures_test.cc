@@ -544,6 +544,45 @@ TEST_F(PictureTest, AFrontLabelGoesWhereItHidesNoOtherDesign) {
             CountColour(*unlabelled, kFeasibleRgb));
 }
 
+TEST_F(PictureTest, FrontDesignsThatTieShareOneLabelNamingThemAll) {
+  // 4 cores at 3 GHz and 6 at 2 GHz: the same cost and time, one marker.
+  // The picture is the one drawn with a single label naming both, not two
+  // labels placed apart (which would say nothing of which one the marker
+  // is) nor one hiding the other.
+  std::vector<ParetoPlotPoint> tied = {{12, 47.55, true, true, "4/3"},
+                                       {12, 47.55, true, true, "6/2"},
+                                       {9, 80, true, true, "3/3"},
+                                       {20, 40, true, true, "10/2"}};
+  std::vector<ParetoPlotPoint> joined = tied;
+  joined[0].label = "4/3, 6/2";
+  joined[1].label.clear();
+  Result<std::string> tied_png = ParetoPlotPng(tied);
+  Result<std::string> joined_png = ParetoPlotPng(joined);
+  ASSERT_TRUE(tied_png.ok() && joined_png.ok());
+  EXPECT_TRUE(*tied_png == *joined_png);
+  // And the joined label is drawn: more text than with one name alone.
+  std::vector<ParetoPlotPoint> one_name = joined;
+  one_name[0].label = "4/3";
+  Result<std::string> one_png = ParetoPlotPng(one_name);
+  ASSERT_TRUE(one_png.ok());
+  EXPECT_FALSE(*one_png == *joined_png);
+
+  // Four copies of one design (a knob that changes nothing): two named,
+  // the others counted.
+  std::vector<ParetoPlotPoint> copies = {{12, 47.55, true, true, "6/2/1"},
+                                         {12, 47.55, true, true, "6/2/2"},
+                                         {12, 47.55, true, true, "6/2/3"},
+                                         {12, 47.55, true, true, "6/2/4"},
+                                         {20, 40, true, true, "10/2/1"}};
+  std::vector<ParetoPlotPoint> counted = copies;
+  counted[0].label = "6/2/1, 6/2/2 +2 more";
+  for (int i = 1; i < 4; ++i) counted[i].label.clear();
+  Result<std::string> copies_png = ParetoPlotPng(copies);
+  Result<std::string> counted_png = ParetoPlotPng(counted);
+  ASSERT_TRUE(copies_png.ok() && counted_png.ok());
+  EXPECT_TRUE(*copies_png == *counted_png);
+}
+
 TEST_F(PictureTest, EveryFeasibleDesignWhoseRunsDisagreeIsRingedAndNamed) {
   // A front point and a dominated design, each stable or not: every
   // unstable feasible design adds a violet ring, the first one also the

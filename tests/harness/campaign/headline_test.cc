@@ -1,0 +1,97 @@
+// The answer every command leads with: the cheapest feasible design, the
+// computers that tie with it, and the cost-time front they sit on.
+#include "harness/campaign/headline.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "harness/spec/spec_parser.h"
+
+namespace adse::campaign {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+spec::Spec Scenario() {
+  spec::ParseOptions options;
+  options.check_files = false;
+  Result<spec::Spec> spec = spec::ParseSpec(
+      "adse: 1\nname: ties\nworld: {map: {generate: parking_lot}}\n"
+      "task: {start: {x: 5, y: -1.75}, goal: {x: 60, y: 29.75}}\n"
+      "design_space:\n"
+      "  cores: {bind: platform.cores, values: [2, 4, 6, 8]}\n"
+      "  freq_ghz: {bind: platform.freq_ghz, values: [1.5, 2.0, 3.0]}\n"
+      "cost: cores * freq_ghz\n"
+      "objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]\n"
+      "constraints: [nav_time_s <= 60]\n",
+      "ties.yaml", ".", options);
+  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
+  return std::move(spec).value();
+}
+
+EvaluationRow Row(int index, double cores, double freq_ghz, double nav_time_s) {
+  EvaluationRow row;
+  row.index = index;
+  row.content_key = std::string(64, static_cast<char>('a' + index));
+  row.status = "complete";
+  row.reason = "goal_reached";
+  row.source = "simulated";
+  row.attempts = 1;
+  row.point = {{"cores", cores}, {"freq_ghz", freq_ghz}};
+  row.metrics = {{"nav_time_s", nav_time_s},
+                 {"hardware_cost", cores * freq_ghz},
+                 {"ctrl_rate_hz", 10},
+                 {"completed", 1}};
+  row.feasible = nav_time_s <= 60;
+  row.bottlenecks_json = "[]";
+  return row;
+}
+
+TEST(HeadlineTest, ComputersThatTieWithTheCheapestAreNamedBesideIt) {
+  const spec::Spec spec = Scenario();
+  // 4 x 3.0 and 6 x 2.0 GHz-cores cost 12 (a last bit apart as doubles)
+  // and arrive in the same time; 8 x 1.5 costs 12 too but is slower.
+  const std::vector<EvaluationRow> rows = {
+      Row(0, 2, 3.0, 70), Row(1, 4, 3.0, 47.55), Row(2, 6, 2.0, 47.55),
+      Row(3, 8, 1.5, 50.0), Row(4, 8, 3.0, 30.0)};
+  const Headline h = ComputeHeadline(spec, rows);
+  EXPECT_EQ(h.cheapest, 1);
+  EXPECT_THAT(h.cheapest_ties, ElementsAre(2));
+  EXPECT_THAT(h.cost_time_front, ElementsAre(1, 2, 4));
+  // The front over both objectives holds the tie too: one answer.
+  EXPECT_THAT(CheapestFirst(rows, h.front), ElementsAre(1, 2, 4));
+  const std::string text = HeadlineText(spec, rows, h);
+  EXPECT_THAT(text, HasSubstr("cheapest feasible   cores=4,freq_ghz=3"));
+  EXPECT_THAT(text, HasSubstr("tied with cheapest  cores=6,freq_ghz=2"));
+  EXPECT_THAT(HeadlineMarkdown(spec, rows, h, "images"),
+              HasSubstr("- **Tied with cheapest:** `cores=6,freq_ghz=2`"));
+}
+
+TEST(HeadlineTest, ADesignAsCheapButSlowerIsNoTie) {
+  const spec::Spec spec = Scenario();
+  const std::vector<EvaluationRow> rows = {Row(0, 4, 3.0, 47.55),
+                                           Row(1, 6, 2.0, 47.6)};
+  const Headline h = ComputeHeadline(spec, rows);
+  EXPECT_EQ(h.cheapest, 0);
+  EXPECT_TRUE(h.cheapest_ties.empty());
+  EXPECT_THAT(h.cost_time_front, ElementsAre(0));
+  EXPECT_THAT(HeadlineText(spec, rows, h),
+              ::testing::Not(HasSubstr("tied with cheapest")));
+}
+
+TEST(HeadlineTest, TiesAboveTheCheapestStayOnTheFrontWithoutBeingCalledTies) {
+  const spec::Spec spec = Scenario();
+  const std::vector<EvaluationRow> rows = {
+      Row(0, 2, 3.0, 55.0), Row(1, 4, 3.0, 40.0), Row(2, 6, 2.0, 40.0)};
+  const Headline h = ComputeHeadline(spec, rows);
+  EXPECT_EQ(h.cheapest, 0);
+  EXPECT_TRUE(h.cheapest_ties.empty());
+  EXPECT_THAT(h.cost_time_front, ElementsAre(0, 1, 2));
+}
+
+}  // namespace
+}  // namespace adse::campaign
