@@ -439,12 +439,15 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
       }
     }
     const auto t_exec = Clock::now();
+    // Where this process handles Ctrl-C and SIGTERM (it ran a real-time
+    // run, e.g. `adse fidelity` between its runs), a virtual run ends on
+    // them too: else the stop would wait for the next real-time run.
+    if (const int sig = RealTimePlatform::Interrupted()) {
+      return Status::Unavailable(
+          fmt::format("interrupted by {} at t={:.2f} s; nothing was recorded",
+                      sig == SIGINT ? "SIGINT (Ctrl-C)" : "SIGTERM", t));
+    }
     if (realtime != nullptr) {
-      if (const int sig = RealTimePlatform::Interrupted()) {
-        return Status::Unavailable(
-            fmt::format("interrupted by {} at t={:.2f} s; nothing was recorded",
-                        sig == SIGINT ? "SIGINT (Ctrl-C)" : "SIGTERM", t));
-      }
       world_lag_max_s =
           std::max(world_lag_max_s,
                    Seconds(t_exec - wall_start) / platform.time_dilation - t);

@@ -11,6 +11,7 @@
 
 #include "analysis/metrics/standing.h"
 #include "analysis/runfile/run_file.h"
+#include "harness/pool/worker_pool.h"
 #include "harness/sim/calibration.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/hash.h"
@@ -382,6 +383,22 @@ TEST(SimulateTest, TheCarChangesLaneIntoAGapNotBesideAnOvertakingCar) {
     EXPECT_NEAR(run->ego[e].y_m, -4.8, 0.3) << "at " << stop.t_s << " s";
   }
   EXPECT_GT(held, 0);
+}
+
+TEST(SimulateTest, AStopAskedForByASignalEndsAVirtualRunTooRecordingNothing) {
+  // As after `adse fidelity`'s first real-time run: the process handles
+  // SIGTERM, and one arrived during a virtual run.
+  pool::RequestInterrupt(SIGTERM);
+  Result<runfile::RunData> run =
+      SimulatePoint(SmallScenario(), SmallPoint(4, 2.1, 7));
+  pool::ClearInterrupt();
+  ASSERT_FALSE(run.ok());
+  EXPECT_EQ(run.status().code(), Status::Code::kUnavailable);
+  EXPECT_NE(run.status().message().find("interrupted by SIGTERM at t=0.00 s"),
+            std::string::npos)
+      << run.status().ToString();
+  // Cleared, the same run goes on as ever.
+  EXPECT_TRUE(SimulatePoint(SmallScenario(), SmallPoint(4, 2.1, 7)).ok());
 }
 
 TEST(SimulateTest, PointOutsideTheSpaceIsRejected) {
