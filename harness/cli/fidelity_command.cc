@@ -132,15 +132,33 @@ struct Comparisons {
   }
 
   // The summary (over more than one point or dispatch), then fidelity.txt
-  // and fidelity.json.
-  Status Finish(size_t points) {
+  // (ending with `tail`) and fidelity.json.
+  Status Finish(size_t points, const std::string& tail = "") {
     if (points > 1 || several_dispatches) {
       const std::string summary = fidelity::FormatDispatchSummary(compared);
       std::printf("%s", summary.c_str());
       text += summary;
     }
+    text += tail;
     ADSE_RETURN_IF_ERROR(WriteFileAtomic(dir + "/fidelity.txt", text));
     return WriteFileAtomic(dir + "/fidelity.json", json.dump(1) + "\n");
+  }
+
+  // A call that failed (or was interrupted) at point `n` of `total`: what
+  // was compared before it is kept, and both files say where it stopped,
+  // so that they never pass for the whole comparison.
+  Status Stop(size_t n, size_t total, const std::string& point,
+              const Status& why) {
+    const std::string note = fmt::format(
+        "stopped at point {} of {} ({}): {}\npoints 1-{} are compared above; "
+        "their runs are in {}/runs\n",
+        n, total, point, why.message(), n - 1, dir);
+    json["stopped"] = {{"at_point", n},
+                       {"of", total},
+                       {"point", point},
+                       {"error", why.message()}};
+    std::fprintf(stderr, "%s", note.c_str());
+    return Finish(n - 1, note);
   }
 };
 
@@ -265,9 +283,9 @@ int RunFidelity(const FidelityArgs& args) {
         fidelity::RunPoint(*spec, points[i], options);
     if (!runs.ok()) {
       ReportError(*spec, runs.status());
-      // What was compared so far stays on disk.
-      if (!c.text.empty()) {
-        (void)WriteFileAtomic(c.dir + "/fidelity.txt", c.text);
+      // What was compared so far stays on disk, saying where it stopped.
+      if (i > 0) {
+        (void)c.Stop(i + 1, points.size(), args.points[i], runs.status());
       }
       return ExitCodeFor(runs.status());
     }

@@ -428,4 +428,41 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
   EXPECT_NE(none.out.find("--runs"), std::string::npos) << none.out;
 }
 
+TEST(CliTest, AFidelityCallThatFailsAtAPointKeepsWhatItComparedAndSaysWhere) {
+  // The second point's real-time run is refused (a CPU quota cannot stand
+  // for a clock above the host's), after the first point was compared.
+  const std::string file = WriteScenario(
+      "fidelity_stops",
+      Replaced(Replaced(ReadText(std::string(ADSE_SOURCE_DIR) +
+                                 "/scenarios/fidelity_small.yaml"),
+                        "timeout_s: 30", "timeout_s: 4"),
+               "values: [1.0, 1.2, 1.5, 1.8, 2.1]", "values: [1.0, 9.9]"));
+  const fs::path out = fs::temp_directory_path() / "adse_cli_fidelity_stops";
+  fs::remove_all(out);
+  const CommandRun run =
+      Adse("fidelity " + file +
+           " --points cores=1,freq_ghz=1,lidar_hz=7 "
+           "cores=1,freq_ghz=9.9,lidar_hz=7 --runs 1 --perturbed-runs 0 "
+           "--clock-by quota -o " +
+           out.string());
+  EXPECT_NE(run.exit_code, 0) << run.out;
+  const std::string text = ReadText((out / "fidelity.txt").string());
+  EXPECT_NE(text.find("cores=1,freq_ghz=1,lidar_hz=7: virtual"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("stopped at point 2 of 2 "
+                      "(cores=1,freq_ghz=9.9,lidar_hz=7): platform.clock_by: "
+                      "quota"),
+            std::string::npos)
+      << text;
+  std::ifstream json_in(out / "fidelity.json");
+  const nlohmann::json json = nlohmann::json::parse(json_in, nullptr, false);
+  ASSERT_FALSE(json.is_discarded());
+  EXPECT_EQ(json["points"].size(), 1u);
+  EXPECT_EQ(json["stopped"]["at_point"], 2);
+  EXPECT_EQ(json["stopped"]["of"], 2);
+  EXPECT_TRUE(fs::is_regular_file(out / "runs/1-realtime-1.h5"));
+  EXPECT_FALSE(fs::exists(out / "runs/2-virtual.h5"));
+}
+
 }  // namespace
