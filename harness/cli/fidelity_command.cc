@@ -113,19 +113,24 @@ struct Comparisons {
   bool several_dispatches = false;
 
   // Point `n`'s runs held against each other per dispatch: printed, kept,
-  // and drawn as fidelity-n[-dispatch].png.
+  // and drawn as fidelity-n[-dispatch].png. Kept only once every picture
+  // is drawn, so that a failed one leaves no part of the point behind.
   Status Add(size_t n, const fidelity::PointRuns& runs,
              const std::string& task_case) {
-    several_dispatches = several_dispatches || runs.dispatches.size() > 1;
+    std::vector<fidelity::PointFidelity> point;
     for (size_t d = 0; d < runs.dispatches.size(); ++d) {
-      const fidelity::PointFidelity f = fidelity::ComparePoint(runs, d);
+      point.push_back(fidelity::ComparePoint(runs, d));
+      ADSE_RETURN_IF_ERROR(DrawPoint(point.back(), runs.realtime_runs.size(),
+                                     task_case,
+                                     fmt::format("{}/fidelity-{}{}.png", dir, n,
+                                                 DispatchSuffix(runs, d))));
+    }
+    several_dispatches = several_dispatches || runs.dispatches.size() > 1;
+    for (const fidelity::PointFidelity& f : point) {
       const std::string table = fidelity::FormatPointFidelity(f);
       std::printf("%s\n", table.c_str());
       text += table + "\n";
       json["points"].push_back(PointJson(f));
-      ADSE_RETURN_IF_ERROR(DrawPoint(f, runs.realtime_runs.size(), task_case,
-                                     fmt::format("{}/fidelity-{}{}.png", dir, n,
-                                                 DispatchSuffix(runs, d))));
       compared.push_back(f);
     }
     return Status::Ok();
@@ -149,10 +154,12 @@ struct Comparisons {
   // so that they never pass for the whole comparison.
   Status Stop(size_t n, size_t total, const std::string& point,
               const Status& why) {
+    const std::string before =
+        n == 2 ? "point 1 is compared above; its"
+               : fmt::format("points 1-{} are compared above; their", n - 1);
     const std::string note = fmt::format(
-        "stopped at point {} of {} ({}): {}\npoints 1-{} are compared above; "
-        "their runs are in {}/runs\n",
-        n, total, point, why.message(), n - 1, dir);
+        "stopped at point {} of {} ({}): {}\n{} runs are in {}/runs\n", n,
+        total, point, why.message(), before, dir);
     json["stopped"] = {{"at_point", n},
                        {"of", total},
                        {"point", point},
@@ -281,20 +288,20 @@ int RunFidelity(const FidelityArgs& args) {
   for (size_t i = 0; i < points.size(); ++i) {
     Result<fidelity::PointRuns> runs =
         fidelity::RunPoint(*spec, points[i], options);
-    if (!runs.ok()) {
-      ReportError(*spec, runs.status());
-      // What was compared so far stays on disk, saying where it stopped.
-      if (i > 0) {
-        (void)c.Stop(i + 1, points.size(), args.points[i], runs.status());
-      }
-      return ExitCodeFor(runs.status());
+    Status kept = runs.status();
+    if (runs.ok()) {
+      // The runs first: a failed picture loses no run.
+      kept = WritePointRuns(c.dir, i + 1, *runs);
+      if (kept.ok()) kept = c.Add(i + 1, *runs, args.task_case);
+      if (!kept.ok())
+        std::fprintf(stderr, "error: %s\n", kept.message().c_str());
+    } else {
+      ReportError(*spec, kept);
     }
-    // The runs first: a failed picture loses no run.
-    Status kept = WritePointRuns(c.dir, i + 1, *runs);
-    if (kept.ok()) kept = c.Add(i + 1, *runs, args.task_case);
     if (!kept.ok()) {
-      std::fprintf(stderr, "error: %s\n", kept.message().c_str());
-      return 1;
+      // What was compared so far stays on disk, saying where it stopped.
+      if (i > 0) (void)c.Stop(i + 1, points.size(), args.points[i], kept);
+      return runs.ok() ? 1 : ExitCodeFor(kept);
     }
   }
   if (Status saved = c.Finish(points.size()); !saved.ok()) {

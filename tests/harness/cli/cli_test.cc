@@ -465,4 +465,40 @@ TEST(CliTest, AFidelityCallThatFailsAtAPointKeepsWhatItComparedAndSaysWhere) {
   EXPECT_FALSE(fs::exists(out / "runs/2-virtual.h5"));
 }
 
+TEST(CliTest, AFidelityCallWhosePointRunsCannotBeWrittenSaysWhereItStopped) {
+  // A folder where the second point's virtual run file goes: the runs are
+  // made, but cannot be kept.
+  const std::string file =
+      WriteScenario("fidelity_unwritable",
+                    Replaced(ReadText(std::string(ADSE_SOURCE_DIR) +
+                                      "/scenarios/fidelity_small.yaml"),
+                             "timeout_s: 30", "timeout_s: 4"));
+  const fs::path out =
+      fs::temp_directory_path() / "adse_cli_fidelity_unwritable";
+  fs::remove_all(out);
+  fs::create_directories(out / "runs/2-virtual.h5");
+  const CommandRun run =
+      Adse("fidelity " + file +
+           " --points cores=1,freq_ghz=1,lidar_hz=7 "
+           "cores=1,freq_ghz=1.2,lidar_hz=7 --runs 1 --perturbed-runs 0 -o " +
+           out.string());
+  EXPECT_EQ(run.exit_code, 1) << run.out;
+  const std::string text = ReadText((out / "fidelity.txt").string());
+  EXPECT_NE(text.find("stopped at point 2 of 2 "
+                      "(cores=1,freq_ghz=1.2,lidar_hz=7): "),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("point 1 is compared above"), std::string::npos) << text;
+  std::ifstream json_in(out / "fidelity.json");
+  const nlohmann::json json = nlohmann::json::parse(json_in, nullptr, false);
+  ASSERT_FALSE(json.is_discarded());
+  EXPECT_EQ(json["points"].size(), 1u);
+  EXPECT_EQ(json["stopped"]["at_point"], 2);
+  EXPECT_NE(json["stopped"]["error"].get<std::string>().find("2-virtual.h5"),
+            std::string::npos)
+      << json.dump(1);
+  EXPECT_TRUE(fs::is_regular_file(out / "runs/1-virtual.h5"));
+  EXPECT_FALSE(fs::exists(out / "fidelity-2.png"));
+}
+
 }  // namespace
