@@ -179,14 +179,18 @@ Headline ComputeHeadline(const spec::Spec& spec,
                            cost(i) == cost(h.cost_time_front.back()) &&
                            t == best_time;
     if (t < best_time || ties_last) {
-      if (ties_last && h.cost_time_front.size() == 1 + h.cheapest_ties.size()) {
-        h.cheapest_ties.push_back(i);
-      }
       h.cost_time_front.push_back(i);
       best_time = t;
     }
   }
   const std::vector<int>& f = h.cost_time_front;
+  // The cheapest leads the front; the designs tied with it follow.
+  for (size_t k = 1;
+       k < f.size() && cost(f[k]) == cost(f[0]) &&
+       analysis::TieKey(time(f[k])) == analysis::TieKey(time(f[0]));
+       ++k) {
+    h.cheapest_ties.push_back(f[k]);
+  }
   if (f.size() >= 3) {
     const double c0 = cost(f.front()), c1 = cost(f.back());
     const double t0 = time(f.back()), t1 = time(f.front());
