@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/runfile/run_data.h"
 #include "stack/base/env.h"
 #include "stack/base/status.h"
 
@@ -22,7 +23,7 @@ struct EvaluationRow {
   int64_t index = 0;        // evaluation number, 0-based, in proposal order
   int64_t iteration = 0;    // the round that proposed it
   std::string content_key;  // 64 hex; the run file is runs/<key>.h5
-  // "complete" (a run file exists) | "failed" (no run after retries)
+  // kRunComplete (a run file exists) | kRunFailed (no run after retries)
   std::string status;
   // complete: the run's termination_reason (goal_reached, timeout, ...);
   // failed: the last attempt's outcome (timeout, out_of_memory, crashed,
@@ -53,6 +54,8 @@ struct EvaluationRow {
   // aggregate (harness/campaign/replicas.h). Empty for a point run once,
   // whose row is its run.
   std::vector<EvaluationRow> replicas;
+
+  bool complete() const { return status == kRunComplete; }
 };
 
 struct IterationRow {

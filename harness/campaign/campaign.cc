@@ -167,7 +167,7 @@ int StopSignal() {
 
 void CountSources(CampaignSummary* summary) {
   for (const EvaluationRow& row : summary->exploration.evaluations) {
-    if (row.status != "complete") ++summary->failed;
+    if (!row.complete()) ++summary->failed;
     if (row.source == "simulated") {
       ++summary->simulated;
     } else {

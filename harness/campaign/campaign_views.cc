@@ -213,8 +213,7 @@ std::string CaseSection(const spec::Spec& spec,
       }
       md << "| " << row.index << " | "
          << spec::FormatPoint(spec.design_space, row.point) << " | " << name
-         << " | " << Cell(run.status == "complete" ? run.reason : run.status)
-         << " | ";
+         << " | " << Cell(run.complete() ? run.reason : run.status) << " | ";
       for (const std::string& col : columns) {
         md << Number(RowMetric(run, col)) << " | ";
       }
@@ -382,7 +381,7 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
   md << "\n## Failures\n\n";
   bool any = false;
   for (const EvaluationRow& row : rows) {
-    if (row.status == "complete") continue;
+    if (row.complete()) continue;
     any = true;
     md << fmt::format("- #{} {} (run `{}`, {} attempt(s)): {}\n", row.index,
                       spec::FormatPoint(spec.design_space, row.point),

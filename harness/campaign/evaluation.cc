@@ -131,7 +131,7 @@ explore::Observation ObservationFromRow(const EvaluationRow& row) {
   explore::Observation o;
   o.point = row.point;
   o.key = row.content_key;
-  o.failed = row.status != "complete";
+  o.failed = !row.complete();
   if (o.failed) return o;
   for (const auto& [name, value] : row.metrics) {
     if (!std::isnan(value)) o.metrics[name] = value;

@@ -31,7 +31,7 @@ int RunsAt(const std::vector<EvaluationRow>& rows, int i) {
   if (i < 0) return 0;
   int n = 0;
   for (const EvaluationRow& row : rows) {
-    if (row.status != "complete" || row.point != rows[i].point) continue;
+    if (!row.complete() || row.point != rows[i].point) continue;
     n += static_cast<int>(std::max<size_t>(1, row.replicas.size()));
   }
   return n;
@@ -146,7 +146,7 @@ Headline ComputeHeadline(const spec::Spec& spec,
   h.front = ParetoFrontOf(spec, rows);
   std::vector<int> feasible;
   for (size_t i = 0; i < rows.size(); ++i) {
-    if (rows[i].status == "complete" && rows[i].feasible && Placed(rows[i])) {
+    if (rows[i].complete() && rows[i].feasible && Placed(rows[i])) {
       feasible.push_back(static_cast<int>(i));
     }
   }

@@ -171,7 +171,7 @@ EvaluationRow PoolEvaluator::FailedRow(const Pending& p,
   row.replica = p.replica;
   row.task_case = p.task_case;
   row.content_key = p.key;
-  row.status = "failed";
+  row.status = runfile::kRunFailed;
   row.reason = record.outcome + ": " + record.detail;
   row.source = source;
   row.attempts = record.attempts;

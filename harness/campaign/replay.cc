@@ -85,7 +85,7 @@ void RecordingEvaluator::Start(const EvalRequest& request) {
   row.index = request.index;
   row.iteration = request.iteration;
   row.point = request.point;
-  row.status = "failed";
+  row.status = runfile::kRunFailed;
   row.reason = "not recorded";
   row.source = "recording";
   row.bottlenecks_json = "[]";
@@ -164,7 +164,7 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
     run.proposals.push_back(row.point);
     run.found_cheapest_feasible =
         run.found_cheapest_feasible ||
-        (row.status == runfile::kRunComplete && row.feasible &&
+        (row.complete() && row.feasible &&
          analysis::TieKey(RowMetric(row, "hardware_cost")) == cheapest);
   }
   return run;

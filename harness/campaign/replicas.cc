@@ -21,8 +21,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-bool Complete(const EvaluationRow& row) { return row.status == "complete"; }
-
 bool Censored(const EvaluationRow& row) {
   return RowMetric(row, analysis::kCensoredMetric) == 1.0;
 }
@@ -53,7 +51,7 @@ int FailingSide(const spec::Spec& spec, const std::string& constraint,
 // the run neither measured nor bounded it.
 std::optional<double> ValueOf(const spec::Spec& spec, const EvaluationRow& row,
                               const std::string& metric) {
-  if (!Complete(row)) return std::nullopt;
+  if (!row.complete()) return std::nullopt;
   const double value = RowMetric(row, metric);
   if (!std::isnan(value)) return value;
   if (!Censored(row)) return std::nullopt;
@@ -183,10 +181,10 @@ EvaluationRow AggregateCases(const spec::Spec& spec,
   double wall_s = 0.0;
   std::set<std::string> names;
   for (const EvaluationRow& c : cases) {
-    complete = complete && Complete(c);
-    feasible = feasible && Complete(c) && c.feasible;
+    complete = complete && c.complete();
+    feasible = feasible && c.complete() && c.feasible;
     unstable = unstable || c.unstable;
-    censored = censored || (Complete(c) && Censored(c));
+    censored = censored || (c.complete() && Censored(c));
     simulated = simulated || c.source == "simulated";
     attempts += c.attempts;
     wall_s += c.wall_s;
@@ -236,7 +234,8 @@ EvaluationRow AggregateCases(const spec::Spec& spec,
     return nullptr;
   };
   if (!complete) {
-    representative = first([](const EvaluationRow& c) { return !Complete(c); });
+    representative =
+        first([](const EvaluationRow& c) { return !c.complete(); });
   } else if (!feasible) {
     const EvaluationRow* stopped = first(
         [](const EvaluationRow& c) { return !c.feasible && Censored(c); });
@@ -265,7 +264,7 @@ EvaluationRow AggregateCases(const spec::Spec& spec,
   }
 
   TakeIdentity(cases.front(), *representative, &row);
-  row.status = complete ? "complete" : representative->status;
+  row.status = complete ? runfile::kRunComplete : representative->status;
   row.feasible = feasible;
   row.unstable = unstable;
   row.source = simulated ? "simulated" : cases.front().source;
@@ -313,13 +312,13 @@ EvaluationRow AggregateReplicas(const spec::Spec& spec,
   bool simulated = false;
   std::set<std::string> names;
   for (const EvaluationRow& r : replicas) {
-    complete += Complete(r);
-    feasible += Complete(r) && r.feasible;
-    stopped += Complete(r) && Censored(r);
+    complete += r.complete();
+    feasible += r.complete() && r.feasible;
+    stopped += r.complete() && Censored(r);
     attempts += static_cast<int>(r.attempts);
     wall_s += r.wall_s;
     simulated = simulated || r.source == "simulated";
-    if (Complete(r)) {
+    if (r.complete()) {
       for (const auto& [name, value] : r.metrics) names.insert(name);
     }
   }
@@ -348,7 +347,7 @@ EvaluationRow AggregateReplicas(const spec::Spec& spec,
   const EvaluationRow* representative = &replicas.front();
   int best = -1;
   for (const EvaluationRow& r : replicas) {
-    if (!Complete(r)) continue;
+    if (!r.complete()) continue;
     const int score = 1 + 2 * (r.feasible == row.feasible) +
                       (r.feasible == row.feasible && Censored(r) == censored);
     if (score > best) {
@@ -357,7 +356,7 @@ EvaluationRow AggregateReplicas(const spec::Spec& spec,
     }
   }
   TakeIdentity(replicas.front(), *representative, &row);
-  row.status = complete > 0 ? "complete" : representative->status;
+  row.status = complete > 0 ? runfile::kRunComplete : representative->status;
   row.source = simulated ? "simulated" : replicas.front().source;
   row.attempts = attempts;
   row.wall_s = wall_s;
@@ -384,8 +383,8 @@ std::string Instability(const spec::Spec& spec, const EvaluationRow& row) {
   for (const EvaluationRow& r : row.replicas) {
     Counts& counts = by_case[r.task_case];
     ++counts.runs;
-    counts.complete += Complete(r) ? 1 : 0;
-    counts.feasible += Complete(r) && r.feasible ? 1 : 0;
+    counts.complete += r.complete() ? 1 : 0;
+    counts.feasible += r.complete() && r.feasible ? 1 : 0;
   }
   const bool several = by_case.size() > 1;
   std::vector<std::string> parts;
@@ -404,7 +403,7 @@ std::string ReplicaSummary(const spec::Spec& spec, const EvaluationRow& row) {
   const size_t n = std::max<size_t>(1, row.replicas.size());
   if (n == 1) return "1 run";
   size_t failed = 0;
-  for (const EvaluationRow& r : row.replicas) failed += !Complete(r);
+  for (const EvaluationRow& r : row.replicas) failed += !r.complete();
   const int cases = CaseCountOf(row);
   std::string text;
   if (cases > 1) {

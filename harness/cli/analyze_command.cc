@@ -231,9 +231,8 @@ int AnalyzeFolder(const std::string& target,
       for (const campaign::EvaluationRow& run :
            row.replicas.empty() ? std::vector<campaign::EvaluationRow>{row}
                                 : row.replicas) {
-        items.push_back({run, run.status == "complete"
-                                  ? folder.RunPath(run.content_key)
-                                  : std::string()});
+        items.push_back({run, run.complete() ? folder.RunPath(run.content_key)
+                                             : std::string()});
       }
     }
   } else {
@@ -357,8 +356,8 @@ int AnalyzeFolder(const std::string& target,
   summary.exploration.evaluations = rows;
   if (index) summary.exploration.iterations = index->iterations;
   for (const campaign::EvaluationRow& row : rows) {
-    summary.failed += row.status != "complete";
-    summary.reused += row.status == "complete";
+    summary.failed += !row.complete();
+    summary.reused += row.complete();
   }
   if (Status s = campaign::WriteAnswerViews(*spec, summary, version, "images");
       !s.ok()) {

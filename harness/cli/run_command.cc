@@ -66,7 +66,7 @@ class Progress : public campaign::ExplorerListener {
 
   void OnEvaluated(const campaign::EvaluationRow& row) override {
     ++done_;
-    const bool failed = row.status != "complete";
+    const bool failed = !row.complete();
     if (failed) ++failed_;
     if (row.source == "simulated") {
       simulated_wall_s_ += row.wall_s;

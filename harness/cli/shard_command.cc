@@ -19,7 +19,7 @@ class ShardProgress : public campaign::ExplorerListener {
   explicit ShardProgress(bool quiet) : quiet_(quiet) {}
   void OnEvaluated(const campaign::EvaluationRow& row) override {
     ++done_;
-    const bool failed = row.status != "complete";
+    const bool failed = !row.complete();
     if (quiet_ && !failed) return;
     std::string point;
     for (const auto& [name, value] : row.point) {

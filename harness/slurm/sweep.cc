@@ -240,7 +240,7 @@ Result<campaign::CampaignSummary> BuildSweepIndex(
   }
   summary.wall_s = any ? last_end - first_start : 0.0;
   for (const campaign::EvaluationRow& row : summary.exploration.evaluations) {
-    if (row.status != "complete") ++summary.failed;
+    if (!row.complete()) ++summary.failed;
     if (row.source == "simulated") {
       ++summary.simulated;
     } else {
