@@ -293,8 +293,9 @@ int RunFidelity(const FidelityArgs& args) {
       // The runs first: a failed picture loses no run.
       kept = WritePointRuns(c.dir, i + 1, *runs);
       if (kept.ok()) kept = c.Add(i + 1, *runs, args.task_case);
-      if (!kept.ok())
+      if (!kept.ok()) {
         std::fprintf(stderr, "error: %s\n", kept.message().c_str());
+      }
     } else {
       ReportError(*spec, kept);
     }

@@ -1,0 +1,85 @@
+# The per-point table of the valet sweep in the README ("Automated valet
+# parking", "A sweep"), from the campaign of that sweep, which runs each
+# case several times (harness.replicas):
+#   /usr/bin/python3 tests/bench/valet_sweep_table.py <campaign>/campaign.h5
+# Per point and case: the runs that parked cleanly (were feasible), what
+# the others did, the median nav time (a run stopped at the bound counts
+# as the bound), the median parking error of the runs that reached the
+# slot, the smallest clearance; last, the median control rate of the
+# runs not stopped early.
+import sys, collections, math, statistics
+import h5py
+
+BOUND = 150.0  # the scenario's constraint nav_time_s <= 150
+f = h5py.File(sys.argv[1], "r")
+
+
+def table(name):
+    g = f[name]
+    cols = {}
+    for k in g:
+        if isinstance(g[k], h5py.Dataset):
+            cols[k] = g[k].asstr()[:] if g[k].dtype.kind in "SO" else g[k][:]
+    for sub in ("point", "metrics"):
+        for n in g[sub].attrs["names"]:
+            n = n.decode() if isinstance(n, bytes) else n
+            cols[n] = g[sub][n][:]
+    return [{k: v[i] for k, v in cols.items()} for i in range(len(cols["index"]))]
+
+
+def fin(x):
+    return x is not None and not (isinstance(x, float) and math.isnan(x)) and math.isfinite(float(x))
+
+
+def other(r):
+    reason = str(r["reason"])
+    touching = fin(r.get("obstacle_collisions")) and r["obstacle_collisions"] > 0
+    if reason.startswith("constraint_violated") or reason == "timeout":
+        label = f"not parked by {BOUND:g} s"
+    elif reason == "no_path":
+        label = "no path"
+    elif reason == "parked_out_of_tolerance":
+        label = "out of tolerance"
+    elif reason == "goal_reached" and touching:
+        return "touching a parked car"
+    else:
+        label = reason
+    return label + (" and touching" if touching else "")
+
+
+def joined(labels):
+    c = collections.Counter(labels)
+    return "; ".join(l if n == 1 else f"{l} ×{n}" for l, n in c.items()) or "—"
+
+
+ev = {int(r["index"]): r for r in table("evaluations")}
+reps = collections.defaultdict(list)
+for r in table("replicas"):
+    reps[int(r["index"])].append(r)
+cases = sorted({int(r["task_case"]) for rs in reps.values() for r in rs})
+rows = []
+for i, e in ev.items():
+    rs = reps[i] or [e]
+    line = [f"{e['cores']:g}", f"{e['freq_ghz']:g}",
+            ("yes" if e["feasible"] else "no") + (" (unstable)" if e.get("unstable", 0) else "")]
+    for c in cases:
+        runs = [r for r in rs if int(r["task_case"]) == c]
+        clean = [r for r in runs if r["feasible"]]
+        line.append(f"{len(clean)} of {len(runs)}")
+        line.append(joined([other(r) for r in runs if not r["feasible"]]))
+        navs = sorted(BOUND if (not fin(r["nav_time_s"]) or str(r["reason"]).startswith("constraint_violated")) else float(r["nav_time_s"]) for r in runs)
+        med = statistics.median(navs)
+        line.append(f"≥ {BOUND:g}" if med >= BOUND else f"{med:.1f}")
+        reached = [r for r in runs if str(r["reason"]) in ("goal_reached", "parked_out_of_tolerance") and fin(r["parking_position_error_m"])]
+        if reached:
+            line.append(f"{statistics.median(r['parking_position_error_m'] for r in reached):.2f} m / "
+                        f"{statistics.median(abs(r['parking_yaw_error_deg']) for r in reached):.1f}°")
+        else:
+            line.append("—")
+        cl = [r["min_clearance_m"] for r in runs if fin(r.get("min_clearance_m")) and str(r["reason"]) in ("goal_reached", "parked_out_of_tolerance")]
+        line.append(f"{max(0.0, min(cl)):.2f}" if cl else "—")
+    ctrl = [r["ctrl_rate_hz"] for r in rs if fin(r["ctrl_rate_hz"]) and not str(r["reason"]).startswith("constraint_violated")]
+    line.append(f"{statistics.median(ctrl):.1f}" if ctrl else "—")
+    rows.append((e["cores"], e["freq_ghz"], line))
+for _, _, line in sorted(rows, key=lambda t: (t[0], t[1])):
+    print("| " + " | ".join(line) + " |")
