@@ -28,13 +28,21 @@ def table(name):
 
 
 def fin(x):
-    return x is not None and not (isinstance(x, float) and math.isnan(x)) and math.isfinite(float(x))
+    return x is not None and math.isfinite(float(x))
+
+
+def stopped(r):  # ended early at the nav-time bound
+    return str(r["reason"]).startswith("constraint_violated")
+
+
+def reached(r):  # stood in the slot when its manoeuvre ended
+    return str(r["reason"]) in ("goal_reached", "parked_out_of_tolerance")
 
 
 def other(r):
     reason = str(r["reason"])
     touching = fin(r.get("obstacle_collisions")) and r["obstacle_collisions"] > 0
-    if reason.startswith("constraint_violated") or reason == "timeout":
+    if stopped(r) or reason == "timeout":
         label = f"not parked by {BOUND:g} s"
     elif reason == "no_path":
         label = "no path"
@@ -67,18 +75,20 @@ for i, e in ev.items():
         clean = [r for r in runs if r["feasible"]]
         line.append(f"{len(clean)} of {len(runs)}")
         line.append(joined([other(r) for r in runs if not r["feasible"]]))
-        navs = sorted(BOUND if (not fin(r["nav_time_s"]) or str(r["reason"]).startswith("constraint_violated")) else float(r["nav_time_s"]) for r in runs)
-        med = statistics.median(navs)
+        med = statistics.median(
+            BOUND if stopped(r) or not fin(r["nav_time_s"]) else float(r["nav_time_s"])
+            for r in runs)
         line.append(f"≥ {BOUND:g}" if med >= BOUND else f"{med:.1f}")
-        reached = [r for r in runs if str(r["reason"]) in ("goal_reached", "parked_out_of_tolerance") and fin(r["parking_position_error_m"])]
-        if reached:
-            line.append(f"{statistics.median(r['parking_position_error_m'] for r in reached):.2f} m / "
-                        f"{statistics.median(abs(r['parking_yaw_error_deg']) for r in reached):.1f}°")
+        slot = [r for r in runs if reached(r)]
+        errors = [r for r in slot if fin(r["parking_position_error_m"])]
+        if errors:
+            line.append(f"{statistics.median(r['parking_position_error_m'] for r in errors):.2f} m / "
+                        f"{statistics.median(abs(r['parking_yaw_error_deg']) for r in errors):.1f}°")
         else:
             line.append("—")
-        cl = [r["min_clearance_m"] for r in runs if fin(r.get("min_clearance_m")) and str(r["reason"]) in ("goal_reached", "parked_out_of_tolerance")]
+        cl = [r["min_clearance_m"] for r in slot if fin(r["min_clearance_m"])]
         line.append(f"{max(0.0, min(cl)):.2f}" if cl else "—")
-    ctrl = [r["ctrl_rate_hz"] for r in rs if fin(r["ctrl_rate_hz"]) and not str(r["reason"]).startswith("constraint_violated")]
+    ctrl = [r["ctrl_rate_hz"] for r in rs if fin(r["ctrl_rate_hz"]) and not stopped(r)]
     line.append(f"{statistics.median(ctrl):.1f}" if ctrl else "—")
     rows.append((e["cores"], e["freq_ghz"], line))
 for _, _, line in sorted(rows, key=lambda t: (t[0], t[1])):
