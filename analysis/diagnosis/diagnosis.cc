@@ -594,31 +594,27 @@ Diagnosis Diagnose(const runfile::RunData& run,
     }
     return best;
   };
-  struct Origin {
-    std::string kind;      // "sensor" | "timer" | "cpu_bound" | "unknown"
-    std::string where;     // sensor topic, timer callback or node
-    double rate_hz = 0.0;  // sensor publish rate or timer rate; 0 unknown
-  };
   auto trace_origin = [&](int topic) {
     std::set<int> seen;
     while (view.ValidTopic(topic) && seen.insert(topic).second) {
       const int p = main_publisher(topic);
       if (p == -1) {
-        return Origin{"sensor", run.topic_names[topic],
-                      view.Rate(publishes[topic])};
+        return RateOrigin{RateOriginKind::kSensor, run.topic_names[topic],
+                          view.Rate(publishes[topic])};
       }
       if (!view.ValidCallback(p)) break;
       const runfile::NamedCallback& info = run.callback_info[p];
       if (cpu_bound_nodes.count(view.NodeOfCallback(p)) > 0) {
-        return Origin{"cpu_bound", view.NodeOfCallback(p), 0.0};
+        return RateOrigin{RateOriginKind::kCpuBound, view.NodeOfCallback(p),
+                          0.0};
       }
       if (info.kind == runfile::CallbackKind::kTimer) {
-        return Origin{"timer", info.name,
-                      info.period_s > 0.0 ? 1.0 / info.period_s : 0.0};
+        return RateOrigin{RateOriginKind::kTimer, info.name,
+                          info.period_s > 0.0 ? 1.0 / info.period_s : 0.0};
       }
       topic = info.topic;
     }
-    return Origin{"unknown", "", 0.0};
+    return RateOrigin{RateOriginKind::kUnknown, "", 0.0};
   };
 
   // Inputs per node: distinct subscribed topics with enough publishes (and,
@@ -663,30 +659,36 @@ Diagnosis Diagnose(const runfile::RunData& run,
     for (int t : topics) {
       f.rates_hz["input_hz:" + run.topic_names[t]] = view.Rate(publishes[t]);
     }
-    const Origin origin = trace_origin(slowest);
-    f.origin = origin.kind == "unknown" ? origin.kind
-                                        : origin.kind + ":" + origin.where;
+    const RateOrigin origin = trace_origin(slowest);
+    f.origin = origin;
     if (origin.rate_hz > 0.0) f.rates_hz["origin_hz"] = origin.rate_hz;
     const std::string upstream =
         f.upstream.empty() ? std::string("unknown") : f.upstream;
     f.remedies.push_back(
         {RemedyKind::kRaisePublisherRate, f.topics[0], upstream});
     std::string cause;
-    if (origin.kind == "cpu_bound") {
-      cause = fmt::format("upstream limit: {} is cpu_bound", origin.where);
-      f.remedies.push_back({RemedyKind::kRelieveNode, origin.where});
-    } else if (origin.kind == "sensor") {
-      cause = fmt::format("its rate is set by the sensor topic {} ({:.2f} Hz)",
-                          origin.where, origin.rate_hz);
-      f.remedies.push_back({RemedyKind::kRaiseSensorRate, origin.where});
-    } else if (origin.kind == "timer") {
-      cause = fmt::format(
-          "its rate is set by the timer {} ({:.2f} Hz): a configuration "
-          "choice",
-          origin.where, origin.rate_hz);
-      f.remedies.push_back({RemedyKind::kShortenTimerPeriod, origin.where});
-    } else {
-      cause = "its origin is unknown";
+    switch (origin.kind) {
+      case RateOriginKind::kCpuBound:
+        cause = fmt::format("upstream limit: {} is cpu_bound", origin.where);
+        f.remedies.push_back({RemedyKind::kRelieveNode, origin.where});
+        break;
+      case RateOriginKind::kSensor:
+        cause =
+            fmt::format("its rate is set by the sensor topic {} ({:.2f} Hz)",
+                        origin.where, origin.rate_hz);
+        f.remedies.push_back({RemedyKind::kRaiseSensorRate, origin.where});
+        break;
+      case RateOriginKind::kTimer:
+        cause = fmt::format(
+            "its rate is set by the timer {} ({:.2f} Hz): a configuration "
+            "choice",
+            origin.where, origin.rate_hz);
+        f.remedies.push_back({RemedyKind::kShortenTimerPeriod, origin.where});
+        break;
+      case RateOriginKind::kNone:
+      case RateOriginKind::kUnknown:
+        cause = "its origin is unknown";
+        break;
     }
     f.remedy = RemediesText(f.remedies);
     f.message = fmt::format(

@@ -112,6 +112,24 @@ struct CallbackStats {
   int64_t timer_overruns = 0;  // whole run (the trace keeps only totals)
 };
 
+// Where a frequency_bound finding's slow input gets its rate: its main
+// publisher followed upstream to the first sensor topic (published from
+// outside the graph), timer or cpu_bound node.
+enum class RateOriginKind {
+  kNone,      // not a frequency_bound finding
+  kSensor,    // `where` is the sensor topic
+  kTimer,     // `where` is the timer callback, "<node>/<callback>"
+  kCpuBound,  // `where` is the cpu_bound node
+  kUnknown,   // the chain ends without one (no publisher seen, a cycle)
+};
+
+struct RateOrigin {
+  RateOriginKind kind = RateOriginKind::kNone;
+  std::string where;  // empty for kNone and kUnknown
+  // The sensor's publish rate or the timer's rate; 0 when it has none.
+  double rate_hz = 0.0;
+};
+
 struct Finding {
   FindingKind kind = FindingKind::kCpuBound;
   // The node that cannot keep up (cpu_bound) / that is input-limited
@@ -121,10 +139,9 @@ struct Finding {
   std::vector<std::string> topics;  // the topic fallen behind / slow input
   // Node(s) publishing topics[0] ("external" for a sensor).
   std::string upstream;
-  // frequency_bound: where the slow input's rate comes from, following its
-  // main publisher upstream to the first of "sensor:<topic>",
-  // "timer:<callback>", "cpu_bound:<node>"; or "unknown". Empty otherwise.
-  std::string origin;
+  // frequency_bound: where the slow input's rate comes from (its kind
+  // chooses the second remedy). kNone for the other kinds.
+  RateOrigin origin;
   // Evidence by name. cpu_bound: publish_hz, take_hz, deficit,
   // allowed_deficit, exec_load, core_wait_ratio. frequency_bound:
   // slowest_hz, others_median_hz, deficit, allowed_fraction,

@@ -146,6 +146,7 @@ TEST(DiagnosisCpuBoundTest, SlowSubscriberIsCpuBoundWithEvidence) {
   ASSERT_EQ(d.findings.size(), 1u);
   const Finding& f = d.findings[0];
   EXPECT_EQ(f.kind, FindingKind::kCpuBound);
+  EXPECT_EQ(f.origin.kind, RateOriginKind::kNone);  // not frequency_bound
   EXPECT_EQ(f.node, "filter");
   EXPECT_EQ(f.topics, std::vector<std::string>{"/in"});
   EXPECT_EQ(f.upstream, "external");
@@ -338,7 +339,9 @@ TEST(DiagnosisFrequencyBoundTest, SlowInputIsNamedWithItsPublisher) {
   EXPECT_NEAR(f.rates_hz.at("input_hz:/in0"), 20.0, 1e-9);
   EXPECT_NEAR(f.rates_hz.at("deficit"), 0.5, 1e-9);
   EXPECT_NEAR(f.severity, 0.5, 1e-9);
-  EXPECT_EQ(f.origin, "timer:pub1/on_timer");
+  EXPECT_EQ(f.origin.kind, RateOriginKind::kTimer);
+  EXPECT_EQ(f.origin.where, "pub1/on_timer");
+  EXPECT_NEAR(f.origin.rate_hz, 10.0, 1e-9);
   EXPECT_NEAR(f.rates_hz.at("origin_hz"), 10.0, 1e-9);
   EXPECT_EQ(f.remedies,
             (std::vector<Remedy>{
@@ -391,7 +394,8 @@ TEST(DiagnosisFrequencyBoundTest, UpstreamCpuBoundIsNamedAsTheCause) {
   EXPECT_EQ(d.findings[1].kind, FindingKind::kFrequencyBound);
   EXPECT_EQ(d.findings[1].node, "fusion");
   EXPECT_EQ(d.findings[1].upstream, "slow");
-  EXPECT_EQ(d.findings[1].origin, "cpu_bound:slow");
+  EXPECT_EQ(d.findings[1].origin.kind, RateOriginKind::kCpuBound);
+  EXPECT_EQ(d.findings[1].origin.where, "slow");
   EXPECT_NE(d.findings[1].message.find("upstream limit: slow is cpu_bound"),
             std::string::npos)
       << d.findings[1].message;
@@ -441,7 +445,9 @@ TEST(DiagnosisFrequencyBoundTest, OriginIsTracedUpstreamToTheSensor) {
   EXPECT_EQ(f.node, "planner");
   EXPECT_EQ(f.topics[0], "/objects");
   EXPECT_EQ(f.upstream, "cluster");
-  EXPECT_EQ(f.origin, "sensor:/raw");
+  EXPECT_EQ(f.origin.kind, RateOriginKind::kSensor);
+  EXPECT_EQ(f.origin.where, "/raw");
+  EXPECT_NEAR(f.origin.rate_hz, 7.0, 1e-9);
   EXPECT_NEAR(f.rates_hz.at("origin_hz"), 7.0, 1e-9);
   EXPECT_EQ(f.remedies,
             (std::vector<Remedy>{
