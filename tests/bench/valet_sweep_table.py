@@ -6,12 +6,25 @@
 # the others did, the median nav time (a run stopped at the bound counts
 # as the bound), the median parking error of the runs that reached the
 # slot, the smallest clearance; last, the median control rate of the
-# runs not stopped early.
-import sys, collections, math, statistics
+# runs not stopped early. The bound is read from the campaign's stored
+# scenario.
+import sys, collections, math, re, statistics
 import h5py
 
-BOUND = 150.0  # the scenario's constraint nav_time_s <= 150
 f = h5py.File(sys.argv[1], "r")
+
+
+def nav_time_bound():  # the stored scenario's constraint nav_time_s <= B
+    text = f.attrs["scenario_text"]
+    text = text.decode() if isinstance(text, bytes) else text
+    m = re.search(r"nav_time_s\s*<=?\s*([0-9.eE+-]+)", text)
+    if not m:
+        sys.exit(f"{sys.argv[1]}: its scenario has no nav_time_s <= <bound> "
+                 "constraint, which the table's medians need")
+    return float(m.group(1))
+
+
+BOUND = nav_time_bound()
 
 
 def table(name):
