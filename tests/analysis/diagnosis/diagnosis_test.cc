@@ -458,6 +458,43 @@ TEST(DiagnosisFrequencyBoundTest, OriginIsTracedUpstreamToTheSensor) {
             "of sensor /raw");
 }
 
+TEST(DiagnosisFrequencyBoundTest, AnOriginThatLoopsBackIsUnknown) {
+  // fusion takes /fast (20 Hz, from a timer) and /loop (10 Hz), which echo
+  // publishes from /back, which relay publishes from /loop: followed
+  // upstream, the chain comes back to /loop without a sensor, timer or
+  // cpu_bound node.
+  TraceBuilder b(10.0);
+  const int fast = b.Topic("/fast");
+  const int loop = b.Topic("/loop");
+  const int back = b.Topic("/back");
+  const int timer = b.Timer("pub", "on_timer", 0.05);
+  const int on_fast = b.Subscription("fusion", "on_fast", "/fast");
+  const int on_loop = b.Subscription("fusion", "on_loop", "/loop");
+  const int echo = b.Subscription("echo", "on_back", "/back");
+  const int relay = b.Subscription("relay", "on_loop", "/loop");
+  b.Publishes(fast, timer, 20.0, 200);
+  b.Takes(fast, on_fast, 20.0, 200, 0.001);
+  b.Publishes(loop, echo, 10.0, 100);
+  b.Takes(loop, on_loop, 10.0, 100, 0.001);
+  b.Takes(loop, relay, 10.0, 100, 0.001);
+  b.Publishes(back, relay, 10.0, 100);
+  b.Takes(back, echo, 10.0, 100, 0.001);
+  const Diagnosis d = Diagnose(b.run());
+  ASSERT_EQ(d.findings.size(), 1u);
+  const Finding& f = d.findings[0];
+  EXPECT_EQ(f.kind, FindingKind::kFrequencyBound);
+  EXPECT_EQ(f.node, "fusion");
+  EXPECT_EQ(f.topics, std::vector<std::string>{"/loop"});
+  EXPECT_EQ(f.origin.kind, RateOriginKind::kUnknown);
+  EXPECT_EQ(f.origin.where, "");
+  EXPECT_EQ(f.rates_hz.count("origin_hz"), 0u);
+  // Only the publisher's remedy: nothing upstream to name.
+  EXPECT_EQ(f.remedies, (std::vector<Remedy>{{RemedyKind::kRaisePublisherRate,
+                                              "/loop", "echo"}}));
+  EXPECT_NE(f.message.find("its origin is unknown"), std::string::npos)
+      << f.message;
+}
+
 TEST(DiagnosisFrequencyBoundTest, DrivingInputsOnlyIgnoresCachedState) {
   DiagnosisOptions o;
   ASSERT_TRUE(SetOption(&o, "frequency_bound_driving_inputs_only", 1).ok());
