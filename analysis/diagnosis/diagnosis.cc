@@ -659,8 +659,8 @@ Diagnosis Diagnose(const runfile::RunData& run,
     for (int t : topics) {
       f.rates_hz["input_hz:" + run.topic_names[t]] = view.Rate(publishes[t]);
     }
-    const RateOrigin origin = trace_origin(slowest);
-    f.origin = origin;
+    f.origin = trace_origin(slowest);
+    const RateOrigin& origin = f.origin;
     if (origin.rate_hz > 0.0) f.rates_hz["origin_hz"] = origin.rate_hz;
     const std::string upstream =
         f.upstream.empty() ? std::string("unknown") : f.upstream;
