@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -163,6 +164,12 @@ Result<std::vector<StepState>> QuerySteps(const std::vector<std::string>& ids) {
     steps.push_back({f[0], f[1], f[2], f[3]});
   }
   return steps;
+}
+
+std::string StepKeyPrefix(const StepState& step) {
+  static constexpr std::string_view kPrefix = "adse-";
+  if (step.name.rfind(kPrefix, 0) != 0) return "";
+  return step.name.substr(kPrefix.size());
 }
 
 bool IsActiveState(const std::string& state) {

@@ -47,6 +47,10 @@ struct StepState {
 // The running steps of the given jobs (and their array tasks).
 Result<std::vector<StepState>> QuerySteps(const std::vector<std::string>& ids);
 
+// The content-key prefix a run's step carries in its name ("adse-<prefix>",
+// set by the campaign's pool evaluator), or "" for any other step.
+std::string StepKeyPrefix(const StepState& step);
+
 // Whether a job state means the job may still run (pending, running,
 // requeued, suspended, completing ...).
 bool IsActiveState(const std::string& state);

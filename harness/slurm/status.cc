@@ -170,8 +170,9 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
   }
   std::set<std::string> running_keys;
   for (const StepState& step : steps) {
-    if (step.name.rfind("adse-", 0) != 0) continue;
-    RunningStep r{step.id, step.name.substr(5), "", step.elapsed, step.nodes};
+    const std::string prefix = StepKeyPrefix(step);
+    if (prefix.empty()) continue;
+    RunningStep r{step.id, prefix, "", step.elapsed, step.nodes};
     for (const auto& [key, point] : point_of) {
       if (!r.key.empty() && key.rfind(r.key, 0) == 0) {
         r.point = point;

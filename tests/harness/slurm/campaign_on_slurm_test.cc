@@ -327,7 +327,7 @@ TEST_F(CampaignOnSlurmTest,
     ASSERT_TRUE(steps.ok()) << steps.status().message();
     size_t running = 0;
     for (const StepState& s : *steps) {
-      if (s.name.rfind("adse-", 0) != 0) continue;
+      if (StepKeyPrefix(s).empty()) continue;
       ++running;
       steps_seen.insert(s.id);
     }
@@ -451,8 +451,8 @@ TEST_F(
     if (!steps.ok()) return false;
     int new_points = 0;
     for (const StepState& step : *steps) {
-      if (step.name.rfind("adse-", 0) != 0) continue;
-      const std::string prefix = step.name.substr(5);
+      const std::string prefix = StepKeyPrefix(step);
+      if (prefix.empty()) continue;
       bool has_file = false;
       for (const auto& [key, file] : files) {
         has_file = has_file || key.rfind(prefix, 0) == 0;
