@@ -12,7 +12,7 @@ PACKAGES=(
   sumo sumo-tools
   libpcl-dev libopencv-dev libceres-dev libhdf5-dev libpagmo-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3-h5py python3-pandas bc
+  python3-h5py python3-pandas python3-yaml bc
   slurm-wlm munge
 )
 if [ "${1:-}" = "--fuzz" ]; then
