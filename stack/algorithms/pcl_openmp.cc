@@ -6,7 +6,7 @@
 // one per point, so a run opens tens of thousands of regions per simulated
 // second. libgomp builds a team for each and wakes the team's barrier with
 // a futex system call even when no thread waits on it: measured on the
-// 2-core development VM, that was two thirds of a closed-loop run's wall
+// 2-core development VM, that was 58-87 % of a closed-loop run's wall
 // time (README, "Performance"). FLANN's own fix (flann-lib/flann#114) was
 // never merged and Debian's PCL is built with OpenMP.
 //
