@@ -65,7 +65,7 @@ for p in stopped[::every]:
     print(",".join("%s=%g" % (n, v) for n, v in zip(names, p)))
 EOF
   echo "scenario: ${scenario}"
-  echo "recording: ${recording} (every ${EVERY:-1}. run it stopped early)"
+  echo "recording: ${recording} (of the runs it stopped early, one in ${EVERY:-1})"
   echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1 /proc/loadavg); ${workers} runs at a time"
   while read -r point; do
     printf 'on %s\noff %s\n' "${point}" "${point}"
