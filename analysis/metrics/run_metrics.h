@@ -23,6 +23,12 @@ struct RunMetricsOptions {
 // only a lower bound.
 inline constexpr char kCensoredMetric[] = "censored";
 
+// The share of the ideal path's length driven by the end of the run (0-1;
+// harness/report sets it from the deviation fit). Of a run stopped early it
+// is the one metric not censored: how far the car got says how far from
+// arriving in time it was.
+inline constexpr char kDrivenFractionMetric[] = "driven_fraction";
+
 // Metrics by name: completed (0/1), censored (0/1), nav_time_s (time to the
 // goal; when not completed, the time the run ended), ctrl_rate_hz (control
 // commands per second over the navigation), e2e_latency_p50_s /

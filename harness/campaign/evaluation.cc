@@ -36,10 +36,11 @@ Result<EvaluationRow> RowFromJson(const nlohmann::json& j,
       for (const auto& [name, value] : j.at("metrics").items()) {
         // A censored run's metrics were measured up to its early stop: the
         // campaign never takes them for measurements, and leaves them out
-        // as the index leaves out what a run lacks (only the point's cost
-        // and the censoring itself are known).
+        // as the index leaves out what a run lacks (only the point's cost,
+        // the censoring itself and how far the car got are known).
         if (censored && name != "hardware_cost" &&
-            name != analysis::kCensoredMetric) {
+            name != analysis::kCensoredMetric &&
+            name != analysis::kDrivenFractionMetric) {
           continue;
         }
         row.metrics[name] = value.is_number()

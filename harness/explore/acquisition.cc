@@ -417,6 +417,20 @@ int AgentStrategy::CheapestPick(const std::vector<Candidate>& candidates,
           (cheapest - c.cost) / std::max(std::abs(cheapest), 1e-12);
       if (saving <= 1e-9 || c.p_feasible < kMinCheapestChance) continue;
       score = c.p_feasible * saving + kFrontTieBreak * c.p_front;
+      // Of two designs equally priced and equally likely (the chance of
+      // the one with less capacity lifted to the other's), the one with
+      // more capacity: its own prediction is no worse by the roles.
+      if (best >= 0 && std::abs(c.cost - candidates[best].cost) <= 1e-9 &&
+          std::abs(c.p_feasible - candidates[best].p_feasible) <= 1e-12) {
+        const int order = CompareCapacity(knobs_, rate_raised_, c.genes,
+                                          candidates[best].genes, false);
+        if (order == -1) continue;
+        if (order == 1) {
+          best_score = score;
+          best = static_cast<int>(i);
+          continue;
+        }
+      }
     }
     if (score > best_score + 1e-12) {
       best_score = score;

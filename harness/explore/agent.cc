@@ -41,6 +41,7 @@
 #include <utility>
 #include <vector>
 
+#include "analysis/metrics/run_metrics.h"
 #include "harness/explore/internal/agent_strategy.h"
 #include "harness/spec/spec_parser.h"
 
@@ -487,6 +488,16 @@ std::optional<CensoredBound> AgentStrategy::CensoredAt(
     bound.bound = 0.5 * (a + b);
     // The run's value lies where the constraint fails.
     bound.side = low ? +1 : -1;
+    // A time stopped at its bound part of the way: past it by as much as
+    // the rest of the route takes at the pace so far.
+    bound.paced_bound = bound.bound;
+    auto driven = observation.metrics.find(analysis::kDrivenFractionMetric);
+    if (model->name == kNavTimeMetric && bound.side > 0 &&
+        driven != observation.metrics.end() && driven->second < 1.0 &&
+        std::isfinite(driven->second)) {
+      bound.driven_fraction = driven->second;
+      bound.paced_bound /= std::max(driven->second, kMinDrivenFraction);
+    }
     return bound;
   }
   return std::nullopt;
@@ -551,6 +562,14 @@ void AgentStrategy::FitModels() {
     std::vector<std::vector<double>> u;
     std::vector<double> values;
     std::vector<int> sides;
+    bool any_measured = false;
+    for (size_t i = first; i < records_.size(); ++i) {
+      auto it = records_[i].observation.metrics.find(model.name);
+      any_measured =
+          any_measured ||
+          (!records_[i].failed && it != records_[i].observation.metrics.end() &&
+           std::isfinite(it->second));
+    }
     for (size_t i = first; i < records_.size(); ++i) {
       const Record& record = records_[i];
       if (record.failed) continue;
@@ -562,7 +581,8 @@ void AgentStrategy::FitModels() {
       }
       if (record.censored && record.censored->metric == model.name) {
         u.push_back(Coordinates(record.genes));
-        values.push_back(record.censored->bound);
+        values.push_back(any_measured ? record.censored->paced_bound
+                                      : record.censored->bound);
         sides.push_back(record.censored->side);
         continue;
       }

@@ -75,6 +75,12 @@ std::string AgentStrategy::LastText() const {
     status = violated.empty()
                  ? std::string("infeasible")
                  : fmt::format("infeasible ({})", fmt::join(violated, "; "));
+    if (last.censored && std::isfinite(last.censored->driven_fraction)) {
+      status += fmt::format(
+          ", stopped {:.0f} % of the way: at its pace {} {} or more",
+          100.0 * last.censored->driven_fraction, last.censored->metric,
+          Num(last.censored->paced_bound));
+    }
   }
   std::string diagnosis;
   RemedyDirections(last, &diagnosis);

@@ -61,11 +61,13 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
     r.metrics["max_deviation_m"] = deviation->max_deviation_m;
     r.metrics["offset_m"] = deviation->offset_m;
     r.metrics["zigzag_index"] = deviation->zigzag_index;
+    r.metrics[analysis::kDrivenFractionMetric] = deviation->driven_fraction;
     r.deviation_complete = deviation->complete;
     r.driven_fraction = deviation->driven_fraction;
   } else {
     r.deviation_error = deviation.status().message();
     r.metrics["deviation_score"] = std::nan("");
+    r.metrics[analysis::kDrivenFractionMetric] = std::nan("");
   }
 
   // Bottlenecks.

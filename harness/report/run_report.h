@@ -74,9 +74,10 @@ struct CallbackSummary {
 // What a report holds, by version: 2, findings carry typed `remedies`
 // beside the readable `remedy`; 3, `standing` says how long the car stood
 // and for which stop reason; 4, metrics carry `localization_lost_s`; 5,
-// findings may be `starved_input`; 6, topics carry `longest_take_gap_s`.
-// A campaign analyses a run again rather than read an older report.
-inline constexpr int kReportVersion = 6;
+// findings may be `starved_input`; 6, topics carry `longest_take_gap_s`;
+// 7, metrics carry `driven_fraction`. A campaign analyses a run again
+// rather than read an older report.
+inline constexpr int kReportVersion = 7;
 
 struct RunReport {
   int report_version = kReportVersion;

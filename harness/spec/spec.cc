@@ -130,6 +130,10 @@ const std::vector<MetricInfo>& KnownMetrics() {
        "collisions the ego caused: at the contact it moved towards the other "
        "vehicle at least as fast as that one moved towards it, count",
        false, true},
+      {"driven_fraction",
+       "share of the ideal path's length driven by the end of the run, 0-1 "
+       "(on arrival a little under 1, the goal's tolerance short of the "
+       "path's end; of a run stopped early, how far it got)"},
       {"localization_lost_s",
        "time the planner had no valid pose to drive by (its stop reason "
        "localization_lost), s"},

@@ -79,6 +79,7 @@ struct StackModel {
 struct Drive {
   bool completed = false;
   double nav_time_s = 0.0;  // the timeout when not completed
+  double full_nav_s = 0.0;  // unrounded, and past the timeout if need be
   double ctrl_rate_hz = 0.0;
   double deviation_score = 0.0;
   double max_deviation_m = 0.0;
@@ -112,6 +113,7 @@ Drive DriveModel(const StackModel& m, const spec::Spec& spec,
   const double excess = std::max(1.0, rho / m.ctrl_knee_load);
   d.ctrl_rate_hz = timer_hz / (excess * excess);
   d.completed = nav_s <= spec.task.timeout_s;
+  d.full_nav_s = nav_s;
   nav_s = std::min(nav_s, spec.task.timeout_s);
   // Times are whole world steps, as a simulated run's are.
   const double step_s = spec.world.step_s;
@@ -403,7 +405,8 @@ std::vector<spec::DesignPoint> Grid(const spec::DesignSpace& space) {
 Result<std::optional<std::string>> EarlyStopped(const spec::Spec& spec,
                                                 const spec::DesignPoint& point,
                                                 const spec::PointConfig& config,
-                                                const Drive& drive) {
+                                                const Drive& drive,
+                                                double* stop_s) {
   Result<sim::EarlyStop> stop =
       sim::EarlyStop::Create(spec, point, config.stack.Get("control.rate_hz"));
   if (!stop.ok()) return stop.status();
@@ -413,6 +416,7 @@ Result<std::optional<std::string>> EarlyStopped(const spec::Spec& spec,
     const sim::RunProgress progress{
         t, static_cast<int64_t>(std::floor(drive.ctrl_rate_hz * t)), 0};
     if (std::optional<std::string> violated = stop->Violated(progress)) {
+      *stop_s = t;
       return violated;
     }
   }
@@ -436,8 +440,9 @@ Result<runfile::EvaluationRow> Row(const Definition& d, const spec::Spec& spec,
     noise_factor = std::exp(random.Normal(0.0, d.model.nav_noise));
   }
   const Drive drive = DriveModel(d.model, spec, *config, noise_factor);
+  double stop_s = drive.nav_time_s;
   Result<std::optional<std::string>> stopped =
-      EarlyStopped(spec, point, *config, drive);
+      EarlyStopped(spec, point, *config, drive, &stop_s);
   if (!stopped.ok()) return stopped.status();
 
   runfile::EvaluationRow row;
@@ -452,9 +457,14 @@ Result<runfile::EvaluationRow> Row(const Definition& d, const spec::Spec& spec,
   row.point = point;
   row.bottlenecks_json = "[]";
   row.metrics["hardware_cost"] = *cost;
+  // The car keeps one pace along the route.
+  row.metrics[analysis::kDrivenFractionMetric] =
+      drive.completed && !stopped->has_value()
+          ? 1.0
+          : std::min(1.0, stop_s / drive.full_nav_s);
   if (stopped->has_value()) {
     // As the campaign stores a censored run (harness/campaign/evaluation.cc):
-    // only the cost and the censoring, infeasible.
+    // only the cost, the censoring and how far it got, infeasible.
     row.reason = "constraint_violated: " + **stopped;
     row.metrics[analysis::kCensoredMetric] = 1.0;
     row.feasible = false;

@@ -167,14 +167,21 @@ TEST(MakeLandscapesTest, OnlyTheConstraintCutStopsRunsEarly) {
       const bool stopped = RowMetric(row, analysis::kCensoredMetric) == 1.0;
       censored += stopped;
       if (stopped) {
-        // As the campaign stores a censored run: the cost and the
-        // censoring, nothing measured, infeasible.
+        // As the campaign stores a censored run: the cost, the censoring
+        // and how far the car got (at one pace, the bound over the time it
+        // would have needed), nothing measured, infeasible.
         EXPECT_FALSE(row.feasible);
         EXPECT_EQ(row.reason, "constraint_violated: nav_time_s <= 200");
-        EXPECT_EQ(row.metrics.size(), 2u);
+        EXPECT_EQ(row.metrics.size(), 3u);
         EXPECT_FALSE(std::isnan(RowMetric(row, "hardware_cost")));
+        const double driven = RowMetric(row, analysis::kDrivenFractionMetric);
+        EXPECT_GT(driven, 0.0);
+        EXPECT_LT(driven, 1.0);
       } else {
         EXPECT_FALSE(std::isnan(RowMetric(row, "nav_time_s")));
+        if (RowMetric(row, "completed") == 1.0) {
+          EXPECT_EQ(RowMetric(row, analysis::kDrivenFractionMetric), 1.0);
+        }
       }
     }
     if (name != "constraint_cut") {

@@ -79,6 +79,12 @@ constexpr char kCostMetric[] = "hardware_cost";
 constexpr char kNavTimeMetric[] = "nav_time_s";
 // The flag of a run that reached its goal.
 constexpr char kCompletedMetric[] = "completed";
+// A run stopped past its time bound having driven a share q of its route
+// would, at the pace it kept, arrive at bound / q: its time's censored
+// bound is taken there (README, "How far a stopped run got"). q is held
+// at least this, so a car that hardly moved bounds its time at 20 times
+// the bound rather than at infinity.
+constexpr double kMinDrivenFraction = 0.05;
 
 using spec::KnobRole;
 
@@ -99,6 +105,12 @@ struct CensoredBound {
   std::string metric;
   double bound = 0.0;
   int side = 0;
+  // A time stopped at its bound part of the way: where it would have
+  // ended at the pace it kept (bound / share of the route driven), else
+  // `bound`. Used once some run's value was measured: with none, the
+  // trend's floor would sit past the bound and nothing could be feasible.
+  double paced_bound = 0.0;
+  double driven_fraction = kNaN;  // of the route, when the run says
 };
 
 struct Record {

@@ -70,6 +70,16 @@ TEST(EvaluationTest, ACensoredRunIsARowWithoutMeasuredMetrics) {
   EXPECT_EQ(measured.violated_constraint, "");
 }
 
+TEST(EvaluationTest, ACensoredRunKeepsHowFarItGot) {
+  report::RunReport stopped = Report(1, 60.05, true);
+  stopped.metrics["driven_fraction"] = 0.4;
+  stopped.metrics["deviation_score"] = 0.03;
+  const EvaluationRow row = RowFromReport(stopped);
+  EXPECT_EQ(RowMetric(row, "driven_fraction"), 0.4);
+  EXPECT_TRUE(std::isnan(RowMetric(row, "deviation_score")));
+  EXPECT_EQ(ObservationFromRow(row).metrics.at("driven_fraction"), 0.4);
+}
+
 TEST(EvaluationTest, ACensoredRunIsNeverOnTheFront) {
   const spec::Spec spec = Scenario();
   // The censored run is cheaper and "faster" so far than the measured one.
@@ -203,8 +213,8 @@ TEST(EvaluationTest, AReportWithoutTypedRemediesIsRefused) {
 
 // An older adse's report lacks what rows now carry (localization_lost_s
 // since version 4, starved_input findings since 5, topics' longest take
-// gaps since 6): the campaign analyses
-// its run again instead.
+// gaps since 6, the driven fraction since 7): the campaign analyses its
+// run again instead.
 TEST(EvaluationTest, AReportOfAnOlderVersionIsStale) {
   nlohmann::json j = report::ToJson(ReportWithFindings());
   ASSERT_TRUE(RowFromReportJson(j.dump(), "new.report.json").ok());
@@ -216,7 +226,7 @@ TEST(EvaluationTest, AReportOfAnOlderVersionIsStale) {
     ASSERT_FALSE(row.ok()) << version;
     EXPECT_EQ(row.status().code(), Status::Code::kCorruption);
     EXPECT_NE(row.status().message().find(
-                  "old.report.json: a report older than report_version 6"),
+                  "old.report.json: a report older than report_version 7"),
               std::string::npos)
         << row.status().message();
   }

@@ -599,6 +599,31 @@ TEST(AgentTest, RationaleGivesNoPredictionForAMetricNoRunMeasured) {
       << text;
 }
 
+// A run stopped at its time bound a quarter of the way along its route
+// would, at the pace it kept, have needed four times the bound: the next
+// pick's reason says so (and the model takes the bound there once a run
+// has measured a time).
+TEST(AgentTest, AStoppedRunIsReadByHowFarItGot) {
+  const spec::Spec spec = MakeSpec(
+      "{budget: 5, start_from: {cores: 2, freq_ghz: 1.0, lidar_hz: 14}}");
+  std::unique_ptr<Strategy> strategy = Create(spec);
+  ASSERT_NE(strategy, nullptr);
+  const std::vector<spec::DesignPoint> first = strategy->Ask(1);
+  ASSERT_EQ(first.size(), 1u);
+  Observation o;
+  o.point = first[0];
+  o.metrics = {
+      {"hardware_cost", 2.0}, {"censored", 1}, {"driven_fraction", 0.25}};
+  o.censored = true;
+  o.violated_constraint = "nav_time_s <= 60";
+  strategy->Tell(o);
+  ASSERT_EQ(strategy->Ask(1).size(), 1u);
+  EXPECT_NE(strategy->rationale().find(
+                "stopped 25 % of the way: at its pace nav_time_s 240 or more"),
+            std::string::npos)
+      << strategy->rationale();
+}
+
 // The constraint-aware front of the whole synthetic space.
 std::set<spec::DesignPoint> TrueFront(const spec::Spec& spec) {
   SpaceGrid grid(spec.design_space);

@@ -136,7 +136,7 @@ TEST(RunReportTest, NamesTheDominantStopReasonAndHowLongTheCarStood) {
                         "static structure, 3.3 m ahead): 40.0 s\n"));
   EXPECT_THAT(text, ::testing::HasSubstr("also localization_lost: 10.0 s\n"));
   const nlohmann::json j = ToJson(*r);
-  EXPECT_EQ(j["report_version"], 6);
+  EXPECT_EQ(j["report_version"], 7);
   EXPECT_EQ(j["standing"]["standing_s"], 50.0);
   ASSERT_EQ(j["standing"]["by_reason"].size(), 2u);
   const nlohmann::json& dominant = j["standing"]["by_reason"][0];
@@ -165,6 +165,20 @@ TEST(RunReportTest, AStalledRunSaysWhatHeldTheCarAndIsCensored) {
                         "road user)\n"));
   EXPECT_THAT(text, ::testing::HasSubstr("nav_time_s is a lower bound"));
   EXPECT_EQ(ToJson(*r)["status"], "stalled");
+}
+
+TEST(RunReportTest, AStoppedRunSaysHowFarAlongItsRouteItGot) {
+  runfile::RunData run = StoodRun();  // drives 10 m, then stands
+  run.status = runfile::kRunInfeasible;
+  run.termination_reason = "constraint_violated: nav_time_s <= 60";
+  for (int i = 0; i <= 40; ++i) run.ideal_path.push_back({i * 1.0, i * 1.0, 0});
+  Result<RunReport> r = AnalyzeRun(run, "memory", AnalyzeOptions{});
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_TRUE(r->censored);
+  // 10 m of a 40 m route: a quarter, as the metric the campaign keeps.
+  EXPECT_NEAR(r->metrics.at("driven_fraction"), 0.25, 0.01);
+  EXPECT_NEAR(ToJson(*r)["metrics"]["driven_fraction"].get<double>(), 0.25,
+              0.01);
 }
 
 TEST(RunReportTest, AnObjectBesideTheCarIsSaidToBeBesideIt) {
