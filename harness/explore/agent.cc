@@ -562,14 +562,7 @@ void AgentStrategy::FitModels() {
     std::vector<std::vector<double>> u;
     std::vector<double> values;
     std::vector<int> sides;
-    bool any_measured = false;
-    for (size_t i = first; i < records_.size(); ++i) {
-      auto it = records_[i].observation.metrics.find(model.name);
-      any_measured =
-          any_measured ||
-          (!records_[i].failed && it != records_[i].observation.metrics.end() &&
-           std::isfinite(it->second));
-    }
+    std::vector<double> paced;  // as `values`, a stopped time at its pace
     for (size_t i = first; i < records_.size(); ++i) {
       const Record& record = records_[i];
       if (record.failed) continue;
@@ -581,8 +574,8 @@ void AgentStrategy::FitModels() {
       }
       if (record.censored && record.censored->metric == model.name) {
         u.push_back(Coordinates(record.genes));
-        values.push_back(any_measured ? record.censored->paced_bound
-                                      : record.censored->bound);
+        values.push_back(record.censored->bound);
+        paced.push_back(record.censored->paced_bound);
         sides.push_back(record.censored->side);
         continue;
       }
@@ -593,8 +586,12 @@ void AgentStrategy::FitModels() {
       }
       u.push_back(Coordinates(record.genes));
       values.push_back(it->second);
+      paced.push_back(it->second);
       sides.push_back(0);
     }
+    // Stopped times at their pace once a run has measured one (see
+    // CensoredBound::paced_bound).
+    if (std::count(sides.begin(), sides.end(), 0) > 0) values = paced;
     std::vector<double> slope = prior;
     if (model.precision_hint) {
       for (size_t d = 0; d < knobs_.size(); ++d) {
