@@ -20,6 +20,12 @@ nlohmann::json Number(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
 
+// The share of the path driven, 0 when the deviation fit failed.
+double DrivenFraction(const RunReport& r) {
+  auto it = r.metrics.find(analysis::kDrivenFractionMetric);
+  return it != r.metrics.end() && std::isfinite(it->second) ? it->second : 0.0;
+}
+
 }  // namespace
 
 Result<RunReport> AnalyzeRun(const runfile::RunData& run,
@@ -63,7 +69,6 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
     r.metrics["zigzag_index"] = deviation->zigzag_index;
     r.metrics[analysis::kDrivenFractionMetric] = deviation->driven_fraction;
     r.deviation_complete = deviation->complete;
-    r.driven_fraction = deviation->driven_fraction;
   } else {
     r.deviation_error = deviation.status().message();
     r.metrics["deviation_score"] = std::nan("");
@@ -161,7 +166,7 @@ nlohmann::json ToJson(const RunReport& r) {
     j["constraints_error"] = r.constraints_error;
   j["feasible"] = r.feasible;
   j["deviation"] = {{"complete", r.deviation_complete},
-                    {"driven_fraction", r.driven_fraction}};
+                    {"driven_fraction", DrivenFraction(r)}};
   if (!r.deviation_error.empty()) j["deviation"]["error"] = r.deviation_error;
   j["findings"] = nlohmann::json::array();
   for (const FindingSummary& f : r.findings) {
@@ -344,7 +349,7 @@ std::string FormatSummary(const RunReport& r) {
   if (!r.deviation_complete && r.deviation_error.empty()) {
     out += fmt::format(
         "deviation   scored on the driven part ({:.0f} % of the path)\n",
-        100 * r.driven_fraction);
+        100 * DrivenFraction(r));
   }
   if (r.standing.by_reason.empty()) {
     out += fmt::format("stood       {:.1f} s{}\n", r.standing.standing_s,

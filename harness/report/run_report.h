@@ -99,9 +99,8 @@ struct RunReport {
   std::string constraints_error;
   bool feasible = false;
   // Deviation fit (also in metrics as deviation_score, max_deviation_m,
-  // offset_m, zigzag_index).
+  // offset_m, zigzag_index, driven_fraction).
   bool deviation_complete = false;
-  double driven_fraction = 0.0;
   std::string deviation_error;
   std::vector<FindingSummary> findings;
   // How long the ego stood and why, longest reason first (the dominant).
