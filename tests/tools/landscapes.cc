@@ -242,7 +242,7 @@ std::vector<Definition> Definitions() {
 // Landscapes no strategy was tuned on: other loads, grids, costs, bounds
 // and noise, written on demand (`make_landscapes --held-out`) and never
 // committed, so that what the agent is measured on there says how it does
-// on a study it has not seen (tests/bench/agent_held_out_bench.sh).
+// on a study it has not seen (tests/bench/agent_targets_bench.sh).
 std::vector<Definition> HeldOutDefinitions() {
   std::vector<Definition> defs;
 

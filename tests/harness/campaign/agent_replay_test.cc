@@ -90,7 +90,7 @@ TEST(AgentReplayTest, OnTheRobotaxiCampaignWithTwoObjectives) {
   // Issue 16's targets are for two objectives: the same recording scored
   // on cost and nav time alone, whose front holds 14 of the 280 points.
   // Measured: a median of 3 true Pareto points, a median hypervolume
-  // ratio of 0.872, 0.006 below random search's (every seed keeps to the
+  // ratio of 0.872, 0.007 below random search's (every seed keeps to the
   // 1.0-1.5 GHz columns after 4 cores at 2.1 GHz stop 87 % of the way,
   // while the front lies at 2.1 GHz), the cheapest design in 20 of 20
   // seeds (before the agent read how far stopped runs got 5, 0.947 and
