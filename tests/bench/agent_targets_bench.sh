@@ -52,6 +52,11 @@ trap 'rm -rf "${out}"' EXIT
 # One study per line: "<folder>" or "<folder>@<objective,objective>".
 studies=()
 if [[ "${family}" == held-out ]]; then
+  if [[ ! -x "${build}/bin/make_landscapes" ]]; then
+    echo "agent_targets_bench.sh: no make_landscapes at" \
+      "${build}/bin/make_landscapes (build first, or set ADSE_BUILD)" >&2
+    exit 2
+  fi
   "${build}/bin/make_landscapes" --held-out "${out}/landscapes" >/dev/null
   for dir in "${out}"/landscapes/*/; do studies+=("${dir%/}"); done
 fi
