@@ -49,7 +49,7 @@ fi
 out="$(mktemp -d)"
 trap 'rm -rf "${out}"' EXIT
 
-# One study per line: "<folder>" or "<folder>@<objective,objective>".
+# The studies' folders.
 studies=()
 if [[ "${family}" == held-out ]]; then
   if [[ ! -x "${build}/bin/make_landscapes" ]]; then
@@ -76,18 +76,19 @@ echo "| study | objectives | points | front | agent: cheapest found (seeds) | ag
 echo "|---|---|---|---|---|---|---|---|---|---|"
 met=0
 rows=0
-i=0
-while ((i < ${#studies[@]})); do
-  study="${studies[i]}"
-  i=$((i + 1))
-  dir="${study%@*}"
-  objectives=()
+# Replays one study ("<folder>" or "<folder>@<objective,objective>"), prints
+# its row, and replays the same recording on the two objectives the targets
+# are set for next when it has more.
+replay() {
+  local study="$1"
+  local dir="${study%@*}"
+  local name objectives=() lines=() start end
   name="$(basename "${dir}")"
   if [[ "${study}" == *@* ]]; then
     objectives=(--objectives "${study#*@}")
     name="${name} (${study#*@})"
   fi
-  json="${out}/${i}.json"
+  local json="${out}/$((rows + 1)).json"
   start=$(date +%s.%N)
   "${adse}" explore --replay "${dir}" --strategy agent,random \
     --budget "${budget}" --seeds 20 "${objectives[@]}" --json >"${json}"
@@ -130,12 +131,9 @@ PY
   )
   echo "${lines[0]}"
   rows=$((rows + 1))
-  [[ "${lines[1]}" == met ]] && met=$((met + 1))
-  if ((${#lines[@]} > 2)); then
-    # The same recording on the two objectives the targets are set for,
-    # replayed next.
-    studies=("${studies[@]:0:i}" "${dir}@${lines[2]}" "${studies[@]:i}")
-  fi
-done
+  if [[ "${lines[1]}" == met ]]; then met=$((met + 1)); fi
+  if ((${#lines[@]} > 2)); then replay "${dir}@${lines[2]}"; fi
+}
+for study in "${studies[@]}"; do replay "${study}"; done
 echo
 echo "${met} of ${rows} studies meet every target."
