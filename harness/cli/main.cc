@@ -7,12 +7,40 @@
 #include <fmt/ranges.h>
 
 #include "harness/cli/commands.h"
-#include "harness/explore/strategy.h"
 #include "harness/pool/worker_pool.h"
+#include "harness/spec/spec.h"
 #include "harness/spec/types.h"
 #include "stack/base/platform_limits.h"
 
 namespace {
+
+// CLI11's PositiveNumber and NonNegativeNumber name the largest double as
+// their range's end in their message; these say what is expected.
+CLI::Validator WholeNumberFrom(int least) {
+  return CLI::Validator(
+      [least](std::string& text) -> std::string {
+        int value = 0;
+        if (CLI::detail::lexical_cast(text, value) && value >= least) {
+          return {};
+        }
+        return fmt::format("expected a whole number of at least {}, found '{}'",
+                           least, text);
+      },
+      fmt::format("INT>={}", least));
+}
+
+CLI::Validator AboveZero() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double value = 0.0;
+        if (CLI::detail::lexical_cast(text, value) && value > 0.0) return {};
+        return fmt::format("expected a number above 0, found '{}'", text);
+      },
+      "NUMBER>0");
+}
+
+// A budget on the command line has the bounds of exploration.budget.
+const CLI::Range kBudget(adse::spec::kMinBudget, adse::spec::kMaxBudget);
 
 // Every command that drives one run of a scenario takes the case it drives.
 void AddCaseOption(CLI::App* command, std::string* task_case) {
@@ -63,7 +91,7 @@ int main(int argc, char** argv) {
   world_cmd
       ->add_option("--save-scans", world.save_every_nth_scan,
                    "Keep every Nth scan as a PCD file (0: none)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(WholeNumberFrom(0));
   world_cmd->add_flag("--json", world.json, "Print the summary as JSON");
 
   adse::cli::SimulateArgs simulate;
@@ -159,11 +187,11 @@ int main(int argc, char** argv) {
   run_cmd
       ->add_option("--budget", run.budget,
                    "Override exploration.budget (evaluations)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kBudget);
   run_cmd
       ->add_option("--workers", run.workers,
                    "Override harness.workers (0: auto)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(WholeNumberFrom(0));
   run_cmd
       ->add_option(
           "--isolation", run.isolation,
@@ -226,15 +254,16 @@ int main(int argc, char** argv) {
       ->add_option(
           "--strategy", explore.strategies,
           "Strategies, comma-separated, among " +
-              fmt::format("{}",
-                          fmt::join(adse::explore::StrategyNames(), ", ")) +
-              " (default: all)")
-      ->delimiter(',');
+              fmt::format("{}", fmt::join(adse::spec::StrategyNames(), ", ")) +
+              " (default: all but llm, which replays a recorded LLM "
+              "campaign's exchanges)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(adse::spec::StrategyNames()));
   explore_cmd
       ->add_option("--budget", explore.budget,
                    "Evaluations per replay (default: the "
                    "recorded scenario's budget)")
-      ->check(CLI::PositiveNumber);
+      ->check(kBudget);
   explore_cmd
       ->add_option("--objectives", explore.objectives,
                    "Replay with only these of the recorded scenario's "
@@ -277,7 +306,7 @@ int main(int argc, char** argv) {
       "Folder of prompt templates (default: the bundled prompts/)");
   interpret_cmd
       ->add_option("--timeout", interpret.timeout_s, "Seconds per request")
-      ->check(CLI::PositiveNumber)
+      ->check(AboveZero())
       ->capture_default_str();
   interpret_cmd
       ->add_option("--retries", interpret.retries, "HTTP retries per request")
@@ -327,7 +356,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(adse::spec::StrategyNames()));
   submit_cmd
       ->add_option("--budget", submit.budget, "Override exploration.budget")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kBudget);
   submit_cmd->add_flag("--dry-run", submit.dry_run,
                        "Print the sbatch scripts; write and submit nothing");
   submit_cmd
@@ -366,7 +395,7 @@ int main(int argc, char** argv) {
   shard_cmd
       ->add_option("--task", shard.task,
                    "Shard number (default: $SLURM_ARRAY_TASK_ID)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(WholeNumberFrom(0));
   shard_cmd->add_flag(
       "--local", shard.local,
       "Run the points in local worker processes instead of job steps");
@@ -443,7 +472,7 @@ int main(int argc, char** argv) {
       ->add_option("--lidar-hz", profile_check.lidar_hz,
                    "LiDAR rate of the reference run (default 10, as the "
                    "source's recording)")
-      ->check(CLI::PositiveNumber);
+      ->check(AboveZero());
   profile_check_cmd->add_option(
       "-o,--out", profile_check.out,
       "Folder for run.h5, check.txt and check.png (default: "

@@ -120,6 +120,11 @@ struct MetricInfo {
 // Metrics a run reports (documented in scenarios/README.md).
 const std::vector<MetricInfo>& KnownMetrics();
 
+// Bounds of exploration.budget, which the command line's --budget
+// overrides within the same bounds.
+inline constexpr int kMinBudget = 1;
+inline constexpr int kMaxBudget = 1000000000;
+
 struct ExplorationOptions {
   std::string strategy = "agent";  // exhaustive|random|ga|nsga2|agent|llm
   int budget = 15;                 // evaluations, replicas not counted

@@ -41,7 +41,7 @@ void SpecReader::ReadExploration(const Val& v) {
   if (const Val* e = f.Get("strategy"))
     ReadEnum(*e, &x.strategy, StrategyNames());
   if (const Val* e = f.Get("budget")) {
-    ReadInt(*e, &x.budget, Bounds::Closed(1, 1e9));
+    ReadInt(*e, &x.budget, Bounds::Closed(kMinBudget, kMaxBudget));
   }
   if (const Val* e = f.Get("batch")) {
     ReadInt(*e, &x.batch, Bounds::Closed(1, 1e6));

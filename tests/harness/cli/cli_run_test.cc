@@ -45,6 +45,14 @@ TEST(CliRunTest, ExploreReplayPrintsADistributionPerStrategy) {
   EXPECT_EQ(bad.exit_code, 2) << bad.out;
   EXPECT_NE(bad.out.find("/nonexistent/campaign"), std::string::npos)
       << bad.out;
+  // An unknown strategy is refused before any of the replay's table.
+  const CommandRun unknown =
+      Adse("explore --replay " + std::string(ADSE_SOURCE_DIR) +
+           "/tests/data/robotaxi_exhaustive --strategy agent,nope");
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
+  EXPECT_NE(unknown.out.find("nope"), std::string::npos) << unknown.out;
+  EXPECT_EQ(unknown.out.find("| strategy |"), std::string::npos) << unknown.out;
+  EXPECT_EQ(unknown.out.find("replay of"), std::string::npos) << unknown.out;
 }
 
 TEST(CliRunTest, ExploreReplayWithTwoOfTheObjectivesScoresAgainstTheirFront) {

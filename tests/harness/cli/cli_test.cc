@@ -145,7 +145,6 @@ TEST(CliTest, MisspelledKeyGetsADidYouMeanAndNothingIsWritten) {
 
 TEST(CliTest, BadFlagsAndMissingFilesExitWith2) {
   EXPECT_EQ(Adse("validate").exit_code, 2);
-  EXPECT_EQ(Adse("world " + Example() + " --save-scans -3").exit_code, 2);
   const CommandRun missing = Adse("validate /nonexistent/scenario.yaml");
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.out.find("/nonexistent/scenario.yaml"), std::string::npos)
@@ -153,6 +152,32 @@ TEST(CliTest, BadFlagsAndMissingFilesExitWith2) {
   const CommandRun help = Adse("--help");
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_NE(help.out.find("validate"), std::string::npos);
+}
+
+TEST(CliTest, ANumberOutOfItsRangeIsRefusedSayingWhatIsExpected) {
+  const CommandRun scans = Adse("world " + Example() + " --save-scans -3");
+  EXPECT_EQ(scans.exit_code, 2);
+  EXPECT_NE(scans.out.find("--save-scans: expected a whole number of at "
+                           "least 0, found '-3'"),
+            std::string::npos)
+      << scans.out;
+  // A budget on the command line has the scenario's bounds: a campaign of
+  // no evaluations is refused, not written.
+  const fs::path out = fs::path(::testing::TempDir()) / "budget_zero";
+  fs::remove_all(out);
+  const CommandRun budget =
+      Adse("run " + Example() + " --budget 0 -o " + out.string());
+  EXPECT_EQ(budget.exit_code, 2);
+  EXPECT_NE(budget.out.find("--budget"), std::string::npos) << budget.out;
+  EXPECT_FALSE(fs::exists(out));
+  const CommandRun timeout = Adse("interpret request --timeout 0");
+  EXPECT_EQ(timeout.exit_code, 2);
+  EXPECT_NE(timeout.out.find("expected a number above 0, found '0'"),
+            std::string::npos)
+      << timeout.out;
+  // CLI11's own positive-number check named the largest double.
+  EXPECT_EQ(budget.out.find("179769313486"), std::string::npos) << budget.out;
+  EXPECT_EQ(timeout.out.find("179769313486"), std::string::npos) << timeout.out;
 }
 
 TEST(CliTest, WorldFollowIdealReachesTheGoalAndWritesWhatItSaw) {
