@@ -1,7 +1,10 @@
 // adse: design-space exploration of autonomous-driving systems.
 #include <CLI/CLI.hpp>
 
+#include <charconv>
+#include <cstdint>
 #include <cstdio>
+#include <limits>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -37,6 +40,23 @@ CLI::Validator AboveZero() {
         return fmt::format("expected a number above 0, found '{}'", text);
       },
       "NUMBER>0");
+}
+
+// A seed as the scenario reads one: 0 to 2^64 - 1 (CLI11 wraps "-1").
+CLI::Validator Seed() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        uint64_t value = 0;
+        const auto [end, ec] =
+            std::from_chars(text.data(), text.data() + text.size(), value);
+        if (!text.empty() && ec == std::errc() &&
+            end == text.data() + text.size()) {
+          return {};
+        }
+        return fmt::format("expected a whole number from 0 to {}, found '{}'",
+                           std::numeric_limits<uint64_t>::max(), text);
+      },
+      "SEED");
 }
 
 // A budget on the command line has the bounds of exploration.budget.
@@ -87,6 +107,7 @@ int main(int argc, char** argv) {
                         "Output folder (default: <output>/world-check)");
   CLI::Option* seed_opt = world_cmd->add_option(
       "--seed", seed, "Traffic seed (overrides world.traffic.seed)");
+  seed_opt->check(Seed());
   world_cmd->add_flag("!--no-scan", world.scan, "Do not simulate the LiDAR");
   world_cmd
       ->add_option("--save-scans", world.save_every_nth_scan,
@@ -110,6 +131,7 @@ int main(int argc, char** argv) {
   CLI::Option* simulate_seed_opt = simulate_cmd->add_option(
       "--seed", simulate_seed,
       "Traffic and sensor seed (overrides world.traffic.seed)");
+  simulate_seed_opt->check(Seed());
   simulate_cmd->add_option("-o,--out", simulate.out,
                            "Run file (default: <output>/simulate/<point>.h5)");
   simulate_cmd->add_flag("--json", simulate.json,
@@ -230,6 +252,7 @@ int main(int argc, char** argv) {
       ->required();
   CLI::Option* worker_seed_opt =
       worker_cmd->add_option("--seed", worker_seed, "Traffic seed");
+  worker_seed_opt->check(Seed());
   worker_cmd->add_option("-o,--out", worker.out, "Run file to write")
       ->required();
   worker_cmd->add_option("--expect-key", worker.expect_key,
@@ -273,8 +296,9 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   explore_cmd->add_option("--seeds", explore.seeds, "Seeds per strategy")
       ->check(CLI::Range(1, 100000));
-  explore_cmd->add_option("--first-seed", explore.first_seed,
-                          "First exploration seed");
+  explore_cmd
+      ->add_option("--first-seed", explore.first_seed, "First exploration seed")
+      ->check(Seed());
   explore_cmd->add_flag("--rationale", explore.rationale,
                         "Also print, per seed, each iteration's proposals "
                         "and the strategy's rationale for them");

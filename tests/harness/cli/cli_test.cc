@@ -175,6 +175,13 @@ TEST(CliTest, ANumberOutOfItsRangeIsRefusedSayingWhatIsExpected) {
   EXPECT_NE(timeout.out.find("expected a number above 0, found '0'"),
             std::string::npos)
       << timeout.out;
+  // CLI11 took "-1" for the largest seed.
+  const CommandRun seed = Adse("simulate " + Example() + " --seed -1");
+  EXPECT_EQ(seed.exit_code, 2);
+  EXPECT_NE(seed.out.find("--seed: expected a whole number from 0 to "
+                          "18446744073709551615, found '-1'"),
+            std::string::npos)
+      << seed.out;
   // CLI11's own positive-number check named the largest double.
   EXPECT_EQ(budget.out.find("179769313486"), std::string::npos) << budget.out;
   EXPECT_EQ(timeout.out.find("179769313486"), std::string::npos) << timeout.out;
