@@ -261,9 +261,9 @@ int AnalyzeFolder(const std::string& target,
     }
     Result<runfile::RunData> run = runfile::ReadRunFile(item.file);
     if (!run.ok()) {
-      // A broken file never stops the rest.
-      std::fprintf(stderr, "skipped %s: %s\n", item.file.c_str(),
-                   run.status().message().c_str());
+      // A broken file never stops the rest. (ReadRunFile's errors name
+      // the file.)
+      std::fprintf(stderr, "skipped %s\n", run.status().message().c_str());
       exit_code = 2;
       ++unreadable;
       if (index) recorded_rows.push_back(item.row);
@@ -466,9 +466,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
     }
     const std::string& file = target;
     Result<runfile::RunData> run = runfile::ReadRunFile(file);
-    if (!run.ok()) {
-      std::fprintf(stderr, "error: %s: %s\n", file.c_str(),
-                   run.status().message().c_str());
+    if (!run.ok()) {  // its errors name the file
+      std::fprintf(stderr, "error: %s\n", run.status().message().c_str());
       exit_code = 2;
       continue;
     }

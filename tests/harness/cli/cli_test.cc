@@ -265,7 +265,9 @@ TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
   std::ofstream(dir / "runs" / "broken.h5") << "truncated";
   const CommandRun first = Adse("analyze " + dir.string());
   EXPECT_EQ(first.exit_code, 2) << first.out;  // one file could not be read
-  EXPECT_NE(first.out.find("skipped " + (dir / "runs" / "broken.h5").string()),
+  const std::string broken = (dir / "runs" / "broken.h5").string();
+  EXPECT_NE(first.out.find("skipped " + broken +
+                           ": not an HDF5 file (no HDF5 signature)"),
             std::string::npos)
       << first.out;
   EXPECT_NE(first.out.find("1 runs analysed"), std::string::npos) << first.out;
