@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <limits>
@@ -36,8 +37,12 @@ CLI::Validator AboveZero() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
         double value = 0.0;
-        if (CLI::detail::lexical_cast(text, value) && value > 0.0) return {};
-        return fmt::format("expected a number above 0, found '{}'", text);
+        if (CLI::detail::lexical_cast(text, value) && std::isfinite(value) &&
+            value > 0.0) {
+          return {};
+        }
+        return fmt::format("expected a finite number above 0, found '{}'",
+                           text);
       },
       "NUMBER>0");
 }
