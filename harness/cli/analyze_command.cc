@@ -14,6 +14,7 @@
 #include <optional>
 #include <set>
 
+#include "analysis/diagnosis/diagnosis.h"
 #include "analysis/runfile/campaign_file.h"
 #include "analysis/runfile/run_file.h"
 #include "harness/campaign/campaign.h"
@@ -422,6 +423,14 @@ int RunAnalyze(const AnalyzeArgs& args) {
       std::fprintf(stderr,
                    "error: --threshold %s: expected NAME=VALUE with a number\n",
                    t.c_str());
+      return 2;
+    }
+    // Name and range checked now, before anything is written.
+    analysis::DiagnosisOptions scratch;
+    if (Status s = analysis::SetOption(&scratch, t.substr(0, eq), value);
+        !s.ok()) {
+      std::fprintf(stderr, "error: --threshold %s: %s\n", t.c_str(),
+                   s.message().c_str());
       return 2;
     }
     options.thresholds[t.substr(0, eq)] = value;

@@ -299,7 +299,17 @@ TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
   const CommandRun bad =
       Adse("analyze " + dir.string() + " --threshold nonsense=1");
   EXPECT_EQ(bad.exit_code, 2) << bad.out;
-  EXPECT_NE(bad.out.find("nonsense"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("--threshold nonsense=1: unknown diagnosis "
+                         "threshold 'nonsense'"),
+            std::string::npos)
+      << bad.out;
+  EXPECT_FALSE(fs::exists(dir / "analysis" / "v3"));
+  // Run files outside a campaign: no analysis folder either.
+  const CommandRun loose = Adse("analyze " + (dir / "runs").string() +
+                                "/a.h5 --threshold frequency_bound_fraction=7");
+  EXPECT_EQ(loose.exit_code, 2) << loose.out;
+  EXPECT_NE(loose.out.find("out of range"), std::string::npos) << loose.out;
+  EXPECT_FALSE(fs::exists(dir / "runs" / "a.analysis"));
 }
 
 TEST(CliTest, AnalyzeOneRunPrintsDeviationAndDiagnosis) {
