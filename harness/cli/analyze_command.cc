@@ -425,15 +425,15 @@ int RunAnalyze(const AnalyzeArgs& args) {
                    t.c_str());
       return 2;
     }
+    const std::string name = t.substr(0, eq);
     // Name and range checked now, before anything is written.
     analysis::DiagnosisOptions scratch;
-    if (Status s = analysis::SetOption(&scratch, t.substr(0, eq), value);
-        !s.ok()) {
+    if (Status s = analysis::SetOption(&scratch, name, value); !s.ok()) {
       std::fprintf(stderr, "error: --threshold %s: %s\n", t.c_str(),
                    s.message().c_str());
       return 2;
     }
-    options.thresholds[t.substr(0, eq)] = value;
+    options.thresholds[name] = value;
   }
   // The reference is read before anything is written.
   std::optional<campaign::Recording> reference;
