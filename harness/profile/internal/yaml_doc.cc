@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <sstream>
 
@@ -63,6 +64,12 @@ std::string Range::Describe() const {
 
 Result<YamlDoc> YamlDoc::Load(const std::string& path,
                               const std::string& what) {
+  // A path that names no file gets the same sentence whatever it is.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    return Status::InvalidArgument(
+        fmt::format("{}: error: expected {}, found a directory", path, what));
+  }
   Result<std::string> text = ReadFile(path, kMaxYamlBytes);
   if (!text.ok()) {
     if (text.status().code() == Status::Code::kNotFound) {

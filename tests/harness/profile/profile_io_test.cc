@@ -256,6 +256,17 @@ TEST(ProfileIoTest, AMissingProfileIsNotFoundByName) {
             std::string::npos);
 }
 
+TEST(ProfileIoTest, AFolderGivenAsAProfileIsNamedLikeAMissingOne) {
+  const fs::path dir = TestDir() / "a-folder";
+  fs::create_directories(dir);
+  Result<Profile> read = ReadProfile(dir.string());
+  ASSERT_FALSE(read.ok());
+  EXPECT_EQ(read.status().message(),
+            dir.string() +
+                ": error: expected a cost profile (adse_profile: 1), found a "
+                "directory");
+}
+
 TEST(ProfileIoTest, TheTableGivesPercentilesLoadAndTheTotal) {
   const Profile p = Example();
   const std::string table = FormatProfileTable(p);
