@@ -165,7 +165,12 @@ int RunCalibrate(const CalibrateArgs& args) {
   }
   std::vector<const runfile::RunData*> pointers;
   for (const auto& r : runs) pointers.push_back(&r);
-  const sim::Calibration calibration = sim::FitCalibration(pointers);
+  Result<sim::Calibration> fitted = sim::FitCalibration(pointers);
+  if (!fitted.ok()) {
+    ReportError(*spec, fitted.status());
+    return ExitCodeFor(fitted.status());
+  }
+  const sim::Calibration& calibration = *fitted;
   Status written =
       sim::WriteCalibration(args.out, calibration, runs.front().host);
   if (!written.ok()) {

@@ -2,13 +2,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "stack/base/files.h"
 
 namespace adse::sim {
 
-Calibration FitCalibration(const std::vector<const runfile::RunData*>& runs) {
+Result<Calibration> FitCalibration(
+    const std::vector<const runfile::RunData*>& runs) {
   struct Sums {
     double n = 0, x = 0, y = 0, xx = 0, xy = 0;
   };
@@ -25,6 +31,22 @@ Calibration FitCalibration(const std::vector<const runfile::RunData*>& runs) {
       s.xx += r.work_units * r.work_units;
       s.xy += r.work_units * r.host_cpu_s;
     }
+  }
+  std::vector<std::string> idle;
+  for (const runfile::RunData* run : runs) {
+    for (const runfile::NamedCallback& callback : run->callback_info) {
+      if (sums.count(callback.name) == 0 &&
+          std::find(idle.begin(), idle.end(), callback.name) == idle.end()) {
+        idle.push_back(callback.name);
+      }
+    }
+  }
+  if (!idle.empty()) {
+    return Status::InvalidArgument(fmt::format(
+        "expected every callback of the stack to run at least once, found "
+        "{} that never ran in the {} calibration run(s): {}; calibrate on a "
+        "point or case where they run (--point, --case)",
+        idle.size(), runs.size(), fmt::join(idle, ", ")));
   }
   Calibration out;
   for (const auto& [name, s] : sums) {

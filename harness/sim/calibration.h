@@ -18,8 +18,11 @@ namespace adse::sim {
 using Calibration = std::map<std::string, stack::CountedCost>;
 
 // Least-squares fit of host_cpu_s = fixed_s + per_unit_s * work_units for
-// every callback of the runs (non-negative coefficients).
-Calibration FitCalibration(const std::vector<const runfile::RunData*>& runs);
+// every callback of the runs (non-negative coefficients). A callback of
+// the runs' graph that never ran in them has nothing to fit: an error
+// naming it, since a counted run would otherwise charge it a default.
+Result<Calibration> FitCalibration(
+    const std::vector<const runfile::RunData*>& runs);
 
 // JSON: {"adse_calibration": 1, "host": ..., "callbacks": {name: {fixed_s,
 // per_unit_s, samples}}}. Written atomically.

@@ -293,6 +293,20 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
         LoadCalibration(platform.calibration);
     if (!calibration.ok())
       return calibration.status().WithContext("platform.calibration");
+    // A callback the file does not cost would be charged the executor's
+    // default: refuse, as for a profile.
+    std::vector<std::string> missing;
+    for (const stack::CallbackSpec& spec : graph.callbacks()) {
+      if (calibration->count(spec.name) == 0) missing.push_back(spec.name);
+    }
+    if (!missing.empty()) {
+      return Status::InvalidArgument(fmt::format(
+          "platform.calibration: {}: expected a cost for every callback the "
+          "stack runs, found none for {} ({} of {}); fit one for this stack "
+          "with `adse calibrate`",
+          platform.calibration, fmt::join(missing, ", "), missing.size(),
+          graph.callbacks().size()));
+    }
     vp.counted = std::move(calibration).value();
   }
   std::map<std::string, std::string> platform_notes;

@@ -3,8 +3,10 @@
 // and shows starvation when it is not. Runs are real: SUMO, LiDAR, PCL NDT.
 #include "harness/sim/simulator.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -161,12 +163,15 @@ TEST(SimulateTest, CountedCostModelGivesIdenticalTraces) {
   Result<runfile::RunData> measured =
       SimulatePoint(spec, SmallPoint(16, 2.1, 7));
   ASSERT_TRUE(measured.ok()) << measured.status().ToString();
-  const Calibration calibration = FitCalibration({&*measured});
+  Result<Calibration> calibration = FitCalibration({&*measured});
+  ASSERT_TRUE(calibration.ok()) << calibration.status().ToString();
+  EXPECT_EQ(calibration->size(), measured->callback_info.size());
   const std::string path = (std::filesystem::temp_directory_path() /
                             "adse_sim_test_calibration.json")
                                .string();
-  ASSERT_TRUE(WriteCalibration(path, calibration, "test").ok());
+  ASSERT_TRUE(WriteCalibration(path, *calibration, "test").ok());
   spec.platform.cost_model = spec::CostModel::kCounted;
+  spec.platform.profile.clear();  // a profile would cost the callbacks
   spec.platform.calibration = path;
   Result<runfile::RunData> a = SimulatePoint(spec, SmallPoint(4, 1.0, 7));
   Result<runfile::RunData> b = SimulatePoint(spec, SmallPoint(4, 1.0, 7));
@@ -174,6 +179,39 @@ TEST(SimulateTest, CountedCostModelGivesIdenticalTraces) {
   ASSERT_TRUE(b.ok()) << b.status().ToString();
   EXPECT_GT(a->trace.callbacks.size(), 100u);
   EXPECT_EQ(Fingerprint(*a), Fingerprint(*b));
+
+  // A file that lacks a callback the stack runs is refused by name, not
+  // charged the executor's default.
+  Calibration partial = *calibration;
+  const std::string dropped = partial.begin()->first;
+  partial.erase(partial.begin());
+  ASSERT_TRUE(WriteCalibration(path, partial, "test").ok());
+  Result<runfile::RunData> refused = SimulatePoint(spec, SmallPoint(4, 1.0, 7));
+  ASSERT_FALSE(refused.ok());
+  EXPECT_THAT(refused.status().message(),
+              ::testing::AllOf(::testing::HasSubstr("platform.calibration"),
+                               ::testing::HasSubstr("found none for " +
+                                                    dropped + " (1 of")));
+
+  // Nor can a callback that never ran in the calibration runs be fitted.
+  runfile::RunData idle = *measured;
+  int index = -1;
+  for (size_t c = 0; c < idle.callback_info.size(); ++c) {
+    if (idle.callback_info[c].name == dropped) index = static_cast<int>(c);
+  }
+  ASSERT_GE(index, 0);
+  auto& records = idle.trace.callbacks;
+  records.erase(std::remove_if(records.begin(), records.end(),
+                               [index](const stack::CallbackRecord& r) {
+                                 return r.callback == index;
+                               }),
+                records.end());
+  Result<Calibration> unfitted = FitCalibration({&idle});
+  ASSERT_FALSE(unfitted.ok());
+  EXPECT_THAT(unfitted.status().message(),
+              ::testing::HasSubstr("found 1 that never ran in the 1 "
+                                   "calibration run(s): " +
+                                   dropped));
 }
 
 TEST(SimulateTest,
