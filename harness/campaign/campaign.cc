@@ -165,6 +165,17 @@ int StopSignal() {
   return interrupt != 0 ? interrupt : pool::DrainRequested();
 }
 
+// The error that stops a campaign whose first run was refused as bad
+// input (PoolEvaluator::refused); runs that landed meanwhile stay in runs/.
+Status Refusal(PoolEvaluator& evaluator) {
+  if (!evaluator.refused()) return Status::Ok();
+  evaluator.Cancel();
+  return Status::InvalidArgument(fmt::format(
+      "the campaign stopped: its first run was refused as bad input, as "
+      "every run would be: {}",
+      *evaluator.refused()));
+}
+
 void CountSources(CampaignSummary* summary) {
   for (const EvaluationRow& row : summary->exploration.evaluations) {
     if (!row.complete()) ++summary->failed;
@@ -214,6 +225,7 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
 
   ViewRefresher refresher(spec, &summary, options.listener, options.env);
   ExplorationResult result = Explore(spec, **strategy, evaluator, &refresher);
+  ADSE_RETURN_IF_ERROR(Refusal(evaluator));
   if (result.interrupted) {
     summary.interrupted_by = StopSignal();
     for (EvaluationRow& row : evaluator.Cancel()) {
@@ -286,6 +298,7 @@ Result<CampaignSummary> EvaluatePoints(const spec::Spec& input,
     if (done.empty() && evaluator.interrupted()) break;
     take(std::move(done));
   }
+  ADSE_RETURN_IF_ERROR(Refusal(evaluator));
   if (evaluator.interrupted()) {
     take(evaluator.Cancel());
     if (rows.size() < points.size()) summary.interrupted_by = StopSignal();

@@ -79,7 +79,8 @@ int PoolEvaluator::outstanding() const {
 }
 
 bool PoolEvaluator::interrupted() const {
-  return pool::InterruptRequested() != 0 || pool::DrainRequested() != 0;
+  return pool::InterruptRequested() != 0 || pool::DrainRequested() != 0 ||
+         refused_.has_value();
 }
 
 std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
@@ -245,6 +246,7 @@ void PoolEvaluator::Start(const EvalRequest& request) {
 }
 
 void PoolEvaluator::Deliver(const Pending& p, EvaluationRow row) {
+  if (row.status != runfile::kRunFailed) any_run_came_through_ = true;
   auto point = points_.find(p.request.index);
   if (point == points_.end()) return;
   point->second[p.run] = std::move(row);
@@ -330,6 +332,12 @@ void PoolEvaluator::Finish(const pool::JobResult& result) {
   // outside the space) fails the same way every time: no retry.
   const bool hopeless =
       result.outcome == pool::Outcome::kExitError && result.exit_code == 2;
+  if (hopeless && !any_run_came_through_) {
+    // The campaign stops (refused()); the point stays unevaluated, as
+    // after an interrupt, so that the mended scenario runs it.
+    if (!refused_) refused_ = detail;
+    return;
+  }
   if (!hopeless && p.attempt <= options_.retries) {
     if (options_.on_attempt_failed) {
       options_.on_attempt_failed(p.request, p.attempt, detail);
@@ -360,7 +368,7 @@ void PoolEvaluator::Finish(const pool::JobResult& result) {
 
 std::vector<EvaluationRow> PoolEvaluator::Wait() {
   while (ready_.empty() && !(queued_.empty() && running_.empty())) {
-    if (pool::InterruptRequested() != 0) break;
+    if (pool::InterruptRequested() != 0 || refused_) break;
     if (pool::DrainRequested() != 0) {
       // Start nothing more; what runs may finish within the grace period.
       queued_.clear();

@@ -49,6 +49,14 @@ class PoolEvaluator : public Evaluator {
   std::vector<EvaluationRow> Wait() override;
   bool interrupted() const override;
 
+  // Why the first run refused as bad input (the worker's exit 2) was
+  // refused, when no run had come through before it: every run is likely
+  // refused the same way (a calibration or profile that lacks a callback
+  // the stack runs, a map it cannot read), so from then on the evaluator
+  // counts as interrupted and the campaign stops with this error rather
+  // than record one refusal per point.
+  const std::optional<std::string>& refused() const { return refused_; }
+
   // Kills running attempts (their points stay unevaluated: no failure
   // record) and forgets queued ones. Returns the rows that were complete
   // but not yet returned by Wait, including runs whose file landed just
@@ -107,6 +115,8 @@ class PoolEvaluator : public Evaluator {
   std::vector<EvaluationRow> ready_;
   // When a drain request stops waiting for running attempts.
   std::optional<std::chrono::steady_clock::time_point> drain_deadline_;
+  bool any_run_came_through_ = false;  // a run file delivered, not a failure
+  std::optional<std::string> refused_;
 };
 
 }  // namespace adse::campaign

@@ -327,6 +327,94 @@ TEST(CampaignTest,
   EXPECT_EQ(again->failed, 3);
 }
 
+// A worker wrapper that refuses the points matching the shell pattern
+// `refused` as bad input (exit 2, as the worker does a scenario its stack
+// cannot run) and otherwise runs the real worker.
+std::string RefusingWorker(const std::string& dir, const std::string& refused) {
+  const std::string path = dir + "/refusing.sh";
+  std::ofstream(path) << "#!/bin/sh\n"
+                         "case \"$3\" in\n"
+                         "  " +
+                             refused +
+                             ") echo 'small.yaml:28:48: error: "
+                             "platform.calibration: found none for "
+                             "ndt_scan_matcher/points' >&2; exit 2 ;;\n"
+                             "esac\n"
+                             "exec " +
+                             kAdse + " worker \"$@\"\n";
+  fs::permissions(path, fs::perms::owner_all);
+  return path;
+}
+
+int FailureRecords(const std::string& folder) {
+  int count = 0;
+  for (const auto& e : fs::directory_iterator(folder + "/runs")) {
+    const std::string name = e.path().filename().string();
+    if (name.size() > 12 && name.substr(name.size() - 12) == ".failed.json") {
+      ++count;
+    }
+  }
+  return count;
+}
+
+TEST(
+    CampaignTest,
+    ACampaignWhoseFirstRunIsRefusedAsBadInputStopsSayingWhyAndRecordsNoFailure) {
+  spec::Spec spec = adse::testing::SmallScenario();
+  spec.design_space.parameters[0].values = {4};
+  const std::string out = TempDir("refused");
+  CampaignOptions o = Options(out, "exhaustive", 4);
+  o.worker_command = {"/bin/sh", RefusingWorker(out, "*")};
+  Result<CampaignSummary> s = RunCampaign(spec, o);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.status().code(), Status::Code::kInvalidArgument);
+  EXPECT_THAT(s.status().message(),
+              ::testing::AllOf(
+                  HasSubstr("the campaign stopped: its first run was refused "
+                            "as bad input, as every run would be: worker "
+                            "exited with status 2"),
+                  HasSubstr("found none for ndt_scan_matcher/points")));
+  // Nothing that reads as an answer, and no failure a mended scenario
+  // would reuse.
+  for (const char* view : {"report.md", "summary.json", "campaign.h5"}) {
+    EXPECT_FALSE(fs::exists(out + "/" + view)) << view;
+  }
+  EXPECT_EQ(FailureRecords(out), 0);
+
+  o.worker_command = {kAdse, "worker"};
+  Result<CampaignSummary> mended = RunCampaign(spec, o);
+  ASSERT_TRUE(mended.ok()) << mended.status().message();
+  EXPECT_EQ(mended->simulated, 4);
+  EXPECT_EQ(mended->failed, 0);
+}
+
+TEST(CampaignTest,
+     APointRefusedAfterARunCameThroughIsRecordedAsFailedWithoutARetry) {
+  spec::Spec spec = adse::testing::SmallScenario();
+  spec.design_space.parameters[0].values = {4};
+  spec.harness.retries = 1;
+  const std::string out = TempDir("refused-point");
+  // Two workers: the last point starts once one of the first two is in.
+  CampaignOptions o = Options(out, "exhaustive", 4);
+  o.worker_command = {"/bin/sh",
+                      RefusingWorker(out, "cores=4,freq_ghz=2.1,lidar_hz=14")};
+  Result<CampaignSummary> s = RunCampaign(spec, o);
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->exploration.evaluations.size(), 4u);
+  EXPECT_EQ(s->failed, 1);
+  for (const EvaluationRow& row : s->exploration.evaluations) {
+    if (spec::FormatPoint(spec.design_space, row.point) !=
+        "cores=4,freq_ghz=2.1,lidar_hz=14") {
+      EXPECT_EQ(row.status, "complete") << row.reason;
+      continue;
+    }
+    EXPECT_EQ(row.status, "failed");
+    EXPECT_THAT(row.reason, HasSubstr("worker exited with status 2"));
+    EXPECT_EQ(row.attempts, 1);
+  }
+  EXPECT_EQ(FailureRecords(out), 1);
+}
+
 // Starts `adse run` as a separate process, so that it can be killed.
 pid_t StartAdseRun(const std::vector<std::string>& args,
                    const std::string& log) {
