@@ -247,25 +247,27 @@ TEST(CampaignTest, TheSharedCacheLetsAnotherCampaignReuseEveryRun) {
   EXPECT_EQ(third->simulated, 1);
 }
 
-// A worker wrapper that misbehaves for chosen points and otherwise runs
-// the real worker: `kill -9` itself, sleep past the timeout, or allocate
-// far past the memory limit.
-std::string MisbehavingWorker(const std::string& dir) {
-  const std::string path = dir + "/worker.sh";
-  std::ofstream(path)
-      << "#!/bin/sh\n"
-         "# $1 scenario, $2 --point, $3 the point\n"
-         "case \"$3\" in\n"
-         "  cores=4,freq_ghz=1,lidar_hz=7) kill -9 $$ ;;\n"
-         "  cores=4,freq_ghz=1,lidar_hz=14) exec sleep 300 ;;\n"
-         "  cores=4,freq_ghz=2.1,lidar_hz=7) exec python3 -c "
-         "'a = bytearray(1 << 30); a[::4096] = b\"x\" * len(a[::4096]); "
-         "import time; time.sleep(30)' ;;\n"
-         "esac\n"
-         "exec " +
-             kAdse + " worker \"$@\"\n";
+// A worker wrapper, `dir`/`name`: the shell `case` arms `arms` on the
+// point ($3; $1 is the scenario, $2 --point), and otherwise the real worker.
+std::string WorkerWrapper(const std::string& dir, const std::string& name,
+                          const std::string& arms) {
+  const std::string path = dir + "/" + name;
+  std::ofstream(path) << "#!/bin/sh\ncase \"$3\" in\n" + arms + "esac\nexec " +
+                             kAdse + " worker \"$@\"\n";
   fs::permissions(path, fs::perms::owner_all);
   return path;
+}
+
+// Misbehaves for chosen points: `kill -9` itself, sleep past the timeout,
+// or allocate far past the memory limit.
+std::string MisbehavingWorker(const std::string& dir) {
+  return WorkerWrapper(
+      dir, "worker.sh",
+      "  cores=4,freq_ghz=1,lidar_hz=7) kill -9 $$ ;;\n"
+      "  cores=4,freq_ghz=1,lidar_hz=14) exec sleep 300 ;;\n"
+      "  cores=4,freq_ghz=2.1,lidar_hz=7) exec python3 -c "
+      "'a = bytearray(1 << 30); a[::4096] = b\"x\" * len(a[::4096]); "
+      "import time; time.sleep(30)' ;;\n");
 }
 
 TEST(CampaignTest,
@@ -327,23 +329,14 @@ TEST(CampaignTest,
   EXPECT_EQ(again->failed, 3);
 }
 
-// A worker wrapper that refuses the points matching the shell pattern
-// `refused` as bad input (exit 2, as the worker does a scenario its stack
-// cannot run) and otherwise runs the real worker.
+// Refuses the points matching the shell pattern `refused` as bad input
+// (exit 2, as the worker does a scenario its stack cannot run).
 std::string RefusingWorker(const std::string& dir, const std::string& refused) {
-  const std::string path = dir + "/refusing.sh";
-  std::ofstream(path) << "#!/bin/sh\n"
-                         "case \"$3\" in\n"
-                         "  " +
-                             refused +
-                             ") echo 'small.yaml:28:48: error: "
-                             "platform.calibration: found none for "
-                             "ndt_scan_matcher/points' >&2; exit 2 ;;\n"
-                             "esac\n"
-                             "exec " +
-                             kAdse + " worker \"$@\"\n";
-  fs::permissions(path, fs::perms::owner_all);
-  return path;
+  return WorkerWrapper(dir, "refusing.sh",
+                       "  " + refused +
+                           ") echo 'small.yaml:28:48: error: "
+                           "platform.calibration: found none for "
+                           "ndt_scan_matcher/points' >&2; exit 2 ;;\n");
 }
 
 int FailureRecords(const std::string& folder) {
