@@ -296,8 +296,10 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     // A callback the file does not cost would be charged the executor's
     // default: refuse, as for a profile.
     std::vector<std::string> missing;
-    for (const stack::CallbackSpec& spec : graph.callbacks()) {
-      if (calibration->count(spec.name) == 0) missing.push_back(spec.name);
+    for (const stack::CallbackSpec& callback : graph.callbacks()) {
+      if (calibration->count(callback.name) == 0) {
+        missing.push_back(callback.name);
+      }
     }
     if (!missing.empty()) {
       return Status::InvalidArgument(fmt::format(
