@@ -16,6 +16,10 @@ std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path) {
     std::fprintf(stderr, "%s\n", loaded.status().message().c_str());
     return std::nullopt;
   }
+  if (Status priced = spec::CheckCostOverSpace(*loaded); !priced.ok()) {
+    ReportError(*loaded, priced);
+    return std::nullopt;
+  }
   return std::move(loaded).value();
 }
 

@@ -11,7 +11,9 @@
 
 namespace adse::cli {
 
-// Loads and validates `path`; on failure prints the errors to stderr.
+// Loads and validates `path`, its cost at every design point of a space
+// of up to spec::kMaxCostCheckPoints included; on failure prints the
+// errors to stderr.
 std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path);
 
 // LoadScenarioOrReport, then the spec of the case `--case` names

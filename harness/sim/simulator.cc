@@ -110,6 +110,9 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   }
   Result<spec::PointConfig> config = spec::ApplyPoint(spec, point);
   if (!config.ok()) return config.status();
+  // A point the cost expression cannot price is refused before it runs.
+  Result<double> cost = spec::EvaluateCost(spec, point);
+  if (!cost.ok()) return cost.status();
   const spec::PlatformOptions& platform = config->platform;
   const StackConfig& stack_config = config->stack;
 
@@ -605,8 +608,7 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
     stats.executor_s = std::nan("");
   }
   run.metrics = analysis::ComputeRunMetrics(run);
-  Result<double> cost = spec::EvaluateCost(spec, point);
-  run.metrics["hardware_cost"] = cost.ok() ? *cost : std::nan("");
+  run.metrics["hardware_cost"] = *cost;
   stats.simulated_s = w.time_s();
   stats.wall_s = Seconds(Clock::now() - t_begin);
   if (stats_out) *stats_out = stats;

@@ -140,20 +140,60 @@ std::map<std::string, double> PointVariables(const Spec& spec,
 
 }  // namespace
 
-Result<double> EvaluateCost(const Spec& spec, const DesignPoint& point) {
-  ADSE_RETURN_IF_ERROR(spec.design_space.Check(point));
+namespace {
+
+Result<Expression> ParseCost(const Spec& spec) {
   Result<Expression> cost =
       Expression::Parse(spec.cost, CostVariableNames(spec.design_space));
   if (!cost.ok()) {
     return Status::InvalidArgument("cost: " + cost.status().message());
   }
-  Result<double> value = cost->TryEvaluate(PointVariables(spec, point));
+  return cost;
+}
+
+Result<double> CostAt(const Spec& spec, const Expression& cost,
+                      const DesignPoint& point) {
+  Result<double> value = cost.TryEvaluate(PointVariables(spec, point));
   if (!value.ok()) return value.status();
   if (!std::isfinite(*value)) {
-    return Status::InvalidArgument("cost: '" + spec.cost +
-                                   "' is not finite at this point");
+    return Status::InvalidArgument(fmt::format(
+        "cost: expected a finite cost at every design point, found '{}' = "
+        "{} at {}",
+        spec.cost, *value, FormatPoint(spec.design_space, point)));
   }
   return *value;
+}
+
+}  // namespace
+
+Result<double> EvaluateCost(const Spec& spec, const DesignPoint& point) {
+  ADSE_RETURN_IF_ERROR(spec.design_space.Check(point));
+  Result<Expression> cost = ParseCost(spec);
+  if (!cost.ok()) return cost.status();
+  return CostAt(spec, *cost, point);
+}
+
+Status CheckCostOverSpace(const Spec& spec) {
+  const std::vector<DesignParameter>& parameters = spec.design_space.parameters;
+  const uint64_t size = spec.design_space.Size();
+  if (parameters.empty() || size > kMaxCostCheckPoints) return Status::Ok();
+  Result<Expression> cost = ParseCost(spec);
+  if (!cost.ok()) return cost.status();
+  // Mixed-radix count over the value indices, first parameter slowest.
+  std::vector<size_t> index(parameters.size(), 0);
+  for (uint64_t n = 0; n < size; ++n) {
+    DesignPoint point;
+    for (size_t d = 0; d < parameters.size(); ++d) {
+      point[parameters[d].name] = parameters[d].values[index[d]];
+    }
+    Result<double> value = CostAt(spec, *cost, point);
+    if (!value.ok()) return value.status();
+    for (size_t d = parameters.size(); d-- > 0;) {
+      if (++index[d] < parameters[d].values.size()) break;
+      index[d] = 0;
+    }
+  }
+  return Status::Ok();
 }
 
 namespace {

@@ -51,6 +51,14 @@ std::vector<std::string> ConstraintVariableNames(const DesignSpace& space);
 // platform defaults.
 Result<double> EvaluateCost(const Spec& spec, const DesignPoint& point);
 
+// Spaces up to this size have their cost checked at every point.
+inline constexpr uint64_t kMaxCostCheckPoints = 100000;
+// Ok when the cost expression is finite at every point of the space (a
+// cost of 10 / (cores - 1) over 1 core is not); a space larger than
+// kMaxCostCheckPoints is not enumerated, and each run checks its own
+// point. The error names the first such point in lexicographic order.
+Status CheckCostOverSpace(const Spec& spec);
+
 // Whether `metrics` (name -> value; booleans as 0/1) and the point satisfy
 // one constraint expression of the spec (true when non-zero).
 Result<bool> EvaluateConstraint(const Spec& spec, const std::string& constraint,

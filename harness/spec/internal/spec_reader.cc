@@ -624,6 +624,10 @@ void SpecReader::ReadPlatform(const Val& v) {
         Error(
             e->mark, e->path, "an existing calibration file",
             Quote(e->node.Scalar()) + " (no such file: " + p.calibration + ")");
+      } else if (p.cost_model != CostModel::kCounted) {
+        Error(e->mark, e->path, "cost_model: counted beside it",
+              "cost_model: " + std::string(CostModelToString(p.cost_model)) +
+                  " (a calibration costs the counted model's callbacks)");
       }
     }
   }

@@ -131,6 +131,27 @@ TEST(CliTest, ACommandThatRunsOneCaseNeedsItNamed) {
   EXPECT_NE(none.out.find("has no task.cases"), std::string::npos) << none.out;
 }
 
+TEST(CliTest, ACostThatIsNotFiniteAtSomePointIsRefusedBeforeAnythingRuns) {
+  const std::string file =
+      Variant("cost", "cost: cores * freq_ghz", "cost: 10 / (cores - 3)");
+  const fs::path out = fs::temp_directory_path() / "adse_cli_cost_out";
+  fs::remove_all(out);
+  for (const std::string& command :
+       {"validate -q --no-world " + file,
+        "run --budget 2 -o " + out.string() + " " + file}) {
+    const CommandRun run = Adse(command);
+    EXPECT_EQ(run.exit_code, 2) << command << "\n" << run.out;
+    EXPECT_TRUE(std::regex_search(
+        run.out, std::regex("adse_cli_cost\\.yaml:[0-9]+:[0-9]+: error: cost: "
+                            "expected a finite cost at every design point, "
+                            "found '10 / \\(cores - 3\\)' = inf at "
+                            "cores=3,freq_ghz=1,lidar_hz=7")))
+        << command << "\n"
+        << run.out;
+  }
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST(CliTest, MisspelledKeyGetsADidYouMeanAndNothingIsWritten) {
   const std::string file = Variant("typo", "weather: clear", "wether: clear");
   const fs::path out = fs::temp_directory_path() / "adse_cli_typo_out";

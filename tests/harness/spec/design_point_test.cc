@@ -169,6 +169,49 @@ cost: cores * freq_ghz + hz / 7
   EXPECT_FALSE(EvaluateCost(*only_hz, {{"hz", 10}}).ok());
 }
 
+TEST(DesignPointTest, ACostNotFiniteAtSomeDesignPointIsNamedAtThatPoint) {
+  auto parsed = [](const std::string& cost, const std::string& cores,
+                   const std::string& freq = "values: [1.0, 2.1]") {
+    Result<Spec> spec = ParseSpec(
+        "adse: 1\nworld: {map: {generate: grid}}\n"
+        "task: {start: {x: 0, y: 0}, goal: {x: 1, y: 1}}\n"
+        "design_space:\n"
+        "  cores: {bind: platform.cores, " +
+            cores +
+            "}\n"
+            "  freq_ghz: {bind: platform.freq_ghz, " +
+            freq +
+            "}\n"
+            "cost: " +
+            cost + "\n",
+        "c.yaml", "");
+    EXPECT_TRUE(spec.ok()) << spec.status().message();
+    return *spec;
+  };
+  EXPECT_TRUE(
+      CheckCostOverSpace(parsed("cores * freq_ghz", "range: [1, 8]")).ok());
+  const Spec broken = parsed("10 / (cores - 4)", "range: [1, 8]");
+  const Status status = CheckCostOverSpace(broken);
+  EXPECT_EQ(status.code(), Status::Code::kInvalidArgument);
+  EXPECT_EQ(status.message(),
+            "cost: expected a finite cost at every design point, found "
+            "'10 / (cores - 4)' = inf at cores=4,freq_ghz=1");
+  // A run of that point is refused the same way; its neighbours are priced.
+  EXPECT_EQ(EvaluateCost(broken, {{"cores", 4}, {"freq_ghz", 2.1}})
+                .status()
+                .message(),
+            "cost: expected a finite cost at every design point, found "
+            "'10 / (cores - 4)' = inf at cores=4,freq_ghz=2.1");
+  EXPECT_NEAR(*EvaluateCost(broken, {{"cores", 5}, {"freq_ghz", 2.1}}), 10.0,
+              1e-12);
+  EXPECT_FALSE(
+      CheckCostOverSpace(parsed("ln(cores - 4)", "range: [4, 8]")).ok());
+  // A space past kMaxCostCheckPoints is left to each run.
+  EXPECT_TRUE(CheckCostOverSpace(parsed("10 / (cores - 4)", "range: [1, 1024]",
+                                        "range: [1.0, 3.0], step: 0.01"))
+                  .ok());
+}
+
 TEST(DesignPointTest, ConstraintsOverMetrics) {
   const Spec spec = Reference();
   const DesignPoint point = {{"cores", 18}, {"freq_ghz", 1.8}, {"lidar_hz", 7}};

@@ -296,6 +296,11 @@ TEST(SpecErrorsTest, AProfileNeedsTheCountedModelAndNoCalibration) {
       ErrorOf(std::string(kHead) + "platform: {profile: README.md}\n", dir),
       HasSubstr("platform.profile: expected cost_model: counted beside it, "
                 "found cost_model: measured"));
+  EXPECT_THAT(
+      ErrorOf(std::string(kHead) + "platform: {calibration: README.md}\n", dir),
+      HasSubstr("platform.calibration: expected cost_model: counted beside "
+                "it, found cost_model: measured (a calibration costs the "
+                "counted model's callbacks)"));
   EXPECT_THAT(ErrorOf(std::string(kHead) +
                           "platform: {cost_model: counted, profile: README.md, "
                           "calibration: README.md}\n",
