@@ -245,8 +245,10 @@ Result<Profile> ReadProfileDoc(const YamlDoc& doc) {
     if (!cost_ms.ok()) return cost_ms.status();
     Result<stack::CallbackCost> cost = ReadCostMs(*cost_ms);
     if (!cost.ok()) return cost.status();
+    // Required, as in the mapping: left out, a work-scaled callback would
+    // silently cost the same for every scan.
     Result<double> units =
-        entry.Number("reference_units", Range::NonNegative(), 0.0);
+        entry.Number("reference_units", Range::NonNegative());
     Result<double> alpha =
         entry.Number("freq_exponent", Range::Between(0.0, 4.0), 1.0);
     Result<double> p =

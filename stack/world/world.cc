@@ -322,6 +322,15 @@ Result<std::unique_ptr<World>> World::Open(const WorldSetup& setup) {
     impl->structure_bounds.emplace_back(centre, radius);
   }
   ADSE_RETURN_IF_ERROR(impl->BuildIdealPath());
+  // A goal within its tolerance of the start leaves nothing to drive:
+  // every design would "arrive" at once.
+  const double tolerance_m = impl->setup.task.goal_tolerance_m;
+  if (impl->ideal.length_m() <= tolerance_m) {
+    return Status::InvalidArgument(fmt::format(
+        "task.goal: expected a goal farther along the road from the start "
+        "than its tolerance_m ({:g} m), found one {:.2f} m from it",
+        tolerance_m, impl->ideal.length_m()));
+  }
   ADSE_RETURN_IF_ERROR(impl->FindRouteSignals());
   ADSE_RETURN_IF_ERROR(impl->PlanTurnarounds());
   ADSE_RETURN_IF_ERROR(impl->FindSwitchedSignals());

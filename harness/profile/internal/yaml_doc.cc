@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include "harness/spec/yaml_limits.h"
@@ -91,6 +92,7 @@ Result<YamlDoc> YamlDoc::Load(const std::string& path,
                        "several ('---' separators)");
     }
     doc.root_ = YAML::Load(*text);
+    ADSE_RETURN_IF_ERROR(doc.CheckKeysOnce(doc.root_, ""));
   } catch (const spec::YamlLimitExceeded& e) {
     return doc.Error(e.mark, "(file)", e.expected, e.found);
   } catch (const YAML::Exception& e) {
@@ -101,6 +103,32 @@ Result<YamlDoc> YamlDoc::Load(const std::string& path,
                      e.what());
   }
   return doc;
+}
+
+Status YamlDoc::CheckKeysOnce(const YAML::Node& node,
+                              const std::string& path) const {
+  if (node.IsSequence()) {
+    for (size_t i = 0; i < node.size(); ++i) {
+      ADSE_RETURN_IF_ERROR(
+          CheckKeysOnce(node[i], fmt::format("{}[{}]", path, i)));
+    }
+  }
+  if (!node.IsMap()) return Status::Ok();
+  // yaml-cpp keeps both entries of a repeated key, and a lookup finds the
+  // first: a value added below an old one would be ignored.
+  std::map<std::string, YAML::Mark> seen;
+  for (auto it = node.begin(); it != node.end(); ++it) {
+    if (!it->first.IsScalar()) continue;
+    const std::string& key = it->first.Scalar();
+    const auto [first, fresh] = seen.emplace(key, it->first.Mark());
+    if (!fresh) {
+      return Error(it->first.Mark(), JoinPath(path, key), "each key once",
+                   fmt::format("'{}' again (first at line {})", key,
+                               LineOf(first->second)));
+    }
+    ADSE_RETURN_IF_ERROR(CheckKeysOnce(it->second, JoinPath(path, key)));
+  }
+  return Status::Ok();
 }
 
 Status YamlDoc::Error(const YAML::Mark& mark, const std::string& field,

@@ -43,7 +43,8 @@ struct Range {
 class YamlDoc {
  public:
   // Reads and parses `path`. A missing file is NotFound; a file that is too
-  // large, nests too deep, or is not YAML is InvalidArgument at its line.
+  // large, nests too deep, is not YAML or writes a key twice in one map is
+  // InvalidArgument at its line.
   // `what` names the expected content in messages ("a cost profile").
   static Result<YamlDoc> Load(const std::string& path, const std::string& what);
 
@@ -58,6 +59,9 @@ class YamlDoc {
                  const std::string& expected) const;
 
  private:
+  // InvalidArgument at the second of a key written twice in one map.
+  Status CheckKeysOnce(const YAML::Node& node, const std::string& path) const;
+
   std::string path_;
   YAML::Node root_;
 };

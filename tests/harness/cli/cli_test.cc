@@ -60,6 +60,20 @@ TEST(CliTest, StartOffTheRoadIsReportedAtItsLineWithExitCode2) {
   EXPECT_NE(run.out.find("off the road network"), std::string::npos) << run.out;
 }
 
+TEST(CliTest, AGoalOnTheStartIsReportedAtItsLine) {
+  const std::string file =
+      Variant("goal_on_start", "goal: {x: 15.0, y: 63.75, tolerance_m: 2.0}",
+              "goal: {x: 21.0, y: -1.75, tolerance_m: 2.0}");
+  const CommandRun run = Adse("validate -q " + file);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_TRUE(std::regex_search(
+      run.out, std::regex("adse_cli_goal_on_start\\.yaml:18:[0-9]+: error: "
+                          "task\\.goal: expected a goal farther along the "
+                          "road from the start than its tolerance_m \\(2 "
+                          "m\\), found one 1\\.[0-9]+ m from it")))
+      << run.out;
+}
+
 TEST(CliTest, UnknownFlowEdgeIsReportedAtItsLine) {
   const std::string file = Variant("flow", "from: W4_E4", "from: E9_W9");
   const CommandRun run = Adse("validate -q " + file);

@@ -209,6 +209,14 @@ TEST(ProfileIoTest, EveryMalformedProfileIsRefusedAtItsLineAndField) {
       {"    freq_exponent: 1\n    parallel_fraction: 0\n    max_threads: 1",
        "    freq_exponent: 5\n    parallel_fraction: 0\n    max_threads: 1",
        {cb + ".freq_exponent: expected a number in [0, 4], found '5'"}},
+      {"    reference_units: 4298\n",
+       "",
+       {"callbacks.ndt_scan_matcher/points.reference_units: expected a "
+        "number >= 0 (required), found nothing"}},
+      {"p50: 1.822",
+       "p50: 1.822, p50: 5",
+       {cb + ".cost_ms.p50: expected each key once, found 'p50' again (first "
+             "at line"}},
       {"max_threads: 4",
        "max_threads: 2.5",
        {"callbacks.ndt_scan_matcher/points.max_threads: expected an integer "
