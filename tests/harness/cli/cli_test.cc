@@ -3,6 +3,7 @@
 // analysis, and the fidelity check.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -266,6 +267,35 @@ TEST(CliTest, SimulateWritesARunFileThatPassesTheSchemaCheck) {
   const CommandRun check = Adse("schema check " + out.string());
   EXPECT_EQ(check.exit_code, 0) << check.out;
   EXPECT_NE(check.out.find(": ok"), std::string::npos) << check.out;
+
+  // A damaged block inside a table passes the schema's checks of the
+  // file's structure, not the read of the table's checksums.
+  const fs::path damaged = fs::temp_directory_path() / "adse_cli_damaged.h5";
+  fs::copy_file(out, damaged, fs::copy_options::overwrite_existing);
+  const fs::path offset_file =
+      fs::temp_directory_path() / "adse_cli_damaged.offset";
+  const std::string find_chunk =
+      "/usr/bin/python3 -c \"import h5py; print(h5py.File('" +
+      damaged.string() +
+      "', 'r')['/trace/callbacks'].id.get_chunk_info(0).byte_offset)\" > " +
+      offset_file.string() + " 2>/dev/null";
+  if (std::system(find_chunk.c_str()) != 0) {
+    GTEST_SKIP() << "no /usr/bin/python3 with h5py to find a chunk";
+  }
+  long offset = -1;
+  std::ifstream(offset_file) >> offset;
+  ASSERT_GT(offset, 0);
+  {
+    std::fstream file(damaged, std::ios::in | std::ios::out | std::ios::binary);
+    file.seekp(offset + 100);
+    file << std::string(64, '\xff');
+  }
+  const CommandRun broken = Adse("schema check " + damaged.string());
+  EXPECT_EQ(broken.exit_code, 2) << broken.out;
+  EXPECT_EQ(broken.out.find(": ok"), std::string::npos) << broken.out;
+  EXPECT_NE(broken.out.find(damaged.string() + ": /trace/callbacks: reading"),
+            std::string::npos)
+      << broken.out;
 }
 
 TEST(CliTest, SimulateRejectsAPointOutsideTheSpace) {
