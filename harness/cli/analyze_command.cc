@@ -3,6 +3,7 @@
 // version (a campaign's under <campaign>/analysis/vN, a single run file's
 // next to it); or compare two campaigns or analysis versions.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
@@ -26,6 +27,7 @@
 #include "harness/cli/commands.h"
 #include "harness/report/run_report.h"
 #include "harness/spec/spec_parser.h"
+#include "harness/spec/text_util.h"
 #include "stack/base/files.h"
 
 namespace adse::cli {
@@ -114,11 +116,16 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
   };
   std::optional<nlohmann::json> a = load(a_path), b = load(b_path);
   if (!a || !b) return 2;
+  // "cores=16,freq_ghz=2.1,lidar_hz=7", as points are written elsewhere.
   auto key = [](const nlohmann::json& r) {
-    std::string k;
-    for (const auto& [name, value] : r["point"].items())
-      k += fmt::format("{}={} ", name, value.dump());
-    return k;
+    std::vector<std::string> parts;
+    for (const auto& [name, value] : r["point"].items()) {
+      parts.push_back(value.is_number()
+                          ? fmt::format("{}={}", name,
+                                        spec::FormatNumber(value.get<double>()))
+                          : fmt::format("{}={}", name, value.dump()));
+    }
+    return fmt::format("{}", fmt::join(parts, ","));
   };
   std::map<std::string, nlohmann::json> in_a, in_b;
   for (const auto& r : (*a)["runs"]) in_a[key(r)] = r;
@@ -169,7 +176,31 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
   }
   std::printf("A = %s\nB = %s\n%zu of %zu points changed\n", a_path.c_str(),
               b_path.c_str(), changes.size(), keys.size());
-  for (const auto& c : changes) std::printf("  %s\n", c.dump().c_str());
+  // One line per point: what changed, A -> B.
+  auto text = [](const nlohmann::json& v) -> std::string {
+    if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
+    if (v.is_number()) return fmt::format("{:.6g}", v.get<double>());
+    if (v.is_null()) return "n/a";
+    return v.is_string() ? v.get<std::string>() : v.dump();
+  };
+  for (const auto& c : changes) {
+    std::vector<std::string> what;
+    if (c.contains("change")) what.push_back(c["change"].get<std::string>());
+    for (const char* field : {"feasible", "on_front"}) {
+      if (!c.contains(field)) continue;
+      what.push_back(
+          fmt::format("{} {} -> {}",
+                      std::string(field) == "on_front" ? "on the front" : field,
+                      text(c[field][0]), text(c[field][1])));
+    }
+    if (c.contains("metrics")) {
+      for (const auto& [m, v] : c["metrics"].items()) {
+        what.push_back(fmt::format("{} {} -> {}", m, text(v[0]), text(v[1])));
+      }
+    }
+    std::printf("  %s: %s\n", c["point"].get<std::string>().c_str(),
+                fmt::format("{}", fmt::join(what, "; ")).c_str());
+  }
   return 0;
 }
 
@@ -185,11 +216,6 @@ std::string CampaignOfRunsFolder(const std::string& target) {
   if (path.filename() != "runs" || !fs::exists(campaign / "campaign.h5", ec)) {
     return target;
   }
-  std::fprintf(stderr,
-               "%s: the run files of the campaign %s, which is analysed "
-               "(into %s)\n",
-               target.c_str(), campaign.c_str(),
-               (campaign / "analysis").c_str());
   return campaign.string();
 }
 
@@ -410,7 +436,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
                    "error: --diff takes two analysis folders: --diff A B\n");
       return 2;
     }
-    return Diff(args.diff[0], args.diff[1], args.json);
+    return Diff(CampaignOfRunsFolder(args.diff[0]),
+                CampaignOfRunsFolder(args.diff[1]), args.json);
   }
   report::AnalyzeOptions options;
   for (const std::string& t : args.thresholds) {
@@ -461,9 +488,16 @@ int RunAnalyze(const AnalyzeArgs& args) {
   for (const std::string& target : args.targets) {
     std::error_code ec;
     if (fs::is_directory(target, ec)) {
+      const std::string folder = CampaignOfRunsFolder(target);
+      if (folder != target) {
+        std::fprintf(stderr,
+                     "%s: the run files of the campaign %s, which is analysed "
+                     "(into %s/analysis)\n",
+                     target.c_str(), folder.c_str(), folder.c_str());
+      }
       exit_code =
           std::max(exit_code,
-                   AnalyzeFolder(CampaignOfRunsFolder(target), options,
+                   AnalyzeFolder(folder, options,
                                  reference ? &*reference : nullptr, args.json));
       continue;
     }

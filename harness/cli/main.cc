@@ -182,7 +182,9 @@ int main(int argc, char** argv) {
                           "frequency_bound_fraction=0.2");
   analyze_cmd
       ->add_option("--diff", analyze.diff,
-                   "Compare two analysis version folders: --diff A B")
+                   "Compare two campaigns or analysis versions (a "
+                   "campaign root, its runs/ folder, or analysis/vN): "
+                   "--diff A B")
       ->expected(2);
   analyze_cmd->add_option(
       "--reference", analyze.reference,

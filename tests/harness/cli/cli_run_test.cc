@@ -278,6 +278,19 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
   EXPECT_EQ(diff.exit_code, 0) << diff.out;
   EXPECT_NE(diff.out.find("of 7 points changed"), std::string::npos)
       << diff.out;
+  // Points read as everywhere else, one line each, no JSON.
+  EXPECT_TRUE(
+      std::regex_search(diff.out, std::regex("\n  cores=[0-9]+,freq_ghz=[0-9.]+"
+                                             ",lidar_hz=[0-9]+: ")) ||
+      diff.out.find("0 of 7 points changed") != std::string::npos)
+      << diff.out;
+  EXPECT_EQ(diff.out.find("{\""), std::string::npos) << diff.out;
+  // A campaign's runs/ folder stands for the campaign, as in analyze.
+  const CommandRun same =
+      Adse("analyze --diff " + (out / "runs").string() + "/ " + out.string());
+  EXPECT_EQ(same.exit_code, 0) << same.out;
+  EXPECT_NE(same.out.find("0 of 7 points changed"), std::string::npos)
+      << same.out;
   // Its runs/ folder stands for the campaign: the same answer, written
   // beside the others, nothing among the run files.
   const CommandRun runs = Adse("analyze " + (out / "runs").string() + "/");
