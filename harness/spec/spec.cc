@@ -141,37 +141,48 @@ const std::vector<MetricInfo>& KnownMetrics() {
       {"parked",
        "valet_parking: the run ended standing in the slot within the goal's "
        "position and heading tolerances (0 or 1)",
-       true},
+       /*boolean=*/true, /*count=*/false, /*precision=*/false,
+       /*valet_parking_only=*/true},
       {"parking_position_error_m",
        "valet_parking: parked body centre's distance from the slot's "
        "target at the end, m",
-       /*boolean=*/false, /*count=*/false, /*precision=*/true},
+       /*boolean=*/false, /*count=*/false, /*precision=*/true,
+       /*valet_parking_only=*/true},
       {"parking_yaw_error_deg",
        "valet_parking: heading error from the parked heading at the end, "
        "degrees",
-       /*boolean=*/false, /*count=*/false, /*precision=*/true},
+       /*boolean=*/false, /*count=*/false, /*precision=*/true,
+       /*valet_parking_only=*/true},
       {"parking_time_s",
        "valet_parking: from the manoeuvre's first plan to the end of the "
-       "run, s"},
+       "run, s",
+       /*boolean=*/false, /*count=*/false, /*precision=*/false,
+       /*valet_parking_only=*/true},
       {"parking_replans",
        "valet_parking: paths found after the first, each planned where the "
        "car stood off the course of the one before or at its end outside "
        "the goal's tolerances, count",
-       false, true},
+       /*boolean=*/false, /*count=*/true, /*precision=*/false,
+       /*valet_parking_only=*/true},
       {"parking_path_deviation_m",
        "valet_parking: mean distance of the rear axle from the planned "
        "manoeuvre while driving it, m",
-       /*boolean=*/false, /*count=*/false, /*precision=*/true},
+       /*boolean=*/false, /*count=*/false, /*precision=*/true,
+       /*valet_parking_only=*/true},
       {"min_clearance_m",
        "valet_parking: smallest gap between the ego's body and a wall, pole "
-       "or parked car, m"},
+       "or parked car, m",
+       /*boolean=*/false, /*count=*/false, /*precision=*/false,
+       /*valet_parking_only=*/true},
       {"obstacle_collisions",
        "valet_parking: contacts of the ego's body with walls, poles or "
        "parked cars, count",
-       false, true},
+       /*boolean=*/false, /*count=*/true, /*precision=*/false,
+       /*valet_parking_only=*/true},
       {"gear_changes",
-       "valet_parking: reversals of the direction of motion, count", false,
-       true},
+       "valet_parking: reversals of the direction of motion, count",
+       /*boolean=*/false, /*count=*/true, /*precision=*/false,
+       /*valet_parking_only=*/true},
       {"censored",
        "early stop ended the run (status infeasible): its other metrics are "
        "measured up to the stop (0 or 1)",

@@ -116,6 +116,9 @@ struct MetricInfo {
   // knob that thins the stack's data (role downsample) makes it worse
   // while it relieves the computer.
   bool precision = false;
+  // Reported by valet_parking runs only (NaN or absent otherwise): an
+  // objective or constraint on it in another task is an error.
+  bool valet_parking_only = false;
 };
 // Metrics a run reports (documented in scenarios/README.md).
 const std::vector<MetricInfo>& KnownMetrics();

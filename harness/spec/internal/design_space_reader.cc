@@ -260,6 +260,19 @@ void SpecReader::ReadExpression(const Val& v,
   }
 }
 
+bool SpecReader::ReportedByTask(const Val& v, const std::string& metric) {
+  if (spec_.task.kind == world::TaskKind::kValetParking) return true;
+  for (const MetricInfo& info : KnownMetrics()) {
+    if (info.name != metric || !info.valet_parking_only) continue;
+    Error(v.mark, v.path,
+          fmt::format("metrics a {} run reports",
+                      world::TaskKindToString(spec_.task.kind)),
+          Quote(metric) + ", which valet_parking runs alone report");
+    return false;
+  }
+  return true;
+}
+
 void SpecReader::ReadCost(const Val& v) {
   if (!ReadString(v, &spec_.cost, "an expression, e.g. cores * freq_ghz")) {
     return;
@@ -295,6 +308,7 @@ void SpecReader::ReadObjectives(const Val& v) {
     Objective objective;
     objective.minimize = f.order[0] == "minimize";
     if (!ReadEnum(e, &objective.metric, metrics)) continue;
+    if (!ReportedByTask(e, objective.metric)) continue;
     if (!seen.insert(objective.metric).second) {
       Error(e, "each metric in one objective only", " (a duplicate)");
       continue;
@@ -319,6 +333,11 @@ void SpecReader::ReadConstraints(const Val& v) {
     }
     ReadExpression(item, names,
                    "a condition over metrics and design parameters");
+    if (Result<Expression> e = Expression::Parse(text, names); e.ok()) {
+      for (const std::string& variable : e->variables()) {
+        if (!ReportedByTask(item, variable)) break;
+      }
+    }
     spec_.constraints.push_back(text);
   }
 }

@@ -62,6 +62,9 @@ class SpecReader : public YamlReader {
                      std::map<std::string, std::string>* bound);
   bool CheckBinding(const DesignParameter& p, const Val& at,
                     const std::vector<Val>* items);
+  // False, with an error at `v`, when `metric` is one the scenario's task
+  // kind does not report (a valet_parking metric in lane driving).
+  bool ReportedByTask(const Val& v, const std::string& metric);
   void ReadCost(const Val& v);
   void ReadObjectives(const Val& v);
   void ReadConstraints(const Val& v);

@@ -436,6 +436,18 @@ TEST(SpecErrorsTest, ObjectiveErrors) {
               "objectives[0]", 9, "exactly one of minimize or maximize");
 }
 
+TEST(SpecErrorsTest, AValetParkingMetricInALaneDrivingTaskIsRefused) {
+  ExpectError(std::string(kHead) + "objectives: [{minimize: gear_changes}]\n",
+              "objectives[0].minimize", 9,
+              "expected metrics a lane_driving run reports, found "
+              "'gear_changes', which valet_parking runs alone report");
+  ExpectError(
+      std::string(kHead) + "constraints: [completed, parking_time_s < 10]\n",
+      "constraints[1]", 9,
+      "found 'parking_time_s', which valet_parking runs alone "
+      "report");
+}
+
 TEST(SpecErrorsTest, VersionAndRequiredSections) {
   std::string text = kHead;
   text.replace(0, 7, "adse: 2");
