@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -137,7 +138,18 @@ Status World::Impl::StartSumo() {
 }
 
 Status World::Impl::BuildScene() {
-  return Guard("building the scene", [&] {
+  // A polygon adse cannot read is an error naming it, not an obstacle
+  // dropped or given a default height.
+  Status unreadable;
+  auto refuse = [&](const std::string& id, const std::string& type,
+                    const std::string& expected, const std::string& found) {
+    unreadable = Status::InvalidArgument(fmt::format(
+        "world.map.polygons: {}: polygon '{}' (type '{}'): expected {}, "
+        "found {}",
+        map.polygons_path.empty() ? "the map's polygons" : map.polygons_path,
+        id, type, expected, found));
+  };
+  Status built = Guard("building the scene", [&] {
     std::vector<std::string> polygon_ids = libsumo::Polygon::getIDList();
     std::sort(polygon_ids.begin(), polygon_ids.end());
     bool any_static = false;
@@ -147,7 +159,23 @@ Status World::Impl::BuildScene() {
       if (shape.size() < 2) continue;
       const std::string height_text =
           libsumo::Polygon::getParameter(id, "height_m");
-      if (type == "adse.parking_slot" && shape.size() >= 4) {
+      double height = 0.0;
+      if (!height_text.empty()) {
+        const char* end = height_text.data() + height_text.size();
+        const auto [ptr, ec] = std::from_chars(height_text.data(), end, height);
+        if (ec != std::errc() || ptr != end || !std::isfinite(height) ||
+            height < 0.0) {
+          refuse(id, type, "height_m as a number of metres >= 0",
+                 "'" + height_text + "'");
+          return;
+        }
+      }
+      if (type == "adse.parking_slot" && shape.size() < 4) {
+        refuse(id, type, "a slot of 4 corners",
+               fmt::format("{} points", shape.size()));
+        return;
+      }
+      if (type == "adse.parking_slot") {
         ParkingSlot slot;
         slot.name = id;
         const Vec2 e1 = shape[1] - shape[0];
@@ -170,8 +198,6 @@ Status World::Impl::BuildScene() {
               1e-6) {
         obstacle.footprint.pop_back();  // closed implicitly
       }
-      double height =
-          height_text.empty() ? 0.0 : std::atof(height_text.c_str());
       if (type == "adse.wall") {
         obstacle.kind = ObstacleKind::kWall;
         if (height <= 0) height = 2.5;
@@ -205,6 +231,7 @@ Status World::Impl::BuildScene() {
       }
     }
   });
+  return unreadable.ok() ? built : unreadable;
 }
 
 void World::Impl::PushEgo() {

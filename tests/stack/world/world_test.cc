@@ -18,6 +18,7 @@
 #include "stack/base/hash.h"
 #include "stack/world/ideal_driver.h"
 #include "stack/world/lidar.h"
+#include "stack/world/map_builder.h"
 #include "stack/world/map_cloud.h"
 #include "tests/stack/world/testing/real_nets.h"
 
@@ -272,6 +273,36 @@ TEST(WorldTest, CorruptNetIsReportedWithSumosCause) {
   // SUMO's own reason, not a bare "Process Error".
   EXPECT_EQ(world.status().message().find("Process Error"), std::string::npos)
       << world.status().message();
+}
+
+TEST(WorldTest, APolygonWhoseHeightIsNoNumberIsRejectedByName) {
+  // The small lot's own net and polygons, its first wall's height mistyped.
+  const WorldSetup lot = SmallLot();
+  Result<MapArtifacts> map = PrepareMap(lot.world.map, lot.cache_dir);
+  ASSERT_TRUE(map.ok()) << map.status().ToString();
+  std::ifstream in(map->polygons_path);
+  std::string polygons((std::istreambuf_iterator<char>(in)),
+                       std::istreambuf_iterator<char>());
+  const std::string height = "<param key=\"height_m\" value=\"2.50\"/>";
+  const size_t at = polygons.find(height);
+  ASSERT_NE(at, std::string::npos);
+  polygons.replace(at, height.size(),
+                   "<param key=\"height_m\" value=\"2,5\"/>");
+  const std::string mistyped =
+      (std::filesystem::temp_directory_path() / "adse_mistyped.poly.xml")
+          .string();
+  std::ofstream(mistyped) << polygons;
+  WorldSetup setup = lot;
+  setup.world.map.generator.clear();
+  setup.world.map.generator_params.clear();
+  setup.world.map.net_path = map->net_path;
+  setup.world.map.polygons_path = mistyped;
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_FALSE(world.ok());
+  EXPECT_EQ(world.status().message(),
+            "world.map.polygons: " + mistyped +
+                ": polygon 'wall_0' (type 'adse.wall'): expected height_m as "
+                "a number of metres >= 0, found '2,5'");
 }
 
 TEST(WorldTest, StartOffTheRoadIsRejected) {
