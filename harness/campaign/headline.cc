@@ -231,8 +231,13 @@ std::string HeadlineText(const spec::Spec& spec,
   std::vector<std::string> objectives;
   for (const spec::Objective& o : spec.objectives)
     objectives.push_back(o.metric);
-  out << fmt::format("Pareto front over {} ({} of {} evaluations):\n",
-                     fmt::join(objectives, ", "), h.front.size(), rows.size());
+  // With nothing feasible the constraint-aware front holds the designs
+  // that violate least; say so, as report.md does.
+  out << fmt::format("Pareto front over {} ({} of {} evaluations{}):\n",
+                     fmt::join(objectives, ", "), h.front.size(), rows.size(),
+                     h.cheapest < 0 ? "; nothing is feasible, so these are "
+                                      "the designs that violate least"
+                                    : "");
   for (int i : CheapestFirst(rows, h.front)) {
     const EvaluationRow& row = rows[i];
     out << fmt::format("  {:<36} cost {:>7}  nav {:>9}  ctrl {:>8}{}\n",
