@@ -14,7 +14,6 @@
 #include "harness/campaign/pool_evaluator.h"
 #include "harness/campaign/run_store.h"
 #include "harness/campaign/strategy_factory.h"
-#include "harness/spec/design_point.h"
 #include "stack/base/files.h"
 #include "stack/base/subprocess.h"
 
@@ -197,7 +196,6 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
   if (!overridden.ok()) return overridden.status();
   const spec::Spec& spec = *overridden;
   ADSE_RETURN_IF_ERROR(CheckStrategyName(spec.exploration.strategy));
-  ADSE_RETURN_IF_ERROR(spec::CheckCostOverSpace(spec));
   if (!options.make_pool) {
     Result<pool::Isolation> isolation =
         pool::ParseIsolation(spec.harness.isolation);

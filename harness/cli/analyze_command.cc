@@ -186,12 +186,11 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
   for (const auto& c : changes) {
     std::vector<std::string> what;
     if (c.contains("change")) what.push_back(c["change"].get<std::string>());
-    for (const char* field : {"feasible", "on_front"}) {
+    for (const auto& [field, label] :
+         {std::pair{"feasible", "feasible"}, {"on_front", "on the front"}}) {
       if (!c.contains(field)) continue;
-      what.push_back(
-          fmt::format("{} {} -> {}",
-                      std::string(field) == "on_front" ? "on the front" : field,
-                      text(c[field][0]), text(c[field][1])));
+      what.push_back(fmt::format("{} {} -> {}", label, text(c[field][0]),
+                                 text(c[field][1])));
     }
     if (c.contains("metrics")) {
       for (const auto& [m, v] : c["metrics"].items()) {

@@ -9,23 +9,20 @@
 
 namespace adse::cli {
 
-std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path) {
+namespace {
+
+std::optional<spec::Spec> ParseScenarioOrReport(const std::string& path) {
   Result<spec::Spec> loaded = spec::LoadSpec(path);
   if (!loaded.ok()) {
     // Parser messages carry their own locations, one error per line.
     std::fprintf(stderr, "%s\n", loaded.status().message().c_str());
     return std::nullopt;
   }
-  if (Status priced = spec::CheckCostOverSpace(*loaded); !priced.ok()) {
-    ReportError(*loaded, priced);
-    return std::nullopt;
-  }
   return std::move(loaded).value();
 }
 
-std::optional<spec::Spec> LoadCaseOrReport(const std::string& path,
-                                           const std::string& name) {
-  std::optional<spec::Spec> loaded = LoadScenarioOrReport(path);
+std::optional<spec::Spec> CaseOrReport(std::optional<spec::Spec> loaded,
+                                       const std::string& name) {
   if (!loaded) return std::nullopt;
   const spec::Spec& spec = *loaded;
   if (spec.cases.empty()) {
@@ -50,6 +47,28 @@ std::optional<spec::Spec> LoadCaseOrReport(const std::string& path,
     return std::nullopt;
   }
   return spec::ForCase(spec, index);
+}
+
+}  // namespace
+
+std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path) {
+  std::optional<spec::Spec> loaded = ParseScenarioOrReport(path);
+  if (!loaded) return std::nullopt;
+  if (Status priced = spec::CheckCostOverSpace(*loaded); !priced.ok()) {
+    ReportError(*loaded, priced);
+    return std::nullopt;
+  }
+  return loaded;
+}
+
+std::optional<spec::Spec> LoadCaseOrReport(const std::string& path,
+                                           const std::string& name) {
+  return CaseOrReport(LoadScenarioOrReport(path), name);
+}
+
+std::optional<spec::Spec> LoadWorkerCaseOrReport(const std::string& path,
+                                                 const std::string& name) {
+  return CaseOrReport(ParseScenarioOrReport(path), name);
 }
 
 void ReportError(const spec::Spec& spec, const Status& status) {

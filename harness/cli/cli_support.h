@@ -23,6 +23,12 @@ std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path);
 std::optional<spec::Spec> LoadCaseOrReport(const std::string& path,
                                            const std::string& task_case);
 
+// The same for a campaign's worker, without the cost's check over the
+// space: its coordinator made it, and the run checks its own point
+// (sim::SimulatePoint), so each run does not price the whole space again.
+std::optional<spec::Spec> LoadWorkerCaseOrReport(const std::string& path,
+                                                 const std::string& task_case);
+
 // Prints `status` as "file:line:col: error: message", locating the field
 // path that starts the message ("task.goal: ...") in the scenario.
 void ReportError(const spec::Spec& spec, const Status& status);

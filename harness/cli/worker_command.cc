@@ -23,7 +23,7 @@ namespace {
 
 int Work(const WorkerArgs& args) {
   std::optional<spec::Spec> spec =
-      LoadCaseOrReport(args.scenario, args.task_case);
+      LoadWorkerCaseOrReport(args.scenario, args.task_case);
   if (!spec) return 2;
   Result<spec::DesignPoint> point =
       spec::ParsePoint(spec->design_space, args.point);
