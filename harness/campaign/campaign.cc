@@ -7,9 +7,11 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <thread>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "harness/campaign/pool_evaluator.h"
 #include "harness/campaign/run_store.h"
@@ -24,36 +26,51 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Keeps the folder's views fresh while the campaign runs (at most every
-// few seconds; they are rebuilt in full at the end) and forwards events.
+// Keeps the folder's views fresh while the campaign runs and forwards
+// events. They are written on every proposal, so that `adse status` sees
+// what runs while the pool is busy, and after a result at most every few
+// seconds; the views are rebuilt in full at the end.
 class ViewRefresher : public ExplorerListener {
  public:
   ViewRefresher(const spec::Spec& spec, CampaignSummary* summary,
                 ExplorerListener* next, Env* env)
-      : spec_(spec), summary_(summary), next_(next), env_(env) {}
+      : spec_(spec), summary_(summary), next_(next), env_(env) {
+    summary_->in_progress = true;
+  }
+  ~ViewRefresher() override {
+    summary_->in_progress = false;
+    summary_->running.clear();
+  }
 
   void OnProposed(const explore::Strategy& strategy,
                   const runfile::IterationRow& iteration,
                   const std::vector<spec::DesignPoint>& points) override {
     summary_->exploration.iterations.push_back(iteration);
+    summary_->running.insert(summary_->running.end(), points.begin(),
+                             points.end());
+    Write();
     if (next_ != nullptr) next_->OnProposed(strategy, iteration, points);
   }
   void OnEvaluated(const EvaluationRow& row) override {
     summary_->exploration.evaluations.push_back(row);
+    std::vector<spec::DesignPoint>& running = summary_->running;
+    auto it = std::find(running.begin(), running.end(), row.point);
+    if (it != running.end()) running.erase(it);
+    if (Clock::now() - last_write_ > std::chrono::seconds(3)) Write();
     if (next_ != nullptr) next_->OnEvaluated(row);
-    const auto now = Clock::now();
-    if (now - last_write_ > std::chrono::seconds(3)) {
-      last_write_ = now;
-      // The runs are safe in runs/; the views are rebuilt at the end, where
-      // a failure that lasts is an error. Say it now all the same.
-      if (Status s = WriteCampaignViews(spec_, *summary_, env_); !s.ok()) {
-        std::fprintf(stderr, "warning: the campaign views are stale: %s\n",
-                     s.message().c_str());
-      }
-    }
   }
 
  private:
+  void Write() {
+    last_write_ = Clock::now();
+    // The runs are safe in runs/; the views are rebuilt at the end, where
+    // a failure that lasts is an error. Say it now all the same.
+    if (Status s = WriteCampaignViews(spec_, *summary_, env_); !s.ok()) {
+      std::fprintf(stderr, "warning: the campaign views are stale: %s\n",
+                   s.message().c_str());
+    }
+  }
+
   const spec::Spec& spec_;
   CampaignSummary* summary_;
   ExplorerListener* next_;
@@ -165,15 +182,42 @@ int StopSignal() {
   return interrupt != 0 ? interrupt : pool::DrainRequested();
 }
 
-// The error that stops a campaign whose first run was refused as bad
-// input (PoolEvaluator::refused); runs that landed meanwhile stay in runs/.
-Status Refusal(PoolEvaluator& evaluator) {
-  if (!evaluator.refused()) return Status::Ok();
+// Why a campaign stops when its first run was refused as bad input
+// (PoolEvaluator::refused), or nullopt; runs that landed meanwhile stay in
+// runs/.
+std::optional<std::string> RefusalReason(PoolEvaluator& evaluator) {
+  if (!evaluator.refused()) return std::nullopt;
   evaluator.Cancel();
-  return Status::InvalidArgument(fmt::format(
-      "the campaign stopped: its first run was refused as bad input, as "
-      "every run would be: {}",
-      *evaluator.refused()));
+  return fmt::format(
+      "its first run was refused as bad input, as every run would be: {}",
+      *evaluator.refused());
+}
+
+Status Refusal(PoolEvaluator& evaluator) {
+  std::optional<std::string> reason = RefusalReason(evaluator);
+  if (!reason) return Status::Ok();
+  return Status::InvalidArgument("the campaign stopped: " + *reason);
+}
+
+// The views of a folder that holds another scenario's campaign are about
+// to become this one's; its runs stay (content keys never collide).
+void WarnOfAnotherScenario(const spec::Spec& spec,
+                           const CampaignFolder& folder) {
+  Result<std::string> text = ReadFile(folder.Path("summary.json"));
+  if (!text.ok()) return;
+  const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
+  if (!j.is_object() || !j.contains("scenario") || !j["scenario"].is_string()) {
+    return;
+  }
+  const std::string other = j["scenario"];
+  if (other == spec.name) return;
+  std::fprintf(stderr,
+               "warning: %s holds the campaign of another scenario, '%s' "
+               "(%s); its runs stay in runs/, but report.md, summary.json, "
+               "campaign.h5 and pareto.png become those of '%s'\n",
+               folder.root().c_str(), other.c_str(),
+               j.value("scenario_file", std::string("?")).c_str(),
+               spec.name.c_str());
 }
 
 void CountSources(CampaignSummary* summary) {
@@ -210,6 +254,7 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
   ADSE_RETURN_IF_ERROR(folder.Create());
   Result<CampaignLock> lock = CampaignLock::Acquire(folder.root());
   if (!lock.ok()) return lock.status();
+  WarnOfAnotherScenario(spec, folder);
   // Created under the lock: the llm strategy records into the folder.
   Result<std::unique_ptr<explore::Strategy>> strategy =
       CreateCampaignStrategy(spec, folder.root(), /*record=*/true, options.env);
@@ -223,9 +268,22 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
   PoolEvaluator evaluator(spec, folder, pool->get(),
                           EvaluatorOptions(spec, options, cache));
 
-  ViewRefresher refresher(spec, &summary, options.listener, options.env);
-  ExplorationResult result = Explore(spec, **strategy, evaluator, &refresher);
-  ADSE_RETURN_IF_ERROR(Refusal(evaluator));
+  ExplorationResult result;
+  {
+    ViewRefresher refresher(spec, &summary, options.listener, options.env);
+    result = Explore(spec, **strategy, evaluator, &refresher);
+  }
+  if (std::optional<std::string> refused = RefusalReason(evaluator)) {
+    // The views written on the way said it was running; now they say why
+    // it stopped, with no answer.
+    summary.exploration = std::move(result);
+    summary.stopped_because = *refused;
+    if (Status s = WriteCampaignViews(spec, summary, options.env); !s.ok()) {
+      std::fprintf(stderr, "warning: the campaign views are stale: %s\n",
+                   s.message().c_str());
+    }
+    return Status::InvalidArgument("the campaign stopped: " + *refused);
+  }
   if (result.interrupted) {
     summary.interrupted_by = StopSignal();
     for (EvaluationRow& row : evaluator.Cancel()) {

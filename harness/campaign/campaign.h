@@ -83,6 +83,13 @@ struct CampaignSummary {
   // Points planned but without a result (a static sweep whose array tasks
   // have not all finished); 0 for a campaign run by adse run.
   int unfinished = 0;
+  // Set while the campaign runs, for the views written on the way (they are
+  // not the answer yet): the points proposed and not yet evaluated.
+  bool in_progress = false;
+  std::vector<spec::DesignPoint> running;
+  // Why the campaign stopped with no answer (its first run refused as bad
+  // input), or empty.
+  std::string stopped_because;
 };
 
 // Runs (or resumes) the campaign of `spec`. Errors: InvalidArgument for

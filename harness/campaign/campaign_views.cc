@@ -283,7 +283,28 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
   const auto& rows = s.exploration.evaluations;
   std::ostringstream md;
   md << "# Campaign: " << spec.name << "\n\n";
-  md << HeadlineMarkdown(spec, rows, headline, image_dir);
+  if (!s.stopped_because.empty()) {
+    md << fmt::format(
+        "> **Stopped: {}.** No answer: mend the scenario and run again; "
+        "runs that finished are kept.\n\n",
+        s.stopped_because);
+  } else if (s.in_progress) {
+    std::vector<std::string> running;
+    for (const spec::DesignPoint& p : s.running) {
+      running.push_back("`" + spec::FormatPoint(spec.design_space, p) + "`");
+    }
+    md << fmt::format(
+        "> **In progress:** {} of {} evaluations so far{}. This report is "
+        "rewritten as runs come in; it holds the answer once `adse run` "
+        "ends.\n\n",
+        rows.size(), spec.exploration.budget,
+        running.empty()
+            ? std::string()
+            : fmt::format(", running {}", fmt::join(running, ", ")));
+  }
+  if (s.stopped_because.empty()) {
+    md << HeadlineMarkdown(spec, rows, headline, image_dir);
+  }
   md << "## Campaign\n\n";
   md << fmt::format("- scenario: `{}`\n", spec.source_path);
   md << fmt::format(
@@ -496,7 +517,16 @@ Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
   j["wall_s"] = summary.wall_s;
   j["interrupted_by_signal"] = summary.interrupted_by;
   j["unfinished"] = summary.unfinished;
-  j["complete"] = summary.interrupted_by == 0 && summary.unfinished == 0;
+  j["in_progress"] = summary.in_progress;
+  j["running"] = nlohmann::json::array();
+  for (const spec::DesignPoint& p : summary.running) {
+    j["running"].push_back(spec::FormatPoint(spec.design_space, p));
+  }
+  if (!summary.stopped_because.empty()) {
+    j["stopped_because"] = summary.stopped_because;
+  }
+  j["complete"] = !summary.in_progress && summary.interrupted_by == 0 &&
+                  summary.unfinished == 0 && summary.stopped_because.empty();
   j["counts"] = {{"evaluations", rows.size()},
                  {"simulated", summary.simulated},
                  {"reused", summary.reused},

@@ -215,6 +215,7 @@ std::string HeadlineText(const spec::Spec& spec,
                          const std::vector<EvaluationRow>& rows,
                          const Headline& h) {
   std::ostringstream out;
+  if (rows.empty()) return "no evaluation has a result yet\n";
   if (h.cheapest < 0) {
     out << fmt::format(
         "no feasible design among {} evaluations: every one violates a "
@@ -278,6 +279,7 @@ std::string HeadlineMarkdown(const spec::Spec& spec,
                              const Headline& h, const std::string& image_dir) {
   std::ostringstream md;
   md << "## Answer\n\n";
+  if (rows.empty()) return md.str() + "No evaluation has a result yet.\n\n";
   if (h.cheapest < 0) {
     md << fmt::format(
         "**No feasible design** among {} evaluations: every one violates a "

@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cstdio>
 
+#include "harness/sim/run_key.h"
 #include "harness/spec/spec_parser.h"
 
 namespace adse::cli {
@@ -54,9 +55,12 @@ std::optional<spec::Spec> CaseOrReport(std::optional<spec::Spec> loaded,
 std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path) {
   std::optional<spec::Spec> loaded = ParseScenarioOrReport(path);
   if (!loaded) return std::nullopt;
-  if (Status priced = spec::CheckCostOverSpace(*loaded); !priced.ok()) {
-    ReportError(*loaded, priced);
-    return std::nullopt;
+  for (const Status& checked :
+       {spec::CheckCostOverSpace(*loaded), sim::CheckKnobsAct(*loaded)}) {
+    if (!checked.ok()) {
+      ReportError(*loaded, checked);
+      return std::nullopt;
+    }
   }
   return loaded;
 }

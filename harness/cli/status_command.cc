@@ -25,7 +25,11 @@ int RunStatus(const StatusArgs& args) {
   // as adse run's, from the scenario stored in it.
   std::optional<campaign::Recording> recorded;
   std::error_code ec;
-  if (std::filesystem::exists(args.campaign + "/campaign.h5", ec)) {
+  // A campaign on its first runs has an index without rows yet.
+  const bool no_result_yet = status->done + status->failed == 0 &&
+                             status->views == slurm::ViewsState::kInProgress;
+  if (!no_result_yet &&
+      std::filesystem::exists(args.campaign + "/campaign.h5", ec)) {
     Result<campaign::Recording> r = campaign::LoadRecording(args.campaign);
     if (r.ok()) {
       recorded = std::move(*r);
@@ -45,8 +49,11 @@ int RunStatus(const StatusArgs& args) {
     return 0;
   }
   std::fputs(slurm::FormatStatus(*status).c_str(), stdout);
+  if (no_result_yet) std::printf("answer so far: no run has a result yet\n");
   if (recorded) {
-    std::printf("answer so far (campaign.h5):\n%s",
+    std::printf("%s (campaign.h5):\n%s",
+                status->views == slurm::ViewsState::kComplete ? "answer"
+                                                              : "answer so far",
                 campaign::HeadlineText(
                     recorded->spec, recorded->rows,
                     campaign::ComputeHeadline(recorded->spec, recorded->rows))

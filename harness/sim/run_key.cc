@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include <fmt/format.h>
+
 #include "harness/sim/early_stop.h"
 #include "stack/base/files.h"
 #include "stack/base/hash.h"
@@ -96,7 +98,38 @@ void AddLocation(ContentHasher* h, const world::Location& l) {
   if (l.has_yaw) h->Add("yaw_deg").Add(l.yaw_deg);
 }
 
+// Whether a stack knob can change what a run does; see StackKnobActs.
+bool KnobActs(const std::string& path, bool valet, bool signals) {
+  if (!valet && path.rfind("parking.", 0) == 0) return false;
+  if (!signals && path.rfind("traffic_light.", 0) == 0) return false;
+  return true;
+}
+
 }  // namespace
+
+Status CheckKnobsAct(const spec::Spec& spec) {
+  Result<bool> signals = MapMayHaveSignals(spec.world.map);
+  if (!signals.ok()) return signals.status();
+  bool valet = false;
+  const size_t cases = std::max<size_t>(1, spec.cases.size());
+  for (size_t c = 0; c < cases; ++c) {
+    valet = valet || CaseSpec(spec, static_cast<int>(c)).task.kind ==
+                         world::TaskKind::kValetParking;
+  }
+  for (const spec::DesignParameter& p : spec.design_space.parameters) {
+    if (p.bind.rfind("stack.", 0) != 0) continue;
+    const std::string knob = p.bind.substr(6);
+    if (KnobActs(knob, valet, *signals)) continue;
+    return Status::InvalidArgument(fmt::format(
+        "design_space.{}: binds {}, which acts only {}; every point would "
+        "drive alike. Sweep it in a scenario where it acts, or drop it",
+        p.name, p.bind,
+        knob.rfind("parking.", 0) == 0
+            ? "in valet_parking tasks, and task.kind is lane_driving"
+            : "on maps with traffic signals, and world.map has none"));
+  }
+  return Status::Ok();
+}
 
 Result<std::string> RunKey(const spec::Spec& spec,
                            const spec::DesignPoint& point, uint64_t seed) {
@@ -162,8 +195,7 @@ Result<std::string> RunKey(const spec::Spec& spec,
   if (!signals.ok()) return signals.status();
   h.Add("stack");
   for (const KnobInfo& knob : StackKnobs()) {
-    if (!valet && knob.path.rfind("parking.", 0) == 0) continue;
-    if (!*signals && knob.path.rfind("traffic_light.", 0) == 0) continue;
+    if (!KnobActs(knob.path, valet, *signals)) continue;
     h.Add(knob.path).Add(spec.stack.Get(knob.path));
   }
   // Platform.

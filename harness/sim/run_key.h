@@ -23,6 +23,14 @@ namespace adse::sim {
 Result<std::string> RunKey(const spec::Spec& spec,
                            const spec::DesignPoint& point, uint64_t seed);
 
+// Ok unless a design parameter binds a stack knob that acts in none of the
+// scenario's runs (a `parking.*` knob outside valet_parking, a
+// `traffic_light.*` knob on a map without signals; run keys leave such
+// knobs out, so every point would drive alike): then InvalidArgument
+// naming the parameter ("design_space.<name>: ..."). Fails also when the
+// map cannot be read.
+Status CheckKnobsAct(const spec::Spec& spec);
+
 // The seed of a point's replica `replica` (harness.replicas; 0-based). It
 // seeds everything random in the run: traffic, cost sampling, sensor noise.
 // Replica 0 runs with the scenario's traffic seed, so a point run once keeps

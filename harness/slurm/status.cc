@@ -1,8 +1,14 @@
 #include "harness/slurm/status.h"
 
+#include <signal.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -58,7 +64,80 @@ std::string Summarise(const std::vector<JobState>& tasks) {
   return fmt::format("{} tasks: {}", tasks.size(), fmt::join(parts, ", "));
 }
 
+// Whether the lock holder's text ("pid N on HOST ...") names a process on
+// this host that is gone, or no holder is left (the lock file is emptied
+// when a campaign ends). A holder on another host cannot be checked.
+bool HolderIsGone(const std::string& holder) {
+  if (holder.empty()) return true;
+  unsigned long pid = 0;
+  char host[256] = {};
+  if (std::sscanf(holder.c_str(), "pid %lu on %255s", &pid, host) != 2) {
+    return false;
+  }
+  char here[256] = {};
+  ::gethostname(here, sizeof(here) - 1);
+  if (std::string(host) != here) return false;
+  return ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
+}
+
+// What the views in summary.json `j` are; a stopped campaign's reason.
+ViewsState ViewsOf(const json& j, const std::string& lock_holder,
+                   std::string* stopped_because) {
+  if (j.value("in_progress", false)) {
+    return HolderIsGone(lock_holder) ? ViewsState::kAbandoned
+                                     : ViewsState::kInProgress;
+  }
+  if (j.value("complete", false)) return ViewsState::kComplete;
+  *stopped_because = j.value("stopped_because", "");
+  const int signal = j.value("interrupted_by_signal", 0);
+  const int unfinished = j.value("unfinished", 0);
+  if (stopped_because->empty() && signal != 0) {
+    *stopped_because = fmt::format("stopped by signal {}", signal);
+  } else if (stopped_because->empty() && unfinished > 0) {
+    *stopped_because =
+        fmt::format("{} planned point(s) have no result yet", unfinished);
+  }
+  return ViewsState::kStopped;
+}
+
+// The content keys of the runs summary.json's evaluations stand on, or
+// nullopt when it lists none (views from before it did).
+std::optional<std::set<std::string>> KeysOf(const json& j) {
+  if (!j.contains("evaluations") || !j["evaluations"].is_array()) {
+    return std::nullopt;
+  }
+  std::set<std::string> keys;
+  for (const json& e : j["evaluations"]) {
+    if (!e.is_object()) continue;
+    if (e.contains("runs") && e["runs"].is_array()) {
+      for (const json& run : e["runs"]) {
+        if (run.is_object()) keys.insert(run.value("content_key", ""));
+      }
+    } else {
+      keys.insert(e.value("content_key", ""));
+    }
+  }
+  keys.erase("");
+  return keys;
+}
+
 }  // namespace
+
+const char* ViewsStateToString(ViewsState state) {
+  switch (state) {
+    case ViewsState::kNone:
+      return "none";
+    case ViewsState::kInProgress:
+      return "in_progress";
+    case ViewsState::kAbandoned:
+      return "abandoned";
+    case ViewsState::kStopped:
+      return "stopped";
+    case ViewsState::kComplete:
+      return "complete";
+  }
+  return "unknown";
+}
 
 const char* CampaignKindToString(CampaignKind kind) {
   switch (kind) {
@@ -103,28 +182,36 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
     st.strategy = plan->strategy;
     st.total = static_cast<int>(plan->points.size());
   }
-  Result<std::string> summary_text = ReadFile(folder + "/summary.json");
-  if (summary_text.ok()) {
-    const json j = json::parse(*summary_text, nullptr, false);
-    if (j.is_object()) {
-      st.has_views = true;
-      st.views_complete = j.value("complete", false);
-      if (st.strategy.empty()) st.strategy = j.value("strategy", "");
-      if (st.scenario.empty()) st.scenario = j.value("scenario_file", "");
-      if (st.total == 0) st.total = j.value("budget", 0);
-      // Without a plan, status counts run files: a point has one per
-      // case and replica.
-      if (!plan.ok()) {
-        st.total *= std::max(1, j.value("replicas", 1)) *
-                    std::max(1, j.value("cases", 1));
-      }
-    }
-  }
   Result<std::string> holder = ReadFile(folder + "/.lock", 4096);
   if (holder.ok()) {
     st.lock_holder = *holder;
     while (!st.lock_holder.empty() && st.lock_holder.back() == '\n') {
       st.lock_holder.pop_back();
+    }
+  }
+  // This campaign's runs, as its views list them (one key per replica and
+  // case): runs/ may hold others' too.
+  std::optional<std::set<std::string>> campaign_keys;
+  int runs_per_point = 1;
+  Result<std::string> summary_text = ReadFile(folder + "/summary.json");
+  if (summary_text.ok()) {
+    const json j = json::parse(*summary_text, nullptr, false);
+    if (j.is_object()) {
+      if (st.strategy.empty()) st.strategy = j.value("strategy", "");
+      if (st.scenario.empty()) st.scenario = j.value("scenario_file", "");
+      if (st.total == 0) st.total = j.value("budget", 0);
+      runs_per_point = std::max(1, j.value("replicas", 1)) *
+                       std::max(1, j.value("cases", 1));
+      // Without a plan, status counts run files: a point has one per
+      // case and replica.
+      if (!plan.ok()) st.total *= runs_per_point;
+      st.views = ViewsOf(j, st.lock_holder, &st.stopped_because);
+      campaign_keys = KeysOf(j);
+      if (st.views == ViewsState::kInProgress && j["running"].is_array()) {
+        for (const json& point : j["running"]) {
+          if (point.is_string()) st.running_points.push_back(point);
+        }
+      }
     }
   }
 
@@ -207,10 +294,35 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
       }
     }
   } else {
-    st.done = static_cast<int>(runs.size());
-    for (const std::string& key : failures) st.failed += runs.count(key) == 0;
-    st.running = static_cast<int>(st.running_steps.size());
+    const std::set<std::string>& counted =
+        campaign_keys ? *campaign_keys : runs;
+    int others = 0;
+    for (const std::string& key : runs) others += counted.count(key) == 0;
+    for (const std::string& key : failures) {
+      others += counted.count(key) == 0 && runs.count(key) == 0;
+    }
+    for (const std::string& key : counted) {
+      if (runs.count(key)) {
+        ++st.done;
+      } else if (failures.count(key)) {
+        ++st.failed;
+      }
+    }
+    st.running =
+        !st.running_steps.empty()
+            ? static_cast<int>(st.running_steps.size())
+            : static_cast<int>(st.running_points.size()) * runs_per_point;
     st.pending = std::max(0, st.total - st.done - st.failed - st.running);
+    // While the campaign runs, runs that landed after its views were
+    // written are not in them yet; once it ended, others are others'.
+    if (others > 0 && (st.views == ViewsState::kComplete ||
+                       st.views == ViewsState::kStopped)) {
+      st.notes.push_back(fmt::format(
+          "runs/ also holds {} run file(s) that no evaluation of this "
+          "campaign uses (another scenario, or another version of this one, "
+          "run into this folder); they are not counted",
+          others));
+    }
   }
   return st;
 }
@@ -254,14 +366,40 @@ std::string FormatStatus(const CampaignStatus& st) {
                       j.job.job_id, j.job.script, shards, j.summary);
     }
   }
-  if (!st.lock_holder.empty()) {
+  if (!st.running_points.empty()) {
+    out += "running points:\n";
+    for (const std::string& point : st.running_points) {
+      out += "  " + point + "\n";
+    }
+  }
+  if (!st.lock_holder.empty() && st.views != ViewsState::kAbandoned) {
     out += fmt::format("campaign lock: {}\n", st.lock_holder);
   }
-  if (st.has_views) {
-    out += fmt::format("views: {} (report.md, campaign.h5)\n",
-                       st.views_complete ? "complete" : "not complete yet");
-  } else {
-    out += "views: none yet\n";
+  switch (st.views) {
+    case ViewsState::kNone:
+      out += "views: none yet\n";
+      break;
+    case ViewsState::kInProgress:
+      out +=
+          "views: in progress (report.md, campaign.h5; rewritten as runs "
+          "come in)\n";
+      break;
+    case ViewsState::kAbandoned:
+      out += fmt::format(
+          "views: left in progress by a campaign that is no longer running "
+          "({}{}): run `adse run` again to resume it\n",
+          st.lock_holder.empty() ? "its lock was released" : st.lock_holder,
+          st.lock_holder.empty() ? "" : ", gone");
+      break;
+    case ViewsState::kStopped:
+      out += fmt::format(
+          "views: of a campaign that stopped before its end{} (report.md, "
+          "campaign.h5)\n",
+          st.stopped_because.empty() ? "" : ": " + st.stopped_because);
+      break;
+    case ViewsState::kComplete:
+      out += "views: complete (report.md, campaign.h5)\n";
+      break;
   }
   for (const std::string& note : st.notes) out += "note: " + note + "\n";
   return out;
@@ -297,23 +435,23 @@ std::string StatusJson(const CampaignStatus& st) {
                     {"active", j.active},
                     {"tasks", tasks}});
   }
-  const json j = {
-      {"folder", st.folder},
-      {"scenario", st.scenario},
-      {"strategy", st.strategy},
-      {"kind", CampaignKindToString(st.kind)},
-      {"total", st.total},
-      {"counts",
-       {{"done", st.done},
-        {"failed", st.failed},
-        {"running", st.running},
-        {"pending", st.pending}}},
-      {"running", running},
-      {"jobs", jobs},
-      {"lock_holder", st.lock_holder},
-      {"views",
-       st.has_views ? (st.views_complete ? "complete" : "incomplete") : "none"},
-      {"notes", st.notes}};
+  const json j = {{"folder", st.folder},
+                  {"scenario", st.scenario},
+                  {"strategy", st.strategy},
+                  {"kind", CampaignKindToString(st.kind)},
+                  {"total", st.total},
+                  {"counts",
+                   {{"done", st.done},
+                    {"failed", st.failed},
+                    {"running", st.running},
+                    {"pending", st.pending}}},
+                  {"running", running},
+                  {"running_points", st.running_points},
+                  {"jobs", jobs},
+                  {"lock_holder", st.lock_holder},
+                  {"views", ViewsStateToString(st.views)},
+                  {"stopped_because", st.stopped_because},
+                  {"notes", st.notes}};
   return j.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
 }
 

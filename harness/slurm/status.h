@@ -40,6 +40,17 @@ enum class CampaignKind {
 // The token of a kind ("sweep"), as `adse status --json` writes it.
 const char* CampaignKindToString(CampaignKind kind);
 
+// What the campaign's views (summary.json, report.md, campaign.h5) are.
+enum class ViewsState {
+  kNone,        // none written yet
+  kInProgress,  // written on the way by a campaign that is running
+  kAbandoned,   // written on the way by a campaign whose process is gone
+  kStopped,     // final, but the campaign stopped before its end
+  kComplete,    // final: the answer
+};
+// The token of a state ("in_progress"), as `adse status --json` writes it.
+const char* ViewsStateToString(ViewsState state);
+
 struct CampaignStatus {
   std::string folder;
   std::string scenario;
@@ -48,10 +59,13 @@ struct CampaignStatus {
   int total = 0;  // planned points, or the budget; 0 when unknown
   int done = 0, failed = 0, running = 0, pending = 0;
   std::vector<RunningStep> running_steps;
+  // The points a local campaign (or a coordinator) is running, as its views
+  // name them.
+  std::vector<std::string> running_points;
   std::vector<JobStatus> jobs;
-  std::string lock_holder;      // who holds (or last held) the campaign lock
-  bool views_complete = false;  // summary.json says the campaign finished
-  bool has_views = false;
+  std::string lock_holder;  // who holds (or last held) the campaign lock
+  ViewsState views = ViewsState::kNone;
+  std::string stopped_because;  // why a stopped campaign stopped
   std::vector<std::string> notes;
 };
 

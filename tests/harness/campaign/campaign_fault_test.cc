@@ -162,18 +162,23 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(CampaignCrashTest,
      ACrashBetweenWriteAndRenameLeavesNoCompleteLookingFileAndResumes) {
   const std::string out = TempDir("crash");
-  // The coordinator dies at its first commit of campaign.h5, after the
-  // temporary was written and flushed and before the rename.
-  ASSERT_EQ(testing::RunUntilCrash(FaultOp::kRenameFile, "campaign.h5",
-                                   [&](Env* env) {
-                                     (void)RunCampaign(
-                                         adse::testing::SmallScenario(),
-                                         Options(out, env));
-                                   }),
+  // The coordinator dies at its second commit of campaign.h5 (the first
+  // is at the first proposal, before any run ended), after the temporary
+  // was written and flushed and before the rename.
+  ASSERT_EQ(testing::RunUntilCrash(
+                FaultOp::kRenameFile, "campaign.h5",
+                [&](Env* env) {
+                  (void)RunCampaign(adse::testing::SmallScenario(),
+                                    Options(out, env));
+                },
+                /*after=*/1),
             testing::kCrashExitCode);
 
-  EXPECT_FALSE(fs::exists(out + "/campaign.h5"))
-      << "the index was never committed";
+  // The committed index is the first one's, of no evaluation.
+  Result<runfile::CampaignIndex> index =
+      runfile::ReadCampaignIndex(out + "/campaign.h5");
+  ASSERT_TRUE(index.ok()) << index.status().message();
+  EXPECT_TRUE(index->evaluations.empty());
   bool index_temporary = false;
   for (const std::string& name : Temporaries(out)) {
     index_temporary |= name.rfind("campaign.h5.tmp.", 0) == 0;

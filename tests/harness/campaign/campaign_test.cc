@@ -16,6 +16,7 @@
 #include <set>
 #include <thread>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "analysis/runfile/campaign_file.h"
@@ -208,6 +209,70 @@ TEST(CampaignTest,
   }
 }
 
+// Reads the folder's views each time the campaign proposes, after they
+// were written for that proposal.
+class ViewsWatcher : public ExplorerListener {
+ public:
+  explicit ViewsWatcher(std::string folder) : folder_(std::move(folder)) {}
+  void OnProposed(const explore::Strategy& /*strategy*/,
+                  const runfile::IterationRow& /*iteration*/,
+                  const std::vector<spec::DesignPoint>& points) override {
+    Seen seen;
+    seen.summary = nlohmann::json::parse(
+        ReadFile(folder_ + "/summary.json").value(), nullptr, false);
+    seen.report = ReadFile(folder_ + "/report.md").value();
+    seen.proposed = points;
+    seen_.push_back(std::move(seen));
+  }
+  struct Seen {
+    nlohmann::json summary;
+    std::string report;
+    std::vector<spec::DesignPoint> proposed;
+  };
+  const std::vector<Seen>& seen() const { return seen_; }
+
+ private:
+  std::string folder_;
+  std::vector<Seen> seen_;
+};
+
+TEST(CampaignTest,
+     ViewsWrittenWhileTheCampaignRunsSayItIsInProgressAndWhatRuns) {
+  const spec::Spec spec = adse::testing::SmallScenario();
+  const std::string out = TempDir("in-progress");
+  ViewsWatcher watcher(out);
+  CampaignOptions o = Options(out, "agent", 3);
+  o.listener = &watcher;
+  Result<CampaignSummary> s = RunCampaign(spec, o);
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_GE(watcher.seen().size(), 2u);
+  for (size_t i = 0; i < watcher.seen().size(); ++i) {
+    const ViewsWatcher::Seen& seen = watcher.seen()[i];
+    ASSERT_TRUE(seen.summary.is_object()) << i;
+    EXPECT_TRUE(seen.summary["in_progress"].get<bool>()) << i;
+    EXPECT_FALSE(seen.summary["complete"].get<bool>()) << i;
+    // The agent proposes one point per round, after the last one's result.
+    const std::string point =
+        spec::FormatPoint(spec.design_space, seen.proposed.at(0));
+    EXPECT_EQ(seen.summary["running"], nlohmann::json::array({point})) << i;
+    EXPECT_EQ(seen.summary["evaluations"].size(), i) << i;
+    EXPECT_THAT(seen.report,
+                HasSubstr(fmt::format("> **In progress:** {} of 3 evaluations "
+                                      "so far, running `{}`",
+                                      i, point)));
+  }
+  EXPECT_THAT(watcher.seen()[0].report,
+              HasSubstr("## Answer\n\nNo evaluation has a result yet."));
+  // The end's views are the answer.
+  const nlohmann::json summary =
+      nlohmann::json::parse(ReadFile(out + "/summary.json").value());
+  EXPECT_FALSE(summary["in_progress"].get<bool>());
+  EXPECT_TRUE(summary["complete"].get<bool>());
+  EXPECT_TRUE(summary["running"].empty());
+  EXPECT_THAT(ReadFile(out + "/report.md").value(),
+              ::testing::Not(HasSubstr("In progress")));
+}
+
 TEST(CampaignTest, ASecondCampaignOnALockedFolderIsRefused) {
   const spec::Spec spec = adse::testing::SmallScenario();
   const std::string out = TempDir("locked");
@@ -367,11 +432,19 @@ TEST(
                             "as bad input, as every run would be: worker "
                             "exited with status 2"),
                   HasSubstr("found none for ndt_scan_matcher/points")));
-  // Nothing that reads as an answer, and no failure a mended scenario
-  // would reuse.
-  for (const char* view : {"report.md", "summary.json", "campaign.h5"}) {
-    EXPECT_FALSE(fs::exists(out + "/" + view)) << view;
-  }
+  // The views say why it stopped and hold no answer; no failure is
+  // recorded that a mended scenario would reuse.
+  const std::string report = ReadFile(out + "/report.md").value();
+  EXPECT_THAT(report, HasSubstr("**Stopped: its first run was refused as bad "
+                                "input"));
+  EXPECT_THAT(report, ::testing::Not(HasSubstr("## Answer")));
+  const nlohmann::json summary =
+      nlohmann::json::parse(ReadFile(out + "/summary.json").value());
+  EXPECT_FALSE(summary["complete"].get<bool>());
+  EXPECT_FALSE(summary["in_progress"].get<bool>());
+  EXPECT_THAT(summary["stopped_because"].get<std::string>(),
+              HasSubstr("found none for ndt_scan_matcher/points"));
+  EXPECT_TRUE(summary["answer"]["cheapest_feasible"].is_null());
   EXPECT_EQ(FailureRecords(out), 0);
 
   o.worker_command = {kAdse, "worker"};

@@ -181,6 +181,41 @@ TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
   EXPECT_NE(status.out.find("\"total\": 2"), std::string::npos) << status.out;
 }
 
+TEST(CliRunTest, ARunIntoAnotherScenariosFolderWarnsAndStatusCountsItsOwnRuns) {
+  const fs::path out = fs::temp_directory_path() / "adse_cli_two_scenarios";
+  fs::remove_all(out);
+  const CommandRun first = Adse("run " + SmallScenarioPath() +
+                                " --budget 1 --no-cache -o " + out.string());
+  ASSERT_EQ(first.exit_code, 0) << first.out;
+  EXPECT_EQ(first.out.find("warning"), std::string::npos) << first.out;
+  // Another scenario (another name, another first point) into the same
+  // folder.
+  const std::string other = WriteScenario(
+      "other_name", Replaced(Replaced(ReadText(SmallScenarioPath()),
+                                      "values: [1, 4, 16]", "values: [16]"),
+                             "name: robotaxi-small", "name: other-small"));
+  const CommandRun second =
+      Adse("run " + other + " --budget 1 --no-cache -o " + out.string());
+  ASSERT_EQ(second.exit_code, 0) << second.out;
+  EXPECT_NE(second.out.find("warning: " + out.string() +
+                            " holds the campaign of another scenario, "
+                            "'robotaxi-small'"),
+            std::string::npos)
+      << second.out;
+  const CommandRun status = Adse("status " + out.string());
+  ASSERT_EQ(status.exit_code, 0) << status.out;
+  EXPECT_NE(status.out.find("runs: 1 done, 0 failed, 0 running, 0 pending "
+                            "(of 1)"),
+            std::string::npos)
+      << status.out;
+  EXPECT_NE(status.out.find("runs/ also holds 1 run file(s) that no "
+                            "evaluation of this campaign uses"),
+            std::string::npos)
+      << status.out;
+  EXPECT_NE(status.out.find("answer (campaign.h5):"), std::string::npos)
+      << status.out;
+}
+
 TEST(CliRunTest, AnInfeasiblePointsProgressLineNamesTheConstraintItBroke) {
   // No run meets a 1 ms latency; no early stop ends a run for it either,
   // so the run reaches the goal and is still infeasible. One point,

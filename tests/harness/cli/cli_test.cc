@@ -167,6 +167,21 @@ TEST(CliTest, ACostThatIsNotFiniteAtSomePointIsRefusedBeforeAnythingRuns) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+TEST(CliTest, AKnobThatCannotActInTheScenarioIsRefusedAtItsLine) {
+  const std::string file =
+      Variant("dead_knob", "  lidar_hz: {bind: stack.lidar.rate_hz",
+              "  lidar_hz: {bind: stack.parking.rate_hz");
+  const CommandRun run = Adse("validate -q --no-world " + file);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_TRUE(std::regex_search(
+      run.out,
+      std::regex("adse_cli_dead_knob\\.yaml:32:[0-9]+: error: "
+                 "design_space\\.lidar_hz: binds stack\\.parking\\.rate_hz, "
+                 "which acts only in valet_parking tasks, and task\\.kind is "
+                 "lane_driving; every point would drive alike")))
+      << run.out;
+}
+
 TEST(CliTest, MisspelledKeyGetsADidYouMeanAndNothingIsWritten) {
   const std::string file = Variant("typo", "weather: clear", "wether: clear");
   const fs::path out = fs::temp_directory_path() / "adse_cli_typo_out";

@@ -93,6 +93,41 @@ TEST(RunKeyTest, TrafficLightKnobsEnterOnlyKeysOfMapsWithSignals) {
   std::filesystem::remove_all(dir);
 }
 
+// A knob the keys leave out would make every point drive alike: sweeping
+// it is refused, naming the parameter.
+TEST(RunKeyTest, SweepingAKnobThatCannotActIsRefusedByName) {
+  EXPECT_TRUE(CheckKnobsAct(Small()).ok());
+  auto with_knob = [](spec::Spec s, const std::string& bind) {
+    s.design_space.parameters.push_back({"knob", bind});
+    s.design_space.parameters.back().values = {1, 2};
+    return s;
+  };
+  const Status parking =
+      CheckKnobsAct(with_knob(Small(), "stack.parking.rate_hz"));
+  EXPECT_EQ(parking.code(), Status::Code::kInvalidArgument);
+  EXPECT_EQ(parking.message().rfind("design_space.knob: binds "
+                                    "stack.parking.rate_hz, which acts only "
+                                    "in valet_parking tasks",
+                                    0),
+            0u)
+      << parking.message();
+  const Status signals = CheckKnobsAct(
+      with_knob(Small(), "stack.traffic_light.detector_latency_s"));
+  EXPECT_EQ(signals.code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(signals.message().find("acts only on maps with traffic signals, "
+                                   "and world.map has none"),
+            std::string::npos)
+      << signals.message();
+  // Where they act, they may be swept.
+  spec::Spec valet = Small();
+  valet.task.kind = world::TaskKind::kValetParking;
+  EXPECT_TRUE(CheckKnobsAct(with_knob(valet, "stack.parking.rate_hz")).ok());
+  Result<spec::Spec> rilsa = spec::LoadSpec(
+      std::string(ADSE_SOURCE_DIR) + "/scenarios/rilsa_traffic_light.yaml");
+  ASSERT_TRUE(rilsa.ok()) << rilsa.status().ToString();
+  EXPECT_TRUE(CheckKnobsAct(*rilsa).ok());
+}
+
 TEST(RunKeyTest, ConstraintsEnterOnlyWhenTheyCanStopTheRunEarly) {
   const spec::Spec base = Small();  // nav_time_s <= 60, ctrl_rate_hz >= 1, ...
   spec::Spec off = base;

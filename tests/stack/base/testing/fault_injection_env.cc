@@ -85,7 +85,7 @@ Status FaultInjectionEnv::CopyFile(const std::string& from,
 }
 
 int RunUntilCrash(FaultOp op, const std::string& path_contains,
-                  const std::function<void(Env* env)>& body) {
+                  const std::function<void(Env* env)>& body, int after) {
   const pid_t child = ::fork();
   if (child < 0) return -1;
   if (child == 0) {
@@ -93,6 +93,7 @@ int RunUntilCrash(FaultOp op, const std::string& path_contains,
     Fault crash;
     crash.op = op;
     crash.path_contains = path_contains;
+    crash.after = after;
     crash.crash = true;
     env.Inject(crash);
     body(&env);

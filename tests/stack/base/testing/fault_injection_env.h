@@ -49,12 +49,13 @@ inline constexpr int kCrashExitCode = 86;
 class FaultInjectionEnv;
 
 // Runs `body` in a forked child process, with an Env that ends the child
-// at the first `op` on a path containing `path_contains` (e.g. a rename
-// after the write: a crash between the two). Returns the child's exit
-// status: kCrashExitCode when it died there, 0 when it got through, -1 when
-// it could not be started or was killed by a signal.
+// at the first `op` on a path containing `path_contains` after `after`
+// such calls went through (e.g. a rename after the write: a crash between
+// the two). Returns the child's exit status: kCrashExitCode when it died
+// there, 0 when it got through, -1 when it could not be started or was
+// killed by a signal.
 int RunUntilCrash(FaultOp op, const std::string& path_contains,
-                  const std::function<void(Env* env)>& body);
+                  const std::function<void(Env* env)>& body, int after = 0);
 
 class FaultInjectionEnv : public EnvWrapper {
  public:
