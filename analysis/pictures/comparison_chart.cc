@@ -67,16 +67,25 @@ Result<std::string> ComparisonChartPng(const std::vector<ComparisonRow>& rows,
     }
     label_px = std::min(label_px, o.width_px / 3);
     const int x0 = margin + label_px + s.Px(8);
-    const int value_px = s.Px(90);  // room for the value after a bar
+    const int value_px = s.Px(130);  // room for the values after a pair
     const int x1 = o.width_px - margin - value_px;
     double top = 0.0;
     for (const ComparisonRow& r : rows) {
       top = std::max({top, r.adse, r.reference.value_or(0.0)});
     }
-    // Five ticks of a round step: the axis ends at most one step past
-    // the longest bar (a round top alone, 500 for a bar of 217, left half
-    // the chart empty).
-    top = 5.0 * internal::NiceAbove((top > 0 ? top : 1.0) / 5.0);
+    // Four to six ticks of a round step, whichever ends nearest past the
+    // longest bar (five alone put a bar of 370 on an axis to 500; a round
+    // top alone, 500 for a bar of 217, left half the chart empty).
+    const double longest = top > 0 ? top : 1.0;
+    int ticks = 5;
+    top = 5.0 * internal::NiceAbove(longest / 5.0);
+    for (int n : {4, 6}) {
+      const double candidate = n * internal::NiceAbove(longest / n);
+      if (candidate < top) {
+        top = candidate;
+        ticks = n;
+      }
+    }
     auto x_of = [&](double v) {
       return x0 + static_cast<int>(std::lround((x1 - x0) * v / top));
     };
@@ -98,8 +107,8 @@ Result<std::string> ComparisonChartPng(const std::vector<ComparisonRow>& rows,
     // Grid and axis ticks.
     const int y_bottom =
         header + static_cast<int>(rows.size()) * o.row_height_px;
-    for (int i = 0; i <= 5; ++i) {
-      const double v = top * i / 5.0;
+    for (int i = 0; i <= ticks; ++i) {
+      const double v = top * i / ticks;
       const int x = x_of(v);
       cv::line(img, {x, header - s.Px(4)}, {x, y_bottom},
                cv::Scalar(225, 225, 225), 1);
@@ -119,11 +128,19 @@ Result<std::string> ComparisonChartPng(const std::vector<ComparisonRow>& rows,
       auto draw_bar = [&](double v, int top_y, Rgb colour) {
         cv::rectangle(img, cv::Rect(x0, top_y, std::max(1, x_of(v) - x0), bar),
                       Bgr(colour), cv::FILLED);
-        DrawText(&img, fmt::format("{:.1f}", v), x_of(v) + s.Px(4),
-                 top_y + bar - 1, Align::kLeft, s, internal::kBlack, false);
       };
       draw_bar(r.adse, y, kAdseBarRgb);
       if (r.reference) draw_bar(*r.reference, y + bar, kReferenceBarRgb);
+      // Both values on one line past the longer bar, in the legend's
+      // order: two bars are thinner than a line of text each.
+      const std::string values =
+          r.reference ? fmt::format("{:.1f} / {:.1f}", r.adse, *r.reference)
+                      : fmt::format("{:.1f}", r.adse);
+      int baseline = 0;
+      const int text_h = internal::TextSize(values, s, &baseline).height;
+      DrawText(&img, values,
+               x_of(std::max(r.adse, r.reference.value_or(0.0))) + s.Px(4),
+               y + bar + text_h / 2, Align::kLeft, s, internal::kBlack, false);
     }
     std::string png;
     ADSE_RETURN_IF_ERROR(internal::EncodeOk(img, &png));

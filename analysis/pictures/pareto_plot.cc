@@ -279,6 +279,20 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
       covered += grown.contains(
           cv::Point(static_cast<int>(c.x), static_cast<int>(c.y)));
     }
+    // A bound hidden under the legend weighs as much as a few designs.
+    constexpr size_t kBoundWeight = 3;
+    for (double v : o.vertical_lines) {
+      const double x = px(v, ay.min).x;
+      if (std::isfinite(v) && x >= grown.x && x <= grown.x + grown.width) {
+        covered += kBoundWeight;
+      }
+    }
+    for (double v : o.horizontal_lines) {
+      const double y = px(ax.min, v).y;
+      if (std::isfinite(v) && y >= grown.y && y <= grown.y + grown.height) {
+        covered += kBoundWeight;
+      }
+    }
     if (covered < least_covered) {
       least_covered = covered;
       legend_box = box;
@@ -330,6 +344,14 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
     }
     return true;
   };
+  // Labels already placed: never overlapped, whatever point they cover.
+  std::vector<cv::Rect> labels;
+  auto clear_of_labels = [&](const cv::Rect& box) {
+    for (const cv::Rect& r : labels) {
+      if ((box & r).area() > 0) return false;
+    }
+    return true;
+  };
   // Front designs drawn on one marker (equal cost and time, e.g. 4 cores
   // at 3 GHz and 6 at 2 GHz) share one label, so that no design on the
   // front hides under another's: the first two named, the rest counted.
@@ -337,6 +359,7 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
     cv::Point centre;
     std::string text;
     int designs = 1;
+    bool ringed = false;  // its label keeps clear of the ring
   };
   std::vector<MarkerLabel> marker_labels;
   for (const auto* p : front) {
@@ -348,9 +371,10 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
         std::find_if(marker_labels.begin(), marker_labels.end(),
                      [&](const MarkerLabel& m) { return m.centre == centre; });
     if (same == marker_labels.end()) {
-      marker_labels.push_back({centre, Ascii(p->label)});
-    } else if (++same->designs == 2) {
-      same->text += ", " + Ascii(p->label);
+      marker_labels.push_back({centre, Ascii(p->label), 1, p->highlight});
+    } else {
+      same->ringed = same->ringed || p->highlight;
+      if (++same->designs == 2) same->text += ", " + Ascii(p->label);
     }
   }
   for (MarkerLabel& m : marker_labels) {
@@ -362,7 +386,8 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
     const std::string& label = m.text;
     const cv::Size size = TextSize(label, s, &baseline);
     const int h = size.height + baseline;
-    const int gap = s.Px(8);
+    // Past the ring (radius + 5 px, 1.5 px wide) of a ringed design.
+    const int gap = m.ringed ? radius + s.Px(9) : s.Px(8);
     // Top-left corners of the candidate boxes: right, upper right, lower
     // right, left, upper left, lower left, above, below.
     const int cx = static_cast<int>(c.x), cy = static_cast<int>(c.y);
@@ -381,13 +406,15 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
         const cv::Rect box(corner.x - s.Px(2), corner.y - s.Px(1),
                            size.width + s.Px(4), h + s.Px(2));
         if ((box & area) != box) continue;
-        if (!clear_of(box, taken, own_point)) continue;
+        if (!clear_of(box, taken, own_point) || !clear_of_labels(box)) {
+          continue;
+        }
         if (pass == 0 && !clear_of(box, others, own_point)) continue;
         // On white, so the dots of other designs under it do not garble it.
         cv::rectangle(img, box, kWhite, cv::FILLED);
         DrawText(&img, label, corner.x, corner.y + size.height, Align::kLeft, s,
                  kDarkGrey, false);
-        taken.push_back(box);
+        labels.push_back(box);
         placed = true;
         break;
       }

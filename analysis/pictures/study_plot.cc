@@ -122,6 +122,17 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
   for (const ParetoPlotPoint& p : points) {
     if (Placed(p)) draw_triangle(px(p.nav_time_s, p.cost), p.feasible);
   }
+  // The answer: the campaign's cheapest feasible design, ringed.
+  auto draw_ring = [&](cv::Point2d c) {
+    cv::circle(img, Fixed(c), s.Px(9) * static_cast<int>(kShiftScale), kBlack,
+               s.Px(1.5), cv::LINE_AA, kShift);
+  };
+  bool any_highlight = false;
+  for (const ParetoPlotPoint& p : points) {
+    if (!Placed(p) || !p.highlight) continue;
+    draw_ring(px(p.nav_time_s, p.cost));
+    any_highlight = true;
+  }
   cv::rectangle(img, area, kBlack, 1);
 
   // Legend: at the top (right, middle or left) where it covers the fewest
@@ -136,6 +147,13 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
        [&](cv::Point2d c) { draw_triangle(c, true); }},
       {o.points_name + ", infeasible",
        [&](cv::Point2d c) { draw_triangle(c, false); }}};
+  if (any_highlight) {
+    entries.push_back(
+        {o.points_name + ", cheapest feasible", [&](cv::Point2d c) {
+           draw_triangle(c, true);
+           draw_ring(c);
+         }});
+  }
   if (!reference.empty()) {
     entries.push_back({o.reference_name, [&](cv::Point2d c) {
                          draw_dot(c, kReferenceDot, dot);

@@ -199,10 +199,10 @@ Status Refusal(PoolEvaluator& evaluator) {
   return Status::InvalidArgument("the campaign stopped: " + *reason);
 }
 
-// The views of a folder that holds another scenario's campaign are about
-// to become this one's; its runs stay (content keys never collide).
-void WarnOfAnotherScenario(const spec::Spec& spec,
-                           const CampaignFolder& folder) {
+// The views of a folder that hold another scenario's campaign, or more
+// evaluations than this campaign's budget, are about to become this
+// campaign's; say so. The runs stay (content keys never collide).
+void WarnOfViewsReplaced(const spec::Spec& spec, const CampaignFolder& folder) {
   Result<std::string> text = ReadFile(folder.Path("summary.json"));
   if (!text.ok()) return;
   const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
@@ -210,14 +210,29 @@ void WarnOfAnotherScenario(const spec::Spec& spec,
     return;
   }
   const std::string other = j["scenario"];
-  if (other == spec.name) return;
-  std::fprintf(stderr,
-               "warning: %s holds the campaign of another scenario, '%s' "
-               "(%s); its runs stay in runs/, but report.md, summary.json, "
-               "campaign.h5 and pareto.png become those of '%s'\n",
-               folder.root().c_str(), other.c_str(),
-               j.value("scenario_file", std::string("?")).c_str(),
-               spec.name.c_str());
+  const std::string views =
+      "report.md, summary.json, campaign.h5 and pareto.png";
+  if (other != spec.name) {
+    std::fprintf(stderr,
+                 "warning: %s holds the campaign of another scenario, '%s' "
+                 "(%s); its runs stay in runs/, but %s become those of "
+                 "'%s'\n",
+                 folder.root().c_str(), other.c_str(),
+                 j.value("scenario_file", std::string("?")).c_str(),
+                 views.c_str(), spec.name.c_str());
+    return;
+  }
+  const size_t before = j.contains("evaluations") && j["evaluations"].is_array()
+                            ? j["evaluations"].size()
+                            : 0;
+  if (before > static_cast<size_t>(std::max(0, spec.exploration.budget))) {
+    std::fprintf(stderr,
+                 "warning: %s holds %zu evaluations, more than this "
+                 "campaign's budget of %d; their runs stay in runs/, but %s "
+                 "become those of this campaign's %d\n",
+                 folder.root().c_str(), before, spec.exploration.budget,
+                 views.c_str(), spec.exploration.budget);
+  }
 }
 
 void CountSources(CampaignSummary* summary) {
@@ -254,7 +269,7 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
   ADSE_RETURN_IF_ERROR(folder.Create());
   Result<CampaignLock> lock = CampaignLock::Acquire(folder.root());
   if (!lock.ok()) return lock.status();
-  WarnOfAnotherScenario(spec, folder);
+  WarnOfViewsReplaced(spec, folder);
   // Created under the lock: the llm strategy records into the folder.
   Result<std::unique_ptr<explore::Strategy>> strategy =
       CreateCampaignStrategy(spec, folder.root(), /*record=*/true, options.env);

@@ -90,6 +90,11 @@ struct CampaignSummary {
   // Why the campaign stopped with no answer (its first run refused as bad
   // input), or empty.
   std::string stopped_because;
+  // An analysis of a campaign folder without summary.json: whether the
+  // campaign finished is not recorded.
+  bool finished_unknown = false;
+  // Said in the report and summary.json (an analysis' unreadable runs).
+  std::vector<std::string> notes;
 };
 
 // Runs (or resumes) the campaign of `spec`. Errors: InvalidArgument for

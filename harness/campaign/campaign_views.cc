@@ -294,9 +294,8 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
       running.push_back("`" + spec::FormatPoint(spec.design_space, p) + "`");
     }
     md << fmt::format(
-        "> **In progress:** {} of {} evaluations so far{}. This report is "
-        "rewritten as runs come in; it holds the answer once `adse run` "
-        "ends.\n\n",
+        "> **In progress:** {} of {} evaluations so far{}; the answer comes "
+        "when the campaign ends.\n\n",
         rows.size(), spec.exploration.budget,
         running.empty()
             ? std::string()
@@ -314,6 +313,11 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
       rows.size(), s.simulated, s.reused, s.failed);
   md << fmt::format("- workers: {}, {}\n", s.workers, s.isolation);
   if (!s.isolation_note.empty()) md << "- note: " << s.isolation_note << "\n";
+  for (const std::string& note : s.notes) md << "- note: " << note << "\n";
+  if (s.finished_unknown) {
+    md << "- whether the campaign finished is not recorded (its folder has "
+          "no summary.json)\n";
+  }
   md << fmt::format("- wall time: {}\n", Duration(s.wall_s));
   if (s.interrupted_by != 0) {
     md << fmt::format(
@@ -525,8 +529,10 @@ Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
   if (!summary.stopped_because.empty()) {
     j["stopped_because"] = summary.stopped_because;
   }
-  j["complete"] = !summary.in_progress && summary.interrupted_by == 0 &&
-                  summary.unfinished == 0 && summary.stopped_because.empty();
+  j["complete"] = !summary.in_progress && !summary.finished_unknown &&
+                  summary.interrupted_by == 0 && summary.unfinished == 0 &&
+                  summary.stopped_because.empty();
+  j["notes"] = summary.notes;
   j["counts"] = {{"evaluations", rows.size()},
                  {"simulated", summary.simulated},
                  {"reused", summary.reused},

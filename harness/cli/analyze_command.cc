@@ -49,6 +49,47 @@ std::string NextVersion(const fs::path& root) {
   return (root / fmt::format("v{}", last + 1)).string();
 }
 
+// An analysis version is written into a private folder and renamed to
+// its number whole at the end, so that a stopped analysis never leaves a
+// version that looks complete.
+struct VersionFolder {
+  std::string final_path;  // <root>/vN
+  std::string tmp_path;    // written into until Commit
+};
+
+VersionFolder StartVersion(const fs::path& root) {
+  VersionFolder v;
+  v.final_path = NextVersion(root);
+  v.tmp_path = TemporaryPathFor(v.final_path);
+  std::error_code ec;
+  fs::remove_all(v.tmp_path, ec);
+  return v;
+}
+
+Status CommitVersion(const VersionFolder& v) {
+  ADSE_RETURN_IF_ERROR(Env::Default()->RenameFile(v.tmp_path, v.final_path));
+  return Env::Default()->SyncDir(fs::path(v.final_path).parent_path());
+}
+
+// Prints why the analysis stopped and removes its unfinished version;
+// returns `exit_code`.
+int Abandon(const VersionFolder& v, const std::string& message, int exit_code) {
+  std::error_code ec;
+  fs::remove_all(v.tmp_path, ec);
+  std::fprintf(stderr, "error: %s\n", message.c_str());
+  return exit_code;
+}
+
+// A report's picture paths, written into the private folder, as they are
+// once it is renamed.
+void MoveImagePaths(const VersionFolder& v, report::RunReport* report) {
+  for (auto& [name, path] : report->images) {
+    if (path.rfind(v.tmp_path, 0) == 0) {
+      path = v.final_path + path.substr(v.tmp_path.size());
+    }
+  }
+}
+
 std::vector<std::string> RunFilesIn(const fs::path& folder) {
   std::vector<std::string> out;
   std::error_code ec;
@@ -88,18 +129,43 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
         std::fprintf(stderr, "error: %s: not valid JSON\n", p.string().c_str());
         return std::nullopt;
       }
+      // Every entry an object with a point, or the file is not ours.
+      auto malformed = [&](const std::string& what) {
+        std::fprintf(stderr, "error: %s: %s\n", p.string().c_str(),
+                     what.c_str());
+        return std::nullopt;
+      };
+      auto has_point = [](const nlohmann::json& r) {
+        return r.is_object() && r.contains("point") && r["point"].is_object();
+      };
       if (doc.contains("evaluations") && doc["evaluations"].is_array()) {
+        const nlohmann::json front_rows =
+            doc.value("pareto_front", nlohmann::json::array());
+        if (!front_rows.is_array()) {
+          return malformed("pareto_front: expected a list of evaluations");
+        }
         std::set<std::string> front;
-        for (const auto& r : doc.value("pareto_front", nlohmann::json::array()))
+        for (const auto& r : front_rows) {
+          if (!has_point(r)) {
+            return malformed(
+                "pareto_front: expected evaluations, each an "
+                "object with a point");
+          }
           front.insert(r.value("content_key", ""));
+        }
         nlohmann::json runs = nlohmann::json::array();
         for (nlohmann::json r : doc["evaluations"]) {
+          if (!has_point(r)) {
+            return malformed(
+                fmt::format("evaluations[{}]: expected an object with a point",
+                            runs.size()));
+          }
           r["on_front"] = front.count(r.value("content_key", "")) > 0;
           runs.push_back(r);
         }
         return nlohmann::json{{"runs", runs}};
       }
-      if (doc.contains("point")) {
+      if (has_point(doc)) {
         return nlohmann::json{{"runs", nlohmann::json::array({doc})}};
       }
       std::fprintf(stderr,
@@ -201,6 +267,39 @@ int Diff(const std::string& a_path, const std::string& b_path, bool json) {
                 fmt::format("{}", fmt::join(what, "; ")).c_str());
   }
   return 0;
+}
+
+// What the campaign's own summary.json says of how it ended (stopped by a
+// signal, still running, ...), carried into the analysis' views: an
+// analysis does not make a campaign complete.
+void CarryCampaignState(const campaign::CampaignFolder& folder,
+                        campaign::CampaignSummary* summary) {
+  Result<std::string> text = ReadFile(folder.Path("summary.json"));
+  const nlohmann::json j = text.ok()
+                               ? nlohmann::json::parse(*text, nullptr, false)
+                               : nlohmann::json();
+  if (!j.is_object()) {
+    summary->finished_unknown = true;
+    return;
+  }
+  auto number = [&](const char* key) {
+    return j.contains(key) && j[key].is_number_integer() ? j[key].get<int>()
+                                                         : 0;
+  };
+  summary->interrupted_by = number("interrupted_by_signal");
+  summary->unfinished = number("unfinished");
+  summary->in_progress = j.contains("in_progress") &&
+                         j["in_progress"].is_boolean() &&
+                         j["in_progress"].get<bool>();
+  if (j.contains("stopped_because") && j["stopped_because"].is_string()) {
+    summary->stopped_because = j["stopped_because"];
+  }
+  if (j.contains("wall_s") && j["wall_s"].is_number()) {
+    summary->wall_s = j["wall_s"];
+  }
+  if (j.contains("workers") && j["workers"].is_number_integer()) {
+    summary->workers = j["workers"];
+  }
 }
 
 // A campaign's runs/ folder stands for its campaign: analyses live in
@@ -322,10 +421,20 @@ int AnalyzeFolder(const std::string& target,
                  scenario_source.c_str(), spec.status().message().c_str());
     return 2;
   }
-  const std::string version = NextVersion(fs::path(target) / "analysis");
+  // The campaign as it ran: its budget and strategy (--budget, --strategy)
+  // rather than the stored scenario's.
+  if (index) {
+    spec->exploration.budget = static_cast<int>(index->budget);
+    spec->exploration.strategy = index->strategy;
+  }
+  const VersionFolder v = StartVersion(fs::path(target) / "analysis");
+  const std::string& version = v.tmp_path;
+  // Whatever stops the analysis leaves no version behind.
+  auto fail = [&](const std::string& message, int code) {
+    return Abandon(v, message, code);
+  };
   if (Status s = MakeDirs(version + "/reports"); !s.ok()) {
-    std::fprintf(stderr, "error: %s\n", s.message().c_str());
-    return 1;
+    return fail(s.message(), 1);
   }
   std::vector<campaign::EvaluationRow> rows;
   for (auto& [item, run] : loaded) {
@@ -335,22 +444,19 @@ int AnalyzeFolder(const std::string& target,
                                 : run.content_key;
     options.image_dir = version + "/images/" + key;
     if (Status s = MakeDirs(options.image_dir); !s.ok()) {
-      std::fprintf(stderr, "error: %s\n", s.message().c_str());
-      return 1;
+      return fail(s.message(), 1);
     }
     Result<report::RunReport> report =
         report::AnalyzeRun(run, item.file, options);
     if (!report.ok()) {
-      std::fprintf(stderr, "error: %s: %s\n", item.file.c_str(),
-                   report.status().message().c_str());
-      fs::remove_all(version, ec);
-      return ExitCodeFor(report.status());
+      return fail(item.file + ": " + report.status().message(),
+                  ExitCodeFor(report.status()));
     }
+    MoveImagePaths(v, &*report);
     if (Status s = WriteJson(version + "/reports/" + key + ".json",
                              report::ToJson(*report));
         !s.ok()) {
-      std::fprintf(stderr, "error: %s\n", s.message().c_str());
-      return 1;
+      return fail(s.message(), 1);
     }
     campaign::EvaluationRow row = campaign::RowFromReport(*report);
     row.index = item.row.index;
@@ -385,10 +491,17 @@ int AnalyzeFolder(const std::string& target,
     summary.failed += !row.complete();
     summary.reused += row.complete();
   }
+  if (index) CarryCampaignState(folder, &summary);
+  if (unreadable > 0) {
+    summary.notes.push_back(fmt::format(
+        "{} run file(s) could not be read: {}", unreadable,
+        index ? "their points are kept as campaign.h5 recorded them, not "
+                "analysed again"
+              : "they are left out"));
+  }
   if (Status s = campaign::WriteAnswerViews(*spec, summary, version, "images");
       !s.ok()) {
-    std::fprintf(stderr, "error: %s\n", s.message().c_str());
-    return 1;
+    return fail(s.message(), 1);
   }
   if (reference != nullptr) {
     const std::string png = version + "/pareto.png";
@@ -399,12 +512,12 @@ int AnalyzeFolder(const std::string& target,
                         reference->spec.name, reference->rows.size()),
             png);
         !s.ok()) {
-      std::fprintf(stderr, "error: %s: %s\n", png.c_str(), s.message().c_str());
-      return 1;
+      return fail(png + ": " + s.message(), 1);
     }
   }
+  if (Status s = CommitVersion(v); !s.ok()) return fail(s.message(), 1);
   if (json) {
-    Result<std::string> text = ReadFile(version + "/summary.json");
+    Result<std::string> text = ReadFile(v.final_path + "/summary.json");
     std::printf("%s", text.ok() ? text->c_str() : "{}\n");
   } else {
     std::printf("%s: %zu runs analysed", target.c_str(), loaded.size());
@@ -418,7 +531,7 @@ int AnalyzeFolder(const std::string& target,
                           *spec, rows, campaign::ComputeHeadline(*spec, rows))
                           .c_str());
     std::printf("wrote %s (report.md, summary.json, pareto.png%s)\n",
-                version.c_str(),
+                v.final_path.c_str(),
                 reference != nullptr
                     ? (" in the study's form over " + reference->folder).c_str()
                     : "");
@@ -513,25 +626,30 @@ int RunAnalyze(const AnalyzeArgs& args) {
       exit_code = 2;
       continue;
     }
-    const std::string version =
-        NextVersion(file.substr(0, file.size() - 3) + ".analysis");
-    options.image_dir = version;
-    if (Status s = MakeDirs(version); !s.ok()) {
-      std::fprintf(stderr, "error: %s\n", s.message().c_str());
-      return 1;
-    }
+    // run.h5 -> run.analysis; a name without ".h5" keeps all of it.
+    const fs::path as_path(file);
+    const std::string base =
+        as_path.extension() == ".h5"
+            ? (as_path.parent_path() / as_path.stem()).string()
+            : file;
+    const VersionFolder v = StartVersion(base + ".analysis");
+    auto fail = [&](const std::string& message, int code) {
+      return Abandon(v, message, code);
+    };
+    options.image_dir = v.tmp_path;
+    if (Status s = MakeDirs(v.tmp_path); !s.ok()) return fail(s.message(), 1);
     Result<report::RunReport> report = report::AnalyzeRun(*run, file, options);
     if (!report.ok()) {
-      std::fprintf(stderr, "error: %s: %s\n", file.c_str(),
-                   report.status().message().c_str());
-      fs::remove_all(version, ec);
-      return ExitCodeFor(report.status());
+      return fail(file + ": " + report.status().message(),
+                  ExitCodeFor(report.status()));
     }
+    MoveImagePaths(v, &*report);
     const nlohmann::json doc = report::ToJson(*report);
-    if (Status s = WriteJson(version + "/report.json", doc); !s.ok()) {
-      std::fprintf(stderr, "error: %s\n", s.message().c_str());
-      return 1;
+    if (Status s = WriteJson(v.tmp_path + "/report.json", doc); !s.ok()) {
+      return fail(s.message(), 1);
     }
+    if (Status s = CommitVersion(v); !s.ok()) return fail(s.message(), 1);
+    const std::string& version = v.final_path;
     if (args.json) {
       std::printf("%s\n", doc.dump(2).c_str());
     } else {

@@ -2,11 +2,18 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
 
 #include "harness/sim/run_key.h"
 #include "harness/spec/spec_parser.h"
+#include "stack/base/env.h"
+#include "stack/base/files.h"
 
 namespace adse::cli {
 
@@ -93,6 +100,107 @@ void ReportError(const spec::Spec& spec, const Status& status) {
   const std::string where =
       field.empty() ? spec.source_path + ": " : spec.Where(field);
   std::fprintf(stderr, "%serror: %s\n", where.c_str(), message.c_str());
+}
+
+Status CheckOutputFolder(const std::string& out,
+                         const OutputFolderLayout& layout) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path path(out);
+  if (!fs::exists(path, ec)) return Status::Ok();
+  const std::string hint =
+      "; give a new folder (or an earlier output's, which is replaced)";
+  if (!fs::is_directory(path, ec)) {
+    return Status::InvalidArgument("-o " + out + ": a file is there" + hint);
+  }
+  const fs::path relative =
+      fs::current_path(ec).lexically_relative(fs::weakly_canonical(path, ec));
+  if (relative.native().rfind("..", 0) != 0) {
+    return Status::InvalidArgument(
+        "-o " + out + ": the current folder or one above it" + hint);
+  }
+  for (const auto& entry : fs::directory_iterator(path, ec)) {
+    const std::string name = entry.path().filename().string();
+    bool ours = std::find(layout.files.begin(), layout.files.end(), name) !=
+                layout.files.end();
+    if (!layout.subfolder.empty() && name == layout.subfolder &&
+        entry.is_directory(ec)) {
+      ours = true;
+      for (const auto& file : fs::directory_iterator(entry.path(), ec)) {
+        ours = ours && file.path().extension() == layout.subfolder_extension;
+      }
+    }
+    if (!ours) {
+      return Status::InvalidArgument(
+          "-o " + out + ": the folder holds " + (path / name).string() +
+          ", which this command does not write" + hint);
+    }
+  }
+  return Status::Ok();
+}
+
+Status CheckOutputFile(const std::string& out, OutputFileKind kind) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (fs::path up = fs::path(out).parent_path(); !up.empty();
+       up = up.parent_path()) {
+    if (fs::exists(up, ec)) {
+      if (!fs::is_directory(up, ec)) {
+        return Status::InvalidArgument("-o " + out + ": " + up.string() +
+                                       " is a file, not a folder");
+      }
+      break;
+    }
+    if (up == up.parent_path()) break;
+  }
+  if (!fs::exists(out, ec)) return Status::Ok();
+  const std::string what = kind == kRunFile ? "a run file (HDF5)"
+                                            : "a calibration (adse calibrate's "
+                                              "JSON)";
+  if (fs::is_directory(out, ec)) {
+    return Status::InvalidArgument("-o " + out + ": a folder is there; give " +
+                                   what + "'s path");
+  }
+  bool ours = false;
+  if (kind == kRunFile) {
+    std::string head(8, '\0');
+    std::ifstream(out, std::ios::binary).read(head.data(), 8);
+    ours = head == std::string("\x89HDF\r\n\x1a\n", 8);
+  } else {
+    Result<std::string> text = ReadFile(out, 16u << 20);
+    const nlohmann::json doc =
+        text.ok() ? nlohmann::json::parse(*text, nullptr, false)
+                  : nlohmann::json();
+    ours = doc.is_object() && doc.contains("adse_calibration");
+  }
+  if (!ours) {
+    return Status::InvalidArgument("-o " + out + ": a file that is not " +
+                                   what + " is there; give another path");
+  }
+  return Status::Ok();
+}
+
+Status PutFolderInPlace(const std::string& tmp, const std::string& out) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const std::string parent = fs::path(out).parent_path().empty()
+                                 ? std::string(".")
+                                 : fs::path(out).parent_path().string();
+  ADSE_RETURN_IF_ERROR(MakeDirs(parent));
+  const std::string earlier = TemporaryPathFor(out + ".earlier");
+  const bool replacing = fs::exists(out, ec);
+  Status status;
+  if (replacing) status = Env::Default()->RenameFile(out, earlier);
+  if (status.ok()) status = Env::Default()->RenameFile(tmp, out);
+  if (status.ok()) status = Env::Default()->SyncDir(parent);
+  if (replacing) {
+    if (status.ok()) {
+      fs::remove_all(earlier, ec);
+    } else if (!fs::exists(out, ec)) {
+      fs::rename(earlier, out, ec);
+    }
+  }
+  return status;
 }
 
 }  // namespace adse::cli

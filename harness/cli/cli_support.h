@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "harness/spec/spec.h"
 #include "stack/base/status.h"
@@ -32,6 +33,42 @@ std::optional<spec::Spec> LoadWorkerCaseOrReport(const std::string& path,
 // Prints `status` as "file:line:col: error: message", locating the field
 // path that starts the message ("task.goal: ...") in the scenario.
 void ReportError(const spec::Spec& spec, const Status& status);
+
+// What a command writes into its output folder, so that an earlier output
+// of it can be told from anything else.
+struct OutputFolderLayout {
+  std::vector<std::string> files;  // "summary.json", ...
+  // A subfolder of files with one extension ("scans", ".pcd"), or empty.
+  std::string subfolder;
+  std::string subfolder_extension;
+};
+
+// Ok when `out` may take a new output folder: nothing is there, or an
+// earlier output of the same layout is (which PutFolderInPlace replaces).
+// Otherwise InvalidArgument saying what is there: a file, the current
+// folder or one above it, or an entry no such output holds.
+Status CheckOutputFolder(const std::string& out,
+                         const OutputFolderLayout& layout);
+
+// What a command's output file is, so that an earlier one can be told
+// from anything else.
+enum class OutputFileKind {
+  kRunFile,          // HDF5 (adse simulate)
+  kCalibrationFile,  // JSON with "adse_calibration" (adse calibrate)
+};
+inline constexpr OutputFileKind kRunFile = OutputFileKind::kRunFile;
+inline constexpr OutputFileKind kCalibrationFile =
+    OutputFileKind::kCalibrationFile;
+
+// Ok when the command may write `out`: nothing is there, or an earlier
+// output of its kind is (which the new one replaces). A scenario, a
+// folder, any other file, or a parent that is a file is InvalidArgument,
+// so that it is said before anything runs.
+Status CheckOutputFile(const std::string& out, OutputFileKind kind);
+
+// Renames the finished folder `tmp` to `out`, an earlier output there
+// stepping aside first and going only once the new one is in place.
+Status PutFolderInPlace(const std::string& tmp, const std::string& out);
 
 }  // namespace adse::cli
 

@@ -6,6 +6,8 @@
 // host gives, a folder without such runs), 1 otherwise.
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -194,6 +196,20 @@ Status WritePointRuns(const std::string& dir, size_t n,
   return written;
 }
 
+// A file of an earlier call's comparison in `dir` (its text, or a run
+// file in runs/), or nullopt.
+std::optional<std::string> EarlierComparison(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(dir + "/fidelity.txt", ec)) return dir + "/fidelity.txt";
+  for (const auto& e : fs::directory_iterator(dir + "/runs", ec)) {
+    if (e.is_regular_file(ec) && e.path().extension() == ".h5") {
+      return e.path().string();
+    }
+  }
+  return std::nullopt;
+}
+
 // `adse fidelity --compare DIR`: the runs an earlier call wrote, compared
 // again (after a change to the comparison, or to read them with another
 // binary); the run files are left as they are.
@@ -263,6 +279,16 @@ int RunFidelity(const FidelityArgs& args) {
   }
   Comparisons c;
   c.dir = args.out.empty() ? spec->ResolvedOutput() + "/fidelity" : args.out;
+  // An earlier call's runs are worth keeping (real-time runs take long),
+  // and mixed with this call's they would be compared as one point's.
+  if (std::optional<std::string> earlier = EarlierComparison(c.dir)) {
+    std::fprintf(stderr,
+                 "error: %s holds an earlier adse fidelity's comparison (%s): "
+                 "give another folder with -o, or remove it; `adse fidelity "
+                 "--compare %s` compares its runs again\n",
+                 c.dir.c_str(), earlier->c_str(), c.dir.c_str());
+    return 2;
+  }
   if (Status made = MakeDirs(c.dir); !made.ok()) {
     std::fprintf(stderr, "error: %s\n", made.message().c_str());
     return 1;

@@ -583,33 +583,47 @@ int main(int argc, char** argv) {
     // CLI11 uses its own codes; usage errors are bad input (2).
     return code == 0 ? 0 : 2;
   }
-  if (seed_opt->count() > 0) world.seed = seed;
-  if (simulate_seed_opt->count() > 0) simulate.seed = simulate_seed;
-  if (worker_seed_opt->count() > 0) worker.seed = worker_seed;
-  if (*profile_import_cmd) return adse::cli::RunProfileImport(profile_import);
-  if (*profile_show_cmd) return adse::cli::RunProfileShow(profile_show);
-  if (*profile_check_cmd) return adse::cli::RunProfileCheck(profile_check);
-  if (*fidelity_cmd) return adse::cli::RunFidelity(fidelity);
-  if (*run_cmd) return adse::cli::RunRun(run);
-  if (*submit_cmd) return adse::cli::RunSubmit(submit);
-  if (*status_cmd) return adse::cli::RunStatus(status);
-  if (*shard_cmd) return adse::cli::RunShard(shard);
-  if (*index_cmd) return adse::cli::RunIndex(index);
-  if (*worker_cmd) return adse::cli::RunWorker(worker);
-  if (*explore_cmd) return adse::cli::RunExplore(explore);
-  if (*interpret_cmd) return adse::cli::RunInterpret(interpret);
-  if (*simulate_cmd) return adse::cli::RunSimulate(simulate);
-  if (*calibrate_cmd) return adse::cli::RunCalibrate(calibrate);
-  if (*schema_check_cmd) return adse::cli::RunSchemaCheck(schema_check);
-  if (*analyze_cmd) {
-    if (analyze.targets.empty() && analyze.diff.empty()) {
-      std::fprintf(
-          stderr, "error: analyze needs run files or folders, or --diff A B\n");
-      return 2;
+  // An exception that escapes a command is a defect of adse; it is said
+  // plainly rather than ending the process with an abort.
+  auto dispatch = [&]() -> int {
+    if (seed_opt->count() > 0) world.seed = seed;
+    if (simulate_seed_opt->count() > 0) simulate.seed = simulate_seed;
+    if (worker_seed_opt->count() > 0) worker.seed = worker_seed;
+    if (*profile_import_cmd) return adse::cli::RunProfileImport(profile_import);
+    if (*profile_show_cmd) return adse::cli::RunProfileShow(profile_show);
+    if (*profile_check_cmd) return adse::cli::RunProfileCheck(profile_check);
+    if (*fidelity_cmd) return adse::cli::RunFidelity(fidelity);
+    if (*run_cmd) return adse::cli::RunRun(run);
+    if (*submit_cmd) return adse::cli::RunSubmit(submit);
+    if (*status_cmd) return adse::cli::RunStatus(status);
+    if (*shard_cmd) return adse::cli::RunShard(shard);
+    if (*index_cmd) return adse::cli::RunIndex(index);
+    if (*worker_cmd) return adse::cli::RunWorker(worker);
+    if (*explore_cmd) return adse::cli::RunExplore(explore);
+    if (*interpret_cmd) return adse::cli::RunInterpret(interpret);
+    if (*simulate_cmd) return adse::cli::RunSimulate(simulate);
+    if (*calibrate_cmd) return adse::cli::RunCalibrate(calibrate);
+    if (*schema_check_cmd) return adse::cli::RunSchemaCheck(schema_check);
+    if (*analyze_cmd) {
+      if (analyze.targets.empty() && analyze.diff.empty()) {
+        std::fprintf(
+            stderr,
+            "error: analyze needs run files or folders, or --diff A B\n");
+        return 2;
+      }
+      return adse::cli::RunAnalyze(analyze);
     }
-    return adse::cli::RunAnalyze(analyze);
+    if (*validate_cmd) return adse::cli::RunValidate(validate);
+    if (*world_cmd) return adse::cli::RunWorld(world);
+    return 2;
+  };
+  try {
+    return dispatch();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr,
+                 "error: internal error (a defect of adse; please report it "
+                 "with the command): %s\n",
+                 e.what());
+    return 1;
   }
-  if (*validate_cmd) return adse::cli::RunValidate(validate);
-  if (*world_cmd) return adse::cli::RunWorld(world);
-  return 2;
 }

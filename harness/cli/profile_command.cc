@@ -3,6 +3,7 @@
 // ok, 2 bad input (a missing or malformed report, mapping or profile), 1
 // anything else (e.g. the write failed); a failed import writes nothing.
 #include <cstdio>
+#include <filesystem>
 #include <set>
 #include <string>
 #include <utility>
@@ -104,6 +105,18 @@ int RunProfileCheck(const ProfileCheckArgs& args) {
   }
   spec.design_space.parameters = std::move(kept);
   spec.exploration.start_from.clear();
+  // By default one folder per case, as simulate and world keep theirs.
+  const std::string out =
+      !args.out.empty()
+          ? args.out
+          : spec.ResolvedOutput() + "/profile-check" +
+                (spec.task_case.empty() ? "" : "/" + spec.task_case);
+  if (Status usable =
+          CheckOutputFolder(out, {{"run.h5", "check.txt", "check.png"}});
+      !usable.ok()) {
+    std::fprintf(stderr, "error: %s\n", usable.message().c_str());
+    return 2;
+  }
   std::fprintf(stderr,
                "simulating %s on the reference machine of profile '%s': %d "
                "cores at %g GHz, LiDAR %g Hz ...\n",
@@ -127,11 +140,11 @@ int RunProfileCheck(const ProfileCheckArgs& args) {
       profile::FormatProfileCheck(check);
   std::printf("%s", text.c_str());
 
-  const std::string dir =
-      args.out.empty() ? spec.ResolvedOutput() + "/profile-check" : args.out;
-  Status saved = MakeDirs(dir);
-  if (saved.ok()) saved = runfile::WriteRunFile(dir + "/run.h5", *run);
-  if (saved.ok()) saved = WriteFileAtomic(dir + "/check.txt", text);
+  // The three files go into a private folder renamed into place whole.
+  const std::string tmp = TemporaryPathFor(out);
+  Status saved = MakeDirs(tmp);
+  if (saved.ok()) saved = runfile::WriteRunFile(tmp + "/run.h5", *run);
+  if (saved.ok()) saved = WriteFileAtomic(tmp + "/check.txt", text);
   if (saved.ok()) {
     // The chains, then the callbacks that cost at least 1 ms at the source.
     std::vector<analysis::ComparisonRow> rows;
@@ -147,13 +160,16 @@ int RunProfileCheck(const ProfileCheckArgs& args) {
         "profile check{}: mean latency, adse on {} cores at {} GHz vs {}",
         of_case, args.cores, costs->costs.reference_ghz, costs->name);
     o.reference_name = "measured by CARET";
-    saved = analysis::RenderComparisonChart(rows, o, dir + "/check.png");
+    saved = analysis::RenderComparisonChart(rows, o, tmp + "/check.png");
   }
+  if (saved.ok()) saved = PutFolderInPlace(tmp, out);
   if (!saved.ok()) {
+    std::error_code ec;
+    std::filesystem::remove_all(tmp, ec);
     std::fprintf(stderr, "error: %s\n", saved.message().c_str());
     return ExitCodeFor(saved);
   }
-  std::printf("\nwrote %s/run.h5, check.txt, check.png\n", dir.c_str());
+  std::printf("\nwrote %s/run.h5, check.txt, check.png\n", out.c_str());
   return 0;
 }
 

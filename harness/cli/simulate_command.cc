@@ -74,6 +74,17 @@ int RunSimulate(const SimulateArgs& args) {
       std::fflush(stderr);
     };
   }
+  // A seed of its own gets a file of its own.
+  const std::string out =
+      args.out.empty()
+          ? spec->output + "/simulate/" + PointSlug(*point) +
+                (spec->task_case.empty() ? "" : "_" + spec->task_case) +
+                (args.seed ? fmt::format("_seed{}", *args.seed) : "") + ".h5"
+          : args.out;
+  if (Status usable = CheckOutputFile(out, kRunFile); !usable.ok()) {
+    std::fprintf(stderr, "error: %s\n", usable.message().c_str());
+    return 2;
+  }
   sim::SimulationStats stats;
   Result<runfile::RunData> run =
       sim::SimulatePoint(*spec, *point, options, &stats);
@@ -82,11 +93,6 @@ int RunSimulate(const SimulateArgs& args) {
     ReportError(*spec, run.status());
     return ExitCodeFor(run.status());
   }
-  const std::string out =
-      args.out.empty()
-          ? spec->output + "/simulate/" + PointSlug(*point) +
-                (spec->task_case.empty() ? "" : "_" + spec->task_case) + ".h5"
-          : args.out;
   // The analysis (deviation fit, diagnosis) of the fresh run; its metrics
   // are stored with the run's own.
   Result<report::RunReport> analysed =
@@ -149,6 +155,11 @@ int RunCalibrate(const CalibrateArgs& args) {
   if (!spec) return 2;
   std::optional<spec::DesignPoint> point = ResolvePoint(*spec, args.point);
   if (!point) return 2;
+  if (Status usable = CheckOutputFile(args.out, kCalibrationFile);
+      !usable.ok()) {
+    std::fprintf(stderr, "error: %s\n", usable.message().c_str());
+    return 2;
+  }
   // Calibration measures host CPU time, whatever the scenario asked for.
   spec->platform.cost_model = spec::CostModel::kMeasured;
   std::vector<runfile::RunData> runs;

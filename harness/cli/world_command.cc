@@ -121,6 +121,14 @@ int RunWorld(const WorldArgs& args) {
           ? spec->output + "/world-check" +
                 (spec->task_case.empty() ? "" : "/" + spec->task_case)
           : args.out;
+  const OutputFolderLayout layout{
+      {"trajectory.csv", "ideal_path.csv", "scans.csv", "summary.json"},
+      "scans",
+      ".pcd"};
+  if (Status usable = CheckOutputFolder(out, layout); !usable.ok()) {
+    std::fprintf(stderr, "error: %s\n", usable.message().c_str());
+    return 2;
+  }
   const std::string tmp = TemporaryPathFor(out);
   std::error_code ec;
   fs::remove_all(tmp, ec);
@@ -196,15 +204,7 @@ int RunWorld(const WorldArgs& args) {
     status = WriteText(tmp + "/" + name, text);
     if (!status.ok()) break;
   }
-  if (status.ok()) {
-    const std::string parent = fs::path(out).parent_path().empty()
-                                   ? std::string(".")
-                                   : fs::path(out).parent_path().string();
-    fs::remove_all(out, ec);
-    status = MakeDirs(parent);
-    if (status.ok()) status = Env::Default()->RenameFile(tmp, out);
-    if (status.ok()) status = Env::Default()->SyncDir(parent);
-  }
+  if (status.ok()) status = PutFolderInPlace(tmp, out);
   if (!status.ok()) {
     fs::remove_all(tmp, ec);
     std::fprintf(stderr, "error: %s\n", status.message().c_str());

@@ -452,6 +452,23 @@ Result<std::vector<PointRuns>> ReadPointRuns(const std::string& dir) {
         first.scenario_text, first_path + ": scenario/yaml", "", parse);
     if (!stored.ok()) return stored.status();
     runs.point = spec::FormatPoint(stored->design_space, first.design_point);
+    // A point's files from two calls into one folder would be compared as
+    // one point's.
+    std::vector<const runfile::RunData*> all;
+    for (const runfile::RunData& r : runs.virtual_runs) all.push_back(&r);
+    for (const auto& per_dispatch : runs.perturbed_runs) {
+      for (const runfile::RunData& r : per_dispatch) all.push_back(&r);
+    }
+    for (const runfile::RunData& r : runs.realtime_runs) all.push_back(&r);
+    for (const runfile::RunData* r : all) {
+      if (r->design_point != first.design_point) {
+        return Status::InvalidArgument(fmt::format(
+            "{}: point {}'s run files are of different design points ({} and "
+            "{}): the folder mixes the runs of several adse fidelity calls",
+            folder.string(), n, runs.point,
+            spec::FormatPoint(stored->design_space, r->design_point)));
+      }
+    }
     out.push_back(std::move(runs));
   }
   return out;

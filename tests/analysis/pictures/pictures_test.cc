@@ -458,6 +458,20 @@ TEST_F(PictureTest, StudyPlotDrawsTheCampaignOverTheReferenceWithItsBound) {
   EXPECT_GT(CountColour(*img, kStudyPointRgb), 4 * 15);
   EXPECT_GT(CountColour(*img, kReferenceRgb), 4 * 10);
   EXPECT_GT(CountColour(*img, kReferenceFrontRgb), 200);  // the front line
+  // The campaign's cheapest feasible design is ringed in black.
+  std::vector<ParetoPlotPoint> ringed = points;
+  ringed[1].highlight = true;
+  Result<std::string> ringed_png = StudyPlotPng(ringed, reference, options);
+  ASSERT_TRUE(ringed_png.ok());
+  {
+    std::ofstream out(Path("ringed_study.png"), std::ios::binary);
+    out << *ringed_png;
+  }
+  Result<RgbImage> ringed_img = ReadImage(Path("ringed_study.png"));
+  ASSERT_TRUE(ringed_img.ok());
+  // The ring, and its sample in the legend.
+  EXPECT_GT(CountColour(*ringed_img, Rgb{0, 0, 0}),
+            CountColour(*img, Rgb{0, 0, 0}) + 40);
   // Without a reference only the campaign's own points are drawn.
   Result<std::string> alone = StudyPlotPng(points, {}, options);
   ASSERT_TRUE(alone.ok());
@@ -542,6 +556,63 @@ TEST_F(PictureTest, AFrontLabelGoesWhereItHidesNoOtherDesign) {
   EXPECT_GT(CountColour(*unlabelled, kFeasibleRgb), 40);
   EXPECT_EQ(CountColour(*labelled, kFeasibleRgb),
             CountColour(*unlabelled, kFeasibleRgb));
+}
+
+TEST_F(PictureTest, FrontLabelsNeverOverlapOneAnother) {
+  // Two front designs a few pixels apart, the second inside the place the
+  // first one's label takes: the second label goes elsewhere or is left
+  // out (and counted), never over the first, whose text stays whole (a
+  // label drawn over another garbled both: "1?/1.2/7").
+  const ParetoPlotPoint a{5.0, 100.0, true, true, "14/1.2/7"};
+  const ParetoPlotPoint b{5.04, 99.7, true, true, "17/1/7"};
+  // The front's last point close by in cost (no staircase to the right of
+  // the two), a dominated design far off setting the scale.
+  const ParetoPlotPoint far{5.1, 50.0, true, true, ""};
+  const ParetoPlotPoint scale{10.0, 120.0, true, false, ""};
+  ParetoPlotPoint a_bare = a, b_bare = b;
+  a_bare.label.clear();
+  b_bare.label.clear();
+  auto render = [&](const std::vector<ParetoPlotPoint>& points,
+                    const std::string& name) {
+    EXPECT_TRUE(RenderParetoPlot(points, Path(name)).ok());
+    Result<RgbImage> img = ReadImage(Path(name));
+    EXPECT_TRUE(img.ok());
+    return img.ok() ? *img : RgbImage{};
+  };
+  const RgbImage none = render({a_bare, b_bare, far, scale}, "none.png");
+  const RgbImage only_a = render({a, b_bare, far, scale}, "only_a.png");
+  const RgbImage both = render({a, b, far, scale}, "both.png");
+  ASSERT_EQ(none.width_px, both.width_px);
+  int a_text = 0, a_changed = 0;
+  for (int r = 0; r < none.height_px; ++r) {
+    for (int c = 0; c < none.width_px; ++c) {
+      if (only_a.At(c, r) == none.At(c, r)) continue;  // not A's label
+      ++a_text;
+      a_changed += both.At(c, r) != only_a.At(c, r);
+    }
+  }
+  EXPECT_GT(a_text, 100);
+  EXPECT_EQ(a_changed, 0);
+}
+
+TEST_F(PictureTest, ARingedDesignsRingStaysWholeBesideItsLabel) {
+  // The ringed design is the front's last, so its label takes the place
+  // to its right, where the ring is; a dominated design far off sets the
+  // scale.
+  std::vector<ParetoPlotPoint> points = {{5, 100, true, true, "6/1.5/7"},
+                                         {10, 50, true, true, "10/2.1/7"},
+                                         {20, 120, true, false, ""}};
+  points[1].highlight = true;
+  ASSERT_TRUE(RenderParetoPlot(points, Path("ringed.png")).ok());
+  for (ParetoPlotPoint& p : points) p.label.clear();
+  ASSERT_TRUE(RenderParetoPlot(points, Path("ringed_bare.png")).ok());
+  Result<RgbImage> labelled = ReadImage(Path("ringed.png"));
+  Result<RgbImage> bare = ReadImage(Path("ringed_bare.png"));
+  ASSERT_TRUE(labelled.ok() && bare.ok());
+  // The ring is the picture's only black besides the frame, the ticks and
+  // the axes' text, which the labels (dark grey) leave alone.
+  EXPECT_EQ(CountColour(*labelled, Rgb{0, 0, 0}),
+            CountColour(*bare, Rgb{0, 0, 0}));
 }
 
 TEST_F(PictureTest, FrontDesignsThatTieShareOneLabelNamingThemAll) {

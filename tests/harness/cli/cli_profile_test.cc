@@ -21,6 +21,7 @@ using adse::testing::ReadText;
 using adse::testing::Replaced;
 using adse::testing::SmallScenarioPath;
 using adse::testing::Variant;
+using adse::testing::WriteScenario;
 
 std::string TrimmedCaret() {
   return std::string(ADSE_SOURCE_DIR) +
@@ -124,16 +125,34 @@ TEST(CliProfileTest, CheckComparesTheChainsOnTheReferenceMachine) {
   EXPECT_EQ(check.out.find("  beyond 5 %", units), std::string::npos)
       << check.out;
 
-  // A scenario with task.cases checks the case it is told to drive.
-  const fs::path parked = fs::temp_directory_path() / "adse_cli_check_case";
-  fs::remove_all(parked);
-  const CommandRun nose_in = Adse(
-      "profile check " + std::string(ADSE_SOURCE_DIR) +
-      "/scenarios/valet_parking.yaml --case nose_in -o " + parked.string());
+  // A scenario with task.cases checks the case it is told to drive, by
+  // default into a folder of that case's.
+  const fs::path campaign = fs::temp_directory_path() / "adse_cli_valet_check";
+  const std::string valet = WriteScenario(
+      "valet_check", Replaced(ReadText(std::string(ADSE_SOURCE_DIR) +
+                                       "/scenarios/valet_parking.yaml"),
+                              "output: results/valet-parking",
+                              "output: " + campaign.string()));
+  const fs::path parked = campaign / "profile-check";
+  fs::remove_all(campaign);
+  const CommandRun nose_in = Adse("profile check " + valet + " --case nose_in");
   ASSERT_EQ(nose_in.exit_code, 0) << nose_in.out;
   EXPECT_NE(nose_in.out.find(", case nose_in: goal_reached"), std::string::npos)
       << nose_in.out;
-  EXPECT_TRUE(fs::is_regular_file(parked / "run.h5"));
+  EXPECT_TRUE(fs::is_regular_file(parked / "nose_in" / "run.h5"));
+  EXPECT_FALSE(fs::exists(parked / "run.h5"));
+
+  // A folder holding what the check does not write is refused before
+  // anything runs, and kept.
+  std::ofstream(out / "notes.txt") << "mine\n";
+  const CommandRun others =
+      Adse("profile check " + SmallScenarioPath() + " -o " + out.string());
+  EXPECT_EQ(others.exit_code, 2) << others.out;
+  EXPECT_NE(others.out.find("notes.txt, which this command does not write"),
+            std::string::npos)
+      << others.out;
+  EXPECT_EQ(others.out.find("simulating"), std::string::npos) << others.out;
+  EXPECT_TRUE(fs::exists(out / "run.h5"));
 
   // A scenario without a profile has nothing to check.
   const std::string calibrated =

@@ -214,6 +214,18 @@ TEST(CliRunTest, ARunIntoAnotherScenariosFolderWarnsAndStatusCountsItsOwnRuns) {
       << status.out;
   EXPECT_NE(status.out.find("answer (campaign.h5):"), std::string::npos)
       << status.out;
+  // The same scenario with a smaller budget than the folder's views hold.
+  const CommandRun wider =
+      Adse("run " + other + " --budget 2 --no-cache -o " + out.string());
+  ASSERT_EQ(wider.exit_code, 0) << wider.out;
+  const CommandRun smaller =
+      Adse("run " + other + " --budget 1 --no-cache -o " + out.string());
+  ASSERT_EQ(smaller.exit_code, 0) << smaller.out;
+  EXPECT_NE(smaller.out.find("warning: " + out.string() +
+                             " holds 2 evaluations, more than this "
+                             "campaign's budget of 1"),
+            std::string::npos)
+      << smaller.out;
 }
 
 TEST(CliRunTest, AnInfeasiblePointsProgressLineNamesTheConstraintItBroke) {
@@ -333,6 +345,46 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
   EXPECT_EQ(FrontSection(runs.out), FrontSection(run.out)) << runs.out;
   EXPECT_TRUE(fs::exists(out / "analysis" / "v3" / "report.md"));
   EXPECT_FALSE(fs::exists(out / "runs" / "analysis"));
+
+  // The analysis says how the campaign ended, as its own views do: its
+  // budget (the run's --budget 7, not the scenario's 12), a stop, or that
+  // nothing records whether it finished.
+  auto analysed = [&](const std::string& version) {
+    return nlohmann::json::parse(
+        ReadText((out / "analysis" / version / "summary.json").string()));
+  };
+  EXPECT_EQ(analysed("v3")["budget"], 7);
+  EXPECT_TRUE(analysed("v3")["complete"].get<bool>());
+  nlohmann::json own =
+      nlohmann::json::parse(ReadText((out / "summary.json").string()));
+  own["interrupted_by_signal"] = 2;
+  own["complete"] = false;
+  std::ofstream(out / "summary.json") << own.dump(2);
+  ASSERT_EQ(Adse("analyze " + out.string()).exit_code, 0);
+  EXPECT_FALSE(analysed("v4")["complete"].get<bool>());
+  EXPECT_NE(ReadText((out / "analysis" / "v4" / "report.md").string())
+                .find("stopped early by signal 2"),
+            std::string::npos);
+  fs::remove(out / "summary.json");
+  ASSERT_EQ(Adse("analyze " + out.string()).exit_code, 0);
+  EXPECT_FALSE(analysed("v5")["complete"].get<bool>());
+  EXPECT_NE(ReadText((out / "analysis" / "v5" / "report.md").string())
+                .find("whether the campaign finished is not recorded"),
+            std::string::npos);
+  // Each version's pictures are named where they are, not where they were
+  // written.
+  for (const auto& e :
+       fs::directory_iterator(out / "analysis" / "v5" / "reports")) {
+    const nlohmann::json report =
+        nlohmann::json::parse(ReadText(e.path().string()));
+    EXPECT_EQ(report["images"]["trajectory"].get<std::string>().rfind(
+                  (out / "analysis" / "v5" / "images").string(), 0),
+              0u)
+        << report["images"];
+  }
+  for (const auto& e : fs::directory_iterator(out / "analysis")) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos);
+  }
 }
 
 TEST(CliRunTest, AnalyzeOfACampaignWithCasesFoldsEveryCaseAsRunDid) {

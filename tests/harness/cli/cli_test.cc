@@ -265,6 +265,92 @@ TEST(CliTest, WorldFollowIdealReachesTheGoalAndWritesWhatItSaw) {
   EXPECT_FALSE(fs::exists(out / "scans" / "scan_00010.pcd"));
 }
 
+TEST(CliTest, WorldFollowIdealNeverReplacesWhatItDidNotWrite) {
+  const fs::path dir = fs::temp_directory_path() / "adse_cli_world_others";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "results");
+  std::ofstream(dir / "results" / "precious.txt") << "keep me\n";
+  std::ofstream(dir / "scenario.yaml") << "keep me too\n";
+  const std::string world = "world " + Example() + " --follow-ideal -o ";
+  const CommandRun folder = Adse(world + (dir / "results").string());
+  EXPECT_EQ(folder.exit_code, 2) << folder.out;
+  EXPECT_NE(folder.out.find((dir / "results" / "precious.txt").string() +
+                            ", which this command does not write"),
+            std::string::npos)
+      << folder.out;
+  const CommandRun file = Adse(world + (dir / "scenario.yaml").string());
+  EXPECT_EQ(file.exit_code, 2) << file.out;
+  EXPECT_NE(file.out.find("a file is there"), std::string::npos) << file.out;
+  // The current folder (here a scratch one) is never the output.
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir);
+  const CommandRun here = Adse(world + ".");
+  fs::current_path(cwd);
+  EXPECT_EQ(here.exit_code, 2) << here.out;
+  EXPECT_NE(here.out.find("the current folder or one above it"),
+            std::string::npos)
+      << here.out;
+  EXPECT_EQ(ReadText((dir / "results" / "precious.txt").string()), "keep me\n");
+  EXPECT_EQ(ReadText((dir / "scenario.yaml").string()), "keep me too\n");
+  // An earlier check is replaced by the new one.
+  const CommandRun first =
+      Adse(world + (dir / "check").string() + " --no-scan");
+  ASSERT_EQ(first.exit_code, 0) << first.out;
+  const CommandRun again =
+      Adse(world + (dir / "check").string() + " --no-scan");
+  EXPECT_EQ(again.exit_code, 0) << again.out;
+  EXPECT_TRUE(fs::exists(dir / "check" / "summary.json"));
+  for (const auto& e : fs::directory_iterator(dir)) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos)
+        << e.path();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(CliTest, SimulateAndCalibrateNeverOverwriteWhatIsNotTheirs) {
+  const fs::path dir = fs::temp_directory_path() / "adse_cli_simulate_out";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "mine.yaml") << "keep me\n";
+  const std::string simulate = "simulate " + SmallScenarioPath() +
+                               " --point cores=16,freq_ghz=2.1,lidar_hz=7 -q ";
+  const CommandRun yaml = Adse(simulate + "-o " + (dir / "mine.yaml").string());
+  EXPECT_EQ(yaml.exit_code, 2) << yaml.out;
+  EXPECT_NE(yaml.out.find("a file that is not a run file (HDF5) is there"),
+            std::string::npos)
+      << yaml.out;
+  const CommandRun calibrate = Adse("calibrate " + SmallScenarioPath() +
+                                    " -p cores=16,freq_ghz=2.1,lidar_hz=7 -o " +
+                                    (dir / "mine.yaml").string());
+  EXPECT_EQ(calibrate.exit_code, 2) << calibrate.out;
+  EXPECT_NE(calibrate.out.find("a file that is not a calibration (adse "
+                               "calibrate's JSON) is there"),
+            std::string::npos)
+      << calibrate.out;
+  EXPECT_EQ(calibrate.out.find("calibration run"), std::string::npos)
+      << calibrate.out;
+  EXPECT_EQ(ReadText((dir / "mine.yaml").string()), "keep me\n");
+  const CommandRun under =
+      Adse(simulate + "-o " + (dir / "mine.yaml" / "run.h5").string());
+  EXPECT_EQ(under.exit_code, 2) << under.out;
+  EXPECT_NE(under.out.find("mine.yaml is a file, not a folder"),
+            std::string::npos)
+      << under.out;
+  // A seed of its own gets a file of its own by default.
+  const std::string scenario = WriteScenario(
+      "simulate_seeds",
+      Replaced(ReadText(SmallScenarioPath()), "output: results/robotaxi-small",
+               "output: " + (dir / "campaign").string()));
+  const CommandRun seeded =
+      Adse("simulate " + scenario +
+           " --point cores=16,freq_ghz=2.1,lidar_hz=7 -q --seed 5");
+  ASSERT_EQ(seeded.exit_code, 0) << seeded.out;
+  EXPECT_TRUE(fs::exists(dir / "campaign" / "simulate" /
+                         "cores-16_freq_ghz-2.1_lidar_hz-7_seed5.h5"))
+      << seeded.out;
+  fs::remove_all(dir);
+}
+
 TEST(CliTest, SimulateWritesARunFileThatPassesTheSchemaCheck) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_simulate.h5";
   fs::remove(out);
@@ -384,6 +470,17 @@ TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
             std::string::npos)
       << bad.out;
   EXPECT_FALSE(fs::exists(dir / "analysis" / "v3"));
+  // An analysis killed on its way leaves no version that looks complete:
+  // every vN there has its summary.
+  const std::string killed =
+      std::string(ADSE_BINARY_DIR) + "/bin/adse analyze " + dir.string() +
+      " > /dev/null 2>&1 & sleep 0.3; kill -9 $! 2>/dev/null; wait";
+  ASSERT_NE(std::system(killed.c_str()), -1);
+  for (const auto& e : fs::directory_iterator(dir / "analysis")) {
+    const std::string name = e.path().filename().string();
+    if (name.find(".tmp.") != std::string::npos) continue;
+    EXPECT_TRUE(fs::exists(e.path() / "summary.json")) << name;
+  }
   // Run files outside a campaign: no analysis folder either.
   const CommandRun loose = Adse("analyze " + (dir / "runs").string() +
                                 "/a.h5 --threshold frequency_bound_fraction=7");
@@ -404,6 +501,40 @@ TEST(CliTest, AnalyzeOneRunPrintsDeviationAndDiagnosis) {
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_NE(r.out.find("deviation_score"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("diagnosis   cpu_bound"), std::string::npos) << r.out;
+  // A run file named otherwise keeps its whole name.
+  const fs::path other = fs::temp_directory_path() / "adse_cli_analyze_run_a";
+  fs::remove_all(fs::temp_directory_path() / "adse_cli_analyze_run_a.analysis");
+  fs::copy_file(run, other, fs::copy_options::overwrite_existing);
+  ASSERT_EQ(Adse("analyze " + other.string()).exit_code, 0);
+  EXPECT_TRUE(fs::exists(fs::temp_directory_path() /
+                         "adse_cli_analyze_run_a.analysis" / "v1" /
+                         "report.json"));
+}
+
+TEST(CliTest, AnalyzeDiffRefusesASummaryItCannotRead) {
+  const fs::path dir = fs::temp_directory_path() / "adse_cli_diff_malformed";
+  fs::remove_all(dir);
+  for (const auto& [name, text] :
+       {std::pair{"a", R"({"evaluations": [{"point": {"cores": 1}}]})"},
+        std::pair{"b", R"({"evaluations": [1]})"},
+        std::pair{"c", R"({"evaluations": [], "pareto_front": {}})"}}) {
+    fs::create_directories(dir / name);
+    std::ofstream(dir / name / "summary.json") << text;
+  }
+  const CommandRun b = Adse("analyze --diff " + (dir / "a").string() + " " +
+                            (dir / "b").string());
+  EXPECT_EQ(b.exit_code, 2) << b.out;
+  EXPECT_NE(b.out.find((dir / "b" / "summary.json").string() +
+                       ": evaluations[0]: expected an object with a point"),
+            std::string::npos)
+      << b.out;
+  const CommandRun c = Adse("analyze --diff " + (dir / "a").string() + " " +
+                            (dir / "c").string());
+  EXPECT_EQ(c.exit_code, 2) << c.out;
+  EXPECT_NE(c.out.find("pareto_front: expected a list of evaluations"),
+            std::string::npos)
+      << c.out;
+  fs::remove_all(dir);
 }
 
 TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
@@ -490,6 +621,33 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
         "runs/1-virtual-processor_sharing-p1.h5", "runs/1-realtime-1.h5"}) {
     EXPECT_TRUE(fs::is_regular_file(both / name)) << name;
   }
+  // A second call into the folder of the first is refused before it runs:
+  // its runs would be compared as one point's with the first's.
+  const CommandRun second = Adse(
+      "fidelity " + file +
+      " --points cores=1,freq_ghz=1,lidar_hz=7 --runs 1 -o " + both.string());
+  EXPECT_EQ(second.exit_code, 2) << second.out;
+  EXPECT_NE(second.out.find(both.string() +
+                            " holds an earlier adse fidelity's comparison"),
+            std::string::npos)
+      << second.out;
+  EXPECT_EQ(second.out.find("run ..."), std::string::npos) << second.out;
+  // A folder that mixes two points' runs as one point's is refused.
+  const fs::path two_points = out / "two_points";
+  fs::create_directories(two_points / "runs");
+  fs::copy_file(out / "runs" / "1-virtual.h5",
+                two_points / "runs" / "1-virtual.h5");
+  const CommandRun other = Adse(
+      "simulate " + file + " --point cores=1,freq_ghz=1,lidar_hz=7 -q -o " +
+      (two_points / "runs" / "1-realtime-1.h5").string());
+  ASSERT_EQ(other.exit_code, 0) << other.out;
+  const CommandRun mix = Adse("fidelity --compare " + two_points.string());
+  EXPECT_EQ(mix.exit_code, 2) << mix.out;
+  EXPECT_NE(mix.out.find("point 1's run files are of different design points "
+                         "(cores=1,freq_ghz=2.1,lidar_hz=7 and "
+                         "cores=1,freq_ghz=1,lidar_hz=7)"),
+            std::string::npos)
+      << mix.out;
   // Compared again from the run files alone: the same comparison, and the
   // runs left as they were.
   const fs::path again = both / "again";
