@@ -111,9 +111,9 @@ int RunProfileCheck(const ProfileCheckArgs& args) {
           ? args.out
           : spec.ResolvedOutput() + "/profile-check" +
                 (spec.task_case.empty() ? "" : "/" + spec.task_case);
-  if (Status usable =
-          CheckOutputFolder(out, {{"run.h5", "check.txt", "check.png"}});
-      !usable.ok()) {
+  OutputFolderLayout layout;
+  layout.files = {"run.h5", "check.txt", "check.png"};
+  if (Status usable = CheckOutputFolder(out, layout); !usable.ok()) {
     std::fprintf(stderr, "error: %s\n", usable.message().c_str());
     return 2;
   }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 
 #include <fmt/format.h>
@@ -208,6 +209,25 @@ int RunRun(const RunArgs& args) {
     // Slurm's warning before the time limit (sbatch --signal=B:USR1@<s>).
     options.drain_signal = SIGUSR1;
     options.drain_grace_s = std::max(0, spec->harness.slurm.signal_lead_s - 30);
+  }
+  // A campaign folder resumes whatever it holds; a file where it or a
+  // folder above it goes is bad input, said before any worker starts.
+  const std::string folder =
+      args.out.empty() ? spec->ResolvedOutput() : args.out;
+  std::error_code ec;
+  for (std::filesystem::path up = folder; !up.empty(); up = up.parent_path()) {
+    if (!std::filesystem::exists(up, ec)) {
+      if (up == up.parent_path()) break;
+      continue;
+    }
+    if (!std::filesystem::is_directory(up, ec)) {
+      std::fprintf(stderr, "error: %s%s: %s is a file, not a folder\n",
+                   args.out.empty() ? spec->Where("output").c_str() : "",
+                   args.out.empty() ? "output" : ("-o " + args.out).c_str(),
+                   up.string().c_str());
+      return 2;
+    }
+    break;
   }
   options.output_dir = args.out;
   options.strategy = args.strategy;

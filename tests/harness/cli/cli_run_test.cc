@@ -155,6 +155,19 @@ TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
   EXPECT_EQ(isolation.exit_code, 2) << isolation.out;
   EXPECT_NE(isolation.out.find("--isolation"), std::string::npos)
       << isolation.out;
+  // A file where the campaign folder, or a folder above it, goes.
+  const fs::path file = fs::temp_directory_path() / "adse_cli_run_file";
+  std::ofstream(file) << "not a folder\n";
+  for (const fs::path& out : {file, file / "campaign"}) {
+    const CommandRun run =
+        Adse("run " + SmallScenarioPath() + " -o " + out.string());
+    EXPECT_EQ(run.exit_code, 2) << run.out;
+    EXPECT_NE(run.out.find("-o " + out.string() + ": " + file.string() +
+                           " is a file, not a folder"),
+              std::string::npos)
+        << run.out;
+  }
+  EXPECT_EQ(ReadText(file.string()), "not a folder\n");
 }
 
 TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {

@@ -98,8 +98,11 @@ TEST(RunKeyTest, TrafficLightKnobsEnterOnlyKeysOfMapsWithSignals) {
 TEST(RunKeyTest, SweepingAKnobThatCannotActIsRefusedByName) {
   EXPECT_TRUE(CheckKnobsAct(Small()).ok());
   auto with_knob = [](spec::Spec s, const std::string& bind) {
-    s.design_space.parameters.push_back({"knob", bind});
-    s.design_space.parameters.back().values = {1, 2};
+    spec::DesignParameter knob;
+    knob.name = "knob";
+    knob.bind = bind;
+    knob.values = {1, 2};
+    s.design_space.parameters.push_back(knob);
     return s;
   };
   const Status parking =
