@@ -139,20 +139,25 @@ Status CheckOutputFolder(const std::string& out,
   return Status::Ok();
 }
 
-Status CheckOutputFile(const std::string& out, OutputFileKind kind) {
+Status CheckFolderPath(const std::string& path, const std::string& what) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  for (fs::path up = fs::path(out).parent_path(); !up.empty();
-       up = up.parent_path()) {
+  for (fs::path up = path; !up.empty(); up = up.parent_path()) {
     if (fs::exists(up, ec)) {
-      if (!fs::is_directory(up, ec)) {
-        return Status::InvalidArgument("-o " + out + ": " + up.string() +
-                                       " is a file, not a folder");
-      }
-      break;
+      if (fs::is_directory(up, ec)) return Status::Ok();
+      return Status::InvalidArgument(what + ": " + up.string() +
+                                     " is a file, not a folder");
     }
     if (up == up.parent_path()) break;
   }
+  return Status::Ok();
+}
+
+Status CheckOutputFile(const std::string& out, OutputFileKind kind) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  ADSE_RETURN_IF_ERROR(
+      CheckFolderPath(fs::path(out).parent_path().string(), "-o " + out));
   if (!fs::exists(out, ec)) return Status::Ok();
   const std::string what = kind == kRunFile ? "a run file (HDF5)"
                                             : "a calibration (adse calibrate's "

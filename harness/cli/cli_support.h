@@ -50,6 +50,11 @@ struct OutputFolderLayout {
 Status CheckOutputFolder(const std::string& out,
                          const OutputFolderLayout& layout);
 
+// Ok unless the nearest existing path at or above `path` is a file (where
+// a folder must go): then InvalidArgument "<what>: <it> is a file, not a
+// folder".
+Status CheckFolderPath(const std::string& path, const std::string& what);
+
 // What a command's output file is, so that an earlier one can be told
 // from anything else.
 enum class OutputFileKind {

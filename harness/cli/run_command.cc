@@ -212,22 +212,13 @@ int RunRun(const RunArgs& args) {
   }
   // A campaign folder resumes whatever it holds; a file where it or a
   // folder above it goes is bad input, said before any worker starts.
-  const std::string folder =
-      args.out.empty() ? spec->ResolvedOutput() : args.out;
-  std::error_code ec;
-  for (std::filesystem::path up = folder; !up.empty(); up = up.parent_path()) {
-    if (!std::filesystem::exists(up, ec)) {
-      if (up == up.parent_path()) break;
-      continue;
-    }
-    if (!std::filesystem::is_directory(up, ec)) {
-      std::fprintf(stderr, "error: %s%s: %s is a file, not a folder\n",
-                   args.out.empty() ? spec->Where("output").c_str() : "",
-                   args.out.empty() ? "output" : ("-o " + args.out).c_str(),
-                   up.string().c_str());
-      return 2;
-    }
-    break;
+  if (Status usable =
+          CheckFolderPath(args.out.empty() ? spec->ResolvedOutput() : args.out,
+                          args.out.empty() ? spec->Where("output") + "output"
+                                           : "-o " + args.out);
+      !usable.ok()) {
+    std::fprintf(stderr, "error: %s\n", usable.message().c_str());
+    return 2;
   }
   options.output_dir = args.out;
   options.strategy = args.strategy;
