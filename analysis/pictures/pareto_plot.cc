@@ -139,22 +139,25 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
                  colour, s.Px(1.5));
     DrawSegment(&img, base, tip, colour, s.Px(1.5));
   };
-  bool any_censored = false;
+  // A point above the plot: a solid wedge on its top edge, unlike a
+  // stopped run's arrow (whose time is a lower bound inside the plot).
+  auto draw_wedge = [&](cv::Point2d tip) {
+    const std::vector<cv::Point> corners = {
+        Fixed(tip), Fixed(tip + cv::Point2d(-1.4 * cross, 2.2 * cross)),
+        Fixed(tip + cv::Point2d(1.4 * cross, 2.2 * cross))};
+    cv::fillConvexPoly(img, corners, Bgr(kInfeasibleRgb), cv::LINE_AA, kShift);
+  };
+  bool any_censored = false, any_cross = false, any_above = false;
   for (const auto* p : shown) {
     if (p->feasible || p->on_front) continue;
-    if (p->censored && !clipped(p)) {
+    if (clipped(p)) {
+      any_above = true;
+      draw_wedge(px(p->cost, ay.max));
+    } else if (p->censored) {
       any_censored = true;
       draw_arrow_up(px(p->cost, p->nav_time_s), Bgr(kInfeasibleRgb));
-    } else if (clipped(p)) {
-      // An arrow pointing up out of the plot.
-      const cv::Point2d tip = px(p->cost, ay.max);
-      DrawPolyline(&img,
-                   {tip + cv::Point2d(-cross, 2 * cross), tip,
-                    tip + cv::Point2d(cross, 2 * cross)},
-                   Bgr(kInfeasibleRgb), s.Px(1.5));
-      DrawSegment(&img, tip, tip + cv::Point2d(0, 3 * cross),
-                  Bgr(kInfeasibleRgb), s.Px(1.5));
     } else {
+      any_cross = true;
       draw_cross(px(p->cost, p->nav_time_s), Bgr(kInfeasibleRgb));
     }
   }
@@ -164,9 +167,10 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
     cv::circle(img, Fixed(c), unstable_radius * static_cast<int>(kShiftScale),
                Bgr(kUnstableRgb), s.Px(1.5), cv::LINE_AA, kShift);
   };
-  bool any_unstable = false;
+  bool any_unstable = false, any_dot = false;
   for (const auto* p : shown) {
     if (p->feasible && !p->on_front) {
+      any_dot = true;
       draw_dot(px(p->cost, p->nav_time_s), Bgr(kFeasibleRgb), radius);
       if (p->unstable) draw_unstable_ring(px(p->cost, p->nav_time_s));
     }
@@ -207,21 +211,37 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
   }
   cv::rectangle(img, area, kBlack, 1);
 
-  // Legend.
+  // Legend: the marks drawn, no others.
   struct Entry {
     std::string name;
     std::function<void(cv::Point2d)> sample;
   };
-  std::vector<Entry> entries = {
-      {"feasible",
-       [&](cv::Point2d c) { draw_dot(c, Bgr(kFeasibleRgb), radius); }},
-      {"infeasible",
-       [&](cv::Point2d c) { draw_cross(c, Bgr(kInfeasibleRgb)); }},
-      {o.front_name, [&](cv::Point2d c) {
-         DrawSegment(&img, c - cv::Point2d(s.Px(12), 0),
-                     c + cv::Point2d(s.Px(12), 0), Bgr(kFrontRgb), s.Px(2));
-         draw_dot(c, Bgr(kFrontRgb), radius + s.Px(1));
-       }}};
+  std::vector<Entry> entries;
+  if (any_dot) {
+    entries.push_back({"feasible", [&](cv::Point2d c) {
+                         draw_dot(c, Bgr(kFeasibleRgb), radius);
+                       }});
+  }
+  // A front of infeasible designs only (nothing is feasible) is crosses.
+  bool front_cross = !front.empty();
+  for (const auto* p : front) front_cross = front_cross && !p->feasible;
+  if (any_cross) {
+    entries.push_back({o.infeasible_name, [&](cv::Point2d c) {
+                         draw_cross(c, Bgr(kInfeasibleRgb));
+                       }});
+  }
+  if (!front.empty()) {
+    entries.push_back({o.front_name, [&, front_cross](cv::Point2d c) {
+                         DrawSegment(&img, c - cv::Point2d(s.Px(12), 0),
+                                     c + cv::Point2d(s.Px(12), 0),
+                                     Bgr(kFrontRgb), s.Px(2));
+                         if (front_cross) {
+                           draw_cross(c, Bgr(kFrontRgb));
+                         } else {
+                           draw_dot(c, Bgr(kFrontRgb), radius + s.Px(1));
+                         }
+                       }});
+  }
   bool any_highlight = false;
   for (const auto* p : front) any_highlight = any_highlight || p->highlight;
   if (any_highlight) {
@@ -243,6 +263,11 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
     entries.push_back({"stopped early (time at least)", [&](cv::Point2d c) {
                          draw_arrow_up(c + cv::Point2d(0, 1.5 * cross),
                                        Bgr(kInfeasibleRgb));
+                       }});
+  }
+  if (any_above) {
+    entries.push_back({"above the plot (see the note)", [&](cv::Point2d c) {
+                         draw_wedge(c - cv::Point2d(0, 1.1 * cross));
                        }});
   }
   if (!o.vertical_lines.empty() || !o.horizontal_lines.empty()) {

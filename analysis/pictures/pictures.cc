@@ -214,6 +214,22 @@ void DrawStandMarker(cv::Mat* img, cv::Point2d at, Rgb colour, const Style& s) {
   DrawRingedDot(img, at, s.Px(6), Bgr(colour), Bgr(kBackgroundRgb));
 }
 
+// A stand where the car started (waiting for the stack) would hide under
+// the start marker: it rings it instead, in the stand's colour.
+void DrawStandRing(cv::Mat* img, cv::Point2d at, Rgb colour, const Style& s) {
+  if (!Finite(at)) return;
+  cv::circle(*img, Fixed(at), s.Px(12) * static_cast<int>(kShiftScale),
+             Bgr(colour), s.Px(3), cv::LINE_AA, kShift);
+}
+
+// What held the car, in words: the planner's reason, or "plan said go"
+// when the plan did not stop (a cause outside the planner held it).
+std::string StandText(const analysis::Stand& stand) {
+  if (!stand.known) return "stood";
+  if (stand.cause.reason == StopReason::kNone) return "plan said go";
+  return StopReasonToString(stand.cause.reason);
+}
+
 // Labels a marker: above and right of it, else (header above, image edge
 // right, another label there) below it or on its left; a label that fits
 // nowhere free is left out. `taken` holds the labels placed so far.
@@ -397,8 +413,14 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   std::stable_sort(by_length.begin(), by_length.end(), [&](size_t a, size_t b) {
     return stands[a].standing_s > stands[b].standing_s;
   });
+  auto at_start = [&](const analysis::Stand& stand) {
+    const cv::Point2d d = px(stand.x_m, stand.y_m) - start;
+    return std::hypot(d.x, d.y) < s.Px(14);
+  };
   for (const analysis::Stand& stand : stands) {
-    DrawStandMarker(&img, px(stand.x_m, stand.y_m), StandRgb(stand), s);
+    if (!at_start(stand)) {
+      DrawStandMarker(&img, px(stand.x_m, stand.y_m), StandRgb(stand), s);
+    }
   }
   const std::vector<CollisionPlace> collisions = CollisionPlaces(run);
   for (const CollisionPlace& c : collisions) {
@@ -408,6 +430,9 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   std::vector<cv::Rect> labels;
   DrawGoalMarker(&img, goal, s);
   DrawStartMarker(&img, start, s);
+  for (const analysis::Stand& stand : stands) {
+    if (at_start(stand)) DrawStandRing(&img, start, StandRgb(stand), s);
+  }
   DrawMarkerLabel(&img, goal, "goal", s, Bgr(kGoalRgb), map.map_top_px,
                   &labels);
   DrawMarkerLabel(&img, start, "start", s, Bgr(kStartRgb), map.map_top_px,
@@ -420,11 +445,10 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   }
   for (size_t k = 0; k < std::min(kLabelledStands, by_length.size()); ++k) {
     const analysis::Stand& stand = stands[by_length[k]];
-    const std::string what =
-        stand.known ? StopReasonToString(stand.cause.reason) : "stood";
-    DrawMarkerLabel(&img, px(stand.x_m, stand.y_m),
-                    fmt::format("{} {:.0f} s", what, stand.standing_s), s,
-                    Bgr(StandRgb(stand)), map.map_top_px, &labels);
+    DrawMarkerLabel(
+        &img, px(stand.x_m, stand.y_m),
+        fmt::format("{} {:.0f} s", StandText(stand), stand.standing_s), s,
+        Bgr(StandRgb(stand)), map.map_top_px, &labels);
   }
 
   // Scale bar, bottom centre.

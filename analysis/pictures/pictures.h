@@ -138,13 +138,15 @@ struct ParetoPlotOptions {
   // Constraint lines (e.g. nav_time_s <= 400 as a horizontal line at 400).
   std::vector<double> vertical_lines, horizontal_lines;
   std::string title;
-  // Legend names of the front and of highlighted points.
+  // Legend names of infeasible points, the front and highlighted points.
+  std::string infeasible_name = "infeasible";
   std::string front_name = "Pareto front";
   std::string highlight_name = "cheapest feasible";
 };
 
 // Scatter of all points (feasible: filled circles; infeasible: grey
-// crosses; front points: in the front colour, a cross if infeasible) with
+// crosses; front points: in the front colour, a cross if infeasible;
+// points far above the rest as grey triangles on the top edge) with
 // the front drawn as a staircase in x order (a min-min front promises
 // nothing between its points), highlighted points ringed in black and
 // unstable feasible ones in violet, constraint lines dashed, linear axes
@@ -154,8 +156,9 @@ struct ParetoPlotOptions {
 // overlap one another, the legend or the front, and hide another design's
 // marker only where no place around their point is free of one; a label
 // without room is left out and counted in a note, as are points with a
-// non-finite coordinate. InvalidArgument for bad options or no finite
-// point; written like RenderTrajectoryImage.
+// non-finite coordinate. The legend lists only the marks drawn.
+// InvalidArgument for bad options or no finite point; written like
+// RenderTrajectoryImage.
 Status RenderParetoPlot(const std::vector<ParetoPlotPoint>& points,
                         const std::string& png_path,
                         const ParetoPlotOptions& o = {});
@@ -176,6 +179,8 @@ struct StudyPlotOptions {
   std::vector<double> cost_bounds;    // horizontal dashed lines
   std::string points_name = "this campaign";
   std::string reference_name = "reference (every point)";
+  // What the cost is, e.g. "hardware cost (cores * freq_ghz)".
+  std::string cost_label = "hardware cost";
 };
 Result<std::string> StudyPlotPng(const std::vector<ParetoPlotPoint>& points,
                                  const std::vector<ParetoPlotPoint>& reference,

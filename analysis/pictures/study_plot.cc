@@ -106,8 +106,9 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
   }
 
   // The campaign's points on top.
-  const double side = s.Px(7);
   auto draw_triangle = [&](cv::Point2d c, bool filled) {
+    // A hollow one a little larger, so that its inside shows.
+    const double side = filled ? s.Px(7) : s.Px(9);
     const std::vector<cv::Point> corners = {
         Fixed(c + cv::Point2d(0, -side * 0.6)),
         Fixed(c + cv::Point2d(-side * 0.55, side * 0.4)),
@@ -115,7 +116,9 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
     if (filled) {
       cv::fillConvexPoly(img, corners, kTriangle, cv::LINE_AA, kShift);
     } else {
-      cv::polylines(img, corners, true, kTriangle, s.Px(1.5), cv::LINE_AA,
+      // White inside, so that stacked hollow triangles still read hollow.
+      cv::fillConvexPoly(img, corners, kWhite, cv::LINE_AA, kShift);
+      cv::polylines(img, corners, true, kTriangle, s.Px(1.2), cv::LINE_AA,
                     kShift);
     }
   };
@@ -142,11 +145,21 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
     std::string name;
     std::function<void(cv::Point2d)> sample;
   };
-  std::vector<Entry> entries = {
-      {o.points_name + ", feasible",
-       [&](cv::Point2d c) { draw_triangle(c, true); }},
-      {o.points_name + ", infeasible",
-       [&](cv::Point2d c) { draw_triangle(c, false); }}};
+  // The marks drawn, no others.
+  bool any_feasible = false, any_infeasible = false;
+  for (const ParetoPlotPoint& p : points) {
+    if (!Placed(p)) continue;
+    (p.feasible ? any_feasible : any_infeasible) = true;
+  }
+  std::vector<Entry> entries;
+  if (any_feasible) {
+    entries.push_back({o.points_name + ", feasible",
+                       [&](cv::Point2d c) { draw_triangle(c, true); }});
+  }
+  if (any_infeasible) {
+    entries.push_back({o.points_name + ", infeasible",
+                       [&](cv::Point2d c) { draw_triangle(c, false); }});
+  }
   if (any_highlight) {
     entries.push_back(
         {o.points_name + ", cheapest feasible", [&](cv::Point2d c) {
@@ -154,10 +167,12 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
            draw_ring(c);
          }});
   }
-  if (!reference.empty()) {
+  if (std::any_of(reference.begin(), reference.end(), Placed)) {
     entries.push_back({o.reference_name, [&](cv::Point2d c) {
                          draw_dot(c, kReferenceDot, dot);
                        }});
+  }
+  if (!front.empty()) {
     entries.push_back({"its true front", [&](cv::Point2d c) {
                          DrawSegment(&img, c - cv::Point2d(s.Px(12), 0),
                                      c + cv::Point2d(s.Px(12), 0),
@@ -216,7 +231,7 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
            kBlack, false);
   DrawText(&img, "navigation time (s)", area.x + area.width / 2,
            o.height_px - s.Px(8) - baseline, Align::kCentre, s, kBlack, false);
-  DrawTurnedLabel(&img, "hardware cost", area, s);
+  DrawTurnedLabel(&img, o.cost_label, area, s);
 
   std::string png;
   ADSE_RETURN_IF_ERROR(EncodeOk(img, &png));

@@ -15,6 +15,7 @@
 #include "analysis/pareto/pareto.h"
 #include "analysis/pictures/pictures.h"
 #include "harness/campaign/replicas.h"
+#include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/files.h"
 
@@ -122,6 +123,31 @@ bool SimpleBound(const std::string& constraint, const std::string& metric,
     return true;
   }
   return false;
+}
+
+std::vector<std::string> UndrawnFailures(
+    const spec::Spec& spec, const std::vector<EvaluationRow>& rows) {
+  std::set<std::string> failed;
+  for (const EvaluationRow& row : rows) {
+    if (row.feasible || !Placed(row) ||
+        RowMetric(row, analysis::kCensoredMetric) == 1.0) {
+      continue;
+    }
+    const std::vector<std::string> violated =
+        spec::ViolatedConstraints(spec, row.metrics, row.point);
+    const bool drawn =
+        std::any_of(violated.begin(), violated.end(), [](const auto& c) {
+          double bound = 0.0;
+          return SimpleBound(c, kTimeMetric, &bound) ||
+                 SimpleBound(c, kCostMetric, &bound);
+        });
+    if (!drawn) failed.insert(violated.begin(), violated.end());
+  }
+  std::vector<std::string> out;
+  for (const std::string& c : spec.constraints) {
+    if (failed.count(c) > 0) out.push_back(c);
+  }
+  return out;
 }
 
 std::vector<int> CheapestFirst(const std::vector<EvaluationRow>& rows,
@@ -362,6 +388,11 @@ std::vector<analysis::ParetoPlotPoint> PlotPoints(
   return plot;
 }
 
+// The cost's axis says what it counts: the scenario's expression.
+std::string CostLabel(const spec::Spec& spec) {
+  return fmt::format("hardware cost ({})", spec.cost);
+}
+
 }  // namespace
 
 Status RenderFrontPicture(const spec::Spec& spec,
@@ -371,6 +402,17 @@ Status RenderFrontPicture(const spec::Spec& spec,
   const std::vector<analysis::ParetoPlotPoint> plot = PlotPoints(spec, rows, h);
   analysis::ParetoPlotOptions options;
   options.title = title;
+  options.x_label = CostLabel(spec);
+  if (const std::vector<std::string> undrawn = UndrawnFailures(spec, rows);
+      !undrawn.empty()) {
+    options.infeasible_name =
+        fmt::format(
+            "infeasible (inside the lines: {})",
+            fmt::join(undrawn.begin(),
+                      undrawn.begin() + std::min<size_t>(undrawn.size(), 2),
+                      ", ")) +
+        (undrawn.size() > 2 ? ", ..." : "");
+  }
   options.front_name = fmt::format("cost-time front ({})",
                                    fmt::join(spec.design_space.Names(), "/"));
   options.horizontal_lines = BoundsOn(spec, kTimeMetric);
@@ -391,6 +433,7 @@ Status RenderStudyPicture(const spec::Spec& spec,
   options.time_bounds_s = BoundsOn(spec, kTimeMetric);
   options.cost_bounds = BoundsOn(spec, kCostMetric);
   options.points_name = spec.exploration.strategy;
+  options.cost_label = CostLabel(spec);
   Result<std::string> png = analysis::StudyPlotPng(
       PlotPoints(spec, rows, ComputeHeadline(spec, rows)),
       PlotPoints(reference_spec, reference_rows,

@@ -99,6 +99,14 @@ std::vector<int> CheapestFirst(const std::vector<EvaluationRow>& rows,
 bool SimpleBound(const std::string& constraint, const std::string& metric,
                  double* bound);
 
+// The constraints that infeasible designs drawn inside the picture's lines
+// fail: of the completed runs that violate no simple bound on cost or
+// nav time (a deviation bound, say), what they do violate, in the spec's
+// order. The picture's legend names them, or such a cross would look
+// feasible.
+std::vector<std::string> UndrawnFailures(
+    const spec::Spec& spec, const std::vector<EvaluationRow>& rows);
+
 }  // namespace adse::campaign
 
 #endif  // ADSE_HARNESS_CAMPAIGN_HEADLINE_H_

@@ -59,6 +59,8 @@ struct VersionFolder {
 
 VersionFolder StartVersion(const fs::path& root) {
   VersionFolder v;
+  // Versions of analyses killed before their end (SIGKILL, SIGTERM).
+  RemoveAbandonedTemporaries(root.string());
   v.final_path = NextVersion(root);
   v.tmp_path = TemporaryPathFor(v.final_path);
   std::error_code ec;
@@ -426,6 +428,16 @@ int AnalyzeFolder(const std::string& target,
   if (index) {
     spec->exploration.budget = static_cast<int>(index->budget);
     spec->exploration.strategy = index->strategy;
+  }
+  // One study's runs over another's would be read as a comparison.
+  if (reference != nullptr && reference->spec.name != spec->name) {
+    std::fprintf(stderr,
+                 "error: --reference: %s is the study of scenario '%s', not "
+                 "of '%s' (%s): give a reference recorded from the same "
+                 "scenario\n",
+                 reference->folder.c_str(), reference->spec.name.c_str(),
+                 spec->name.c_str(), scenario_source.c_str());
+    return 2;
   }
   const VersionFolder v = StartVersion(fs::path(target) / "analysis");
   const std::string& version = v.tmp_path;

@@ -185,12 +185,27 @@ Status CheckOutputFile(const std::string& out, OutputFileKind kind) {
   return Status::Ok();
 }
 
+namespace {
+
+std::string FolderAbove(const std::string& out) {
+  const std::filesystem::path parent = std::filesystem::path(out).parent_path();
+  return parent.empty() ? std::string(".") : parent.string();
+}
+
+}  // namespace
+
+std::string StartOutputFolder(const std::string& out) {
+  RemoveAbandonedTemporaries(FolderAbove(out));
+  const std::string tmp = TemporaryPathFor(out);
+  std::error_code ec;
+  std::filesystem::remove_all(tmp, ec);
+  return tmp;
+}
+
 Status PutFolderInPlace(const std::string& tmp, const std::string& out) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  const std::string parent = fs::path(out).parent_path().empty()
-                                 ? std::string(".")
-                                 : fs::path(out).parent_path().string();
+  const std::string parent = FolderAbove(out);
   ADSE_RETURN_IF_ERROR(MakeDirs(parent));
   const std::string earlier = TemporaryPathFor(out + ".earlier");
   const bool replacing = fs::exists(out, ec);

@@ -71,6 +71,11 @@ inline constexpr OutputFileKind kCalibrationFile =
 // so that it is said before anything runs.
 Status CheckOutputFile(const std::string& out, OutputFileKind kind);
 
+// The private folder an output is written into before PutFolderInPlace
+// (TemporaryPathFor(out), emptied). What commands killed before their end
+// left beside `out` goes first (RemoveAbandonedTemporaries).
+std::string StartOutputFolder(const std::string& out);
+
 // Renames the finished folder `tmp` to `out`, an earlier output there
 // stepping aside first and going only once the new one is in place.
 Status PutFolderInPlace(const std::string& tmp, const std::string& out);

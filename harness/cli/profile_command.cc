@@ -141,7 +141,7 @@ int RunProfileCheck(const ProfileCheckArgs& args) {
   std::printf("%s", text.c_str());
 
   // The three files go into a private folder renamed into place whole.
-  const std::string tmp = TemporaryPathFor(out);
+  const std::string tmp = StartOutputFolder(out);
   Status saved = MakeDirs(tmp);
   if (saved.ok()) saved = runfile::WriteRunFile(tmp + "/run.h5", *run);
   if (saved.ok()) saved = WriteFileAtomic(tmp + "/check.txt", text);

@@ -129,9 +129,8 @@ int RunWorld(const WorldArgs& args) {
     std::fprintf(stderr, "error: %s\n", usable.message().c_str());
     return 2;
   }
-  const std::string tmp = TemporaryPathFor(out);
+  const std::string tmp = StartOutputFolder(out);
   std::error_code ec;
-  fs::remove_all(tmp, ec);
   Status status = MakeDirs(tmp + "/scans");
   if (!status.ok()) {
     std::fprintf(stderr, "error: %s\n", status.message().c_str());

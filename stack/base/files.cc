@@ -1,5 +1,6 @@
 #include "stack/base/files.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -84,7 +85,10 @@ Status MakeDirs(const std::string& path, Env* env) {
   return env->CreateDir(path);
 }
 
-std::string TemporaryPathFor(const std::string& path) {
+namespace {
+
+// This host's name as temporary paths carry it.
+std::string HostLabel() {
   char host[256] = {};
   if (::gethostname(host, sizeof(host) - 1) != 0 || host[0] == '\0') {
     std::snprintf(host, sizeof(host), "host");
@@ -95,8 +99,38 @@ std::string TemporaryPathFor(const std::string& path) {
   for (char& c : name) {
     if (c == '/') c = '_';
   }
-  return path + ".tmp." + name + "." +
+  return name;
+}
+
+}  // namespace
+
+std::string TemporaryPathFor(const std::string& path) {
+  return path + ".tmp." + HostLabel() + "." +
          std::to_string(static_cast<long>(::getpid()));
+}
+
+int RemoveAbandonedTemporaries(const std::string& folder) {
+  const std::string marker = ".tmp." + HostLabel() + ".";
+  int removed = 0;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    const size_t at = name.rfind(marker);
+    if (at == std::string::npos || at == 0) continue;
+    const std::string digits = name.substr(at + marker.size());
+    if (digits.empty() || digits.size() > 9 ||
+        digits.find_first_not_of("0123456789") != std::string::npos) {
+      continue;
+    }
+    const long pid = std::stol(digits);
+    // Alive, or someone else's to signal: not ours to remove.
+    if (pid <= 0 || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) {
+      continue;
+    }
+    std::error_code remove_ec;
+    if (fs::remove_all(entry.path(), remove_ec) > 0 && !remove_ec) ++removed;
+  }
+  return removed;
 }
 
 }  // namespace adse

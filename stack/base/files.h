@@ -46,6 +46,13 @@ Status MakeDirs(const std::string& path, Env* env = Env::Default());
 // folder on a network filesystem (pids repeat across hosts).
 std::string TemporaryPathFor(const std::string& path);
 
+// Removes what writers on this host that are gone left in `folder`: every
+// "<name>.tmp.<this host>.<pid>" whose process no longer exists (killed
+// before it could rename or remove it). Others' and live writers' are
+// kept. Returns how many were removed; a folder that cannot be read
+// removes none.
+int RemoveAbandonedTemporaries(const std::string& folder);
+
 }  // namespace adse
 
 #endif  // ADSE_STACK_BASE_FILES_H_

@@ -195,6 +195,33 @@ TEST_F(PictureTest, WhereTheCarStoodIsMarkedInTheColourOfWhatHeldIt) {
   EXPECT_EQ(CountColour(*plain, kStandRedLightRgb), 0);
 }
 
+TEST_F(PictureTest, AStandWhereTheCarStartedRingsTheStartMarker) {
+  // The car waits 10 s at its first sample (0, 1), held by a red light: a
+  // dot there would hide under the start marker, so a ring in the stand's
+  // colour goes round it.
+  RunData run = SquareRun();
+  std::vector<runfile::EgoSample> ego(100, run.ego.front());
+  for (runfile::EgoSample& e : ego) e.v_mps = 0.0;
+  ego.insert(ego.end(), run.ego.begin(), run.ego.end());
+  double t = 0;
+  for (runfile::EgoSample& e : ego) e.t_s = (t += 0.1);
+  run.ego = ego;
+  for (double ts = 0; ts <= t; ts += 0.1) {
+    run.stop_reasons.push_back(
+        {ts, ts, StopReason::kRedLight, 0.0, -1, -1.0, 0});
+  }
+  ASSERT_TRUE(RenderTrajectoryImage(run, Path("waited.png")).ok());
+  Result<RgbImage> img = ReadImage(Path("waited.png"));
+  ASSERT_TRUE(img.ok());
+  Result<WorldToImage> map = TrajectoryImageMapping(run);
+  ASSERT_TRUE(map.ok());
+  const double column = map->Column(0.0), row = map->Row(1.0);
+  EXPECT_TRUE(ColourNear(*img, column, row, kStartRgb, 2));
+  // The ring, 12 px out, left and right of the marker.
+  EXPECT_TRUE(ColourNear(*img, column - 12, row, kStandRedLightRgb, 2));
+  EXPECT_TRUE(ColourNear(*img, column + 12, row, kStandRedLightRgb, 2));
+}
+
 TEST_F(PictureTest, ACollisionWithTrafficIsMarkedWhereItHappened) {
   // At 5.0 s the ego is at (49, 1); a flow car recorded at (52, 3) then.
   RunData run = SquareRun();
@@ -489,6 +516,59 @@ TEST_F(PictureTest, StudyPlotDrawsTheCampaignOverTheReferenceWithItsBound) {
   EXPECT_FALSE(StudyPlotPng(points, reference, options).ok());
 }
 
+// Rows in which a shade of `colour` (antialiased lines have few pixels of
+// the exact colour) runs, then up to 12 pixels of others with the
+// background among them, then the shade again: a hollow mark's sides.
+int HollowRows(const RgbImage& img, Rgb colour) {
+  auto shade = [&](int c, int r) {
+    const Rgb p = img.At(c, r);
+    return std::abs(p.r - colour.r) + std::abs(p.g - colour.g) +
+               std::abs(p.b - colour.b) <
+           120;
+  };
+  int rows = 0;
+  for (int r = 0; r < img.height_px; ++r) {
+    bool hollow = false;
+    for (int c = 1; c < img.width_px && !hollow; ++c) {
+      if (!shade(c - 1, r) || shade(c, r)) continue;
+      bool background = false;
+      for (int k = c; k < std::min(img.width_px, c + 12); ++k) {
+        if (shade(k, r)) {
+          hollow = background;
+          break;
+        }
+        background = background || img.At(k, r) == kBackgroundRgb;
+      }
+    }
+    rows += hollow;
+  }
+  return rows;
+}
+
+TEST_F(PictureTest,
+       AnInfeasibleTriangleReadsHollowAndTheLegendOnlyWhatIsDrawn) {
+  // One infeasible campaign point on a reference dot, another beside it:
+  // its triangle and its legend sample are hollow (white inside, hiding
+  // the dot under it); with one feasible point alone nothing is hollow,
+  // so the legend has no infeasible sample.
+  ParetoPlotPoint p{10, 100, false, false, ""};
+  auto render = [&](const std::vector<ParetoPlotPoint>& points,
+                    const std::string& name) {
+    Result<std::string> png = StudyPlotPng(
+        points, {{10, 100, true, false, ""}, {30, 300, true, false, ""}}, {});
+    EXPECT_TRUE(png.ok());
+    std::ofstream(Path(name), std::ios::binary) << *png;
+    Result<RgbImage> img = ReadImage(Path(name));
+    EXPECT_TRUE(img.ok());
+    return img.ok() ? *img : RgbImage{};
+  };
+  const RgbImage hollow = render({p}, "hollow.png");
+  p.feasible = true;
+  const RgbImage filled = render({p}, "filled.png");
+  EXPECT_GE(HollowRows(hollow, kStudyPointRgb), 4);
+  EXPECT_EQ(HollowRows(filled, kStudyPointRgb), 0);
+}
+
 TEST_F(PictureTest, ParetoPlotRendersPointsFrontAndConstraints) {
   ParetoPlotOptions options;
   options.horizontal_lines = {400};
@@ -538,6 +618,63 @@ TEST_F(PictureTest, ParetoPlotKeepsTheFrontReadableBelowFarOutliers) {
   EXPECT_GT(rows_with_dots, 40);
   // The timeout is still shown, as an arrow on the top edge.
   EXPECT_GT(CountColour(*img, kInfeasibleRgb), 5);
+}
+
+TEST_F(PictureTest, TheLegendListsOnlyTheMarksDrawn) {
+  // A front of feasible designs alone: no feasible dot off the front, no
+  // infeasible cross, so neither colour anywhere (the legend's samples
+  // included).
+  std::vector<ParetoPlotPoint> points = {{5, 100, true, true, ""},
+                                         {10, 50, true, true, ""}};
+  ASSERT_TRUE(RenderParetoPlot(points, Path("front_only.png")).ok());
+  Result<RgbImage> front_only = ReadImage(Path("front_only.png"));
+  ASSERT_TRUE(front_only.ok());
+  // (A stray antialiased pixel of the text may match; a sample is dozens.)
+  EXPECT_LT(CountColour(*front_only, kFeasibleRgb), 5);
+  EXPECT_LT(CountColour(*front_only, kInfeasibleRgb), 5);
+  EXPECT_GT(CountColour(*front_only, kFrontRgb), 100);
+  // One run stopped early and nothing else: its arrow, no front.
+  ParetoPlotPoint stopped{1, 60, false, false, ""};
+  stopped.censored = true;
+  ASSERT_TRUE(RenderParetoPlot({stopped}, Path("stopped.png")).ok());
+  Result<RgbImage> alone = ReadImage(Path("stopped.png"));
+  ASSERT_TRUE(alone.ok());
+  EXPECT_LT(CountColour(*alone, kFrontRgb), 5);
+  EXPECT_LT(CountColour(*alone, kFeasibleRgb), 5);
+  EXPECT_GT(CountColour(*alone, kInfeasibleRgb), 10);  // arrow and sample
+}
+
+TEST_F(PictureTest, APointAboveThePlotIsAWedgeUnlikeAStoppedRunsArrow) {
+  // The same design far above the rest (a timeout at 6000 s) and stopped
+  // early inside the plot: a solid wedge has rows of grey as wide as its
+  // base, an arrow only where its lines meet.
+  std::vector<ParetoPlotPoint> points;
+  for (int i = 0; i < 6; ++i) {
+    points.push_back({3.0 + i, 80.0 - 10.0 * i, true, true, ""});
+  }
+  std::vector<ParetoPlotPoint> above = points, stopped = points;
+  above.push_back({2, 6000, false, false, ""});
+  ParetoPlotPoint censored{2, 85, false, false, ""};
+  censored.censored = true;
+  stopped.push_back(censored);
+  ASSERT_TRUE(RenderParetoPlot(above, Path("above.png")).ok());
+  ASSERT_TRUE(RenderParetoPlot(stopped, Path("arrow.png")).ok());
+  Result<RgbImage> wedge = ReadImage(Path("above.png"));
+  Result<RgbImage> arrow = ReadImage(Path("arrow.png"));
+  ASSERT_TRUE(wedge.ok() && arrow.ok());
+  auto widest_run = [](const RgbImage& img) {
+    int widest = 0;
+    for (int r = 0; r < img.height_px; ++r) {
+      int run = 0;
+      for (int c = 0; c < img.width_px; ++c) {
+        run = img.At(c, r) == kInfeasibleRgb ? run + 1 : 0;
+        widest = std::max(widest, run);
+      }
+    }
+    return widest;
+  };
+  EXPECT_GE(widest_run(*wedge), 12);
+  EXPECT_LE(widest_run(*arrow), 10);
 }
 
 TEST_F(PictureTest, AFrontLabelGoesWhereItHidesNoOtherDesign) {

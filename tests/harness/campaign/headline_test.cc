@@ -93,5 +93,43 @@ TEST(HeadlineTest, TiesAboveTheCheapestStayOnTheFrontWithoutBeingCalledTies) {
   EXPECT_THAT(h.cost_time_front, ElementsAre(0, 1, 2));
 }
 
+TEST(HeadlineTest, TheConstraintsInfeasibleDesignsInsideTheLinesFailAreNamed) {
+  spec::ParseOptions options;
+  options.check_files = false;
+  Result<spec::Spec> spec = spec::ParseSpec(
+      "adse: 1\nname: hidden\nworld: {map: {generate: parking_lot}}\n"
+      "task: {start: {x: 5, y: -1.75}, goal: {x: 60, y: 29.75}}\n"
+      "design_space:\n"
+      "  cores: {bind: platform.cores, values: [2, 4, 6, 8]}\n"
+      "  freq_ghz: {bind: platform.freq_ghz, values: [1.5, 2.0, 3.0]}\n"
+      "cost: cores * freq_ghz\n"
+      "objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]\n"
+      "constraints: [nav_time_s <= 60, deviation_score <= 0.6, "
+      "ctrl_rate_hz >= 5]\n",
+      "hidden.yaml", ".", options);
+  ASSERT_TRUE(spec.ok()) << spec.status().ToString();
+  std::vector<EvaluationRow> rows = {Row(0, 2, 3.0, 70), Row(1, 4, 3.0, 40),
+                                     Row(2, 6, 2.0, 45), Row(3, 8, 3.0, 30)};
+  for (EvaluationRow& row : rows) row.metrics["deviation_score"] = 0.1;
+  // Too slow, and straying: the time bound shows why.
+  rows[0].metrics["deviation_score"] = 0.9;
+  rows[0].feasible = false;
+  // Inside the time bound, infeasible by the deviation alone.
+  rows[1].metrics["deviation_score"] = 0.7;
+  rows[1].feasible = false;
+  EXPECT_THAT(UndrawnFailures(*spec, rows),
+              ElementsAre("deviation_score <= 0.6"));
+  // And one by the control rate too: both, in the scenario's order.
+  rows[2].metrics["ctrl_rate_hz"] = 2;
+  rows[2].feasible = false;
+  EXPECT_THAT(UndrawnFailures(*spec, rows),
+              ElementsAre("deviation_score <= 0.6", "ctrl_rate_hz >= 5"));
+  // Every infeasible design beyond a line: nothing to name.
+  rows[1].feasible = rows[2].feasible = true;
+  rows[1].metrics["deviation_score"] = 0.1;
+  rows[2].metrics["ctrl_rate_hz"] = 10;
+  EXPECT_TRUE(UndrawnFailures(*spec, rows).empty());
+}
+
 }  // namespace
 }  // namespace adse::campaign

@@ -434,14 +434,29 @@ TEST(CliRunTest, AnalyzeWithAReferenceDrawsTheStudysFigureOrRefusesClearly) {
       Adse("run " + SmallScenarioPath() + " --budget 3 -q -o " + out.string())
           .exit_code,
       0);
-  const std::string recording =
-      std::string(ADSE_SOURCE_DIR) + "/tests/data/reference_study";
+  // The reference: the same scenario's exhaustive sweep.
+  const fs::path recording = fs::temp_directory_path() / "adse_cli_study_ref";
+  fs::remove_all(recording);
+  ASSERT_EQ(Adse("run " + SmallScenarioPath() +
+                 " --strategy exhaustive -q -o " + recording.string())
+                .exit_code,
+            0);
   const CommandRun ok =
-      Adse("analyze " + out.string() + " --reference " + recording);
+      Adse("analyze " + out.string() + " --reference " + recording.string());
   ASSERT_EQ(ok.exit_code, 0) << ok.out;
   EXPECT_NE(ok.out.find("in the study's form over"), std::string::npos)
       << ok.out;
   EXPECT_TRUE(fs::exists(out / "analysis" / "v1" / "pareto.png"));
+  // Another scenario's study: exit 2 naming both, nothing written.
+  const CommandRun other =
+      Adse("analyze " + out.string() + " --reference " +
+           std::string(ADSE_SOURCE_DIR) + "/tests/data/reference_study");
+  EXPECT_EQ(other.exit_code, 2) << other.out;
+  EXPECT_NE(other.out.find("of scenario 'reference-study', not of "
+                           "'robotaxi-small'"),
+            std::string::npos)
+      << other.out;
+  EXPECT_FALSE(fs::exists(out / "analysis" / "v2"));
   // A reference that is no campaign: exit 2, named, nothing written.
   const CommandRun missing =
       Adse("analyze " + out.string() + " --reference /nonexistent/ref");
@@ -452,7 +467,7 @@ TEST(CliRunTest, AnalyzeWithAReferenceDrawsTheStudysFigureOrRefusesClearly) {
   EXPECT_FALSE(fs::exists(out / "analysis" / "v2"));
   // The figure is a campaign's: a run file with --reference is refused.
   const CommandRun file = Adse("analyze " + (out / "campaign.h5").string() +
-                               " --reference " + recording);
+                               " --reference " + recording.string());
   EXPECT_EQ(file.exit_code, 2) << file.out;
   EXPECT_NE(file.out.find("not a campaign folder"), std::string::npos)
       << file.out;

@@ -2,6 +2,8 @@
 // scenario's lines, the world check's output folder, single runs and their
 // analysis, and the fidelity check.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -10,6 +12,7 @@
 #include <regex>
 
 #include "analysis/runfile/run_file.h"
+#include "stack/base/files.h"
 #include "tests/harness/cli/example_files.h"
 #include "tests/harness/testing/adse_command.h"
 #include "tests/harness/testing/small_scenario.h"
@@ -292,6 +295,15 @@ TEST(CliTest, WorldFollowIdealNeverReplacesWhatItDidNotWrite) {
       << here.out;
   EXPECT_EQ(ReadText((dir / "results" / "precious.txt").string()), "keep me\n");
   EXPECT_EQ(ReadText((dir / "scenario.yaml").string()), "keep me too\n");
+  // What a check killed on its way left (its private folder, named for
+  // this host and a process that is gone) goes with the next check.
+  const std::string own = adse::TemporaryPathFor((dir / "check").string());
+  const pid_t gone = ::fork();
+  if (gone == 0) ::_exit(0);
+  ::waitpid(gone, nullptr, 0);
+  const std::string left =
+      own.substr(0, own.rfind('.') + 1) + std::to_string(gone);
+  fs::create_directories(left + "/scans");
   // An earlier check is replaced by the new one.
   const CommandRun first =
       Adse(world + (dir / "check").string() + " --no-scan");
@@ -480,6 +492,21 @@ TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
     const std::string name = e.path().filename().string();
     if (name.find(".tmp.") != std::string::npos) continue;
     EXPECT_TRUE(fs::exists(e.path() / "summary.json")) << name;
+  }
+  // What it left (here also one planted, of a process that is gone) goes
+  // with the next analysis.
+  const std::string own =
+      adse::TemporaryPathFor((dir / "analysis" / "v9").string());
+  const pid_t gone = ::fork();
+  if (gone == 0) ::_exit(0);
+  ::waitpid(gone, nullptr, 0);
+  fs::create_directories(own.substr(0, own.rfind('.') + 1) +
+                         std::to_string(gone) + "/reports");
+  // (Exit 2: the folder's broken file is still skipped.)
+  ASSERT_EQ(Adse("analyze " + dir.string()).exit_code, 2);
+  for (const auto& e : fs::directory_iterator(dir / "analysis")) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos)
+        << e.path();
   }
   // Run files outside a campaign: no analysis folder either.
   const CommandRun loose = Adse("analyze " + (dir / "runs").string() +

@@ -1,4 +1,6 @@
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -72,6 +74,41 @@ TEST(FilesTest, AtomicWriteReplacesWholeAndLeavesNoTemporary) {
   EXPECT_EQ(ReadFile((dir / "missing").string()).status().code(),
             Status::Code::kNotFound);
   EXPECT_EQ(ReadFile(path, 3).status().code(), Status::Code::kInvalidArgument);
+}
+
+// A pid no process has: a child's, once it has been reaped.
+pid_t GonePid() {
+  const pid_t pid = ::fork();
+  if (pid == 0) ::_exit(0);
+  ::waitpid(pid, nullptr, 0);
+  return pid;
+}
+
+TEST(FilesTest, TemporariesOfWritersThatAreGoneAreRemovedOthersKept) {
+  const fs::path dir = fs::temp_directory_path() / "adse_abandoned_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // "<path>.tmp.<host>.<pid>": this host's label from this process's name.
+  const std::string own = TemporaryPathFor((dir / "out").string());
+  const std::string stem = own.substr(0, own.rfind('.') + 1);
+  const std::string gone = stem + std::to_string(GonePid());
+  fs::create_directories(gone + "/scans");
+  std::ofstream(gone + "/scans/a.pcd") << "x";
+  std::ofstream(stem + std::to_string(GonePid())) << "a file";
+  fs::create_directories(own);  // a live writer's: this process
+  const std::string other_host =
+      (dir / ("out.tmp.elsewhere." + std::to_string(GonePid()))).string();
+  fs::create_directories(other_host);
+  fs::create_directories(stem + "12ab");
+  std::ofstream(dir / "out") << "the output";
+  EXPECT_EQ(RemoveAbandonedTemporaries(dir.string()), 2);
+  EXPECT_FALSE(fs::exists(gone));
+  EXPECT_TRUE(fs::exists(own));
+  EXPECT_TRUE(fs::exists(other_host));
+  EXPECT_TRUE(fs::exists(stem + "12ab"));
+  EXPECT_TRUE(fs::exists(dir / "out"));
+  EXPECT_EQ(RemoveAbandonedTemporaries((dir / "missing").string()), 0);
+  fs::remove_all(dir);
 }
 
 TEST(SubprocessTest, ExitStatusAndOutputTailAreReported) {
