@@ -16,7 +16,8 @@ namespace {
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
-spec::Spec Scenario() {
+// `constraints` as the scenario writes them.
+spec::Spec Scenario(const std::string& constraints = "[nav_time_s <= 60]") {
   spec::ParseOptions options;
   options.check_files = false;
   Result<spec::Spec> spec = spec::ParseSpec(
@@ -27,7 +28,8 @@ spec::Spec Scenario() {
       "  freq_ghz: {bind: platform.freq_ghz, values: [1.5, 2.0, 3.0]}\n"
       "cost: cores * freq_ghz\n"
       "objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]\n"
-      "constraints: [nav_time_s <= 60]\n",
+      "constraints: " +
+          constraints + "\n",
       "ties.yaml", ".", options);
   EXPECT_TRUE(spec.ok()) << spec.status().ToString();
   return std::move(spec).value();
@@ -94,20 +96,8 @@ TEST(HeadlineTest, TiesAboveTheCheapestStayOnTheFrontWithoutBeingCalledTies) {
 }
 
 TEST(HeadlineTest, TheConstraintsInfeasibleDesignsInsideTheLinesFailAreNamed) {
-  spec::ParseOptions options;
-  options.check_files = false;
-  Result<spec::Spec> spec = spec::ParseSpec(
-      "adse: 1\nname: hidden\nworld: {map: {generate: parking_lot}}\n"
-      "task: {start: {x: 5, y: -1.75}, goal: {x: 60, y: 29.75}}\n"
-      "design_space:\n"
-      "  cores: {bind: platform.cores, values: [2, 4, 6, 8]}\n"
-      "  freq_ghz: {bind: platform.freq_ghz, values: [1.5, 2.0, 3.0]}\n"
-      "cost: cores * freq_ghz\n"
-      "objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]\n"
-      "constraints: [nav_time_s <= 60, deviation_score <= 0.6, "
-      "ctrl_rate_hz >= 5]\n",
-      "hidden.yaml", ".", options);
-  ASSERT_TRUE(spec.ok()) << spec.status().ToString();
+  const spec::Spec spec =
+      Scenario("[nav_time_s <= 60, deviation_score <= 0.6, ctrl_rate_hz >= 5]");
   std::vector<EvaluationRow> rows = {Row(0, 2, 3.0, 70), Row(1, 4, 3.0, 40),
                                      Row(2, 6, 2.0, 45), Row(3, 8, 3.0, 30)};
   for (EvaluationRow& row : rows) row.metrics["deviation_score"] = 0.1;
@@ -117,18 +107,18 @@ TEST(HeadlineTest, TheConstraintsInfeasibleDesignsInsideTheLinesFailAreNamed) {
   // Inside the time bound, infeasible by the deviation alone.
   rows[1].metrics["deviation_score"] = 0.7;
   rows[1].feasible = false;
-  EXPECT_THAT(UndrawnFailures(*spec, rows),
+  EXPECT_THAT(UndrawnFailures(spec, rows),
               ElementsAre("deviation_score <= 0.6"));
   // And one by the control rate too: both, in the scenario's order.
   rows[2].metrics["ctrl_rate_hz"] = 2;
   rows[2].feasible = false;
-  EXPECT_THAT(UndrawnFailures(*spec, rows),
+  EXPECT_THAT(UndrawnFailures(spec, rows),
               ElementsAre("deviation_score <= 0.6", "ctrl_rate_hz >= 5"));
   // Every infeasible design beyond a line: nothing to name.
   rows[1].feasible = rows[2].feasible = true;
   rows[1].metrics["deviation_score"] = 0.1;
   rows[2].metrics["ctrl_rate_hz"] = 10;
-  EXPECT_TRUE(UndrawnFailures(*spec, rows).empty());
+  EXPECT_TRUE(UndrawnFailures(spec, rows).empty());
 }
 
 }  // namespace

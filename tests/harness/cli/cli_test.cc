@@ -268,6 +268,16 @@ TEST(CliTest, WorldFollowIdealReachesTheGoalAndWritesWhatItSaw) {
   EXPECT_FALSE(fs::exists(out / "scans" / "scan_00010.pcd"));
 }
 
+// The private path a writer of `path` on this host that is gone would
+// have left: TemporaryPathFor's, with the pid of a reaped child.
+std::string AbandonedTemporaryOf(const fs::path& path) {
+  const std::string own = adse::TemporaryPathFor(path.string());
+  const pid_t gone = ::fork();
+  if (gone == 0) ::_exit(0);
+  ::waitpid(gone, nullptr, 0);
+  return own.substr(0, own.rfind('.') + 1) + std::to_string(gone);
+}
+
 TEST(CliTest, WorldFollowIdealNeverReplacesWhatItDidNotWrite) {
   const fs::path dir = fs::temp_directory_path() / "adse_cli_world_others";
   fs::remove_all(dir);
@@ -297,13 +307,7 @@ TEST(CliTest, WorldFollowIdealNeverReplacesWhatItDidNotWrite) {
   EXPECT_EQ(ReadText((dir / "scenario.yaml").string()), "keep me too\n");
   // What a check killed on its way left (its private folder, named for
   // this host and a process that is gone) goes with the next check.
-  const std::string own = adse::TemporaryPathFor((dir / "check").string());
-  const pid_t gone = ::fork();
-  if (gone == 0) ::_exit(0);
-  ::waitpid(gone, nullptr, 0);
-  const std::string left =
-      own.substr(0, own.rfind('.') + 1) + std::to_string(gone);
-  fs::create_directories(left + "/scans");
+  fs::create_directories(AbandonedTemporaryOf(dir / "check") + "/scans");
   // An earlier check is replaced by the new one.
   const CommandRun first =
       Adse(world + (dir / "check").string() + " --no-scan");
@@ -495,13 +499,8 @@ TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
   }
   // What it left (here also one planted, of a process that is gone) goes
   // with the next analysis.
-  const std::string own =
-      adse::TemporaryPathFor((dir / "analysis" / "v9").string());
-  const pid_t gone = ::fork();
-  if (gone == 0) ::_exit(0);
-  ::waitpid(gone, nullptr, 0);
-  fs::create_directories(own.substr(0, own.rfind('.') + 1) +
-                         std::to_string(gone) + "/reports");
+  fs::create_directories(AbandonedTemporaryOf(dir / "analysis" / "v9") +
+                         "/reports");
   // (Exit 2: the folder's broken file is still skipped.)
   ASSERT_EQ(Adse("analyze " + dir.string()).exit_code, 2);
   for (const auto& e : fs::directory_iterator(dir / "analysis")) {
