@@ -222,6 +222,41 @@ void DrawStandRing(cv::Mat* img, cv::Point2d at, Rgb colour, const Style& s) {
              Bgr(colour), s.Px(3), cv::LINE_AA, kShift);
 }
 
+// Where a run that did not reach its goal ended: a black square.
+void DrawEndMarker(cv::Mat* img, cv::Point2d at, const Style& s) {
+  if (!Finite(at)) return;
+  const double half = s.Px(6);
+  const cv::Point2d d(half, half);
+  cv::rectangle(*img, Fixed(at - d - cv::Point2d(s.Px(2), s.Px(2))),
+                Fixed(at + d + cv::Point2d(s.Px(2), s.Px(2))), kWhite,
+                cv::FILLED, cv::LINE_AA, kShift);
+  cv::rectangle(*img, Fixed(at - d), Fixed(at + d), kBlack, cv::FILLED,
+                cv::LINE_AA, kShift);
+}
+
+// How a run that did not reach its goal ended, in words, with the time;
+// empty for one that did (its goal marker says so).
+std::string EndText(const runfile::RunData& run, double t_s) {
+  const std::string& reason = run.termination_reason;
+  if (reason == "goal_reached") return "";
+  std::string what;
+  if (!runfile::ViolatedConstraint(reason).empty()) {
+    what = "stopped early";  // the title names the constraint
+  } else if (const std::string held =
+                 runfile::ReasonAfter(reason, runfile::kStalledPrefix);
+             !held.empty()) {
+    what = "stalled (" + held + ")";
+  } else if (reason == "timeout" || reason == "no_path" ||
+             reason == "parked_out_of_tolerance") {
+    what = reason == "no_path"   ? "no path"
+           : reason == "timeout" ? "timeout"
+                                 : "parked out of tolerance";
+  } else {
+    what = "ended";
+  }
+  return fmt::format("{} {:.0f} s", what, t_s);
+}
+
 // What held the car, in words: the planner's reason, or "plan said go"
 // when the plan did not stop (a cause outside the planner held it).
 std::string StandText(const analysis::Stand& stand) {
@@ -426,6 +461,18 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   for (const CollisionPlace& c : collisions) {
     DrawContactMarker(&img, px(c.x_m, c.y_m), s);
   }
+  // Where a run that did not arrive ended: its last position.
+  cv::Point2d end(NAN, NAN);
+  double end_t_s = 0.0;
+  for (size_t i = ego.size(); i-- > 0;) {
+    if (Finite(ego[i])) {
+      end = ego[i];
+      end_t_s = run.ego[i].t_s;
+      break;
+    }
+  }
+  const std::string end_text = EndText(run, end_t_s);
+  if (!end_text.empty()) DrawEndMarker(&img, end, s);
   // Start and goal labelled first, so they get the first choice of place.
   std::vector<cv::Rect> labels;
   DrawGoalMarker(&img, goal, s);
@@ -437,6 +484,9 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
                   &labels);
   DrawMarkerLabel(&img, start, "start", s, Bgr(kStartRgb), map.map_top_px,
                   &labels);
+  if (!end_text.empty()) {
+    DrawMarkerLabel(&img, end, end_text, s, kBlack, map.map_top_px, &labels);
+  }
   for (const CollisionPlace& c : collisions) {
     DrawMarkerLabel(&img, px(c.x_m, c.y_m),
                     fmt::format("collision {:.0f} s{}", c.t_s,
@@ -519,6 +569,11 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
   legend.Add("goal", [&](cv::Point2d a, cv::Point2d b) {
     DrawGoalMarker(&img, 0.5 * (a + b), s);
   });
+  if (!end_text.empty() && Finite(end)) {
+    legend.Add("where it ended", [&](cv::Point2d a, cv::Point2d b) {
+      DrawEndMarker(&img, 0.5 * (a + b), s);
+    });
+  }
   if (!stands.empty()) {
     legend.Add("stood >= 3 s", [&](cv::Point2d a, cv::Point2d b) {
       DrawStandMarker(&img, 0.5 * (a + b), StandRgb(stands.front()), s);

@@ -222,6 +222,29 @@ TEST_F(PictureTest, AStandWhereTheCarStartedRingsTheStartMarker) {
   EXPECT_TRUE(ColourNear(*img, column + 12, row, kStandRedLightRgb, 2));
 }
 
+TEST_F(PictureTest, ARunThatDidNotArriveIsMarkedWhereItEnded) {
+  // The square loop's run, ended halfway (its last sample at (99, 1)):
+  // stopped early, timed out or stalled, a black square there; arrived,
+  // none.
+  RunData arrived = SquareRun();
+  arrived.ego.resize(101);
+  for (const std::string reason :
+       {"constraint_violated: nav_time_s <= 60", "timeout", "stalled: obstacle",
+        "goal_reached"}) {
+    RunData run = arrived;
+    run.termination_reason = reason;
+    ASSERT_TRUE(RenderTrajectoryImage(run, Path("ended.png")).ok());
+    Result<RgbImage> img = ReadImage(Path("ended.png"));
+    ASSERT_TRUE(img.ok());
+    Result<WorldToImage> map = TrajectoryImageMapping(run);
+    ASSERT_TRUE(map.ok());
+    EXPECT_EQ(
+        ColourNear(*img, map->Column(99.0), map->Row(1.0), Rgb{0, 0, 0}, 2),
+        reason != "goal_reached")
+        << reason;
+  }
+}
+
 TEST_F(PictureTest, ACollisionWithTrafficIsMarkedWhereItHappened) {
   // At 5.0 s the ego is at (49, 1); a flow car recorded at (52, 3) then.
   RunData run = SquareRun();
