@@ -88,8 +88,10 @@ std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
   const std::string path = folder_.RunPath(p.key);
   std::error_code ec;
   std::optional<EvaluationRow> row;
-  // The worker's own analysis, when it left one for this very run.
-  if (fs::exists(path, ec)) {
+  // The worker's own analysis, when it left one for this very run and the
+  // run file still reads whole (a file cut short or damaged since, or a
+  // folder in its place, is analysed below, found unusable and run again).
+  if (fs::is_regular_file(path, ec) && runfile::ReadRunFile(path).ok()) {
     Result<std::string> text = ReadFile(folder_.ReportPath(p.key), 16 << 20);
     if (text.ok()) {
       Result<EvaluationRow> stored =

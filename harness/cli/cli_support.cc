@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/runfile/run_file.h"
 #include "harness/sim/run_key.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/env.h"
@@ -18,6 +19,15 @@
 namespace adse::cli {
 
 namespace {
+
+// Whether `path` is the current folder or one above it.
+bool CurrentOrAbove(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::filesystem::path relative =
+      std::filesystem::current_path(ec).lexically_relative(
+          std::filesystem::weakly_canonical(path, ec));
+  return relative.native().rfind("..", 0) != 0;
+}
 
 std::optional<spec::Spec> ParseScenarioOrReport(const std::string& path) {
   Result<spec::Spec> loaded = spec::LoadSpec(path);
@@ -113,9 +123,7 @@ Status CheckOutputFolder(const std::string& out,
   if (!fs::is_directory(path, ec)) {
     return Status::InvalidArgument("-o " + out + ": a file is there" + hint);
   }
-  const fs::path relative =
-      fs::current_path(ec).lexically_relative(fs::weakly_canonical(path, ec));
-  if (relative.native().rfind("..", 0) != 0) {
+  if (CurrentOrAbove(path)) {
     return Status::InvalidArgument(
         "-o " + out + ": the current folder or one above it" + hint);
   }
@@ -153,32 +161,101 @@ Status CheckFolderPath(const std::string& path, const std::string& what) {
   return Status::Ok();
 }
 
+Status CheckCampaignFolder(const std::string& folder, const std::string& what) {
+  namespace fs = std::filesystem;
+  ADSE_RETURN_IF_ERROR(CheckFolderPath(folder, what));
+  std::error_code ec;
+  const fs::path path(folder);
+  if (!fs::exists(path, ec)) return Status::Ok();
+  const std::string hint = "; give a new folder, or a campaign's to resume it";
+  if (fs::exists(path / "campaign.h5", ec)) return Status::Ok();
+  if (CurrentOrAbove(path)) {
+    return Status::InvalidArgument(
+        what + ": " + folder + " is the current folder or one above it" + hint);
+  }
+  // Before its first views a campaign's folder holds only these.
+  for (const auto& entry : fs::directory_iterator(path, ec)) {
+    const std::string name = entry.path().filename().string();
+    const bool ours = name == "runs" || name == "images" || name == "logs" ||
+                      name == ".lock" || name == "slurm" ||
+                      name.find(".tmp.") != std::string::npos;
+    if (!ours) {
+      return Status::InvalidArgument(
+          what + ": " + folder + " is no campaign's folder (no campaign.h5) " +
+          "and holds " + (path / name).string() +
+          ", which a campaign would write over or mix with" + hint);
+    }
+  }
+  return Status::Ok();
+}
+
+namespace {
+
+// Whether `out` lies in a campaign's runs/ folder, whose files are the
+// campaign's runs under their content keys.
+bool InCampaignRuns(const std::filesystem::path& out) {
+  const std::filesystem::path runs =
+      std::filesystem::absolute(out).lexically_normal().parent_path();
+  std::error_code ec;
+  return runs.filename() == "runs" &&
+         std::filesystem::exists(runs.parent_path() / "campaign.h5", ec);
+}
+
+// Whether an existing file is an earlier output of `kind`.
+bool IsOutputOf(const std::string& out, OutputFileKind kind) {
+  if (kind == kRunFile) return runfile::ReadRunFile(out).ok();
+  Result<std::string> text = ReadFile(out, 16u << 20);
+  if (!text.ok()) return false;
+  switch (kind) {
+    case kCalibrationFile: {
+      const nlohmann::json doc = nlohmann::json::parse(*text, nullptr, false);
+      return doc.is_object() && doc.contains("adse_calibration");
+    }
+    case kProfileFile:
+      return text->find("\nadse_profile:") != std::string::npos ||
+             text->rfind("adse_profile:", 0) == 0;
+    case kInterpretedScenario:
+      return text->rfind(kInterpretHeader, 0) == 0;
+    case kRunFile:
+      break;
+  }
+  return false;
+}
+
+}  // namespace
+
 Status CheckOutputFile(const std::string& out, OutputFileKind kind) {
   namespace fs = std::filesystem;
   std::error_code ec;
   ADSE_RETURN_IF_ERROR(
       CheckFolderPath(fs::path(out).parent_path().string(), "-o " + out));
+  if (kind == kRunFile && InCampaignRuns(out)) {
+    return Status::InvalidArgument(
+        "-o " + out +
+        ": a campaign's runs/ folder holds its runs under their keys; give "
+        "a path outside it");
+  }
   if (!fs::exists(out, ec)) return Status::Ok();
-  const std::string what = kind == kRunFile ? "a run file (HDF5)"
-                                            : "a calibration (adse calibrate's "
-                                              "JSON)";
+  const char* what = "";
+  switch (kind) {
+    case kRunFile:
+      what = "a run file";
+      break;
+    case kCalibrationFile:
+      what = "a calibration (adse calibrate's JSON)";
+      break;
+    case kProfileFile:
+      what = "a profile (adse profile import's YAML)";
+      break;
+    case kInterpretedScenario:
+      what = "a scenario adse interpret wrote";
+      break;
+  }
   if (fs::is_directory(out, ec)) {
     return Status::InvalidArgument("-o " + out + ": a folder is there; give " +
                                    what + "'s path");
   }
-  bool ours = false;
-  if (kind == kRunFile) {
-    std::string head(8, '\0');
-    std::ifstream(out, std::ios::binary).read(head.data(), 8);
-    ours = head == std::string("\x89HDF\r\n\x1a\n", 8);
-  } else {
-    Result<std::string> text = ReadFile(out, 16u << 20);
-    const nlohmann::json doc =
-        text.ok() ? nlohmann::json::parse(*text, nullptr, false)
-                  : nlohmann::json();
-    ours = doc.is_object() && doc.contains("adse_calibration");
-  }
-  if (!ours) {
+  if (!IsOutputOf(out, kind)) {
     return Status::InvalidArgument("-o " + out + ": a file that is not " +
                                    what + " is there; give another path");
   }

@@ -55,20 +55,37 @@ Status CheckOutputFolder(const std::string& out,
 // folder".
 Status CheckFolderPath(const std::string& path, const std::string& what);
 
+// Ok when `folder` may hold a campaign (adse run resumes what it holds):
+// nothing is there, or a campaign's folder is (its campaign.h5), or one
+// whose first run has not ended (its runs/, images/, logs/, lock). Else
+// the current folder or one above it, a file, and a folder holding anything
+// else (a report.md that is not a campaign's, the user's files) are
+// InvalidArgument naming `what` (the flag or field that gave the path).
+Status CheckCampaignFolder(const std::string& folder, const std::string& what);
+
 // What a command's output file is, so that an earlier one can be told
 // from anything else.
 enum class OutputFileKind {
-  kRunFile,          // HDF5 (adse simulate)
-  kCalibrationFile,  // JSON with "adse_calibration" (adse calibrate)
+  kRunFile,              // a readable run file (adse simulate)
+  kCalibrationFile,      // JSON with "adse_calibration" (adse calibrate)
+  kProfileFile,          // YAML with "adse_profile" (adse profile import)
+  kInterpretedScenario,  // a scenario adse interpret wrote (its header)
 };
 inline constexpr OutputFileKind kRunFile = OutputFileKind::kRunFile;
 inline constexpr OutputFileKind kCalibrationFile =
     OutputFileKind::kCalibrationFile;
+inline constexpr OutputFileKind kProfileFile = OutputFileKind::kProfileFile;
+inline constexpr OutputFileKind kInterpretedScenario =
+    OutputFileKind::kInterpretedScenario;
+
+// The first line of every scenario adse interpret writes.
+inline constexpr char kInterpretHeader[] = "# Written by `adse interpret`";
 
 // Ok when the command may write `out`: nothing is there, or an earlier
 // output of its kind is (which the new one replaces). A scenario, a
-// folder, any other file, or a parent that is a file is InvalidArgument,
-// so that it is said before anything runs.
+// folder, any other file, a parent that is a file, or (for a run file) a
+// place in a campaign's runs/ folder is InvalidArgument, so that it is
+// said before anything runs.
 Status CheckOutputFile(const std::string& out, OutputFileKind kind);
 
 // The private folder an output is written into before PutFolderInPlace

@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
 #include "harness/llm/exchange_log.h"
 #include "harness/llm/interpret.h"
@@ -59,6 +60,13 @@ int RunInterpret(const InterpretArgs& args) {
                        : fs::absolute(args.out).lexically_normal().string();
   const std::string folder = out.empty() ? fs::current_path().string()
                                          : fs::path(out).parent_path().string();
+  if (!out.empty()) {
+    if (Status usable = CheckOutputFile(out, kInterpretedScenario);
+        !usable.ok()) {
+      std::fprintf(stderr, "adse interpret: %s\n", usable.message().c_str());
+      return 2;
+    }
+  }
   std::string record = args.record;
   if (record.empty() && !out.empty()) {
     record = (fs::path(out).parent_path() /
@@ -132,7 +140,7 @@ int RunInterpret(const InterpretArgs& args) {
                  d.c_str());
   }
   const std::string text =
-      "# Written by `adse interpret` from the request:\n#   " +
+      std::string(kInterpretHeader) + " from the request:\n#   " +
       ReplaceAll(args.request, "\n", "\n#   ") + "\n" + result->yaml;
   if (out.empty()) {
     std::fputs(text.c_str(), stdout);

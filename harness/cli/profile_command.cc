@@ -24,6 +24,20 @@
 namespace adse::cli {
 
 int RunProfileImport(const ProfileImportArgs& args) {
+  // Never over its own input, nor over anything but an earlier profile.
+  std::error_code same_ec;
+  if (std::filesystem::exists(args.out, same_ec) &&
+      std::filesystem::equivalent(args.out, args.mapping, same_ec)) {
+    std::fprintf(stderr,
+                 "error: -o %s: that is the mapping (--map) being read; give "
+                 "the profile a path of its own\n",
+                 args.out.c_str());
+    return 2;
+  }
+  if (Status usable = CheckOutputFile(args.out, kProfileFile); !usable.ok()) {
+    std::fprintf(stderr, "error: %s\n", usable.message().c_str());
+    return 2;
+  }
   Result<profile::Profile> imported =
       profile::ImportCaret(args.caret, args.mapping);
   if (!imported.ok()) {

@@ -211,11 +211,12 @@ int RunRun(const RunArgs& args) {
     options.drain_grace_s = std::max(0, spec->harness.slurm.signal_lead_s - 30);
   }
   // A campaign folder resumes whatever it holds; a file where it or a
-  // folder above it goes is bad input, said before any worker starts.
-  if (Status usable =
-          CheckFolderPath(args.out.empty() ? spec->ResolvedOutput() : args.out,
-                          args.out.empty() ? spec->Where("output") + "output"
-                                           : "-o " + args.out);
+  // folder above it goes, or a folder that is no campaign's, is bad input,
+  // said before any worker starts.
+  if (Status usable = CheckCampaignFolder(
+          args.out.empty() ? spec->ResolvedOutput() : args.out,
+          args.out.empty() ? spec->Where("output") + "output"
+                           : "-o " + args.out);
       !usable.ok()) {
     std::fprintf(stderr, "error: %s\n", usable.message().c_str());
     return 2;

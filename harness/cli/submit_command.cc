@@ -18,6 +18,14 @@ namespace adse::cli {
 int RunSubmit(const SubmitArgs& args) {
   std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
   if (!spec) return 2;
+  if (Status usable = CheckCampaignFolder(
+          args.out.empty() ? spec->ResolvedOutput() : args.out,
+          args.out.empty() ? spec->Where("output") + "output"
+                           : "-o " + args.out);
+      !usable.ok()) {
+    std::fprintf(stderr, "error: %s\n", usable.message().c_str());
+    return 2;
+  }
   slurm::SubmitOptions options;
   options.output_dir = args.out;
   options.strategy = args.strategy;

@@ -91,6 +91,27 @@ TEST(CliProfileTest, ImportOfBadInputExitsWith2AndWritesNothing) {
       << unknown.out;
   EXPECT_FALSE(fs::exists(out));
 
+  // -o never over its own mapping, nor over a file that is no profile.
+  const std::string mapping_text = ReadText(mapping.string());
+  const CommandRun over_map =
+      Adse("profile import --caret " + TrimmedCaret() + " --map " +
+           mapping.string() + " -o " + mapping.string());
+  EXPECT_EQ(over_map.exit_code, 2) << over_map.out;
+  EXPECT_NE(over_map.out.find("that is the mapping (--map) being read"),
+            std::string::npos)
+      << over_map.out;
+  const std::string scenario = WriteScenario("not_a_profile", "keep me\n");
+  const CommandRun over_other =
+      Adse("profile import --caret " + TrimmedCaret() + " --map " +
+           BundledMapping() + " -o " + scenario);
+  EXPECT_EQ(over_other.exit_code, 2) << over_other.out;
+  EXPECT_NE(over_other.out.find("a file that is not a profile (adse profile "
+                                "import's YAML) is there"),
+            std::string::npos)
+      << over_other.out;
+  EXPECT_EQ(ReadText(mapping.string()), mapping_text);
+  EXPECT_EQ(ReadText(scenario), "keep me\n");
+
   EXPECT_EQ(Adse("profile import --caret " + TrimmedCaret()).exit_code, 2);
   const CommandRun show = Adse("profile show /nonexistent/profile.yaml");
   EXPECT_EQ(show.exit_code, 2) << show.out;

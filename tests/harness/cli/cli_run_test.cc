@@ -194,6 +194,61 @@ TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
   EXPECT_NE(status.out.find("\"total\": 2"), std::string::npos) << status.out;
 }
 
+TEST(CliRunTest, ARunNeverWritesIntoAFolderThatIsNoCampaigns) {
+  const fs::path dir = fs::temp_directory_path() / "adse_cli_user_folder";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "report.md") << "my notes\n";
+  const std::string run = "run " + SmallScenarioPath() + " --budget 1 -q -o ";
+  const CommandRun into = Adse(run + dir.string());
+  EXPECT_EQ(into.exit_code, 2) << into.out;
+  EXPECT_NE(
+      into.out.find("is no campaign's folder (no campaign.h5) and holds " +
+                    (dir / "report.md").string()),
+      std::string::npos)
+      << into.out;
+  // Nor into the current folder, unless it is a campaign's.
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir);
+  const CommandRun here = Adse(run + ".");
+  fs::current_path(cwd);
+  EXPECT_EQ(here.exit_code, 2) << here.out;
+  EXPECT_EQ(ReadText((dir / "report.md").string()), "my notes\n");
+  EXPECT_FALSE(fs::exists(dir / "campaign.h5"));
+  fs::remove(dir / "report.md");
+  ASSERT_EQ(Adse(run + (dir / "c").string()).exit_code, 0);
+  fs::current_path(dir / "c");
+  const CommandRun resumed = Adse(run + ".");
+  fs::current_path(cwd);
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.out;
+  fs::remove_all(dir);
+}
+
+TEST(CliRunTest, ADamagedRunFileIsRunAgainWhenTheCampaignResumes) {
+  const fs::path out = fs::temp_directory_path() / "adse_cli_damaged_run";
+  fs::remove_all(out);
+  const std::string run = "run " + SmallScenarioPath() +
+                          " --budget 1 --strategy exhaustive --no-cache -o " +
+                          out.string();
+  ASSERT_EQ(Adse(run).exit_code, 0);
+  fs::path file;
+  for (const auto& e : fs::directory_iterator(out / "runs")) {
+    if (e.path().extension() == ".h5") file = e.path();
+  }
+  ASSERT_FALSE(file.empty());
+  // Cut in half: its report.json, left by the worker, still says it ran.
+  const std::string whole = ReadText(file.string());
+  std::ofstream(file, std::ios::binary | std::ios::trunc)
+      << whole.substr(0, whole.size() / 2);
+  const CommandRun resumed = Adse(run);
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.out;
+  EXPECT_NE(resumed.out.find(file.string() + " is unusable"), std::string::npos)
+      << resumed.out;
+  EXPECT_NE(resumed.out.find("1 simulated"), std::string::npos) << resumed.out;
+  EXPECT_EQ(ReadText(file.string()).size(), whole.size());
+  fs::remove_all(out);
+}
+
 TEST(CliRunTest, ARunIntoAnotherScenariosFolderWarnsAndStatusCountsItsOwnRuns) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_two_scenarios";
   fs::remove_all(out);

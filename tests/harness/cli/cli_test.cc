@@ -332,7 +332,7 @@ TEST(CliTest, SimulateAndCalibrateNeverOverwriteWhatIsNotTheirs) {
                                " --point cores=16,freq_ghz=2.1,lidar_hz=7 -q ";
   const CommandRun yaml = Adse(simulate + "-o " + (dir / "mine.yaml").string());
   EXPECT_EQ(yaml.exit_code, 2) << yaml.out;
-  EXPECT_NE(yaml.out.find("a file that is not a run file (HDF5) is there"),
+  EXPECT_NE(yaml.out.find("a file that is not a run file is there"),
             std::string::npos)
       << yaml.out;
   const CommandRun calibrate = Adse("calibrate " + SmallScenarioPath() +
@@ -352,6 +352,28 @@ TEST(CliTest, SimulateAndCalibrateNeverOverwriteWhatIsNotTheirs) {
   EXPECT_NE(under.out.find("mine.yaml is a file, not a folder"),
             std::string::npos)
       << under.out;
+  // A campaign's index, or a place among its runs, is no run file's to
+  // take.
+  const fs::path campaign = dir / "camp";
+  ASSERT_EQ(Adse("run " + SmallScenarioPath() +
+                 " --budget 1 --strategy exhaustive -q -o " + campaign.string())
+                .exit_code,
+            0);
+  const std::string index_before =
+      ReadText((campaign / "campaign.h5").string());
+  const CommandRun over_index =
+      Adse(simulate + "-o " + (campaign / "campaign.h5").string());
+  EXPECT_EQ(over_index.exit_code, 2) << over_index.out;
+  EXPECT_NE(over_index.out.find("a file that is not a run file is there"),
+            std::string::npos)
+      << over_index.out;
+  EXPECT_EQ(ReadText((campaign / "campaign.h5").string()), index_before);
+  const CommandRun among_runs =
+      Adse(simulate + "-o " + (campaign / "runs" / "mine.h5").string());
+  EXPECT_EQ(among_runs.exit_code, 2) << among_runs.out;
+  EXPECT_NE(among_runs.out.find("a campaign's runs/ folder holds its runs"),
+            std::string::npos)
+      << among_runs.out;
   // A seed of its own gets a file of its own by default.
   const std::string scenario = WriteScenario(
       "simulate_seeds",

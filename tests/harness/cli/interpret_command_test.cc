@@ -131,6 +131,26 @@ TEST(InterpretCommandTest, AModelThatNeverGetsItRightWritesNothing) {
   EXPECT_EQ((*server)->requests().size(), 2u);
 }
 
+TEST(InterpretCommandTest, AFileItDidNotWriteIsNeverReplaced) {
+  const std::string dir = TempDir("mine");
+  std::ofstream(dir + "/study.yaml") << "my own scenario\n";
+  // Refused before asking: the server has no answer to give.
+  Result<std::unique_ptr<FakeLlmServer>> server =
+      FakeLlmServer::Start(FakeLlmServer::Sequence({}));
+  ASSERT_TRUE(server.ok());
+  const CommandRun run =
+      Adse(std::string("interpret ") + kRequest + " -o " + dir +
+           "/study.yaml --model interp --endpoint " + (*server)->url());
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_THAT(run.out, HasSubstr("a file that is not a scenario adse "
+                                 "interpret wrote is there"));
+  EXPECT_TRUE((*server)->requests().empty());
+  std::ifstream in(dir + "/study.yaml");
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "my own scenario");
+}
+
 TEST(InterpretCommandTest, AServerThatIsDownIsNamedWithWhatToStart) {
   const std::string dir = TempDir("down");
   const CommandRun run =
