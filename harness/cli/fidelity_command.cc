@@ -277,6 +277,15 @@ int RunFidelity(const FidelityArgs& args) {
     }
     points.push_back(*point);
   }
+  // Every point runnable in real time here, said before hours of runs.
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (Status runnable = fidelity::CheckPointRunnable(*spec, points[i]);
+        !runnable.ok()) {
+      std::fprintf(stderr, "--points %s: ", args.points[i].c_str());
+      ReportError(*spec, runnable);
+      return 2;
+    }
+  }
   Comparisons c;
   c.dir = args.out.empty() ? spec->ResolvedOutput() + "/fidelity" : args.out;
   // An earlier call's runs are worth keeping (real-time runs take long),

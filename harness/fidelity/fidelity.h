@@ -116,6 +116,14 @@ struct PointRuns {
   std::vector<runfile::RunData> realtime_runs;
 };
 
+// Whether `point` can be run both ways here, said before any run: it lies
+// in the space, the scenario has a cost profile (the real-time platform
+// pads every callback to it), and this process may use a host CPU per
+// core of the point. InvalidArgument naming what is missing; Unavailable
+// naming both CPU counts.
+Status CheckPointRunnable(const spec::Spec& spec,
+                          const spec::DesignPoint& point);
+
 // Runs `point` both ways. Early stop is off for these runs: a censored
 // time would compare nothing. Errors: the point's or the platform's
 // (InvalidArgument for a point outside the space or a scenario without a

@@ -585,6 +585,43 @@ TEST(CliTest, AnalyzeDiffRefusesASummaryItCannotRead) {
   fs::remove_all(dir);
 }
 
+TEST(CliTest, FidelityRefusesAPointItCannotRunInRealTimeBeforeAnyRun) {
+  // A second point with more cores (1024) than a host this test runs on
+  // gives the process, and a scenario without a cost profile: exit 2 before the
+  // first point's runs, nothing written.
+  const fs::path out = fs::temp_directory_path() / "adse_cli_fidelity_refused";
+  fs::remove_all(out);
+  const std::string small =
+      WriteScenario("fidelity_many_cores",
+                    Replaced(ReadText(std::string(ADSE_SOURCE_DIR) +
+                                      "/scenarios/fidelity_small.yaml"),
+                             "values: [1, 2]}", "values: [1, 2, 1024]}"));
+  const CommandRun cores =
+      Adse("fidelity " + small +
+           " --points cores=1,freq_ghz=2.1,lidar_hz=7 "
+           "cores=1024,freq_ghz=2.1,lidar_hz=7 --runs 1 -o " +
+           out.string());
+  EXPECT_EQ(cores.exit_code, 2) << cores.out;
+  EXPECT_NE(cores.out.find("--points cores=1024,freq_ghz=2.1,lidar_hz=7: "),
+            std::string::npos)
+      << cores.out;
+  EXPECT_NE(cores.out.find("one host CPU per core of the point, 1024 here"),
+            std::string::npos)
+      << cores.out;
+  EXPECT_EQ(cores.out.find("run ..."), std::string::npos) << cores.out;
+  EXPECT_FALSE(fs::exists(out));
+  const CommandRun profile =
+      Adse("fidelity " + std::string(ADSE_SOURCE_DIR) +
+           "/scenarios/grid_town.yaml --points cores=2,freq_ghz=1.2,beams=16 "
+           "-o " +
+           out.string());
+  EXPECT_EQ(profile.exit_code, 2) << profile.out;
+  EXPECT_NE(profile.out.find("pads every callback to its cost profile"),
+            std::string::npos)
+      << profile.out;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
   const std::string file = WriteScenario(
       "fidelity", Replaced(ReadText(std::string(ADSE_SOURCE_DIR) +
