@@ -316,7 +316,7 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
   for (const std::string& note : s.notes) md << "- note: " << note << "\n";
   if (s.finished_unknown) {
     md << "- whether the campaign finished is not recorded (its folder has "
-          "no summary.json)\n";
+          "no summary.json it can read)\n";
   }
   md << fmt::format("- wall time: {}\n", Duration(s.wall_s));
   if (s.interrupted_by != 0) {

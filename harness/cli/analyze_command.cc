@@ -282,6 +282,11 @@ void CarryCampaignState(const campaign::CampaignFolder& folder,
                                : nlohmann::json();
   if (!j.is_object()) {
     summary->finished_unknown = true;
+    if (text.ok()) {
+      summary->notes.push_back(folder.Path("summary.json") +
+                               " is no JSON object: how the campaign ended "
+                               "is not known");
+    }
     return;
   }
   auto number = [&](const char* key) {
@@ -500,8 +505,12 @@ int AnalyzeFolder(const std::string& target,
   summary.exploration.evaluations = rows;
   if (index) summary.exploration.iterations = index->iterations;
   for (const campaign::EvaluationRow& row : rows) {
+    // As the campaign got them: simulated by it, or from its folder or the
+    // shared cache (loose run files are all found).
     summary.failed += !row.complete();
-    summary.reused += row.complete();
+    (row.complete() && row.source == "simulated" ? summary.simulated
+                                                 : summary.reused) +=
+        row.complete();
   }
   if (index) CarryCampaignState(folder, &summary);
   if (unreadable > 0) {

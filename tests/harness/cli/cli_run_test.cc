@@ -356,8 +356,8 @@ std::string FrontSection(const std::string& out) {
 TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_one_answer";
   fs::remove_all(out);
-  const CommandRun run =
-      Adse("run " + SmallScenarioPath() + " --budget 7 -q -o " + out.string());
+  const CommandRun run = Adse("run " + SmallScenarioPath() +
+                              " --budget 7 --no-cache -q -o " + out.string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
   ASSERT_NE(run.out.find("cheapest feasible"), std::string::npos) << run.out;
   ASSERT_FALSE(FrontSection(run.out).empty()) << run.out;
@@ -383,6 +383,16 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
   EXPECT_TRUE(fs::exists(out / "analysis" / "v1" / "pareto.png"));
   EXPECT_TRUE(fs::exists(out / "analysis" / "v1" / "report.md"));
   EXPECT_FALSE(fs::exists(out / "runs" / "analysis"));
+  // How the runs were got, as the campaign said it.
+  const std::regex got("[0-9]+ simulated, [0-9]+ reused");
+  std::smatch campaign_got, analysis_got;
+  const std::string campaign_md = ReadText((out / "report.md").string());
+  const std::string analysis_md =
+      ReadText((out / "analysis" / "v1" / "report.md").string());
+  ASSERT_TRUE(std::regex_search(campaign_md, campaign_got, got));
+  ASSERT_TRUE(std::regex_search(analysis_md, analysis_got, got));
+  EXPECT_EQ(campaign_got.str(), "7 simulated, 0 reused");
+  EXPECT_EQ(analysis_got.str(), campaign_got.str());
   ASSERT_EQ(Adse("analyze " + out.string() +
                  " --threshold frequency_bound_fraction=0.8")
                 .exit_code,
