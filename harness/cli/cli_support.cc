@@ -12,6 +12,7 @@
 
 #include "analysis/runfile/run_file.h"
 #include "harness/sim/run_key.h"
+#include "harness/sim/simulator.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/env.h"
 #include "stack/base/files.h"
@@ -73,7 +74,8 @@ std::optional<spec::Spec> LoadScenarioOrReport(const std::string& path) {
   std::optional<spec::Spec> loaded = ParseScenarioOrReport(path);
   if (!loaded) return std::nullopt;
   for (const Status& checked :
-       {spec::CheckCostOverSpace(*loaded), sim::CheckKnobsAct(*loaded)}) {
+       {spec::CheckCostOverSpace(*loaded), sim::CheckKnobsAct(*loaded),
+        sim::CheckCostModelFile(*loaded)}) {
     if (!checked.ok()) {
       ReportError(*loaded, checked);
       return std::nullopt;
@@ -173,17 +175,22 @@ Status CheckCampaignFolder(const std::string& folder, const std::string& what) {
     return Status::InvalidArgument(
         what + ": " + folder + " is the current folder or one above it" + hint);
   }
-  // Before its first views a campaign's folder holds only these.
-  for (const auto& entry : fs::directory_iterator(path, ec)) {
-    const std::string name = entry.path().filename().string();
-    const bool ours = name == "runs" || name == "images" || name == "logs" ||
-                      name == ".lock" || name == "slurm" ||
-                      name.find(".tmp.") != std::string::npos;
-    if (!ours) {
+  // No campaign's yet: nothing there that a campaign writes, which it
+  // would replace (the user's own report.md, say). Other files (a log the
+  // shell opened for this run) stay beside it untouched.
+  for (const char* name : {"report.md", "summary.json", "pareto.png"}) {
+    if (fs::exists(path / name, ec)) {
       return Status::InvalidArgument(
           what + ": " + folder + " is no campaign's folder (no campaign.h5) " +
           "and holds " + (path / name).string() +
-          ", which a campaign would write over or mix with" + hint);
+          ", which a campaign would write over" + hint);
+    }
+  }
+  for (const char* name : {"runs", "images", "logs"}) {
+    if (fs::exists(path / name, ec) && !fs::is_directory(path / name, ec)) {
+      return Status::InvalidArgument(what + ": " + folder + " holds a file " +
+                                     (path / name).string() +
+                                     " where a campaign keeps a folder" + hint);
     }
   }
   return Status::Ok();

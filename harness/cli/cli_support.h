@@ -56,11 +56,12 @@ Status CheckOutputFolder(const std::string& out,
 Status CheckFolderPath(const std::string& path, const std::string& what);
 
 // Ok when `folder` may hold a campaign (adse run resumes what it holds):
-// nothing is there, or a campaign's folder is (its campaign.h5), or one
-// whose first run has not ended (its runs/, images/, logs/, lock). Else
-// the current folder or one above it, a file, and a folder holding anything
-// else (a report.md that is not a campaign's, the user's files) are
-// InvalidArgument naming `what` (the flag or field that gave the path).
+// nothing is there, or a campaign's folder is (its campaign.h5), or any
+// other folder holding nothing a campaign writes. Else the current folder
+// or one above it, a file, and a folder holding a report.md, summary.json
+// or pareto.png that is no campaign's (or a file named runs, images or
+// logs) are InvalidArgument naming `what` (the flag or field that gave
+// the path).
 Status CheckCampaignFolder(const std::string& folder, const std::string& what);
 
 // What a command's output file is, so that an earlier one can be told

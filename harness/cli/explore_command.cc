@@ -3,7 +3,9 @@
 // true Pareto points found and of the hypervolume ratio.
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <numeric>
+#include <string>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -37,6 +39,30 @@ Distribution Describe(std::vector<double> v) {
 }  // namespace
 
 int RunExplore(const ExploreArgs& args) {
+  // Seeds first..first+seeds-1, none past the largest.
+  if (args.seeds > 0 &&
+      args.first_seed > std::numeric_limits<uint64_t>::max() -
+                            static_cast<uint64_t>(args.seeds - 1)) {
+    std::fprintf(
+        stderr,
+        "error: --first-seed %llu: with --seeds %d the seeds run "
+        "past %llu; give a smaller first seed\n",
+        static_cast<unsigned long long>(args.first_seed), args.seeds,
+        static_cast<unsigned long long>(std::numeric_limits<uint64_t>::max()));
+    return 2;
+  }
+  // Each strategy once, none empty ("agent,,random").
+  for (size_t i = 0; i < args.strategies.size(); ++i) {
+    const std::string& name = args.strategies[i];
+    if (name.empty() ||
+        std::find(args.strategies.begin(), args.strategies.begin() + i, name) !=
+            args.strategies.begin() + i) {
+      std::fprintf(stderr, "error: --strategy: %s; name each strategy once\n",
+                   name.empty() ? "an empty name in the list"
+                                : ("'" + name + "' given twice").c_str());
+      return 2;
+    }
+  }
   Result<campaign::Recording> recording = campaign::LoadRecording(args.replay);
   if (!recording.ok()) {
     std::fprintf(stderr, "error: --replay: %s\n",

@@ -1,6 +1,8 @@
 #include <fmt/core.h>
 
 #include <cstdio>
+#include <limits>
+#include <string>
 
 #include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
@@ -44,11 +46,18 @@ int RunValidate(const ValidateArgs& args) {
     if (!factors.empty()) factors += " x ";
     factors += fmt::format("{} {}", p.name, p.values.size());
   }
+  // Size() saturates at 2^64 - 1: past that, the product as a double.
+  double points = 1.0;
+  for (const spec::DesignParameter& p : spec->design_space.parameters) {
+    points *= static_cast<double>(p.values.size());
+  }
+  const uint64_t size = spec->design_space.Size();
+  const std::string count = size == std::numeric_limits<uint64_t>::max()
+                                ? fmt::format("about {:.3g}", points)
+                                : std::to_string(size);
   // A YAML comment, so stdout stays a loadable scenario.
-  std::fprintf(stdout, "# %s: valid; design space: %llu points (%s)\n",
-               args.scenario.c_str(),
-               static_cast<unsigned long long>(spec->design_space.Size()),
-               factors.c_str());
+  std::fprintf(stdout, "# %s: valid; design space: %s points (%s)\n",
+               args.scenario.c_str(), count.c_str(), factors.c_str());
   return 0;
 }
 

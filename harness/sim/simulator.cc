@@ -96,6 +96,21 @@ world::WorldSetup WorldSetupFromSpec(const spec::Spec& spec) {
   return setup;
 }
 
+Status CheckCostModelFile(const spec::Spec& spec) {
+  const spec::PlatformOptions& platform = spec.platform;
+  if (platform.cost_model != spec::CostModel::kCounted) return Status::Ok();
+  if (!platform.profile.empty()) {
+    return profile::ReadProfile(platform.profile)
+        .status()
+        .WithContext("platform.profile");
+  }
+  // No file named is the run's to refuse, saying what to make.
+  if (platform.calibration.empty()) return Status::Ok();
+  return LoadCalibration(platform.calibration)
+      .status()
+      .WithContext("platform.calibration");
+}
+
 Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
                                        const spec::DesignPoint& point,
                                        const SimulateOptions& options,

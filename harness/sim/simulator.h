@@ -41,6 +41,13 @@ struct SimulationStats {
 // The world and task of a scenario, ready for World::Open.
 world::WorldSetup WorldSetupFromSpec(const spec::Spec& spec);
 
+// Ok when the counted cost model's file reads: platform.profile as a
+// profile, or else platform.calibration, when one is named, as a
+// calibration (each file's own checks, e.g. a p95 below its p50); said
+// before any run, as the first run would refuse it. Whether it costs every
+// callback of the route's graph is the run's to check.
+Status CheckCostModelFile(const spec::Spec& spec);
+
 // Simulates `point` of `spec`. Bad input (a point outside the space, a
 // world that does not load) returns InvalidArgument naming the field.
 // A run that ends without reaching the goal is still a successful

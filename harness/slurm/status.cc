@@ -135,6 +135,8 @@ const char* ViewsStateToString(ViewsState state) {
       return "stopped";
     case ViewsState::kComplete:
       return "complete";
+    case ViewsState::kUnreadable:
+      return "unreadable";
   }
   return "unknown";
 }
@@ -196,6 +198,7 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
   Result<std::string> summary_text = ReadFile(folder + "/summary.json");
   if (summary_text.ok()) {
     const json j = json::parse(*summary_text, nullptr, false);
+    if (!j.is_object()) st.views = ViewsState::kUnreadable;
     if (j.is_object()) {
       if (st.strategy.empty()) st.strategy = j.value("strategy", "");
       if (st.scenario.empty()) st.scenario = j.value("scenario_file", "");
@@ -378,6 +381,12 @@ std::string FormatStatus(const CampaignStatus& st) {
   switch (st.views) {
     case ViewsState::kNone:
       out += "views: none yet\n";
+      break;
+    case ViewsState::kUnreadable:
+      out += fmt::format(
+          "views: {}/summary.json is no JSON object (damaged?); `adse run` "
+          "again writes the views anew from campaign.h5 and the runs\n",
+          st.folder);
       break;
     case ViewsState::kInProgress:
       out +=

@@ -47,6 +47,7 @@ enum class ViewsState {
   kAbandoned,   // written on the way by a campaign whose process is gone
   kStopped,     // final, but the campaign stopped before its end
   kComplete,    // final: the answer
+  kUnreadable,  // a summary.json that is no JSON object
 };
 // The token of a state ("in_progress"), as `adse status --json` writes it.
 const char* ViewsStateToString(ViewsState state);

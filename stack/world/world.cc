@@ -74,6 +74,39 @@ Status Guard(const std::string& what, Fn&& fn) {
   }
 }
 
+// Starts SUMO with `args`. SUMO prints the cause of a load failure to
+// stderr and throws a bare "Process Error": stderr is captured while it
+// starts (into a file in `folder`) and its text returned as `*cause`.
+Status StartCapturingCause(const std::vector<std::string>& args,
+                           const std::string& folder, std::string* cause) {
+  const std::string log = folder + "/sumo-stderr." +
+                          std::to_string(static_cast<long>(::getpid())) +
+                          ".log";
+  std::fflush(stderr);
+  const int saved = ::dup(STDERR_FILENO);
+  const int capture = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (capture >= 0) ::dup2(capture, STDERR_FILENO);
+  Status status =
+      Guard("starting SUMO", [&] { libsumo::Simulation::start(args); });
+  std::fflush(stderr);
+  if (saved >= 0) {
+    ::dup2(saved, STDERR_FILENO);
+    ::close(saved);
+  }
+  if (capture >= 0) ::close(capture);
+  cause->clear();
+  if (Result<std::string> text = ReadFile(log, 1 << 20); text.ok())
+    *cause = *text;
+  std::error_code ec;
+  fs::remove(log, ec);
+  while (!cause->empty() &&
+         std::isspace(static_cast<unsigned char>(cause->back()))) {
+    cause->pop_back();
+  }
+  if (cause->empty() && !status.ok()) *cause = status.message();
+  return status;
+}
+
 }  // namespace
 
 Status World::Impl::StartSumo() {
@@ -95,6 +128,7 @@ Status World::Impl::StartSumo() {
       "-1",
       "--ignore-route-errors",
       "true"};
+  const std::vector<std::string> net_only = args;
   if (!map.polygons_path.empty()) {
     args.push_back("--additional-files");
     args.push_back(map.polygons_path);
@@ -102,36 +136,20 @@ Status World::Impl::StartSumo() {
   if (std::getenv("SUMO_HOME") == nullptr) {
     ::setenv("SUMO_HOME", "/usr/share/sumo", 0);
   }
-  // SUMO prints the cause of a load failure to stderr and throws a bare
-  // "Process Error": capture stderr while it starts and report the cause.
-  const std::string log = map.cache_folder + "/sumo-stderr." +
-                          std::to_string(static_cast<long>(::getpid())) +
-                          ".log";
-  std::fflush(stderr);
-  const int saved = ::dup(STDERR_FILENO);
-  const int capture = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (capture >= 0) ::dup2(capture, STDERR_FILENO);
-  Status status =
-      Guard("starting SUMO", [&] { libsumo::Simulation::start(args); });
-  std::fflush(stderr);
-  if (saved >= 0) {
-    ::dup2(saved, STDERR_FILENO);
-    ::close(saved);
-  }
-  if (capture >= 0) ::close(capture);
   std::string cause;
-  if (Result<std::string> text = ReadFile(log, 1 << 20); text.ok())
-    cause = *text;
-  std::error_code ec;
-  fs::remove(log, ec);
-  if (!status.ok()) {
-    while (!cause.empty() &&
-           std::isspace(static_cast<unsigned char>(cause.back()))) {
-      cause.pop_back();
+  if (!StartCapturingCause(args, map.cache_folder, &cause).ok()) {
+    // Which file SUMO could not load: the network alone, tried again,
+    // says whether it is the polygons'.
+    std::string net_cause;
+    if (!map.polygons_path.empty() &&
+        StartCapturingCause(net_only, map.cache_folder, &net_cause).ok()) {
+      (void)Guard("closing SUMO", [] { libsumo::Simulation::close(); });
+      return Status::InvalidArgument(
+          fmt::format("world.map.polygons: SUMO cannot load '{}': {}",
+                      map.polygons_path, cause));
     }
-    return Status::InvalidArgument(
-        fmt::format("world.map.net: SUMO cannot load '{}': {}", map.net_path,
-                    cause.empty() ? status.message() : cause));
+    return Status::InvalidArgument(fmt::format(
+        "world.map.net: SUMO cannot load '{}': {}", map.net_path, cause));
   }
   sumo_running = true;
   return Status::Ok();

@@ -248,7 +248,8 @@ void SpecReader::ReadWorld(const Val& v) {
              world::StringToWeather);
   }
   if (const Val* e = f.Get("step_s")) {
-    ReadNumber(*e, &spec_.world.step_s, {0, 1, true, false});
+    // SUMO's smallest step is 1 ms.
+    ReadNumber(*e, &spec_.world.step_s, Bounds::Closed(0.001, 1));
   }
 }
 

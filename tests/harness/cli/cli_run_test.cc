@@ -53,6 +53,19 @@ TEST(CliRunTest, ExploreReplayPrintsADistributionPerStrategy) {
   EXPECT_NE(unknown.out.find("nope"), std::string::npos) << unknown.out;
   EXPECT_EQ(unknown.out.find("| strategy |"), std::string::npos) << unknown.out;
   EXPECT_EQ(unknown.out.find("replay of"), std::string::npos) << unknown.out;
+  // A strategy named twice, and seeds that would run past 2^64 - 1.
+  const std::string replay = "explore --replay " +
+                             std::string(ADSE_SOURCE_DIR) +
+                             "/tests/data/robotaxi_exhaustive ";
+  const CommandRun twice = Adse(replay + "--strategy agent,agent");
+  EXPECT_EQ(twice.exit_code, 2) << twice.out;
+  EXPECT_NE(twice.out.find("'agent' given twice"), std::string::npos)
+      << twice.out;
+  const CommandRun wrapped =
+      Adse(replay + "--seeds 100 --first-seed 18446744073709551615");
+  EXPECT_EQ(wrapped.exit_code, 2) << wrapped.out;
+  EXPECT_NE(wrapped.out.find("the seeds run past"), std::string::npos)
+      << wrapped.out;
 }
 
 TEST(CliRunTest, ExploreReplayWithTwoOfTheObjectivesScoresAgainstTheirFront) {
@@ -207,6 +220,11 @@ TEST(CliRunTest, ARunNeverWritesIntoAFolderThatIsNoCampaigns) {
                     (dir / "report.md").string()),
       std::string::npos)
       << into.out;
+  // A log the shell opened for the run is no obstacle.
+  fs::create_directories(dir / "logged");
+  std::ofstream(dir / "logged" / "run.log") << "";
+  EXPECT_EQ(Adse(run + (dir / "logged").string()).exit_code, 0);
+  EXPECT_EQ(ReadText((dir / "logged" / "run.log").string()), "");
   // Nor into the current folder, unless it is a campaign's.
   const fs::path cwd = fs::current_path();
   fs::current_path(dir);

@@ -40,6 +40,32 @@ TEST(CliTest, ValidateReportsTheRobotaxiSpaceOf280Points) {
       << run.out;
 }
 
+TEST(CliTest, ValidateSaysTheSizeOfASpaceBeyondSixtyFourBits) {
+  // 1024 x 99,991 x 99,501 x 49,001 x 99,001 x 19,001 points, about 9e26.
+  const std::string scenario = WriteScenario(
+      "big_space",
+      Replaced(ReadText(SmallScenarioPath()),
+               "  cores:    {bind: platform.cores,      values: [1, 4, 16]}\n"
+               "  freq_ghz: {bind: platform.freq_ghz,   values: [1.0, 2.1]}\n"
+               "  lidar_hz: {bind: stack.lidar.rate_hz, values: [7, 14]}\n",
+               "  cores: {bind: platform.cores, range: [1, 1024]}\n"
+               "  freq_ghz: {bind: platform.freq_ghz, range: [0.0001, 10], "
+               "step: 0.0001}\n"
+               "  lidar_hz: {bind: stack.lidar.rate_hz, range: [0.5, 100], "
+               "step: 0.001}\n"
+               "  a: {bind: stack.localization.voxel_leaf_m, range: [0.1, 5], "
+               "step: 0.0001}\n"
+               "  b: {bind: stack.odometry.rate_hz, range: [1, 100], "
+               "step: 0.001}\n"
+               "  c: {bind: stack.lidar.horizontal_resolution_deg, range: "
+               "[0.1, 2], step: 0.0001}\n"));
+  const CommandRun run = Adse("validate --quiet --no-world " + scenario);
+  EXPECT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_TRUE(std::regex_search(
+      run.out, std::regex("design space: about [0-9.]+e\\+26 points")))
+      << run.out;
+}
+
 TEST(CliTest, ValidatePrintsAReloadableNormalisedSpec) {
   const CommandRun run =
       Adse("validate --no-world " + Example() + " 2>/dev/null");

@@ -181,5 +181,17 @@ TEST(StatusTest, ACampaignThatStoppedBeforeItsEndSaysWhy) {
   EXPECT_EQ(json::parse(StatusJson(*st))["views"], "stopped");
 }
 
+TEST(StatusTest, ASummaryThatIsNoJsonIsSaidToBeUnreadable) {
+  const TestFolder folder("status-garbage");
+  LayOut(folder.path(), json::object(), {Key('a')}, {}, "");
+  Touch(folder.path() + "/summary.json", "garbage");
+  Result<CampaignStatus> st = ReadCampaignStatus(folder.path());
+  ASSERT_TRUE(st.ok());
+  EXPECT_EQ(st->views, ViewsState::kUnreadable);
+  EXPECT_THAT(FormatStatus(*st),
+              HasSubstr("/summary.json is no JSON object (damaged?)"));
+  EXPECT_EQ(json::parse(StatusJson(*st))["views"], "unreadable");
+}
+
 }  // namespace
 }  // namespace adse::slurm::testing

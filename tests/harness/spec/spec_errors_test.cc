@@ -359,7 +359,11 @@ TEST(SpecErrorsTest, NonPositiveRatesAndTimeouts) {
   ExpectError(text, "task.stall_timeout_s", 6, "a number >= 0");
   text = kHead;
   text.replace(text.find("  map:"), 0, "  step_s: 0\n");
-  ExpectError(text, "world.step_s", 3, "a number in (0, 1]");
+  ExpectError(text, "world.step_s", 3, "a number in [0.001, 1]");
+  text = kHead;
+  // Under SUMO's smallest step, said at its line (not by SUMO's loader).
+  text.replace(text.find("  map:"), 0, "  step_s: 1e-9\n");
+  ExpectError(text, "world.step_s", 3, "a number in [0.001, 1]");
   ExpectError(std::string(kHead) + "exploration: {budget: 0, batch: -1}\n",
               "exploration.budget", 9, "an integer in [1, ");
   ExpectError(std::string(kHead) + "exploration: {budget: 0, batch: -1}\n",

@@ -305,6 +305,37 @@ TEST(WorldTest, APolygonWhoseHeightIsNoNumberIsRejectedByName) {
                 "a number of metres >= 0, found '2,5'");
 }
 
+TEST(WorldTest, APolygonsFileSumoCannotLoadIsNamedAsThePolygons) {
+  // The small lot's own net, its polygons file holding one id twice.
+  const WorldSetup lot = SmallLot();
+  Result<MapArtifacts> map = PrepareMap(lot.world.map, lot.cache_dir);
+  ASSERT_TRUE(map.ok()) << map.status().ToString();
+  const std::string twice =
+      (std::filesystem::temp_directory_path() / "adse_twice.poly.xml").string();
+  std::ofstream(twice)
+      << "<additional>\n"
+         "  <poly id=\"p\" type=\"adse.wall\" shape=\"0,0 1,0 1,1\"/>\n"
+         "  <poly id=\"p\" type=\"adse.wall\" shape=\"2,0 3,0 3,1\"/>\n"
+         "</additional>\n";
+  WorldSetup setup = lot;
+  setup.world.map.generator.clear();
+  setup.world.map.generator_params.clear();
+  setup.world.map.net_path = map->net_path;
+  setup.world.map.polygons_path = twice;
+  Result<std::unique_ptr<World>> world = World::Open(setup);
+  ASSERT_FALSE(world.ok());
+  EXPECT_NE(world.status().message().find("world.map.polygons: SUMO cannot "
+                                          "load '" +
+                                          twice + "'"),
+            std::string::npos)
+      << world.status().message();
+  EXPECT_EQ(world.status().message().find("world.map.net"), std::string::npos)
+      << world.status().message();
+  // The network alone still loads: the next world opens.
+  setup.world.map.polygons_path = map->polygons_path;
+  EXPECT_TRUE(World::Open(setup).ok());
+}
+
 TEST(WorldTest, StartOffTheRoadIsRejected) {
   WorldSetup setup = SmallLot();
   setup.task.start = Location::Xy(15.0, 8.0);  // in the parking rows
