@@ -196,6 +196,12 @@ Status CheckCampaignFolder(const std::string& folder, const std::string& what) {
   return Status::Ok();
 }
 
+Status CheckCampaignFolderOf(const spec::Spec& spec, const std::string& out) {
+  return CheckCampaignFolder(
+      out.empty() ? spec.ResolvedOutput() : out,
+      out.empty() ? spec.Where("output") + "output" : "-o " + out);
+}
+
 namespace {
 
 // Whether `out` lies in a campaign's runs/ folder, whose files are the

@@ -63,6 +63,9 @@ Status CheckFolderPath(const std::string& path, const std::string& what);
 // logs) are InvalidArgument naming `what` (the flag or field that gave
 // the path).
 Status CheckCampaignFolder(const std::string& folder, const std::string& what);
+// The same for the folder a campaign of `spec` goes to: `-o out`, or the
+// scenario's output when `out` is empty (named by its line).
+Status CheckCampaignFolderOf(const spec::Spec& spec, const std::string& out);
 
 // What a command's output file is, so that an earlier one can be told
 // from anything else.

@@ -213,11 +213,7 @@ int RunRun(const RunArgs& args) {
   // A campaign folder resumes whatever it holds; a file where it or a
   // folder above it goes, or a folder that is no campaign's, is bad input,
   // said before any worker starts.
-  if (Status usable = CheckCampaignFolder(
-          args.out.empty() ? spec->ResolvedOutput() : args.out,
-          args.out.empty() ? spec->Where("output") + "output"
-                           : "-o " + args.out);
-      !usable.ok()) {
+  if (Status usable = CheckCampaignFolderOf(*spec, args.out); !usable.ok()) {
     std::fprintf(stderr, "error: %s\n", usable.message().c_str());
     return 2;
   }

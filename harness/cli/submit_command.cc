@@ -18,11 +18,7 @@ namespace adse::cli {
 int RunSubmit(const SubmitArgs& args) {
   std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
   if (!spec) return 2;
-  if (Status usable = CheckCampaignFolder(
-          args.out.empty() ? spec->ResolvedOutput() : args.out,
-          args.out.empty() ? spec->Where("output") + "output"
-                           : "-o " + args.out);
-      !usable.ok()) {
+  if (Status usable = CheckCampaignFolderOf(*spec, args.out); !usable.ok()) {
     std::fprintf(stderr, "error: %s\n", usable.message().c_str());
     return 2;
   }

@@ -275,6 +275,16 @@ TEST(WorldTest, CorruptNetIsReportedWithSumosCause) {
       << world.status().message();
 }
 
+// `setup` on a net and polygons file of its own instead of its generator.
+WorldSetup OnFiles(WorldSetup setup, const std::string& net,
+                   const std::string& polygons) {
+  setup.world.map.generator.clear();
+  setup.world.map.generator_params.clear();
+  setup.world.map.net_path = net;
+  setup.world.map.polygons_path = polygons;
+  return setup;
+}
+
 TEST(WorldTest, APolygonWhoseHeightIsNoNumberIsRejectedByName) {
   // The small lot's own net and polygons, its first wall's height mistyped.
   const WorldSetup lot = SmallLot();
@@ -292,11 +302,7 @@ TEST(WorldTest, APolygonWhoseHeightIsNoNumberIsRejectedByName) {
       (std::filesystem::temp_directory_path() / "adse_mistyped.poly.xml")
           .string();
   std::ofstream(mistyped) << polygons;
-  WorldSetup setup = lot;
-  setup.world.map.generator.clear();
-  setup.world.map.generator_params.clear();
-  setup.world.map.net_path = map->net_path;
-  setup.world.map.polygons_path = mistyped;
+  WorldSetup setup = OnFiles(lot, map->net_path, mistyped);
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_FALSE(world.ok());
   EXPECT_EQ(world.status().message(),
@@ -317,11 +323,7 @@ TEST(WorldTest, APolygonsFileSumoCannotLoadIsNamedAsThePolygons) {
          "  <poly id=\"p\" type=\"adse.wall\" shape=\"0,0 1,0 1,1\"/>\n"
          "  <poly id=\"p\" type=\"adse.wall\" shape=\"2,0 3,0 3,1\"/>\n"
          "</additional>\n";
-  WorldSetup setup = lot;
-  setup.world.map.generator.clear();
-  setup.world.map.generator_params.clear();
-  setup.world.map.net_path = map->net_path;
-  setup.world.map.polygons_path = twice;
+  WorldSetup setup = OnFiles(lot, map->net_path, twice);
   Result<std::unique_ptr<World>> world = World::Open(setup);
   ASSERT_FALSE(world.ok());
   EXPECT_NE(world.status().message().find("world.map.polygons: SUMO cannot "
