@@ -142,15 +142,16 @@ class LlmStrategy : public explore::Strategy {
       point = answer.value->point;
       rationale_ = answer.value->rationale;
     } else {
-      Event(
-          "dse", LlmEventKind::kFallback,
-          "the built-in agent proposes this iteration's point: " + answer.why);
+      Event("dse", LlmEventKind::kFallback,
+            "the built-in agent proposes this iteration's point: the DSE "
+            "agent " +
+                answer.why);
       const std::vector<spec::DesignPoint> fallback = fallback_->Ask(1);
       if (fallback.empty()) return {};
       point = fallback.front();
       proposed_by = "agent";
       fell_back_ = true;
-      rationale_ = "fallback to the built-in agent, since the DSE agent " +
+      rationale_ = "fallback to the built-in agent: the DSE agent " +
                    answer.why + ". agent: " + fallback_->rationale();
     }
 
@@ -345,8 +346,7 @@ class LlmStrategy : public explore::Strategy {
   template <typename T>
   struct Answer {
     std::optional<T> value;
-    std::string
-        why;  // when there is none: "its answers could not be used (...)"
+    std::string why;  // when there is none: "could not ask its model (...)"
   };
 
   // One agent's turn: the request, strict parsing with one corrective
@@ -374,10 +374,10 @@ class LlmStrategy : public explore::Strategy {
       failure_ = turn.error;
       Event(agent, LlmEventKind::kError, turn.error.message());
     }
-    out.why =
-        turn.error.ok()
-            ? "its answers could not be used (" + turn.rejected.back() + ")"
-            : "the model could not be asked (" + turn.error.message() + ")";
+    out.why = turn.error.ok()
+                  ? "gave answers that could not be used (" +
+                        turn.rejected.back() + ")"
+                  : "could not ask its model (" + turn.error.message() + ")";
     return out;
   }
 

@@ -335,7 +335,8 @@ TEST(LlmCampaignTest,
   EXPECT_EQ(Count(events, "dse", LlmEventKind::kFallback), 1);
   ASSERT_EQ(s->exploration.iterations.size(), 2u);
   EXPECT_THAT(s->exploration.iterations[0].rationale,
-              HasSubstr("fallback to the built-in agent"));
+              HasSubstr("fallback to the built-in agent: the DSE agent gave "
+                        "answers that could not be used ("));
   EXPECT_THAT(s->exploration.iterations[0].rationale,
               HasSubstr("cores=3 is outside"));
   EXPECT_THAT(ReadFile(out + "/report.md").value(),
