@@ -235,6 +235,8 @@ void WarnOfViewsReplaced(const spec::Spec& spec, const CampaignFolder& folder) {
   }
 }
 
+}  // namespace
+
 void CountSources(CampaignSummary* summary) {
   for (const EvaluationRow& row : summary->exploration.evaluations) {
     if (!row.complete()) ++summary->failed;
@@ -245,8 +247,6 @@ void CountSources(CampaignSummary* summary) {
     }
   }
 }
-
-}  // namespace
 
 Result<CampaignSummary> RunCampaign(const spec::Spec& input,
                                     const CampaignOptions& options) {

@@ -136,6 +136,11 @@ Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
                         const std::string& dir, const std::string& image_dir,
                         Env* env = Env::Default());
 
+// Adds up how the summary's evaluations were got: failed, and simulated by
+// the campaign or reused (from its folder or the shared cache), as every
+// command that reports a campaign counts them.
+void CountSources(CampaignSummary* summary);
+
 }  // namespace adse::campaign
 
 #endif  // ADSE_HARNESS_CAMPAIGN_CAMPAIGN_H_

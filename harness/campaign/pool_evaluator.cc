@@ -88,10 +88,11 @@ std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
   const std::string path = folder_.RunPath(p.key);
   std::error_code ec;
   std::optional<EvaluationRow> row;
-  // The worker's own analysis, when it left one for this very run and the
-  // run file still reads whole (a file cut short or damaged since, or a
-  // folder in its place, is analysed below, found unusable and run again).
-  if (fs::is_regular_file(path, ec) && runfile::ReadRunFile(path).ok()) {
+  // The run file, read back whole once: one cut short or damaged since, or
+  // a folder in its place, is found unusable below and run again.
+  Result<runfile::RunData> run = runfile::ReadRunFile(path);
+  // The worker's own analysis, when it left one for this very run.
+  if (run.ok()) {
     Result<std::string> text = ReadFile(folder_.ReportPath(p.key), 16 << 20);
     if (text.ok()) {
       Result<EvaluationRow> stored =
@@ -100,7 +101,6 @@ std::optional<EvaluationRow> PoolEvaluator::LoadRun(const Pending& p,
     }
   }
   if (!row) {
-    Result<runfile::RunData> run = runfile::ReadRunFile(path);
     if (run.ok() && run->content_key != p.key) {
       run = Status::Corruption(fmt::format(
           "{}: holds run {} (renamed by hand?)", path, run->content_key));

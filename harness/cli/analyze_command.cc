@@ -504,14 +504,8 @@ int AnalyzeFolder(const std::string& target,
   summary.isolation = index ? index->isolation : std::string();
   summary.exploration.evaluations = rows;
   if (index) summary.exploration.iterations = index->iterations;
-  for (const campaign::EvaluationRow& row : rows) {
-    // As the campaign got them: simulated by it, or from its folder or the
-    // shared cache (loose run files are all found).
-    summary.failed += !row.complete();
-    (row.complete() && row.source == "simulated" ? summary.simulated
-                                                 : summary.reused) +=
-        row.complete();
-  }
+  // As the campaign got them (loose run files are all found).
+  campaign::CountSources(&summary);
   if (index) CarryCampaignState(folder, &summary);
   if (unreadable > 0) {
     summary.notes.push_back(fmt::format(

@@ -16,7 +16,6 @@
 #include "analysis/metrics/run_metrics.h"
 #include "analysis/runfile/run_file.h"
 #include "harness/profile/profile_check.h"
-#include "harness/sim/host_placement.h"
 #include "harness/sim/simulator.h"
 #include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
@@ -261,15 +260,9 @@ PointFidelity CompareRuns(const runfile::RunData& virtual_run,
 Status CheckPointRunnable(const spec::Spec& spec,
                           const spec::DesignPoint& point) {
   ADSE_RETURN_IF_ERROR(spec.design_space.Check(point));
-  if (spec.platform.cost_model != spec::CostModel::kCounted ||
-      spec.platform.profile.empty()) {
-    return Status::InvalidArgument(
-        "platform.kind: cgroup pads every callback to its cost profile: "
-        "set platform.cost_model: counted and platform.profile");
-  }
   Result<spec::PointConfig> config = spec::ApplyPoint(spec, point);
   if (!config.ok()) return config.status();
-  return sim::PlaceOnHost(config->platform.cores).status();
+  return sim::CheckRealTimePlatform(config->platform);
 }
 
 Result<PointRuns> RunPoint(const spec::Spec& input,

@@ -111,6 +111,25 @@ Status CheckCostModelFile(const spec::Spec& spec) {
       .WithContext("platform.calibration");
 }
 
+namespace {
+
+Status CheckRealTimeProfile(const spec::PlatformOptions& platform) {
+  if (platform.cost_model == spec::CostModel::kCounted &&
+      !platform.profile.empty()) {
+    return Status::Ok();
+  }
+  return Status::InvalidArgument(
+      "platform.kind: cgroup pads every callback to its cost profile: "
+      "set platform.cost_model: counted and platform.profile");
+}
+
+}  // namespace
+
+Status CheckRealTimePlatform(const spec::PlatformOptions& platform) {
+  ADSE_RETURN_IF_ERROR(CheckRealTimeProfile(platform));
+  return PlaceOnHost(platform.cores).status();
+}
+
 Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
                                        const spec::DesignPoint& point,
                                        const SimulateOptions& options,
@@ -336,11 +355,8 @@ Result<runfile::RunData> SimulatePoint(const spec::Spec& spec,
   Result<std::unique_ptr<stack::Executor>> made =
       Status::Internal("no executor made");
   if (platform.kind == spec::PlatformKind::kCgroup) {
-    if (vp.profile == nullptr) {
-      return Status::InvalidArgument(
-          "platform.kind: cgroup pads every callback to its cost profile: "
-          "set platform.cost_model: counted and platform.profile");
-    }
+    // (The host's CPUs are the real-time platform's to place.)
+    ADSE_RETURN_IF_ERROR(CheckRealTimeProfile(platform));
     stack::RealTimeOptions rt;
     rt.cores = platform.cores;
     rt.freq_ghz = platform.freq_ghz;

@@ -48,6 +48,12 @@ world::WorldSetup WorldSetupFromSpec(const spec::Spec& spec);
 // callback of the route's graph is the run's to check.
 Status CheckCostModelFile(const spec::Spec& spec);
 
+// Ok when `platform` (a point's, see spec::ApplyPoint) can run in real
+// time here: the counted cost model with a profile, which the real-time
+// platform pads every callback to (else InvalidArgument), and a host CPU
+// per core of the point (else PlaceOnHost's Unavailable).
+Status CheckRealTimePlatform(const spec::PlatformOptions& platform);
+
 // Simulates `point` of `spec`. Bad input (a point outside the space, a
 // world that does not load) returns InvalidArgument naming the field.
 // A run that ends without reaching the goal is still a successful

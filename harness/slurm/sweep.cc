@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "harness/campaign/campaign.h"
 #include "harness/campaign/replicas.h"
 #include "harness/campaign/run_store.h"
 #include "harness/sim/run_key.h"
@@ -239,14 +240,7 @@ Result<campaign::CampaignSummary> BuildSweepIndex(
     any = true;
   }
   summary.wall_s = any ? last_end - first_start : 0.0;
-  for (const campaign::EvaluationRow& row : summary.exploration.evaluations) {
-    if (!row.complete()) ++summary.failed;
-    if (row.source == "simulated") {
-      ++summary.simulated;
-    } else {
-      ++summary.reused;
-    }
-  }
+  campaign::CountSources(&summary);
   summary.pareto_front =
       campaign::ParetoFrontOf(spec, summary.exploration.evaluations);
   ADSE_RETURN_IF_ERROR(campaign::WriteCampaignViews(spec, summary));
