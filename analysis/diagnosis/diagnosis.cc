@@ -21,7 +21,7 @@ constexpr char kExternal[] = "external";
 
 // ---- Options ---------------------------------------------------------------
 
-enum class Range { kAny, kNonNegative, kPositive, kFraction, kFlag };
+enum class Range { kAny, kNonNegative, kCount, kPositive, kFraction, kFlag };
 
 struct OptionSpec {
   const char* name;
@@ -42,7 +42,7 @@ constexpr OptionSpec kOptionSpecs[] = {
      Range::kFraction},
     {"frequency_bound_driving_inputs_only",
      &DiagnosisOptions::frequency_bound_driving_inputs_only, Range::kFlag},
-    {"min_messages", &DiagnosisOptions::min_messages, Range::kNonNegative},
+    {"min_messages", &DiagnosisOptions::min_messages, Range::kCount},
     {"start_s", &DiagnosisOptions::start_s, Range::kNonNegative},
     {"end_s", &DiagnosisOptions::end_s, Range::kAny},
     {"remedy_exec_load", &DiagnosisOptions::remedy_exec_load, Range::kPositive},
@@ -60,6 +60,8 @@ bool InRange(Range range, double v) {
       return true;
     case Range::kNonNegative:
       return v >= 0.0;
+    case Range::kCount:
+      return v >= 0.0 && v == std::floor(v);
     case Range::kPositive:
       return v > 0.0;
     case Range::kFraction:
@@ -76,6 +78,8 @@ const char* RangeText(Range range) {
       return "finite";
     case Range::kNonNegative:
       return ">= 0";
+    case Range::kCount:
+      return "a whole number >= 0";
     case Range::kPositive:
       return "> 0";
     case Range::kFraction:

@@ -21,9 +21,6 @@
 namespace adse::analysis::internal {
 
 constexpr int kMinPlotSidePx = 300;
-// Points more than this many times above the highest point that matters
-// are drawn as arrows on the top edge instead of stretching the axis.
-constexpr double kClipRatio = 2.0;
 
 // ---------------------------------------------------------------------------
 // Pareto plot.

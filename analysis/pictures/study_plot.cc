@@ -8,6 +8,7 @@
 #include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <tuple>
 
 #include "analysis/pictures/internal/drawing_impl.h"
 #include "analysis/pictures/pictures.h"
@@ -35,15 +36,34 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
                       o.height_px, kMinSidePx, kMaxSidePx));
     }
   }
+  // Runs that went on far past everything that matters (a 600 s timeout
+  // beside a 90 s bound) would squash the figure against its left axis: as
+  // in the front's picture, the time axis then ends a little past what
+  // matters, and the slower points sit on its right edge as wedges.
+  double x_matters = -kInf, x_all = -kInf;
+  for (const auto* set : {&points, &reference}) {
+    for (const ParetoPlotPoint& p : *set) {
+      if (!Placed(p)) continue;
+      x_all = std::max(x_all, p.nav_time_s);
+      if (p.feasible || p.on_front)
+        x_matters = std::max(x_matters, p.nav_time_s);
+    }
+  }
+  for (double v : o.time_bounds_s) {
+    if (std::isfinite(v)) x_matters = std::max(x_matters, v);
+  }
+  const bool clip_x = std::isfinite(x_matters) && x_matters > 0.0 &&
+                      x_all > kClipRatio * x_matters;
   std::vector<double> xs, ys;
   for (const auto* set : {&points, &reference}) {
     for (const ParetoPlotPoint& p : *set) {
       if (!Placed(p)) continue;
-      xs.push_back(p.nav_time_s);
+      if (!clip_x || p.nav_time_s <= x_matters) xs.push_back(p.nav_time_s);
       ys.push_back(p.cost);
     }
   }
-  if (xs.empty()) return Status::InvalidArgument("no point to plot");
+  if (ys.empty()) return Status::InvalidArgument("no point to plot");
+  if (clip_x) xs.push_back(x_matters * 1.15);  // room for the wedges
   for (double v : o.time_bounds_s) {
     if (std::isfinite(v)) xs.push_back(v);
   }
@@ -60,6 +80,11 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
   const int right = frame.right();
   const cv::Rect& area = frame.area;
   auto px = [&](double time, double cost) { return frame.ToPx(time, cost); };
+  auto beyond = [&](const ParetoPlotPoint& p) { return p.nav_time_s > ax.max; };
+  // Where a point is drawn: a point beyond the axis on its right edge.
+  auto at = [&](const ParetoPlotPoint& p) {
+    return px(std::min(p.nav_time_s, ax.max), p.cost);
+  };
 
   cv::Mat img(o.height_px, o.width_px, CV_8UC3, Bgr(kBackgroundRgb));
   DrawAxes(&img, area, ax, ay, s);
@@ -83,10 +108,24 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
     cv::circle(img, Fixed(c), r * static_cast<int>(kShiftScale), colour,
                cv::FILLED, cv::LINE_AA, kShift);
   };
+  // A point beyond the axis: a wedge pointing right from its edge.
+  auto draw_wedge = [&](cv::Point2d tip, const cv::Scalar& colour) {
+    const double side = s.Px(4);
+    const std::vector<cv::Point> corners = {
+        Fixed(tip), Fixed(tip + cv::Point2d(-2.2 * side, -1.4 * side)),
+        Fixed(tip + cv::Point2d(-2.2 * side, 1.4 * side))};
+    cv::fillConvexPoly(img, corners, colour, cv::LINE_AA, kShift);
+  };
+  bool reference_beyond = false, points_beyond = false;
   std::vector<const ParetoPlotPoint*> front;
   for (const ParetoPlotPoint& p : reference) {
     if (!Placed(p)) continue;
-    draw_dot(px(p.nav_time_s, p.cost), kReferenceDot, dot);
+    if (beyond(p)) {
+      reference_beyond = true;
+      draw_wedge(at(p), kReferenceDot);
+    } else {
+      draw_dot(px(p.nav_time_s, p.cost), kReferenceDot, dot);
+    }
     if (p.on_front && p.feasible) front.push_back(&p);
   }
   std::sort(front.begin(), front.end(), [](const auto* a, const auto* b) {
@@ -123,7 +162,13 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
     }
   };
   for (const ParetoPlotPoint& p : points) {
-    if (Placed(p)) draw_triangle(px(p.nav_time_s, p.cost), p.feasible);
+    if (!Placed(p)) continue;
+    if (beyond(p)) {
+      points_beyond = true;
+      draw_wedge(at(p), kTriangle);
+    } else {
+      draw_triangle(px(p.nav_time_s, p.cost), p.feasible);
+    }
   }
   // The answer: the campaign's cheapest feasible design, ringed.
   auto draw_ring = [&](cv::Point2d c) {
@@ -133,7 +178,7 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
   bool any_highlight = false;
   for (const ParetoPlotPoint& p : points) {
     if (!Placed(p) || !p.highlight) continue;
-    draw_ring(px(p.nav_time_s, p.cost));
+    draw_ring(at(p));
     any_highlight = true;
   }
   cv::rectangle(img, area, kBlack, 1);
@@ -148,7 +193,7 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
   // The marks drawn, no others.
   bool any_feasible = false, any_infeasible = false;
   for (const ParetoPlotPoint& p : points) {
-    if (!Placed(p)) continue;
+    if (!Placed(p) || beyond(p)) continue;
     (p.feasible ? any_feasible : any_infeasible) = true;
   }
   std::vector<Entry> entries;
@@ -179,6 +224,16 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
                                      kReferenceLine, s.Px(2));
                        }});
   }
+  // Short, so that the legend still fits beside the bound.
+  for (const auto& [drawn, name, colour] :
+       {std::tuple(points_beyond, o.points_name + ", ", kTriangle),
+        std::tuple(reference_beyond, std::string(), kReferenceDot)}) {
+    if (!drawn) continue;
+    entries.push_back({fmt::format("{}slower than {:.0f} s", name, ax.max),
+                       [&, colour = colour](cv::Point2d c) {
+                         draw_wedge(c + cv::Point2d(s.Px(8), 0), colour);
+                       }});
+  }
   if (!o.time_bounds_s.empty() || !o.cost_bounds.empty()) {
     entries.push_back({"constraint bound", [&](cv::Point2d c) {
                          DrawDashed(&img, c - cv::Point2d(s.Px(12), 0),
@@ -202,7 +257,7 @@ Result<std::string> StudyPngImpl(const std::vector<ParetoPlotPoint>& points,
     for (const auto* set : {&points, &reference}) {
       for (const ParetoPlotPoint& p : *set) {
         if (!Placed(p)) continue;
-        const cv::Point2d c = px(p.nav_time_s, p.cost);
+        const cv::Point2d c = at(p);
         covered += candidate.contains(
             cv::Point(static_cast<int>(c.x), static_cast<int>(c.y)));
       }

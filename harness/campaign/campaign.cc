@@ -16,6 +16,7 @@
 #include "harness/campaign/pool_evaluator.h"
 #include "harness/campaign/run_store.h"
 #include "harness/campaign/strategy_factory.h"
+#include "harness/pool/worker_pool.h"
 #include "stack/base/files.h"
 #include "stack/base/subprocess.h"
 
@@ -97,6 +98,19 @@ Result<spec::Spec> Overridden(const spec::Spec& input,
         spec.harness.executor +
         "' runs need a pool for it: adse run --executor slurm inside a Slurm "
         "allocation, or adse submit");
+  }
+  if (!options.make_pool) {
+    // Said of the flag or field that asked, before anything is written.
+    std::string asked = spec.Where("harness.workers") + "harness.workers";
+    if (spec.harness.workers == 0) {  // auto: as many as its width allows
+      asked =
+          spec.Where("harness.cores_per_worker") + "harness.cores_per_worker";
+    } else if (options.workers > 0) {
+      asked = fmt::format("--workers {}", options.workers);
+    }
+    ADSE_RETURN_IF_ERROR(pool::CheckWorkersFit(spec.harness.workers,
+                                               spec.harness.cores_per_worker)
+                             .WithContext(asked));
   }
   return spec;
 }

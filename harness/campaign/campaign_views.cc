@@ -19,6 +19,7 @@
 #include "harness/llm/exchange_log.h"
 #include "harness/llm/llm_strategy.h"
 #include "harness/spec/spec_parser.h"
+#include "harness/spec/text_util.h"
 #include "stack/base/files.h"
 
 namespace adse::campaign {
@@ -294,9 +295,9 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
       running.push_back("`" + spec::FormatPoint(spec.design_space, p) + "`");
     }
     md << fmt::format(
-        "> **In progress:** {} of {} evaluations so far{}; the answer comes "
+        "> **In progress:** {} of {} so far{}; the answer comes "
         "when the campaign ends.\n\n",
-        rows.size(), spec.exploration.budget,
+        rows.size(), spec::Counted(spec.exploration.budget, "evaluation"),
         running.empty()
             ? std::string()
             : fmt::format(", running {}", fmt::join(running, ", ")));
@@ -307,10 +308,11 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
   md << "## Campaign\n\n";
   md << fmt::format("- scenario: `{}`\n", spec.source_path);
   md << fmt::format(
-      "- strategy: `{}` (exploration.seed {}), budget {}: {} evaluations, {} "
+      "- strategy: `{}` (exploration.seed {}), budget {}: {}, {} "
       "simulated, {} reused (this folder or the shared cache), {} failed\n",
       spec.exploration.strategy, spec.exploration.seed, spec.exploration.budget,
-      rows.size(), s.simulated, s.reused, s.failed);
+      spec::Counted(rows.size(), "evaluation"), s.simulated, s.reused,
+      s.failed);
   md << fmt::format("- workers: {}, {}\n", s.workers, s.isolation);
   if (!s.isolation_note.empty()) md << "- note: " << s.isolation_note << "\n";
   for (const std::string& note : s.notes) md << "- note: " << note << "\n";
@@ -353,8 +355,9 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
     }
   }
   const std::set<int> front(s.pareto_front.begin(), s.pareto_front.end());
-  md << fmt::format("## Pareto front over {} ({} points)\n\n",
-                    fmt::join(objectives, ", "), front.size());
+  md << fmt::format("## Pareto front over {} ({})\n\n",
+                    fmt::join(objectives, ", "),
+                    spec::Counted(front.size(), "point"));
   md << "Constraint-aware and non-dominated over the objectives; infeasible "
         "points appear only when nothing is feasible.\n\n";
   md << "| # | point | " << fmt::format("{}", fmt::join(columns, " | "))
@@ -582,9 +585,9 @@ Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
   // finite point) leaves the other views intact.
   (void)RenderFrontPicture(
       spec, rows, headline,
-      fmt::format("{}: {} evaluations, {} on the cost-time front ({})",
-                  spec.name, rows.size(), headline.cost_time_front.size(),
-                  spec.exploration.strategy),
+      fmt::format("{}: {}, {} on the cost-time front ({})", spec.name,
+                  spec::Counted(rows.size(), "evaluation"),
+                  headline.cost_time_front.size(), spec.exploration.strategy),
       folder.Path("pareto.png"), env);
   return Status::Ok();
 }

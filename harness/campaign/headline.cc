@@ -17,6 +17,7 @@
 #include "harness/campaign/replicas.h"
 #include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
+#include "harness/spec/text_util.h"
 #include "stack/base/files.h"
 
 namespace adse::campaign {
@@ -244,9 +245,10 @@ std::string HeadlineText(const spec::Spec& spec,
   if (rows.empty()) return "no evaluation has a result yet\n";
   if (h.cheapest < 0) {
     out << fmt::format(
-        "no feasible design among {} evaluations: every one violates a "
+        "no feasible design among {}: every one violates a "
         "constraint ({})\n",
-        rows.size(), fmt::join(spec.constraints, ", "));
+        spec::Counted(rows.size(), "evaluation"),
+        fmt::join(spec.constraints, ", "));
   }
   for (const Line& line : Lines(rows, h)) {
     if (line.row < 0) continue;
@@ -260,8 +262,9 @@ std::string HeadlineText(const spec::Spec& spec,
     objectives.push_back(o.metric);
   // With nothing feasible the constraint-aware front holds the designs
   // that violate least; say so, as report.md does.
-  out << fmt::format("Pareto front over {} ({} of {} evaluations{}):\n",
-                     fmt::join(objectives, ", "), h.front.size(), rows.size(),
+  out << fmt::format("Pareto front over {} ({} of {}{}):\n",
+                     fmt::join(objectives, ", "), h.front.size(),
+                     spec::Counted(rows.size(), "evaluation"),
                      h.cheapest < 0 ? "; nothing is feasible, so these are "
                                       "the designs that violate least"
                                     : "");
@@ -308,9 +311,9 @@ std::string HeadlineMarkdown(const spec::Spec& spec,
   if (rows.empty()) return md.str() + "No evaluation has a result yet.\n\n";
   if (h.cheapest < 0) {
     md << fmt::format(
-        "**No feasible design** among {} evaluations: every one violates a "
+        "**No feasible design** among {}: every one violates a "
         "constraint.\n\n",
-        rows.size());
+        spec::Counted(rows.size(), "evaluation"));
   }
   for (const Line& line : Lines(rows, h)) {
     if (line.row < 0) continue;

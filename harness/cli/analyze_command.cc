@@ -24,6 +24,7 @@
 #include "harness/campaign/replay.h"
 #include "harness/campaign/replicas.h"
 #include "harness/campaign/run_store.h"
+#include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
 #include "harness/report/run_report.h"
 #include "harness/spec/spec_parser.h"
@@ -309,21 +310,6 @@ void CarryCampaignState(const campaign::CampaignFolder& folder,
   }
 }
 
-// A campaign's runs/ folder stands for its campaign: analyses live in
-// <campaign>/analysis, never among the run files. Any other folder is
-// itself.
-std::string CampaignOfRunsFolder(const std::string& target) {
-  std::error_code ec;
-  fs::path path = fs::absolute(target, ec).lexically_normal();
-  if (ec) return target;
-  if (path.filename().empty()) path = path.parent_path();
-  const fs::path campaign = path.parent_path();
-  if (path.filename() != "runs" || !fs::exists(campaign / "campaign.h5", ec)) {
-    return target;
-  }
-  return campaign.string();
-}
-
 // A folder: a campaign (its campaign.h5 names the runs and holds the
 // scenario) or loose run files of one scenario. Every run is analysed
 // again and the answer views are written by the code adse run uses, into
@@ -454,6 +440,7 @@ int AnalyzeFolder(const std::string& target,
     return fail(s.message(), 1);
   }
   std::vector<campaign::EvaluationRow> rows;
+  size_t undiagnosed = 0;  // runs that end before the window starts
   for (auto& [item, run] : loaded) {
     report::AnalyzeOptions options = base_options;
     const std::string key = run.content_key.empty()
@@ -470,6 +457,9 @@ int AnalyzeFolder(const std::string& target,
                   ExitCodeFor(report.status()));
     }
     MoveImagePaths(v, &*report);
+    if (report->diagnosis_window_s <= 0.0 && report->diagnosis_start_s > 0.0) {
+      ++undiagnosed;
+    }
     if (Status s = WriteJson(version + "/reports/" + key + ".json",
                              report::ToJson(*report));
         !s.ok()) {
@@ -484,6 +474,15 @@ int AnalyzeFolder(const std::string& target,
     row.attempts = item.row.attempts;
     row.wall_s = item.row.wall_s;
     rows.push_back(std::move(row));
+  }
+  if (undiagnosed > 0) {
+    std::fprintf(stderr,
+                 "warning: %s of %zu end before the diagnosis' window starts "
+                 "(--threshold start_s=%g): they have no diagnosis\n",
+                 spec::Counted(undiagnosed, "run").c_str(), loaded.size(),
+                 base_options.thresholds.count("start_s")
+                     ? base_options.thresholds.at("start_s")
+                     : 0.0);
   }
   rows.insert(rows.end(), recorded_rows.begin(), recorded_rows.end());
   {
@@ -522,9 +521,10 @@ int AnalyzeFolder(const std::string& target,
     const std::string png = version + "/pareto.png";
     if (Status s = campaign::RenderStudyPicture(
             *spec, rows, reference->spec, reference->rows,
-            fmt::format("{}: {} evaluations ({}) over {} ({} points)",
-                        spec->name, rows.size(), summary.strategy,
-                        reference->spec.name, reference->rows.size()),
+            fmt::format("{}: {} ({}) over {} ({} points)", spec->name,
+                        spec::Counted(rows.size(), "evaluation"),
+                        summary.strategy, reference->spec.name,
+                        reference->rows.size()),
             png);
         !s.ok()) {
       return fail(png + ": " + s.message(), 1);
@@ -535,7 +535,8 @@ int AnalyzeFolder(const std::string& target,
     Result<std::string> text = ReadFile(v.final_path + "/summary.json");
     std::printf("%s", text.ok() ? text->c_str() : "{}\n");
   } else {
-    std::printf("%s: %zu runs analysed", target.c_str(), loaded.size());
+    std::printf("%s: %s analysed", target.c_str(),
+                spec::Counted(loaded.size(), "run").c_str());
     if (unreadable > 0 && index) {
       std::printf(
           ", %d kept as campaign.h5 recorded them (run file unreadable)",
@@ -569,13 +570,12 @@ int RunAnalyze(const AnalyzeArgs& args) {
   report::AnalyzeOptions options;
   for (const std::string& t : args.thresholds) {
     const size_t eq = t.find('=');
-    char* end = nullptr;
-    const double value =
-        eq == std::string::npos ? 0.0 : std::strtod(t.c_str() + eq + 1, &end);
-    if (eq == std::string::npos || end == nullptr || *end != '\0' ||
-        eq + 1 == t.size()) {
+    double value = 0.0;
+    if (eq == std::string::npos ||
+        !spec::ParseNumber(std::string_view(t).substr(eq + 1), &value)) {
       std::fprintf(stderr,
-                   "error: --threshold %s: expected NAME=VALUE with a number\n",
+                   "error: --threshold %s: expected NAME=VALUE with a decimal "
+                   "number\n",
                    t.c_str());
       return 2;
     }
@@ -588,6 +588,15 @@ int RunAnalyze(const AnalyzeArgs& args) {
       return 2;
     }
     options.thresholds[name] = value;
+  }
+  if (options.thresholds.count("start_s") &&
+      options.thresholds.count("end_s") && options.thresholds["end_s"] >= 0.0 &&
+      options.thresholds["end_s"] <= options.thresholds["start_s"]) {
+    std::fprintf(stderr,
+                 "error: --threshold end_s=%g: not after start_s=%g; the "
+                 "diagnosis' window would be empty\n",
+                 options.thresholds["end_s"], options.thresholds["start_s"]);
+    return 2;
   }
   // The reference is read before anything is written.
   std::optional<campaign::Recording> reference;

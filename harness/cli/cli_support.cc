@@ -2,9 +2,13 @@
 
 #include <fmt/core.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -119,6 +123,9 @@ Status CheckOutputFolder(const std::string& out,
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path path(out);
+  // Written beside itself first, then renamed into place.
+  ADSE_RETURN_IF_ERROR(CheckFolderPath(
+      path.lexically_normal().parent_path().string(), "-o " + out));
   if (!fs::exists(path, ec)) return Status::Ok();
   const std::string hint =
       "; give a new folder (or an earlier output's, which is replaced)";
@@ -152,15 +159,38 @@ Status CheckOutputFolder(const std::string& out,
 Status CheckFolderPath(const std::string& path, const std::string& what) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  for (fs::path up = path; !up.empty(); up = up.parent_path()) {
+  for (fs::path up = path.empty() ? "." : path; !up.empty();
+       up = up.parent_path()) {
     if (fs::exists(up, ec)) {
-      if (fs::is_directory(up, ec)) return Status::Ok();
-      return Status::InvalidArgument(what + ": " + up.string() +
-                                     " is a file, not a folder");
+      if (!fs::is_directory(up, ec)) {
+        return Status::InvalidArgument(what + ": " + up.string() +
+                                       " is a file, not a folder");
+      }
+      // Found now rather than when the work is done and its result is
+      // written (a read-only folder or file system).
+      if (access(up.c_str(), W_OK | X_OK) != 0) {
+        return Status::InvalidArgument(
+            fmt::format("{}: cannot write in {} ({})", what, up.string(),
+                        std::strerror(errno)));
+      }
+      return Status::Ok();
     }
     if (up == up.parent_path()) break;
   }
   return Status::Ok();
+}
+
+std::string CampaignOfRunsFolder(const std::string& target) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path path = fs::absolute(target, ec).lexically_normal();
+  if (ec) return target;
+  if (path.filename().empty()) path = path.parent_path();
+  const fs::path campaign = path.parent_path();
+  if (path.filename() != "runs" || !fs::exists(campaign / "campaign.h5", ec)) {
+    return target;
+  }
+  return campaign.string();
 }
 
 Status CheckCampaignFolder(const std::string& folder, const std::string& what) {
@@ -200,6 +230,16 @@ Status CheckCampaignFolderOf(const spec::Spec& spec, const std::string& out) {
   return CheckCampaignFolder(
       out.empty() ? spec.ResolvedOutput() : out,
       out.empty() ? spec.Where("output") + "output" : "-o " + out);
+}
+
+Status CheckCacheFolderOf(const spec::Spec& spec,
+                          const std::string& cache_dir) {
+  if (!cache_dir.empty()) {
+    return CheckFolderPath(cache_dir, "--cache-dir " + cache_dir);
+  }
+  if (spec.harness.cache_dir.empty()) return Status::Ok();
+  return CheckFolderPath(spec.harness.cache_dir,
+                         spec.Where("harness.cache_dir") + "harness.cache_dir");
 }
 
 namespace {

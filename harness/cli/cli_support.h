@@ -50,9 +50,10 @@ struct OutputFolderLayout {
 Status CheckOutputFolder(const std::string& out,
                          const OutputFolderLayout& layout);
 
-// Ok unless the nearest existing path at or above `path` is a file (where
-// a folder must go): then InvalidArgument "<what>: <it> is a file, not a
-// folder".
+// Ok unless the nearest existing path at or above `path` ("" the current
+// folder) is a file (where a folder must go), "<what>: <it> is a file, not
+// a folder", or a folder this process cannot write in, "<what>: cannot
+// write in <it> (Permission denied)": InvalidArgument.
 Status CheckFolderPath(const std::string& path, const std::string& what);
 
 // Ok when `folder` may hold a campaign (adse run resumes what it holds):
@@ -63,9 +64,18 @@ Status CheckFolderPath(const std::string& path, const std::string& what);
 // logs) are InvalidArgument naming `what` (the flag or field that gave
 // the path).
 Status CheckCampaignFolder(const std::string& folder, const std::string& what);
+
+// A campaign's runs/ folder stands for its campaign (for analyze and
+// status): the campaign's folder when `target` is <campaign>/runs, else
+// `target` itself.
+std::string CampaignOfRunsFolder(const std::string& target);
 // The same for the folder a campaign of `spec` goes to: `-o out`, or the
 // scenario's output when `out` is empty (named by its line).
 Status CheckCampaignFolderOf(const spec::Spec& spec, const std::string& out);
+// CheckFolderPath of the shared run cache a campaign of `spec` uses:
+// `--cache-dir cache_dir`, or the scenario's harness.cache_dir when
+// `cache_dir` is empty (named by its line); Ok for the default cache.
+Status CheckCacheFolderOf(const spec::Spec& spec, const std::string& cache_dir);
 
 // What a command's output file is, so that an earlier one can be told
 // from anything else.

@@ -2,6 +2,7 @@
 // simulating, over many seeds; prints per strategy the distribution of
 // true Pareto points found and of the hypervolume ratio.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <limits>
 #include <numeric>
@@ -15,6 +16,7 @@
 #include "harness/cli/commands.h"
 #include "harness/explore/strategy.h"
 #include "harness/spec/spec_parser.h"
+#include "harness/spec/text_util.h"
 
 namespace adse::cli {
 namespace {
@@ -94,28 +96,14 @@ int RunExplore(const ExploreArgs& args) {
       campaign::ComputeHeadline(recording->spec, recording->rows);
   out["answer"] =
       campaign::AnswerJson(recording->spec, recording->rows, answer);
-  if (!args.json) {
-    std::printf(
-        "replay of %s: %zu recorded evaluations, budget %d, seeds "
-        "%llu..%llu\n",
-        args.replay.c_str(), recording->rows.size(), budget,
-        static_cast<unsigned long long>(args.first_seed),
-        static_cast<unsigned long long>(args.first_seed + args.seeds - 1));
-    std::printf("the recording's answer:\n%s\n",
-                campaign::HeadlineText(recording->spec, recording->rows, answer)
-                    .c_str());
-    std::printf(
-        "| strategy | true Pareto points found (min / median / mean / max) | "
-        "of front | "
-        "hypervolume ratio (min / median / mean / max) | first true Pareto "
-        "point at "
-        "(median eval) | cheapest feasible found | not recorded "
-        "|\n|---|---|---|---|---|---|---|\n");
-  }
+  // The table is printed once every strategy has replayed: one that cannot
+  // (an llm strategy without recorded exchanges) leaves no half table.
+  std::string table;
   // --rationale: every seed's rounds, printed after the table.
   const bool show_rationale = args.rationale && !args.json;
   std::string rationales;
   for (const std::string& name : strategies) {
+    const auto started = std::chrono::steady_clock::now();
     std::vector<double> found, ratio, first;
     int front = 0, missing = 0, cheapest = 0;
     nlohmann::json runs = nlohmann::json::array();
@@ -184,18 +172,38 @@ int RunExplore(const ExploreArgs& args) {
                                {"true_front_size", front},
                                {"seeds_that_found_cheapest_feasible", cheapest},
                                {"runs", runs}};
-    if (!args.json) {
-      std::printf(
-          "| %s | %g / %g / %.2f / %g | %d | %.3f / %.3f / %.3f / %.3f | %s | "
-          "%d of %d seeds | %d |\n",
-          name.c_str(), f.min, f.median, f.mean, f.max, front, r.min, r.median,
-          r.mean, r.max,
-          first.empty() ? "never"
-                        : fmt::format("{:g} ({} of {} seeds)", a.median,
-                                      first.size(), args.seeds)
-                              .c_str(),
-          cheapest, args.seeds, missing);
-    }
+    table += fmt::format(
+        "| {} | {:g} / {:g} / {:.2f} / {:g} | {} | {:.3f} / {:.3f} / {:.3f} / "
+        "{:.3f} | {} | {} of {} seeds | {} |\n",
+        name, f.min, f.median, f.mean, f.max, front, r.min, r.median, r.mean,
+        r.max,
+        first.empty() ? "never"
+                      : fmt::format("{:g} ({} of {} seeds)", a.median,
+                                    first.size(), args.seeds),
+        cheapest, args.seeds, missing);
+    if (args.json) continue;  // stdout's JSON alone
+    std::fprintf(stderr, "%s: %s replayed in %.0f s\n", name.c_str(),
+                 spec::Counted(static_cast<size_t>(args.seeds), "seed").c_str(),
+                 std::chrono::duration<double>(
+                     std::chrono::steady_clock::now() - started)
+                     .count());
+  }
+  if (!args.json) {
+    std::printf(
+        "replay of %s: %zu recorded evaluations, budget %d, seeds "
+        "%llu..%llu\n",
+        args.replay.c_str(), recording->rows.size(), budget,
+        static_cast<unsigned long long>(args.first_seed),
+        static_cast<unsigned long long>(args.first_seed + args.seeds - 1));
+    std::printf("the recording's answer:\n%s\n",
+                campaign::HeadlineText(recording->spec, recording->rows, answer)
+                    .c_str());
+    std::printf(
+        "| strategy | true Pareto points found (min / median / mean / max) | "
+        "of front | hypervolume ratio (min / median / mean / max) | first "
+        "true Pareto point at (median eval) | cheapest feasible found | not "
+        "recorded |\n|---|---|---|---|---|---|---|\n%s",
+        table.c_str());
   }
   if (!rationales.empty()) std::printf("\n%s", rationales.c_str());
   if (args.json) std::printf("%s\n", out.dump(2).c_str());

@@ -8,6 +8,7 @@
 #include "harness/campaign/headline.h"
 #include "harness/cli/commands.h"
 #include "harness/slurm/sweep.h"
+#include "harness/spec/text_util.h"
 #include "stack/base/files.h"
 
 namespace adse::cli {
@@ -26,9 +27,10 @@ int RunIndex(const IndexArgs& args) {
     std::printf("%s", text.ok() ? text->c_str() : "{}\n");
   } else {
     const auto& rows = s.exploration.evaluations;
-    std::printf("%s: %zu evaluations (%d simulated, %d reused, %d failed)\n",
-                s.output_dir.c_str(), rows.size(), s.simulated, s.reused,
-                s.failed);
+    std::printf("%s: %s (%d simulated, %d reused, %d failed)\n",
+                s.output_dir.c_str(),
+                spec::Counted(rows.size(), "evaluation").c_str(), s.simulated,
+                s.reused, s.failed);
     std::printf("%s", campaign::HeadlineText(
                           spec, rows, campaign::ComputeHeadline(spec, rows))
                           .c_str());

@@ -124,8 +124,10 @@ int RunInterpret(const InterpretArgs& args) {
   if (!result.ok()) {
     std::fprintf(stderr, "adse interpret: %s\n",
                  result.status().message().c_str());
-    if (!record.empty())
+    std::error_code ec;
+    if (!record.empty() && fs::exists(record, ec)) {
       std::fprintf(stderr, "exchanges recorded in %s\n", record.c_str());
+    }
     return ExitCodeFor(result.status());
   }
   for (const std::string& d : result->dropped) {

@@ -13,6 +13,7 @@
 #include "harness/cli/commands.h"
 #include "harness/pool/worker_pool.h"
 #include "harness/spec/spec.h"
+#include "harness/spec/text_util.h"
 #include "harness/spec/types.h"
 #include "stack/base/platform_limits.h"
 
@@ -20,17 +21,22 @@ namespace {
 
 // CLI11's PositiveNumber and NonNegativeNumber name the largest double as
 // their range's end in their message; these say what is expected.
-CLI::Validator WholeNumberFrom(int least) {
+// A whole number in [least, most], written as the scenario may write one
+// ("1000", "1e3"), handed on as plain digits.
+CLI::Validator WholeNumber(int64_t least, int64_t most) {
   return CLI::Validator(
-      [least](std::string& text) -> std::string {
-        int value = 0;
-        if (CLI::detail::lexical_cast(text, value) && value >= least) {
+      [least, most](std::string& text) -> std::string {
+        double value = 0.0;
+        if (adse::spec::ParseNumber(text, &value) &&
+            value == std::floor(value) && value >= static_cast<double>(least) &&
+            value <= static_cast<double>(most)) {
+          text = std::to_string(static_cast<int64_t>(value));
           return {};
         }
-        return fmt::format("expected a whole number of at least {}, found '{}'",
-                           least, text);
+        return fmt::format("expected a whole number from {} to {}, found '{}'",
+                           least, most, text);
       },
-      fmt::format("INT>={}", least));
+      fmt::format("INT in [{}, {}]", least, most));
 }
 
 CLI::Validator AboveZero() {
@@ -65,7 +71,8 @@ CLI::Validator Seed() {
 }
 
 // A budget on the command line has the bounds of exploration.budget.
-const CLI::Range kBudget(adse::spec::kMinBudget, adse::spec::kMaxBudget);
+const CLI::Validator kBudget =
+    WholeNumber(adse::spec::kMinBudget, adse::spec::kMaxBudget);
 
 // Every command that drives one run of a scenario takes the case it drives.
 void AddCaseOption(CLI::App* command, std::string* task_case) {
@@ -117,7 +124,7 @@ int main(int argc, char** argv) {
   world_cmd
       ->add_option("--save-scans", world.save_every_nth_scan,
                    "Keep every Nth scan as a PCD file (0: none)")
-      ->check(WholeNumberFrom(0));
+      ->transform(WholeNumber(0, std::numeric_limits<int>::max()));
   world_cmd->add_flag("--json", world.json, "Print the summary as JSON");
 
   adse::cli::SimulateArgs simulate;
@@ -156,7 +163,7 @@ int main(int argc, char** argv) {
       "-p,--point", calibrate.point,
       "Design point to run (default: exploration.start_from)");
   calibrate_cmd->add_option("--runs", calibrate.runs, "Measured runs to fit")
-      ->check(CLI::Range(1, 100));
+      ->transform(WholeNumber(1, 100));
   calibrate_cmd->add_option("-o,--out", calibrate.out,
                             "Calibration file to write");
 
@@ -216,11 +223,11 @@ int main(int argc, char** argv) {
   run_cmd
       ->add_option("--budget", run.budget,
                    "Override exploration.budget (evaluations)")
-      ->check(kBudget);
+      ->transform(kBudget);
   run_cmd
       ->add_option("--workers", run.workers,
                    "Override harness.workers (0: auto)")
-      ->check(WholeNumberFrom(0));
+      ->transform(WholeNumber(0, 1000000));
   run_cmd
       ->add_option(
           "--isolation", run.isolation,
@@ -293,7 +300,7 @@ int main(int argc, char** argv) {
       ->add_option("--budget", explore.budget,
                    "Evaluations per replay (default: the "
                    "recorded scenario's budget)")
-      ->check(kBudget);
+      ->transform(kBudget);
   explore_cmd
       ->add_option("--objectives", explore.objectives,
                    "Replay with only these of the recorded scenario's "
@@ -302,7 +309,7 @@ int main(int argc, char** argv) {
                    "theirs too (default: all)")
       ->delimiter(',');
   explore_cmd->add_option("--seeds", explore.seeds, "Seeds per strategy")
-      ->check(CLI::Range(1, 100000));
+      ->transform(WholeNumber(1, 100000));
   explore_cmd
       ->add_option("--first-seed", explore.first_seed, "First exploration seed")
       ->check(Seed());
@@ -341,12 +348,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   interpret_cmd
       ->add_option("--retries", interpret.retries, "HTTP retries per request")
-      ->check(CLI::Range(0, 100))
+      ->transform(WholeNumber(0, 100))
       ->capture_default_str();
   interpret_cmd
       ->add_option("--max-corrections", interpret.max_corrections,
                    "Validation errors sent back to the model at most")
-      ->check(CLI::Range(0, 20))
+      ->transform(WholeNumber(0, 20))
       ->capture_default_str();
   interpret_cmd->add_option(
       "--record", interpret.record,
@@ -387,7 +394,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(adse::spec::StrategyNames()));
   submit_cmd
       ->add_option("--budget", submit.budget, "Override exploration.budget")
-      ->check(kBudget);
+      ->transform(kBudget);
   submit_cmd->add_flag("--dry-run", submit.dry_run,
                        "Print the sbatch scripts; write and submit nothing");
   submit_cmd
@@ -426,7 +433,7 @@ int main(int argc, char** argv) {
   shard_cmd
       ->add_option("--task", shard.task,
                    "Shard number (default: $SLURM_ARRAY_TASK_ID)")
-      ->check(WholeNumberFrom(0));
+      ->transform(WholeNumber(0, std::numeric_limits<int>::max()));
   shard_cmd->add_flag(
       "--local", shard.local,
       "Run the points in local worker processes instead of job steps");
@@ -498,7 +505,7 @@ int main(int argc, char** argv) {
       ->add_option("--cores", profile_check.cores,
                    "Cores of the reference machine (default 16, the "
                    "i9-12900KF's)")
-      ->check(CLI::Range(1, adse::kMaxPlatformCores));
+      ->transform(WholeNumber(1, adse::kMaxPlatformCores));
   profile_check_cmd
       ->add_option("--lidar-hz", profile_check.lidar_hz,
                    "LiDAR rate of the reference run (default 10, as the "
@@ -535,7 +542,7 @@ int main(int argc, char** argv) {
       ->add_option("--runs", fidelity.runs,
                    "Real-time runs per point (default 3; their median is "
                    "compared)")
-      ->check(CLI::Range(1, 100));
+      ->transform(WholeNumber(1, 100));
   fidelity_cmd
       ->add_option(
           "--perturbed-runs", fidelity.perturbed_runs,
@@ -544,7 +551,7 @@ int main(int argc, char** argv) {
           "starved closed loop answers so small a change with another "
           "callback order, so one virtual run is one draw, as one real-time "
           "run is; the run metrics' median over them is compared)")
-      ->check(CLI::Range(0, 100));
+      ->transform(WholeNumber(0, 100));
   fidelity_cmd
       ->add_option(
           "--clock-by", fidelity.clock_by,

@@ -25,6 +25,7 @@
 #include "harness/slurm/step_pool.h"
 #include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
+#include "harness/spec/text_util.h"
 #include "stack/base/files.h"
 
 namespace adse::cli {
@@ -213,9 +214,14 @@ int RunRun(const RunArgs& args) {
   // A campaign folder resumes whatever it holds; a file where it or a
   // folder above it goes, or a folder that is no campaign's, is bad input,
   // said before any worker starts.
-  if (Status usable = CheckCampaignFolderOf(*spec, args.out); !usable.ok()) {
-    std::fprintf(stderr, "error: %s\n", usable.message().c_str());
-    return 2;
+  for (const Status& usable :
+       {CheckCampaignFolderOf(*spec, args.out),
+        args.no_cache ? Status::Ok()
+                      : CheckCacheFolderOf(*spec, args.cache_dir)}) {
+    if (!usable.ok()) {
+      std::fprintf(stderr, "error: %s\n", usable.message().c_str());
+      return 2;
+    }
   }
   options.output_dir = args.out;
   options.strategy = args.strategy;
@@ -257,11 +263,11 @@ int RunRun(const RunArgs& args) {
     std::printf("%s", text.ok() ? text->c_str() : "{}\n");
   } else {
     std::printf(
-        "%s: %zu evaluations (%d simulated, %d reused, %d failed) in %s with "
-        "%d "
-        "worker(s)\n",
-        spec->name.c_str(), s.exploration.evaluations.size(), s.simulated,
-        s.reused, s.failed, Eta(s.wall_s).c_str(), s.workers);
+        "%s: %s (%d simulated, %d reused, %d failed) in %s with %s\n",
+        spec->name.c_str(),
+        spec::Counted(s.exploration.evaluations.size(), "evaluation").c_str(),
+        s.simulated, s.reused, s.failed, Eta(s.wall_s).c_str(),
+        spec::Counted(s.workers, "worker").c_str());
     const auto& rows = s.exploration.evaluations;
     std::printf("%s", campaign::HeadlineText(
                           *spec, rows, campaign::ComputeHeadline(*spec, rows))
@@ -269,11 +275,12 @@ int RunRun(const RunArgs& args) {
     std::printf("report: %s/report.md\n", s.output_dir.c_str());
   }
   if (s.interrupted_by != 0) {
-    std::fprintf(stderr,
-                 "stopped by signal %d: %zu evaluations kept; run the same "
-                 "command again to "
-                 "resume\n",
-                 s.interrupted_by, s.exploration.evaluations.size());
+    std::fprintf(
+        stderr,
+        "stopped by signal %d: %s kept; run the same command "
+        "again to resume\n",
+        s.interrupted_by,
+        spec::Counted(s.exploration.evaluations.size(), "evaluation").c_str());
     return 128 + s.interrupted_by;
   }
   return 0;

@@ -9,14 +9,20 @@
 
 #include "harness/campaign/headline.h"
 #include "harness/campaign/replay.h"
+#include "harness/cli/cli_support.h"
 #include "harness/cli/commands.h"
 #include "harness/slurm/status.h"
 
 namespace adse::cli {
 
 int RunStatus(const StatusArgs& args) {
-  Result<slurm::CampaignStatus> status =
-      slurm::ReadCampaignStatus(args.campaign);
+  std::error_code ec;
+  if (!std::filesystem::exists(args.campaign, ec)) {
+    std::fprintf(stderr, "error: %s: no such folder\n", args.campaign.c_str());
+    return 2;
+  }
+  const std::string folder = CampaignOfRunsFolder(args.campaign);
+  Result<slurm::CampaignStatus> status = slurm::ReadCampaignStatus(folder);
   if (!status.ok()) {
     std::fprintf(stderr, "error: %s\n", status.status().message().c_str());
     return ExitCodeFor(status.status());
@@ -24,16 +30,17 @@ int RunStatus(const StatusArgs& args) {
   // The answer so far, when the campaign has an index: the same headline
   // as adse run's, from the scenario stored in it.
   std::optional<campaign::Recording> recorded;
-  std::error_code ec;
   // A campaign on its first runs has an index without rows yet.
   const bool no_result_yet = status->done + status->failed == 0 &&
                              status->views == slurm::ViewsState::kInProgress;
-  if (!no_result_yet &&
-      std::filesystem::exists(args.campaign + "/campaign.h5", ec)) {
-    Result<campaign::Recording> r = campaign::LoadRecording(args.campaign);
+  if (!no_result_yet && std::filesystem::exists(folder + "/campaign.h5", ec)) {
+    Result<campaign::Recording> r = campaign::LoadRecording(folder);
     if (r.ok()) {
       recorded = std::move(*r);
     } else {
+      // The views are not complete when their index does not read.
+      status->views = slurm::ViewsState::kUnreadable;
+      status->unreadable_because = r.status().message();
       std::fprintf(stderr, "warning: no answer: %s\n",
                    r.status().message().c_str());
     }

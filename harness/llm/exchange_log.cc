@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <utility>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "stack/base/files.h"
@@ -35,12 +36,20 @@ const char* CodeName(Status::Code code) {
 
 Status StatusFromRecord(const ExchangeRecord& r) {
   const std::string& c = r.error_code;
-  if (c == "invalid_argument") return Status::InvalidArgument(r.error);
-  if (c == "not_found") return Status::NotFound(r.error);
-  if (c == "corruption") return Status::Corruption(r.error);
-  if (c == "io_error") return Status::IoError(r.error);
-  if (c == "unavailable") return Status::Unavailable(r.error);
-  return Status::Internal(r.error);
+  // A hand-edited or foreign record may fail without saying why.
+  const std::string error =
+      r.error.empty()
+          ? fmt::format(
+                "the recorded exchange {} ({} agent) failed, and its "
+                "record says no more",
+                r.seq, r.agent)
+          : r.error;
+  if (c == "invalid_argument") return Status::InvalidArgument(error);
+  if (c == "not_found") return Status::NotFound(error);
+  if (c == "corruption") return Status::Corruption(error);
+  if (c == "io_error") return Status::IoError(error);
+  if (c == "unavailable") return Status::Unavailable(error);
+  return Status::Internal(error);
 }
 
 json ToJson(const ExchangeRecord& r) {

@@ -1,7 +1,9 @@
 #include "harness/llm/interpret.h"
 
 #include <algorithm>
+#include <map>
 
+#include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include "harness/llm/agents.h"
@@ -121,8 +123,17 @@ Result<InterpretResult> Interpret(const std::string& request,
         problem = "the answer is not a YAML mapping of scenario sections";
       } else {
         YAML::Node kept(YAML::NodeType::Map);
+        std::map<std::string, int> line_of;  // each section once
         for (const auto& item : root) {
           const std::string key = item.first.as<std::string>();
+          const int line = item.first.Mark().line + 1;
+          if (auto [seen, first] = line_of.emplace(key, line); !first) {
+            problem = fmt::format(
+                "the answer gives the section '{}' twice (lines {} and {}); "
+                "give each section once",
+                key, seen->second, line);
+            break;
+          }
           const auto& allowed = InterpretableSections();
           if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
             dropped.push_back(key);
@@ -131,14 +142,14 @@ Result<InterpretResult> Interpret(const std::string& request,
           }
         }
         for (const auto& [section, text] : InterpretDefaults()) {
-          if (!kept[section]) {
+          if (problem.empty() && !kept[section]) {
             kept[section] = YAML::Load(text);
             filled.push_back(section + ": " + text);
           }
         }
         YAML::Emitter emitter;
         emitter << kept;
-        yaml = std::string(emitter.c_str()) + "\n";
+        if (problem.empty()) yaml = std::string(emitter.c_str()) + "\n";
       }
     } catch (const YAML::Exception& e) {
       problem = std::string("the answer is not valid YAML: ") + e.what();

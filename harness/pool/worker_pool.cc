@@ -474,7 +474,43 @@ std::vector<JobResult> PoolImpl::CancelAll() {
   return results;
 }
 
+// The CPUs this process may use, in order.
+Result<std::vector<int>> AllowedCpus() {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (::sched_getaffinity(0, sizeof(allowed), &allowed) != 0) {
+    return Status::IoError(std::string("sched_getaffinity: ") +
+                           std::strerror(errno));
+  }
+  std::vector<int> cores;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+    if (CPU_ISSET(cpu, &allowed)) cores.push_back(cpu);
+  }
+  return cores;
+}
+
+Status WorkersFit(int workers, int per, const std::vector<int>& cores) {
+  if (static_cast<size_t>(workers) * per > cores.size()) {
+    return Status::InvalidArgument(fmt::format(
+        "{} workers x {} cores per worker need {} cores, but this process "
+        "may use only {} ({})",
+        workers, per, static_cast<int64_t>(workers) * per, cores.size(),
+        internal::FormatCpuList(cores)));
+  }
+  return Status::Ok();
+}
+
 }  // namespace
+
+Status CheckWorkersFit(int workers, int cores_per_worker) {
+  Result<std::vector<int>> cores = AllowedCpus();
+  if (!cores.ok()) return cores.status();
+  const int per = std::max(1, cores_per_worker);
+  return WorkersFit(workers > 0
+                        ? workers
+                        : std::max(1, static_cast<int>(cores->size()) / per),
+                    per, *cores);
+}
 
 Result<std::unique_ptr<WorkerPool>> WorkerPool::Create(
     const PoolOptions& options) {
@@ -486,27 +522,14 @@ Result<std::unique_ptr<WorkerPool>> WorkerPool::Create(
         options.workers, options.cores_per_worker, options.memory_mb,
         options.pids_max));
   }
-  cpu_set_t allowed;
-  CPU_ZERO(&allowed);
-  if (::sched_getaffinity(0, sizeof(allowed), &allowed) != 0) {
-    return Status::IoError(std::string("pool: sched_getaffinity: ") +
-                           std::strerror(errno));
-  }
-  std::vector<int> cores;
-  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
-    if (CPU_ISSET(cpu, &allowed)) cores.push_back(cpu);
-  }
+  Result<std::vector<int>> allowed = AllowedCpus();
+  if (!allowed.ok()) return allowed.status().WithContext("pool");
+  const std::vector<int>& cores = *allowed;
   const int per = options.cores_per_worker;
   const int workers = options.workers > 0
                           ? options.workers
                           : std::max(1, static_cast<int>(cores.size()) / per);
-  if (static_cast<size_t>(workers) * per > cores.size()) {
-    return Status::InvalidArgument(fmt::format(
-        "pool: {} workers x {} cores per worker need {} cores, but this "
-        "process may use only {} ({})",
-        workers, per, workers * per, cores.size(),
-        internal::FormatCpuList(cores)));
-  }
+  ADSE_RETURN_IF_ERROR(WorkersFit(workers, per, cores).WithContext("pool"));
   const std::string name = options.group_name.empty()
                                ? fmt::format("adse-{}", ::getpid())
                                : options.group_name;

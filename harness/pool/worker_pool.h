@@ -98,6 +98,13 @@ struct JobResult {
   int slot = -1;
 };
 
+// Ok when `workers` (0: as many as fit, at least one) of `cores_per_worker`
+// CPUs each fit in the CPUs this process may use; else InvalidArgument "12
+// workers x 1 cores per worker need 12 cores, but this process may use only 2
+// (0-1)". WorkerPool::Create checks the same; a command checks it first to name
+// the flag or field that asked.
+Status CheckWorkersFit(int workers, int cores_per_worker);
+
 // Not thread-safe: one thread drives a pool.
 class WorkerPool {
  public:

@@ -85,6 +85,9 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
   }
   const analysis::Diagnosis diagnosis =
       analysis::Diagnose(run, diagnosis_options);
+  r.diagnosis_start_s = diagnosis.window_start_s;
+  r.diagnosis_window_s = diagnosis.window_s;
+  r.diagnosis_thresholds = options.thresholds;
   for (const analysis::Finding& f : diagnosis.findings) {
     r.findings.push_back({f.kind, f.node, f.remedy, f.message, f.topics,
                           f.rates_hz, f.remedies});
@@ -168,6 +171,9 @@ nlohmann::json ToJson(const RunReport& r) {
   j["deviation"] = {{"complete", r.deviation_complete},
                     {"driven_fraction", DrivenFraction(r)}};
   if (!r.deviation_error.empty()) j["deviation"]["error"] = r.deviation_error;
+  j["diagnosis"] = {{"window_start_s", Number(r.diagnosis_start_s)},
+                    {"window_s", Number(r.diagnosis_window_s)},
+                    {"thresholds", r.diagnosis_thresholds}};
   j["findings"] = nlohmann::json::array();
   for (const FindingSummary& f : r.findings) {
     j["findings"].push_back({{"kind", analysis::FindingKindToString(f.kind)},
@@ -373,7 +379,22 @@ std::string FormatSummary(const RunReport& r) {
   if (!r.constraints_error.empty())
     out += "constraints n/a: " + r.constraints_error + "\n";
   out += fmt::format("feasible    {}\n", r.feasible ? "yes" : "no");
-  if (r.findings.empty()) out += "diagnosis   no bottleneck found\n";
+  if (!r.diagnosis_thresholds.empty()) {
+    std::vector<std::string> given;
+    for (const auto& [name, value] : r.diagnosis_thresholds) {
+      given.push_back(fmt::format("{}={:g}", name, value));
+    }
+    out += fmt::format(
+        "diagnosis   window {:g}-{:g} s, thresholds {}\n", r.diagnosis_start_s,
+        r.diagnosis_start_s + r.diagnosis_window_s, fmt::join(given, ", "));
+  }
+  if (r.diagnosis_window_s <= 0.0 && r.diagnosis_start_s > 0.0) {
+    out +=
+        "diagnosis   none: its window is empty (start_s at or past the "
+        "run's end)\n";
+  } else if (r.findings.empty()) {
+    out += "diagnosis   no bottleneck found\n";
+  }
   for (const FindingSummary& f : r.findings) {
     out +=
         fmt::format("diagnosis   {}: {} (remedy: {})\n",

@@ -102,6 +102,11 @@ struct RunReport {
   // offset_m, zigzag_index, driven_fraction).
   bool deviation_complete = false;
   std::string deviation_error;
+  // The diagnosis' window in sim seconds (empty when the thresholds' start_s
+  // lies past the run's end) and the thresholds given in AnalyzeOptions.
+  double diagnosis_start_s = 0.0;
+  double diagnosis_window_s = 0.0;
+  std::map<std::string, double> diagnosis_thresholds;
   std::vector<FindingSummary> findings;
   // How long the ego stood and why, longest reason first (the dominant).
   analysis::StandingSummary standing;

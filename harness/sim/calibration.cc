@@ -100,6 +100,10 @@ Result<Calibration> LoadCalibration(const std::string& path) {
   if (!doc.contains("callbacks") || !doc["callbacks"].is_object()) {
     return Status::InvalidArgument(path + ": missing the \"callbacks\" object");
   }
+  // A callback (or one unit of its work) costing more than a minute is no
+  // real stack's: a typo such as 1e308 would stall every run without a
+  // word from the diagnosis.
+  constexpr double kMaxCost_s = 60.0;
   Calibration out;
   for (const auto& [name, entry] : doc["callbacks"].items()) {
     stack::CountedCost cost;
@@ -107,10 +111,13 @@ Result<Calibration> LoadCalibration(const std::string& path) {
     const auto per_unit = entry.find("per_unit_s");
     if (!entry.is_object() || fixed == entry.end() || per_unit == entry.end() ||
         !fixed->is_number() || !per_unit->is_number() ||
-        fixed->get<double>() < 0 || per_unit->get<double>() < 0) {
+        !(fixed->get<double>() >= 0 && fixed->get<double>() <= kMaxCost_s) ||
+        !(per_unit->get<double>() >= 0 &&
+          per_unit->get<double>() <= kMaxCost_s)) {
       return Status::InvalidArgument(
           path + ": callbacks." + name +
-          ": expected {fixed_s: number >= 0, per_unit_s: number >= 0}");
+          ": expected {fixed_s: seconds in [0, 60], per_unit_s: seconds in "
+          "[0, 60]}");
     }
     cost.fixed_s = fixed->get<double>();
     cost.per_unit_s = per_unit->get<double>();

@@ -198,7 +198,10 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
   Result<std::string> summary_text = ReadFile(folder + "/summary.json");
   if (summary_text.ok()) {
     const json j = json::parse(*summary_text, nullptr, false);
-    if (!j.is_object()) st.views = ViewsState::kUnreadable;
+    if (!j.is_object()) {
+      st.views = ViewsState::kUnreadable;
+      st.unreadable_because = "summary.json is no JSON object (damaged?)";
+    }
     if (j.is_object()) {
       if (st.strategy.empty()) st.strategy = j.value("strategy", "");
       if (st.scenario.empty()) st.scenario = j.value("scenario_file", "");
@@ -384,9 +387,9 @@ std::string FormatStatus(const CampaignStatus& st) {
       break;
     case ViewsState::kUnreadable:
       out += fmt::format(
-          "views: {}/summary.json is no JSON object (damaged?); `adse run` "
-          "again writes the views anew from campaign.h5 and the runs\n",
-          st.folder);
+          "views: unreadable in {}: {}; `adse run` again writes the views "
+          "anew from the run files\n",
+          st.folder, st.unreadable_because);
       break;
     case ViewsState::kInProgress:
       out +=
@@ -460,6 +463,7 @@ std::string StatusJson(const CampaignStatus& st) {
                   {"lock_holder", st.lock_holder},
                   {"views", ViewsStateToString(st.views)},
                   {"stopped_because", st.stopped_because},
+                  {"unreadable_because", st.unreadable_because},
                   {"notes", st.notes}};
   return j.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
 }

@@ -67,6 +67,9 @@ struct CampaignStatus {
   std::string lock_holder;  // who holds (or last held) the campaign lock
   ViewsState views = ViewsState::kNone;
   std::string stopped_because;  // why a stopped campaign stopped
+  // kUnreadable: which view could not be read and why, e.g.
+  // "summary.json is no JSON object".
+  std::string unreadable_because;
   std::vector<std::string> notes;
 };
 

@@ -81,6 +81,10 @@ std::string FormatNumber(double value) {
   return fmt::format("{}", value);
 }
 
+std::string Counted(size_t count, std::string_view noun) {
+  return fmt::format("{} {}{}", count, noun, count == 1 ? "" : "s");
+}
+
 std::string JoinList(const std::vector<std::string>& items,
                      std::string_view quote) {
   std::string out;

@@ -3,6 +3,7 @@
 #ifndef ADSE_HARNESS_SPEC_TEXT_UTIL_H_
 #define ADSE_HARNESS_SPEC_TEXT_UTIL_H_
 
+#include <cstddef>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -23,6 +24,9 @@ bool ParseNumber(std::string_view text, double* value);
 
 // Shortest text that reads back as the same double ("2.1", "10", "1e-06").
 std::string FormatNumber(double value);
+
+// "1 evaluation", "12 evaluations": a count and its regular noun.
+std::string Counted(size_t count, std::string_view noun);
 
 // "a, b, c" (each item wrapped in `quote` when given).
 std::string JoinList(const std::vector<std::string>& items,

@@ -30,7 +30,10 @@ class YamlLimitScanner : public YAML::EventHandler {
  public:
   explicit YamlLimitScanner(const YamlLimits& limits) : limits_(limits) {}
 
-  void OnDocumentStart(const YAML::Mark&) override { ++documents_; }
+  void OnDocumentStart(const YAML::Mark& mark) override {
+    if (documents_ == 1) second_document_ = mark;
+    ++documents_;
+  }
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { Count(mark); }
   void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
@@ -57,6 +60,8 @@ class YamlLimitScanner : public YAML::EventHandler {
   void OnMapEnd() override { --depth_; }
 
   int documents() const { return documents_; }
+  // Where the second document starts (when documents() > 1).
+  const YAML::Mark& second_document() const { return second_document_; }
 
  private:
   void Count(const YAML::Mark& mark) {
@@ -82,6 +87,7 @@ class YamlLimitScanner : public YAML::EventHandler {
   int depth_ = 0;
   int nodes_ = 0;
   int aliases_ = 0;
+  YAML::Mark second_document_ = YAML::Mark::null_mark();
 };
 
 }  // namespace adse::spec

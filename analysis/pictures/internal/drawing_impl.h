@@ -23,6 +23,10 @@ inline constexpr double kMaxUi = 3.5;
 // Sub-pixel drawing: coordinates are passed to OpenCV times 2^kShift.
 inline constexpr int kShift = 4;
 inline constexpr double kShiftScale = 1 << kShift;
+// Points more than this many times slower than the slowest that matters
+// (feasible designs, the front, the bounds) are drawn on the time axis'
+// edge instead of stretching it.
+inline constexpr double kClipRatio = 2.0;
 
 inline cv::Scalar Bgr(Rgb c) { return cv::Scalar(c.b, c.g, c.r); }
 inline const cv::Scalar kBlack(0, 0, 0);

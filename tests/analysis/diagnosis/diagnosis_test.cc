@@ -666,7 +666,7 @@ TEST(DiagnosisOptionsTest, SetOptionByName) {
   for (const std::string& name : DiagnosisOptionNames()) {
     const bool flag = name == "frequency_bound_driving_inputs_only" ||
                       name == "cpu_bound_state_inputs_per_output";
-    const double v = flag ? 1 : 0.5;
+    const double v = flag || name == "min_messages" ? 1 : 0.5;
     EXPECT_TRUE(SetOption(&o, name, v).ok()) << name;
   }
 
@@ -680,6 +680,10 @@ TEST(DiagnosisOptionsTest, SetOptionByName) {
   DiagnosisOptions after;
   EXPECT_FALSE(SetOption(&after, "cpu_bound_tighten_hz", 0.0).ok());
   EXPECT_FALSE(SetOption(&after, "min_messages", -1.0).ok());
+  const Status fraction = SetOption(&after, "min_messages", 1.5);
+  EXPECT_FALSE(fraction.ok());
+  EXPECT_NE(fraction.message().find("a whole number >= 0"), std::string::npos)
+      << fraction.message();
   EXPECT_FALSE(SetOption(&after, "frequency_bound_fraction", 1.0).ok());
   EXPECT_FALSE(SetOption(&after, "start_s", std::nan("")).ok());
   EXPECT_EQ(after.cpu_bound_tighten_hz, before.cpu_bound_tighten_hz);

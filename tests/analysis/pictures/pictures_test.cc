@@ -539,6 +539,53 @@ TEST_F(PictureTest, StudyPlotDrawsTheCampaignOverTheReferenceWithItsBound) {
   EXPECT_FALSE(StudyPlotPng(points, reference, options).ok());
 }
 
+TEST_F(PictureTest, ARunFarPastTheBoundSitsOnTheTimeAxisEdgeInTheStudysForm) {
+  // A 6000 s timeout in each set beside a front of 165-380 s and a 400 s
+  // bound: the axis ends near what matters, not at 6000 s.
+  std::vector<ParetoPlotPoint> reference = StudyPoints();
+  reference.push_back({3.6, 6000, false, false, ""});
+  std::vector<ParetoPlotPoint> points(2);
+  points[0].cost = 12.0;
+  points[0].nav_time_s = 380.0;
+  points[1].cost = 3.6;
+  points[1].nav_time_s = 6000.0;
+  points[1].feasible = false;
+  StudyPlotOptions options;
+  options.time_bounds_s = {400};
+  Result<std::string> png = StudyPlotPng(points, reference, options);
+  ASSERT_TRUE(png.ok()) << png.status().ToString();
+  {
+    std::ofstream out(Path("study_clipped.png"), std::ios::binary);
+    out << *png;
+  }
+  Result<RgbImage> img = ReadImage(Path("study_clipped.png"));
+  ASSERT_TRUE(img.ok());
+  // The dashed 400 s bound: the column about half black (the frame's are
+  // wholly black). Past 40 % of the width when the axis ends near 600 s;
+  // at 6000 s it would sit at about 7 %.
+  int bound_column = -1;
+  for (int c = 0; c < img->width_px; ++c) {
+    int black = 0;
+    for (int r = 0; r < img->height_px; ++r) {
+      black += img->At(c, r) == Rgb{0, 0, 0};
+    }
+    if (black > img->height_px / 4 && black < img->height_px * 3 / 4) {
+      bound_column = c;
+      break;
+    }
+  }
+  EXPECT_GT(bound_column, img->width_px * 2 / 5) << bound_column;
+  // The slow runs are wedges on the right edge, low down (cost 3.6), the
+  // campaign's in red; the legend's samples are at the top.
+  int red_far_right = 0;
+  for (int r = img->height_px / 2; r < img->height_px; ++r) {
+    for (int c = bound_column + 100; c < img->width_px; ++c) {
+      red_far_right += img->At(c, r) == kStudyPointRgb;
+    }
+  }
+  EXPECT_GT(red_far_right, 10);
+}
+
 // Rows in which a shade of `colour` (antialiased lines have few pixels of
 // the exact colour) runs, then up to 12 pixels of others with the
 // background among them, then the shade again: a hollow mark's sides.

@@ -53,6 +53,15 @@ TEST(CliRunTest, ExploreReplayPrintsADistributionPerStrategy) {
   EXPECT_NE(unknown.out.find("nope"), std::string::npos) << unknown.out;
   EXPECT_EQ(unknown.out.find("| strategy |"), std::string::npos) << unknown.out;
   EXPECT_EQ(unknown.out.find("replay of"), std::string::npos) << unknown.out;
+  // So is a strategy that cannot replay (llm without recorded exchanges),
+  // even after one that could.
+  const CommandRun llm =
+      Adse("explore --replay " + std::string(ADSE_SOURCE_DIR) +
+           "/tests/data/robotaxi_exhaustive --strategy random,llm --seeds 1");
+  EXPECT_NE(llm.exit_code, 0) << llm.out;
+  EXPECT_NE(llm.out.find("--strategy llm"), std::string::npos) << llm.out;
+  EXPECT_EQ(llm.out.find("| strategy |"), std::string::npos) << llm.out;
+  EXPECT_EQ(llm.out.find("| random |"), std::string::npos) << llm.out;
   // A strategy named twice, and seeds that would run past 2^64 - 1.
   const std::string replay = "explore --replay " +
                              std::string(ADSE_SOURCE_DIR) +
@@ -481,6 +490,54 @@ TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
   for (const auto& e : fs::directory_iterator(out / "analysis")) {
     EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos);
   }
+
+  // Thresholds: decimal numbers in range, a window that holds something;
+  // those given are recorded in each report.
+  for (const char* bad : {"min_messages=1.5", "min_messages=0x10",
+                          "start_s=50 --threshold end_s=20"}) {
+    const CommandRun refused =
+        Adse("analyze " + out.string() + " --threshold " + bad);
+    EXPECT_EQ(refused.exit_code, 2) << bad << "\n" << refused.out;
+  }
+  EXPECT_FALSE(fs::exists(out / "analysis" / "v6"));
+  const CommandRun late =
+      Adse("analyze " + out.string() + " --threshold start_s=100000");
+  ASSERT_EQ(late.exit_code, 0) << late.out;
+  EXPECT_NE(late.out.find("warning: 7 runs of 7 end before the diagnosis' "
+                          "window starts (--threshold start_s=100000)"),
+            std::string::npos)
+      << late.out;
+  for (const auto& e :
+       fs::directory_iterator(out / "analysis" / "v6" / "reports")) {
+    const nlohmann::json report =
+        nlohmann::json::parse(ReadText(e.path().string()));
+    EXPECT_EQ(report["diagnosis"]["thresholds"]["start_s"], 100000.0);
+    EXPECT_EQ(report["diagnosis"]["window_s"], 0.0);
+    EXPECT_TRUE(report["findings"].empty());
+  }
+
+  // adse status takes the campaign's runs/ for the campaign, as analyze
+  // does, and says a folder that is not there is not there.
+  const CommandRun of_runs = Adse("status " + (out / "runs").string());
+  ASSERT_EQ(of_runs.exit_code, 0) << of_runs.out;
+  EXPECT_EQ(FrontSection(of_runs.out), FrontSection(run.out)) << of_runs.out;
+  const CommandRun nowhere = Adse("status " + (out / "nowhere").string());
+  EXPECT_EQ(nowhere.exit_code, 2) << nowhere.out;
+  EXPECT_NE(nowhere.out.find("nowhere: no such folder"), std::string::npos)
+      << nowhere.out;
+  // A campaign.h5 cut short makes the views unreadable, not complete.
+  {
+    const std::string index = ReadText((out / "campaign.h5").string());
+    std::ofstream(out / "campaign.h5", std::ios::binary | std::ios::trunc)
+        << index.substr(0, index.size() / 2);
+  }
+  const CommandRun damaged = Adse("status " + out.string());
+  EXPECT_EQ(damaged.exit_code, 0) << damaged.out;
+  EXPECT_NE(damaged.out.find("views: unreadable in"), std::string::npos)
+      << damaged.out;
+  EXPECT_NE(damaged.out.find("campaign.h5"), std::string::npos) << damaged.out;
+  EXPECT_EQ(damaged.out.find("views: complete"), std::string::npos)
+      << damaged.out;
 }
 
 TEST(CliRunTest, AnalyzeOfACampaignWithCasesFoldsEveryCaseAsRunDid) {
@@ -505,7 +562,7 @@ TEST(CliRunTest, AnalyzeOfACampaignWithCasesFoldsEveryCaseAsRunDid) {
   EXPECT_NE(analyze.out.find("2 runs analysed"), std::string::npos)
       << analyze.out;
   EXPECT_EQ(FrontSection(analyze.out), FrontSection(run.out)) << analyze.out;
-  EXPECT_NE(FrontSection(analyze.out).find("1 of 1 evaluations"),
+  EXPECT_NE(FrontSection(analyze.out).find("(1 of 1 evaluation"),
             std::string::npos)
       << analyze.out;
 }

@@ -237,10 +237,47 @@ TEST(CliTest, BadFlagsAndMissingFilesExitWith2) {
 TEST(CliTest, ANumberOutOfItsRangeIsRefusedSayingWhatIsExpected) {
   const CommandRun scans = Adse("world " + Example() + " --save-scans -3");
   EXPECT_EQ(scans.exit_code, 2);
-  EXPECT_NE(scans.out.find("--save-scans: expected a whole number of at "
-                           "least 0, found '-3'"),
+  EXPECT_NE(scans.out.find("--save-scans: expected a whole number from 0 to "
+                           "2147483647, found '-3'"),
             std::string::npos)
       << scans.out;
+  // Read as the scenario reads numbers: 1e3 is a thousand, 2.5 no count.
+  const CommandRun budgets =
+      Adse("explore --replay " + std::string(ADSE_SOURCE_DIR) +
+           "/tests/data/landscapes/saturating --strategy random --seeds 1 "
+           "--budget 1e1 --json");
+  ASSERT_EQ(budgets.exit_code, 0) << budgets.out;
+  EXPECT_EQ(nlohmann::json::parse(budgets.out)["budget"], 10) << budgets.out;
+  const CommandRun half =
+      Adse("explore --replay " + std::string(ADSE_SOURCE_DIR) +
+           "/tests/data/landscapes/saturating --budget 2.5");
+  EXPECT_EQ(half.exit_code, 2) << half.out;
+  EXPECT_NE(half.out.find("--budget: expected a whole number from 1 to "
+                          "1000000000, found '2.5'"),
+            std::string::npos)
+      << half.out;
+  // More workers than CPUs is said of the flag, before any run.
+  const fs::path crowded = fs::path(::testing::TempDir()) / "crowded";
+  fs::remove_all(crowded);
+  const CommandRun workers =
+      Adse("run " + Example() + " --workers 100000 -o " + crowded.string());
+  EXPECT_EQ(workers.exit_code, 2) << workers.out;
+  EXPECT_NE(workers.out.find("--workers 100000: 100000 workers x 1 cores per "
+                             "worker need 100000 cores"),
+            std::string::npos)
+      << workers.out;
+  EXPECT_FALSE(fs::exists(crowded / "campaign.h5"));
+  // So is a worker wider than the machine, of the field that asked.
+  const CommandRun wide =
+      Adse("run " +
+           Variant("wide", "cores_per_worker: 1", "cores_per_worker: 1024") +
+           " -o " + crowded.string());
+  EXPECT_EQ(wide.exit_code, 2) << wide.out;
+  EXPECT_NE(wide.out.find("harness.cores_per_worker: 1 workers x 1024 cores "
+                          "per worker need 1024 cores"),
+            std::string::npos)
+      << wide.out;
+  EXPECT_FALSE(fs::exists(crowded / "campaign.h5"));
   // A budget on the command line has the scenario's bounds: a campaign of
   // no evaluations is refused, not written.
   const fs::path out = fs::path(::testing::TempDir()) / "budget_zero";
@@ -415,6 +452,71 @@ TEST(CliTest, SimulateAndCalibrateNeverOverwriteWhatIsNotTheirs) {
   fs::remove_all(dir);
 }
 
+// Runs adse with `args` while `folder` is read-only: a read-only tmpfs
+// over it in a mount namespace of the command's own for root (who writes
+// through permission bits), its permission bits for anyone else.
+CommandRun AdseWithReadOnly(const fs::path& folder, const std::string& args) {
+  if (::geteuid() != 0) {
+    fs::permissions(folder, fs::perms::owner_read | fs::perms::owner_exec);
+    CommandRun run = Adse(args);
+    fs::permissions(folder, fs::perms::owner_all);
+    return run;
+  }
+  const std::string inner = "mount -t tmpfs -o ro adse-ro " + folder.string() +
+                            " && " + ADSE_BINARY_DIR + "/bin/adse " + args;
+  FILE* pipe = ::popen(("unshare -m sh -c '" + inner + "' 2>&1").c_str(), "r");
+  std::string out;
+  char buffer[4096];
+  size_t n;
+  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) {
+    out.append(buffer, n);
+  }
+  const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+TEST(CliTest, AFolderItCannotWriteInIsRefusedBeforeAnyWork) {
+  const fs::path dir = fs::temp_directory_path() / "adse_cli_read_only";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "locked");
+  const fs::path locked = dir / "locked";
+  const std::string point = " --point cores=16,freq_ghz=2.1,lidar_hz=7 -q ";
+  struct Case {
+    std::string args;
+    std::string named;  // the flag or field the message names
+  };
+  const Case cases[] = {
+      {"simulate " + SmallScenarioPath() + point + "-o " +
+           (locked / "run.h5").string(),
+       "-o " + (locked / "run.h5").string()},
+      {"simulate " + SmallScenarioPath() + point + "-o " +
+           (locked / "sub" / "run.h5").string(),
+       "-o "},
+      {"run " + SmallScenarioPath() + " --budget 1 -q -o " +
+           (locked / "camp").string(),
+       "-o "},
+      {"run " + SmallScenarioPath() + " --budget 1 -q -o " +
+           (dir / "camp").string() + " --cache-dir " +
+           (locked / "cache").string(),
+       "--cache-dir "},
+      {"world " + SmallScenarioPath() + " --follow-ideal --no-scan -o " +
+           (locked / "w").string(),
+       "-o "},
+  };
+  for (const Case& c : cases) {
+    const CommandRun run = AdseWithReadOnly(locked, c.args);
+    EXPECT_EQ(run.exit_code, 2) << c.args << "\n" << run.out;
+    EXPECT_NE(run.out.find(c.named), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find(": cannot write in " + locked.string()),
+              std::string::npos)
+        << run.out;
+    // Said before any simulation: no run's progress or result.
+    EXPECT_EQ(run.out.find("nav_time_s"), std::string::npos) << run.out;
+  }
+  EXPECT_FALSE(fs::exists(dir / "camp"));
+  fs::remove_all(dir);
+}
+
 TEST(CliTest, SimulateWritesARunFileThatPassesTheSchemaCheck) {
   const fs::path out = fs::temp_directory_path() / "adse_cli_simulate.h5";
   fs::remove(out);
@@ -500,7 +602,7 @@ TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
                            ": not an HDF5 file (no HDF5 signature)"),
             std::string::npos)
       << first.out;
-  EXPECT_NE(first.out.find("1 runs analysed"), std::string::npos) << first.out;
+  EXPECT_NE(first.out.find("1 run analysed"), std::string::npos) << first.out;
   ASSERT_TRUE(fs::exists(dir / "analysis" / "v1" / "summary.json"));
   EXPECT_TRUE(fs::exists(dir / "analysis" / "v1" / "pareto.png"));
   EXPECT_TRUE(fs::exists(dir / "analysis" / "v1" / "report.md"));

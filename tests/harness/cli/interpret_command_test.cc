@@ -113,6 +113,29 @@ TEST(InterpretCommandTest,
   EXPECT_THAT(other.out,
               HasSubstr("no recorded answer for this interpretation request"));
   EXPECT_FALSE(fs::exists(dir + "/replayed/other.yaml"));
+  // Its exchanges were not recorded, so no file is named for them.
+  EXPECT_FALSE(fs::exists(dir + "/replayed/other.interpret.jsonl"));
+  EXPECT_THAT(other.out, ::testing::Not(HasSubstr("exchanges recorded in")));
+}
+
+TEST(InterpretCommandTest, ASectionGivenTwiceGoesBackToTheModel) {
+  // YAML keeps the last of two equal keys; the model is told instead.
+  Result<std::unique_ptr<FakeLlmServer>> server =
+      FakeLlmServer::Start(FakeLlmServer::Sequence(
+          {{200, std::string(kValid) + "task: {timeout_s: 5}\n"},
+           {200, kValid}}));
+  ASSERT_TRUE(server.ok());
+  const std::string dir = TempDir("twice");
+  const CommandRun run =
+      Adse(std::string("interpret ") + kRequest + " -o " + dir +
+           "/study.yaml --model interp --endpoint " + (*server)->url());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_THAT(run.out, HasSubstr("2 answers, 1 corrected"));
+  const std::vector<llm::testing::ReceivedRequest> requests =
+      (*server)->requests();
+  ASSERT_EQ(requests.size(), 2u);
+  EXPECT_THAT(requests[1].TextOf("user"),
+              HasSubstr("gives the section 'task' twice (lines 6 and 13)"));
 }
 
 TEST(InterpretCommandTest, AModelThatNeverGetsItRightWritesNothing) {

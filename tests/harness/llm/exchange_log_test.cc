@@ -393,6 +393,22 @@ TEST(RecordingBackendTest, ReplaysARecordedErrorAsTheSameCodeAndMessage) {
   EXPECT_EQ(replay.replayed(), static_cast<int>(std::size(errors)));
 }
 
+TEST(RecordingBackendTest, ARecordedErrorWithoutAMessageSaysWhichRecord) {
+  std::vector<ExchangeRecord> recorded =
+      RecordSession("", {Request()}, {"answer"});
+  recorded[0].ok = false;
+  recorded[0].answer.clear();
+  recorded[0].error_code = "unavailable";
+  recorded[0].error.clear();  // a hand-edited "ok": false
+  RecordingBackend replay(std::move(recorded), nullptr, JsonlLog(), "x");
+  Result<ChatReply> reply = replay.Chat(Request());
+  ASSERT_FALSE(reply.ok());
+  EXPECT_EQ(reply.status().code(), Status::Code::kUnavailable);
+  EXPECT_EQ(reply.status().message(),
+            "the recorded exchange 0 (dse agent) failed, and its record says "
+            "no more");
+}
+
 TEST(RecordingBackendTest,
      ReplayOnlyRefusesAnUnrecordedRequestNamingTheSource) {
   const std::vector<ExchangeRecord> recorded =

@@ -189,7 +189,7 @@ TEST(StatusTest, ASummaryThatIsNoJsonIsSaidToBeUnreadable) {
   ASSERT_TRUE(st.ok());
   EXPECT_EQ(st->views, ViewsState::kUnreadable);
   EXPECT_THAT(FormatStatus(*st),
-              HasSubstr("/summary.json is no JSON object (damaged?)"));
+              HasSubstr(": summary.json is no JSON object (damaged?)"));
   EXPECT_EQ(json::parse(StatusJson(*st))["views"], "unreadable");
 }
 

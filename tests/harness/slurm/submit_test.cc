@@ -209,6 +209,10 @@ TEST(SubmitTest, ShardIndexAndStatusRefuseFoldersTheyCannotUse) {
   EXPECT_THAT(run.output, HasSubstr("SLURM_ARRAY_TASK_ID is not set"));
   run = Adse({"status", dir + "/elsewhere"});
   EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("elsewhere: no such folder"));
+  fs::create_directories(dir + "/elsewhere");
+  run = Adse({"status", dir + "/elsewhere"});
+  EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_THAT(run.output, HasSubstr("not a campaign folder"));
   // A folder with nothing yet: all zero, no Slurm jobs.
   run = Adse({"status", dir + "/campaign", "--json"});

@@ -154,7 +154,28 @@ TEST(SpecHostileTest, MultipleDocumentsAreRefused) {
   const std::string message = FailsFast(
       std::string(kHead) +
       "design_space: {n: {bind: platform.cores, values: [1]}}\n---\nadse: 1\n");
-  EXPECT_THAT(message, HasSubstr("expected one YAML document"));
+  EXPECT_THAT(message, HasSubstr("evil.yaml:5:1: error: (file): expected one "
+                                 "YAML document, found a second from line 5"));
+  // '...' ends a document too: what follows it is another.
+  EXPECT_THAT(FailsFast(std::string(kHead) + "...\noutput: x\n"),
+              HasSubstr("found a second from line 5"));
+}
+
+TEST(SpecHostileTest, TextThatIsNotUtf8IsNamedByItsEncoding) {
+  std::string utf16("\xFF\xFE", 2);
+  for (char c : std::string(kHead)) utf16 += std::string{c, '\0'};
+  EXPECT_THAT(FailsFast(utf16),
+              HasSubstr("evil.yaml:1:1: error: (file): expected UTF-8 text, "
+                        "found a UTF-16 byte-order mark; save the file as "
+                        "UTF-8"));
+  EXPECT_THAT(FailsFast(std::string(kHead) + std::string("x: \0\n", 5)),
+              HasSubstr("found a NUL byte"));
+}
+
+TEST(SpecHostileTest, ATabInTheIndentationIsNamed) {
+  EXPECT_THAT(FailsFast(std::string(kHead) + "platform:\n\tkind: virtual\n"),
+              HasSubstr("(a tab in the indentation of line 5: YAML indents "
+                        "with spaces)"));
 }
 
 TEST(SpecHostileTest, NonScalarKeysAndControlCharacters) {
