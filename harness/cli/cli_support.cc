@@ -232,8 +232,10 @@ Status CheckCampaignFolderOf(const spec::Spec& spec, const std::string& out) {
       out.empty() ? spec.Where("output") + "output" : "-o " + out);
 }
 
-Status CheckCacheFolderOf(const spec::Spec& spec,
-                          const std::string& cache_dir) {
+Status CheckCampaignFolders(const spec::Spec& spec, const std::string& out,
+                            bool use_cache, const std::string& cache_dir) {
+  ADSE_RETURN_IF_ERROR(CheckCampaignFolderOf(spec, out));
+  if (!use_cache) return Status::Ok();
   if (!cache_dir.empty()) {
     return CheckFolderPath(cache_dir, "--cache-dir " + cache_dir);
   }

@@ -72,10 +72,12 @@ std::string CampaignOfRunsFolder(const std::string& target);
 // The same for the folder a campaign of `spec` goes to: `-o out`, or the
 // scenario's output when `out` is empty (named by its line).
 Status CheckCampaignFolderOf(const spec::Spec& spec, const std::string& out);
-// CheckFolderPath of the shared run cache a campaign of `spec` uses:
-// `--cache-dir cache_dir`, or the scenario's harness.cache_dir when
-// `cache_dir` is empty (named by its line); Ok for the default cache.
-Status CheckCacheFolderOf(const spec::Spec& spec, const std::string& cache_dir);
+// CheckCampaignFolderOf, then (with `use_cache`) CheckFolderPath of the
+// shared run cache the campaign uses: `--cache-dir cache_dir`, or the
+// scenario's harness.cache_dir when `cache_dir` is empty (named by its
+// line); the default cache is not checked.
+Status CheckCampaignFolders(const spec::Spec& spec, const std::string& out,
+                            bool use_cache, const std::string& cache_dir);
 
 // What a command's output file is, so that an earlier one can be told
 // from anything else.

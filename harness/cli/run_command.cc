@@ -214,14 +214,11 @@ int RunRun(const RunArgs& args) {
   // A campaign folder resumes whatever it holds; a file where it or a
   // folder above it goes, or a folder that is no campaign's, is bad input,
   // said before any worker starts.
-  for (const Status& usable :
-       {CheckCampaignFolderOf(*spec, args.out),
-        args.no_cache ? Status::Ok()
-                      : CheckCacheFolderOf(*spec, args.cache_dir)}) {
-    if (!usable.ok()) {
-      std::fprintf(stderr, "error: %s\n", usable.message().c_str());
-      return 2;
-    }
+  if (Status usable =
+          CheckCampaignFolders(*spec, args.out, !args.no_cache, args.cache_dir);
+      !usable.ok()) {
+    std::fprintf(stderr, "error: %s\n", usable.message().c_str());
+    return 2;
   }
   options.output_dir = args.out;
   options.strategy = args.strategy;

@@ -18,14 +18,11 @@ namespace adse::cli {
 int RunSubmit(const SubmitArgs& args) {
   std::optional<spec::Spec> spec = LoadScenarioOrReport(args.scenario);
   if (!spec) return 2;
-  for (const Status& usable :
-       {CheckCampaignFolderOf(*spec, args.out),
-        args.no_cache ? Status::Ok()
-                      : CheckCacheFolderOf(*spec, args.cache_dir)}) {
-    if (!usable.ok()) {
-      std::fprintf(stderr, "error: %s\n", usable.message().c_str());
-      return 2;
-    }
+  if (Status usable =
+          CheckCampaignFolders(*spec, args.out, !args.no_cache, args.cache_dir);
+      !usable.ok()) {
+    std::fprintf(stderr, "error: %s\n", usable.message().c_str());
+    return 2;
   }
   slurm::SubmitOptions options;
   options.output_dir = args.out;
