@@ -181,12 +181,14 @@ int RunExplore(const ExploreArgs& args) {
                       : fmt::format("{:g} ({} of {} seeds)", a.median,
                                     first.size(), args.seeds),
         cheapest, args.seeds, missing);
-    if (args.json) continue;  // stdout's JSON alone
-    std::fprintf(stderr, "%s: %s replayed in %.0f s\n", name.c_str(),
-                 spec::Counted(static_cast<size_t>(args.seeds), "seed").c_str(),
-                 std::chrono::duration<double>(
-                     std::chrono::steady_clock::now() - started)
-                     .count());
+    if (!args.json) {  // with --json, stdout's JSON alone
+      std::fprintf(
+          stderr, "%s: %s replayed in %.0f s\n", name.c_str(),
+          spec::Counted(static_cast<size_t>(args.seeds), "seed").c_str(),
+          std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                        started)
+              .count());
+    }
   }
   if (!args.json) {
     std::printf(

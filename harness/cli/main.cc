@@ -227,7 +227,7 @@ int main(int argc, char** argv) {
   run_cmd
       ->add_option("--workers", run.workers,
                    "Override harness.workers (0: auto)")
-      ->transform(WholeNumber(0, 1000000));
+      ->transform(WholeNumber(0, adse::spec::kMaxWorkers));
   run_cmd
       ->add_option(
           "--isolation", run.isolation,

@@ -127,6 +127,8 @@ const std::vector<MetricInfo>& KnownMetrics();
 // overrides within the same bounds.
 inline constexpr int kMinBudget = 1;
 inline constexpr int kMaxBudget = 1000000000;
+// harness.workers (and --workers) at most.
+inline constexpr int kMaxWorkers = 1000000;
 
 struct ExplorationOptions {
   std::string strategy = "agent";  // exhaustive|random|ga|nsga2|agent|llm

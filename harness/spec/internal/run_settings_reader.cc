@@ -176,7 +176,7 @@ void SpecReader::ReadHarness(const Val& v) {
     } else {
       double value = 0;
       if (!e->node.IsScalar() || !ParseNumber(e->node.Scalar(), &value) ||
-          value != std::floor(value) || value < 1 || value > 1e6) {
+          value != std::floor(value) || value < 1 || value > kMaxWorkers) {
         Error(*e, "'auto' or an integer >= 1");
       } else {
         h.workers = static_cast<int>(value);
