@@ -18,6 +18,7 @@
 #include "harness/campaign/run_store.h"
 #include "harness/llm/exchange_log.h"
 #include "harness/llm/llm_strategy.h"
+#include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
 #include "harness/spec/text_util.h"
 #include "stack/base/files.h"
@@ -54,6 +55,23 @@ LlmRecords LoadLlmRecords(const std::string& folder) {
 std::string Number(double v) {
   if (std::isnan(v)) return "—";
   return fmt::format("{:.4g}", v);
+}
+
+// The metrics the report's tables show: the objectives', the constraints',
+// then cost, nav time and control rate, which every study reads.
+std::vector<std::string> MetricColumns(const spec::Spec& spec) {
+  std::vector<std::string> columns;
+  auto add = [&columns](const std::string& metric) {
+    if (std::find(columns.begin(), columns.end(), metric) == columns.end()) {
+      columns.push_back(metric);
+    }
+  };
+  for (const spec::Objective& o : spec.objectives) add(o.metric);
+  for (const std::string& metric : spec::ConstraintMetrics(spec)) add(metric);
+  for (const char* metric : {"hardware_cost", "nav_time_s", "ctrl_rate_hz"}) {
+    add(metric);
+  }
+  return columns;
 }
 
 // With replicas: each point's metrics as median [min–max] over its runs,
@@ -347,13 +365,7 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
           ? std::string("none")
           : fmt::format("`{}`", fmt::join(spec.constraints, "`, `")));
 
-  std::vector<std::string> columns;
-  for (const spec::Objective& o : spec.objectives) columns.push_back(o.metric);
-  for (const char* extra : {"hardware_cost", "nav_time_s", "ctrl_rate_hz"}) {
-    if (std::find(columns.begin(), columns.end(), extra) == columns.end()) {
-      columns.push_back(extra);
-    }
-  }
+  const std::vector<std::string> columns = MetricColumns(spec);
   const std::set<int> front(s.pareto_front.begin(), s.pareto_front.end());
   md << fmt::format("## Pareto front over {} ({})\n\n",
                     fmt::join(objectives, ", "),
@@ -390,20 +402,21 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
   }
 
   md << "\n## All evaluations\n\n| # | point | status | reason | source | "
-        "hardware_cost | nav_time_s | ctrl_rate_hz | deviation_score | "
-        "feasible |\n|---|---|---|---|---|---|---|---|---|---|\n";
+     << fmt::format("{}", fmt::join(columns, " | "))
+     << " | feasible |\n|---|---|---|---|---|";
+  for (size_t i = 0; i < columns.size(); ++i) md << "---|";
+  md << "---|\n";
   for (const EvaluationRow& row : rows) {
-    md << fmt::format(
-        "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", row.index,
-        spec::FormatPoint(spec.design_space, row.point), row.status,
-        Cell(row.reason), row.source, Number(RowMetric(row, "hardware_cost")),
-        Number(RowMetric(row, "nav_time_s")),
-        Number(RowMetric(row, "ctrl_rate_hz")),
-        Number(RowMetric(row, "deviation_score")),
-        row.replicas.size() > 1
-            ? fmt::format("{} ({})", row.feasible ? "yes" : "no",
-                          ReplicaSummary(spec, row))
-            : std::string(row.feasible ? "yes" : "no"));
+    md << fmt::format("| {} | {} | {} | {} | {} | ", row.index,
+                      spec::FormatPoint(spec.design_space, row.point),
+                      row.status, Cell(row.reason), row.source);
+    for (const std::string& c : columns)
+      md << Number(RowMetric(row, c)) << " | ";
+    md << (row.replicas.size() > 1
+               ? fmt::format("{} ({})", row.feasible ? "yes" : "no",
+                             ReplicaSummary(spec, row))
+               : std::string(row.feasible ? "yes" : "no"))
+       << " |\n";
   }
 
   md << "\n## Failures\n\n";

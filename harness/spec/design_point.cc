@@ -225,6 +225,25 @@ Result<bool> EvaluateConstraint(const Spec& spec, const std::string& constraint,
   return Holds(*e, metrics, point);
 }
 
+std::vector<std::string> ConstraintMetrics(const Spec& spec) {
+  const std::vector<std::string> parameters = spec.design_space.Names();
+  const std::vector<std::string> names =
+      ConstraintVariableNames(spec.design_space);
+  std::vector<std::string> metrics;
+  for (const std::string& text : spec.constraints) {
+    Result<Expression> e = Expression::Parse(text, names);
+    if (!e.ok()) continue;
+    for (const std::string& name : e->variables()) {
+      if (std::find(parameters.begin(), parameters.end(), name) ==
+              parameters.end() &&
+          std::find(metrics.begin(), metrics.end(), name) == metrics.end()) {
+        metrics.push_back(name);
+      }
+    }
+  }
+  return metrics;
+}
+
 ConstraintChecker::ConstraintChecker(const Spec& spec)
     : texts_(spec.constraints) {
   const std::vector<std::string> names =

@@ -76,6 +76,11 @@ int ViolatedConstraintCount(const Spec& spec,
                             const std::map<std::string, double>& metrics,
                             const DesignPoint& point);
 
+// The metrics the spec's constraints read (not its design parameters),
+// each once, constraint by constraint (alphabetically within one); a
+// constraint that does not parse names none.
+std::vector<std::string> ConstraintMetrics(const Spec& spec);
+
 // The spec's constraints parsed once, to check many rows: parsing is most
 // of a check (a front over a campaign's rows checks every infeasible one).
 // Not thread-safe on one object (muParser keeps state); copies are.

@@ -17,7 +17,7 @@
 #include "harness/campaign/evaluation.h"
 #include "harness/campaign/replay.h"
 #include "tests/harness/testing/recording.h"
-#include "tests/harness/testing/temp_files.h"
+#include "tests/testing/temp_files.h"
 #include "tests/tools/landscapes.h"
 
 namespace adse::landscapes {
@@ -50,7 +50,7 @@ void ExpectNearMaps(const std::map<std::string, double>& fresh,
 }
 
 TEST(MakeLandscapesTest, TheCommittedLandscapesAreWhatTheGeneratorWrites) {
-  const std::string dir = adse::testing::TestTempDir("make-landscapes");
+  const std::string dir = adse::testing::TestTempDir("adse-make-landscapes");
   const Status written = WriteLandscapes(dir);
   ASSERT_TRUE(written.ok()) << written.message();
   for (const std::string& name : LandscapeNames()) {
@@ -323,7 +323,8 @@ TEST(MakeLandscapesTest,
   const std::vector<std::string> held_out =
       LandscapeNames(LandscapeFamily::kHeldOut);
   ASSERT_GE(held_out.size(), 6u);
-  const std::string dir = adse::testing::TestTempDir("held-out-landscapes");
+  const std::string dir =
+      adse::testing::TestTempDir("adse-held-out-landscapes");
   const Status written = WriteLandscapes(dir, LandscapeFamily::kHeldOut);
   ASSERT_TRUE(written.ok()) << written.message();
   for (const std::string& name : held_out) {

@@ -1,30 +1,22 @@
-// A fixture that gives each test a fresh temporary folder, removed after it.
+// A fixture that gives each test a fresh temporary folder (its scratch
+// folder, removed once it passes).
 #ifndef ADSE_TESTS_ANALYSIS_TESTING_TEMP_DIR_TEST_H_
 #define ADSE_TESTS_ANALYSIS_TESTING_TEMP_DIR_TEST_H_
-
-#include <stdlib.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <string>
-#include <system_error>
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "tests/testing/temp_files.h"
 
 namespace adse::testing {
 
 class TempDirTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string pattern = ::testing::TempDir() + "adse_test_XXXXXX";
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    std::filesystem::remove_all(dir_, ec);
-  }
+  void SetUp() override { dir_ = TestScratch().string(); }
   std::string Path(const std::string& name) const {
     return (std::filesystem::path(dir_) / name).string();
   }

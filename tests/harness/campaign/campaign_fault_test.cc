@@ -16,8 +16,8 @@
 #include "harness/campaign/campaign.h"
 #include "stack/base/files.h"
 #include "tests/harness/testing/small_scenario.h"
-#include "tests/harness/testing/temp_files.h"
 #include "tests/stack/base/testing/fault_injection_env.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::campaign {
 namespace {

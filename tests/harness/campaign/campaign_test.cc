@@ -25,9 +25,11 @@
 #include "harness/campaign/replay.h"
 #include "harness/campaign/run_store.h"
 #include "harness/report/run_report.h"
+#include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/files.h"
 #include "tests/harness/testing/small_scenario.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::campaign {
 namespace {
@@ -37,12 +39,7 @@ using ::testing::HasSubstr;
 const std::string kAdse = std::string(ADSE_BINARY_DIR) + "/bin/adse";
 
 std::string TempDir(const std::string& name) {
-  const std::string dir = fs::temp_directory_path().string() +
-                          "/adse-campaign-" + name + "-" +
-                          std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return adse::testing::FreshTempDir("adse-campaign", name);
 }
 
 CampaignOptions Options(const std::string& out, const std::string& strategy,
@@ -99,6 +96,19 @@ TEST(CampaignTest,
   EXPECT_THAT(report, HasSubstr("## Pareto front"));
   EXPECT_THAT(report, HasSubstr("## Iterations"));
   EXPECT_THAT(report, HasSubstr("cores=16,freq_ghz=2.1"));
+  // Both tables show each metric the objectives and constraints read
+  // (`completed` is only a constraint's here).
+  std::vector<std::string> metrics = spec::ConstraintMetrics(spec);
+  EXPECT_THAT(metrics, ::testing::Contains("completed"));
+  for (const spec::Objective& o : spec.objectives) metrics.push_back(o.metric);
+  for (const char* table : {"## Pareto front", "## All evaluations"}) {
+    const size_t at = report.find("| # | point |", report.find(table));
+    ASSERT_NE(at, std::string::npos) << table;
+    const std::string header = report.substr(at, report.find('\n', at) - at);
+    for (const std::string& metric : metrics) {
+      EXPECT_THAT(header, HasSubstr("| " + metric + " |")) << table;
+    }
+  }
   // Starved (1 core, 1 GHz) points are infeasible; generous ones feasible.
   int feasible = 0;
   for (const EvaluationRow& row : first->exploration.evaluations) {
@@ -561,7 +571,7 @@ TEST(CampaignTest,
   const pid_t coordinator = StartAdseRun(
       {"run", adse::testing::SmallScenarioPath(), "-o", out, "--strategy",
        "exhaustive", "--workers", "2", "--no-cache", "--quiet"},
-      out + "-stderr.log");
+      (adse::testing::TestScratch() / "stderr.log").string());
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::seconds(240);
   while (RunFiles(out).empty() && std::chrono::steady_clock::now() < deadline) {

@@ -23,7 +23,7 @@
 #include "harness/spec/spec_parser.h"
 #include "stack/base/files.h"
 #include "tests/harness/testing/small_scenario.h"
-#include "tests/harness/testing/temp_files.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::campaign {
 namespace {

@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "stack/base/files.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::campaign {
 namespace {
@@ -18,12 +19,7 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
 std::string TempDir(const std::string& name) {
-  const std::string dir = fs::temp_directory_path().string() +
-                          "/adse-run-store-" + name + "-" +
-                          std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return adse::testing::FreshTempDir("adse-run-store", name);
 }
 
 TEST(CampaignLockTest, ASecondHolderIsRefusedWithTheFirstOnesPid) {

@@ -10,6 +10,7 @@
 #include "tests/harness/cli/example_files.h"
 #include "tests/harness/testing/adse_command.h"
 #include "tests/harness/testing/small_scenario.h"
+#include "tests/testing/temp_files.h"
 
 namespace {
 
@@ -33,7 +34,7 @@ std::string BundledMapping() {
 }
 
 TEST(CliProfileTest, ImportWritesTheProfileAndShowPrintsItsTotalLoad) {
-  const fs::path out = fs::temp_directory_path() / "adse_cli_profile.yaml";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_profile.yaml";
   fs::remove(out);
   const CommandRun import =
       Adse("profile import --caret " + TrimmedCaret() + " --map " +
@@ -59,7 +60,8 @@ TEST(CliProfileTest, ImportWritesTheProfileAndShowPrintsItsTotalLoad) {
 }
 
 TEST(CliProfileTest, ImportOfBadInputExitsWith2AndWritesNothing) {
-  const fs::path out = fs::temp_directory_path() / "adse_cli_bad_profile.yaml";
+  const fs::path out =
+      adse::testing::TestScratch() / "adse_cli_bad_profile.yaml";
   fs::remove(out);
   const CommandRun missing =
       Adse("profile import --caret /nonexistent/caret --map " +
@@ -71,7 +73,8 @@ TEST(CliProfileTest, ImportOfBadInputExitsWith2AndWritesNothing) {
       << missing.out;
   EXPECT_FALSE(fs::exists(out));
 
-  const fs::path mapping = fs::temp_directory_path() / "adse_cli_mapping.yaml";
+  const fs::path mapping =
+      adse::testing::TestScratch() / "adse_cli_mapping.yaml";
   std::ofstream(mapping) << Replaced(ReadText(BundledMapping()),
                                      "top/velodyne_convert_node/callback_0",
                                      "top/velodyne/callback_0");
@@ -119,7 +122,7 @@ TEST(CliProfileTest, ImportOfBadInputExitsWith2AndWritesNothing) {
 }
 
 TEST(CliProfileTest, CheckComparesTheChainsOnTheReferenceMachine) {
-  const fs::path out = fs::temp_directory_path() / "adse_cli_profile_check";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_profile_check";
   fs::remove_all(out);
   const CommandRun check =
       Adse("profile check " + SmallScenarioPath() + " -o " + out.string());
@@ -148,7 +151,8 @@ TEST(CliProfileTest, CheckComparesTheChainsOnTheReferenceMachine) {
 
   // A scenario with task.cases checks the case it is told to drive, by
   // default into a folder of that case's.
-  const fs::path campaign = fs::temp_directory_path() / "adse_cli_valet_check";
+  const fs::path campaign =
+      adse::testing::TestScratch() / "adse_cli_valet_check";
   const std::string valet = WriteScenario(
       "valet_check", Replaced(ReadText(std::string(ADSE_SOURCE_DIR) +
                                        "/scenarios/valet_parking.yaml"),

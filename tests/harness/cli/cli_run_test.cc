@@ -13,6 +13,7 @@
 #include "tests/harness/cli/example_files.h"
 #include "tests/harness/testing/adse_command.h"
 #include "tests/harness/testing/small_scenario.h"
+#include "tests/testing/temp_files.h"
 
 namespace {
 
@@ -178,7 +179,7 @@ TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
   EXPECT_NE(isolation.out.find("--isolation"), std::string::npos)
       << isolation.out;
   // A file where the campaign folder, or a folder above it, goes.
-  const fs::path file = fs::temp_directory_path() / "adse_cli_run_file";
+  const fs::path file = adse::testing::TestScratch() / "adse_cli_run_file";
   std::ofstream(file) << "not a folder\n";
   for (const fs::path& out : {file, file / "campaign"}) {
     const CommandRun run =
@@ -195,7 +196,7 @@ TEST(CliRunTest, RunRejectsBadFlagsAndUnsupportedSettingsByName) {
 TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
   const std::string file = WriteScenario(
       "replicas", ReadText(SmallScenarioPath()) + "harness: {replicas: 2}\n");
-  const fs::path out = fs::temp_directory_path() / "adse_cli_replicas";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_replicas";
   fs::remove_all(out);
   const CommandRun run =
       Adse("run " + file + " --budget 1 --no-cache -o " + out.string());
@@ -217,7 +218,7 @@ TEST(CliRunTest, RunWithReplicasRunsEachPointOncePerReplicaAndShowsTheSpread) {
 }
 
 TEST(CliRunTest, ARunNeverWritesIntoAFolderThatIsNoCampaigns) {
-  const fs::path dir = fs::temp_directory_path() / "adse_cli_user_folder";
+  const fs::path dir = adse::testing::TestScratch() / "adse_cli_user_folder";
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "report.md") << "my notes\n";
@@ -252,7 +253,7 @@ TEST(CliRunTest, ARunNeverWritesIntoAFolderThatIsNoCampaigns) {
 }
 
 TEST(CliRunTest, ADamagedRunFileIsRunAgainWhenTheCampaignResumes) {
-  const fs::path out = fs::temp_directory_path() / "adse_cli_damaged_run";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_damaged_run";
   fs::remove_all(out);
   const std::string run = "run " + SmallScenarioPath() +
                           " --budget 1 --strategy exhaustive --no-cache -o " +
@@ -277,7 +278,7 @@ TEST(CliRunTest, ADamagedRunFileIsRunAgainWhenTheCampaignResumes) {
 }
 
 TEST(CliRunTest, ARunIntoAnotherScenariosFolderWarnsAndStatusCountsItsOwnRuns) {
-  const fs::path out = fs::temp_directory_path() / "adse_cli_two_scenarios";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_two_scenarios";
   fs::remove_all(out);
   const CommandRun first = Adse("run " + SmallScenarioPath() +
                                 " --budget 1 --no-cache -o " + out.string());
@@ -335,7 +336,7 @@ TEST(CliRunTest, AnInfeasiblePointsProgressLineNamesTheConstraintItBroke) {
                         "constraints: [nav_time_s <= 60, e2e_latency_p50_s <= "
                         "0.001, completed]"),
                "values: [1, 4, 16]", "values: [16]"));
-  const fs::path out = fs::temp_directory_path() / "adse_cli_latency_bound";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_latency_bound";
   fs::remove_all(out);
   const CommandRun run =
       Adse("run " + file + " --budget 1 --no-cache -o " + out.string());
@@ -353,7 +354,7 @@ TEST(CliRunTest,
       "llm_down", ReadText(SmallScenarioPath()) +
                       "llm: {endpoint: \"http://127.0.0.1:9\", retries: 0}\n");
   const std::string out =
-      (fs::temp_directory_path() / "adse_cli_llm_down").string();
+      (adse::testing::TestScratch() / "adse_cli_llm_down").string();
   fs::remove_all(out);
   const CommandRun run =
       Adse("run " + file + " --strategy llm --budget 1 -o " + out);
@@ -381,7 +382,7 @@ std::string FrontSection(const std::string& out) {
 }
 
 TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
-  const fs::path out = fs::temp_directory_path() / "adse_cli_one_answer";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_one_answer";
   fs::remove_all(out);
   const CommandRun run = Adse("run " + SmallScenarioPath() +
                               " --budget 7 --no-cache -q -o " + out.string());
@@ -551,7 +552,7 @@ TEST(CliRunTest, AnalyzeOfACampaignWithCasesFoldsEveryCaseAsRunDid) {
               "    - {name: across, goal: {x: 10.0, y: 29.75}}\n"
               "    - {name: along, goal: {x: 40.0, y: -1.75}}\n");
   const std::string scenario = WriteScenario("cases", text);
-  const fs::path out = fs::temp_directory_path() / "adse_cli_cases";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_cases";
   fs::remove_all(out);
   const CommandRun run = Adse(
       "run " + scenario +
@@ -568,14 +569,15 @@ TEST(CliRunTest, AnalyzeOfACampaignWithCasesFoldsEveryCaseAsRunDid) {
 }
 
 TEST(CliRunTest, AnalyzeWithAReferenceDrawsTheStudysFigureOrRefusesClearly) {
-  const fs::path out = fs::temp_directory_path() / "adse_cli_study_figure";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_study_figure";
   fs::remove_all(out);
   ASSERT_EQ(
       Adse("run " + SmallScenarioPath() + " --budget 3 -q -o " + out.string())
           .exit_code,
       0);
   // The reference: the same scenario's exhaustive sweep.
-  const fs::path recording = fs::temp_directory_path() / "adse_cli_study_ref";
+  const fs::path recording =
+      adse::testing::TestScratch() / "adse_cli_study_ref";
   fs::remove_all(recording);
   ASSERT_EQ(Adse("run " + SmallScenarioPath() +
                  " --strategy exhaustive -q -o " + recording.string())
@@ -618,7 +620,7 @@ TEST(CliRunTest, WorkersRunTheCampaignsOwnAdseWhenItsFileIsReplaced) {
   // started, its file is replaced by another program (as a rebuild does).
   // The second point's worker still runs the campaign's adse; by the
   // file's path it ran the other program and failed.
-  const fs::path dir = fs::temp_directory_path() / "adse_cli_replaced";
+  const fs::path dir = adse::testing::TestScratch() / "adse_cli_replaced";
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path copy = dir / "adse";
@@ -650,7 +652,7 @@ TEST(CliRunTest, WorkersRunTheCampaignsOwnAdseWhenItsFileIsReplaced) {
 
 TEST(CliRunTest, WorkerRefusesAScenarioThatChangedUnderItsCampaign) {
   const std::string out =
-      (fs::temp_directory_path() / "adse_cli_worker.h5").string();
+      (adse::testing::TestScratch() / "adse_cli_worker.h5").string();
   const CommandRun run = Adse("worker " + SmallScenarioPath() +
                               " --point cores=4,freq_ghz=2.1,lidar_hz=14 -o " +
                               out + " --expect-key " + std::string(64, '0'));
@@ -662,7 +664,7 @@ TEST(CliRunTest, WorkerRefusesAScenarioThatChangedUnderItsCampaign) {
 }
 
 TEST(CliRunTest, WorkerLeavesItsAnalysisBesideTheRunFileWhenAsked) {
-  const fs::path dir = fs::temp_directory_path() / "adse_cli_worker_report";
+  const fs::path dir = adse::testing::TestScratch() / "adse_cli_worker_report";
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string out = (dir / "run.h5").string();

@@ -16,6 +16,7 @@
 #include "tests/harness/cli/example_files.h"
 #include "tests/harness/testing/adse_command.h"
 #include "tests/harness/testing/small_scenario.h"
+#include "tests/testing/temp_files.h"
 
 namespace {
 
@@ -70,7 +71,8 @@ TEST(CliTest, ValidatePrintsAReloadableNormalisedSpec) {
   const CommandRun run =
       Adse("validate --no-world " + Example() + " 2>/dev/null");
   ASSERT_EQ(run.exit_code, 0) << run.out;
-  const fs::path copy = fs::temp_directory_path() / "adse_cli_normalised.yaml";
+  const fs::path copy =
+      adse::testing::TestScratch() / "adse_cli_normalised.yaml";
   std::ofstream(copy) << run.out;
   const CommandRun again = Adse("validate --quiet --no-world " + copy.string());
   EXPECT_EQ(again.exit_code, 0) << again.out;
@@ -116,21 +118,12 @@ TEST(CliTest, UnknownFlowEdgeIsReportedAtItsLine) {
       << run.out;
 }
 
-// The valet example's task.cases with a case's line replaced, written with
-// the profile beside it.
+// The valet example's task.cases with a case's line replaced.
 std::string ValetVariant(const std::string& name, const std::string& from,
                          const std::string& to) {
-  const std::string text = Replaced(
-      ReadText(std::string(ADSE_SOURCE_DIR) + "/scenarios/valet_parking.yaml"),
-      from, to);
-  const fs::path profile = fs::temp_directory_path() /
-                           "profiles/autoware-2022.12-i9-12900kf-valet.yaml";
-  fs::create_directories(profile.parent_path());
-  fs::copy_file(
-      std::string(ADSE_SOURCE_DIR) +
-          "/scenarios/profiles/autoware-2022.12-i9-12900kf-valet.yaml",
-      profile, fs::copy_options::overwrite_existing);
-  return WriteScenario(name, text);
+  return WriteScenario(name, Replaced(ReadText(std::string(ADSE_SOURCE_DIR) +
+                                               "/scenarios/valet_parking.yaml"),
+                                      from, to));
 }
 
 TEST(CliTest, AnOccupiedSlotInOneCaseIsReportedAtThatCasesLine) {
@@ -178,7 +171,7 @@ TEST(CliTest, ACommandThatRunsOneCaseNeedsItNamed) {
 TEST(CliTest, ACostThatIsNotFiniteAtSomePointIsRefusedBeforeAnythingRuns) {
   const std::string file =
       Variant("cost", "cost: cores * freq_ghz", "cost: 10 / (cores - 3)");
-  const fs::path out = fs::temp_directory_path() / "adse_cli_cost_out";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_cost_out";
   fs::remove_all(out);
   for (const std::string& command :
        {"validate -q --no-world " + file,
@@ -213,7 +206,7 @@ TEST(CliTest, AKnobThatCannotActInTheScenarioIsRefusedAtItsLine) {
 
 TEST(CliTest, MisspelledKeyGetsADidYouMeanAndNothingIsWritten) {
   const std::string file = Variant("typo", "weather: clear", "wether: clear");
-  const fs::path out = fs::temp_directory_path() / "adse_cli_typo_out";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_typo_out";
   fs::remove_all(out);
   const CommandRun run =
       Adse("world " + file + " --follow-ideal -o " + out.string());
@@ -257,7 +250,7 @@ TEST(CliTest, ANumberOutOfItsRangeIsRefusedSayingWhatIsExpected) {
             std::string::npos)
       << half.out;
   // More workers than CPUs is said of the flag, before any run.
-  const fs::path crowded = fs::path(::testing::TempDir()) / "crowded";
+  const fs::path crowded = adse::testing::TestScratch() / "crowded";
   fs::remove_all(crowded);
   const CommandRun workers =
       Adse("run " + Example() + " --workers 100000 -o " + crowded.string());
@@ -280,7 +273,7 @@ TEST(CliTest, ANumberOutOfItsRangeIsRefusedSayingWhatIsExpected) {
   EXPECT_FALSE(fs::exists(crowded / "campaign.h5"));
   // A budget on the command line has the scenario's bounds: a campaign of
   // no evaluations is refused, not written.
-  const fs::path out = fs::path(::testing::TempDir()) / "budget_zero";
+  const fs::path out = adse::testing::TestScratch() / "budget_zero";
   fs::remove_all(out);
   const CommandRun budget =
       Adse("run " + Example() + " --budget 0 -o " + out.string());
@@ -305,7 +298,7 @@ TEST(CliTest, ANumberOutOfItsRangeIsRefusedSayingWhatIsExpected) {
 }
 
 TEST(CliTest, WorldFollowIdealReachesTheGoalAndWritesWhatItSaw) {
-  const fs::path out = fs::temp_directory_path() / "adse_cli_world_check";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_world_check";
   fs::remove_all(out);
   const CommandRun run =
       Adse("world " + Example() + " --follow-ideal --json --save-scans 50 -o " +
@@ -342,7 +335,7 @@ std::string AbandonedTemporaryOf(const fs::path& path) {
 }
 
 TEST(CliTest, WorldFollowIdealNeverReplacesWhatItDidNotWrite) {
-  const fs::path dir = fs::temp_directory_path() / "adse_cli_world_others";
+  const fs::path dir = adse::testing::TestScratch() / "adse_cli_world_others";
   fs::remove_all(dir);
   fs::create_directories(dir / "results");
   std::ofstream(dir / "results" / "precious.txt") << "keep me\n";
@@ -387,7 +380,7 @@ TEST(CliTest, WorldFollowIdealNeverReplacesWhatItDidNotWrite) {
 }
 
 TEST(CliTest, SimulateAndCalibrateNeverOverwriteWhatIsNotTheirs) {
-  const fs::path dir = fs::temp_directory_path() / "adse_cli_simulate_out";
+  const fs::path dir = adse::testing::TestScratch() / "adse_cli_simulate_out";
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "mine.yaml") << "keep me\n";
@@ -476,7 +469,7 @@ CommandRun AdseWithReadOnly(const fs::path& folder, const std::string& args) {
 }
 
 TEST(CliTest, AFolderItCannotWriteInIsRefusedBeforeAnyWork) {
-  const fs::path dir = fs::temp_directory_path() / "adse_cli_read_only";
+  const fs::path dir = adse::testing::TestScratch() / "adse_cli_read_only";
   fs::remove_all(dir);
   fs::create_directories(dir / "locked");
   const fs::path locked = dir / "locked";
@@ -518,7 +511,7 @@ TEST(CliTest, AFolderItCannotWriteInIsRefusedBeforeAnyWork) {
 }
 
 TEST(CliTest, SimulateWritesARunFileThatPassesTheSchemaCheck) {
-  const fs::path out = fs::temp_directory_path() / "adse_cli_simulate.h5";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_simulate.h5";
   fs::remove(out);
   const CommandRun run =
       Adse("simulate " + SmallScenarioPath() +
@@ -537,10 +530,10 @@ TEST(CliTest, SimulateWritesARunFileThatPassesTheSchemaCheck) {
 
   // A damaged block inside a table passes the schema's checks of the
   // file's structure, not the read of the table's checksums.
-  const fs::path damaged = fs::temp_directory_path() / "adse_cli_damaged.h5";
+  const fs::path damaged = adse::testing::TestScratch() / "adse_cli_damaged.h5";
   fs::copy_file(out, damaged, fs::copy_options::overwrite_existing);
   const fs::path offset_file =
-      fs::temp_directory_path() / "adse_cli_damaged.offset";
+      adse::testing::TestScratch() / "adse_cli_damaged.offset";
   const std::string find_chunk =
       "/usr/bin/python3 -c \"import h5py; print(h5py.File('" +
       damaged.string() +
@@ -578,7 +571,7 @@ TEST(CliTest, SimulateRejectsAPointOutsideTheSpace) {
 }
 
 TEST(CliTest, SchemaCheckRejectsAFileThatIsNotARunFile) {
-  const fs::path bogus = fs::temp_directory_path() / "adse_cli_bogus.h5";
+  const fs::path bogus = adse::testing::TestScratch() / "adse_cli_bogus.h5";
   std::ofstream(bogus) << "not hdf5\n";
   const CommandRun run = Adse("schema check " + bogus.string());
   EXPECT_EQ(run.exit_code, 2) << run.out;
@@ -586,7 +579,7 @@ TEST(CliTest, SchemaCheckRejectsAFileThatIsNotARunFile) {
 }
 
 TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
-  const fs::path dir = fs::temp_directory_path() / "adse_cli_analyze";
+  const fs::path dir = adse::testing::TestScratch() / "adse_cli_analyze";
   fs::remove_all(dir);
   fs::create_directories(dir / "runs");
   const CommandRun sim =
@@ -666,8 +659,9 @@ TEST(CliTest, AnalyzeReanalysesAFolderSkipsBrokenFilesAndDiffsVersions) {
 }
 
 TEST(CliTest, AnalyzeOneRunPrintsDeviationAndDiagnosis) {
-  const fs::path run = fs::temp_directory_path() / "adse_cli_analyze_one.h5";
-  fs::remove_all(fs::temp_directory_path() / "adse_cli_analyze_one.analysis");
+  const fs::path run = adse::testing::TestScratch() / "adse_cli_analyze_one.h5";
+  fs::remove_all(adse::testing::TestScratch() /
+                 "adse_cli_analyze_one.analysis");
   ASSERT_EQ(
       Adse("simulate " + SmallScenarioPath() +
            " --point cores=1,freq_ghz=1.0,lidar_hz=14 -q -o " + run.string())
@@ -678,17 +672,19 @@ TEST(CliTest, AnalyzeOneRunPrintsDeviationAndDiagnosis) {
   EXPECT_NE(r.out.find("deviation_score"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("diagnosis   cpu_bound"), std::string::npos) << r.out;
   // A run file named otherwise keeps its whole name.
-  const fs::path other = fs::temp_directory_path() / "adse_cli_analyze_run_a";
-  fs::remove_all(fs::temp_directory_path() / "adse_cli_analyze_run_a.analysis");
+  const fs::path other =
+      adse::testing::TestScratch() / "adse_cli_analyze_run_a";
+  fs::remove_all(adse::testing::TestScratch() /
+                 "adse_cli_analyze_run_a.analysis");
   fs::copy_file(run, other, fs::copy_options::overwrite_existing);
   ASSERT_EQ(Adse("analyze " + other.string()).exit_code, 0);
-  EXPECT_TRUE(fs::exists(fs::temp_directory_path() /
+  EXPECT_TRUE(fs::exists(adse::testing::TestScratch() /
                          "adse_cli_analyze_run_a.analysis" / "v1" /
                          "report.json"));
 }
 
 TEST(CliTest, AnalyzeDiffRefusesASummaryItCannotRead) {
-  const fs::path dir = fs::temp_directory_path() / "adse_cli_diff_malformed";
+  const fs::path dir = adse::testing::TestScratch() / "adse_cli_diff_malformed";
   fs::remove_all(dir);
   for (const auto& [name, text] :
        {std::pair{"a", R"({"evaluations": [{"point": {"cores": 1}}]})"},
@@ -717,7 +713,8 @@ TEST(CliTest, FidelityRefusesAPointItCannotRunInRealTimeBeforeAnyRun) {
   // A second point with more cores (1024) than a host this test runs on
   // gives the process, and a scenario without a cost profile: exit 2 before the
   // first point's runs, nothing written.
-  const fs::path out = fs::temp_directory_path() / "adse_cli_fidelity_refused";
+  const fs::path out =
+      adse::testing::TestScratch() / "adse_cli_fidelity_refused";
   fs::remove_all(out);
   const std::string small =
       WriteScenario("fidelity_many_cores",
@@ -755,7 +752,7 @@ TEST(CliTest, FidelityComparesTheVirtualPlatformWithARealTimeRun) {
       "fidelity", Replaced(ReadText(std::string(ADSE_SOURCE_DIR) +
                                     "/scenarios/fidelity_small.yaml"),
                            "timeout_s: 30", "timeout_s: 4"));
-  const fs::path out = fs::temp_directory_path() / "adse_cli_fidelity";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_fidelity";
   fs::remove_all(out);
   const CommandRun run = Adse(
       "fidelity " + file +
@@ -932,7 +929,7 @@ TEST(CliTest, AFidelityCallThatFailsAtAPointKeepsWhatItComparedAndSaysWhere) {
                                  "/scenarios/fidelity_small.yaml"),
                         "timeout_s: 30", "timeout_s: 4"),
                "values: [1.0, 1.2, 1.5, 1.8, 2.1]", "values: [1.0, 9.9]"));
-  const fs::path out = fs::temp_directory_path() / "adse_cli_fidelity_stops";
+  const fs::path out = adse::testing::TestScratch() / "adse_cli_fidelity_stops";
   fs::remove_all(out);
   const CommandRun run =
       Adse("fidelity " + file +
@@ -969,7 +966,7 @@ TEST(CliTest, AFidelityCallWhosePointRunsCannotBeWrittenSaysWhereItStopped) {
                                       "/scenarios/fidelity_small.yaml"),
                              "timeout_s: 30", "timeout_s: 4"));
   const fs::path out =
-      fs::temp_directory_path() / "adse_cli_fidelity_unwritable";
+      adse::testing::TestScratch() / "adse_cli_fidelity_unwritable";
   fs::remove_all(out);
   fs::create_directories(out / "runs/2-virtual.h5");
   const CommandRun run =

@@ -11,24 +11,26 @@
 #include <iterator>
 #include <string>
 
+#include "tests/testing/temp_files.h"
+
 namespace adse::testing {
 
 inline std::string Example() {
   return std::string(ADSE_SOURCE_DIR) + "/scenarios/robotaxi_parking_lot.yaml";
 }
 
-// Writes scenario text to the temporary folder as adse_cli_<name>.yaml,
-// with the bundled calibration and profile beside it (the examples name
+// Writes scenario text to the test's scratch folder as adse_cli_<name>.yaml,
+// with the bundled calibration and profiles beside it (the examples name
 // them relative to themselves).
 inline std::string WriteScenario(const std::string& name,
                                  const std::string& text) {
   namespace fs = std::filesystem;
-  const fs::path path =
-      fs::temp_directory_path() / ("adse_cli_" + name + ".yaml");
+  const fs::path path = TestScratch() / ("adse_cli_" + name + ".yaml");
   std::ofstream(path) << text;
   for (const char* file : {"calibration/reference.json",
-                           "profiles/autoware-2022.12-i9-12900kf.yaml"}) {
-    const fs::path to = fs::temp_directory_path() / file;
+                           "profiles/autoware-2022.12-i9-12900kf.yaml",
+                           "profiles/autoware-2022.12-i9-12900kf-valet.yaml"}) {
+    const fs::path to = TestScratch() / file;
     fs::create_directories(to.parent_path());
     fs::copy_file(std::string(ADSE_SOURCE_DIR) + "/scenarios/" + file, to,
                   fs::copy_options::overwrite_existing);

@@ -12,7 +12,7 @@
 #include "stack/base/files.h"
 #include "tests/harness/llm/testing/fake_llm_server.h"
 #include "tests/harness/testing/adse_command.h"
-#include "tests/harness/testing/temp_files.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse {
 namespace {

@@ -21,6 +21,7 @@
 
 #include "analysis/runfile/run_file.h"
 #include "harness/pool/thread_group.h"
+#include "tests/testing/temp_files.h"
 
 namespace {
 
@@ -44,7 +45,7 @@ class RealTimeCliTest : public ::testing::Test {
       }
       GTEST_SKIP() << "needs root and a cgroup v1 cpuset";
     }
-    dir_ = fs::temp_directory_path() /
+    dir_ = adse::testing::TestScratch() /
            ("adse_rt_exit_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_ / "profiles");

@@ -3,6 +3,7 @@
 // between runs that reached the goal (a run that did not misses the target),
 // and callbacks under 1 ms left out.
 #include "harness/fidelity/fidelity.h"
+#include "tests/testing/temp_files.h"
 
 #include <gtest/gtest.h>
 
@@ -317,7 +318,7 @@ TEST(FidelityTest, MoreWorkIsToldFromASlowerExecutorPerWorkUnit) {
 // runs back).
 TEST(FidelityTest, AFolderWithoutFidelityRunsIsAnErrorNamingIt) {
   const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / "adse_fidelity_read_test";
+      adse::testing::TestScratch() / "adse_fidelity_read_test";
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   Result<std::vector<PointRuns>> none = ReadPointRuns(dir.string());

@@ -18,7 +18,7 @@
 
 #include "stack/base/hash.h"
 #include "tests/harness/llm/testing/scripted_backend.h"
-#include "tests/harness/testing/temp_files.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::llm {
 namespace {

@@ -17,8 +17,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "tests/harness/testing/temp_files.h"
 #include "tests/stack/base/testing/fault_injection_env.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::llm {
 namespace {

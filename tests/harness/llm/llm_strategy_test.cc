@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/harness/testing/temp_files.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::llm {
 namespace {
@@ -31,7 +31,7 @@ TEST(LlmStrategyTest, EveryEventKindRoundTripsAndAnUnknownOneIsNot) {
 }
 
 TEST(LlmStrategyTest, EventsAreReadBackTypedAndAnUnknownKindNamesItsLine) {
-  const std::string dir = adse::testing::TestTempDir("llm_events");
+  const std::string dir = adse::testing::TestTempDir("adse-llm-events");
   std::filesystem::create_directories(dir + "/llm");
   const std::string path = EventsPath(dir);
   adse::testing::WriteRaw(

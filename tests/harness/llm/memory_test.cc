@@ -20,6 +20,7 @@
 #include "harness/explore/strategy.h"
 #include "harness/llm/jsonl_log.h"
 #include "tests/harness/testing/small_scenario.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::llm {
 namespace {
@@ -35,12 +36,7 @@ using ::testing::StartsWith;
 using Picked = std::vector<std::pair<const MemoryRecord*, std::string>>;
 
 std::string TempDir(const std::string& name) {
-  const std::string dir = fs::temp_directory_path().string() +
-                          "/adse-llmunit-memory-" + name + "-" +
-                          std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return adse::testing::FreshTempDir("adse-llmunit-memory", name);
 }
 
 struct Outcome {

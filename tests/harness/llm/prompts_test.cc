@@ -1,7 +1,7 @@
 // Prompt templates: the bundled set loads, a broken folder is refused with
 // the file and line to fix, and rendering fills placeholders exactly once.
 #include "harness/llm/prompts.h"
-#include "tests/harness/testing/temp_files.h"
+#include "tests/testing/temp_files.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -13,7 +13,7 @@
 #include <sstream>
 
 #include "harness/profile/profile.h"
-#include "tests/harness/testing/temp_files.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::profile {
 namespace {

@@ -11,8 +11,8 @@
 
 #include "harness/profile/profile.h"
 #include "stack/base/files.h"
-#include "tests/harness/testing/temp_files.h"
 #include "tests/stack/base/testing/fault_injection_env.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::profile {
 namespace {

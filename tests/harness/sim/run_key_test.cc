@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "harness/spec/spec_parser.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::sim {
 namespace {
@@ -71,8 +72,7 @@ TEST(RunKeyTest, TrafficLightKnobsEnterOnlyKeysOfMapsWithSignals) {
   EXPECT_EQ(Key(lot), Key(lot_knob));
 
   const std::string dir =
-      (std::filesystem::temp_directory_path() / "adse_run_key_signals")
-          .string();
+      (adse::testing::TestScratch() / "adse_run_key_signals").string();
   std::filesystem::create_directories(dir);
   auto net_key = [&](const std::string& text, double latency_s) {
     const std::string net = dir + "/map.net.xml";
@@ -163,8 +163,7 @@ TEST(RunKeyTest, AProfileEntersByContent) {
       std::string(ADSE_SOURCE_DIR) +
       "/scenarios/profiles/autoware-2022.12-i9-12900kf.yaml";
   const std::string copy =
-      (std::filesystem::temp_directory_path() / "adse_run_key_profile.yaml")
-          .string();
+      (adse::testing::TestScratch() / "adse_run_key_profile.yaml").string();
   std::filesystem::copy_file(bundled, copy,
                              std::filesystem::copy_options::overwrite_existing);
   spec::Spec s = Small();  // names the bundled profile

@@ -18,6 +18,7 @@
 #include "harness/spec/spec_parser.h"
 #include "stack/base/hash.h"
 #include "tests/harness/testing/small_scenario.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::sim {
 namespace {
@@ -58,9 +59,9 @@ spec::Spec ProfiledSmallScenario() {
 // problem expected) and read back.
 Result<runfile::RunData> WrittenAndReadBack(const runfile::RunData& run,
                                             const std::string& name) {
-  const std::string path = (std::filesystem::temp_directory_path() /
-                            ("adse_sim_test_" + name + ".h5"))
-                               .string();
+  const std::string path =
+      (adse::testing::TestScratch() / ("adse_sim_test_" + name + ".h5"))
+          .string();
   Status written = runfile::WriteRunFile(path, run);
   if (!written.ok()) return written;
   std::vector<std::string> problems;
@@ -166,9 +167,9 @@ TEST(SimulateTest, CountedCostModelGivesIdenticalTraces) {
   Result<Calibration> calibration = FitCalibration({&*measured});
   ASSERT_TRUE(calibration.ok()) << calibration.status().ToString();
   EXPECT_EQ(calibration->size(), measured->callback_info.size());
-  const std::string path = (std::filesystem::temp_directory_path() /
-                            "adse_sim_test_calibration.json")
-                               .string();
+  const std::string path =
+      (adse::testing::TestScratch() / "adse_sim_test_calibration.json")
+          .string();
   ASSERT_TRUE(WriteCalibration(path, *calibration, "test").ok());
   spec.platform.cost_model = spec::CostModel::kCounted;
   spec.platform.profile.clear();  // a profile would cost the callbacks

@@ -15,6 +15,7 @@
 #include "stack/world/ideal_driver.h"
 #include "stack/world/world.h"
 #include "tests/harness/testing/net_scenario.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::sim {
 namespace {
@@ -74,8 +75,7 @@ TEST(TrafficLightsTest, TheEgoWaitsAtTheRedLightThenDrivesOnToTheGoal) {
   // The run file says why it stood: red_light, for many seconds (it
   // arrives at about 16 s and waits for the green at 45 s).
   const std::string path =
-      (std::filesystem::temp_directory_path() / "adse_traffic_lights_test.h5")
-          .string();
+      (adse::testing::TestScratch() / "adse_traffic_lights_test.h5").string();
   ASSERT_TRUE(runfile::WriteRunFile(path, *run).ok());
   std::vector<std::string> problems;
   EXPECT_TRUE(runfile::CheckRunFile(path, &problems).ok())

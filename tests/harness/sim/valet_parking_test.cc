@@ -12,6 +12,7 @@
 #include "analysis/runfile/run_file.h"
 #include "harness/sim/simulator.h"
 #include "harness/spec/spec_parser.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::sim {
 namespace {
@@ -48,7 +49,7 @@ void ExpectParked(const runfile::RunData& run, int min_gear_changes) {
   EXPECT_GT(run.parking.planned_path.size(), 10u);
   // The record survives the run file and passes the schema check.
   const std::string path =
-      (std::filesystem::temp_directory_path() / "adse_valet_test.h5").string();
+      (adse::testing::TestScratch() / "adse_valet_test.h5").string();
   ASSERT_TRUE(runfile::WriteRunFile(path, run).ok());
   std::vector<std::string> problems;
   EXPECT_TRUE(runfile::CheckRunFile(path, &problems).ok());

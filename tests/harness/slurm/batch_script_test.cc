@@ -14,6 +14,7 @@
 
 #include "stack/base/files.h"
 #include "stack/base/subprocess.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::slurm {
 namespace {
@@ -50,10 +51,7 @@ struct Supervised {
 
 Supervised StartSupervised(const std::string& name, const std::string& child) {
   Supervised s;
-  s.dir = fs::temp_directory_path().string() + "/adse-supervised-" + name +
-          "-" + std::to_string(::getpid());
-  fs::remove_all(s.dir);
-  fs::create_directories(s.dir);
+  s.dir = adse::testing::FreshTempDir("adse-supervised", name);
   BatchScript script;
   // scontrol stands in for Slurm's: it records what it was asked.
   script.body = {"scontrol() { echo \"scontrol $*\"; }",

@@ -9,14 +9,14 @@
 #include <string>
 #include <vector>
 
-#include "tests/harness/testing/temp_files.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::slurm {
 namespace {
 using ::testing::HasSubstr;
 
 TEST(RecordsTest, EveryJobKindRoundTripsThroughTheJobLog) {
-  const std::string dir = adse::testing::TestTempDir("slurm_records");
+  const std::string dir = adse::testing::TestTempDir("adse-slurm-records");
   std::filesystem::create_directories(SlurmDir(dir));
   JobLog log;
   log.scenario = "s.yaml";
@@ -40,7 +40,7 @@ TEST(RecordsTest, EveryJobKindRoundTripsThroughTheJobLog) {
 }
 
 TEST(RecordsTest, AJobOfAnUnknownKindIsRefusedNamingTheFileAndTheJob) {
-  const std::string dir = adse::testing::TestTempDir("slurm_records");
+  const std::string dir = adse::testing::TestTempDir("adse-slurm-records");
   std::filesystem::create_directories(SlurmDir(dir));
   const std::string path = SlurmDir(dir) + "/jobs.json";
   adse::testing::WriteRaw(

@@ -255,6 +255,17 @@ TEST(DesignPointTest, AConstraintCheckerParsedOnceAgreesRowByRow) {
             std::vector<std::string>{"nav_time_s <="});
 }
 
+TEST(DesignPointTest, TheMetricsConstraintsReadLeaveOutDesignParameters) {
+  Spec spec = Reference();
+  spec.constraints = {"nav_time_s <= 60 && cores <= 8", "completed",
+                      "ctrl_rate_hz >= 1 || nav_time_s < 10", "nav_time_s <="};
+  EXPECT_EQ(
+      ConstraintMetrics(spec),
+      (std::vector<std::string>{"nav_time_s", "completed", "ctrl_rate_hz"}));
+  spec.constraints.clear();
+  EXPECT_TRUE(ConstraintMetrics(spec).empty());
+}
+
 TEST(DesignPointTest, ApplyPointSetsPlatformAndStack) {
   const Spec spec = Reference();
   Result<PointConfig> config =

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "harness/spec/spec_parser.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::spec {
 namespace {
@@ -316,15 +317,13 @@ TEST(SpecErrorsTest, AProfileNeedsTheCountedModelAndNoCalibration) {
 }
 
 TEST(SpecErrorsTest, MapFileThatIsNotASumoNetwork) {
-  std::string dir = (fs::temp_directory_path() / "adse-spec-XXXXXX").string();
-  ASSERT_NE(mkdtemp(dir.data()), nullptr);
+  const std::string dir = adse::testing::TestScratch().string();
   std::ofstream(dir + "/x.net.xml") << "<html>not a network</html>\n";
   std::string text = kHead;
   text.replace(text.find("{generate: grid}"), 16, "{net: x.net.xml}");
   const std::string message = ErrorOf(text, dir);
   EXPECT_THAT(message, HasSubstr("bad.yaml:3:14: error: world.map.net: "
                                  "expected a SUMO network file"));
-  fs::remove_all(dir);
 }
 
 TEST(SpecErrorsTest, MapNeedsExactlyOneSource) {

@@ -1,6 +1,7 @@
 // Parsing of valid scenarios: the reference example, defaults, paths, the
 // repository's example files and the NormalizedYaml round trip.
 #include "harness/spec/spec_parser.h"
+#include "tests/testing/temp_files.h"
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
@@ -45,15 +46,6 @@ output: results/robotaxi-parking-lot
 )";
 
 constexpr double kTol = 1e-9;
-
-// A fresh folder per test (each TEST runs in its own process).
-std::string MakeTempDir() {
-  std::string pattern =
-      (fs::temp_directory_path() / "adse-spec-test-XXXXXX").string();
-  const char* dir = mkdtemp(pattern.data());
-  EXPECT_NE(dir, nullptr);
-  return dir ? std::string(dir) : std::string();
-}
 
 void WriteText(const fs::path& path, const std::string& text) {
   fs::create_directories(path.parent_path());
@@ -271,7 +263,7 @@ design_space:
 }
 
 TEST(SpecParserTest, NetAndPolygonPathsResolveFromTheFileFolder) {
-  const std::string dir = MakeTempDir();
+  const std::string dir = adse::testing::TestScratch().string();
   WriteText(fs::path(dir) / "maps/town.net.xml",
             "<?xml version=\"1.0\"?>\n<net version=\"1.16\">\n</net>\n");
   WriteText(fs::path(dir) / "maps/town.poly.xml", "<additional/>\n");
@@ -290,7 +282,6 @@ design_space: {cores: {bind: platform.cores, range: [1, 2]}}
   EXPECT_EQ(spec->base_dir, dir);
   EXPECT_EQ(spec->source_path, dir + "/town.yaml");
   EXPECT_EQ(spec->Where("world.map.net").rfind(dir + "/town.yaml:3:", 0), 0u);
-  fs::remove_all(dir);
 }
 
 TEST(SpecParserTest, NormalizedYamlRoundTrips) {
@@ -498,7 +489,7 @@ design_space: {cores: {bind: platform.cores, range: [1, 4]}}
 }
 
 TEST(SpecParserTest, NormalizedYamlRoundTripsNetMapsAndEdges) {
-  const std::string dir = MakeTempDir();
+  const std::string dir = adse::testing::TestScratch().string();
   WriteText(fs::path(dir) / "a.net.xml", "<net version=\"1.16\"></net>\n");
   const std::string text = R"(adse: 1
 name: weird.name_1
@@ -540,7 +531,6 @@ output: /tmp/adse out/x
             (std::vector<std::string>{"--qos=long", "--comment=#x #y"}));
   EXPECT_EQ(again->output, "/tmp/adse out/x");
   EXPECT_EQ(again->constraints[1], "nav_time_s <= 400 && completed");
-  fs::remove_all(dir);
 }
 
 TEST(SpecParserTest, EveryExampleScenarioInTheRepositoryParses) {

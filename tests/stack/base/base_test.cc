@@ -11,6 +11,7 @@
 #include "stack/base/random.h"
 #include "stack/base/status.h"
 #include "stack/base/subprocess.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse {
 namespace {
@@ -59,7 +60,7 @@ TEST(RandomTest, SameSeedSameStreamAndDerivedSeedsDiffer) {
 }
 
 TEST(FilesTest, AtomicWriteReplacesWholeAndLeavesNoTemporary) {
-  const fs::path dir = fs::temp_directory_path() / "adse_files_test";
+  const fs::path dir = adse::testing::TestScratch() / "adse_files_test";
   fs::remove_all(dir);
   const std::string path = (dir / "sub" / "f.txt").string();
   ASSERT_TRUE(WriteFileAtomic(path, "first").ok());
@@ -85,7 +86,7 @@ pid_t GonePid() {
 }
 
 TEST(FilesTest, TemporariesOfWritersThatAreGoneAreRemovedOthersKept) {
-  const fs::path dir = fs::temp_directory_path() / "adse_abandoned_test";
+  const fs::path dir = adse::testing::TestScratch() / "adse_abandoned_test";
   fs::remove_all(dir);
   fs::create_directories(dir);
   // "<path>.tmp.<host>.<pid>": this host's label from this process's name.

@@ -15,6 +15,7 @@
 
 #include "stack/base/files.h"
 #include "tests/stack/base/testing/fault_injection_env.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse {
 namespace {
@@ -26,11 +27,7 @@ using ::adse::testing::FaultOp;
 using ::testing::HasSubstr;
 
 std::string TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() /
-                       ("adse-env-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir.string();
+  return adse::testing::FreshTempDir("adse-env", name);
 }
 
 std::vector<std::string> Names(const std::string& dir) {

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "tests/stack/base/testing/fault_injection_env.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::world {
 namespace {
@@ -14,7 +15,8 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string FreshCache(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("adse_map_cache_" + name);
+  const fs::path dir =
+      adse::testing::TestScratch() / ("adse_map_cache_" + name);
   fs::remove_all(dir);
   return dir.string();
 }
@@ -116,7 +118,7 @@ TEST(MapBuilderTest, GivenNetIsKeyedByItsContent) {
   const std::string cache = FreshCache("given");
   Result<MapArtifacts> generated = PrepareMap(Lot(2), cache);
   ASSERT_TRUE(generated.ok());
-  const fs::path copy = fs::temp_directory_path() / "adse_given.net.xml";
+  const fs::path copy = adse::testing::TestScratch() / "adse_given.net.xml";
   fs::copy_file(generated->net_path, copy,
                 fs::copy_options::overwrite_existing);
   MapOptions given;

@@ -10,6 +10,7 @@
 
 #include "stack/base/files.h"
 #include "stack/base/random.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::world {
 namespace {
@@ -193,13 +194,8 @@ TEST(MapCloudTest, ACorridorKeepsWhatIsNearTheRouteAndDropsWhatIsFar) {
 
 class PcdTest : public ::testing::Test {
  protected:
-  void TearDown() override {
-    std::error_code ec;
-    std::filesystem::remove_all(Dir(), ec);
-  }
   static std::filesystem::path Dir() {
-    return std::filesystem::path(::testing::TempDir()) /
-           ("adse_map_cloud_test_" + std::to_string(::getpid()));
+    return adse::testing::TestScratch() / "adse_map_cloud_test";
   }
   std::string Path(const std::string& name) {
     std::filesystem::create_directories(Dir());

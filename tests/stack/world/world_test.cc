@@ -21,6 +21,7 @@
 #include "stack/world/map_builder.h"
 #include "stack/world/map_cloud.h"
 #include "tests/stack/world/testing/real_nets.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::world {
 namespace {
@@ -256,8 +257,7 @@ TEST(WorldTest, MapCloudIsBuiltOnceAndCached) {
 
 TEST(WorldTest, CorruptNetIsReportedWithSumosCause) {
   const std::string net =
-      (std::filesystem::temp_directory_path() / "adse_corrupt.net.xml")
-          .string();
+      (adse::testing::TestScratch() / "adse_corrupt.net.xml").string();
   std::ofstream(net) << "<net version=\"1.9\">\n  <edge id=\"a\"\n";
   WorldSetup setup;
   setup.world.map.net_path = net;
@@ -299,8 +299,7 @@ TEST(WorldTest, APolygonWhoseHeightIsNoNumberIsRejectedByName) {
   polygons.replace(at, height.size(),
                    "<param key=\"height_m\" value=\"2,5\"/>");
   const std::string mistyped =
-      (std::filesystem::temp_directory_path() / "adse_mistyped.poly.xml")
-          .string();
+      (adse::testing::TestScratch() / "adse_mistyped.poly.xml").string();
   std::ofstream(mistyped) << polygons;
   WorldSetup setup = OnFiles(lot, map->net_path, mistyped);
   Result<std::unique_ptr<World>> world = World::Open(setup);
@@ -317,7 +316,7 @@ TEST(WorldTest, APolygonsFileSumoCannotLoadIsNamedAsThePolygons) {
   Result<MapArtifacts> map = PrepareMap(lot.world.map, lot.cache_dir);
   ASSERT_TRUE(map.ok()) << map.status().ToString();
   const std::string twice =
-      (std::filesystem::temp_directory_path() / "adse_twice.poly.xml").string();
+      (adse::testing::TestScratch() / "adse_twice.poly.xml").string();
   std::ofstream(twice)
       << "<additional>\n"
          "  <poly id=\"p\" type=\"adse.wall\" shape=\"0,0 1,0 1,1\"/>\n"
@@ -362,7 +361,7 @@ TEST(WorldTest, AStoppedVehicleOffTheRoadIsRejectedByItsIndex) {
 
 TEST(WorldTest, UnreachableGoalIsRejected) {
   // Two separate road pieces: no route joins them.
-  const auto dir = std::filesystem::temp_directory_path() / "adse_islands";
+  const auto dir = adse::testing::TestScratch() / "adse_islands";
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "n.nod.xml") << R"(<nodes>
   <node id="a" x="0" y="0"/><node id="b" x="100" y="0"/>

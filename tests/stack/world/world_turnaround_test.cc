@@ -17,6 +17,7 @@
 #include "stack/world/ideal_driver.h"
 #include "stack/world/world.h"
 #include "tests/stack/world/testing/real_nets.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::world {
 namespace {
@@ -33,7 +34,7 @@ std::string TwoWayNet(
     double lane_width_m = 0.0) {
   const std::string width =
       lane_width_m > 0 ? " width=\"" + std::to_string(lane_width_m) + "\"" : "";
-  const auto dir = std::filesystem::temp_directory_path() / ("adse_" + name);
+  const auto dir = adse::testing::TestScratch() / ("adse_" + name);
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "n.nod.xml") << "<nodes>" << nodes << "</nodes>";
   {

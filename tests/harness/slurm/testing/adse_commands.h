@@ -14,6 +14,7 @@
 
 #include "stack/base/files.h"
 #include "stack/base/subprocess.h"
+#include "tests/testing/temp_files.h"
 
 namespace adse::slurm::testing {
 
@@ -51,21 +52,11 @@ inline AdseRun Adse(const std::vector<std::string>& args,
 }
 
 // A fresh folder for one test (removed first if a failed run left it),
-// removed again at the end unless the test failed: then it is the evidence.
+// removed again once the test passed; a failed one's is the evidence.
 class TestFolder {
  public:
   explicit TestFolder(const std::string& name)
-      : path_(std::filesystem::temp_directory_path().string() +
-              "/adse-slurm-test-" + name + "-" + std::to_string(::getpid())) {
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~TestFolder() {
-    std::error_code ec;
-    if (!::testing::Test::HasFailure()) {
-      std::filesystem::remove_all(path_, ec);
-    }
-  }
+      : path_(adse::testing::FreshTempDir("adse-slurm-test", name)) {}
   TestFolder(const TestFolder&) = delete;
   TestFolder& operator=(const TestFolder&) = delete;
   const std::string& path() const { return path_; }
