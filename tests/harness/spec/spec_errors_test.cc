@@ -1,7 +1,6 @@
 // Bad scenarios: every class of mistake gives a located, named error.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
 #include <algorithm>
 #include <filesystem>

@@ -4,7 +4,6 @@
 #include "tests/testing/temp_files.h"
 
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
 #include <filesystem>
 #include <fstream>

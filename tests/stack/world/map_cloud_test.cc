@@ -1,7 +1,6 @@
 #include "stack/world/map_cloud.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstring>

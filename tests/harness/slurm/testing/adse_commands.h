@@ -4,7 +4,6 @@
 #define ADSE_TESTS_HARNESS_SLURM_TESTING_ADSE_COMMANDS_H_
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
