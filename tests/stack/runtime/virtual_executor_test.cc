@@ -565,14 +565,17 @@ TEST(VirtualExecutorTest, ChainLatencyIsSumOfCosts) {
 }
 
 // Measured model: cost follows the callback's host CPU time, scaled by
-// reference / frequency. Host CPU time is what the thread used, so the loose
-// tolerance only absorbs clock granularity and the loop's overshoot.
+// reference / frequency. Host CPU time is what the thread used; in a VM
+// guest a stolen slice can land in it after the burn has ended, so the
+// burns are compared by their median over ten firings, and the tolerance
+// absorbs clock granularity and the loop's overshoot.
 TEST(VirtualExecutorTest, MeasuredCostFollowsHostCpuTime) {
+  constexpr int kFirings = 10;
   for (double freq : {1.0, 4.0}) {
     Graph g;
-    const int small = g.AddTimer(g.AddNode("a"), "small", 100.0,
+    const int small = g.AddTimer(g.AddNode("a"), "small", 0.1,
                                  [](CallbackContext&) { BurnCpu(0.01); });
-    const int big = g.AddTimer(g.AddNode("b"), "big", 100.0,
+    const int big = g.AddTimer(g.AddNode("b"), "big", 0.1,
                                [](CallbackContext&) { BurnCpu(0.03); });
     VirtualPlatformOptions o;
     o.cores = 2;
@@ -580,16 +583,24 @@ TEST(VirtualExecutorTest, MeasuredCostFollowsHostCpuTime) {
     o.freq_ghz = freq;
     o.cost_model = CostModelKind::kMeasured;
     auto ex = CreateVirtual(g, o);
-    ASSERT_TRUE(ex->AdvanceTo(1.0).ok());
-    const auto rs = RecordsOf(ex->trace(), small);
-    const auto rb = RecordsOf(ex->trace(), big);
-    ASSERT_EQ(rs.size(), 1u);
-    ASSERT_EQ(rb.size(), 1u);
-    EXPECT_NEAR(rs[0].host_cpu_s, 0.01, 0.003);
-    EXPECT_NEAR(rb[0].host_cpu_s, 0.03, 0.009);
-    EXPECT_NEAR(rs[0].cost_s, rs[0].host_cpu_s * 2.0 / freq, kTol);
-    EXPECT_NEAR(rb[0].cost_s, rb[0].host_cpu_s * 2.0 / freq, kTol);
-    EXPECT_NEAR(rb[0].cost_s / rs[0].cost_s, 3.0, 0.9);
+    // Firings at 0, 0.1, ... 0.9 s, all done before the next at 1 s.
+    ASSERT_TRUE(ex->AdvanceTo(0.1 * kFirings - 0.01).ok());
+    std::vector<double> host[2];
+    for (int which : {0, 1}) {
+      const auto records = RecordsOf(ex->trace(), which == 0 ? small : big);
+      ASSERT_EQ(records.size(), static_cast<size_t>(kFirings));
+      for (const auto& r : records) {
+        EXPECT_GE(r.host_cpu_s, which == 0 ? 0.01 : 0.03);
+        EXPECT_NEAR(r.cost_s, r.host_cpu_s * 2.0 / freq, kTol);
+        host[which].push_back(r.host_cpu_s);
+      }
+      std::sort(host[which].begin(), host[which].end());
+    }
+    const double small_s = host[0][kFirings / 2];
+    const double big_s = host[1][kFirings / 2];
+    EXPECT_NEAR(small_s, 0.01, 0.003);
+    EXPECT_NEAR(big_s, 0.03, 0.009);
+    EXPECT_NEAR(big_s / small_s, 3.0, 0.9);
   }
 }
 
