@@ -3,8 +3,8 @@
 # agent and random search over a family of recorded studies with 20 seeds
 # each and prints, per study, what the targets ask (the cheapest feasible
 # design found in how many seeds, the median true Pareto points, the
-# median hypervolume ratio, random search's median beside it) and which
-# targets it misses.
+# median hypervolume ratio, random search's median beside it), how many
+# distinct paths the agent's 20 seeds took, and which targets it misses.
 #   tests/bench/agent_targets_bench.sh [budget] [family]
 # Families:
 #   held-out    (default) the landscapes no strategy was tuned on
@@ -72,8 +72,8 @@ fi
 echo "studies: ${family}; budget ${budget}, seeds 1..20; $(basename "${adse}")"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1 /proc/loadavg)"
 echo
-echo "| study | objectives | points | front | agent: cheapest found (seeds) | agent: true Pareto (median) | agent: hypervolume ratio (median) | random: hypervolume ratio (median) | targets missed | wall s |"
-echo "|---|---|---|---|---|---|---|---|---|---|"
+echo "| study | objectives | points | front | agent: cheapest found (seeds) | agent: distinct paths (seeds) | agent: true Pareto (median) | agent: hypervolume ratio (median) | random: hypervolume ratio (median) | targets missed | wall s |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
 met=0
 rows=0
 # Replays one study ("<folder>" or "<folder>@<objective,objective>"), prints
@@ -107,6 +107,9 @@ cheapest = a["seeds_that_found_cheapest_feasible"]
 found = a["true_pareto_found"]["median"]
 volume = a["hypervolume_ratio"]["median"]
 random_volume = r["hypervolume_ratio"]["median"]
+# Seeds that proposed the same points in the same order took one path: 20
+# seeds on one path say less than 20 that part.
+paths = len({tuple(run["proposals"]) for run in a["runs"]})
 volume_target = 0.97 if budget >= 30 else 0.9
 missed = []
 if cheapest < 18:
@@ -119,7 +122,7 @@ if volume < random_volume:
     missed.append(f"below random by {random_volume - volume:.3f}")
 objectives = d.get("objectives", [])
 print(f"| `{name}` | {len(objectives)} | {d.get('recorded_evaluations', '')} "
-      f"| {front} | {cheapest} of 20 | {found:g} | {volume:.3f} "
+      f"| {front} | {cheapest} of 20 | {paths} | {found:g} | {volume:.3f} "
       f"| {random_volume:.3f} | {'; '.join(missed) or 'none'} "
       f"| {float(sys.argv[5]) - float(sys.argv[4]):.0f} |")
 print("missed" if missed else "met")
