@@ -501,8 +501,24 @@ nlohmann::json AnswerJson(const spec::Spec& spec,
   };
   nlohmann::json ties = nlohmann::json::array();
   for (int i : headline.cheapest_ties) ties.push_back(RowJson(spec, rows[i]));
+  const CheaperDesigns& c = headline.cheaper;
+  nlohmann::json cheaper;  // null: no feasible design, or not counted
+  if (c.counted) {
+    nlohmann::json untried = nlohmann::json::array();
+    for (size_t k = 0; k < c.untried.size(); ++k) {
+      untried.push_back(
+          {{"point", spec::FormatPoint(spec.design_space, c.untried[k])},
+           {"hardware_cost", c.untried_cost[k]}});
+    }
+    cheaper = {{"in_space", c.cheaper},
+               {"run", c.run},
+               {"ruled_out_by_capacity", c.ruled_out},
+               {"untried_count", c.untried_count},
+               {"untried", untried}};
+  }
   return {{"cheapest_feasible", row_or_null(headline.cheapest)},
           {"tied_with_cheapest", ties},
+          {"cheaper_designs", cheaper},
           {"fastest_feasible", row_or_null(headline.fastest)},
           {"knee", row_or_null(headline.knee)},
           {"cost_time_front", headline.cost_time_front}};

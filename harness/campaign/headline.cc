@@ -15,6 +15,8 @@
 #include "analysis/pareto/pareto.h"
 #include "analysis/pictures/pictures.h"
 #include "harness/campaign/replicas.h"
+#include "harness/explore/capacity.h"
+#include "harness/explore/strategy.h"
 #include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
 #include "harness/spec/text_util.h"
@@ -106,7 +108,120 @@ std::vector<Line> Lines(const std::vector<EvaluationRow>& rows,
   return lines;
 }
 
+// What the rows say of the designs that cost less than `cost`.
+CheaperDesigns CountCheaper(const spec::Spec& spec,
+                            const std::vector<EvaluationRow>& rows,
+                            double cost) {
+  CheaperDesigns out;
+  const uint64_t size = spec.design_space.Size();
+  if (size > spec::kMaxCostCheckPoints) {
+    out.why_not_counted =
+        fmt::format("a space of {} designs, more than the {} adse counts", size,
+                    spec::kMaxCostCheckPoints);
+    return out;
+  }
+  const explore::SpaceGrid grid(spec.design_space);
+  std::vector<spec::KnobRole> roles;
+  for (const spec::DesignParameter& p : spec.design_space.parameters) {
+    roles.push_back(p.role);
+  }
+  // The designs run, and those whose run failed for lack of capacity
+  // (with whether it failed on load alone, so that coarser data counts as
+  // more capacity against it, as the agent counts it).
+  const std::vector<explore::CapacityConstraint> constraints =
+      explore::CapacityConstraintsOf(spec);
+  std::set<explore::Genes> run;
+  std::vector<std::pair<explore::Genes, bool>> failed;
+  for (const EvaluationRow& row : rows) {
+    std::optional<explore::Genes> genes = grid.FromPoint(row.point);
+    if (!genes || !row.complete()) continue;
+    run.insert(*genes);
+    if (row.feasible) continue;
+    const explore::Observation observation = ObservationFromRow(row);
+    if (explore::FailsForCapacity(constraints, observation, false)) {
+      failed.emplace_back(
+          *genes, explore::FailsForCapacity(constraints, observation, true));
+    }
+  }
+  const double limit = analysis::TieKey(cost);
+  std::vector<std::pair<double, spec::DesignPoint>> untried;
+  const Status status = spec::ForEachPointCost(
+      spec, [&](const spec::DesignPoint& point, double design_cost) {
+        if (!(analysis::TieKey(design_cost) < limit)) return;
+        ++out.cheaper;
+        const std::optional<explore::Genes> genes = grid.FromPoint(point);
+        if (!genes) return;
+        if (run.count(*genes) > 0) {
+          ++out.run;
+          return;
+        }
+        for (const auto& [failed_genes, load_only] : failed) {
+          const int order = explore::CompareCapacity(roles, {}, *genes,
+                                                     failed_genes, load_only);
+          if (order == -1 || order == 0) {
+            ++out.ruled_out;
+            return;
+          }
+        }
+        ++out.untried_count;
+        untried.emplace_back(design_cost, point);
+      });
+  if (!status.ok()) {
+    out = CheaperDesigns();
+    out.why_not_counted = status.message();
+    return out;
+  }
+  std::stable_sort(
+      untried.begin(), untried.end(), [](const auto& a, const auto& b) {
+        return analysis::TieKey(a.first) < analysis::TieKey(b.first);
+      });
+  for (size_t k = 0; k < untried.size() &&
+                     k < static_cast<size_t>(CheaperDesigns::kMaxListed);
+       ++k) {
+    out.untried_cost.push_back(untried[k].first);
+    out.untried.push_back(std::move(untried[k].second));
+  }
+  out.counted = true;
+  return out;
+}
+
 }  // namespace
+
+std::string CheaperText(const spec::Spec& spec, const CheaperDesigns& c) {
+  if (!c.counted) {
+    return c.why_not_counted.empty()
+               ? std::string()
+               : fmt::format("not counted ({})", c.why_not_counted);
+  }
+  if (c.cheaper == 0) return "none in the space";
+  std::vector<std::string> parts;
+  if (c.run > 0) {
+    parts.push_back(fmt::format("{} run, none feasible", c.run));
+  }
+  if (c.ruled_out > 0) {
+    parts.push_back(fmt::format(
+        "{} with no more capacity than a run that failed", c.ruled_out));
+  }
+  if (c.untried_count == 0) {
+    parts.push_back("none untried");
+  } else {
+    std::vector<std::string> listed;
+    const size_t shown = std::min<size_t>(c.untried.size(), 3);
+    for (size_t k = 0; k < shown; ++k) {
+      listed.push_back(
+          fmt::format("{} (cost {:.4g})",
+                      spec::FormatPoint(spec.design_space, c.untried[k]),
+                      c.untried_cost[k]));
+    }
+    parts.push_back(
+        fmt::format("{} untried, cheapest first: {}{}", c.untried_count,
+                    fmt::join(listed, ", "),
+                    c.untried_count > static_cast<int64_t>(shown)
+                        ? fmt::format(" and {} more", c.untried_count - shown)
+                        : std::string()));
+  }
+  return fmt::format("{} in the space: {}", c.cheaper, fmt::join(parts, "; "));
+}
 
 bool SimpleBound(const std::string& constraint, const std::string& metric,
                  double* bound) {
@@ -232,6 +347,8 @@ Headline ComputeHeadline(const spec::Spec& spec,
       }
     }
   }
+  h.cheaper =
+      CountCheaper(spec, rows, RowMetric(rows[h.cheapest], kCostMetric));
   h.cheapest_runs = RunsAt(rows, h.cheapest);
   h.fastest_runs = RunsAt(rows, h.fastest);
   h.knee_runs = RunsAt(rows, h.knee);
@@ -256,6 +373,10 @@ std::string HeadlineText(const spec::Spec& spec,
         "{:<19} {}  {}\n", line.what,
         spec::FormatPoint(spec.design_space, rows[line.row].point),
         Facts(spec, rows, line.row, line.runs));
+  }
+  if (const std::string cheaper = CheaperText(spec, h.cheaper);
+      !cheaper.empty()) {
+    out << fmt::format("{:<19} {}\n", "cheaper designs", cheaper);
   }
   std::vector<std::string> objectives;
   for (const spec::Objective& o : spec.objectives)
@@ -324,6 +445,10 @@ std::string HeadlineMarkdown(const spec::Spec& spec,
                       spec::FormatPoint(spec.design_space, row.point),
                       Facts(spec, rows, line.row, line.runs),
                       PictureLinks(spec, row, image_dir));
+  }
+  if (const std::string cheaper = CheaperText(spec, h.cheaper);
+      !cheaper.empty()) {
+    md << fmt::format("- **Cheaper designs:** {}.\n", cheaper);
   }
   if (spec.objectives.size() > 2 ||
       (spec.objectives.size() == 2 &&

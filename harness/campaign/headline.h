@@ -5,6 +5,7 @@
 #ifndef ADSE_HARNESS_CAMPAIGN_HEADLINE_H_
 #define ADSE_HARNESS_CAMPAIGN_HEADLINE_H_
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,27 @@ namespace adse::campaign {
 // The two metrics of the cost-time view; every scenario reports both.
 inline constexpr char kCostMetric[] = "hardware_cost";
 inline constexpr char kTimeMetric[] = "nav_time_s";
+
+// How sure the cheapest feasible design is of being the cheapest: what the
+// campaign knows of the designs of the space that cost less.
+struct CheaperDesigns {
+  // The space was enumerated: a design is feasible and the space holds at
+  // most spec::kMaxCostCheckPoints designs.
+  bool counted = false;
+  std::string why_not_counted;  // when a design is feasible but not counted
+  int64_t cheaper = 0;  // designs that cost less (costs equal to 12 digits tie)
+  int64_t run = 0;  // of them, run to the end or stopped early (none feasible)
+  // Not run, with no more capacity than a run that failed a constraint on
+  // measured metrics (explore::CompareCapacity, a faster sensor counted as
+  // more load): by the knobs' roles they fail too.
+  int64_t ruled_out = 0;
+  // The rest: neither run nor ruled out, the designs a longer search
+  // would try. `untried` holds the first kMaxListed of them, cheapest first.
+  int64_t untried_count = 0;
+  std::vector<spec::DesignPoint> untried;
+  std::vector<double> untried_cost;  // per entry of `untried`
+  static constexpr int kMaxListed = 20;
+};
 
 struct Headline {
   // Row indices; -1 when no row qualifies.
@@ -39,6 +61,8 @@ struct Headline {
   // computers that answer the question as well, e.g. 6 cores at 2 GHz
   // beside 4 at 3 GHz.
   std::vector<int> cheapest_ties;
+  // The designs cheaper than `cheapest` (counted only when it exists).
+  CheaperDesigns cheaper;
   // Rows at the same design point as each of cheapest/fastest/knee
   // (replicas); 1 when the point ran once.
   int cheapest_runs = 0, fastest_runs = 0, knee_runs = 0;
@@ -47,9 +71,14 @@ struct Headline {
 Headline ComputeHeadline(const spec::Spec& spec,
                          const std::vector<EvaluationRow>& rows);
 
+// "12 in the space: 3 run, none feasible; 8 with no more capacity than
+// a run that failed; 1 untried: cores=5,freq_ghz=1.5 (cost 7.5)", or
+// "not counted (...)"; empty without a cheapest design.
+std::string CheaperText(const spec::Spec& spec, const CheaperDesigns& cheaper);
+
 // "cheapest feasible: cores=2,freq_ghz=1.2 cost 2.4, nav 150.2 s,
-// ctrl 9.8 Hz (1 run)" and the like, one line per design, then the front;
-// for the terminal.
+// ctrl 9.8 Hz (1 run)" and the like, one line per design, what the
+// campaign knows of cheaper designs, then the front; for the terminal.
 std::string HeadlineText(const spec::Spec& spec,
                          const std::vector<EvaluationRow>& rows,
                          const Headline& headline);

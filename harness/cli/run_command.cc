@@ -84,8 +84,10 @@ class Progress : public campaign::ExplorerListener {
     std::string line;
     if (failed) {
       line = fmt::format(
-          "[{}/{}] FAILED {}: {} ({} attempt(s); see runs/{}.failed.json)",
-          done_, budget_, point, row.reason, row.attempts, row.content_key);
+          "[{}/{}] #{} FAILED {}: {} ({} attempt(s); see "
+          "runs/{}.failed.json)",
+          done_, budget_, row.index, point, row.reason, row.attempts,
+          row.content_key);
     } else if (!quiet_ && !tty_) {
       // An early-stopped run has no measured nav time or rate: its reason
       // says which bound stopped it.
@@ -99,9 +101,9 @@ class Progress : public campaign::ExplorerListener {
                             spec::CaseName(spec_, row.task_case),
                             spec_.cases.size());
       line = fmt::format(
-          "[{}/{}] {}: {}{}, cost {:.3g}, {} "
+          "[{}/{}] #{} {}: {}{}, cost {:.3g}, {} "
           "({}{})",
-          done_, budget_, point, reason,
+          done_, budget_, row.index, point, reason,
           censored ? std::string(" (stopped early, metrics censored)")
                    : fmt::format(", nav {:.1f} s, ctrl {:.1f} Hz",
                                  campaign::RowMetric(row, "nav_time_s"),

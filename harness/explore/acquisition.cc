@@ -90,10 +90,10 @@ bool AgentStrategy::SampleOutcome(
     values[knobs_[d].parameter->name] = knobs_[d].parameter->values[c.genes[d]];
   }
   if (c.verdict == Verdict::kFails) return false;
-  for (size_t i = 0; i < constraints_.size(); ++i) {
-    const spec::Expression& constraint = constraints_[i];
+  for (const CapacityConstraint& capacity : constraints_) {
+    const spec::Expression& constraint = capacity.expression;
     // A run with less capacity already met the metric constraints.
-    if (c.verdict == Verdict::kHolds && metric_only_[i]) continue;
+    if (c.verdict == Verdict::kHolds && capacity.metric_only) continue;
     // A constraint on a metric no run has shown yet cannot be predicted:
     // it is taken to hold until a run says otherwise.
     bool known = true;
@@ -181,7 +181,7 @@ std::string AgentStrategy::Choose(int n, std::vector<Genes>* chosen) {
     for (size_t j = 0; j < candidates.size(); ++j) {
       if (candidates[j].p_feasible <= envelope[i]) continue;
       const int order =
-          CompareCapacity(knobs_, rate_raised_, candidates[i].genes,
+          CompareCapacity(roles_, rate_raised_, candidates[i].genes,
                           candidates[j].genes, false);
       if (order == 0 || order == 1) envelope[i] = candidates[j].p_feasible;
     }
@@ -422,7 +422,7 @@ int AgentStrategy::CheapestPick(const std::vector<Candidate>& candidates,
       // more capacity: its own prediction is no worse by the roles.
       if (best >= 0 && std::abs(c.cost - candidates[best].cost) <= 1e-9 &&
           std::abs(c.p_feasible - candidates[best].p_feasible) <= 1e-12) {
-        const int order = CompareCapacity(knobs_, rate_raised_, c.genes,
+        const int order = CompareCapacity(roles_, rate_raised_, c.genes,
                                           candidates[best].genes, false);
         if (order == -1) continue;
         if (order == 1) {

@@ -48,26 +48,6 @@
 namespace adse::explore {
 namespace internal {
 
-int CompareCapacity(const std::vector<Knob>& knobs,
-                    const std::vector<bool>& rate_raised, const Genes& a,
-                    const Genes& b, bool coarser_is_capacity) {
-  int sign = 0;
-  for (size_t d = 0; d < knobs.size(); ++d) {
-    if (a[d] == b[d]) continue;
-    const KnobRole role = knobs[d].role;
-    int here = a[d] < b[d] ? -1 : +1;
-    if (role == KnobRole::kSensorRate && !rate_raised[d]) {
-      here = -here;  // a faster sensor is more load
-    } else if (role != KnobRole::kCores && role != KnobRole::kFrequency &&
-               !(role == KnobRole::kDownsample && coarser_is_capacity)) {
-      return 2;
-    }
-    if (sign != 0 && sign != here) return 2;
-    sign = here;
-  }
-  return sign;
-}
-
 AgentStrategy::AgentStrategy(const spec::Spec& spec)
     : spec_(&spec),
       grid_(spec.design_space),
@@ -159,8 +139,9 @@ void AgentStrategy::Remember(const Observation& observation) {
   record.feasible = observation.feasible && !observation.failed;
   record.objectives = Objectives(observation);
   if (observation.censored) record.censored = CensoredAt(observation);
-  record.metrics_fail = !record.failed && MetricsFail(observation, false);
-  record.load_fail = record.metrics_fail && MetricsFail(observation, true);
+  record.metrics_fail = FailsForCapacity(constraints_, observation, false);
+  record.load_fail =
+      record.metrics_fail && FailsForCapacity(constraints_, observation, true);
   records_.push_back(std::move(record));
   ++fresh_;
 }
@@ -189,6 +170,7 @@ void AgentStrategy::SetUpKnobs() {
     Knob knob;
     knob.parameter = &parameter;
     knob.role = parameter.role;
+    roles_.push_back(parameter.role);
     const std::string prefix = "stack.";
     if (knob.role == KnobRole::kSensorRate &&
         parameter.bind.compare(0, prefix.size(), prefix) == 0) {
@@ -238,28 +220,16 @@ void AgentStrategy::SetUpMetrics() {
     if (objective.metric == kCostMetric) continue;
     add(objective.metric)->good_direction = objective.minimize ? -1 : +1;
   }
-  const std::vector<std::string> names =
-      spec::ConstraintVariableNames(spec_->design_space);
-  for (const std::string& text : spec_->constraints) {
-    Result<spec::Expression> expression = spec::Expression::Parse(text, names);
-    if (!expression.ok()) continue;
-    bool metric_only = true;
-    bool reads_precision = false;
-    for (const std::string& variable : expression->variables()) {
+  constraints_ = CapacityConstraintsOf(*spec_);
+  for (const CapacityConstraint& constraint : constraints_) {
+    for (const std::string& variable : constraint.expression.variables()) {
       if (variable == kCostMetric ||
           std::find(parameter_names.begin(), parameter_names.end(), variable) !=
               parameter_names.end()) {
-        metric_only = false;
         continue;
       }
-      MetricModel* model = add(variable);
-      model->in_constraint = true;
-      reads_precision = reads_precision || model->precision_hint;
+      add(variable)->in_constraint = true;
     }
-    metric_only_.push_back(metric_only);
-    reads_precision_.push_back(reads_precision);
-    constraints_.push_back(std::move(*expression));
-    constraint_texts_.push_back(text);
   }
   for (const spec::Objective& objective : spec_->objectives) {
     int index = -1;
@@ -310,7 +280,8 @@ void AgentStrategy::ProbeDirections() {
     const double low = flag ? 0.0 : (value > 0 ? value * 0.5 : value - 1.0);
     const double high = flag ? 1.0 : (value > 0 ? value * 2.0 : value + 1.0);
     int score = 0;
-    for (const spec::Expression& constraint : constraints_) {
+    for (const CapacityConstraint& capacity : constraints_) {
+      const spec::Expression& constraint = capacity.expression;
       const auto& vars = constraint.variables();
       if (std::find(vars.begin(), vars.end(), model.name) == vars.end()) {
         continue;
@@ -392,39 +363,18 @@ std::vector<int> AgentStrategy::RemedyDirections(const Record& record,
   return direction;
 }
 
-bool AgentStrategy::MetricsFail(const Observation& observation,
-                                bool load_only) const {
-  for (size_t i = 0; i < constraints_.size(); ++i) {
-    if (!metric_only_[i] || (load_only && reads_precision_[i])) continue;
-    if (observation.censored &&
-        observation.violated_constraint == constraint_texts_[i]) {
-      return true;
-    }
-    bool measured = true;
-    for (const std::string& variable : constraints_[i].variables()) {
-      auto it = observation.metrics.find(variable);
-      measured = measured && it != observation.metrics.end() &&
-                 std::isfinite(it->second);
-    }
-    if (!measured) continue;
-    const double v = constraints_[i].Evaluate(observation.metrics);
-    if (!std::isfinite(v) || v == 0.0) return true;
-  }
-  return false;
-}
-
 Verdict AgentStrategy::CapacityVerdict(const Genes& genes) const {
   Verdict verdict = Verdict::kUnknown;
   for (const Record& record : records_) {
     if (record.failed) continue;
     if (record.metrics_fail) {
-      const int order = CompareCapacity(knobs_, rate_raised_, genes,
+      const int order = CompareCapacity(roles_, rate_raised_, genes,
                                         record.genes, record.load_fail);
       if (order == -1 || order == 0) return Verdict::kFails;
     }
     if (record.feasible) {
       const int order =
-          CompareCapacity(knobs_, rate_raised_, genes, record.genes, false);
+          CompareCapacity(roles_, rate_raised_, genes, record.genes, false);
       if (order == +1 || order == 0) verdict = Verdict::kHolds;
     }
   }
@@ -433,24 +383,28 @@ Verdict AgentStrategy::CapacityVerdict(const Genes& genes) const {
 
 std::optional<CensoredBound> AgentStrategy::CensoredAt(
     const Observation& observation) const {
-  auto found = std::find(constraint_texts_.begin(), constraint_texts_.end(),
-                         observation.violated_constraint);
-  if (found == constraint_texts_.end() && observation.stalled) {
+  const spec::Expression* found = nullptr;
+  for (const CapacityConstraint& c : constraints_) {
+    if (c.expression.text() == observation.violated_constraint) {
+      found = &c.expression;
+      break;
+    }
+  }
+  if (found == nullptr && observation.stalled) {
     // A stalled car never arrives: the first constraint on the nav time
     // alone that an endless drive fails is the one it violates.
-    for (size_t i = 0; i < constraints_.size(); ++i) {
-      const std::vector<std::string> variables = constraints_[i].variables();
+    for (const CapacityConstraint& c : constraints_) {
+      const std::vector<std::string>& variables = c.expression.variables();
       if (variables.size() != 1 || variables[0] != kNavTimeMetric) continue;
-      const double v = constraints_[i].Evaluate({{kNavTimeMetric, 1e12}});
+      const double v = c.expression.Evaluate({{kNavTimeMetric, 1e12}});
       if (std::isfinite(v) && v == 0.0) {
-        found = constraint_texts_.begin() + static_cast<long>(i);
+        found = &c.expression;
         break;
       }
     }
   }
-  if (found == constraint_texts_.end()) return std::nullopt;
-  const spec::Expression& constraint =
-      constraints_[found - constraint_texts_.begin()];
+  if (found == nullptr) return std::nullopt;
+  const spec::Expression& constraint = *found;
   const MetricModel* model = nullptr;
   for (const std::string& variable : constraint.variables()) {
     for (const MetricModel& m : models_) {

@@ -173,13 +173,15 @@ Result<double> EvaluateCost(const Spec& spec, const DesignPoint& point) {
   return CostAt(spec, *cost, point);
 }
 
-Status CheckCostOverSpace(const Spec& spec) {
+Status ForEachPointCost(
+    const Spec& spec,
+    const std::function<void(const DesignPoint& point, double cost)>& visit) {
   const std::vector<DesignParameter>& parameters = spec.design_space.parameters;
-  const uint64_t size = spec.design_space.Size();
-  if (parameters.empty() || size > kMaxCostCheckPoints) return Status::Ok();
+  if (parameters.empty()) return Status::Ok();
   Result<Expression> cost = ParseCost(spec);
   if (!cost.ok()) return cost.status();
   // Mixed-radix count over the value indices, first parameter slowest.
+  const uint64_t size = spec.design_space.Size();
   std::vector<size_t> index(parameters.size(), 0);
   for (uint64_t n = 0; n < size; ++n) {
     DesignPoint point;
@@ -188,12 +190,18 @@ Status CheckCostOverSpace(const Spec& spec) {
     }
     Result<double> value = CostAt(spec, *cost, point);
     if (!value.ok()) return value.status();
+    visit(point, *value);
     for (size_t d = parameters.size(); d-- > 0;) {
       if (++index[d] < parameters[d].values.size()) break;
       index[d] = 0;
     }
   }
   return Status::Ok();
+}
+
+Status CheckCostOverSpace(const Spec& spec) {
+  if (spec.design_space.Size() > kMaxCostCheckPoints) return Status::Ok();
+  return ForEachPointCost(spec, [](const DesignPoint&, double) {});
 }
 
 namespace {

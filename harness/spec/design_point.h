@@ -4,6 +4,7 @@
 #ifndef ADSE_HARNESS_SPEC_DESIGN_POINT_H_
 #define ADSE_HARNESS_SPEC_DESIGN_POINT_H_
 
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -51,8 +52,18 @@ std::vector<std::string> ConstraintVariableNames(const DesignSpace& space);
 // platform defaults.
 Result<double> EvaluateCost(const Spec& spec, const DesignPoint& point);
 
-// Spaces up to this size have their cost checked at every point.
+// Spaces up to this size have their cost checked at every point, and are
+// enumerated where every design is counted (the headline's cheaper
+// designs).
 inline constexpr uint64_t kMaxCostCheckPoints = 100000;
+
+// Calls `visit` with every point of the space and its cost, in
+// lexicographic order (the first parameter slowest). The caller bounds the
+// space's size first. Errors: the cost expression does not parse, or is
+// not finite at a point (named; nothing is visited after it).
+Status ForEachPointCost(
+    const Spec& spec,
+    const std::function<void(const DesignPoint& point, double cost)>& visit);
 // Ok when the cost expression is finite at every point of the space (a
 // cost of 10 / (cores - 1) over 1 core is not); a space larger than
 // kMaxCostCheckPoints is not enumerated, and each run checks its own

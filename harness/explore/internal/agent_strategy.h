@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/explore/capacity.h"
 #include "harness/explore/internal/surrogate.h"
 #include "harness/explore/strategy.h"
 #include "harness/spec/expression.h"
@@ -138,15 +139,6 @@ struct Record {
 // a feasible one feasible.
 enum class Verdict { kUnknown, kFails, kHolds };
 
-// -1, 0 or +1: whether `a` has at most, the same or at least `b`'s
-// capacity by the knobs' roles (see Verdict); 2 when neither. A knob of no
-// capacity role must be equal; so must a sensor rate the diagnosis asked
-// to raise (`rate_raised`, per knob) and, unless `coarser_is_capacity`, a
-// downsample knob.
-int CompareCapacity(const std::vector<Knob>& knobs,
-                    const std::vector<bool>& rate_raised, const Genes& a,
-                    const Genes& b, bool coarser_is_capacity);
-
 struct Candidate {
   Genes genes;
   std::vector<double> u;
@@ -197,11 +189,6 @@ class AgentStrategy : public Strategy {
   std::optional<CensoredBound> CensoredAt(const Observation& observation) const;
 
   void FitModels();
-
-  // Whether the metric constraints failed at a run (evaluated on what it
-  // measured, or named by its early stop); with `load_only`, those of them
-  // that read no precision metric.
-  bool MetricsFail(const Observation& observation, bool load_only) const;
 
   Verdict CapacityVerdict(const Genes& genes) const;
 
@@ -270,18 +257,14 @@ class AgentStrategy : public Strategy {
   int budget_;
   Random random_;
   std::vector<Knob> knobs_;
-  std::vector<double> lengths_;  // GP length scale per knob
+  std::vector<spec::KnobRole> roles_;  // per knob, for CompareCapacity
+  std::vector<double> lengths_;        // GP length scale per knob
   // Per knob: a sensor rate the diagnosis asked to raise, so a faster
   // sensor is not taken for more load (FitModels).
   std::vector<bool> rate_raised_;
   std::vector<MetricModel> models_;
   bool any_failed_ = false;
-  std::vector<spec::Expression> constraints_;
-  std::vector<std::string> constraint_texts_;  // as the scenario writes them
-  // Per constraint: it reads only measured metrics (no cost, no knob).
-  std::vector<bool> metric_only_;
-  // Per constraint: it reads a precision metric (spec::MetricInfo).
-  std::vector<bool> reads_precision_;
+  std::vector<CapacityConstraint> constraints_;
   std::vector<std::vector<double>> z_;  // [sample][model]
   std::vector<int> objective_model_;    // per objective, index or -1
   std::optional<Genes> start_;

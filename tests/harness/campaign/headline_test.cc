@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -16,19 +17,24 @@ namespace {
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
-// `constraints` as the scenario writes them.
-spec::Spec Scenario(const std::string& constraints = "[nav_time_s <= 60]") {
+constexpr char kGrid[] =
+    "  cores: {bind: platform.cores, values: [2, 4, 6, 8]}\n"
+    "  freq_ghz: {bind: platform.freq_ghz, values: [1.5, 2.0, 3.0]}\n";
+
+// `constraints` as the scenario writes them; `space` the design space's
+// lines.
+spec::Spec Scenario(const std::string& constraints = "[nav_time_s <= 60]",
+                    const std::string& space = kGrid) {
   spec::ParseOptions options;
   options.check_files = false;
   Result<spec::Spec> spec = spec::ParseSpec(
       "adse: 1\nname: ties\nworld: {map: {generate: parking_lot}}\n"
       "task: {start: {x: 5, y: -1.75}, goal: {x: 60, y: 29.75}}\n"
-      "design_space:\n"
-      "  cores: {bind: platform.cores, values: [2, 4, 6, 8]}\n"
-      "  freq_ghz: {bind: platform.freq_ghz, values: [1.5, 2.0, 3.0]}\n"
-      "cost: cores * freq_ghz\n"
-      "objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]\n"
-      "constraints: " +
+      "design_space:\n" +
+          space +
+          "cost: cores * freq_ghz\n"
+          "objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]\n"
+          "constraints: " +
           constraints + "\n",
       "ties.yaml", ".", options);
   EXPECT_TRUE(spec.ok()) << spec.status().ToString();
@@ -119,6 +125,112 @@ TEST(HeadlineTest, TheConstraintsInfeasibleDesignsInsideTheLinesFailAreNamed) {
   rows[1].metrics["deviation_score"] = 0.1;
   rows[2].metrics["ctrl_rate_hz"] = 10;
   EXPECT_TRUE(UndrawnFailures(spec, rows).empty());
+}
+
+// Costs over the grid (cores x GHz): 2 cores 3, 4, 6; 4 cores 6, 8, 12;
+// 6 cores 9, 12, 18; 8 cores 12, 16, 24.
+TEST(HeadlineTest,
+     DesignsCheaperThanTheAnswerAreRunRuledOutByCapacityOrUntried) {
+  const spec::Spec spec = Scenario();
+  const std::vector<EvaluationRow> rows = {
+      Row(0, 4, 2.0, 70), Row(1, 6, 2.0, 45), Row(2, 8, 1.5, 50),
+      Row(3, 2, 3.0, 80)};
+  const Headline h = ComputeHeadline(spec, rows);
+  ASSERT_EQ(h.cheapest, 1);  // cost 12, as 8 x 1.5 and 4 x 3.0: no cheaper
+  const CheaperDesigns& c = h.cheaper;
+  ASSERT_TRUE(c.counted);
+  // 2 x 1.5, 2 x 2.0, 2 x 3.0, 4 x 1.5, 4 x 2.0 and 6 x 1.5 cost less.
+  EXPECT_EQ(c.cheaper, 6);
+  EXPECT_EQ(c.run, 2);  // 4 x 2.0 and 2 x 3.0, both too slow
+  // 2 x 1.5, 2 x 2.0 and 4 x 1.5 have no more capacity than 4 x 2.0.
+  EXPECT_EQ(c.ruled_out, 3);
+  EXPECT_EQ(c.untried_count, 1);
+  ASSERT_EQ(c.untried.size(), 1u);
+  EXPECT_EQ(spec::FormatPoint(spec.design_space, c.untried[0]),
+            "cores=6,freq_ghz=1.5");
+  EXPECT_DOUBLE_EQ(c.untried_cost[0], 9.0);
+  const std::string sentence =
+      "6 in the space: 2 run, none feasible; 3 with no more capacity than a "
+      "run that failed; 1 untried, cheapest first: cores=6,freq_ghz=1.5 "
+      "(cost 9)";
+  EXPECT_EQ(CheaperText(spec, c), sentence);
+  EXPECT_THAT(HeadlineText(spec, rows, h),
+              HasSubstr("cheaper designs     " + sentence + "\n"));
+  EXPECT_THAT(HeadlineMarkdown(spec, rows, h, "images"),
+              HasSubstr("- **Cheaper designs:** " + sentence + ".\n"));
+  const nlohmann::json answer = AnswerJson(spec, rows, h);
+  const nlohmann::json& cheaper = answer.at("cheaper_designs");
+  EXPECT_EQ(cheaper.at("in_space"), 6);
+  EXPECT_EQ(cheaper.at("run"), 2);
+  EXPECT_EQ(cheaper.at("ruled_out_by_capacity"), 3);
+  EXPECT_EQ(cheaper.at("untried_count"), 1);
+  EXPECT_EQ(cheaper.at("untried").at(0).at("point"), "cores=6,freq_ghz=1.5");
+  EXPECT_DOUBLE_EQ(cheaper.at("untried").at(0).at("hardware_cost"), 9.0);
+}
+
+TEST(HeadlineTest, OnlyARunShortOfCapacityRulesOutTheDesignsBelowIt) {
+  // 2 x 3.0 fails a bound on a knob, not on what it measured: the smaller
+  // computers below it are not ruled out by it. A run that crashed says
+  // nothing, and its design is not counted as run.
+  const spec::Spec spec = Scenario("[nav_time_s <= 60, cores >= 4]");
+  std::vector<EvaluationRow> rows = {Row(0, 2, 3.0, 40), Row(1, 4, 2.0, 45),
+                                     Row(2, 4, 1.5, 80)};
+  rows[0].feasible = false;
+  rows[2].status = "failed";
+  rows[2].metrics.clear();
+  const Headline h = ComputeHeadline(spec, rows);
+  ASSERT_EQ(h.cheapest, 1);  // cost 8
+  const CheaperDesigns& c = h.cheaper;
+  EXPECT_EQ(c.cheaper, 4);  // 2 x 1.5, 2 x 2.0, 2 x 3.0, 4 x 1.5
+  EXPECT_EQ(c.run, 1);
+  EXPECT_EQ(c.ruled_out, 0);
+  EXPECT_EQ(c.untried_count, 3);
+  EXPECT_THAT(CheaperText(spec, c),
+              HasSubstr("3 untried, cheapest first: cores=2,freq_ghz=1.5 "
+                        "(cost 3), cores=2,freq_ghz=2 (cost 4), "
+                        "cores=4,freq_ghz=1.5 (cost 6)"));
+}
+
+TEST(HeadlineTest, AnExhaustiveCampaignLeavesNoCheaperDesignUntried) {
+  const spec::Spec spec = Scenario();
+  std::vector<EvaluationRow> rows;
+  int index = 0;
+  for (double cores : {2, 4, 6, 8}) {
+    for (double ghz : {1.5, 2.0, 3.0}) {
+      rows.push_back(Row(index++, cores, ghz, 240.0 / (cores * ghz)));
+    }
+  }
+  const Headline h = ComputeHeadline(spec, rows);
+  ASSERT_GE(h.cheapest, 0);
+  EXPECT_EQ(RowMetric(rows[h.cheapest], kCostMetric), 4.0);  // 60 s
+  EXPECT_EQ(CheaperText(spec, h.cheaper),
+            "1 in the space: 1 run, none feasible; none untried");
+  // The cheapest design of the space: nothing costs less.
+  rows = {Row(0, 2, 1.5, 50)};
+  EXPECT_EQ(CheaperText(spec, ComputeHeadline(spec, rows).cheaper),
+            "none in the space");
+  // Nothing feasible: nothing to be sure of.
+  rows = {Row(0, 2, 1.5, 90)};
+  const Headline none = ComputeHeadline(spec, rows);
+  EXPECT_FALSE(none.cheaper.counted);
+  EXPECT_EQ(CheaperText(spec, none.cheaper), "");
+  EXPECT_TRUE(AnswerJson(spec, rows, none).at("cheaper_designs").is_null());
+}
+
+TEST(HeadlineTest,
+     ASpaceTooLargeToEnumerateSaysItsCheaperDesignsAreNotCounted) {
+  const spec::Spec spec = Scenario(
+      "[nav_time_s <= 60]",
+      "  cores: {bind: platform.cores, range: [1, 1001]}\n"
+      "  freq_ghz: {bind: platform.freq_ghz, range: [0.1, 10.0], step: 0.1}\n");
+  const std::vector<EvaluationRow> rows = {Row(0, 4, 2.0, 45)};
+  const Headline h = ComputeHeadline(spec, rows);
+  ASSERT_EQ(h.cheapest, 0);
+  EXPECT_FALSE(h.cheaper.counted);
+  EXPECT_EQ(CheaperText(spec, h.cheaper),
+            "not counted (a space of 100100 designs, more than the 100000 "
+            "adse counts)");
+  EXPECT_TRUE(AnswerJson(spec, rows, h).at("cheaper_designs").is_null());
 }
 
 }  // namespace
