@@ -187,7 +187,8 @@ CheaperDesigns CountCheaper(const spec::Spec& spec,
 
 }  // namespace
 
-std::string CheaperText(const spec::Spec& spec, const CheaperDesigns& c) {
+std::string CheaperText(const spec::Spec& spec, const CheaperDesigns& c,
+                        int shown_at_most) {
   if (!c.counted) {
     return c.why_not_counted.empty()
                ? std::string()
@@ -206,7 +207,8 @@ std::string CheaperText(const spec::Spec& spec, const CheaperDesigns& c) {
     parts.push_back("none untried");
   } else {
     std::vector<std::string> listed;
-    const size_t shown = std::min<size_t>(c.untried.size(), 3);
+    const size_t shown = std::min<size_t>(
+        c.untried.size(), static_cast<size_t>(std::max(shown_at_most, 0)));
     for (size_t k = 0; k < shown; ++k) {
       listed.push_back(
           fmt::format("{} (cost {:.4g})",
@@ -446,7 +448,9 @@ std::string HeadlineMarkdown(const spec::Spec& spec,
                       Facts(spec, rows, line.row, line.runs),
                       PictureLinks(spec, row, image_dir));
   }
-  if (const std::string cheaper = CheaperText(spec, h.cheaper);
+  // The report lists every untried design it holds: the ones to run next.
+  if (const std::string cheaper =
+          CheaperText(spec, h.cheaper, CheaperDesigns::kMaxListed);
       !cheaper.empty()) {
     md << fmt::format("- **Cheaper designs:** {}.\n", cheaper);
   }

@@ -72,9 +72,11 @@ Headline ComputeHeadline(const spec::Spec& spec,
                          const std::vector<EvaluationRow>& rows);
 
 // "12 in the space: 3 run, none feasible; 8 with no more capacity than
-// a run that failed; 1 untried: cores=5,freq_ghz=1.5 (cost 7.5)", or
-// "not counted (...)"; empty without a cheapest design.
-std::string CheaperText(const spec::Spec& spec, const CheaperDesigns& cheaper);
+// a run that failed; 1 untried, cheapest first: cores=5,freq_ghz=1.5
+// (cost 7.5)", naming at most `shown_at_most` untried designs ("and 4
+// more"), or "not counted (...)"; empty without a cheapest design.
+std::string CheaperText(const spec::Spec& spec, const CheaperDesigns& cheaper,
+                        int shown_at_most = 3);
 
 // "cheapest feasible: cores=2,freq_ghz=1.2 cost 2.4, nav 150.2 s,
 // ctrl 9.8 Hz (1 run)" and the like, one line per design, what the

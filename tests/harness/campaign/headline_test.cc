@@ -173,22 +173,25 @@ TEST(HeadlineTest, OnlyARunShortOfCapacityRulesOutTheDesignsBelowIt) {
   // computers below it are not ruled out by it. A run that crashed says
   // nothing, and its design is not counted as run.
   const spec::Spec spec = Scenario("[nav_time_s <= 60, cores >= 4]");
-  std::vector<EvaluationRow> rows = {Row(0, 2, 3.0, 40), Row(1, 4, 2.0, 45),
+  std::vector<EvaluationRow> rows = {Row(0, 2, 3.0, 40), Row(1, 6, 1.5, 45),
                                      Row(2, 4, 1.5, 80)};
   rows[0].feasible = false;
   rows[2].status = "failed";
   rows[2].metrics.clear();
   const Headline h = ComputeHeadline(spec, rows);
-  ASSERT_EQ(h.cheapest, 1);  // cost 8
+  ASSERT_EQ(h.cheapest, 1);  // cost 9
   const CheaperDesigns& c = h.cheaper;
-  EXPECT_EQ(c.cheaper, 4);  // 2 x 1.5, 2 x 2.0, 2 x 3.0, 4 x 1.5
+  EXPECT_EQ(c.cheaper, 5);  // 2 x 1.5, 2 x 2.0, 2 x 3.0, 4 x 1.5, 4 x 2.0
   EXPECT_EQ(c.run, 1);
   EXPECT_EQ(c.ruled_out, 0);
-  EXPECT_EQ(c.untried_count, 3);
-  EXPECT_THAT(CheaperText(spec, c),
-              HasSubstr("3 untried, cheapest first: cores=2,freq_ghz=1.5 "
-                        "(cost 3), cores=2,freq_ghz=2 (cost 4), "
-                        "cores=4,freq_ghz=1.5 (cost 6)"));
+  EXPECT_EQ(c.untried_count, 4);
+  // The terminal names three, report.md every one it holds.
+  const std::string three =
+      "4 untried, cheapest first: cores=2,freq_ghz=1.5 (cost 3), "
+      "cores=2,freq_ghz=2 (cost 4), cores=4,freq_ghz=1.5 (cost 6)";
+  EXPECT_THAT(CheaperText(spec, c), HasSubstr(three + " and 1 more"));
+  EXPECT_THAT(HeadlineMarkdown(spec, rows, h, "images"),
+              HasSubstr(three + ", cores=4,freq_ghz=2 (cost 8).\n"));
 }
 
 TEST(HeadlineTest, AnExhaustiveCampaignLeavesNoCheaperDesignUntried) {
