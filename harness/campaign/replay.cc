@@ -167,6 +167,14 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
         (row.complete() && row.feasible &&
          analysis::TieKey(RowMetric(row, "hardware_cost")) == cheapest);
   }
+  if (run.found_cheapest_feasible) {
+    const CheaperDesigns& left =
+        ComputeHeadline(spec, result.evaluations).cheaper;
+    if (left.counted) {
+      run.cheaper_left_untried = left.untried_count;
+      run.cheapest_confirmed = left.untried_count == 0;
+    }
+  }
   return run;
 }
 

@@ -70,6 +70,15 @@ struct ReplayRun {
   // feasible cost (what the user asked for; designs tying in cost are
   // equally cheap); false when the recording has none.
   bool found_cheapest_feasible = false;
+  // It found it, and its own runs leave no cheaper design untried: each was
+  // run or has no more capacity than one of its runs that failed
+  // (Headline::cheaper over its evaluations), so the seed's campaign could
+  // tell its user the answer is the cheapest, not only the cheapest found.
+  bool cheapest_confirmed = false;
+  // When it found it: how many cheaper designs its runs leave untried
+  // (CheaperDesigns::untried_count; 0 when confirmed); -1 otherwise, or
+  // when the space is too large to count.
+  int64_t cheaper_left_untried = -1;
   std::vector<spec::DesignPoint> proposals;  // in order
   std::vector<ReplayIteration> iterations;   // in order
 };

@@ -104,8 +104,8 @@ int RunExplore(const ExploreArgs& args) {
   std::string rationales;
   for (const std::string& name : strategies) {
     const auto started = std::chrono::steady_clock::now();
-    std::vector<double> found, ratio, first;
-    int front = 0, missing = 0, cheapest = 0;
+    std::vector<double> found, ratio, first, left;
+    int front = 0, missing = 0, cheapest = 0, confirmed = 0;
     nlohmann::json runs = nlohmann::json::array();
     for (int i = 0; i < args.seeds; ++i) {
       const uint64_t seed = args.first_seed + static_cast<uint64_t>(i);
@@ -123,6 +123,10 @@ int RunExplore(const ExploreArgs& args) {
       front = run->front_size;
       missing += run->missing;
       cheapest += run->found_cheapest_feasible;
+      confirmed += run->cheapest_confirmed;
+      if (run->cheaper_left_untried >= 0) {
+        left.push_back(static_cast<double>(run->cheaper_left_untried));
+      }
       const spec::DesignSpace& space = recording->spec.design_space;
       nlohmann::json proposals = nlohmann::json::array();
       for (const spec::DesignPoint& point : run->proposals) {
@@ -155,6 +159,11 @@ int RunExplore(const ExploreArgs& args) {
                       {"hypervolume_ratio", run->hypervolume_ratio},
                       {"first_true_pareto_at", run->first_true_pareto_at},
                       {"found_cheapest_feasible", run->found_cheapest_feasible},
+                      {"cheapest_confirmed", run->cheapest_confirmed},
+                      {"cheaper_left_untried",
+                       run->cheaper_left_untried >= 0
+                           ? nlohmann::json(run->cheaper_left_untried)
+                           : nlohmann::json()},
                       {"not_recorded", run->missing}});
     }
     const Distribution f = Describe(found), r = Describe(ratio),
@@ -171,16 +180,21 @@ int RunExplore(const ExploreArgs& args) {
                                  {"max", r.max}}},
                                {"true_front_size", front},
                                {"seeds_that_found_cheapest_feasible", cheapest},
+                               {"seeds_that_confirmed_cheapest", confirmed},
                                {"runs", runs}};
     table += fmt::format(
         "| {} | {:g} / {:g} / {:.2f} / {:g} | {} | {:.3f} / {:.3f} / {:.3f} / "
-        "{:.3f} | {} | {} of {} seeds | {} |\n",
+        "{:.3f} | {} | {} of {} seeds | {} of {} seeds{} | {} |\n",
         name, f.min, f.median, f.mean, f.max, front, r.min, r.median, r.mean,
         r.max,
         first.empty() ? "never"
                       : fmt::format("{:g} ({} of {} seeds)", a.median,
                                     first.size(), args.seeds),
-        cheapest, args.seeds, missing);
+        cheapest, args.seeds, confirmed, args.seeds,
+        left.empty()
+            ? std::string()
+            : fmt::format(" (median {:g} left)", Describe(left).median),
+        missing);
     if (!args.json) {  // with --json, stdout's JSON alone
       std::fprintf(
           stderr, "%s: %s replayed in %.0f s\n", name.c_str(),
@@ -203,8 +217,9 @@ int RunExplore(const ExploreArgs& args) {
     std::printf(
         "| strategy | true Pareto points found (min / median / mean / max) | "
         "of front | hypervolume ratio (min / median / mean / max) | first "
-        "true Pareto point at (median eval) | cheapest feasible found | not "
-        "recorded |\n|---|---|---|---|---|---|---|\n%s",
+        "true Pareto point at (median eval) | cheapest feasible found | "
+        "cheapest confirmed (no cheaper design left untried) | not "
+        "recorded |\n|---|---|---|---|---|---|---|---|\n%s",
         table.c_str());
   }
   if (!rationales.empty()) std::printf("\n%s", rationales.c_str());

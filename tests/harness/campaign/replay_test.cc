@@ -70,6 +70,27 @@ TEST(ReplayTest, AReplaySaysWhetherItEvaluatedTheCheapestFeasibleDesign) {
   EXPECT_FALSE(two->found_cheapest_feasible);
 }
 
+TEST(ReplayTest, AReplaySaysWhetherItsRunsLeaveACheaperDesignUntried) {
+  // Every design run: nothing cheaper is left, the answer is proven.
+  Result<ReplayRun> all = Replay(Recorded(), "exhaustive", 1, 280);
+  ASSERT_TRUE(all.ok());
+  EXPECT_TRUE(all->cheapest_confirmed);
+  EXPECT_EQ(all->cheaper_left_untried, 0);
+  // Not found: nothing to confirm.
+  Result<ReplayRun> two = Replay(Recorded(), "exhaustive", 1, 2);
+  ASSERT_TRUE(two.ok());
+  EXPECT_FALSE(two->cheapest_confirmed);
+  EXPECT_EQ(two->cheaper_left_untried, -1);
+  // The agent's 15 runs find the answer (7 cores at 1.2 GHz) but leave
+  // cheaper designs that no failed run of theirs rules out (README,
+  // "How sure the cheapest design is").
+  Result<ReplayRun> agent = Replay(Recorded(), "agent", 1, 15);
+  ASSERT_TRUE(agent.ok());
+  EXPECT_TRUE(agent->found_cheapest_feasible);
+  EXPECT_FALSE(agent->cheapest_confirmed);
+  EXPECT_GT(agent->cheaper_left_untried, 0);
+}
+
 TEST(ReplayTest, ReplayIsDeterministicAndAnUnknownStrategyIsAnError) {
   Result<ReplayRun> a = Replay(Recorded(), "nsga2", 3, 15);
   Result<ReplayRun> b = Replay(Recorded(), "nsga2", 3, 15);

@@ -40,6 +40,10 @@ TEST(CliRunTest, ExploreReplayPrintsADistributionPerStrategy) {
                          "  cost 8.4,"),
             std::string::npos)
       << run.out;
+  EXPECT_NE(run.out.find("| cheapest feasible found | cheapest confirmed (no "
+                         "cheaper design left untried) |"),
+            std::string::npos)
+      << run.out;
   EXPECT_NE(run.out.find("| agent |"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("| ga |"), std::string::npos) << run.out;
   const CommandRun bad = Adse("explore --replay /nonexistent/campaign");
@@ -97,6 +101,15 @@ TEST(CliRunTest, ExploreReplayWithTwoOfTheObjectivesScoresAgainstTheirFront) {
             nlohmann::json::array({"hardware_cost", "nav_time_s"}));
   EXPECT_EQ(out["strategies"]["random"]["true_front_size"], 14) << two.out;
   EXPECT_EQ(four["strategies"]["random"]["true_front_size"], 72) << all.out;
+  // Whether each seed's runs confirm the answer: random search's one seed
+  // found no cheapest design, so it has nothing to confirm.
+  EXPECT_EQ(four["strategies"]["random"]["seeds_that_confirmed_cheapest"], 0);
+  EXPECT_EQ(four["strategies"]["random"]["runs"][0]["cheapest_confirmed"],
+            false);
+  EXPECT_TRUE(
+      four["strategies"]["random"]["runs"][0]["cheaper_left_untried"].is_null())
+      << all.out;
+  EXPECT_TRUE(four["answer"]["cheaper_designs"].is_object()) << all.out;
 
   const CommandRun unknown = Adse(replay + " --objectives nav_time,cost");
   EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
