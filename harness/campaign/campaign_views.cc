@@ -504,17 +504,25 @@ nlohmann::json AnswerJson(const spec::Spec& spec,
   const CheaperDesigns& c = headline.cheaper;
   nlohmann::json cheaper;  // null: no feasible design, or not counted
   if (c.counted) {
-    nlohmann::json untried = nlohmann::json::array();
-    for (size_t k = 0; k < c.untried.size(); ++k) {
-      untried.push_back(
-          {{"point", spec::FormatPoint(spec.design_space, c.untried[k])},
-           {"hardware_cost", c.untried_cost[k]}});
-    }
+    auto designs = [&](const std::vector<spec::DesignPoint>& points,
+                       const std::vector<double>& costs) {
+      nlohmann::json out = nlohmann::json::array();
+      for (size_t k = 0; k < points.size(); ++k) {
+        out.push_back(
+            {{"point", spec::FormatPoint(spec.design_space, points[k])},
+             {"hardware_cost", costs[k]}});
+      }
+      return out;
+    };
     cheaper = {{"in_space", c.cheaper},
                {"run", c.run},
                {"ruled_out_by_capacity", c.ruled_out},
                {"untried_count", c.untried_count},
-               {"untried", untried}};
+               {"untried", designs(c.untried, c.untried_cost)},
+               {"to_settle_count", c.to_settle_count >= 0
+                                       ? nlohmann::json(c.to_settle_count)
+                                       : nlohmann::json()},
+               {"to_settle", designs(c.to_settle, c.to_settle_cost)}};
   }
   return {{"cheapest_feasible", row_or_null(headline.cheapest)},
           {"tied_with_cheapest", ties},

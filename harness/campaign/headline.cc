@@ -175,6 +175,31 @@ CheaperDesigns CountCheaper(const spec::Spec& spec,
       untried.begin(), untried.end(), [](const auto& a, const auto& b) {
         return analysis::TieKey(a.first) < analysis::TieKey(b.first);
       });
+  // The untried designs that no other exceeds in capacity: each untried
+  // design has no more capacity than one of them, so their failures would
+  // rule every one out (quadratic: only for a modest count).
+  if (out.untried_count > CheaperDesigns::kMaxSettleSearch) {
+    out.to_settle_count = -1;
+  } else {
+    std::vector<explore::Genes> genes;
+    for (const auto& [design_cost, point] : untried) {
+      genes.push_back(*grid.FromPoint(point));
+    }
+    for (size_t i = 0; i < untried.size(); ++i) {
+      bool exceeded = false;
+      for (size_t j = 0; j < untried.size() && !exceeded; ++j) {
+        exceeded = explore::CompareCapacity(roles, {}, genes[j], genes[i],
+                                            false) == +1;
+      }
+      if (exceeded) continue;
+      ++out.to_settle_count;
+      if (out.to_settle.size() <
+          static_cast<size_t>(CheaperDesigns::kMaxListed)) {
+        out.to_settle.push_back(untried[i].second);
+        out.to_settle_cost.push_back(untried[i].first);
+      }
+    }
+  }
   for (size_t k = 0; k < untried.size() &&
                      k < static_cast<size_t>(CheaperDesigns::kMaxListed);
        ++k) {
@@ -203,24 +228,36 @@ std::string CheaperText(const spec::Spec& spec, const CheaperDesigns& c,
     parts.push_back(fmt::format(
         "{} with no more capacity than a run that failed", c.ruled_out));
   }
+  // "a (cost 6), b (cost 7.2) and 5 more"
+  auto list = [&](const std::vector<spec::DesignPoint>& points,
+                  const std::vector<double>& costs, int64_t count) {
+    std::vector<std::string> listed;
+    const size_t shown = std::min<size_t>(
+        points.size(), static_cast<size_t>(std::max(shown_at_most, 0)));
+    for (size_t k = 0; k < shown; ++k) {
+      listed.push_back(fmt::format(
+          "{} (cost {:.4g})", spec::FormatPoint(spec.design_space, points[k]),
+          costs[k]));
+    }
+    return fmt::format("{}{}", fmt::join(listed, ", "),
+                       count > static_cast<int64_t>(shown)
+                           ? fmt::format(" and {} more", count - shown)
+                           : std::string());
+  };
   if (c.untried_count == 0) {
     parts.push_back("none untried");
   } else {
-    std::vector<std::string> listed;
-    const size_t shown = std::min<size_t>(
-        c.untried.size(), static_cast<size_t>(std::max(shown_at_most, 0)));
-    for (size_t k = 0; k < shown; ++k) {
-      listed.push_back(
-          fmt::format("{} (cost {:.4g})",
-                      spec::FormatPoint(spec.design_space, c.untried[k]),
-                      c.untried_cost[k]));
-    }
     parts.push_back(
-        fmt::format("{} untried, cheapest first: {}{}", c.untried_count,
-                    fmt::join(listed, ", "),
-                    c.untried_count > static_cast<int64_t>(shown)
-                        ? fmt::format(" and {} more", c.untried_count - shown)
-                        : std::string()));
+        fmt::format("{} untried, cheapest first: {}", c.untried_count,
+                    list(c.untried, c.untried_cost, c.untried_count)));
+    if (c.to_settle_count > 0 && c.to_settle_count < c.untried_count) {
+      parts.push_back(fmt::format(
+          "{} settle{} them (if these fail, every other has no more "
+          "capacity than one that failed): {}",
+          spec::Counted(static_cast<size_t>(c.to_settle_count), "run"),
+          c.to_settle_count == 1 ? "s" : "",
+          list(c.to_settle, c.to_settle_cost, c.to_settle_count)));
+    }
   }
   return fmt::format("{} in the space: {}", c.cheaper, fmt::join(parts, "; "));
 }

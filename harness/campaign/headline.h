@@ -40,7 +40,15 @@ struct CheaperDesigns {
   int64_t untried_count = 0;
   std::vector<spec::DesignPoint> untried;
   std::vector<double> untried_cost;  // per entry of `untried`
+  // The untried designs no other untried one exceeds in capacity: run
+  // these, and if each fails, every untried design is ruled out. -1 when
+  // more than kMaxSettleSearch are untried (not searched). `to_settle`
+  // holds the first kMaxListed, cheapest first.
+  int64_t to_settle_count = 0;
+  std::vector<spec::DesignPoint> to_settle;
+  std::vector<double> to_settle_cost;  // per entry of `to_settle`
   static constexpr int kMaxListed = 20;
+  static constexpr int64_t kMaxSettleSearch = 4096;
 };
 
 struct Headline {
@@ -73,8 +81,10 @@ Headline ComputeHeadline(const spec::Spec& spec,
 
 // "12 in the space: 3 run, none feasible; 8 with no more capacity than
 // a run that failed; 1 untried, cheapest first: cores=5,freq_ghz=1.5
-// (cost 7.5)", naming at most `shown_at_most` untried designs ("and 4
-// more"), or "not counted (...)"; empty without a cheapest design.
+// (cost 7.5)"; with more untried than settle them, "...; 2 runs settle
+// them (if these fail, ...): cores=5,freq_ghz=1.5 (cost 7.5), ...", naming at
+// most `shown_at_most` designs per list ("and 4 more"), or "not counted
+// (...)"; empty without a cheapest design.
 std::string CheaperText(const spec::Spec& spec, const CheaperDesigns& cheaper,
                         int shown_at_most = 3);
 

@@ -172,6 +172,7 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
         ComputeHeadline(spec, result.evaluations).cheaper;
     if (left.counted) {
       run.cheaper_left_untried = left.untried_count;
+      run.runs_to_settle = left.to_settle_count;
       run.cheapest_confirmed = left.untried_count == 0;
     }
   }

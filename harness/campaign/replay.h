@@ -79,6 +79,9 @@ struct ReplayRun {
   // (CheaperDesigns::untried_count; 0 when confirmed); -1 otherwise, or
   // when the space is too large to count.
   int64_t cheaper_left_untried = -1;
+  // ... and how many more runs would settle them if they fail
+  // (CheaperDesigns::to_settle_count; -1 likewise, or when not searched).
+  int64_t runs_to_settle = -1;
   std::vector<spec::DesignPoint> proposals;  // in order
   std::vector<ReplayIteration> iterations;   // in order
 };

@@ -104,7 +104,7 @@ int RunExplore(const ExploreArgs& args) {
   std::string rationales;
   for (const std::string& name : strategies) {
     const auto started = std::chrono::steady_clock::now();
-    std::vector<double> found, ratio, first, left;
+    std::vector<double> found, ratio, first, left, settle;
     int front = 0, missing = 0, cheapest = 0, confirmed = 0;
     nlohmann::json runs = nlohmann::json::array();
     for (int i = 0; i < args.seeds; ++i) {
@@ -126,6 +126,9 @@ int RunExplore(const ExploreArgs& args) {
       confirmed += run->cheapest_confirmed;
       if (run->cheaper_left_untried >= 0) {
         left.push_back(static_cast<double>(run->cheaper_left_untried));
+      }
+      if (run->runs_to_settle >= 0) {
+        settle.push_back(static_cast<double>(run->runs_to_settle));
       }
       const spec::DesignSpace& space = recording->spec.design_space;
       nlohmann::json proposals = nlohmann::json::array();
@@ -151,20 +154,24 @@ int RunExplore(const ExploreArgs& args) {
                               {"points", points},
                               {"rationale", iteration.rationale}});
       }
-      runs.push_back({{"seed", seed},
-                      {"proposals", proposals},
-                      {"iterations", iterations},
-                      {"evaluations", run->evaluations},
-                      {"true_pareto_found", run->true_pareto_found},
-                      {"hypervolume_ratio", run->hypervolume_ratio},
-                      {"first_true_pareto_at", run->first_true_pareto_at},
-                      {"found_cheapest_feasible", run->found_cheapest_feasible},
-                      {"cheapest_confirmed", run->cheapest_confirmed},
-                      {"cheaper_left_untried",
-                       run->cheaper_left_untried >= 0
-                           ? nlohmann::json(run->cheaper_left_untried)
-                           : nlohmann::json()},
-                      {"not_recorded", run->missing}});
+      runs.push_back(
+          {{"seed", seed},
+           {"proposals", proposals},
+           {"iterations", iterations},
+           {"evaluations", run->evaluations},
+           {"true_pareto_found", run->true_pareto_found},
+           {"hypervolume_ratio", run->hypervolume_ratio},
+           {"first_true_pareto_at", run->first_true_pareto_at},
+           {"found_cheapest_feasible", run->found_cheapest_feasible},
+           {"cheapest_confirmed", run->cheapest_confirmed},
+           {"cheaper_left_untried",
+            run->cheaper_left_untried >= 0
+                ? nlohmann::json(run->cheaper_left_untried)
+                : nlohmann::json()},
+           {"runs_to_settle", run->runs_to_settle >= 0
+                                  ? nlohmann::json(run->runs_to_settle)
+                                  : nlohmann::json()},
+           {"not_recorded", run->missing}});
     }
     const Distribution f = Describe(found), r = Describe(ratio),
                        a = Describe(first);
@@ -193,7 +200,13 @@ int RunExplore(const ExploreArgs& args) {
         cheapest, args.seeds, confirmed, args.seeds,
         left.empty()
             ? std::string()
-            : fmt::format(" (median {:g} left)", Describe(left).median),
+            : fmt::format(
+                  " (median {:g} left{})", Describe(left).median,
+                  settle.empty()
+                      ? std::string()
+                      : fmt::format(", {:g} run{} to settle them",
+                                    Describe(settle).median,
+                                    Describe(settle).median == 1 ? "" : "s")),
         missing);
     if (!args.json) {  // with --json, stdout's JSON alone
       std::fprintf(

@@ -153,6 +153,7 @@ TEST(HeadlineTest,
       "6 in the space: 2 run, none feasible; 3 with no more capacity than a "
       "run that failed; 1 untried, cheapest first: cores=6,freq_ghz=1.5 "
       "(cost 9)";
+  EXPECT_EQ(c.to_settle_count, 1);  // the one untried: not named twice
   EXPECT_EQ(CheaperText(spec, c), sentence);
   EXPECT_THAT(HeadlineText(spec, rows, h),
               HasSubstr("cheaper designs     " + sentence + "\n"));
@@ -189,9 +190,20 @@ TEST(HeadlineTest, OnlyARunShortOfCapacityRulesOutTheDesignsBelowIt) {
   const std::string three =
       "4 untried, cheapest first: cores=2,freq_ghz=1.5 (cost 3), "
       "cores=2,freq_ghz=2 (cost 4), cores=4,freq_ghz=1.5 (cost 6)";
-  EXPECT_THAT(CheaperText(spec, c), HasSubstr(three + " and 1 more"));
-  EXPECT_THAT(HeadlineMarkdown(spec, rows, h, "images"),
-              HasSubstr(three + ", cores=4,freq_ghz=2 (cost 8).\n"));
+  // 4 x 2.0 has at least the others' capacity: its failure would settle
+  // them all.
+  EXPECT_EQ(c.to_settle_count, 1);
+  const std::string settle =
+      "; 1 run settles them (if these fail, every other has no more "
+      "capacity than one that failed): cores=4,freq_ghz=2 (cost 8)";
+  EXPECT_THAT(CheaperText(spec, c), HasSubstr(three + " and 1 more" + settle));
+  EXPECT_THAT(
+      HeadlineMarkdown(spec, rows, h, "images"),
+      HasSubstr(three + ", cores=4,freq_ghz=2 (cost 8)" + settle + ".\n"));
+  const nlohmann::json answer = AnswerJson(spec, rows, h);
+  EXPECT_EQ(answer.at("cheaper_designs").at("to_settle_count"), 1);
+  EXPECT_EQ(answer.at("cheaper_designs").at("to_settle").at(0).at("point"),
+            "cores=4,freq_ghz=2");
 }
 
 TEST(HeadlineTest, AnExhaustiveCampaignLeavesNoCheaperDesignUntried) {

@@ -89,6 +89,11 @@ TEST(ReplayTest, AReplaySaysWhetherItsRunsLeaveACheaperDesignUntried) {
   EXPECT_TRUE(agent->found_cheapest_feasible);
   EXPECT_FALSE(agent->cheapest_confirmed);
   EXPECT_GT(agent->cheaper_left_untried, 0);
+  // Fewer runs would settle them: each untried design has no more capacity
+  // than one of those.
+  EXPECT_GT(agent->runs_to_settle, 0);
+  EXPECT_LE(agent->runs_to_settle, agent->cheaper_left_untried);
+  EXPECT_EQ(all->runs_to_settle, 0);
 }
 
 TEST(ReplayTest, ReplayIsDeterministicAndAnUnknownStrategyIsAnError) {
