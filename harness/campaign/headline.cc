@@ -144,7 +144,12 @@ CheaperDesigns CountCheaper(const spec::Spec& spec,
     }
   }
   const double limit = analysis::TieKey(cost);
-  std::vector<std::pair<double, spec::DesignPoint>> untried;
+  struct Untried {
+    double cost;
+    spec::DesignPoint point;
+    explore::Genes genes;
+  };
+  std::vector<Untried> untried;
   const Status status = spec::ForEachPointCost(
       spec, [&](const spec::DesignPoint& point, double design_cost) {
         if (!(analysis::TieKey(design_cost) < limit)) return;
@@ -164,47 +169,43 @@ CheaperDesigns CountCheaper(const spec::Spec& spec,
           }
         }
         ++out.untried_count;
-        untried.emplace_back(design_cost, point);
+        untried.push_back({design_cost, point, *genes});
       });
   if (!status.ok()) {
     out = CheaperDesigns();
     out.why_not_counted = status.message();
     return out;
   }
-  std::stable_sort(
-      untried.begin(), untried.end(), [](const auto& a, const auto& b) {
-        return analysis::TieKey(a.first) < analysis::TieKey(b.first);
-      });
+  std::stable_sort(untried.begin(), untried.end(),
+                   [](const auto& a, const auto& b) {
+                     return analysis::TieKey(a.cost) < analysis::TieKey(b.cost);
+                   });
   // The untried designs that no other exceeds in capacity: each untried
   // design has no more capacity than one of them, so their failures would
   // rule every one out (quadratic: only for a modest count).
   if (out.untried_count > CheaperDesigns::kMaxSettleSearch) {
     out.to_settle_count = -1;
   } else {
-    std::vector<explore::Genes> genes;
-    for (const auto& [design_cost, point] : untried) {
-      genes.push_back(*grid.FromPoint(point));
-    }
-    for (size_t i = 0; i < untried.size(); ++i) {
+    for (const Untried& u : untried) {
       bool exceeded = false;
       for (size_t j = 0; j < untried.size() && !exceeded; ++j) {
-        exceeded = explore::CompareCapacity(roles, {}, genes[j], genes[i],
-                                            false) == +1;
+        exceeded = explore::CompareCapacity(roles, {}, untried[j].genes,
+                                            u.genes, false) == +1;
       }
       if (exceeded) continue;
       ++out.to_settle_count;
       if (out.to_settle.size() <
           static_cast<size_t>(CheaperDesigns::kMaxListed)) {
-        out.to_settle.push_back(untried[i].second);
-        out.to_settle_cost.push_back(untried[i].first);
+        out.to_settle.push_back(u.point);
+        out.to_settle_cost.push_back(u.cost);
       }
     }
   }
   for (size_t k = 0; k < untried.size() &&
                      k < static_cast<size_t>(CheaperDesigns::kMaxListed);
        ++k) {
-    out.untried_cost.push_back(untried[k].first);
-    out.untried.push_back(std::move(untried[k].second));
+    out.untried_cost.push_back(untried[k].cost);
+    out.untried.push_back(std::move(untried[k].point));
   }
   out.counted = true;
   return out;

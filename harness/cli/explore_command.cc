@@ -38,6 +38,20 @@ Distribution Describe(std::vector<double> v) {
   return d;
 }
 
+// " (median 8 left, 3 runs to settle them)" over the seeds that found the
+// cheapest design; empty when none did.
+std::string UntriedText(const std::vector<double>& left,
+                        const std::vector<double>& settle) {
+  if (left.empty()) return std::string();
+  std::string settling;
+  if (!settle.empty()) {
+    const double runs = Describe(settle).median;
+    settling =
+        fmt::format(", {:g} run{} to settle them", runs, runs == 1 ? "" : "s");
+  }
+  return fmt::format(" (median {:g} left{})", Describe(left).median, settling);
+}
+
 }  // namespace
 
 int RunExplore(const ExploreArgs& args) {
@@ -197,16 +211,7 @@ int RunExplore(const ExploreArgs& args) {
         first.empty() ? "never"
                       : fmt::format("{:g} ({} of {} seeds)", a.median,
                                     first.size(), args.seeds),
-        cheapest, args.seeds, confirmed, args.seeds,
-        left.empty()
-            ? std::string()
-            : fmt::format(
-                  " (median {:g} left{})", Describe(left).median,
-                  settle.empty()
-                      ? std::string()
-                      : fmt::format(", {:g} run{} to settle them",
-                                    Describe(settle).median,
-                                    Describe(settle).median == 1 ? "" : "s")),
+        cheapest, args.seeds, confirmed, args.seeds, UntriedText(left, settle),
         missing);
     if (!args.json) {  // with --json, stdout's JSON alone
       std::fprintf(
