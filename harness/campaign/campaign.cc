@@ -43,14 +43,14 @@ class ViewRefresher : public ExplorerListener {
     summary_->running.clear();
   }
 
-  void OnProposed(const explore::Strategy& strategy,
-                  const runfile::IterationRow& iteration,
-                  const std::vector<spec::DesignPoint>& points) override {
+  void OnProposed(const runfile::IterationRow& iteration,
+                  const std::vector<spec::DesignPoint>& points,
+                  bool fell_back) override {
     summary_->exploration.iterations.push_back(iteration);
     summary_->running.insert(summary_->running.end(), points.begin(),
                              points.end());
     Write();
-    if (next_ != nullptr) next_->OnProposed(strategy, iteration, points);
+    if (next_ != nullptr) next_->OnProposed(iteration, points, fell_back);
   }
   void OnEvaluated(const EvaluationRow& row) override {
     summary_->exploration.evaluations.push_back(row);
@@ -89,6 +89,9 @@ Result<spec::Spec> Overridden(const spec::Spec& input,
   spec::Spec spec = input;
   if (!options.strategy.empty()) spec.exploration.strategy = options.strategy;
   if (options.budget >= 0) spec.exploration.budget = options.budget;
+  if (options.confirm_runs >= 0) {
+    spec.exploration.confirm_runs = options.confirm_runs;
+  }
   if (!options.isolation.empty()) spec.harness.isolation = options.isolation;
   if (options.workers >= 0) spec.harness.workers = options.workers;
 
@@ -326,7 +329,7 @@ Result<CampaignSummary> RunCampaign(const spec::Spec& input,
     const uint64_t planned = std::min<uint64_t>(
         static_cast<uint64_t>(std::max(0, spec.exploration.budget)),
         spec.design_space.Size());
-    if (pool::InterruptRequested() == 0 &&
+    if (pool::InterruptRequested() == 0 && !result.confirm_cut &&
         result.evaluations.size() >= planned) {
       summary.interrupted_by = 0;
     }

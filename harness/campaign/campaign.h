@@ -28,6 +28,7 @@ struct CampaignOptions {
   // Overrides of the scenario's exploration settings (empty / < 0: keep).
   std::string strategy;
   int budget = -1;
+  int confirm_runs = -1;
   // Overrides of the scenario's harness settings (empty / < 0: keep).
   std::string isolation;
   int workers = -1;

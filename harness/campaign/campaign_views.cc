@@ -325,11 +325,24 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
   }
   md << "## Campaign\n\n";
   md << fmt::format("- scenario: `{}`\n", spec.source_path);
+  std::string confirm;
+  if (spec.exploration.confirm_runs > 0) {
+    std::set<int64_t> confirming;
+    for (const runfile::IterationRow& it : s.exploration.iterations) {
+      if (it.strategy == kConfirmPhase) confirming.insert(it.iteration);
+    }
+    const auto used =
+        std::count_if(rows.begin(), rows.end(), [&](const EvaluationRow& row) {
+          return confirming.count(row.iteration) > 0;
+        });
+    confirm = fmt::format(" and up to {} confirm runs ({} used)",
+                          spec.exploration.confirm_runs, used);
+  }
   md << fmt::format(
-      "- strategy: `{}` (exploration.seed {}), budget {}: {}, {} "
+      "- strategy: `{}` (exploration.seed {}), budget {}{}: {}, {} "
       "simulated, {} reused (this folder or the shared cache), {} failed\n",
       spec.exploration.strategy, spec.exploration.seed, spec.exploration.budget,
-      spec::Counted(rows.size(), "evaluation"), s.simulated, s.reused,
+      confirm, spec::Counted(rows.size(), "evaluation"), s.simulated, s.reused,
       s.failed);
   md << fmt::format("- workers: {}, {}\n", s.workers, s.isolation);
   if (!s.isolation_note.empty()) md << "- note: " << s.isolation_note << "\n";
@@ -519,9 +532,7 @@ nlohmann::json AnswerJson(const spec::Spec& spec,
                {"ruled_out_by_capacity", c.ruled_out},
                {"untried_count", c.untried_count},
                {"untried", designs(c.untried, c.untried_cost)},
-               {"to_settle_count", c.to_settle_count >= 0
-                                       ? nlohmann::json(c.to_settle_count)
-                                       : nlohmann::json()},
+               {"to_settle_count", c.to_settle_count},
                {"to_settle", designs(c.to_settle, c.to_settle_cost)}};
   }
   return {{"cheapest_feasible", row_or_null(headline.cheapest)},
@@ -553,6 +564,7 @@ Status WriteAnswerViews(const spec::Spec& spec, const CampaignSummary& summary,
   j["strategy"] = spec.exploration.strategy;
   j["exploration_seed"] = spec.exploration.seed;
   j["budget"] = spec.exploration.budget;
+  j["confirm_runs"] = spec.exploration.confirm_runs;
   j["replicas"] = spec.harness.replicas;
   j["cases"] = spec::CaseCount(spec);
   j["workers"] = summary.workers;

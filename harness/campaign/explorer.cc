@@ -1,7 +1,15 @@
 #include "harness/campaign/explorer.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <map>
+#include <string>
+
+#include "harness/campaign/cheaper.h"
+#include "harness/campaign/headline.h"
+#include "harness/spec/design_point.h"
+#include "harness/spec/text_util.h"
 
 namespace adse::campaign {
 namespace {
@@ -22,6 +30,9 @@ class Loop {
       RunAsSlotsFree();
     }
     ExplorationResult result;
+    if (spec_.exploration.confirm_runs > 0 && strategy_.failure().ok()) {
+      result.confirm_cut = !RunConfirmPhase();
+    }
     result.interrupted = evaluator_.interrupted();
     for (auto& [index, row] : done_) result.evaluations.push_back(row);
     for (runfile::IterationRow& it : iterations_) {
@@ -40,16 +51,83 @@ class Loop {
   bool Propose(int k) {
     const std::vector<spec::DesignPoint> points = strategy_.Ask(k);
     if (points.empty()) return false;
+    Issue(points, strategy_.name(), strategy_.rationale(),
+          strategy_.fell_back());
+    return true;
+  }
+
+  // Starts `points` as one iteration.
+  void Issue(const std::vector<spec::DesignPoint>& points,
+             const std::string& strategy, const std::string& rationale,
+             bool fell_back) {
     runfile::IterationRow it;
     it.iteration = static_cast<int64_t>(iterations_.size());
-    it.strategy = strategy_.name();
-    it.rationale = strategy_.rationale();
+    it.strategy = strategy;
+    it.rationale = rationale;
     iterations_.push_back(it);
-    if (listener_ != nullptr) listener_->OnProposed(strategy_, it, points);
+    if (listener_ != nullptr) listener_->OnProposed(it, points, fell_back);
     for (const spec::DesignPoint& point : points) {
       EvalRequest request{next_index_++, it.iteration, point};
       proposed_[it.iteration].push_back(request.index);
       evaluator_.Start(request);
+    }
+  }
+
+  // Waits for every outstanding run; false when interrupted first.
+  bool Drain() {
+    while (evaluator_.outstanding() > 0) {
+      const std::vector<EvaluationRow> rows = evaluator_.Wait();
+      for (const EvaluationRow& row : rows) Record(row);
+      if (rows.empty() && evaluator_.interrupted()) return false;
+    }
+    return !evaluator_.interrupted();
+  }
+
+  // The confirm phase; false when an interrupt cut it short.
+  bool RunConfirmPhase() {
+    const spec::DesignSpace& space = spec_.design_space;
+    int left = spec_.exploration.confirm_runs;
+    const int round = std::max(1, spec_.exploration.batch);
+    int done = 0;
+    while (left > 0) {
+      if (evaluator_.interrupted()) return false;
+      std::vector<EvaluationRow> rows;
+      for (const auto& [index, row] : done_) rows.push_back(row);
+      const Headline answer = ComputeHeadline(spec_, rows);
+      if (answer.cheapest < 0) return true;  // nothing to confirm
+      const EvaluationRow& cheapest = rows[answer.cheapest];
+      const std::vector<SettlePick> picks = SettlePicks(
+          spec_, rows, RowMetric(cheapest, kCostMetric), std::min(round, left));
+      if (picks.empty()) return true;
+      const int64_t untried = answer.cheaper.untried_count;
+      std::vector<spec::DesignPoint> points;
+      std::vector<std::string> named;
+      for (const SettlePick& pick : picks) {
+        points.push_back(pick.point);
+        named.push_back(
+            fmt::format("{} (cost {:.4g}: if it fails, {} of the {} fail too)",
+                        spec::FormatPoint(space, pick.point), pick.cost,
+                        pick.settles, untried));
+      }
+      const std::string which =
+          points.size() == 1
+              ? fmt::format("run {}", done + 1)
+              : fmt::format("runs {}-{}", done + 1, done + points.size());
+      Issue(
+          points, kConfirmPhase,
+          fmt::format("Confirm {} of at most {}: of the {} cheaper than the "
+                      "cheapest feasible one, {} (cost {:.4g}), {} {} "
+                      "untried; running {}.",
+                      which, spec_.exploration.confirm_runs,
+                      spec::Counted(static_cast<size_t>(answer.cheaper.cheaper),
+                                    "design"),
+                      spec::FormatPoint(space, cheapest.point),
+                      RowMetric(cheapest, kCostMetric), untried,
+                      untried == 1 ? "is" : "are", fmt::join(named, ", ")),
+          false);
+      left -= static_cast<int>(points.size());
+      done += static_cast<int>(points.size());
+      if (!Drain()) return false;
     }
     return true;
   }

@@ -48,9 +48,11 @@ class Evaluator {
 class ExplorerListener {
  public:
   virtual ~ExplorerListener() = default;
-  virtual void OnProposed(const explore::Strategy& /*strategy*/,
-                          const runfile::IterationRow& /*iteration*/,
-                          const std::vector<spec::DesignPoint>& /*points*/) {}
+  // `fell_back`: explore::Strategy::fell_back() of the strategy that
+  // proposed them (false for the confirm phase).
+  virtual void OnProposed(const runfile::IterationRow& /*iteration*/,
+                          const std::vector<spec::DesignPoint>& /*points*/,
+                          bool /*fell_back*/) {}
   virtual void OnEvaluated(const EvaluationRow& /*row*/) {}
 };
 
@@ -58,12 +60,22 @@ struct ExplorationResult {
   std::vector<EvaluationRow> evaluations;         // by index
   std::vector<runfile::IterationRow> iterations;  // by iteration
   bool interrupted = false;
+  // An interrupt came before the confirm phase ended (it may have had
+  // runs left to propose even when the strategy's budget was spent).
+  bool confirm_cut = false;
 };
 
-// Runs `strategy` to the end of its budget (or an interrupt). Non-adaptive
-// strategies are asked whenever a slot is free; adaptive ones round by
-// round, their Tells in proposal order. Each iteration row lists the
-// content keys of the points it proposed (known once they are evaluated).
+// The iterations of the confirm phase carry this strategy name.
+inline constexpr char kConfirmPhase[] = "confirm";
+
+// Runs `strategy` to the end of its budget (or an interrupt), then the
+// confirm phase when exploration.confirm_runs > 0: rounds of up to
+// exploration.batch SettlePicks (campaign/cheaper.h) of the runs so far,
+// until nothing cheaper than the cheapest feasible design is left untried
+// or the confirm runs are spent. Non-adaptive strategies are asked
+// whenever a slot is free; adaptive ones round by round, their Tells in
+// proposal order. Each iteration row lists the content keys of the points
+// it proposed (known once they are evaluated).
 ExplorationResult Explore(const spec::Spec& spec, explore::Strategy& strategy,
                           Evaluator& evaluator,
                           ExplorerListener* listener = nullptr);

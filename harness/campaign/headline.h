@@ -11,6 +11,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "harness/campaign/cheaper.h"
 #include "harness/campaign/evaluation.h"
 #include "harness/spec/spec.h"
 #include "stack/base/env.h"
@@ -21,35 +22,6 @@ namespace adse::campaign {
 // The two metrics of the cost-time view; every scenario reports both.
 inline constexpr char kCostMetric[] = "hardware_cost";
 inline constexpr char kTimeMetric[] = "nav_time_s";
-
-// How sure the cheapest feasible design is of being the cheapest: what the
-// campaign knows of the designs of the space that cost less.
-struct CheaperDesigns {
-  // The space was enumerated: a design is feasible and the space holds at
-  // most spec::kMaxCostCheckPoints designs.
-  bool counted = false;
-  std::string why_not_counted;  // when a design is feasible but not counted
-  int64_t cheaper = 0;  // designs that cost less (costs equal to 12 digits tie)
-  int64_t run = 0;  // of them, run to the end or stopped early (none feasible)
-  // Not run, with no more capacity than a run that failed a constraint on
-  // measured metrics (explore::CompareCapacity, a faster sensor counted as
-  // more load): by the knobs' roles they fail too.
-  int64_t ruled_out = 0;
-  // The rest: neither run nor ruled out, the designs a longer search
-  // would try. `untried` holds the first kMaxListed of them, cheapest first.
-  int64_t untried_count = 0;
-  std::vector<spec::DesignPoint> untried;
-  std::vector<double> untried_cost;  // per entry of `untried`
-  // The untried designs no other untried one exceeds in capacity: run
-  // these, and if each fails, every untried design is ruled out. -1 when
-  // more than kMaxSettleSearch are untried (not searched). `to_settle`
-  // holds the first kMaxListed, cheapest first.
-  int64_t to_settle_count = 0;
-  std::vector<spec::DesignPoint> to_settle;
-  std::vector<double> to_settle_cost;  // per entry of `to_settle`
-  static constexpr int kMaxListed = 20;
-  static constexpr int64_t kMaxSettleSearch = 4096;
-};
 
 struct Headline {
   // Row indices; -1 when no row qualifies.
@@ -78,15 +50,6 @@ struct Headline {
 
 Headline ComputeHeadline(const spec::Spec& spec,
                          const std::vector<EvaluationRow>& rows);
-
-// "12 in the space: 3 run, none feasible; 8 with no more capacity than
-// a run that failed; 1 untried, cheapest first: cores=5,freq_ghz=1.5
-// (cost 7.5)"; with more untried than settle them, "...; 2 runs settle
-// them (if these fail, ...): cores=5,freq_ghz=1.5 (cost 7.5), ...", naming at
-// most `shown_at_most` designs per list ("and 4 more"), or "not counted
-// (...)"; empty without a cheapest design.
-std::string CheaperText(const spec::Spec& spec, const CheaperDesigns& cheaper,
-                        int shown_at_most = 3);
 
 // "cheapest feasible: cores=2,freq_ghz=1.2 cost 2.4, nav 150.2 s,
 // ctrl 9.8 Hz (1 run)" and the like, one line per design, what the

@@ -99,11 +99,12 @@ std::vector<EvaluationRow> RecordingEvaluator::Wait() {
 }
 
 Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
-                         uint64_t seed, int budget) {
+                         uint64_t seed, int budget, int confirm_runs) {
   spec::Spec spec = recording.spec;
   spec.exploration.strategy = name;
   spec.exploration.seed = seed;
   if (budget > 0) spec.exploration.budget = budget;
+  if (confirm_runs >= 0) spec.exploration.confirm_runs = confirm_runs;
   Result<std::unique_ptr<explore::Strategy>> strategy =
       CreateCampaignStrategy(spec, recording.folder, /*record=*/false);
   if (!strategy.ok()) return strategy.status();
@@ -156,6 +157,7 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
     for (const EvaluationRow& evaluation : result.evaluations) {
       if (evaluation.iteration == row.iteration) {
         iteration.points.push_back(evaluation.point);
+        if (row.strategy == kConfirmPhase) ++run.confirm_evaluations;
       }
     }
     run.iterations.push_back(std::move(iteration));

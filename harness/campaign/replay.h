@@ -59,10 +59,11 @@ struct ReplayIteration {
 struct ReplayRun {
   std::string strategy;
   uint64_t seed = 0;
-  int evaluations = 0;
-  int missing = 0;            // proposed points the recording lacks
-  int true_pareto_found = 0;  // of the recording's front
-  int front_size = 0;         // the recording's front
+  int evaluations = 0;          // the confirm phase's included
+  int confirm_evaluations = 0;  // of them, the confirm phase's
+  int missing = 0;              // proposed points the recording lacks
+  int true_pareto_found = 0;    // of the recording's front
+  int front_size = 0;           // the recording's front
   double hypervolume_ratio = 0.0;
   // Evaluation index (1-based) of the first true Pareto point, 0 if none.
   int first_true_pareto_at = 0;
@@ -80,17 +81,18 @@ struct ReplayRun {
   // when the space is too large to count.
   int64_t cheaper_left_untried = -1;
   // ... and how many more runs would settle them if they fail
-  // (CheaperDesigns::to_settle_count; -1 likewise, or when not searched).
+  // (CheaperDesigns::to_settle_count; -1 likewise).
   int64_t runs_to_settle = -1;
   std::vector<spec::DesignPoint> proposals;  // in order
   std::vector<ReplayIteration> iterations;   // in order
 };
 
-// Replays `strategy` with exploration.seed = seed and the given budget
-// (<= 0: the recording's scenario budget) over the recording.
+// Replays `strategy` with exploration.seed = seed, the given budget (<= 0:
+// the recording's scenario budget) and confirm runs (< 0: the recording's
+// exploration.confirm_runs) over the recording.
 Result<ReplayRun> Replay(const Recording& recording,
-                         const std::string& strategy, uint64_t seed,
-                         int budget);
+                         const std::string& strategy, uint64_t seed, int budget,
+                         int confirm_runs = -1);
 
 }  // namespace adse::campaign
 

@@ -83,6 +83,7 @@ struct RunArgs {
   std::string out;        // campaign folder; default: the scenario's output
   std::string strategy;   // overrides exploration.strategy
   int budget = -1;        // overrides exploration.budget
+  int confirm_runs = -1;  // overrides exploration.confirm_runs
   int workers = -1;       // overrides harness.workers (0: auto)
   std::string isolation;  // overrides harness.isolation
   bool no_cache = false;
@@ -98,6 +99,7 @@ struct ExploreArgs {
   std::string replay;                   // recorded campaign folder
   std::vector<std::string> strategies;  // default: the recorded strategy set
   int budget = 0;                       // 0: the recording's scenario budget
+  int confirm_runs = -1;  // -1: the recording's exploration.confirm_runs
   // Replay as if the scenario had only these of its objectives (metric
   // names); empty: all of them.
   std::vector<std::string> objectives;
@@ -129,6 +131,7 @@ struct SubmitArgs {
   std::string out;                       // campaign folder
   std::string strategy;                  // overrides exploration.strategy
   int budget = -1;                       // overrides exploration.budget
+  int confirm_runs = -1;                 // overrides exploration.confirm_runs
   bool dry_run = false;                  // print the scripts only
   std::vector<std::string> sbatch_args;  // more #SBATCH options
   bool no_cache = false;

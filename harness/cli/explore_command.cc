@@ -52,6 +52,14 @@ std::string UntriedText(const std::vector<double>& left,
   return fmt::format(" (median {:g} left{})", Describe(left).median, settling);
 }
 
+// " after a median of 2 confirm runs of at most 3"; empty without any.
+std::string ConfirmText(const std::vector<double>& used, int at_most) {
+  if (at_most <= 0) return std::string();
+  const double median = Describe(used).median;
+  return fmt::format(" after a median of {:g} confirm run{} of at most {}",
+                     median, median == 1 ? "" : "s", at_most);
+}
+
 }  // namespace
 
 int RunExplore(const ExploreArgs& args) {
@@ -96,9 +104,13 @@ int RunExplore(const ExploreArgs& args) {
   if (strategies.empty()) strategies = explore::StrategyNames();
   const int budget =
       args.budget > 0 ? args.budget : recording->spec.exploration.budget;
+  const int confirm_runs = args.confirm_runs >= 0
+                               ? args.confirm_runs
+                               : recording->spec.exploration.confirm_runs;
   nlohmann::json out = {{"recording", args.replay},
                         {"recorded_evaluations", recording->rows.size()},
                         {"budget", budget},
+                        {"confirm_runs", confirm_runs},
                         {"seeds", args.seeds},
                         {"objectives", nlohmann::json::array()},
                         {"strategies", nlohmann::json::object()}};
@@ -118,13 +130,13 @@ int RunExplore(const ExploreArgs& args) {
   std::string rationales;
   for (const std::string& name : strategies) {
     const auto started = std::chrono::steady_clock::now();
-    std::vector<double> found, ratio, first, left, settle;
+    std::vector<double> found, ratio, first, left, settle, confirming;
     int front = 0, missing = 0, cheapest = 0, confirmed = 0;
     nlohmann::json runs = nlohmann::json::array();
     for (int i = 0; i < args.seeds; ++i) {
       const uint64_t seed = args.first_seed + static_cast<uint64_t>(i);
       Result<campaign::ReplayRun> run =
-          campaign::Replay(*recording, name, seed, budget);
+          campaign::Replay(*recording, name, seed, budget, confirm_runs);
       if (!run.ok()) {
         std::fprintf(stderr, "error: --strategy %s: %s\n", name.c_str(),
                      run.status().message().c_str());
@@ -138,6 +150,7 @@ int RunExplore(const ExploreArgs& args) {
       missing += run->missing;
       cheapest += run->found_cheapest_feasible;
       confirmed += run->cheapest_confirmed;
+      confirming.push_back(run->confirm_evaluations);
       if (run->cheaper_left_untried >= 0) {
         left.push_back(static_cast<double>(run->cheaper_left_untried));
       }
@@ -173,6 +186,7 @@ int RunExplore(const ExploreArgs& args) {
            {"proposals", proposals},
            {"iterations", iterations},
            {"evaluations", run->evaluations},
+           {"confirm_evaluations", run->confirm_evaluations},
            {"true_pareto_found", run->true_pareto_found},
            {"hypervolume_ratio", run->hypervolume_ratio},
            {"first_true_pareto_at", run->first_true_pareto_at},
@@ -205,13 +219,14 @@ int RunExplore(const ExploreArgs& args) {
                                {"runs", runs}};
     table += fmt::format(
         "| {} | {:g} / {:g} / {:.2f} / {:g} | {} | {:.3f} / {:.3f} / {:.3f} / "
-        "{:.3f} | {} | {} of {} seeds | {} of {} seeds{} | {} |\n",
+        "{:.3f} | {} | {} of {} seeds | {} of {} seeds{}{} | {} |\n",
         name, f.min, f.median, f.mean, f.max, front, r.min, r.median, r.mean,
         r.max,
         first.empty() ? "never"
                       : fmt::format("{:g} ({} of {} seeds)", a.median,
                                     first.size(), args.seeds),
-        cheapest, args.seeds, confirmed, args.seeds, UntriedText(left, settle),
+        cheapest, args.seeds, confirmed, args.seeds,
+        ConfirmText(confirming, confirm_runs), UntriedText(left, settle),
         missing);
     if (!args.json) {  // with --json, stdout's JSON alone
       std::fprintf(
@@ -224,9 +239,12 @@ int RunExplore(const ExploreArgs& args) {
   }
   if (!args.json) {
     std::printf(
-        "replay of %s: %zu recorded evaluations, budget %d, seeds "
+        "replay of %s: %zu recorded evaluations, budget %d%s, seeds "
         "%llu..%llu\n",
         args.replay.c_str(), recording->rows.size(), budget,
+        confirm_runs > 0
+            ? fmt::format(" and up to {} confirm runs", confirm_runs).c_str()
+            : "",
         static_cast<unsigned long long>(args.first_seed),
         static_cast<unsigned long long>(args.first_seed + args.seeds - 1));
     std::printf("the recording's answer:\n%s\n",

@@ -74,6 +74,17 @@ CLI::Validator Seed() {
 const CLI::Validator kBudget =
     WholeNumber(adse::spec::kMinBudget, adse::spec::kMaxBudget);
 
+// --confirm-runs, as exploration.confirm_runs.
+void AddConfirmRunsOption(CLI::App* command, int* confirm_runs,
+                          const std::string& default_text) {
+  command
+      ->add_option("--confirm-runs", *confirm_runs,
+                   "Runs after the budget, at most, that settle the designs "
+                   "cheaper than the cheapest feasible one (0: none; " +
+                       default_text + ")")
+      ->transform(WholeNumber(0, adse::spec::kMaxBudget));
+}
+
 // Every command that drives one run of a scenario takes the case it drives.
 void AddCaseOption(CLI::App* command, std::string* task_case) {
   command->add_option(
@@ -224,6 +235,8 @@ int main(int argc, char** argv) {
       ->add_option("--budget", run.budget,
                    "Override exploration.budget (evaluations)")
       ->transform(kBudget);
+  AddConfirmRunsOption(run_cmd, &run.confirm_runs,
+                       "default: exploration.confirm_runs");
   run_cmd
       ->add_option("--workers", run.workers,
                    "Override harness.workers (0: auto)")
@@ -301,6 +314,8 @@ int main(int argc, char** argv) {
                    "Evaluations per replay (default: the "
                    "recorded scenario's budget)")
       ->transform(kBudget);
+  AddConfirmRunsOption(explore_cmd, &explore.confirm_runs,
+                       "default: the recorded scenario's");
   explore_cmd
       ->add_option("--objectives", explore.objectives,
                    "Replay with only these of the recorded scenario's "
@@ -395,6 +410,8 @@ int main(int argc, char** argv) {
   submit_cmd
       ->add_option("--budget", submit.budget, "Override exploration.budget")
       ->transform(kBudget);
+  AddConfirmRunsOption(submit_cmd, &submit.confirm_runs,
+                       "default: exploration.confirm_runs");
   submit_cmd->add_flag("--dry-run", submit.dry_run,
                        "Print the sbatch scripts; write and submit nothing");
   submit_cmd

@@ -45,23 +45,34 @@ std::string Eta(double s) {
 // per event otherwise. Failures are always printed as they happen.
 class Progress : public campaign::ExplorerListener {
  public:
-  Progress(const spec::Spec& spec, int budget, bool tty, bool quiet)
-      : spec_(spec), budget_(budget), tty_(tty), quiet_(quiet) {}
+  // `confirm_runs`: exploration.confirm_runs, the runs at most after the
+  // budget's.
+  Progress(const spec::Spec& spec, int budget, int confirm_runs, bool tty,
+           bool quiet)
+      : spec_(spec),
+        budget_(budget),
+        confirm_runs_(confirm_runs),
+        tty_(tty),
+        quiet_(quiet) {}
 
   void set_workers(int workers) { workers_ = workers; }
 
-  void OnProposed(const explore::Strategy& strategy,
-                  const runfile::IterationRow& it,
-                  const std::vector<spec::DesignPoint>& points) override {
+  void OnProposed(const runfile::IterationRow& it,
+                  const std::vector<spec::DesignPoint>& points,
+                  bool fell_back) override {
     proposed_ += static_cast<int>(points.size());
+    if (it.strategy == campaign::kConfirmPhase && confirm_from_ < 0) {
+      confirm_from_ = done_;  // every run of the budget has come back
+    }
     // An llm iteration the built-in agent had to take over is shown even
-    // under the bar: a model server that is down should not go unnoticed.
-    const bool fallback = strategy.fell_back();
-    if (!quiet_ && !it.rationale.empty() && (!tty_ || fallback)) {
+    // under the bar: a model server that is down should not go unnoticed;
+    // so is every confirm run, a run past the budget.
+    const bool shown = fell_back || it.strategy == campaign::kConfirmPhase;
+    if (!quiet_ && !it.rationale.empty() && (!tty_ || shown)) {
       if (tty_) std::fprintf(stderr, "\r\033[K");
       std::fprintf(stderr, "iteration %lld (%s): %s\n",
-                   static_cast<long long>(it.iteration),
-                   strategy.name().c_str(), it.rationale.c_str());
+                   static_cast<long long>(it.iteration), it.strategy.c_str(),
+                   it.rationale.c_str());
     }
     Draw();
   }
@@ -81,13 +92,13 @@ class Progress : public campaign::ExplorerListener {
       best_point_ = spec::FormatPoint(spec_.design_space, row.point);
     }
     const std::string point = spec::FormatPoint(spec_.design_space, row.point);
+    const std::string count = Count();
     std::string line;
     if (failed) {
       line = fmt::format(
-          "[{}/{}] #{} FAILED {}: {} ({} attempt(s); see "
+          "[{}] #{} FAILED {}: {} ({} attempt(s); see "
           "runs/{}.failed.json)",
-          done_, budget_, row.index, point, row.reason, row.attempts,
-          row.content_key);
+          count, row.index, point, row.reason, row.attempts, row.content_key);
     } else if (!quiet_ && !tty_) {
       // An early-stopped run has no measured nav time or rate: its reason
       // says which bound stopped it.
@@ -101,9 +112,9 @@ class Progress : public campaign::ExplorerListener {
                             spec::CaseName(spec_, row.task_case),
                             spec_.cases.size());
       line = fmt::format(
-          "[{}/{}] #{} {}: {}{}, cost {:.3g}, {} "
+          "[{}] #{} {}: {}{}, cost {:.3g}, {} "
           "({}{})",
-          done_, budget_, row.index, point, reason,
+          count, row.index, point, reason,
           censored ? std::string(" (stopped early, metrics censored)")
                    : fmt::format(", nav {:.1f} s, ctrl {:.1f} Hz",
                                  campaign::RowMetric(row, "nav_time_s"),
@@ -148,6 +159,12 @@ class Progress : public campaign::ExplorerListener {
   }
 
  private:
+  // "3/15", or "confirm 1/3" past the budget.
+  std::string Count() const {
+    if (confirm_from_ < 0) return fmt::format("{}/{}", done_, budget_);
+    return fmt::format("confirm {}/{}", done_ - confirm_from_, confirm_runs_);
+  }
+
   void Draw() {
     if (!tty_ || quiet_) return;
     const int running = std::max(0, std::min(workers_, proposed_ - done_));
@@ -156,14 +173,17 @@ class Progress : public campaign::ExplorerListener {
         budget_ > 0 ? std::min(kWidth, done_ * kWidth / budget_) : 0;
     const double per_run =
         simulated_ > 0 ? simulated_wall_s_ / simulated_ : NAN;
-    const double eta =
-        per_run * std::max(0, budget_ - done_) / std::max(1, workers_);
+    // Past the budget: the confirm runs left, at most.
+    const int left = confirm_from_ < 0
+                         ? budget_ - done_
+                         : confirm_runs_ - (done_ - confirm_from_);
+    const double eta = per_run * std::max(0, left) / std::max(1, workers_);
     std::fprintf(
         stderr,
-        "\r\033[K[%s%s] %d/%d done, %d running, %d failed, ETA %s, best "
+        "\r\033[K[%s%s] %s done, %d running, %d failed, ETA %s, best "
         "feasible %s",
         std::string(filled, '#').c_str(),
-        std::string(kWidth - filled, '.').c_str(), done_, budget_, running,
+        std::string(kWidth - filled, '.').c_str(), Count().c_str(), running,
         failed_, Eta(eta).c_str(),
         std::isfinite(best_cost_)
             ? fmt::format("cost {:.3g} ({})", best_cost_, best_point_).c_str()
@@ -173,6 +193,8 @@ class Progress : public campaign::ExplorerListener {
 
   const spec::Spec& spec_;
   int budget_;
+  int confirm_runs_;
+  int confirm_from_ = -1;  // runs done when the confirm phase began
   bool tty_, quiet_;
   int workers_ = 1;
   int proposed_ = 0, done_ = 0, failed_ = 0, simulated_ = 0;
@@ -225,6 +247,7 @@ int RunRun(const RunArgs& args) {
   options.output_dir = args.out;
   options.strategy = args.strategy;
   options.budget = args.budget;
+  options.confirm_runs = args.confirm_runs;
   options.workers = args.workers;
   options.isolation = args.isolation;
   options.use_cache = !args.no_cache;
@@ -234,6 +257,8 @@ int RunRun(const RunArgs& args) {
   const int budget = args.budget >= 0 ? args.budget : spec->exploration.budget;
   const uint64_t space = spec->design_space.Size();
   Progress progress(*spec, static_cast<int>(std::min<uint64_t>(budget, space)),
+                    args.confirm_runs >= 0 ? args.confirm_runs
+                                           : spec->exploration.confirm_runs,
                     ::isatty(STDERR_FILENO) != 0, args.quiet);
   options.listener = &progress;
   options.on_attempt_failed = [&progress](const campaign::EvalRequest& r,

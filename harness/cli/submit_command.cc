@@ -28,6 +28,7 @@ int RunSubmit(const SubmitArgs& args) {
   options.output_dir = args.out;
   options.strategy = args.strategy;
   options.budget = args.budget;
+  options.confirm_runs = args.confirm_runs;
   options.use_cache = !args.no_cache;
   options.cache_dir = args.cache_dir;
   options.dry_run = args.dry_run;

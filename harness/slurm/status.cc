@@ -206,11 +206,15 @@ Result<CampaignStatus> ReadCampaignStatus(const std::string& folder_in) {
       if (st.strategy.empty()) st.strategy = j.value("strategy", "");
       if (st.scenario.empty()) st.scenario = j.value("scenario_file", "");
       if (st.total == 0) st.total = j.value("budget", 0);
+      st.confirm_runs = j.value("confirm_runs", 0);
       runs_per_point = std::max(1, j.value("replicas", 1)) *
                        std::max(1, j.value("cases", 1));
       // Without a plan, status counts run files: a point has one per
       // case and replica.
-      if (!plan.ok()) st.total *= runs_per_point;
+      if (!plan.ok()) {
+        st.total *= runs_per_point;
+        st.confirm_runs *= runs_per_point;
+      }
       st.views = ViewsOf(j, st.lock_holder, &st.stopped_because);
       campaign_keys = KeysOf(j);
       if (st.views == ViewsState::kInProgress && j["running"].is_array()) {
@@ -349,9 +353,16 @@ std::string FormatStatus(const CampaignStatus& st) {
                         st.strategy.empty() ? "" : " (" + st.strategy + ")");
   out += fmt::format("campaign: {}\n  {}\n", st.folder, what);
   if (!st.scenario.empty()) out += fmt::format("  scenario: {}\n", st.scenario);
-  out += fmt::format("runs: {} done, {} failed, {} running, {} pending{}\n",
-                     st.done, st.failed, st.running, st.pending,
-                     st.total > 0 ? fmt::format(" (of {})", st.total) : "");
+  out += fmt::format(
+      "runs: {} done, {} failed, {} running, {} pending{}\n", st.done,
+      st.failed, st.running, st.pending,
+      st.total > 0
+          ? fmt::format(" (of {}{})", st.total,
+                        st.confirm_runs > 0
+                            ? fmt::format(", and up to {} confirm runs",
+                                          st.confirm_runs)
+                            : "")
+          : "");
   if (!st.running_steps.empty()) {
     out += "running steps:\n";
     for (const RunningStep& r : st.running_steps) {
@@ -452,6 +463,7 @@ std::string StatusJson(const CampaignStatus& st) {
                   {"strategy", st.strategy},
                   {"kind", CampaignKindToString(st.kind)},
                   {"total", st.total},
+                  {"confirm_runs", st.confirm_runs},
                   {"counts",
                    {{"done", st.done},
                     {"failed", st.failed},

@@ -58,6 +58,9 @@ struct CampaignStatus {
   std::string strategy;
   CampaignKind kind = CampaignKind::kLocal;
   int total = 0;  // planned points, or the budget; 0 when unknown
+  // Runs at most after the budget (exploration.confirm_runs, as
+  // summary.json holds it), not in `total`.
+  int confirm_runs = 0;
   int done = 0, failed = 0, running = 0, pending = 0;
   std::vector<RunningStep> running_steps;
   // The points a local campaign (or a coordinator) is running, as its views

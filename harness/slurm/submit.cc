@@ -124,9 +124,13 @@ BatchScript CoordinatorScript(const Context& c, int steps, int tasks,
   script.header = Header(
       c,
       {fmt::format("adse coordinator of campaign '{}': strategy {} "
-                   "(adaptive), budget {}.",
+                   "(adaptive), budget {}{}.",
                    spec.name, spec.exploration.strategy,
-                   spec.exploration.budget),
+                   spec.exploration.budget,
+                   spec.exploration.confirm_runs > 0
+                       ? fmt::format(" and up to {} confirm runs",
+                                     spec.exploration.confirm_runs)
+                       : ""),
        fmt::format("Each run is a job step (srun --exact -n1 -c{} --mem={}M), "
                    "{} at once; the",
                    h.cores_per_worker, h.memory_mb, steps),
@@ -155,6 +159,9 @@ BatchScript CoordinatorScript(const Context& c, int steps, int tasks,
   }
   if (c.options.budget >= 0) {
     command += fmt::format(" --budget {}", c.options.budget);
+  }
+  if (c.options.confirm_runs >= 0) {
+    command += fmt::format(" --confirm-runs {}", c.options.confirm_runs);
   }
   command += CacheFlags(c.options);
   script.body = {
@@ -363,6 +370,9 @@ Result<SubmitResult> Submit(const spec::Spec& input,
   spec::Spec spec = input;
   if (!options.strategy.empty()) spec.exploration.strategy = options.strategy;
   if (options.budget >= 0) spec.exploration.budget = options.budget;
+  if (options.confirm_runs >= 0) {
+    spec.exploration.confirm_runs = options.confirm_runs;
+  }
   if (spec.harness.isolation != "auto") {
     return Status::InvalidArgument(
         spec.Where("harness.isolation") + "harness.isolation: on Slurm, " +
@@ -389,6 +399,15 @@ Result<SubmitResult> Submit(const spec::Spec& input,
     return Status::InvalidArgument(
         spec.Where("exploration.strategy") +
         "exploration.strategy: " + adaptive.status().message());
+  }
+  if (!*adaptive && spec.exploration.confirm_runs > 0) {
+    return Status::InvalidArgument(fmt::format(
+        "{}exploration.confirm_runs: a sweep ({}) plans its points before any "
+        "run ends, and the confirm phase picks from their results; expected 0 "
+        "for a sweep on Slurm, found {} (an adaptive strategy's coordinator "
+        "runs its confirm phase: agent, ga, nsga2, llm)",
+        spec.Where("exploration.confirm_runs"), spec.exploration.strategy,
+        spec.exploration.confirm_runs));
   }
   // A sweep's points and a round's size come from the strategy itself; the
   // llm strategy (which needs its model, not wanted here) proposes one

@@ -35,6 +35,7 @@ struct SubmitOptions {
   std::string output_dir;  // campaign folder; empty: the scenario's output
   std::string strategy;    // overrides exploration.strategy
   int budget = -1;         // overrides exploration.budget
+  int confirm_runs = -1;   // overrides exploration.confirm_runs
   bool use_cache = true;   // false: --no-cache for every job
   std::string cache_dir;   // overrides harness.cache_dir
   // Print the scripts; write, plan and submit nothing.

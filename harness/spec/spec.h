@@ -133,7 +133,11 @@ inline constexpr int kMaxWorkers = 1000000;
 struct ExplorationOptions {
   std::string strategy = "agent";  // exhaustive|random|ga|nsga2|agent|llm
   int budget = 15;                 // evaluations, replicas not counted
-  int batch = 1;                   // points proposed per round
+  // Runs after the budget, at most, that settle the designs cheaper than
+  // the cheapest feasible one (campaign/cheaper.h, SettlePicks); the phase
+  // ends early when none is left untried. 0: no confirm phase.
+  int confirm_runs = 0;
+  int batch = 1;  // points proposed per round
   uint64_t seed = 1;
   DesignPoint start_from;  // empty: the strategy chooses
   // GA / NSGA-II settings.

@@ -352,6 +352,7 @@ const std::vector<Field<ExplorationOptions>>& ExplorationFields() {
   static const std::vector<Field<X>> kFields = {
       Plain("strategy", &X::strategy),
       Integer("budget", &X::budget),
+      Integer("confirm_runs", &X::confirm_runs),
       Integer("batch", &X::batch),
       Integer("seed", &X::seed),
       {"start_from",

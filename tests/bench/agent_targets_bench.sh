@@ -28,49 +28,22 @@ budget="${1:-15}"
 family="${2:-held-out}"
 build="${ADSE_BUILD:-${root}/build}"
 adse="${ADSE_BIN:-${build}/bin/adse}"
-case "${family}" in
-  held-out | committed | recordings | all) ;;
-  *)
-    echo "agent_targets_bench.sh: unknown family '${family}'" \
-      "(expected held-out, committed, recordings or all)" >&2
-    exit 2
-    ;;
-esac
+# shellcheck source=tests/bench/lib/studies.sh
+source "${root}/tests/bench/lib/studies.sh"
 if ! [[ "${budget}" =~ ^[1-9][0-9]*$ ]]; then
   echo "agent_targets_bench.sh: budget '${budget}' is not a positive" \
     "whole number" >&2
   exit 2
 fi
-if [[ ! -x "${adse}" ]]; then
-  echo "agent_targets_bench.sh: no adse binary at ${adse}" \
-    "(build first, or set ADSE_BIN)" >&2
-  exit 2
-fi
+
+require_adse "${adse}"
 out="$(mktemp -d)"
 trap 'rm -rf "${out}"' EXIT
-
 # The studies' folders.
-studies=()
-if [[ "${family}" == held-out ]]; then
-  if [[ ! -x "${build}/bin/make_landscapes" ]]; then
-    echo "agent_targets_bench.sh: no make_landscapes at" \
-      "${build}/bin/make_landscapes (build first, or set ADSE_BUILD)" >&2
-    exit 2
-  fi
-  "${build}/bin/make_landscapes" --held-out "${out}/landscapes" >/dev/null
-  for dir in "${out}"/landscapes/*/; do studies+=("${dir%/}"); done
-fi
-if [[ "${family}" == committed || "${family}" == all ]]; then
-  for dir in "${root}"/tests/data/landscapes/*/; do studies+=("${dir%/}"); done
-fi
-if [[ "${family}" == recordings || "${family}" == all ]]; then
-  for index in "${root}"/tests/data/*/campaign.h5; do
-    studies+=("$(dirname "${index}")")
-  done
-fi
+select_studies "${family}" "${out}" "${root}" "${build}" || exit 2
 
 echo "studies: ${family}; budget ${budget}, seeds 1..20; $(basename "${adse}")"
-echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1 /proc/loadavg)"
+machine_line
 echo
 echo "| study | objectives | points | front | agent: cheapest found (seeds) | agent: distinct paths (seeds) | agent: true Pareto (median) | agent: hypervolume ratio (median) | random: hypervolume ratio (median) | targets missed | wall s |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|"

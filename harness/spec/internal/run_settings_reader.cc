@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::vector<std::string> kExplorationKeys = {
-    "strategy",   "budget",     "batch",          "seed",
+    "strategy",   "budget",     "confirm_runs",   "batch",        "seed",
     "start_from", "population", "crossover_rate", "mutation_rate"};
 const std::vector<std::string> kLlmKeys = {
     "backend",     "endpoint",  "models",  "prompts",
@@ -42,6 +42,9 @@ void SpecReader::ReadExploration(const Val& v) {
     ReadEnum(*e, &x.strategy, StrategyNames());
   if (const Val* e = f.Get("budget")) {
     ReadInt(*e, &x.budget, Bounds::Closed(kMinBudget, kMaxBudget));
+  }
+  if (const Val* e = f.Get("confirm_runs")) {
+    ReadInt(*e, &x.confirm_runs, Bounds::Closed(0, kMaxBudget));
   }
   if (const Val* e = f.Get("batch")) {
     ReadInt(*e, &x.batch, Bounds::Closed(1, 1e6));

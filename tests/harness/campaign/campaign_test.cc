@@ -193,20 +193,23 @@ TEST(CampaignTest,
   }
 
   // Replay of the agent over this recording proposes exactly what a live
-  // agent campaign does when every run comes from the recording's cache.
+  // agent campaign does when every run comes from the recording's cache,
+  // confirm phase included.
   const std::string cache = TempDir("replay-cache");
   for (const std::string& key : RunFiles(out)) {
     ASSERT_TRUE(RunCache(cache).Insert(key, out + "/runs/" + key + ".h5").ok());
   }
   Result<Recording> recording = LoadRecording(out);
   ASSERT_TRUE(recording.ok()) << recording.status().message();
+  int confirming = 0;
   for (const char* strategy : {"agent", "ga", "random"}) {
     Result<ReplayRun> replay =
-        Replay(*recording, strategy, spec.exploration.seed, 6);
+        Replay(*recording, strategy, spec.exploration.seed, 5, 4);
     ASSERT_TRUE(replay.ok()) << replay.status().message();
     EXPECT_EQ(replay->missing, 0);
     CampaignOptions live =
-        Options(TempDir(std::string("live-") + strategy), strategy, 6);
+        Options(TempDir(std::string("live-") + strategy), strategy, 5);
+    live.confirm_runs = 4;
     live.use_cache = true;
     live.cache_dir = cache;
     Result<CampaignSummary> s = RunCampaign(spec, live);
@@ -216,7 +219,18 @@ TEST(CampaignTest,
     for (const EvaluationRow& row : s->exploration.evaluations)
       proposed.push_back(row.point);
     EXPECT_EQ(proposed, replay->proposals) << strategy;
+    EXPECT_EQ(proposed.size(), 5u + replay->confirm_evaluations) << strategy;
+    // The views say how many confirm runs it took.
+    const nlohmann::json summary = nlohmann::json::parse(
+        ReadFile(s->output_dir + "/summary.json").value());
+    EXPECT_EQ(summary.at("confirm_runs"), 4);
+    EXPECT_THAT(ReadFile(s->output_dir + "/report.md").value(),
+                HasSubstr(fmt::format("budget 5 and up to 4 confirm runs ({} "
+                                      "used)",
+                                      replay->confirm_evaluations)));
+    confirming += replay->confirm_evaluations;
   }
+  EXPECT_GT(confirming, 0) << "no strategy left a cheaper design untried";
 }
 
 // Reads the folder's views each time the campaign proposes, after they
@@ -224,9 +238,9 @@ TEST(CampaignTest,
 class ViewsWatcher : public ExplorerListener {
  public:
   explicit ViewsWatcher(std::string folder) : folder_(std::move(folder)) {}
-  void OnProposed(const explore::Strategy& /*strategy*/,
-                  const runfile::IterationRow& /*iteration*/,
-                  const std::vector<spec::DesignPoint>& points) override {
+  void OnProposed(const runfile::IterationRow& /*iteration*/,
+                  const std::vector<spec::DesignPoint>& points,
+                  bool /*fell_back*/) override {
     Seen seen;
     seen.summary = nlohmann::json::parse(
         ReadFile(folder_ + "/summary.json").value(), nullptr, false);

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <set>
 
+#include "harness/campaign/headline.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/random.h"
 
@@ -151,6 +152,75 @@ TEST(ExplorerInterruptTest, AnInterruptStopsProposing) {
   EXPECT_TRUE(r.interrupted);
   EXPECT_LE(evaluator.started_, 6);
   EXPECT_LT(r.evaluations.size(), 30u);
+}
+
+// The evaluations of the confirm phase's iterations.
+std::vector<EvaluationRow> ConfirmRows(const ExplorationResult& r) {
+  std::set<int64_t> confirming;
+  for (const runfile::IterationRow& it : r.iterations) {
+    if (it.strategy == kConfirmPhase) confirming.insert(it.iteration);
+  }
+  std::vector<EvaluationRow> rows;
+  for (const EvaluationRow& row : r.evaluations) {
+    if (confirming.count(row.iteration) > 0) rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST(ExplorerConfirmTest,
+     TheConfirmPhaseRunsCheaperDesignsUntilNoneIsLeftUntriedWhateverTheOrder) {
+  spec::Spec spec = Space("random", 4, 2);
+  const ExplorationResult plain = RunWith(spec, 1, 1);
+  // The budget's runs found a feasible design, but not the cheapest (2
+  // cores at 1.5 GHz, cost 3): the phase has work to do.
+  const Headline before = ComputeHeadline(spec, plain.evaluations);
+  ASSERT_GE(before.cheapest, 0);
+  ASSERT_GT(RowMetric(plain.evaluations[before.cheapest], kCostMetric), 3.0);
+  ASSERT_GT(before.cheaper.untried_count, 0);
+  EXPECT_TRUE(ConfirmRows(plain).empty());
+
+  spec.exploration.confirm_runs = 40;
+  const ExplorationResult confirmed = RunWith(spec, 1, 1);
+  EXPECT_FALSE(confirmed.confirm_cut);
+  // The strategy's runs are the same; the phase's come after them.
+  ASSERT_GT(confirmed.evaluations.size(), plain.evaluations.size());
+  for (size_t i = 0; i < plain.evaluations.size(); ++i) {
+    EXPECT_EQ(confirmed.evaluations[i].point, plain.evaluations[i].point);
+  }
+  const std::vector<EvaluationRow> phase = ConfirmRows(confirmed);
+  EXPECT_EQ(phase.size(),
+            confirmed.evaluations.size() - plain.evaluations.size());
+  EXPECT_LT(phase.size(), 40u) << "it ends once nothing cheaper is untried";
+  std::set<spec::DesignPoint> seen;
+  for (const EvaluationRow& row : confirmed.evaluations) {
+    EXPECT_TRUE(seen.insert(row.point).second) << "proposed twice";
+  }
+  const Headline after = ComputeHeadline(spec, confirmed.evaluations);
+  ASSERT_GE(after.cheapest, 0);
+  EXPECT_DOUBLE_EQ(
+      RowMetric(confirmed.evaluations[after.cheapest], kCostMetric), 3.0);
+  EXPECT_EQ(after.cheaper.untried_count, 0);
+  // As the strategy's, the phase's picks do not depend on how fast runs
+  // finish or how many run at once.
+  for (int capacity : {2, 3}) {
+    const ExplorationResult other = RunWith(spec, capacity, 5);
+    EXPECT_EQ(Proposals(other), Proposals(confirmed)) << capacity;
+  }
+  // Fewer confirm runs than it would take: the phase stops at them.
+  spec.exploration.confirm_runs = 1;
+  EXPECT_EQ(ConfirmRows(RunWith(spec, 1, 1)).size(), 1u);
+}
+
+TEST(ExplorerConfirmTest, AnInterruptCutsTheConfirmPhase) {
+  spec::Spec spec = Space("random", 4);
+  spec.exploration.confirm_runs = 40;
+  auto strategy = explore::CreateStrategy("random", {&spec}).value();
+  FormulaEvaluator evaluator(1, 1);
+  evaluator.interrupt_after_ = 5;  // the phase's first run
+  const ExplorationResult r = Explore(spec, *strategy, evaluator);
+  EXPECT_TRUE(r.interrupted);
+  EXPECT_TRUE(r.confirm_cut);
+  EXPECT_LE(r.evaluations.size(), 5u);
 }
 
 }  // namespace

@@ -110,6 +110,35 @@ TEST(CliRunTest, ExploreReplayWithTwoOfTheObjectivesScoresAgainstTheirFront) {
       four["strategies"]["random"]["runs"][0]["cheaper_left_untried"].is_null())
       << all.out;
   EXPECT_TRUE(four["answer"]["cheaper_designs"].is_object()) << all.out;
+  // With confirm runs after the budget, the seed settles the designs
+  // cheaper than its answer: it finds the recording's and confirms it.
+  const CommandRun confirm = Adse(replay + " --confirm-runs 10");
+  ASSERT_EQ(confirm.exit_code, 0) << confirm.out;
+  const nlohmann::json confirmed = nlohmann::json::parse(confirm.out);
+  EXPECT_EQ(confirmed["confirm_runs"], 10);
+  const nlohmann::json& seed = confirmed["strategies"]["random"]["runs"][0];
+  EXPECT_GT(seed["confirm_evaluations"], 0) << confirm.out;
+  EXPECT_EQ(seed["evaluations"], 15 + seed["confirm_evaluations"].get<int>());
+  EXPECT_EQ(seed["found_cheapest_feasible"], true) << confirm.out;
+  EXPECT_EQ(seed["cheapest_confirmed"], true) << confirm.out;
+  // The table says what they cost.
+  std::string table = replay + " --confirm-runs 10";
+  table.erase(table.find(" --json"), 7);
+  const CommandRun text = Adse(table);
+  ASSERT_EQ(text.exit_code, 0) << text.out;
+  EXPECT_NE(text.out.find("budget 15 and up to 10 confirm runs"),
+            std::string::npos)
+      << text.out;
+  EXPECT_NE(
+      text.out.find("1 of 1 seeds after a median of " +
+                    std::to_string(seed["confirm_evaluations"].get<int>()) +
+                    " confirm runs of at most 10"),
+      std::string::npos)
+      << text.out;
+  const CommandRun negative = Adse(replay + " --confirm-runs -1");
+  EXPECT_EQ(negative.exit_code, 2) << negative.out;
+  EXPECT_NE(negative.out.find("--confirm-runs"), std::string::npos)
+      << negative.out;
 
   const CommandRun unknown = Adse(replay + " --objectives nav_time,cost");
   EXPECT_EQ(unknown.exit_code, 2) << unknown.out;

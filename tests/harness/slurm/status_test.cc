@@ -101,6 +101,7 @@ TEST(StatusTest, ACampaignOnItsWayShowsItsRunningPointsAndWhatIsLeft) {
       {"scenario", "small"},
       {"strategy", "agent"},
       {"budget", 4},
+      {"confirm_runs", 3},
       {"replicas", 2},
       {"cases", 1},
       {"in_progress", true},
@@ -120,11 +121,14 @@ TEST(StatusTest, ACampaignOnItsWayShowsItsRunningPointsAndWhatIsLeft) {
   EXPECT_EQ(st->done, 2);
   EXPECT_EQ(st->running, 2);
   EXPECT_EQ(st->pending, 4);
+  EXPECT_EQ(st->confirm_runs, 6);  // after the budget, at most
   const std::string text = FormatStatus(*st);
+  EXPECT_THAT(text, HasSubstr("(of 8, and up to 6 confirm runs)"));
   EXPECT_THAT(text, HasSubstr("running points:\n  cores=16,freq_ghz=2.1\n"));
   EXPECT_THAT(text, HasSubstr("views: in progress"));
   const json j = json::parse(StatusJson(*st));
   EXPECT_EQ(j["views"], "in_progress");
+  EXPECT_EQ(j["confirm_runs"], 6);
   EXPECT_EQ(j["running_points"], json::array({"cores=16,freq_ghz=2.1"}));
 }
 

@@ -89,8 +89,9 @@ TEST(SubmitTest, DryRunOfAnAdaptiveCampaignSizesTheCoordinatorFromTheScenario) {
       SmallScenarioIn(dir, "{strategy: agent, budget: 4, batch: 2}",
                       "{workers: 2, cores_per_worker: 2, memory_mb: 1000, "
                       "slurm: {account: lab, time_limit: \"1-00:00:00\"}}");
-  const AdseRun run = Adse({"submit", scenario, "-o", dir + "/campaign",
-                            "--dry-run", "--json", "--no-cache"});
+  const AdseRun run =
+      Adse({"submit", scenario, "-o", dir + "/campaign", "--dry-run", "--json",
+            "--no-cache", "--confirm-runs", "3"});
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::map<std::string, std::string> scripts = DryRunScripts(run);
   ASSERT_EQ(scripts.count("coordinator"), 1u) << run.output;
@@ -101,7 +102,8 @@ TEST(SubmitTest, DryRunOfAnAdaptiveCampaignSizesTheCoordinatorFromTheScenario) {
         "#SBATCH --mem=3024M\n",  // 2 steps x 1000 MB + 1024 MB
         "#SBATCH --time=1-00:00:00\n", "#SBATCH --signal=B:USR1@300\n",
         "#SBATCH --account=lab\n", "#SBATCH --requeue\n",
-        "--executor slurm --no-cache &", "kill -USR1 \"$pid\"",
+        "(adaptive), budget 4 and up to 3 confirm runs.",
+        "--executor slurm --confirm-runs 3 --no-cache &", "kill -USR1 \"$pid\"",
         "kill -INT \"$pid\"", "scontrol requeue \"$SLURM_JOB_ID\""}) {
     EXPECT_THAT(s, HasSubstr(line));
   }
@@ -191,6 +193,19 @@ TEST(SubmitTest, BadInputIsRefusedNamingTheFieldOrFlag) {
   run = Adse({"submit", bad, "-o", out, "--dry-run"});
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.output, HasSubstr("harness.isolation: on Slurm"));
+
+  // A sweep plans its points before any run ends: no confirm phase.
+  bad = SmallScenarioIn(dir, "{strategy: random, budget: 2, confirm_runs: 3}",
+                        "{}");
+  run = Adse({"submit", bad, "-o", out, "--dry-run"});
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("scenario.yaml:"));
+  EXPECT_THAT(run.output,
+              HasSubstr("exploration.confirm_runs: a sweep (random) plans "
+                        "its points before any run ends"));
+  run = Adse({"submit", ok, "-o", out, "--dry-run", "--confirm-runs", "2"});
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("exploration.confirm_runs"));
   EXPECT_FALSE(fs::exists(out));
 }
 

@@ -366,6 +366,8 @@ TEST(SpecErrorsTest, NonPositiveRatesAndTimeouts) {
               "exploration.budget", 9, "an integer in [1, ");
   ExpectError(std::string(kHead) + "exploration: {budget: 0, batch: -1}\n",
               "exploration.batch", 9, "an integer in [1, ");
+  ExpectError(std::string(kHead) + "exploration: {confirm_runs: -1}\n",
+              "exploration.confirm_runs", 9, "an integer in [0, ");
   ExpectError(std::string(kHead) +
                   "harness: {memory_mb: 0, cores_per_worker: 0, replicas: 0, "
                   "retries: -1, workers: 0}\n",

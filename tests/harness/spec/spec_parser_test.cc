@@ -129,6 +129,7 @@ TEST(SpecParserTest, ReferenceExampleFillsEverySection) {
 
   EXPECT_EQ(spec.exploration.strategy, "agent");
   EXPECT_EQ(spec.exploration.budget, 15);
+  EXPECT_EQ(spec.exploration.confirm_runs, 0);  // off unless asked for
   EXPECT_NEAR(spec.exploration.start_from.at("freq_ghz"), 1.5, kTol);
   EXPECT_EQ(spec.exploration.population, 8);
 
