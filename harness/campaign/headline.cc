@@ -15,8 +15,6 @@
 #include "analysis/pareto/pareto.h"
 #include "analysis/pictures/pictures.h"
 #include "harness/campaign/replicas.h"
-#include "harness/explore/capacity.h"
-#include "harness/explore/strategy.h"
 #include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
 #include "harness/spec/text_util.h"

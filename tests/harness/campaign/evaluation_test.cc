@@ -13,23 +13,18 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/spec/spec_parser.h"
+#include "tests/harness/testing/lot_scenario.h"
 #include "tests/harness/testing/recording.h"
 
 namespace adse::campaign {
 namespace {
 
 spec::Spec Scenario() {
-  spec::ParseOptions options;
-  options.check_files = false;
-  Result<spec::Spec> spec = spec::ParseSpec(
-      "adse: 1\nname: rows\nworld: {map: {generate: parking_lot}}\n"
-      "task: {start: {x: 5, y: -1.75}, goal: {x: 60, y: 29.75}}\n"
+  return adse::testing::LotScenario(
+      "rows",
       "design_space:\n  cores: {bind: platform.cores, values: [1, 4]}\n"
       "objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]\n"
-      "constraints: [nav_time_s <= 60]\n",
-      "rows.yaml", ".", options);
-  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
-  return std::move(spec).value();
+      "constraints: [nav_time_s <= 60]\n");
 }
 
 report::RunReport Report(double cores, double nav_time_s, bool censored) {

@@ -13,6 +13,7 @@
 #include "analysis/runfile/run_data.h"
 #include "harness/campaign/headline.h"
 #include "harness/spec/spec_parser.h"
+#include "tests/harness/testing/lot_scenario.h"
 
 namespace adse::campaign {
 namespace {
@@ -20,18 +21,12 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 spec::Spec Scenario() {
-  spec::ParseOptions options;
-  options.check_files = false;
-  Result<spec::Spec> spec = spec::ParseSpec(
-      "adse: 1\nname: replicas\nworld: {map: {generate: parking_lot}}\n"
-      "task: {start: {x: 5, y: -1.75}, goal: {x: 60, y: 29.75}}\n"
+  return adse::testing::LotScenario(
+      "replicas",
       "design_space:\n  cores: {bind: platform.cores, values: [1, 4]}\n"
       "objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]\n"
       "constraints: [nav_time_s <= 60, ctrl_rate_hz >= 1]\n"
-      "harness: {replicas: 3}\n",
-      "replicas.yaml", ".", options);
-  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
-  return std::move(spec).value();
+      "harness: {replicas: 3}\n");
 }
 
 // A run that reached the goal in `nav_time_s` at 4 cores.

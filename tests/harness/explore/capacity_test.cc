@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "harness/spec/spec_parser.h"
+#include "tests/harness/testing/lot_scenario.h"
 
 namespace adse::explore {
 namespace {
@@ -61,20 +62,14 @@ TEST(CapacityTest, CoarserDataIsMoreCapacityOnlyWhereAsked) {
 // A scenario with a bound on the time (a load metric), one on the
 // deviation (a precision metric), one on the cost and one on a knob.
 spec::Spec Scenario() {
-  spec::ParseOptions options;
-  options.check_files = false;
-  Result<spec::Spec> spec = spec::ParseSpec(
-      "adse: 1\nname: capacity\nworld: {map: {generate: parking_lot}}\n"
-      "task: {start: {x: 5, y: -1.75}, goal: {x: 60, y: 29.75}}\n"
+  return adse::testing::LotScenario(
+      "capacity",
       "design_space:\n"
       "  cores: {bind: platform.cores, values: [2, 4]}\n"
       "cost: cores\n"
       "objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]\n"
       "constraints: [nav_time_s <= 60, deviation_score <= 0.5,\n"
-      "              hardware_cost <= 3, cores >= 4]\n",
-      "capacity.yaml", ".", options);
-  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
-  return std::move(spec).value();
+      "              hardware_cost <= 3, cores >= 4]\n");
 }
 
 Observation RunOf(double nav_time_s, double deviation_score) {

@@ -7,10 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <string>
-#include <utility>
 
 #include "harness/campaign/evaluation.h"
-#include "harness/spec/spec_parser.h"
+#include "tests/harness/testing/lot_scenario.h"
 
 namespace adse::testing {
 
@@ -19,24 +18,16 @@ inline constexpr char kGrid[] =
     "  freq_ghz: {bind: platform.freq_ghz, values: [1.5, 2.0, 3.0]}\n";
 
 // `constraints` as the scenario writes them; `space` the design space's
-// lines; parsed without file checks.
+// lines.
 inline spec::Spec GridScenario(
     const std::string& constraints = "[nav_time_s <= 60]",
     const std::string& space = kGrid) {
-  spec::ParseOptions options;
-  options.check_files = false;
-  Result<spec::Spec> spec = spec::ParseSpec(
-      "adse: 1\nname: ties\nworld: {map: {generate: parking_lot}}\n"
-      "task: {start: {x: 5, y: -1.75}, goal: {x: 60, y: 29.75}}\n"
-      "design_space:\n" +
-          space +
-          "cost: cores * freq_ghz\n"
-          "objectives: [{minimize: hardware_cost}, {minimize: nav_time_s}]\n"
-          "constraints: " +
-          constraints + "\n",
-      "ties.yaml", ".", options);
-  EXPECT_TRUE(spec.ok()) << spec.status().ToString();
-  return std::move(spec).value();
+  return LotScenario("ties", "design_space:\n" + space +
+                                 "cost: cores * freq_ghz\n"
+                                 "objectives: [{minimize: hardware_cost}, "
+                                 "{minimize: nav_time_s}]\n"
+                                 "constraints: " +
+                                 constraints + "\n");
 }
 
 // A complete run of the grid, feasible when it arrives within 60 s.
