@@ -242,13 +242,23 @@ void WarnOfViewsReplaced(const spec::Spec& spec, const CampaignFolder& folder) {
   const size_t before = j.contains("evaluations") && j["evaluations"].is_array()
                             ? j["evaluations"].size()
                             : 0;
-  if (before > static_cast<size_t>(std::max(0, spec.exploration.budget))) {
+  // The confirm phase's runs come on top of the budget.
+  const int64_t most =
+      static_cast<int64_t>(std::max(0, spec.exploration.budget)) +
+      std::max(0, spec.exploration.confirm_runs);
+  if (static_cast<int64_t>(before) > most) {
+    const std::string limit =
+        spec.exploration.confirm_runs > 0
+            ? fmt::format("budget of {} and {} confirm runs",
+                          spec.exploration.budget,
+                          spec.exploration.confirm_runs)
+            : fmt::format("budget of {}", spec.exploration.budget);
     std::fprintf(stderr,
                  "warning: %s holds %zu evaluations, more than this "
-                 "campaign's budget of %d; their runs stay in runs/, but %s "
-                 "become those of this campaign's %d\n",
-                 folder.root().c_str(), before, spec.exploration.budget,
-                 views.c_str(), spec.exploration.budget);
+                 "campaign's %s; their runs stay in runs/, but %s become "
+                 "those of this campaign's %lld at most\n",
+                 folder.root().c_str(), before, limit.c_str(), views.c_str(),
+                 static_cast<long long>(most));
   }
 }
 

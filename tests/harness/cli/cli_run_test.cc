@@ -353,8 +353,19 @@ TEST(CliRunTest, ARunIntoAnotherScenariosFolderWarnsAndStatusCountsItsOwnRuns) {
   EXPECT_NE(status.out.find("answer (campaign.h5):"), std::string::npos)
       << status.out;
   // The same scenario with a smaller budget than the folder's views hold.
-  const CommandRun wider =
-      Adse("run " + other + " --budget 2 --no-cache -o " + out.string());
+  const std::string wide =
+      "run " + other + " --budget 2 --no-cache -o " + out.string();
+  ASSERT_EQ(Adse(wide).exit_code, 0);
+  // Confirm runs come on top of the budget: two evaluations are no more
+  // than one with one confirm run.
+  const CommandRun confirming = Adse("run " + other +
+                                     " --budget 1 --confirm-runs 1 --no-cache "
+                                     "-o " +
+                                     out.string());
+  ASSERT_EQ(confirming.exit_code, 0) << confirming.out;
+  EXPECT_EQ(confirming.out.find("warning:"), std::string::npos)
+      << confirming.out;
+  const CommandRun wider = Adse(wide);
   ASSERT_EQ(wider.exit_code, 0) << wider.out;
   const CommandRun smaller =
       Adse("run " + other + " --budget 1 --no-cache -o " + out.string());
