@@ -313,9 +313,13 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
       running.push_back("`" + spec::FormatPoint(spec.design_space, p) + "`");
     }
     md << fmt::format(
-        "> **In progress:** {} of {} so far{}; the answer comes "
+        "> **In progress:** {} of {}{} so far{}; the answer comes "
         "when the campaign ends.\n\n",
         rows.size(), spec::Counted(spec.exploration.budget, "evaluation"),
+        spec.exploration.confirm_runs > 0
+            ? fmt::format(" and up to {} confirm runs",
+                          spec.exploration.confirm_runs)
+            : std::string(),
         running.empty()
             ? std::string()
             : fmt::format(", running {}", fmt::join(running, ", ")));
