@@ -144,6 +144,14 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
         Fixed(tip + cv::Point2d(1.4 * cross, 2.2 * cross))};
     cv::fillConvexPoly(img, corners, Bgr(kInfeasibleRgb), cv::LINE_AA, kShift);
   };
+  // The rings of highlighted designs (radius + 5 px, 1.5 px wide).
+  const double ring_reach = radius + s.Px(5) + s.Px(3);
+  std::vector<cv::Point2d> rings;
+  for (const auto* p : shown) {
+    if (p->on_front && p->highlight && !clipped(p)) {
+      rings.push_back(px(p->cost, p->nav_time_s));
+    }
+  }
   bool any_censored = false, any_cross = false, any_above = false;
   for (const auto* p : shown) {
     if (p->feasible || p->on_front) continue;
@@ -152,7 +160,16 @@ Result<std::string> ParetoPngImpl(const std::vector<ParetoPlotPoint>& points,
       draw_wedge(px(p->cost, ay.max));
     } else if (p->censored) {
       any_censored = true;
-      draw_arrow_up(px(p->cost, p->nav_time_s), Bgr(kInfeasibleRgb));
+      // A run stopped at the bound a ringed design sits on (as dear, but
+      // too slow) starts its arrow above the ring, not through it.
+      cv::Point2d base = px(p->cost, p->nav_time_s);
+      for (const cv::Point2d& ring : rings) {
+        if (std::abs(base.x - ring.x) < ring_reach &&
+            std::abs(base.y - ring.y) < ring_reach) {
+          base.y = std::min(base.y, ring.y - ring_reach);
+        }
+      }
+      draw_arrow_up(base, Bgr(kInfeasibleRgb));
     } else {
       any_cross = true;
       draw_cross(px(p->cost, p->nav_time_s), Bgr(kInfeasibleRgb));

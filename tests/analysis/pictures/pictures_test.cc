@@ -664,6 +664,28 @@ TEST_F(PictureTest, ParetoPlotRendersPointsFrontAndConstraints) {
   EXPECT_EQ(CountColour(*plain, kConstraintRgb), 0);
 }
 
+TEST_F(PictureTest,
+       AStoppedRunAtTheRingedDesignsCostDrawsItsArrowAboveTheRing) {
+  // The cheapest design arrives just inside a 90 s bound; a design of the
+  // same cost was stopped at the bound. Its arrow shows whole, above the
+  // ring, as much of it as of an arrow in the open; drawn through the
+  // ring, the dot and the ring would hide part of it.
+  auto arrow_pixels = [&](double stopped_cost, const std::string& name) {
+    std::vector<ParetoPlotPoint> points = {
+        {8.4, 89.85, true, true, "7/1.2/7", true},
+        {16.8, 34.9, true, true, "8/2.1/7"},
+        {stopped_cost, 90.0, false, false, "", false, true}};
+    EXPECT_TRUE(RenderParetoPlot(points, Path(name)).ok());
+    Result<RgbImage> img = ReadImage(Path(name));
+    EXPECT_TRUE(img.ok());
+    return img.ok() ? CountColour(*img, kInfeasibleRgb) : 0;
+  };
+  const int open = arrow_pixels(12.0, "arrow_open.png");
+  const int at_ring = arrow_pixels(8.4, "arrow_at_ring.png");
+  EXPECT_GT(open, 20);
+  EXPECT_GE(at_ring, open * 95 / 100) << "the ring hides part of the arrow";
+}
+
 TEST_F(PictureTest, ParetoPlotKeepsTheFrontReadableBelowFarOutliers) {
   // Feasible designs between 30 and 80 s and one timeout at 6000 s: drawn
   // to scale, the feasible dots would share a few rows at the bottom.
