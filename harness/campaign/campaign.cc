@@ -17,6 +17,7 @@
 #include "harness/campaign/run_store.h"
 #include "harness/campaign/strategy_factory.h"
 #include "harness/pool/worker_pool.h"
+#include "harness/spec/design_point.h"
 #include "stack/base/files.h"
 #include "stack/base/subprocess.h"
 
@@ -92,6 +93,7 @@ Result<spec::Spec> Overridden(const spec::Spec& input,
   if (options.confirm_runs >= 0) {
     spec.exploration.confirm_runs = options.confirm_runs;
   }
+  ADSE_RETURN_IF_ERROR(spec::CheckConfirmRuns(spec));
   if (!options.isolation.empty()) spec.harness.isolation = options.isolation;
   if (options.workers >= 0) spec.harness.workers = options.workers;
 

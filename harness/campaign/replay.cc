@@ -9,6 +9,7 @@
 #include "analysis/pareto/pareto.h"
 #include "harness/campaign/headline.h"
 #include "harness/campaign/strategy_factory.h"
+#include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
 
 namespace adse::campaign {
@@ -105,6 +106,7 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
   spec.exploration.seed = seed;
   if (budget > 0) spec.exploration.budget = budget;
   if (confirm_runs >= 0) spec.exploration.confirm_runs = confirm_runs;
+  ADSE_RETURN_IF_ERROR(spec::CheckConfirmRuns(spec));
   Result<std::unique_ptr<explore::Strategy>> strategy =
       CreateCampaignStrategy(spec, recording.folder, /*record=*/false);
   if (!strategy.ok()) return strategy.status();

@@ -18,6 +18,7 @@
 #include "harness/slurm/client.h"
 #include "harness/slurm/records.h"
 #include "harness/slurm/sharding.h"
+#include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
 #include "stack/base/clock.h"
 #include "stack/base/files.h"
@@ -373,6 +374,7 @@ Result<SubmitResult> Submit(const spec::Spec& input,
   if (options.confirm_runs >= 0) {
     spec.exploration.confirm_runs = options.confirm_runs;
   }
+  ADSE_RETURN_IF_ERROR(spec::CheckConfirmRuns(spec));
   if (spec.harness.isolation != "auto") {
     return Status::InvalidArgument(
         spec.Where("harness.isolation") + "harness.isolation: on Slurm, " +

@@ -204,6 +204,19 @@ Status CheckCostOverSpace(const Spec& spec) {
   return ForEachPointCost(spec, [](const DesignPoint&, double) {});
 }
 
+Status CheckConfirmRuns(const Spec& spec) {
+  const uint64_t size = spec.design_space.Size();
+  if (spec.exploration.confirm_runs == 0 || size <= kMaxCostCheckPoints) {
+    return Status::Ok();
+  }
+  return Status::InvalidArgument(fmt::format(
+      "{}exploration.confirm_runs: the confirm phase runs designs cheaper "
+      "than the answer, which adse enumerates in spaces of at most {} "
+      "designs; this space holds {}: expected 0, found {}",
+      spec.Where("exploration.confirm_runs"), kMaxCostCheckPoints, size,
+      spec.exploration.confirm_runs));
+}
+
 namespace {
 
 // Whether a parsed constraint holds for the metrics and the point.

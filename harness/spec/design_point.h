@@ -69,6 +69,10 @@ Status ForEachPointCost(
 // kMaxCostCheckPoints is not enumerated, and each run checks its own
 // point. The error names the first such point in lexicographic order.
 Status CheckCostOverSpace(const Spec& spec);
+// Ok unless exploration.confirm_runs asks for a confirm phase over a space
+// larger than kMaxCostCheckPoints, where the designs cheaper than the
+// answer are not enumerated, so the phase could pick nothing.
+Status CheckConfirmRuns(const Spec& spec);
 
 // Whether `metrics` (name -> value; booleans as 0/1) and the point satisfy
 // one constraint expression of the spec (true when non-zero).

@@ -212,6 +212,38 @@ TEST(DesignPointTest, ACostNotFiniteAtSomeDesignPointIsNamedAtThatPoint) {
                   .ok());
 }
 
+TEST(DesignPointTest, AConfirmPhaseOverASpaceTooLargeToEnumerateIsRefused) {
+  auto parsed = [](const std::string& cores, int confirm_runs) {
+    Result<Spec> spec = ParseSpec(
+        "adse: 1\nworld: {map: {generate: grid}}\n"
+        "task: {start: {x: 0, y: 0}, goal: {x: 1, y: 1}}\n"
+        "design_space:\n"
+        "  cores: {bind: platform.cores, " +
+            cores +
+            "}\n"
+            "  freq_ghz: {bind: platform.freq_ghz, range: [1.0, 3.0], step: "
+            "0.01}\n"
+            "exploration: {confirm_runs: " +
+            std::to_string(confirm_runs) + "}\n",
+        "c.yaml", "");
+    EXPECT_TRUE(spec.ok()) << spec.status().message();
+    return *spec;
+  };
+  EXPECT_TRUE(CheckConfirmRuns(parsed("range: [1, 8]", 5)).ok());
+  EXPECT_TRUE(CheckConfirmRuns(parsed("range: [1, 1024]", 0)).ok());
+  const Status status = CheckConfirmRuns(parsed("range: [1, 1024]", 5));
+  EXPECT_EQ(status.code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(status.message().find("c.yaml:"), std::string::npos)
+      << status.message();
+  EXPECT_NE(status.message().find(
+                "exploration.confirm_runs: the confirm phase runs designs "
+                "cheaper than the answer, which adse enumerates in spaces of "
+                "at most 100000 designs; this space holds 205824: expected "
+                "0, found 5"),
+            std::string::npos)
+      << status.message();
+}
+
 TEST(DesignPointTest, ConstraintsOverMetrics) {
   const Spec spec = Reference();
   const DesignPoint point = {{"cores", 18}, {"freq_ghz", 1.8}, {"lidar_hz", 7}};
