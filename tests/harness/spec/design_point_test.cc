@@ -169,24 +169,28 @@ cost: cores * freq_ghz + hz / 7
   EXPECT_FALSE(EvaluateCost(*only_hz, {{"hz", 10}}).ok());
 }
 
+// A cores x clock space on a generated grid (each knob's values or range
+// as `cores` and `freq` say), then `rest`, as c.yaml.
+Spec CoresAndClock(const std::string& cores, const std::string& freq,
+                   const std::string& rest) {
+  Result<Spec> spec = ParseSpec(
+      "adse: 1\nworld: {map: {generate: grid}}\n"
+      "task: {start: {x: 0, y: 0}, goal: {x: 1, y: 1}}\n"
+      "design_space:\n"
+      "  cores: {bind: platform.cores, " +
+          cores +
+          "}\n"
+          "  freq_ghz: {bind: platform.freq_ghz, " +
+          freq + "}\n" + rest,
+      "c.yaml", "");
+  EXPECT_TRUE(spec.ok()) << spec.status().message();
+  return *spec;
+}
+
 TEST(DesignPointTest, ACostNotFiniteAtSomeDesignPointIsNamedAtThatPoint) {
   auto parsed = [](const std::string& cost, const std::string& cores,
                    const std::string& freq = "values: [1.0, 2.1]") {
-    Result<Spec> spec = ParseSpec(
-        "adse: 1\nworld: {map: {generate: grid}}\n"
-        "task: {start: {x: 0, y: 0}, goal: {x: 1, y: 1}}\n"
-        "design_space:\n"
-        "  cores: {bind: platform.cores, " +
-            cores +
-            "}\n"
-            "  freq_ghz: {bind: platform.freq_ghz, " +
-            freq +
-            "}\n"
-            "cost: " +
-            cost + "\n",
-        "c.yaml", "");
-    EXPECT_TRUE(spec.ok()) << spec.status().message();
-    return *spec;
+    return CoresAndClock(cores, freq, "cost: " + cost + "\n");
   };
   EXPECT_TRUE(
       CheckCostOverSpace(parsed("cores * freq_ghz", "range: [1, 8]")).ok());
@@ -214,20 +218,9 @@ TEST(DesignPointTest, ACostNotFiniteAtSomeDesignPointIsNamedAtThatPoint) {
 
 TEST(DesignPointTest, AConfirmPhaseOverASpaceTooLargeToEnumerateIsRefused) {
   auto parsed = [](const std::string& cores, int confirm_runs) {
-    Result<Spec> spec = ParseSpec(
-        "adse: 1\nworld: {map: {generate: grid}}\n"
-        "task: {start: {x: 0, y: 0}, goal: {x: 1, y: 1}}\n"
-        "design_space:\n"
-        "  cores: {bind: platform.cores, " +
-            cores +
-            "}\n"
-            "  freq_ghz: {bind: platform.freq_ghz, range: [1.0, 3.0], step: "
-            "0.01}\n"
-            "exploration: {confirm_runs: " +
-            std::to_string(confirm_runs) + "}\n",
-        "c.yaml", "");
-    EXPECT_TRUE(spec.ok()) << spec.status().message();
-    return *spec;
+    return CoresAndClock(
+        cores, "range: [1.0, 3.0], step: 0.01",
+        "exploration: {confirm_runs: " + std::to_string(confirm_runs) + "}\n");
   };
   EXPECT_TRUE(CheckConfirmRuns(parsed("range: [1, 8]", 5)).ok());
   EXPECT_TRUE(CheckConfirmRuns(parsed("range: [1, 1024]", 0)).ok());
