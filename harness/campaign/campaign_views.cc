@@ -331,16 +331,9 @@ std::string ReportMarkdown(const spec::Spec& spec, const CampaignSummary& s,
   md << fmt::format("- scenario: `{}`\n", spec.source_path);
   std::string confirm;
   if (spec.exploration.confirm_runs > 0) {
-    std::set<int64_t> confirming;
-    for (const runfile::IterationRow& it : s.exploration.iterations) {
-      if (it.strategy == kConfirmPhase) confirming.insert(it.iteration);
-    }
-    const auto used =
-        std::count_if(rows.begin(), rows.end(), [&](const EvaluationRow& row) {
-          return confirming.count(row.iteration) > 0;
-        });
     confirm = fmt::format(" and up to {} confirm runs ({} used)",
-                          spec.exploration.confirm_runs, used);
+                          spec.exploration.confirm_runs,
+                          ConfirmEvaluations(s.exploration));
   }
   md << fmt::format(
       "- strategy: `{}` (exploration.seed {}), budget {}{}: {}, {} "

@@ -73,9 +73,9 @@ std::vector<size_t> Maximal(const std::vector<spec::KnobRole>& roles,
 
 // With `skip_held`, a design some row holds (a failed run's too) is not
 // untried: the confirm phase never proposes a point twice.
-std::optional<Search> SearchCheaper(const spec::Spec& spec,
-                                    const std::vector<EvaluationRow>& rows,
-                                    double cost, bool skip_held) {
+Search SearchCheaper(const spec::Spec& spec,
+                     const std::vector<EvaluationRow>& rows, double cost,
+                     bool skip_held) {
   Search out;
   const uint64_t size = spec.design_space.Size();
   if (size > spec::kMaxCostCheckPoints) {
@@ -152,18 +152,18 @@ std::optional<Search> SearchCheaper(const spec::Spec& spec,
 CheaperDesigns CountCheaper(const spec::Spec& spec,
                             const std::vector<EvaluationRow>& rows,
                             double cost) {
-  std::optional<Search> search = SearchCheaper(spec, rows, cost, false);
-  CheaperDesigns out = std::move(search->counts);
+  Search search = SearchCheaper(spec, rows, cost, false);
+  CheaperDesigns out = std::move(search.counts);
   if (!out.counted) return out;
   const size_t listed = static_cast<size_t>(CheaperDesigns::kMaxListed);
-  for (size_t k = 0; k < search->maximal.size() && k < listed; ++k) {
-    const Untried& u = search->untried[search->maximal[k]];
+  for (size_t k = 0; k < search.maximal.size() && k < listed; ++k) {
+    const Untried& u = search.untried[search.maximal[k]];
     out.to_settle.push_back(u.point);
     out.to_settle_cost.push_back(u.cost);
   }
-  for (size_t k = 0; k < search->untried.size() && k < listed; ++k) {
-    out.untried_cost.push_back(search->untried[k].cost);
-    out.untried.push_back(std::move(search->untried[k].point));
+  for (size_t k = 0; k < search.untried.size() && k < listed; ++k) {
+    out.untried_cost.push_back(search.untried[k].cost);
+    out.untried.push_back(std::move(search.untried[k].point));
   }
   return out;
 }
@@ -171,15 +171,15 @@ CheaperDesigns CountCheaper(const spec::Spec& spec,
 std::vector<SettlePick> SettlePicks(const spec::Spec& spec,
                                     const std::vector<EvaluationRow>& rows,
                                     double cost, int k) {
-  std::optional<Search> search = SearchCheaper(spec, rows, cost, true);
-  if (!search->counts.counted || k < 1) return {};
+  const Search search = SearchCheaper(spec, rows, cost, true);
+  if (!search.counts.counted || k < 1) return {};
   std::vector<SettlePick> picks;
-  for (size_t m : search->maximal) {
-    const Untried& top = search->untried[m];
+  for (size_t m : search.maximal) {
+    const Untried& top = search.untried[m];
     SettlePick pick{top.point, top.cost, 0};
-    for (const Untried& u : search->untried) {
-      const int order = explore::CompareCapacity(search->roles, {}, top.genes,
-                                                 u.genes, false);
+    for (const Untried& u : search.untried) {
+      const int order =
+          explore::CompareCapacity(search.roles, {}, top.genes, u.genes, false);
       if (order == +1 || order == 0) ++pick.settles;
     }
     picks.push_back(std::move(pick));

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 #include <string>
 
 #include "harness/campaign/cheaper.h"
@@ -73,14 +74,15 @@ class Loop {
     }
   }
 
-  // Waits for every outstanding run; false when interrupted first.
+  // Waits for every outstanding run, recording each; false when an
+  // interrupt came before all of them.
   bool Drain() {
     while (evaluator_.outstanding() > 0) {
       const std::vector<EvaluationRow> rows = evaluator_.Wait();
       for (const EvaluationRow& row : rows) Record(row);
       if (rows.empty() && evaluator_.interrupted()) return false;
     }
-    return !evaluator_.interrupted();
+    return true;
   }
 
   // The confirm phase; false when an interrupt cut it short.
@@ -170,19 +172,10 @@ class Loop {
     while (!evaluator_.interrupted()) {
       const int64_t first = next_index_;
       if (!Propose(round)) return;
-      std::map<int64_t, EvaluationRow> results;
-      while (evaluator_.outstanding() > 0) {
-        const std::vector<EvaluationRow> rows = evaluator_.Wait();
-        for (const EvaluationRow& row : rows) {
-          results[row.index] = row;
-          Record(row);
-        }
-        if (rows.empty() && evaluator_.interrupted()) return;
-      }
       // An interrupted round is not told: on resume it is asked again.
-      if (static_cast<int64_t>(results.size()) != next_index_ - first) return;
-      for (const auto& [index, row] : results) {
-        strategy_.Tell(ObservationFromRow(row));
+      if (!Drain()) return;
+      for (auto it = done_.lower_bound(first); it != done_.end(); ++it) {
+        strategy_.Tell(ObservationFromRow(it->second));
       }
     }
   }
@@ -198,6 +191,18 @@ class Loop {
 };
 
 }  // namespace
+
+int ConfirmEvaluations(const ExplorationResult& result) {
+  std::set<int64_t> confirming;
+  for (const runfile::IterationRow& it : result.iterations) {
+    if (it.strategy == kConfirmPhase) confirming.insert(it.iteration);
+  }
+  return static_cast<int>(
+      std::count_if(result.evaluations.begin(), result.evaluations.end(),
+                    [&](const EvaluationRow& row) {
+                      return confirming.count(row.iteration) > 0;
+                    }));
+}
 
 ExplorationResult Explore(const spec::Spec& spec, explore::Strategy& strategy,
                           Evaluator& evaluator, ExplorerListener* listener) {

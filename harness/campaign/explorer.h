@@ -68,6 +68,9 @@ struct ExplorationResult {
 // The iterations of the confirm phase carry this strategy name.
 inline constexpr char kConfirmPhase[] = "confirm";
 
+// How many of `result`'s evaluations the confirm phase proposed.
+int ConfirmEvaluations(const ExplorationResult& result);
+
 // Runs `strategy` to the end of its budget (or an interrupt), then the
 // confirm phase when exploration.confirm_runs > 0: rounds of up to
 // exploration.batch SettlePicks (campaign/cheaper.h) of the runs so far,

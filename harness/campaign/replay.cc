@@ -128,6 +128,7 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
   run.strategy = name;
   run.seed = seed;
   run.evaluations = static_cast<int>(result.evaluations.size());
+  run.confirm_evaluations = ConfirmEvaluations(result);
   run.missing = evaluator.missing();
   run.true_pareto_found = quality.true_pareto_points_found;
   run.front_size = quality.true_front_size;
@@ -159,7 +160,6 @@ Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
     for (const EvaluationRow& evaluation : result.evaluations) {
       if (evaluation.iteration == row.iteration) {
         iteration.points.push_back(evaluation.point);
-        if (row.strategy == kConfirmPhase) ++run.confirm_evaluations;
       }
     }
     run.iterations.push_back(std::move(iteration));
