@@ -10,6 +10,8 @@
 #include <pagmo/utils/multi_objective.hpp>
 #include <utility>
 
+#include "stack/base/decimal.h"
+
 namespace adse::analysis {
 namespace {
 
@@ -19,8 +21,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // differ in the last bits; they still form one level.
 constexpr double kViolationRelTol = 1e-12;
 constexpr double kDesignPointTol = 1e-9;
-// Objective values equal to this many significant digits tie.
-constexpr int kTieDigits = 12;
 
 // The most common objective count (first seen wins ties); 0 if none.
 size_t ObjectiveCount(const std::vector<Evaluation>& evals) {
@@ -269,11 +269,7 @@ SearchQuality CompareImpl(const std::vector<Evaluation>& found,
 }  // namespace
 
 double TieKey(double value) {
-  if (!std::isfinite(value) || value == 0.0) return value;
-  const int digits = kTieDigits - 1 -
-                     static_cast<int>(std::floor(std::log10(std::abs(value))));
-  const double scale = std::pow(10.0, digits);
-  return std::round(value * scale) / scale;
+  return RoundToSignificantDigits(value, kDecimalDigits);
 }
 
 bool SameDesignPoint(const std::map<std::string, double>& a,

@@ -8,6 +8,7 @@
 #include "harness/spec/expression.h"
 #include "harness/spec/internal/spec_reader.h"
 #include "harness/spec/text_util.h"
+#include "stack/base/decimal.h"
 
 namespace adse::spec {
 
@@ -161,7 +162,10 @@ Result<double> CostAt(const Spec& spec, const Expression& cost,
         "{} at {}",
         spec.cost, *value, FormatPoint(spec.design_space, point)));
   }
-  return *value;
+  // The knobs are short decimals: what lies past 12 digits of their
+  // product is float noise, which would be stored and shown (14.7 as
+  // 14.700000000000001) and order equally priced designs by chance.
+  return RoundToSignificantDigits(*value, kDecimalDigits);
 }
 
 }  // namespace

@@ -3,8 +3,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "harness/spec/spec_parser.h"
 #include "harness/spec/text_util.h"
@@ -185,6 +187,25 @@ Spec CoresAndClock(const std::string& cores, const std::string& freq,
       "c.yaml", "");
   EXPECT_TRUE(spec.ok()) << spec.status().message();
   return *spec;
+}
+
+TEST(DesignPointTest, ACostOfShortDecimalsIsStoredWithoutFloatNoise) {
+  const Spec spec = CoresAndClock("range: [1, 8]", "values: [1.2, 1.8, 2.1]",
+                                  "cost: cores * freq_ghz\n");
+  // 6 x 1.2 and 7 x 2.1 are 7.199999999999999 and 14.700000000000001 in
+  // binary floating point; what a user reads and compares is 7.2 and 14.7.
+  ASSERT_NE(6 * 1.2, 7.2);
+  ASSERT_NE(7 * 2.1, 14.7);
+  EXPECT_EQ(*EvaluateCost(spec, {{"cores", 6}, {"freq_ghz", 1.2}}), 7.2);
+  EXPECT_EQ(*EvaluateCost(spec, {{"cores", 7}, {"freq_ghz", 2.1}}), 14.7);
+  // Equally priced designs tie exactly, whatever their factors.
+  EXPECT_EQ(*EvaluateCost(spec, {{"cores", 6}, {"freq_ghz", 1.2}}),
+            *EvaluateCost(spec, {{"cores", 4}, {"freq_ghz", 1.8}}));
+  std::vector<double> costs;
+  ASSERT_TRUE(ForEachPointCost(spec, [&](const DesignPoint&, double cost) {
+                costs.push_back(cost);
+              }).ok());
+  EXPECT_NE(std::find(costs.begin(), costs.end(), 14.7), costs.end());
 }
 
 TEST(DesignPointTest, ACostNotFiniteAtSomeDesignPointIsNamedAtThatPoint) {

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "stack/base/decimal.h"
 #include "stack/base/files.h"
 #include "stack/base/hash.h"
 #include "stack/base/random.h"
@@ -24,6 +25,20 @@ TEST(StatusTest, ExitCodesSeparateBadInputFromFailures) {
   EXPECT_EQ(ExitCodeFor(Status::Corruption("x")), 2);
   EXPECT_EQ(ExitCodeFor(Status::IoError("x")), 1);
   EXPECT_EQ(Status::NotFound("f").WithContext("map").message(), "map: f");
+}
+
+TEST(DecimalTest, RoundsToSignificantDigitsAtEveryScale) {
+  EXPECT_EQ(RoundToSignificantDigits(6 * 1.2, kDecimalDigits), 7.2);
+  EXPECT_EQ(RoundToSignificantDigits(0.1 + 0.2, kDecimalDigits), 0.3);
+  EXPECT_EQ(RoundToSignificantDigits(-14.700000000000001, kDecimalDigits),
+            -14.7);
+  EXPECT_EQ(RoundToSignificantDigits(1.23456789e-7, 3), 1.23e-7);
+  // Past 10^digits the scale is a divisor: 10^-k is not exact, 10^k is.
+  EXPECT_EQ(RoundToSignificantDigits(123456789012345.0, 3), 123e12);
+  EXPECT_EQ(RoundToSignificantDigits(2.5, 1), 3.0);
+  EXPECT_EQ(RoundToSignificantDigits(0.0, kDecimalDigits), 0.0);
+  EXPECT_TRUE(std::isinf(RoundToSignificantDigits(INFINITY, 3)));
+  EXPECT_TRUE(std::isnan(RoundToSignificantDigits(NAN, 3)));
 }
 
 TEST(HashTest, Sha256MatchesAKnownVectorAndPartsAreDelimited) {
