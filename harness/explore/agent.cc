@@ -472,7 +472,7 @@ void AgentStrategy::FitModels() {
   // Prior slope sizes per knob: resources help; the diagnoses of the runs
   // strengthen the knobs they name on balance. A feasible run's counts
   // too: the start's diagnosis already says which resource the stack is
-  // short of (README, "Diagnoses of feasible runs").
+  // short of (docs/agent_development.md, "Diagnoses of feasible runs").
   std::vector<double> prior(knobs_.size(), 0.0);
   std::vector<int> votes(knobs_.size(), 0);
   for (const Record& record : records_) {

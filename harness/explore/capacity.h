@@ -3,7 +3,7 @@
 // stack, and a faster sensor never lightens it. So a design with no more
 // capacity than a run that failed for lack of it fails too, and one with
 // no less than a feasible run's holds (the order holds on every recording
-// in tests/data; see the README, "Capacity order").
+// in tests/data; see docs/agent_development.md, "Capacity order").
 #ifndef ADSE_HARNESS_EXPLORE_CAPACITY_H_
 #define ADSE_HARNESS_EXPLORE_CAPACITY_H_
 

@@ -25,7 +25,7 @@ namespace adse::explore::internal {
 // Joint samples of the predicted metrics per candidate. At 64 the draws'
 // noise decided which path a seed took near the feasibility bound; 256
 // cost three times the time per pick (0.15 s) and found more of each front
-// (README, "256 Monte Carlo samples").
+// (docs/agent_development.md, "256 Monte Carlo samples").
 constexpr int kSamples = 256;
 // Spaces up to this size are scored exhaustively.
 constexpr uint64_t kEnumerateLimit = 4096;
@@ -67,12 +67,12 @@ constexpr double kHypervolumeWeight = 0.3;
 // feasible with probability kMinCheapestChance at least, the one of
 // largest expected saving. (Measured on the recordings and landscapes in
 // tests/data: it finds the cheapest design in far more seeds, at the price
-// of a few front points; see the README.)
+// of a few front points; see docs/agent_development.md.)
 constexpr int kCheapestEvery = 4;
 // A front pick goes to a design feasible with at least this chance while
 // any is: the cheapest-design picks already take the long shots, and a
 // front pick that fails adds nothing to the front (measured on held-out
-// landscapes, see the README's "Three changes that held").
+// landscapes, see docs/agent_development.md, "Three changes that held").
 constexpr double kFrontMinChance = 0.5;
 constexpr double kMinCheapestChance = 0.25;
 // The metric computed from the cost expression rather than modelled.
@@ -82,9 +82,9 @@ constexpr char kNavTimeMetric[] = "nav_time_s";
 constexpr char kCompletedMetric[] = "completed";
 // A run stopped past its time bound having driven a share q of its route
 // would, at the pace it kept, arrive at bound / q: its time's censored
-// bound is taken there (README, "How far a stopped run got"). q is held
-// at least this, so a car that hardly moved bounds its time at 20 times
-// the bound rather than at infinity.
+// bound is taken there (docs/agent_development.md, "How far a stopped run
+// got"). q is held at least this, so a car that hardly moved bounds its time at
+// 20 times the bound rather than at infinity.
 constexpr double kMinDrivenFraction = 0.05;
 
 using spec::KnobRole;

@@ -25,8 +25,8 @@ constexpr double kOptimismRoom = 0.025;
 // for positive metrics: about 10 %; standard deviations otherwise).
 constexpr double kCensoredMargin = 0.1;
 // Measured runs a time needs before its rate is tried as its model: a
-// leave-one-out comparison of fewer runs chose badly (README, "Strategies
-// and replay").
+// leave-one-out comparison of fewer runs chose badly
+// (docs/agent_development.md, "The nav time's rate model").
 constexpr int kMinRateChoicePoints = 10;
 
 template <typename T>

@@ -94,7 +94,7 @@ TEST(AgentReplayTest, OnTheRobotaxiCampaignWithTwoObjectives) {
   // 1.0-1.5 GHz columns after 4 cores at 2.1 GHz stop 87 % of the way,
   // while the front lies at 2.1 GHz), the cheapest design in 20 of 20
   // seeds (before the agent read how far stopped runs got 5, 0.947 and
-  // 10; README, "How far a stopped run got").
+  // 10; docs/agent_development.md, "How far a stopped run got").
   Recording recording =
       adse::testing::RecordingUnderTestData("robotaxi_exhaustive");
   ASSERT_TRUE(KeepObjectives({"hardware_cost", "nav_time_s"}, &recording).ok());
