@@ -7,6 +7,7 @@
 
 #include "analysis/metrics/parking_metrics.h"
 #include "stack/algorithms/stop_reason.h"
+#include "stack/base/decimal.h"
 
 namespace adse::analysis {
 namespace {
@@ -74,7 +75,10 @@ std::map<std::string, double> ComputeRunMetrics(
   const double end_s = run.ego.empty() ? 0.0 : run.ego.back().t_s;
   m["completed"] = completed ? 1.0 : 0.0;
   m[kCensoredMetric] = runfile::EndedEarly(run.status) ? 1.0 : 0.0;
-  m["nav_time_s"] = end_s;
+  // The world's clock is a sum of fixed steps, whose float error reaches
+  // the last digits (41 s as 40.99999999999981); the time is a whole
+  // number of steps, so those digits are noise.
+  m["nav_time_s"] = RoundToSignificantDigits(end_s, kDecimalDigits);
 
   auto topic_index = [&](const std::string& name) {
     for (size_t i = 0; i < run.topic_names.size(); ++i) {

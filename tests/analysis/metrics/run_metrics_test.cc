@@ -57,6 +57,19 @@ TEST(RunMetricsTest, KnownRunGivesKnownMetrics) {
   EXPECT_NEAR(m.at("cpu_utilization"), 10.0 / 20.0, 1e-9);
 }
 
+TEST(RunMetricsTest, ANavTimeSummedFromStepsIsStoredWithoutFloatNoise) {
+  runfile::RunData run = TenSecondRun();
+  run.ego.clear();
+  double t_s = 0.0;
+  for (int i = 0; i < 820; ++i) {
+    run.ego.push_back({t_s, 0, 0, 0, 0, 0, 0});
+    t_s += 0.05;  // as the world's clock advances
+  }
+  run.ego.push_back({t_s, 0, 0, 0, 0, 0, 0});
+  ASSERT_NE(t_s, 41.0);  // 40.99999999999981
+  EXPECT_EQ(ComputeRunMetrics(run).at("nav_time_s"), 41.0);
+}
+
 // Processor sharing and real time: a team of two and another callback on
 // two cores hold three threads, but only two cores can be busy.
 TEST(RunMetricsTest, ThreadsBeyondThePlatformsCoresAreNotBusyCores) {
