@@ -11,6 +11,7 @@
 #include "analysis/metrics/run_metrics.h"
 #include "analysis/pictures/pictures.h"
 #include "harness/spec/spec_parser.h"
+#include "stack/base/decimal.h"
 #include "stack/base/files.h"
 
 namespace adse::report {
@@ -43,10 +44,12 @@ Result<RunReport> AnalyzeRun(const runfile::RunData& run,
   r.content_key = run.content_key;
   // Metrics are recomputed from the trace, never copied, so a changed
   // metric definition reaches old runs too; hardware_cost comes from the
-  // scenario's cost expression as stored.
+  // scenario's cost expression as stored, rounded as the expression's value
+  // now is (runs stored before 2026-12-07 carry its float noise).
   r.metrics = analysis::ComputeRunMetrics(run);
   if (auto it = run.metrics.find("hardware_cost"); it != run.metrics.end()) {
-    r.metrics["hardware_cost"] = it->second;
+    r.metrics["hardware_cost"] =
+        RoundToSignificantDigits(it->second, kDecimalDigits);
   }
 
   // Deviation from the ideal path.

@@ -207,6 +207,15 @@ TEST(RunReportTest, AWaitForALaneChangeNamesTheCarWithoutItsGap) {
             "lane_change (track 122, 20.0 m away in the target lane): 19.1 s");
 }
 
+TEST(RunReportTest, AnOldRunFilesCostIsReadWithoutItsFloatNoise) {
+  runfile::RunData run = StoodRun();
+  run.metrics["hardware_cost"] = 7 * 2.1;  // as runs stored it before
+  ASSERT_NE(run.metrics["hardware_cost"], 14.7);
+  Result<RunReport> r = AnalyzeRun(run, "memory", AnalyzeOptions{});
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->metrics.at("hardware_cost"), 14.7);
+}
+
 TEST(RunReportTest, AnOldRunFileSaysItHasNoStopReasons) {
   runfile::RunData run = StoodRun();
   run.stop_reasons.clear();
