@@ -12,6 +12,8 @@ double RoundToSignificantDigits(double value, int digits) {
   // reciprocal, which is not: large values divide, small ones multiply.
   if (exponent >= 0) {
     const double scale = std::pow(10.0, exponent);
+    // Below about 1e-296 the scale overflows: such a value is kept.
+    if (!std::isfinite(scale) || !std::isfinite(value * scale)) return value;
     return std::round(value * scale) / scale;
   }
   const double scale = std::pow(10.0, -exponent);

@@ -37,6 +37,11 @@ TEST(DecimalTest, RoundsToSignificantDigitsAtEveryScale) {
   EXPECT_EQ(RoundToSignificantDigits(123456789012345.0, 3), 123e12);
   EXPECT_EQ(RoundToSignificantDigits(2.5, 1), 3.0);
   EXPECT_EQ(RoundToSignificantDigits(0.0, kDecimalDigits), 0.0);
+  // At the ends of the double range the value is kept or rounded, never
+  // lost to an overflowing scale.
+  EXPECT_EQ(RoundToSignificantDigits(1e-300, kDecimalDigits), 1e-300);
+  EXPECT_EQ(RoundToSignificantDigits(4.9e-324, kDecimalDigits), 4.9e-324);
+  EXPECT_EQ(RoundToSignificantDigits(1.7e308, kDecimalDigits), 1.7e308);
   EXPECT_TRUE(std::isinf(RoundToSignificantDigits(INFINITY, 3)));
   EXPECT_TRUE(std::isnan(RoundToSignificantDigits(NAN, 3)));
 }
