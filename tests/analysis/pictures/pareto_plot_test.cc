@@ -332,15 +332,12 @@ TEST_F(PictureTest, AFrontLabelGoesWhereItHidesNoOtherDesign) {
   std::vector<ParetoPlotPoint> points = {{5, 100, true, true, "5/1.5/7"},
                                          {5.3, 103, true, false, ""},
                                          {10, 50, true, true, "10/2.1/7"}};
-  ASSERT_TRUE(RenderParetoPlot(points, Path("labelled.png")).ok());
-  for (ParetoPlotPoint& p : points) p.label.clear();
-  ASSERT_TRUE(RenderParetoPlot(points, Path("unlabelled.png")).ok());
-  Result<RgbImage> labelled = ReadImage(Path("labelled.png"));
-  Result<RgbImage> unlabelled = ReadImage(Path("unlabelled.png"));
-  ASSERT_TRUE(labelled.ok() && unlabelled.ok());
-  EXPECT_GT(CountColour(*unlabelled, kFeasibleRgb), 40);
-  EXPECT_EQ(CountColour(*labelled, kFeasibleRgb),
-            CountColour(*unlabelled, kFeasibleRgb));
+  RgbImage labelled, unlabelled;
+  ASSERT_NO_FATAL_FAILURE(
+      RenderWithAndWithoutLabels(points, "labelled", &labelled, &unlabelled));
+  EXPECT_GT(CountColour(unlabelled, kFeasibleRgb), 40);
+  EXPECT_EQ(CountColour(labelled, kFeasibleRgb),
+            CountColour(unlabelled, kFeasibleRgb));
 }
 
 TEST_F(PictureTest, FrontLabelsNeverOverlapOneAnother) {
@@ -388,16 +385,13 @@ TEST_F(PictureTest, ARingedDesignsRingStaysWholeBesideItsLabel) {
                                          {10, 50, true, true, "10/2.1/7"},
                                          {20, 120, true, false, ""}};
   points[1].highlight = true;
-  ASSERT_TRUE(RenderParetoPlot(points, Path("ringed.png")).ok());
-  for (ParetoPlotPoint& p : points) p.label.clear();
-  ASSERT_TRUE(RenderParetoPlot(points, Path("ringed_bare.png")).ok());
-  Result<RgbImage> labelled = ReadImage(Path("ringed.png"));
-  Result<RgbImage> bare = ReadImage(Path("ringed_bare.png"));
-  ASSERT_TRUE(labelled.ok() && bare.ok());
+  RgbImage labelled, bare;
+  ASSERT_NO_FATAL_FAILURE(
+      RenderWithAndWithoutLabels(points, "ringed", &labelled, &bare));
   // The ring is the picture's only black besides the frame, the ticks and
   // the axes' text, which the labels (dark grey) leave alone.
-  EXPECT_EQ(CountColour(*labelled, Rgb{0, 0, 0}),
-            CountColour(*bare, Rgb{0, 0, 0}));
+  EXPECT_EQ(CountColour(labelled, Rgb{0, 0, 0}),
+            CountColour(bare, Rgb{0, 0, 0}));
 }
 
 TEST_F(PictureTest, FrontDesignsThatTieShareOneLabelNamingThemAll) {

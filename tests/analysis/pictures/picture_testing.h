@@ -3,8 +3,11 @@
 #ifndef ADSE_TESTS_ANALYSIS_PICTURES_PICTURE_TESTING_H_
 #define ADSE_TESTS_ANALYSIS_PICTURES_PICTURE_TESTING_H_
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "analysis/pictures/pictures.h"
@@ -41,13 +44,26 @@ inline int CountColour(const RgbImage& img, Rgb colour) {
   return n;
 }
 
-// A square lane loop of 100 m, an ideal path along its bottom and right
-// sides, and a trajectory 1 m to the left of the path; one other vehicle
-
 class PictureTest : public adse::testing::TempDirTest {
  protected:
   std::vector<std::string> Listing() const {
     return TempDirTest::Listing(/*recursive=*/true);
+  }
+
+  // `points` drawn as given (`name`.png) and with every label cleared
+  // (`name`_bare.png), read back: what differs is what the labels cover.
+  // Call under ASSERT_NO_FATAL_FAILURE.
+  void RenderWithAndWithoutLabels(std::vector<ParetoPlotPoint> points,
+                                  const std::string& name, RgbImage* labelled,
+                                  RgbImage* bare) {
+    ASSERT_TRUE(RenderParetoPlot(points, Path(name + ".png")).ok());
+    for (ParetoPlotPoint& p : points) p.label.clear();
+    ASSERT_TRUE(RenderParetoPlot(points, Path(name + "_bare.png")).ok());
+    Result<RgbImage> with = ReadImage(Path(name + ".png"));
+    Result<RgbImage> without = ReadImage(Path(name + "_bare.png"));
+    ASSERT_TRUE(with.ok() && without.ok());
+    *labelled = std::move(with).value();
+    *bare = std::move(without).value();
   }
 };
 

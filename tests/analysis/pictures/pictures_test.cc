@@ -26,6 +26,9 @@ using testing::PictureTest;
 
 using runfile::RunData;
 
+// A square lane loop of 100 m, an ideal path along its bottom and right
+// sides, and a trajectory 1 m to the left of the path; one other vehicle
+// crossing the middle.
 RunData SquareRun() {
   RunData run;
   run.scenario_name = "square_loop";
