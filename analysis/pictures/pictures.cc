@@ -117,8 +117,8 @@ std::string Title(const runfile::RunData& run) {
     // A censored run stopped early: its nav time is only a lower bound.
     outcome +=
         runfile::EndedEarly(run.status)
-            ? fmt::format(", nav >= {:.1f} s (stopped early)", it->second)
-            : fmt::format(", nav {:.1f} s", it->second);
+            ? ", nav >= " + FormatNumber(it->second) + " s (stopped early)"
+            : ", nav " + FormatNumber(it->second) + " s";
   }
   // Contacts with traffic (valet parking's with the lot are drawn).
   if (!run.collisions.empty()) {
