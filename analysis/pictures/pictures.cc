@@ -16,6 +16,7 @@
 #include "analysis/metrics/standing.h"
 #include "analysis/pictures/internal/drawing_impl.h"
 #include "analysis/pictures/internal/parking_layer_impl.h"
+#include "analysis/pictures/internal/trajectory_text.h"
 
 namespace adse::analysis::internal {
 
@@ -102,44 +103,6 @@ Result<WorldToImage> MappingImpl(const runfile::RunData& run,
   map.min_x_m = centre_x - 0.5 * extent_x;
   map.max_y_m = centre_y + 0.5 * map_height_px / map.px_per_m;
   return map;
-}
-
-std::string Title(const runfile::RunData& run) {
-  std::string point;
-  for (const auto& [name, value] : run.design_point) {
-    point += (point.empty() ? "" : ", ") + name + "=" + FormatNumber(value);
-  }
-  std::string reason = run.termination_reason;
-  reason = reason.substr(0, reason.find('\n'));
-  std::string outcome =
-      run.status == runfile::kRunFailed ? "FAILED: " + reason : reason;
-  if (auto it = run.metrics.find("nav_time_s"); it != run.metrics.end()) {
-    // A censored run stopped early: its nav time is only a lower bound.
-    outcome +=
-        runfile::EndedEarly(run.status)
-            ? ", nav >= " + FormatNumber(it->second) + " s (stopped early)"
-            : ", nav " + FormatNumber(it->second) + " s";
-  }
-  // Contacts with traffic (valet parking's with the lot are drawn).
-  if (!run.collisions.empty()) {
-    const auto ego_caused = std::count_if(
-        run.collisions.begin(), run.collisions.end(),
-        [](const runfile::CollisionEvent& c) { return c.ego_caused == 1; });
-    outcome += fmt::format(", {} collision{} ({} caused by the ego)",
-                           run.collisions.size(),
-                           run.collisions.size() == 1 ? "" : "s", ego_caused);
-  }
-  // The picture shows the last plan in colour; say when there were others.
-  if (run.parking.replans > 0) {
-    outcome += fmt::format(", re-planned {}x", run.parking.replans);
-  }
-  // A run of one of the scenario's task.cases names it.
-  const std::string scenario =
-      (run.scenario_name.empty() ? "(no scenario)" : run.scenario_name) +
-      (run.task_case.empty() ? "" : " (" + run.task_case + ")");
-  return fmt::format("{} | {} | {}", scenario,
-                     point.empty() ? "(no design point)" : point,
-                     outcome.empty() ? "(no outcome)" : outcome);
 }
 
 void DrawStartMarker(cv::Mat* img, cv::Point2d at, const Style& s) {
@@ -232,29 +195,6 @@ void DrawEndMarker(cv::Mat* img, cv::Point2d at, const Style& s) {
                 cv::FILLED, cv::LINE_AA, kShift);
   cv::rectangle(*img, Fixed(at - d), Fixed(at + d), kBlack, cv::FILLED,
                 cv::LINE_AA, kShift);
-}
-
-// How a run that did not reach its goal ended, in words, with the time;
-// empty for one that did (its goal marker says so).
-std::string EndText(const runfile::RunData& run, double t_s) {
-  const std::string& reason = run.termination_reason;
-  if (reason == "goal_reached") return "";
-  std::string what;
-  if (!runfile::ViolatedConstraint(reason).empty()) {
-    what = "stopped early";  // the title names the constraint
-  } else if (const std::string held =
-                 runfile::ReasonAfter(reason, runfile::kStalledPrefix);
-             !held.empty()) {
-    what = "stalled (" + held + ")";
-  } else if (reason == "timeout" || reason == "no_path" ||
-             reason == "parked_out_of_tolerance") {
-    what = reason == "no_path"   ? "no path"
-           : reason == "timeout" ? "timeout"
-                                 : "parked out of tolerance";
-  } else {
-    what = "ended";
-  }
-  return fmt::format("{} {:.0f} s", what, t_s);
 }
 
 // What held the car, in words: the planner's reason, or "plan said go"
@@ -550,8 +490,8 @@ Result<std::string> TrajectoryPngImpl(const runfile::RunData& run,
                 Bgr(kBackgroundRgb), cv::FILLED);
   const int header_lines = run.parking.present ? 3 : 2;
   const int line_px = (map.map_top_px - s.Px(8)) / header_lines;
-  DrawText(&img, Title(run), s.Px(8), line_px - baseline, Align::kLeft, s,
-           kBlack, false);
+  DrawText(&img, TrajectoryTitle(run), s.Px(8), line_px - baseline,
+           Align::kLeft, s, kBlack, false);
   HeaderLegend legend(&img, 2 * line_px - baseline, line_px, s);
   auto line_sample = [&](Rgb c, int thickness) {
     return [&img, c, thickness](cv::Point2d a, cv::Point2d b) {
