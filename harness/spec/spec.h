@@ -119,6 +119,10 @@ struct MetricInfo {
   // Reported by valet_parking runs only (NaN or absent otherwise): an
   // objective or constraint on it in another task is an error.
   bool valet_parking_only = false;
+  // Rounded to kDecimalDigits where a run makes it (a sum of 0.05 s steps,
+  // a product of short decimals), so that it ties where it should; read
+  // rounded from files written before it was (2026-12-07).
+  bool decimal = false;
 };
 // Metrics a run reports (documented in scenarios/README.md).
 const std::vector<MetricInfo>& KnownMetrics();

@@ -8,6 +8,11 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+#include <vector>
+
+#include "analysis/runfile/campaign_file.h"
+
 #include "tests/harness/testing/recording.h"
 
 namespace adse::campaign {
@@ -104,6 +109,35 @@ TEST(ReplayTest, ReplayIsDeterministicAndAnUnknownStrategyIsAnError) {
   Result<ReplayRun> bad = Replay(Recorded(), "simulated-annealing", 1, 15);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("valid:"), std::string::npos);
+}
+
+TEST(ReplayTest, ARecordingWrittenBeforeRoundingReadsItsTimesAndCostsRounded) {
+  // The robotaxi recording (2026-11) stores a product of GHz-cores and a
+  // sum of 0.05 s steps with their float noise; read as a recording, they
+  // are the numbers adse analyze and a new run give.
+  Result<runfile::CampaignIndex> raw =
+      runfile::ReadCampaignIndex(std::string(ADSE_SOURCE_DIR) +
+                                 "/tests/data/robotaxi_exhaustive/campaign.h5");
+  ASSERT_TRUE(raw.ok()) << raw.status().message();
+  const spec::DesignPoint answer = {
+      {"cores", 7}, {"freq_ghz", 1.2}, {"lidar_hz", 7}};
+  const spec::DesignPoint six_fast = {
+      {"cores", 6}, {"freq_ghz", 2.1}, {"lidar_hz", 7}};
+  auto metric = [](const std::vector<EvaluationRow>& rows,
+                   const spec::DesignPoint& point, const char* name) {
+    for (const EvaluationRow& row : rows) {
+      if (row.point == point) return row.metrics.at(name);
+    }
+    ADD_FAILURE() << "no row for the point";
+    return 0.0;
+  };
+  EXPECT_NE(metric(raw->evaluations, answer, "nav_time_s"), 89.85);
+  EXPECT_EQ(metric(Recorded().rows, answer, "nav_time_s"), 89.85);
+  EXPECT_NE(metric(raw->evaluations, six_fast, "hardware_cost"), 12.6);
+  EXPECT_EQ(metric(Recorded().rows, six_fast, "hardware_cost"), 12.6);
+  // A metric no run rounds is read as stored.
+  EXPECT_EQ(metric(Recorded().rows, answer, "deviation_score"),
+            metric(raw->evaluations, answer, "deviation_score"));
 }
 
 TEST(ReplayTest, AMissingOrDamagedRecordingNamesTheFile) {
