@@ -11,6 +11,7 @@
 #include "analysis/metrics/run_metrics.h"
 #include "analysis/runfile/run_data.h"
 #include "harness/spec/design_point.h"
+#include "stack/base/decimal.h"
 
 namespace adse::campaign {
 
@@ -187,6 +188,26 @@ std::vector<int> ParetoFrontOf(const spec::Spec& spec,
     observations.push_back(ObservationFromRow(row));
   }
   return explore::ParetoFrontOf(spec, observations);
+}
+
+namespace {
+void RoundDecimalMetrics(EvaluationRow* row) {
+  for (const spec::MetricInfo& info : spec::KnownMetrics()) {
+    if (!info.decimal) continue;
+    auto it = row->metrics.find(info.name);
+    if (it != row->metrics.end()) {
+      it->second = RoundToSignificantDigits(it->second, kDecimalDigits);
+    }
+  }
+  for (EvaluationRow& replica : row->replicas) RoundDecimalMetrics(&replica);
+}
+}  // namespace
+
+Result<runfile::CampaignIndex> ReadIndex(const std::string& path) {
+  Result<runfile::CampaignIndex> index = runfile::ReadCampaignIndex(path);
+  if (!index.ok()) return index;
+  for (EvaluationRow& row : index->evaluations) RoundDecimalMetrics(&row);
+  return index;
 }
 
 }  // namespace adse::campaign

@@ -51,6 +51,13 @@ explore::Observation ObservationFromRow(const EvaluationRow& row);
 analysis::Evaluation ParetoEvaluation(const spec::Spec& spec,
                                       const EvaluationRow& row);
 
+// The campaign index at `path` as every command reads it: an index
+// written before some metrics were rounded where a run makes them
+// (spec::MetricInfo::decimal, 2026-12-07) reads them rounded, as an old
+// run file's cost is (report::AnalyzeRun), so that every command gives
+// one number (89.85 s, not 89.84999999999704 s).
+Result<runfile::CampaignIndex> ReadIndex(const std::string& path);
+
 // Indices (into `rows`) of the constraint-aware Pareto front.
 std::vector<int> ParetoFrontOf(const spec::Spec& spec,
                                const std::vector<EvaluationRow>& rows);

@@ -11,7 +11,6 @@
 #include "harness/campaign/strategy_factory.h"
 #include "harness/spec/design_point.h"
 #include "harness/spec/spec_parser.h"
-#include "stack/base/decimal.h"
 
 namespace adse::campaign {
 namespace fs = std::filesystem;
@@ -47,29 +46,12 @@ Status KeepObjectives(const std::vector<std::string>& metrics,
   return Status::Ok();
 }
 
-namespace {
-// A recording written before some metrics were rounded where a run makes
-// them (spec::MetricInfo::decimal) reads as one written since, as
-// AnalyzeRun reads an old run file's cost: every command then gives the
-// same number (89.85 s, not 89.84999999999704 s).
-void RoundDecimalMetrics(EvaluationRow* row) {
-  for (const spec::MetricInfo& info : spec::KnownMetrics()) {
-    if (!info.decimal) continue;
-    auto it = row->metrics.find(info.name);
-    if (it != row->metrics.end()) {
-      it->second = RoundToSignificantDigits(it->second, kDecimalDigits);
-    }
-  }
-  for (EvaluationRow& replica : row->replicas) RoundDecimalMetrics(&replica);
-}
-}  // namespace
-
 Result<Recording> LoadRecording(const std::string& folder_or_file) {
   std::error_code ec;
   const std::string path = fs::is_directory(folder_or_file, ec)
                                ? folder_or_file + "/campaign.h5"
                                : folder_or_file;
-  Result<runfile::CampaignIndex> index = runfile::ReadCampaignIndex(path);
+  Result<runfile::CampaignIndex> index = ReadIndex(path);
   if (!index.ok()) return index.status();
   spec::ParseOptions parse;
   parse.check_files = false;  // only the space, objectives and constraints
@@ -82,7 +64,6 @@ Result<Recording> LoadRecording(const std::string& folder_or_file) {
   if (recording.rows.empty()) {
     return Status::InvalidArgument(path + ": the campaign has no evaluations");
   }
-  for (EvaluationRow& row : recording.rows) RoundDecimalMetrics(&row);
   return recording;
 }
 

@@ -322,7 +322,7 @@ int AnalyzeFolder(const std::string& target,
   std::error_code ec;
   if (fs::exists(folder.Path("campaign.h5"), ec)) {
     Result<runfile::CampaignIndex> read =
-        runfile::ReadCampaignIndex(folder.Path("campaign.h5"));
+        campaign::ReadIndex(folder.Path("campaign.h5"));
     if (!read.ok()) {
       std::fprintf(stderr,
                    "error: %s: %s (adse run or adse index rebuilds it from "

@@ -434,6 +434,35 @@ std::string FrontSection(const std::string& out) {
   return section;
 }
 
+TEST(CliRunTest, AnOldCampaignsNavTimeReadsTheSameInItsAnalysisAndItsReplay) {
+  // The robotaxi recording's index predates the nav time's rounding
+  // (89.84999999999704 s stored). Its analysis keeps every row as the
+  // index recorded it (no run file is here) and its replay reads the
+  // index: both say 89.85 s, as a new run would.
+  const fs::path dir = adse::testing::TestScratch() / "adse_cli_old_index";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "runs");
+  fs::copy_file(std::string(ADSE_SOURCE_DIR) +
+                    "/tests/data/robotaxi_exhaustive/campaign.h5",
+                dir / "campaign.h5");
+  const CommandRun analyze = Adse("analyze " + dir.string());
+  EXPECT_EQ(analyze.exit_code, 2) << analyze.out;  // no run file to read
+  EXPECT_NE(analyze.out.find("280 kept as campaign.h5 recorded them"),
+            std::string::npos)
+      << analyze.out;
+  const nlohmann::json summary = nlohmann::json::parse(
+      ReadText((dir / "analysis" / "v1" / "summary.json").string()));
+  const CommandRun replay =
+      Adse("explore --replay " + dir.string() + " --strategy random --json");
+  ASSERT_EQ(replay.exit_code, 0) << replay.out;
+  const nlohmann::json replayed = nlohmann::json::parse(replay.out);
+  for (const nlohmann::json* answer : {&summary, &replayed}) {
+    const nlohmann::json& cheapest = (*answer)["answer"]["cheapest_feasible"];
+    EXPECT_EQ(cheapest["metrics"]["nav_time_s"].get<double>(), 89.85)
+        << cheapest.dump();
+  }
+}
+
 TEST(CliRunTest, AnalyzeOfACampaignFromAnotherFolderGivesTheSameAnswerAsRun) {
   const fs::path out = adse::testing::TestScratch() / "adse_cli_one_answer";
   fs::remove_all(out);
