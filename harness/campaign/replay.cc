@@ -100,12 +100,14 @@ std::vector<EvaluationRow> RecordingEvaluator::Wait() {
 }
 
 Result<ReplayRun> Replay(const Recording& recording, const std::string& name,
-                         uint64_t seed, int budget, int confirm_runs) {
+                         uint64_t seed, int budget, int confirm_runs,
+                         int initial_points) {
   spec::Spec spec = recording.spec;
   spec.exploration.strategy = name;
   spec.exploration.seed = seed;
   if (budget > 0) spec.exploration.budget = budget;
   if (confirm_runs >= 0) spec.exploration.confirm_runs = confirm_runs;
+  if (initial_points >= 0) spec.exploration.initial_points = initial_points;
   ADSE_RETURN_IF_ERROR(spec::CheckConfirmRuns(spec));
   Result<std::unique_ptr<explore::Strategy>> strategy =
       CreateCampaignStrategy(spec, recording.folder, /*record=*/false);

@@ -88,11 +88,12 @@ struct ReplayRun {
 };
 
 // Replays `strategy` with exploration.seed = seed, the given budget (<= 0:
-// the recording's scenario budget) and confirm runs (< 0: the recording's
-// exploration.confirm_runs) over the recording.
+// the recording's scenario budget), confirm runs and initial points (< 0:
+// the recording's exploration.confirm_runs, exploration.initial_points)
+// over the recording.
 Result<ReplayRun> Replay(const Recording& recording,
                          const std::string& strategy, uint64_t seed, int budget,
-                         int confirm_runs = -1);
+                         int confirm_runs = -1, int initial_points = -1);
 
 }  // namespace adse::campaign
 

@@ -100,6 +100,8 @@ struct ExploreArgs {
   std::vector<std::string> strategies;  // default: the recorded strategy set
   int budget = 0;                       // 0: the recording's scenario budget
   int confirm_runs = -1;  // -1: the recording's exploration.confirm_runs
+  // -1: the recording's exploration.initial_points (the agent's).
+  int initial_points = -1;
   // Replay as if the scenario had only these of its objectives (metric
   // names); empty: all of them.
   std::vector<std::string> objectives;

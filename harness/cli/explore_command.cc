@@ -107,10 +107,14 @@ int RunExplore(const ExploreArgs& args) {
   const int confirm_runs = args.confirm_runs >= 0
                                ? args.confirm_runs
                                : recording->spec.exploration.confirm_runs;
+  const int initial_points = args.initial_points >= 0
+                                 ? args.initial_points
+                                 : recording->spec.exploration.initial_points;
   nlohmann::json out = {{"recording", args.replay},
                         {"recorded_evaluations", recording->rows.size()},
                         {"budget", budget},
                         {"confirm_runs", confirm_runs},
+                        {"initial_points", initial_points},
                         {"seeds", args.seeds},
                         {"objectives", nlohmann::json::array()},
                         {"strategies", nlohmann::json::object()}};
@@ -135,8 +139,8 @@ int RunExplore(const ExploreArgs& args) {
     nlohmann::json runs = nlohmann::json::array();
     for (int i = 0; i < args.seeds; ++i) {
       const uint64_t seed = args.first_seed + static_cast<uint64_t>(i);
-      Result<campaign::ReplayRun> run =
-          campaign::Replay(*recording, name, seed, budget, confirm_runs);
+      Result<campaign::ReplayRun> run = campaign::Replay(
+          *recording, name, seed, budget, confirm_runs, initial_points);
       if (!run.ok()) {
         std::fprintf(stderr, "error: --strategy %s: %s\n", name.c_str(),
                      run.status().message().c_str());
@@ -239,11 +243,16 @@ int RunExplore(const ExploreArgs& args) {
   }
   if (!args.json) {
     std::printf(
-        "replay of %s: %zu recorded evaluations, budget %d%s, seeds "
+        "replay of %s: %zu recorded evaluations, budget %d%s%s, seeds "
         "%llu..%llu\n",
         args.replay.c_str(), recording->rows.size(), budget,
         confirm_runs > 0
             ? fmt::format(" and up to {} confirm runs", confirm_runs).c_str()
+            : "",
+        initial_points > 0
+            ? fmt::format(" (the agent's {} initial point{} seeded)",
+                          initial_points, initial_points == 1 ? "" : "s")
+                  .c_str()
             : "",
         static_cast<unsigned long long>(args.first_seed),
         static_cast<unsigned long long>(args.first_seed + args.seeds - 1));

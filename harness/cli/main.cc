@@ -317,6 +317,13 @@ int main(int argc, char** argv) {
   AddConfirmRunsOption(explore_cmd, &explore.confirm_runs,
                        "default: the recorded scenario's");
   explore_cmd
+      ->add_option("--initial-points", explore.initial_points,
+                   "The built-in agent's seeded space-filling points after "
+                   "its first, before its model picks (as "
+                   "exploration.initial_points; default: the recorded "
+                   "scenario's)")
+      ->transform(WholeNumber(0, adse::spec::kMaxBudget));
+  explore_cmd
       ->add_option("--objectives", explore.objectives,
                    "Replay with only these of the recorded scenario's "
                    "objectives (metric names, comma-separated), e.g. "

@@ -531,14 +531,72 @@ void AgentStrategy::ApplyFactors(std::vector<Candidate>* candidates) {
   }
 }
 
-std::string AgentStrategy::SpaceFilling(std::vector<Candidate>* candidates,
-                                        int wanted,
-                                        std::vector<Genes>* chosen) {
+std::vector<std::vector<double>> AgentStrategy::Anchors(
+    const std::vector<Genes>& chosen) const {
   std::vector<std::vector<double>> anchors;
-  for (const Genes& genes : *chosen) anchors.push_back(Coordinates(genes));
+  for (const Genes& genes : chosen) anchors.push_back(Coordinates(genes));
   for (const Record& record : records_) {
     anchors.push_back(Coordinates(record.genes));
   }
+  return anchors;
+}
+
+std::string AgentStrategy::InitialDesign(int n, std::vector<Genes>* chosen) {
+  // Pick 0 is the start (start_from, or the middle of the space).
+  auto pick = [&] { return proposed_ + static_cast<int>(chosen->size()); };
+  const int last = spec_->exploration.initial_points;
+  if (pick() < 1 || pick() > last) return {};
+  std::vector<Candidate> candidates;
+  for (Genes& genes : Candidates(*chosen)) {
+    Candidate c;
+    c.genes = std::move(genes);
+    c.u = Coordinates(c.genes);
+    candidates.push_back(std::move(c));
+  }
+  for (Candidate& c : candidates) c.runs = RunsProbability(c);
+  std::vector<std::vector<double>> anchors = Anchors(*chosen);
+  const int first = pick();
+  std::vector<std::string> drawn;
+  while (!candidates.empty() && static_cast<int>(chosen->size()) < n &&
+         pick() <= last) {
+    int best = -1;
+    double best_score = -1.0;
+    for (int draw = 0; draw < kInitialDraws; ++draw) {
+      const int i = static_cast<int>(initial_random_.Below(candidates.size()));
+      const Candidate& c = candidates[i];
+      if (std::find(chosen->begin(), chosen->end(), c.genes) != chosen->end()) {
+        continue;
+      }
+      double nearest = kInf;
+      for (const auto& a : anchors) {
+        nearest = std::min(nearest, Distance2(c.u, a));
+      }
+      const double score = nearest * c.runs;
+      if (score > best_score) {
+        best_score = score;
+        best = i;
+      }
+    }
+    if (best < 0) break;
+    chosen->push_back(candidates[best].genes);
+    anchors.push_back(candidates[best].u);
+    drawn.push_back(Describe(grid_.ToPoint(candidates[best].genes)));
+  }
+  if (drawn.empty()) return {};
+  const int through = first + static_cast<int>(drawn.size()) - 1;
+  return fmt::format(
+      "Initial design, point{} {} of {} (exploration.initial_points): "
+      "seeded space-filling draw{} at ({}).",
+      drawn.size() > 1 ? "s" : "",
+      through > first ? fmt::format("{}-{}", first, through)
+                      : fmt::format("{}", first),
+      last, drawn.size() > 1 ? "s" : "", fmt::join(drawn, "), ("));
+}
+
+std::string AgentStrategy::SpaceFilling(std::vector<Candidate>* candidates,
+                                        int wanted,
+                                        std::vector<Genes>* chosen) {
+  std::vector<std::vector<double>> anchors = Anchors(*chosen);
   std::vector<double> middle(knobs_.size(), 0.5);
   int added = 0;
   while (added < wanted) {

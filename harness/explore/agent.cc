@@ -53,7 +53,9 @@ AgentStrategy::AgentStrategy(const spec::Spec& spec)
       grid_(spec.design_space),
       budget_(std::max(0, spec.exploration.budget)),
       random_(Random::DeriveSeed(spec.exploration.seed,
-                                 "explore.agent.candidates")) {
+                                 "explore.agent.candidates")),
+      initial_random_(
+          Random::DeriveSeed(spec.exploration.seed, "explore.agent.initial")) {
   SetUpKnobs();
   SetUpMetrics();
   if (!spec.exploration.start_from.empty()) {
@@ -97,7 +99,13 @@ std::vector<spec::DesignPoint> AgentStrategy::Ask(int k) {
   std::string choice_text;
   if (static_cast<int>(chosen.size()) < n) {
     try {
-      choice_text = Choose(n, &chosen);
+      choice_text = InitialDesign(n, &chosen);
+      if (static_cast<int>(chosen.size()) < n) {
+        const std::string model_text = Choose(n, &chosen);
+        if (!model_text.empty()) {
+          choice_text += (choice_text.empty() ? "" : " ") + model_text;
+        }
+      }
     } catch (...) {
       // Nothing may throw: fall back to random unseen points.
       choice_text = Fallback(n, &chosen);

@@ -144,6 +144,11 @@ struct ExplorationOptions {
   int batch = 1;  // points proposed per round
   uint64_t seed = 1;
   DesignPoint start_from;  // empty: the strategy chooses
+  // The built-in agent's proposals after its first point that are seeded
+  // space-filling draws rather than its model's picks (an initial design,
+  // as Optuna's n_startup_trials); 0: the model picks from the second
+  // point on. Other strategies do not read it.
+  int initial_points = 0;
   // GA / NSGA-II settings.
   int population = 8;
   double crossover_rate = 0.9;

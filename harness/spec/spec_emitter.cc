@@ -360,6 +360,13 @@ const std::vector<Field<ExplorationOptions>>& ExplorationFields() {
          EmitPoint(out, x.start_from, spec.design_space);
        },
        [](const X& x) { return !x.start_from.empty(); }},
+      // Written only when set, so that scenarios without it keep their
+      // normalised text.
+      [] {
+        Field<X> f = Integer("initial_points", &X::initial_points);
+        f.present = [](const X& x) { return x.initial_points != 0; };
+        return f;
+      }(),
       Integer("population", &X::population),
       Number("crossover_rate", &X::crossover_rate),
       Number("mutation_rate", &X::mutation_rate)};

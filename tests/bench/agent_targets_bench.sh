@@ -5,7 +5,7 @@
 # design found in how many seeds, the median true Pareto points, the
 # median hypervolume ratio, random search's median beside it), how many
 # distinct paths the agent's 20 seeds took, and which targets it misses.
-#   tests/bench/agent_targets_bench.sh [budget] [family]
+#   tests/bench/agent_targets_bench.sh [budget] [family] [initial_points]
 # Families:
 #   held-out    (default) the landscapes no strategy was tuned on
 #               (make_landscapes --held-out: other loads, grids, costs,
@@ -21,11 +21,16 @@
 # cheapest feasible design in 18 of 20 seeds; a median of 8 true Pareto
 # points (all of them where the front holds fewer); a median hypervolume
 # ratio of 0.9; never below random search's median. ADSE_BIN picks the
-# binary, so that two builds compare one after the other.
+# binary, so that two builds compare one after the other. initial_points
+# (default 0) replays the agent with that many seeded space-filling points
+# after its first (exploration.initial_points): its seeds then part from
+# their second run, which measures how much its answers depend on the
+# path one start sets.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 budget="${1:-15}"
 family="${2:-held-out}"
+initial="${3:-0}"
 build="${ADSE_BUILD:-${root}/build}"
 adse="${ADSE_BIN:-${build}/bin/adse}"
 # shellcheck source=tests/bench/lib/studies.sh
@@ -35,6 +40,11 @@ if ! [[ "${budget}" =~ ^[1-9][0-9]*$ ]]; then
     "whole number" >&2
   exit 2
 fi
+if ! [[ "${initial}" =~ ^(0|[1-9][0-9]*)$ ]]; then
+  echo "agent_targets_bench.sh: initial_points '${initial}' is not a whole" \
+    "number" >&2
+  exit 2
+fi
 
 require_adse "${adse}"
 out="$(mktemp -d)"
@@ -42,7 +52,8 @@ trap 'rm -rf "${out}"' EXIT
 # The studies' folders.
 select_studies "${family}" "${out}" "${root}" "${build}" || exit 2
 
-echo "studies: ${family}; budget ${budget}, seeds 1..20; $(basename "${adse}")"
+echo "studies: ${family}; budget ${budget}, seeds 1..20, the agent's" \
+  "initial points ${initial}; $(basename "${adse}")"
 machine_line
 echo
 echo "| study | objectives | points | front | agent: cheapest found (seeds) | agent: distinct paths (seeds) | agent: true Pareto (median) | agent: hypervolume ratio (median) | random: hypervolume ratio (median) | targets missed | wall s |"
@@ -64,7 +75,8 @@ replay() {
   local json="${out}/$((rows + 1)).json"
   start=$(date +%s.%N)
   "${adse}" explore --replay "${dir}" --strategy agent,random \
-    --budget "${budget}" --seeds 20 "${objectives[@]}" --json >"${json}"
+    --budget "${budget}" --initial-points "${initial}" --seeds 20 \
+    "${objectives[@]}" --json >"${json}"
   end=$(date +%s.%N)
   # Prints the row, then "met" or "missed", then the objectives when a
   # two-objective replay should follow.

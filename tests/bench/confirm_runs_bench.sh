@@ -6,13 +6,16 @@
 # feasible design was found and confirmed (no cheaper design left untried
 # by the seed's runs), and the median confirm runs spent.
 #   tests/bench/confirm_runs_bench.sh [budget] [confirm_runs] [family]
+#                                     [initial_points]
 # Families as in agent_targets_bench.sh (default held-out). ADSE_BIN picks
-# the binary.
+# the binary. initial_points (default 0) replays the agent with that many
+# seeded space-filling points after its first, as agent_targets_bench.sh.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 budget="${1:-15}"
 confirm="${2:-5}"
 family="${3:-held-out}"
+initial="${4:-0}"
 build="${ADSE_BUILD:-${root}/build}"
 adse="${ADSE_BIN:-${build}/bin/adse}"
 # shellcheck source=tests/bench/lib/studies.sh
@@ -24,13 +27,18 @@ for value in "${budget}" "${confirm}"; do
     exit 2
   fi
 done
+if ! [[ "${initial}" =~ ^(0|[1-9][0-9]*)$ ]]; then
+  echo "confirm_runs_bench.sh: initial_points '${initial}' is not a whole" \
+    "number" >&2
+  exit 2
+fi
 require_adse "${adse}"
 out="$(mktemp -d)"
 trap 'rm -rf "${out}"' EXIT
 select_studies "${family}" "${out}" "${root}" "${build}" || exit 2
 
 echo "studies: ${family}; budget ${budget}, up to ${confirm} confirm runs," \
-  "seeds 1..20; $(basename "${adse}")"
+  "seeds 1..20, the agent's initial points ${initial}; $(basename "${adse}")"
 machine_line
 echo
 echo "| study | strategy | found at the budget | confirmed at the budget | found with confirm runs | confirmed with confirm runs | confirm runs spent (median / max) |"
@@ -38,7 +46,8 @@ echo "|---|---|---|---|---|---|---|"
 for dir in "${studies[@]}"; do
   for runs in 0 "${confirm}"; do
     "${adse}" explore --replay "${dir}" --strategy agent,random \
-      --budget "${budget}" --confirm-runs "${runs}" --seeds 20 --json \
+      --budget "${budget}" --confirm-runs "${runs}" \
+      --initial-points "${initial}" --seeds 20 --json \
       >"${out}/${runs}.json"
   done
   /usr/bin/python3 - "${out}/0.json" "${out}/${confirm}.json" \

@@ -29,6 +29,10 @@ namespace adse::explore::internal {
 constexpr int kSamples = 256;
 // Spaces up to this size are scored exhaustively.
 constexpr uint64_t kEnumerateLimit = 4096;
+// Seeded draws among which each initial-design point is the farthest from
+// the runs (exploration.initial_points): a spread that still varies with
+// the seed.
+constexpr int kInitialDraws = 8;
 // Random candidates drawn in larger spaces (plus neighbours of seen points).
 constexpr int kSampledCandidates = 2000;
 // In larger spaces, the neighbours of this many latest runs are scored too.
@@ -233,8 +237,20 @@ class AgentStrategy : public Strategy {
   // their remedies say get a bonus.
   void ApplyFactors(std::vector<Candidate>* candidates);
 
+  // The coordinates of the points chosen so far and of every run, which
+  // space-filling picks keep away from.
+  std::vector<std::vector<double>> Anchors(
+      const std::vector<Genes>& chosen) const;
+
   std::string SpaceFilling(std::vector<Candidate>* candidates, int wanted,
                            std::vector<Genes>* chosen);
+
+  // exploration.initial_points: while the pick is one of the initial
+  // design's (picks 1 to initial_points), chooses the farthest from every
+  // run and choice so far of kInitialDraws seeded draws among the
+  // candidates (weighed by the chance that a run works there); returns the
+  // sentence that says so, empty when it chose none.
+  std::string InitialDesign(int n, std::vector<Genes>* chosen);
 
   std::string Describe(const spec::DesignPoint& point) const;
 
@@ -256,6 +272,7 @@ class AgentStrategy : public Strategy {
   SpaceGrid grid_;
   int budget_;
   Random random_;
+  Random initial_random_;  // the initial design's draws
   std::vector<Knob> knobs_;
   std::vector<spec::KnobRole> roles_;  // per knob, for CompareCapacity
   std::vector<double> lengths_;        // GP length scale per knob

@@ -18,8 +18,9 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::vector<std::string> kExplorationKeys = {
-    "strategy",   "budget",     "confirm_runs",   "batch",        "seed",
-    "start_from", "population", "crossover_rate", "mutation_rate"};
+    "strategy",       "budget",       "confirm_runs",   "batch",
+    "seed",           "start_from",   "initial_points", "population",
+    "crossover_rate", "mutation_rate"};
 const std::vector<std::string> kLlmKeys = {
     "backend",     "endpoint",  "models",  "prompts",
     "replay_from", "timeout_s", "retries", "api_key_env"};
@@ -45,6 +46,9 @@ void SpecReader::ReadExploration(const Val& v) {
   }
   if (const Val* e = f.Get("confirm_runs")) {
     ReadInt(*e, &x.confirm_runs, Bounds::Closed(0, kMaxBudget));
+  }
+  if (const Val* e = f.Get("initial_points")) {
+    ReadInt(*e, &x.initial_points, Bounds::Closed(0, kMaxBudget));
   }
   if (const Val* e = f.Get("batch")) {
     ReadInt(*e, &x.batch, Bounds::Closed(1, 1e6));

@@ -82,6 +82,46 @@ TEST(CliRunTest, ExploreReplayPrintsADistributionPerStrategy) {
       << wrapped.out;
 }
 
+TEST(CliRunTest,
+     ExploreReplayWithInitialPointsSeedsTheAgentsSecondAndThirdRuns) {
+  const std::string replay = "explore --replay " +
+                             std::string(ADSE_SOURCE_DIR) +
+                             "/tests/data/landscapes/saturating --strategy "
+                             "agent --seeds 2 --budget 4 --json";
+  const CommandRun seeded = Adse(replay + " --initial-points 2");
+  ASSERT_EQ(seeded.exit_code, 0) << seeded.out;
+  const nlohmann::json out = nlohmann::json::parse(seeded.out);
+  EXPECT_EQ(out["initial_points"], 2);
+  const nlohmann::json& runs = out["strategies"]["agent"]["runs"];
+  ASSERT_EQ(runs.size(), 2u);
+  for (const nlohmann::json& run : runs) {
+    const nlohmann::json& rounds = run["iterations"];
+    ASSERT_EQ(rounds.size(), 4u) << seeded.out;
+    EXPECT_NE(rounds[1]["rationale"].get<std::string>().find(
+                  "Initial design, point 1 of 2"),
+              std::string::npos)
+        << seeded.out;
+    EXPECT_NE(rounds[2]["rationale"].get<std::string>().find(
+                  "Initial design, point 2 of 2"),
+              std::string::npos)
+        << seeded.out;
+    EXPECT_EQ(rounds[3]["rationale"].get<std::string>().find("Initial design"),
+              std::string::npos)
+        << seeded.out;
+  }
+  // The same start, then each seed's own draws.
+  EXPECT_EQ(runs[0]["proposals"][0], runs[1]["proposals"][0]);
+  EXPECT_NE(runs[0]["proposals"][1], runs[1]["proposals"][1]);
+  // Without it, the recording's own (none).
+  const CommandRun plain = Adse(replay);
+  ASSERT_EQ(plain.exit_code, 0) << plain.out;
+  EXPECT_EQ(nlohmann::json::parse(plain.out)["initial_points"], 0);
+  const CommandRun negative = Adse(replay + " --initial-points -1");
+  EXPECT_EQ(negative.exit_code, 2) << negative.out;
+  EXPECT_NE(negative.out.find("--initial-points"), std::string::npos)
+      << negative.out;
+}
+
 TEST(CliRunTest, ExploreReplayWithTwoOfTheObjectivesScoresAgainstTheirFront) {
   const std::string replay = "explore --replay " +
                              std::string(ADSE_SOURCE_DIR) +

@@ -190,6 +190,70 @@ TEST(AgentTest, StartsFromStartFrom) {
   EXPECT_NE(strategy->rationale().find("start_from"), std::string::npos);
 }
 
+TEST(AgentTest, AnInitialDesignSpreadsItsSecondRunsBySeedThenTheModelPicks) {
+  // The second and third points are the initial design's: seeded, so two
+  // seeds part there, and each a spread-out draw (not a neighbour of the
+  // start); from the fourth on the model picks, as its rationale says.
+  auto run = [](int seed, std::vector<std::string>* rationales) {
+    const spec::Spec spec =
+        MakeSpec("{budget: 6, seed: " + std::to_string(seed) +
+                 ", initial_points: 2, start_from: {cores: 8, freq_ghz: 1.5, "
+                 "lidar_hz: 7}}");
+    std::unique_ptr<Strategy> strategy = Create(spec);
+    std::vector<spec::DesignPoint> points;
+    while (strategy) {
+      std::vector<spec::DesignPoint> asked = strategy->Ask(1);
+      if (asked.empty()) break;
+      rationales->push_back(strategy->rationale());
+      points.push_back(asked[0]);
+      strategy->Tell(Evaluate(asked[0]));
+    }
+    return points;
+  };
+  std::set<std::vector<spec::DesignPoint>> seconds;
+  for (int seed = 1; seed <= 4; ++seed) {
+    std::vector<std::string> rationales;
+    const std::vector<spec::DesignPoint> points = run(seed, &rationales);
+    ASSERT_EQ(points.size(), 6u);
+    seconds.insert({points[1], points[2]});
+    for (int i : {1, 2}) {
+      EXPECT_NE(rationales[i].find("Initial design, point " +
+                                   std::to_string(i) + " of 2"),
+                std::string::npos)
+          << rationales[i];
+      // Farther from the start than its next core count.
+      const double steps = std::abs(points[i].at("cores") - 8) / 15.0 +
+                           std::abs(points[i].at("freq_ghz") - 1.5) / 1.1 +
+                           std::abs(points[i].at("lidar_hz") - 7) / 7.0;
+      EXPECT_GT(steps, 1.0 / 15.0 + 1e-9) << i;
+    }
+    for (int i = 3; i < 6; ++i) {
+      EXPECT_EQ(rationales[i].find("Initial design"), std::string::npos)
+          << rationales[i];
+    }
+  }
+  EXPECT_GE(seconds.size(), 3u);
+  // The same seed, the same initial design.
+  std::vector<std::string> a, b;
+  EXPECT_EQ(run(2, &a), run(2, &b));
+  // In a batch, the start and both draws in the first round, then the
+  // model's picks.
+  const spec::Spec batch = MakeSpec(
+      "{budget: 6, batch: 3, initial_points: 2, start_from: {cores: 8, "
+      "freq_ghz: 1.5, lidar_hz: 7}}");
+  std::unique_ptr<Strategy> strategy = Create(batch);
+  ASSERT_NE(strategy, nullptr);
+  const std::vector<spec::DesignPoint> first = strategy->Ask(3);
+  ASSERT_EQ(first.size(), 3u);
+  EXPECT_NE(strategy->rationale().find("Initial design, points 1-2 of 2"),
+            std::string::npos)
+      << strategy->rationale();
+  for (const spec::DesignPoint& point : first) strategy->Tell(Evaluate(point));
+  ASSERT_EQ(strategy->Ask(3).size(), 3u);
+  EXPECT_EQ(strategy->rationale().find("Initial design"), std::string::npos)
+      << strategy->rationale();
+}
+
 TEST(AgentTest, WithoutStartFromItStillProposes) {
   const spec::Spec spec = MakeSpec("{budget: 6}");
   std::unique_ptr<Strategy> strategy = Create(spec);

@@ -368,6 +368,8 @@ TEST(SpecErrorsTest, NonPositiveRatesAndTimeouts) {
               "exploration.batch", 9, "an integer in [1, ");
   ExpectError(std::string(kHead) + "exploration: {confirm_runs: -1}\n",
               "exploration.confirm_runs", 9, "an integer in [0, ");
+  ExpectError(std::string(kHead) + "exploration: {initial_points: 1.5}\n",
+              "exploration.initial_points", 9, "an integer in [0, ");
   ExpectError(std::string(kHead) +
                   "harness: {memory_mb: 0, cores_per_worker: 0, replicas: 0, "
                   "retries: -1, workers: 0}\n",

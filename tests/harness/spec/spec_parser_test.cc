@@ -129,7 +129,8 @@ TEST(SpecParserTest, ReferenceExampleFillsEverySection) {
 
   EXPECT_EQ(spec.exploration.strategy, "agent");
   EXPECT_EQ(spec.exploration.budget, 15);
-  EXPECT_EQ(spec.exploration.confirm_runs, 0);  // off unless asked for
+  EXPECT_EQ(spec.exploration.confirm_runs, 0);    // off unless asked for
+  EXPECT_EQ(spec.exploration.initial_points, 0);  // the model picks
   EXPECT_NEAR(spec.exploration.start_from.at("freq_ghz"), 1.5, kTol);
   EXPECT_EQ(spec.exploration.population, 8);
 
@@ -319,6 +320,13 @@ TEST(SpecParserTest, NormalizedYamlRoundTrips) {
   EXPECT_EQ(again->llm.endpoint, spec.llm.endpoint);
   EXPECT_EQ(again->harness.workers, 0);
   EXPECT_EQ(again->harness.slurm.time_limit, "02:00:00");
+  // An unset initial design is left out of the text, a set one kept.
+  EXPECT_EQ(yaml.find("initial_points"), std::string::npos);
+  Spec seeded = spec;
+  seeded.exploration.initial_points = 3;
+  Result<Spec> kept = ParseSpec(NormalizedYaml(seeded), "n.yaml", "");
+  ASSERT_TRUE(kept.ok()) << kept.status().message();
+  EXPECT_EQ(kept->exploration.initial_points, 3);
 }
 
 TEST(SpecParserTest, ValetGoalBySlotWithHeadingRoundTrips) {
