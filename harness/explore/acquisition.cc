@@ -551,9 +551,9 @@ std::string AgentStrategy::InitialDesign(int n, std::vector<Genes>* chosen) {
     Candidate c;
     c.genes = std::move(genes);
     c.u = Coordinates(c.genes);
+    c.runs = RunsProbability(c);
     candidates.push_back(std::move(c));
   }
-  for (Candidate& c : candidates) c.runs = RunsProbability(c);
   std::vector<std::vector<double>> anchors = Anchors(*chosen);
   const int first = pick();
   std::vector<std::string> drawn;

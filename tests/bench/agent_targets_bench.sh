@@ -40,11 +40,7 @@ if ! [[ "${budget}" =~ ^[1-9][0-9]*$ ]]; then
     "whole number" >&2
   exit 2
 fi
-if ! [[ "${initial}" =~ ^(0|[1-9][0-9]*)$ ]]; then
-  echo "agent_targets_bench.sh: initial_points '${initial}' is not a whole" \
-    "number" >&2
-  exit 2
-fi
+require_initial_points "${initial}"
 
 require_adse "${adse}"
 out="$(mktemp -d)"

@@ -27,11 +27,7 @@ for value in "${budget}" "${confirm}"; do
     exit 2
   fi
 done
-if ! [[ "${initial}" =~ ^(0|[1-9][0-9]*)$ ]]; then
-  echo "confirm_runs_bench.sh: initial_points '${initial}' is not a whole" \
-    "number" >&2
-  exit 2
-fi
+require_initial_points "${initial}"
 require_adse "${adse}"
 out="$(mktemp -d)"
 trap 'rm -rf "${out}"' EXIT

@@ -53,6 +53,15 @@ require_adse() {
   fi
 }
 
+# Exits 2 with a message when $1, the agent's initial points
+# (exploration.initial_points, --initial-points), is not a whole number.
+require_initial_points() {
+  if ! [[ "$1" =~ ^(0|[1-9][0-9]*)$ ]]; then
+    echo "${0##*/}: initial_points '$1' is not a whole number" >&2
+    exit 2
+  fi
+}
+
 # "machine: 2 cores, <model>, load 0.87", for the bench's header.
 machine_line() {
   echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p')," \
